@@ -1,0 +1,170 @@
+"""A form-finding case: target surface + crease pattern + symmetry + settings (Step 1).
+
+This is the entry point that validates user choices once; the CLI and the benchmarks call it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold import patterns
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.mesh import CreasePattern
+from rigidfold.optimize import FormFindingProblem, OptimizeResult
+from rigidfold.surfaces import Surface, get_surface
+
+
+@dataclass(frozen=True, eq=False)
+class Case:
+    """Everything problem (6) needs, validated.
+
+    surface : Surface; pattern_name : str; pattern : CreasePattern (the triangulated target
+    surface); planes : mirror planes used for constraint (9); settings : Settings.
+    """
+
+    surface: Surface
+    pattern_name: str
+    pattern: CreasePattern
+    planes: tuple
+    settings: Settings
+
+    def problem(self, *, build_ipopt: bool = True) -> FormFindingProblem:
+        """Build problem (6) for this case."""
+        return FormFindingProblem(
+            self.pattern,
+            self.surface,
+            planes=self.planes,
+            settings=self.settings,
+            build_ipopt=build_ipopt,
+        )
+
+    def metadata(self) -> dict:
+        """JSON-serialisable description of the case."""
+        s = self.settings
+        return {
+            "surface": self.surface.metadata(),
+            "pattern": self.pattern_name,
+            "symmetry_planes": [str(p) for p in self.planes],
+            "dz_m": s.dz,
+            "theta_min_deg": math.degrees(s.theta_min),
+            "theta_max_deg": math.degrees(s.theta_max),
+            "rho_bar_deg": None if s.rho_bar is None else math.degrees(s.rho_bar),
+            "F_tol": s.f_tol,
+        }
+
+
+def make_case(
+    surface: str | Surface,
+    pattern: str,
+    *,
+    seed: int | None = None,
+    expr: str | None = None,
+    symmetric: bool = False,
+    settings: Settings = DEFAULTS,
+) -> Case:
+    """Validate the user's choices and build the initial triangulated shape.
+
+    surface : a name ("bezier", "dome", "hp", "expr") or a Surface; pattern : "1", "2" or "11".
+    ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
+    """
+    surf = surface if isinstance(surface, Surface) else get_surface(surface, seed=seed, expr=expr)
+    shape = patterns.build(pattern, surf)
+    planes = tuple(surf.mirror_planes) if symmetric else ()
+    if symmetric and not planes:
+        raise ValueError(
+            f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
+            "(dome or hp)"
+        )
+    return Case(surf, str(pattern), shape, planes, settings)
+
+
+def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:
+    """Parse "I,J,..." crease indices into an (E,) bool mask, checking every index."""
+    mask = np.zeros(pattern.n_edges, dtype=bool)
+    if not text:
+        return mask
+    for token in text.split(","):
+        token = token.strip()
+        if not token:
+            continue
+        try:
+            e = int(token)
+        except ValueError:
+            raise ValueError(
+                f"--fixed expects comma-separated edge indices, got {token!r}"
+            ) from None
+        if not 0 <= e < pattern.n_edges:
+            raise ValueError(f"--fixed edge {e} out of range 0..{pattern.n_edges - 1}")
+        if pattern.is_boundary_edge[e]:
+            raise ValueError(f"--fixed edge {e} is a boundary edge, not a crease line")
+        mask[e] = True
+    return mask
+
+
+def shape_report(case: Case, result: OptimizeResult, build_time: float) -> dict:
+    """summary.json content: solver figures, sizes and shape measures of a solution."""
+    shape = result.pattern
+    dz = shape.coords[:, 2] - np.asarray(
+        case.surface.height(shape.coords[:, 0], shape.coords[:, 1])
+    )
+    angles = np.degrees(shape.corner_angles)
+    free = shape.free_creases
+    return {
+        **result.summary(),
+        "build_time_s": build_time,
+        "V": shape.n_vertices,
+        "E": shape.n_edges,
+        "F_faces": shape.n_faces,
+        "facets": shape.n_facets,
+        "fixed_creases": shape.fixed_creases.tolist(),
+        "generic_dof": shape.generic_dof,
+        "max_abs_dz_m": float(np.abs(dz).max()),
+        "min_sector_angle_deg": float(angles.min()),
+        "max_sector_angle_deg": float(angles.max()),
+        "max_abs_fold_angle_deg": float(np.degrees(np.abs(shape.fold_angles[free])).max())
+        if len(free)
+        else 0.0,
+        "case": case.metadata(),
+    }
+
+
+def prepare_output_dir(path: str | os.PathLike) -> Path:
+    """Create the output directory and check it is writable, before any computation."""
+    out = Path(path)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".rigidfold-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(f"cannot write to output directory {str(out)!r}: {exc.strerror}") from None
+    return out
+
+
+def jsonable(value):
+    """Convert NumPy values to Python ones and non-finite floats to None (strict JSON)."""
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, (np.integer, np.bool_)):
+        return value.item()
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def write_json(path: Path, data: dict) -> None:
+    """Write JSON atomically (a temporary file, then rename)."""
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(json.dumps(jsonable(data), indent=2, allow_nan=False) + "\n")
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise ValueError(f"cannot write {str(path)!r}: {exc.strerror}") from None

@@ -1,0 +1,111 @@
+"""Tolerances and defaults, in one place.
+
+Every numerical threshold and every default design parameter of rigidfold lives in
+:class:`Settings`. Library functions take a ``settings`` argument (default
+:data:`DEFAULTS`) instead of scattering literals through the code.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Design parameters of problem (6) and the numerical tolerances of rigidfold.
+
+    Design parameters (paper, Section 6.1)
+    ---------------------------------------
+    dz : float
+        Bound on |z_i - f(x_i, y_i)| in metres (paper: 0.30 m).
+    theta_min, theta_max : float
+        Bounds on every sector angle in radians (paper: pi/6 and 2 pi/3).
+    rho_bar : float or None
+        Optional bound on |rho_j| of free creases, constraint (12), radians.
+    f_tol : float
+        A solution of (6) is accepted when F <= f_tol (paper: 1e-7).
+
+    Tolerances
+    ----------
+    constraint_tol : float
+        Largest accepted violation of any constraint of (6) (metres or radians).
+    ipopt_tol, ipopt_max_iter, ipopt_mu_strategy : float, int, str
+        IPOPT's convergence tolerance, iteration limit and barrier-parameter strategy.
+    slsqp_ftol, slsqp_max_iter : float, int
+        SciPy SLSQP's stopping tolerance and iteration limit.
+    degenerate_area : float
+        A triangle whose area is below ``degenerate_area * (longest edge)**2`` is degenerate.
+    corner_angle : float
+        A boundary vertex is a corner when the boundary turns there by more than this (radians).
+    flat_angle : float
+        A free crease with |rho| below this (radians) is flat ("F" in FOLD files).
+    linear_rank_tol : float
+        Relative threshold of the rank-revealing QR that eliminates constraints (7)-(9).
+    map_prune_tol : float
+        Entries of the variable map below this magnitude are dropped as round-off.
+    symmetry_match_tol : float
+        Distance (metres) within which a mirrored vertex must land on another vertex.
+    """
+
+    # design parameters of problem (6)
+    dz: float = 0.30
+    theta_min: float = math.pi / 6
+    theta_max: float = 2 * math.pi / 3
+    rho_bar: float | None = None
+    f_tol: float = 1e-7
+    # solver tolerances
+    constraint_tol: float = 1e-8
+    ipopt_tol: float = 1e-8
+    ipopt_max_iter: int = 500
+    ipopt_mu_strategy: str = "adaptive"
+    slsqp_ftol: float = 1e-12
+    slsqp_max_iter: int = 1000
+    # geometry tolerances
+    degenerate_area: float = 1e-10
+    corner_angle: float = math.radians(1.0)
+    flat_angle: float = 1e-6
+    linear_rank_tol: float = 1e-10
+    map_prune_tol: float = 1e-13
+    symmetry_match_tol: float = 1e-6
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.dz) and self.dz > 0):
+            raise ValueError(f"dz must be a positive number of metres, got {self.dz!r}")
+        if not (0 < self.theta_min < self.theta_max < math.pi):
+            raise ValueError(
+                "sector-angle bounds must satisfy 0 < theta_min < theta_max < 180 degrees, got "
+                f"theta_min={math.degrees(self.theta_min):g}, "
+                f"theta_max={math.degrees(self.theta_max):g} degrees"
+            )
+        if self.rho_bar is not None and not (0 < self.rho_bar < math.pi):
+            raise ValueError(
+                f"rho_bar must lie in (0, 180) degrees, got {math.degrees(self.rho_bar):g}"
+            )
+        if not self.f_tol > 0:
+            raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
+
+    def with_(self, **changes) -> Settings:
+        """A copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+    @classmethod
+    def from_degrees(
+        cls,
+        *,
+        theta_min_deg: float = 30.0,
+        theta_max_deg: float = 120.0,
+        rho_bar_deg: float | None = None,
+        **kwargs,
+    ) -> Settings:
+        """Build settings with angles given in degrees (as on the command line)."""
+        return cls(
+            theta_min=math.radians(theta_min_deg),
+            theta_max=math.radians(theta_max_deg),
+            rho_bar=None if rho_bar_deg is None else math.radians(rho_bar_deg),
+            **kwargs,
+        )
+
+
+DEFAULTS = Settings()
+"""The paper's parameters (Section 6.1) and rigidfold's default tolerances."""

@@ -1,0 +1,592 @@
+"""Reading and writing crease patterns as FOLD 1.2 files.
+
+FOLD (https://github.com/edemaine/fold, ``doc/spec.md``) is the JSON exchange format of
+origami software (Origami Simulator, Rabbit Ear, ...). rigidfold writes one triangulated
+model per file: ``vertices_coords`` (3D, metres), ``faces_vertices`` (counter-clockwise seen
+from +z), ``edges_vertices`` in the order of :attr:`CreasePattern.edges`, ``edges_assignment``
+and ``edges_foldAngle`` (degrees, valley positive). Fixed crease lines are joins, ``"J"``.
+Custom data live under keys prefixed ``rigidfold:``.
+
+The reader accepts FOLD files from other tools too: 2D coordinates (the flat state), polygon
+faces (triangulated here, the added diagonals become ``"J"`` joins), missing edges (derived
+from the faces) and frames. Every problem with the input is a one-line ``ValueError`` that
+names the file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import numbers
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.mesh import CreasePattern, topology
+
+FOLD_SPEC = 1.2
+"""The FOLD version rigidfold writes."""
+
+PREFIX = "rigidfold:"
+"""Namespace of rigidfold's own keys in FOLD files."""
+
+ASSIGNMENTS = frozenset("BMVFUCJ")
+"""Edge assignments of FOLD 1.2: boundary, mountain, valley, flat, unassigned, cut, join."""
+
+
+@dataclass(frozen=True, eq=False)
+class FoldData:
+    """A FOLD file read into a crease pattern.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+        The triangulated model. Its first ``n_file_edges`` edges are the file's
+        ``edges_vertices`` in file order (so file edge indices are pattern edge indices);
+        then come the diagonals added to triangulate polygon faces (``"J"``), then the edges
+        derived from faces that the file does not list.
+    n_file_edges : int
+        Number of edges listed in the file's ``edges_vertices``.
+    assignment : list of str, length E
+        FOLD assignment of every pattern edge, as read or derived (``"B"`` for derived
+        boundary edges, ``"U"`` for derived creases, ``"J"`` for added diagonals).
+    metadata : dict
+        The ``rigidfold:`` keys of the frame, prefix stripped.
+    raw : dict
+        The whole FOLD document as parsed from JSON.
+    frame_classes : list of str
+        The frame's ``frame_classes`` (e.g. ``["foldedForm"]``), empty when absent.
+    """
+
+    pattern: CreasePattern
+    n_file_edges: int
+    assignment: list[str]
+    metadata: dict
+    raw: dict = field(repr=False)
+    frame_classes: list[str]
+
+
+# ---------------------------------------------------------------------------------- writing
+def fold_dict(
+    pattern: CreasePattern,
+    *,
+    title: str = "",
+    frame_class: str = "foldedForm",
+    metadata: dict | None = None,
+    creator: str = "rigidfold",
+    settings: Settings = DEFAULTS,
+) -> dict:
+    """The FOLD 1.2 document of a crease pattern.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        The model; coordinates (V, 3), faces (F, 3), edges (E, 2) are written as they are.
+    title : str
+        ``frame_title``.
+    frame_class : str
+        The single entry of ``frame_classes``, e.g. ``"foldedForm"`` or ``"creasePattern"``.
+    metadata : dict, optional
+        Extra data; each item is stored as ``"rigidfold:<key>"``. NumPy scalars and arrays
+        become JSON numbers and lists; non-finite floats become ``null``.
+    creator : str
+        ``file_creator``.
+    settings : Settings
+        ``settings.flat_angle`` decides which free creases are flat (``"F"``).
+
+    Returns
+    -------
+    dict
+        JSON-serialisable FOLD document. Edge assignments: ``"B"`` boundary, ``"J"`` fixed
+        crease, and free creases ``"V"`` (fold angle > flat_angle), ``"M"`` (< -flat_angle)
+        or ``"F"``. ``edges_foldAngle`` (E,) is the signed fold angle in degrees for every
+        edge, fixed creases included, 0 on the boundary.
+    """
+    data = {
+        "file_spec": FOLD_SPEC,
+        "file_creator": creator,
+        "file_classes": ["singleModel"],
+        "frame_classes": [frame_class],
+        "frame_title": title,
+        "frame_unit": "m",
+        "vertices_coords": pattern.coords.tolist(),
+        "faces_vertices": pattern.faces.tolist(),
+        "edges_vertices": pattern.edges.tolist(),
+        "edges_assignment": _assignment(pattern, settings.flat_angle),
+        "edges_foldAngle": np.degrees(pattern.fold_angles).tolist(),
+    }
+    for key, value in (metadata or {}).items():
+        if not isinstance(key, str):
+            raise ValueError(f"metadata keys must be strings, got {key!r}")
+        data[PREFIX + key] = _jsonable(value, key)
+    return data
+
+
+def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Path:
+    """Write a crease pattern as a FOLD file, atomically.
+
+    The text goes to ``<path>.tmp`` in the same directory, which then replaces ``path``, so an
+    interrupted run never leaves a half-written file. Tables are written one row per line.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Destination file.
+    pattern : CreasePattern
+        The model.
+    **kwargs
+        Keyword arguments of :func:`fold_dict` (title, frame_class, metadata, creator,
+        settings).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        ``"cannot write <path>: <reason>"`` when the file cannot be written.
+    """
+    path = Path(path)
+    text = _dumps(fold_dict(pattern, **kwargs))
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise ValueError(f"cannot write {path}: {exc.strerror or exc}") from None
+        raise
+    return path
+
+
+def _assignment(pattern: CreasePattern, flat_angle: float) -> list[str]:
+    """FOLD assignment letter of each edge.  -> list of E str"""
+    rho = pattern.fold_angles
+    letters = np.where(rho > flat_angle, "V", np.where(rho < -flat_angle, "M", "F"))
+    letters[pattern.fixed] = "J"
+    letters[pattern.is_boundary_edge] = "B"
+    return letters.tolist()
+
+
+def _jsonable(value, key: str):
+    """``value`` with NumPy types made plain Python and non-finite floats made None."""
+    if isinstance(value, np.ndarray | np.generic):
+        return _jsonable(value.tolist(), key)
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v, key) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(v, key) for v in value]
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if value is None or isinstance(value, str | bool | int):
+        return value
+    raise ValueError(f"metadata {key!r} holds a {type(value).__name__}, which is not JSON data")
+
+
+def _dumps(data: dict) -> str:
+    """JSON text: one top-level key per line, tables (lists of lists) one row per line."""
+    items = []
+    for key, value in data.items():
+        if isinstance(value, list) and value and all(isinstance(row, list) for row in value):
+            rows = ",\n  ".join(json.dumps(row, allow_nan=False) for row in value)
+            text = f"[\n  {rows}\n ]"
+        else:
+            text = json.dumps(value, allow_nan=False)
+        items.append(f" {json.dumps(key)}: {text}")
+    return "{\n" + ",\n".join(items) + "\n}\n"
+
+
+# ---------------------------------------------------------------------------------- reading
+def read_fold(source: str | os.PathLike | dict, frame: int = 0) -> FoldData:
+    """Read a FOLD file (or an already parsed FOLD dict) into a crease pattern.
+
+    Parameters
+    ----------
+    source : str, path-like or dict
+        FOLD file, or its parsed JSON.
+    frame : int
+        Frame to read: 0 is the top level, ``k >= 1`` is ``file_frames[k - 1]``, which
+        inherits the keys it lacks from its ``frame_parent`` (default 0) when
+        ``frame_inherit`` is true.
+
+    Returns
+    -------
+    FoldData
+        The triangulated pattern and what the file says about it. 2D coordinates get z = 0;
+        polygon faces are ear-clipped in their best-fit plane, each diagonal an added ``"J"``
+        edge; edges that the file omits are derived from the faces. If the faces are
+        consistently oriented but clockwise seen from +z in total, all are reversed. Edges
+        assigned ``"J"`` are fixed creases, all other interior edges free creases.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file and the problem: unreadable file, invalid JSON, missing or
+        malformed keys, non-finite coordinates, indices out of range, cut edges (``"C"``),
+        a boundary edge assigned ``"J"``, a surface that is not an oriented disc.
+    """
+    label, raw = _load(source)
+    try:
+        return _parse(raw, frame)
+    except ValueError as exc:
+        raise ValueError(f"{label}: {' '.join(str(exc).split())}") from None
+
+
+def pattern_from_fold(source: str | os.PathLike | dict, frame: int = 0) -> CreasePattern:
+    """The crease pattern of a FOLD file; see :func:`read_fold`."""
+    return read_fold(source, frame).pattern
+
+
+def _load(source) -> tuple[str, dict]:
+    """(label for messages, parsed FOLD document) of a path or dict."""
+    if isinstance(source, dict):
+        return "FOLD data", source
+    if not isinstance(source, str | os.PathLike):
+        raise ValueError(f"read_fold needs a file path or a dict, got {type(source).__name__}")
+    path = Path(source)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"not a FOLD file: {path}: not UTF-8 text") from None
+    try:
+        raw = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(
+            f"not a FOLD file: {path}: invalid JSON at line {exc.lineno} column {exc.colno}"
+        ) from None
+    if not isinstance(raw, dict):
+        raise ValueError(
+            f"not a FOLD file: {path}: the top level is {_kind(raw)}, not a JSON object"
+        )
+    return str(path), raw
+
+
+def _parse(raw: dict, frame: int) -> FoldData:
+    data = _frame(raw, frame)
+    coords = _coords(data)
+    polygons = _polygons(data, len(coords))
+    file_edges, file_assignment = _file_edges(data, len(coords))
+    triangles, diagonals = _triangulate_faces(coords, polygons)
+    triangles = _orient_up(coords, triangles)
+    edges, assignment = _complete_edges(
+        file_edges, file_assignment, diagonals, triangles, len(coords)
+    )
+    fixed = np.array([a == "J" for a in assignment], dtype=bool)
+    pattern = CreasePattern(coords=coords, faces=triangles, edges=edges, fixed=fixed)
+    classes = data.get("frame_classes", [])
+    if not isinstance(classes, list) or not all(isinstance(c, str) for c in classes):
+        raise ValueError(f"frame_classes must be a list of strings, got {_short(classes)}")
+    return FoldData(
+        pattern=pattern,
+        n_file_edges=len(file_edges),
+        assignment=assignment,
+        metadata={
+            k[len(PREFIX) :]: v
+            for k, v in data.items()
+            if isinstance(k, str) and k.startswith(PREFIX)
+        },
+        raw=raw,
+        frame_classes=list(classes),
+    )
+
+
+def _frame(raw: dict, index: int) -> dict:
+    """The keys of frame ``index`` (0 = top level), inherited keys included."""
+    if not (_is_integer(index) and index >= 0):
+        raise ValueError(f"frame must be a non-negative integer, got {index!r}")
+    frames = raw.get("file_frames", [])
+    if not isinstance(frames, list) or not all(isinstance(f, dict) for f in frames):
+        raise ValueError("file_frames must be a list of objects")
+    frames = [raw, *frames]
+    if index >= len(frames):
+        raise ValueError(f"frame {index} does not exist (frames 0..{len(frames) - 1})")
+    chain = [index]
+    data = dict(frames[index])
+    while chain[-1] != 0 and frames[chain[-1]].get("frame_inherit") is True:
+        parent = frames[chain[-1]].get("frame_parent", 0)
+        if not (_is_integer(parent) and 0 <= parent < len(frames)):
+            raise ValueError(f"frame {chain[-1]} has an invalid frame_parent {_short(parent)}")
+        if parent in chain:
+            raise ValueError(f"frames {chain} inherit from each other in a cycle")
+        chain.append(parent)
+        data = {**frames[parent], **data}
+    return data
+
+
+def _coords(data: dict) -> np.ndarray:
+    """``vertices_coords`` as a (V, 3) float array, z = 0 for 2D points."""
+    rows = _required_list(data, "vertices_coords")
+    coords = np.zeros((len(rows), 3))
+    for i, row in enumerate(rows):
+        if not (isinstance(row, list) and len(row) in (2, 3) and all(map(_is_number, row))):
+            raise ValueError(f"vertices_coords[{i}] must be 2 or 3 numbers, got {_short(row)}")
+        try:
+            coords[i, : len(row)] = row
+        except OverflowError:  # an integer too large for a float
+            coords[i] = math.inf
+        if not np.isfinite(coords[i]).all():
+            raise ValueError(f"vertices_coords[{i}] is not finite: {_short(row)}")
+    return coords
+
+
+def _polygons(data: dict, n_vertices: int) -> list[list[int]]:
+    """``faces_vertices``, checked: each face >= 3 distinct vertex indices in range."""
+    rows = _required_list(data, "faces_vertices")
+    for k, row in enumerate(rows):
+        if not (isinstance(row, list) and len(row) >= 3 and all(map(_is_integer, row))):
+            raise ValueError(
+                f"faces_vertices[{k}] must be a list of at least 3 vertex indices, "
+                f"got {_short(row)}"
+            )
+        _check_range(row, n_vertices, f"faces_vertices[{k}]")
+        if len(set(row)) != len(row):
+            raise ValueError(f"faces_vertices[{k}] repeats a vertex: {_short(row)}")
+    return [[int(v) for v in row] for row in rows]
+
+
+def _file_edges(data: dict, n_vertices: int) -> tuple[list[tuple[int, int]], list[str] | None]:
+    """``edges_vertices`` (checked) and ``edges_assignment`` (None when absent)."""
+    rows = data.get("edges_vertices", [])
+    if not isinstance(rows, list):
+        raise ValueError(f"edges_vertices must be a list, got {_kind(rows)}")
+    for k, row in enumerate(rows):
+        if not (isinstance(row, list) and len(row) == 2 and all(map(_is_integer, row))):
+            raise ValueError(f"edges_vertices[{k}] must be 2 vertex indices, got {_short(row)}")
+        _check_range(row, n_vertices, f"edges_vertices[{k}]")
+    edges = [(int(u), int(v)) for u, v in rows]
+    if "edges_assignment" not in data:
+        return edges, None
+    assignment = data["edges_assignment"]
+    if not isinstance(assignment, list) or len(assignment) != len(edges):
+        raise ValueError(
+            f"edges_assignment must be a list of {len(edges)} letters (one per edge in "
+            f"edges_vertices), got {_kind(assignment)}"
+        )
+    for k, letter in enumerate(assignment):
+        if not isinstance(letter, str) or letter not in ASSIGNMENTS:
+            raise ValueError(f"edges_assignment[{k}] is {_short(letter)}, not one of B M V F U C J")
+        if letter == "C":
+            raise ValueError(
+                f'edge {k} is a cut ("C"): rigidfold handles crease patterns without cuts only'
+            )
+    return edges, list(assignment)
+
+
+def _triangulate_faces(
+    coords: np.ndarray, polygons: list[list[int]]
+) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """Triangles (F, 3) of all faces, and the diagonals added inside polygons."""
+    triangles, diagonals = [], []
+    for k, (polygon, xy) in enumerate(zip(polygons, _plane_coords(coords, polygons), strict=True)):
+        if len(polygon) == 3:
+            triangles.append(polygon)
+            continue
+        try:
+            local_triangles, local_diagonals = _ear_clip(xy)
+        except ValueError as exc:
+            raise ValueError(f"faces_vertices[{k}]: {exc}") from None
+        triangles += [[polygon[i] for i in tri] for tri in local_triangles]
+        diagonals += [(polygon[a], polygon[b]) for a, b in local_diagonals]
+    return np.asarray(triangles, dtype=np.int64), diagonals
+
+
+def _orient_up(coords: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Reverse all triangles (F, 3) when their total signed area in plan is negative."""
+    p = coords[triangles]
+    a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    area = np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    return np.ascontiguousarray(triangles[:, ::-1]) if area < 0 else triangles
+
+
+def _complete_edges(
+    file_edges: list[tuple[int, int]],
+    file_assignment: list[str] | None,
+    diagonals: list[tuple[int, int]],
+    triangles: np.ndarray,
+    n_vertices: int,
+) -> tuple[np.ndarray, list[str]]:
+    """Edges (E, 2) and their assignments: file edges, then diagonals, then derived edges.
+
+    Edges derived from the triangles, and file edges without an assignment, are ``"B"`` when
+    one triangle uses them and ``"U"`` otherwise; diagonals are ``"J"``. Raises ValueError for
+    a boundary edge assigned ``"J"``.
+    """
+
+    def key(u: int, v: int) -> int:
+        return min(u, v) * n_vertices + max(u, v)
+
+    side_keys, uses = np.unique(
+        topology.edge_keys(topology.half_edges(triangles), n_vertices), return_counts=True
+    )
+    boundary = set(side_keys[uses == 1].tolist())
+
+    def derived(u: int, v: int) -> str:
+        return "B" if key(u, v) in boundary else "U"
+
+    if file_assignment is None:
+        assignment = [derived(u, v) for u, v in file_edges]
+    else:
+        assignment = list(file_assignment)
+    for e, (u, v) in enumerate(file_edges):
+        if assignment[e] == "J" and key(u, v) in boundary:
+            raise ValueError(f'edge {e} is assigned "J" (a fixed crease) but lies on the boundary')
+    edges = list(file_edges)
+    known = {key(u, v) for u, v in edges}
+    candidates = [(u, v, "J") for u, v in diagonals]
+    candidates += [(u, v, derived(u, v)) for u, v in topology.edges_from_faces(triangles).tolist()]
+    for u, v, letter in candidates:
+        if key(u, v) not in known:
+            known.add(key(u, v))
+            edges.append((u, v))
+            assignment.append(letter)
+    return np.asarray(edges, dtype=np.int64).reshape(-1, 2), assignment
+
+
+def _ear_clip(xy: list[list[float]]) -> tuple[list[tuple[int, ...]], list[tuple[int, int]]]:
+    """Triangulate a simple polygon by ear clipping.
+
+    Of all ears, the one with the largest smallest angle is clipped first.
+
+    Parameters
+    ----------
+    xy : (n, 2) list of float
+        Polygon vertices in order, counter-clockwise, n >= 3.
+
+    Returns
+    -------
+    triangles : list of n - 2 (i, j, k)
+        Local vertex indices, counter-clockwise.
+    diagonals : list of n - 3 (i, j)
+        The added interior edges.
+
+    Raises
+    ------
+    ValueError
+        When the polygon is degenerate or self-intersecting.
+    """
+    size = max(max(p[d] for p in xy) - min(p[d] for p in xy) for d in (0, 1))
+    tol = 1e-12 * size**2
+    remaining = list(range(len(xy)))
+    triangles, diagonals = [], []
+    while len(remaining) > 3:
+        m = len(remaining)
+        best, best_quality = None, -1.0
+        for k in range(m):
+            a, b, c = remaining[k - 1], remaining[k], remaining[(k + 1) % m]
+            if _cross(xy[a], xy[b], xy[c]) <= tol:
+                continue
+            others = (i for i in remaining if i not in (a, b, c))
+            if any(_in_triangle(xy[i], xy[a], xy[b], xy[c], tol) for i in others):
+                continue
+            quality = _min_angle(xy[a], xy[b], xy[c])
+            if quality > best_quality:
+                best, best_quality = k, quality
+        if best is None:
+            raise ValueError("the polygon is degenerate or self-intersecting")
+        a, b, c = remaining[best - 1], remaining[best], remaining[(best + 1) % m]
+        triangles.append((a, b, c))
+        diagonals.append((a, c))
+        remaining.pop(best)
+    if _cross(*(xy[i] for i in remaining)) <= tol:
+        raise ValueError("the polygon is degenerate or self-intersecting")
+    triangles.append(tuple(remaining))
+    return triangles, diagonals
+
+
+def _plane_coords(coords: np.ndarray, polygons: list[list[int]]) -> list[list[list[float]]]:
+    """2D coordinates of each polygon's vertices in the plane normal to its Newell normal.
+
+    The frame (u, w) of a polygon has u x w = its normal, so the polygon runs
+    counter-clockwise in it; it need not be planar.
+
+    coords : (V, 3) float; polygons : F lists of vertex indices  ->  F lists of (n, 2) float
+    Raises ValueError for a polygon of zero area.
+    """
+    sizes = np.array([len(p) for p in polygons])
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    owner = np.repeat(np.arange(len(polygons)), sizes)
+    flat = np.concatenate(polygons)
+    following = flat[starts[owner] + (np.arange(len(flat)) - starts[owner] + 1) % sizes[owner]]
+    first = coords[flat[starts[owner]]]  # relative positions: no cancellation far from 0
+    normal = np.add.reduceat(np.cross(coords[flat] - first, coords[following] - first), starts)
+    length = np.linalg.norm(normal, axis=1)
+    if (length == 0).any():
+        k = int(np.argmin(length))
+        raise ValueError(f"faces_vertices[{k}]: the polygon is degenerate (zero area)")
+    normal /= length[:, None]
+    u = np.cross(normal, np.eye(3)[np.argmin(np.abs(normal), axis=1)])
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    w = np.cross(normal, u)
+    p = coords[flat]
+    xy = np.column_stack([np.sum(p * u[owner], axis=1), np.sum(p * w[owner], axis=1)])
+    return [part.tolist() for part in np.split(xy, starts[1:])]
+
+
+def _cross(a: list[float], b: list[float], c: list[float]) -> float:
+    """Twice the signed area of the 2D triangle (a, b, c), positive when counter-clockwise."""
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def _in_triangle(
+    p: list[float], a: list[float], b: list[float], c: list[float], tol: float
+) -> bool:
+    """True when p lies in the counter-clockwise triangle (a, b, c) or on its sides."""
+    return _cross(a, b, p) >= -tol and _cross(b, c, p) >= -tol and _cross(c, a, p) >= -tol
+
+
+def _min_angle(a: list[float], b: list[float], c: list[float]) -> float:
+    """Smallest interior angle of the 2D triangle (a, b, c), radians."""
+    angles = []
+    for p, q, r in ((a, b, c), (b, c, a), (c, a, b)):
+        dot = (q[0] - p[0]) * (r[0] - p[0]) + (q[1] - p[1]) * (r[1] - p[1])
+        angles.append(math.atan2(abs(_cross(p, q, r)), dot))
+    return min(angles)
+
+
+# ---------------------------------------------------------------------------------- helpers
+def _required_list(data: dict, key: str) -> list:
+    if key not in data:
+        raise ValueError(f"missing {key}")
+    value = data[key]
+    if not isinstance(value, list) or not value:
+        raise ValueError(f"{key} must be a non-empty list, got {_kind(value)}")
+    return value
+
+
+def _check_range(indices: list, n_vertices: int, where: str) -> None:
+    for v in indices:
+        if not 0 <= v < n_vertices:
+            raise ValueError(f"{where} refers to vertex {v}, but there are {n_vertices} vertices")
+
+
+def _is_number(x) -> bool:
+    return isinstance(x, numbers.Real) and not isinstance(x, bool)
+
+
+def _is_integer(x) -> bool:
+    return isinstance(x, numbers.Integral) and not isinstance(x, bool)
+
+
+def _kind(value) -> str:
+    """Short description of a JSON value for messages, e.g. 'an array of 3 items'."""
+    if isinstance(value, list):
+        return f"an array of {len(value)} items"
+    if isinstance(value, dict):
+        return "an object"
+    return _short(value)
+
+
+def _short(value, limit: int = 60) -> str:
+    """repr of a value for messages, cut to ``limit`` characters."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."

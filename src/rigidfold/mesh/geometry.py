@@ -1,0 +1,99 @@
+"""Geometry of a triangulated polyhedron: angles, normals, fold angles.
+
+Pure NumPy array functions. Angles use ``atan2(|a x b|, a . b)``, which is accurate for
+small and for nearly straight angles alike.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Unsigned angle between vectors.  a, b : (..., 3) -> (...,) radians in [0, pi]"""
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.einsum("...i,...i", a, b))
+
+
+def corner_angles(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Interior angle of each triangle at each of its corners.
+
+    coords : (V, 3) float, faces : (F, 3) int  ->  (F, 3) float radians;
+    entry ``[f, k]`` is the angle at vertex ``faces[f, k]``.
+    """
+    p = coords[faces]  # (F, 3, 3)
+    to_next = np.roll(p, -1, axis=1) - p
+    to_prev = np.roll(p, 1, axis=1) - p
+    return angle_between(to_next, to_prev)
+
+
+def angle_sums(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Sum of the sector angles around each vertex.  -> (V,) radians"""
+    return np.bincount(
+        faces.ravel(), weights=corner_angles(coords, faces).ravel(), minlength=len(coords)
+    )
+
+
+def face_normals(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Unit normals by the right-hand rule on the face order.  -> (F, 3) float"""
+    p = coords[faces]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def face_areas(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Triangle areas.  -> (F,) float"""
+    p = coords[faces]
+    return 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+
+
+def projected_area(coords: np.ndarray, faces: np.ndarray) -> float:
+    """Signed area of the faces projected on the xy plane (positive when CCW from +z)."""
+    p = coords[faces, :2]
+    a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return 0.5 * float(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]))
+
+
+def edge_lengths(coords: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Edge lengths.  edges : (E, 2) int  ->  (E,) float"""
+    return np.linalg.norm(coords[edges[:, 1]] - coords[edges[:, 0]], axis=1)
+
+
+def fold_angles(
+    coords: np.ndarray, faces: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray
+) -> np.ndarray:
+    """Signed fold angle of each edge, FOLD convention: valley positive, mountain negative.
+
+    With ``n_a`` the normal of the face on the left of ``edges[e, 0] -> edges[e, 1]``, ``n_b``
+    that of the face on the right and ``t`` the unit edge direction,
+    ``rho = atan2(-(n_a x n_b) . t, n_a . n_b)``. A valley (a trough seen from +z, the side the
+    CCW normals point to) gives rho > 0. Boundary edges get 0.
+
+    coords : (V, 3), faces : (F, 3), edges : (E, 2), edge_faces : (E, 2) -> (E,) radians
+    """
+    rho = np.zeros(len(edges))
+    interior = (edge_faces >= 0).all(axis=1)
+    if not interior.any():
+        return rho
+    n = face_normals(coords, faces)
+    na = n[edge_faces[interior, 0]]
+    nb = n[edge_faces[interior, 1]]
+    t = coords[edges[interior, 1]] - coords[edges[interior, 0]]
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    sin = -np.einsum("ij,ij->i", np.cross(na, nb), t)
+    cos = np.einsum("ij,ij->i", na, nb)
+    rho[interior] = np.arctan2(sin, cos)
+    return rho
+
+
+def plan_turning_angles(coords: np.ndarray, loop: np.ndarray) -> np.ndarray:
+    """Turning angle of a closed polygon in plan (xy) at each of its vertices.
+
+    coords : (V, 3), loop : (B,) int vertex indices in order  ->  (B,) radians, 0 where the
+    polygon goes straight on.
+    """
+    p = coords[loop, :2]
+    d_in = p - np.roll(p, 1, axis=0)
+    d_out = np.roll(p, -1, axis=0) - p
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    dot = np.einsum("ij,ij->i", d_in, d_out)
+    return np.arctan2(cross, dot)

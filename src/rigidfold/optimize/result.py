@@ -1,0 +1,87 @@
+"""The one result type every solver of problem (6) returns."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigidfold.mesh import CreasePattern
+
+
+class Status(enum.Enum):
+    """Outcome of a solve, judged by rigidfold (not only by the solver's own flag).
+
+    CONVERGED          F <= F_tol and every constraint met to ``constraint_tol``.
+    TOLERANCE_NOT_MET  the solver stopped at a feasible point with F > F_tol.
+    INFEASIBLE         the solver reports infeasibility, or the point violates a constraint.
+    ITERATION_LIMIT    the iteration (or time) limit was reached before F <= F_tol.
+    FAILED             any other solver failure (e.g. a line-search or evaluation error).
+    """
+
+    CONVERGED = "converged"
+    TOLERANCE_NOT_MET = "tolerance_not_met"
+    INFEASIBLE = "infeasible"
+    ITERATION_LIMIT = "iteration_limit"
+    FAILED = "failed"
+
+
+@dataclass(frozen=True, eq=False)
+class OptimizeResult:
+    """Solution of problem (6).
+
+    pattern : CreasePattern
+        The optimised shape with the fixed-crease mask that was solved for.
+    coords : (V, 3) float64
+        Its vertex coordinates (``pattern.coords``).
+    F, F1, F2 : float
+        Objective and its developability and flatness parts at the returned point.
+    max_violation : float
+        Largest violation of any constraint of (6) (metres for dz and (7)-(9), radians for angles).
+    status : Status
+    message : str
+        The solver's own words and rigidfold's verdict.
+    iterations : int
+    wall_time : float
+        Seconds spent in the solve (not in building the model).
+    solver : str
+        "ipopt", "slsqp" or "slsqp-fd".
+    n_variables : int
+        Number of independent variables.
+    """
+
+    pattern: CreasePattern
+    F: float
+    F1: float
+    F2: float
+    max_violation: float
+    status: Status
+    message: str
+    iterations: int
+    wall_time: float
+    solver: str
+    n_variables: int
+
+    @property
+    def coords(self) -> np.ndarray:
+        return self.pattern.coords
+
+    @property
+    def converged(self) -> bool:
+        return self.status is Status.CONVERGED
+
+    def summary(self) -> dict:
+        """JSON-serialisable figures of the solve."""
+        return {
+            "status": self.status.value,
+            "message": self.message,
+            "solver": self.solver,
+            "F": self.F,
+            "F1": self.F1,
+            "F2": self.F2,
+            "max_violation": self.max_violation,
+            "iterations": self.iterations,
+            "wall_time_s": self.wall_time,
+            "n_variables": self.n_variables,
+        }

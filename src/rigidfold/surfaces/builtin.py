@@ -1,0 +1,176 @@
+"""Target surfaces z = f(x, y) over the 3 m x 3 m plan square (Step 1).
+
+``height(x, y, xp=numpy)`` is written with arithmetic and ``xp.<function>`` calls only, so the
+same code evaluates NumPy arrays and builds CasADi symbolic expressions (``xp=casadi``) for
+the exact derivatives of problem (6). ``gradient`` is analytic.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from math import comb
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class MirrorPlane:
+    """Vertical plane ``a x + b y + c = 0`` (metres)."""
+
+    a: float
+    b: float
+    c: float
+
+    def _unit(self) -> tuple[float, float, float]:
+        n = float(np.hypot(self.a, self.b))
+        if n == 0:
+            raise ValueError("a mirror plane needs (a, b) != (0, 0)")
+        return self.a / n, self.b / n, self.c / n
+
+    def signed_distance(self, xy: np.ndarray) -> np.ndarray:
+        """Distance of plan points (N, 2) from the plane, signed.  -> (N,)"""
+        a, b, c = self._unit()
+        xy = np.asarray(xy, dtype=float)
+        return a * xy[:, 0] + b * xy[:, 1] + c
+
+    def reflect(self, xy: np.ndarray) -> np.ndarray:
+        """Mirror images of plan points.  (N, 2) -> (N, 2)"""
+        a, b, _ = self._unit()
+        d = self.signed_distance(xy)
+        return np.asarray(xy, dtype=float) - 2 * d[:, None] * np.array([a, b])
+
+    def __str__(self) -> str:
+        """E.g. "x = 1.5", "x - y = 0", "x + y = 3"."""
+        lhs = ""
+        for coef, var in ((self.a, "x"), (self.b, "y")):
+            if coef == 0:
+                continue
+            sign = "-" if coef < 0 else "+"
+            mag = "" if abs(coef) == 1 else f"{abs(coef):g} "
+            lhs += f" {sign} {mag}{var}" if lhs else f"{'-' if coef < 0 else ''}{mag}{var}"
+        return f"{lhs} = {-self.c + 0.0:g}"
+
+
+class Surface(ABC):
+    """A target surface z = f(x, y)."""
+
+    name: str = "surface"
+    mirror_planes: tuple[MirrorPlane, ...] = ()
+
+    @abstractmethod
+    def height(self, x, y, xp=np):
+        """z at plan points; x, y are arrays of one shape (or CasADi symbols with xp=casadi)."""
+
+    @abstractmethod
+    def gradient(self, x, y) -> tuple[np.ndarray, np.ndarray]:
+        """(dz/dx, dz/dy) at plan points, exact.  arrays of the shape of x."""
+
+    @abstractmethod
+    def metadata(self) -> dict:
+        """JSON-serialisable description."""
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.metadata()})"
+
+
+def _bernstein(i: int, t):
+    return comb(3, i) * t**i * (1 - t) ** (3 - i)
+
+
+def _bernstein_derivative(i: int, t):
+    """d/dt of the cubic Bernstein polynomial B_i."""
+    lower = 0 if i == 0 else 3 * comb(2, i - 1) * t ** (i - 1) * (1 - t) ** (3 - i)
+    upper = 0 if i == 3 else 3 * comb(2, i) * t**i * (1 - t) ** (2 - i)
+    return lower - upper
+
+
+class Bezier(Surface):
+    """Bicubic Bezier patch over [0, 3]^2 with random control heights.
+
+    Control point (i, j) lies at plan position (x, y) = (i, j), i, j = 0..3, so u = x / 3,
+    v = y / 3 and ``z = sum_ij B_i(u) B_j(v) h[i, j]`` with ``B_i(t) = C(3, i) t^i (1-t)^(3-i)``.
+    The heights are ``h = numpy.random.default_rng(seed).uniform(0, 3, size=(4, 4))``; h[i, j]
+    belongs to the control point at (x = i, y = j). (The paper gives no formula.)
+    """
+
+    name = "bezier"
+
+    def __init__(self, seed: int = 0) -> None:
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise ValueError(f"the Bezier seed must be a non-negative integer, got {seed!r}")
+        self.seed = int(seed)
+        self.heights = np.random.default_rng(self.seed).uniform(0.0, 3.0, size=(4, 4))
+
+    @classmethod
+    def from_heights(cls, heights: np.ndarray) -> Bezier:
+        """A patch with given control heights h (4, 4)."""
+        h = np.asarray(heights, dtype=float)
+        if h.shape != (4, 4) or not np.isfinite(h).all():
+            raise ValueError(f"Bezier control heights must be a finite (4, 4) array, got {h.shape}")
+        surface = cls.__new__(cls)
+        surface.seed, surface.heights = None, h
+        return surface
+
+    def height(self, x, y, xp=np):
+        u, v = x / 3.0, y / 3.0
+        bu = [_bernstein(i, u) for i in range(4)]
+        bv = [_bernstein(j, v) for j in range(4)]
+        return sum(bu[i] * bv[j] * float(self.heights[i, j]) for i in range(4) for j in range(4))
+
+    def gradient(self, x, y):
+        u, v = np.asarray(x, dtype=float) / 3.0, np.asarray(y, dtype=float) / 3.0
+        bu, bv = [_bernstein(i, u) for i in range(4)], [_bernstein(j, v) for j in range(4)]
+        du = [_bernstein_derivative(i, u) for i in range(4)]
+        dv = [_bernstein_derivative(j, v) for j in range(4)]
+        h = self.heights
+        gx = sum(du[i] * bv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
+        gy = sum(bu[i] * dv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
+        return gx + 0 * u, gy + 0 * v
+
+    def metadata(self) -> dict:
+        return {"name": self.name, "seed": self.seed, "control_heights": self.heights.tolist()}
+
+
+class Dome(Surface):
+    """Spherical cap through the four corners (z = 0) with its apex 1.5 m high at (1.5, 1.5).
+
+    Radius R = 2.25 m, centre (1.5, 1.5, -0.75): ``z = -0.75 + sqrt(R^2 - (x-1.5)^2 - (y-1.5)^2)``.
+    """
+
+    name = "dome"
+    radius = 2.25
+    centre_z = -0.75
+    mirror_planes = (MirrorPlane(1.0, 0.0, -1.5), MirrorPlane(0.0, 1.0, -1.5))
+
+    def height(self, x, y, xp=np):
+        return self.centre_z + xp.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
+
+    def gradient(self, x, y):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        root = np.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
+        return -(x - 1.5) / root, -(y - 1.5) / root
+
+    def metadata(self) -> dict:
+        return {"name": self.name, "apex_m": 1.5, "radius_m": self.radius}
+
+
+class HyperbolicParaboloid(Surface):
+    """z = 0.4 (x - 1.5)(y - 1.5): 1.8 m between the lowest and the highest corner.
+
+    Its mirror planes are the diagonals x = y and x + y = 3 (z changes sign across x = 1.5).
+    """
+
+    name = "hp"
+    k = 0.4
+    mirror_planes = (MirrorPlane(1.0, -1.0, 0.0), MirrorPlane(1.0, 1.0, -3.0))
+
+    def height(self, x, y, xp=np):
+        return self.k * (x - 1.5) * (y - 1.5)
+
+    def gradient(self, x, y):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        return self.k * (y - 1.5), self.k * (x - 1.5)
+
+    def metadata(self) -> dict:
+        return {"name": self.name, "k": self.k}

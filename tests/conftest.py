@@ -1,0 +1,37 @@
+"""Shared fixtures: small reference shapes built directly from arrays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidfold.mesh import CreasePattern
+
+
+def degree_n_vertex(n: int, lift: float = 0.15, seed: int = 0) -> CreasePattern:
+    """One interior vertex of degree n at the origin, rim vertices at random heights."""
+    rng = np.random.default_rng(seed)
+    phi = np.sort(2 * np.pi * (np.arange(n) + 0.3 * rng.uniform(-1, 1, n)) / n)
+    rim = np.column_stack([np.cos(phi), np.sin(phi), lift * rng.uniform(-1, 1, n)])
+    coords = np.vstack([[0.0, 0.0, 0.0], rim])
+    faces = np.array([[0, 1 + k, 1 + (k + 1) % n] for k in range(n)])
+    return CreasePattern.from_faces(coords, faces)
+
+
+def folded_grid(n: int = 4, amplitude: float = 0.1, seed: int = 1) -> CreasePattern:
+    """An n x n vertex grid with random heights (a generic folded triangulated sheet)."""
+    rng = np.random.default_rng(seed)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="xy")
+    xy = np.column_stack([i.ravel(), j.ravel()]).astype(float)
+    z = amplitude * rng.standard_normal(n * n)
+    faces = []
+    for b in range(n - 1):
+        for a in range(n - 1):
+            v = b * n + a
+            faces += [(v, v + 1, v + n + 1), (v, v + n + 1, v + n)]
+    return CreasePattern.from_faces(np.column_stack([xy, z]), np.array(faces))
+
+
+@pytest.fixture
+def grid() -> CreasePattern:
+    return folded_grid()

@@ -1,0 +1,209 @@
+"""Problem (6): variable elimination, exact derivatives, solver behaviour."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidfold.case import make_case
+from rigidfold.config import DEFAULTS
+from rigidfold.optimize import FormFindingProblem, Status, build_linear_map
+from rigidfold.surfaces import get_surface
+
+
+@pytest.fixture(scope="module")
+def bezier_problem() -> FormFindingProblem:
+    case = make_case("bezier", "1", seed=3)
+    return case.problem(build_ipopt=False)
+
+
+# ---------------------------------------------------------------- Table 4, (7)-(11)
+@pytest.mark.parametrize(
+    ("surface", "pattern", "symmetric", "n"),
+    [
+        ("bezier", "1", False, 115),
+        ("bezier", "2", False, 124),
+        ("dome", "11", False, 315),
+        ("dome", "11", True, 83),
+        ("hp", "11", False, 315),
+        ("hp", "11", True, 83),
+    ],
+)
+def test_independent_variables_table4(surface, pattern, symmetric, n):
+    case = make_case(surface, pattern, seed=0, symmetric=symmetric)
+    lmap = build_linear_map(case.pattern, case.planes)
+    assert lmap.n_variables == n
+
+
+@pytest.mark.parametrize("surface", ["dome", "hp"])
+def test_linear_map_satisfies_constraints(surface):
+    case = make_case(surface, "11", symmetric=True)
+    lmap = build_linear_map(case.pattern, case.planes)
+    rng = np.random.default_rng(0)
+    xi = lmap.restrict(case.pattern.coords) + 0.05 * rng.standard_normal(lmap.n_variables)
+    coords = lmap.expand(xi)
+    assert lmap.residual(coords) < 1e-12
+    assert np.allclose(lmap.restrict(coords), xi)
+    # corners never move, and mirror images stay mirror images
+    assert np.allclose(coords[case.pattern.corners], case.pattern.coords[case.pattern.corners])
+    for plane in case.planes:
+        image = plane.reflect(coords[:, :2])
+        dist = np.min(np.linalg.norm(image[:, None] - coords[None, :, :2], axis=2), axis=1)
+        assert dist.max() < 1e-12
+
+
+def test_boundary_vertices_stay_on_their_sides(bezier_problem):
+    lmap, shape = bezier_problem.map, bezier_problem.pattern
+    rng = np.random.default_rng(1)
+    coords = lmap.expand(lmap.restrict(shape.coords) + 0.1 * rng.standard_normal(lmap.n_variables))
+    for side in shape.boundary_sides:
+        b1, b2, b3 = side.line
+        assert np.allclose(b1 * coords[side.inner, 0] + b2 * coords[side.inner, 1] + b3, 0)
+
+
+def test_asymmetric_surface_breaks_symmetry_constraints():
+    """Mirror planes that the corner heights contradict are reported, not silently used."""
+    bez = get_surface("bezier", seed=2)
+    dome = get_surface("dome")
+    case = make_case(bez, "11")
+    with pytest.raises(ValueError, match="contradict"):
+        build_linear_map(case.pattern, dome.mirror_planes)
+
+
+# ---------------------------------------------------------------- exact derivatives
+def _random_point(problem, seed):
+    rng = np.random.default_rng(seed)
+    xi = problem.start_point() + 0.03 * rng.standard_normal(problem.n_variables)
+    w = np.zeros(problem.pattern.n_edges)
+    w[rng.choice(problem.pattern.interior_edges, 12, replace=False)] = 1.0
+    return xi, w
+
+
+def _central_diff(fun, x, h=1e-6):
+    cols = []
+    for i in range(len(x)):
+        e = np.zeros_like(x)
+        e[i] = h
+        cols.append((np.asarray(fun(x + e)) - np.asarray(fun(x - e))) / (2 * h))
+    return np.stack(cols, axis=-1)
+
+
+def _rel(a, b):
+    return np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
+
+
+@pytest.mark.parametrize("part", ["F1", "F2"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_objective_derivatives_match_finite_differences(bezier_problem, part, seed):
+    fun = bezier_problem.derivative_functions()[part]
+    xi, w = _random_point(bezier_problem, seed)
+    value, grad, hess = (np.asarray(v) for v in fun(xi, w))
+    fd_grad = _central_diff(lambda x: np.asarray(fun(x, w)[0]).item(), xi)
+    fd_hess = _central_diff(lambda x: np.asarray(fun(x, w)[1]).ravel(), xi)
+    assert value.item() > 0
+    assert _rel(grad.ravel(), fd_grad) < 1e-6
+    assert _rel(hess, fd_hess) < 1e-6
+
+
+def test_angle_derivatives_match_finite_differences(bezier_problem):
+    fun = bezier_problem.derivative_functions()["theta"]
+    xi, _ = _random_point(bezier_problem, 5)
+    lam = np.random.default_rng(6).standard_normal(3 * bezier_problem.pattern.n_faces)
+    theta, jac, hess = (np.asarray(ca_value) for ca_value in fun(xi, lam))
+    fd_jac = _central_diff(lambda x: np.asarray(fun(x, lam)[0]).ravel(), xi)
+    fd_hess = _central_diff(lambda x: lam @ np.asarray(fun(x, lam)[1]), xi)
+    assert _rel(jac, fd_jac) < 1e-6
+    assert _rel(hess, fd_hess) < 1e-6
+    # the symbolic angles are the mesh's own angles
+    shape = bezier_problem.pattern.with_coords(bezier_problem.map.expand(xi))
+    assert np.allclose(theta.ravel(), shape.corner_angles.T.ravel())
+
+
+def test_objective_matches_mesh_geometry(bezier_problem):
+    xi, w = _random_point(bezier_problem, 2)
+    F, F1, F2 = (float(v) for v in bezier_problem.objective(xi, w))
+    shape = bezier_problem.pattern.with_coords(bezier_problem.map.expand(xi)).with_fixed(w > 0)
+    assert F1 == pytest.approx(np.sum(shape.angle_defects**2), rel=1e-12)
+    assert F2 == pytest.approx(shape.flatness_residuals.sum(), rel=1e-12)
+    assert F == pytest.approx(F1 + F2)
+
+
+# ---------------------------------------------------------------- solving
+def test_ipopt_solves_pattern1_and_result_is_consistent():
+    case = make_case("bezier", "1", seed=4)
+    result = case.problem().solve()
+    assert result.status is Status.CONVERGED
+    assert result.F <= DEFAULTS.f_tol
+    assert result.max_violation <= DEFAULTS.constraint_tol
+    shape = result.pattern
+    assert np.sum(shape.angle_defects**2) == pytest.approx(result.F1, abs=1e-14)
+    assert np.all(np.abs(shape.coords[:, 2] - case.surface.height(*shape.coords[:, :2].T)) <= 0.3)
+    assert shape.corner_angles.min() >= DEFAULTS.theta_min - 1e-8
+
+
+def test_fixed_creases_become_flat():
+    case = make_case("bezier", "1", seed=5)
+    problem = case.problem()
+    first = problem.solve()
+    fold = np.abs(first.pattern.fold_angles)
+    fold[first.pattern.is_boundary_edge] = np.inf
+    flattest = np.argsort(fold)[:3]
+    second = problem.solve(fixed=flattest, start=first.coords)
+    assert second.converged
+    assert second.pattern.n_facets == second.pattern.n_faces - 3
+    assert np.all(second.pattern.flatness_residuals <= DEFAULTS.f_tol)
+
+
+def test_fold_angle_bound():
+    settings = DEFAULTS.with_(rho_bar=np.radians(25.0))
+    case = make_case("bezier", "1", seed=6, settings=settings)
+    result = case.problem().solve()
+    free = result.pattern.free_creases
+    assert np.degrees(np.abs(result.pattern.fold_angles[free]).max()) <= 25.0 + 1e-6
+
+
+def test_pattern2_infeasible_start_is_repaired():
+    case = make_case("bezier", "2", seed=0)
+    assert case.pattern.corner_angles.min() < DEFAULTS.theta_min
+    result = case.problem().solve()
+    assert result.converged
+    assert result.pattern.corner_angles.min() >= DEFAULTS.theta_min - 1e-8
+
+
+@pytest.mark.parametrize("solver", ["slsqp", "slsqp-fd"])
+def test_slsqp_reference_solvers_return_a_result(solver):
+    """SLSQP runs on the same model and reports through the same result type."""
+    case = make_case("bezier", "1", seed=1, settings=DEFAULTS.with_(slsqp_max_iter=15))
+    result = case.problem(build_ipopt=False).solve(solver=solver)
+    assert result.solver == solver
+    assert result.iterations <= 15
+    assert result.status in (Status.CONVERGED, Status.ITERATION_LIMIT, Status.TOLERANCE_NOT_MET)
+    assert result.F < float(
+        case.problem(build_ipopt=False).objective(
+            case.problem(build_ipopt=False).start_point(), np.zeros(case.pattern.n_edges)
+        )[0]
+    )
+
+
+def test_iteration_limit_is_a_status_not_silence():
+    case = make_case("dome", "11", settings=DEFAULTS.with_(ipopt_max_iter=3))
+    result = case.problem().solve()
+    assert result.status is Status.ITERATION_LIMIT
+    assert "Maximum_Iterations_Exceeded" in result.message
+
+
+def test_impossible_bounds_are_not_converged():
+    """A tight dz bound on a strongly curved dome cannot be met with F <= F_tol."""
+    case = make_case("dome", "11", settings=DEFAULTS.with_(dz=1e-4))
+    result = case.problem().solve()
+    assert result.status in (Status.TOLERANCE_NOT_MET, Status.INFEASIBLE, Status.ITERATION_LIMIT)
+    assert not result.converged
+
+
+def test_bad_fixed_selection(bezier_problem):
+    with pytest.raises(ValueError, match="out of range"):
+        bezier_problem.fixed_mask([10_000])
+    with pytest.raises(ValueError, match="boundary"):
+        bezier_problem.fixed_mask([int(bezier_problem.pattern.boundary_edges[0])])
+    with pytest.raises(ValueError, match="unknown solver"):
+        bezier_problem.solve(solver="newton")

@@ -1,0 +1,53 @@
+"""The paper's crease patterns: Table 4 and the layout properties stated in the docs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidfold import patterns
+from rigidfold.mesh import CreasePattern
+
+# Table 4 (E of pattern 2 corrected from 117 to 129, see patterns.grids.pattern2)
+TABLE4 = {"1": (49, 120, 72, 21), "2": (52, 129, 78, 21), "11": (121, 320, 200, 37)}
+
+
+@pytest.mark.parametrize("name", list(TABLE4))
+def test_table4_sizes_and_initial_dof(name):
+    xy, faces = patterns.plan(name)
+    shape = CreasePattern.from_faces(xy, faces)
+    V, E, F, dof = TABLE4[name]
+    assert (shape.n_vertices, shape.n_edges, shape.n_faces) == (V, E, F)
+    assert len(shape.interior_edges) - 3 * len(shape.interior_vertices) == dof
+    assert shape.generic_dof == dof
+    assert sorted(map(tuple, shape.coords[shape.corners, :2].tolist())) == [
+        (0, 0),
+        (0, 3),
+        (3, 0),
+        (3, 3),
+    ]
+    assert np.all(shape.face_normals[:, 2] > 0)  # counter-clockwise seen from +z
+
+
+def test_pattern2_side_angles_below_theta_min():
+    xy, faces = patterns.plan("2")
+    shape = CreasePattern.from_faces(xy, faces)
+    assert np.degrees(shape.corner_angles.min()) == pytest.approx(26.565, abs=1e-3)
+
+
+def test_grid11_mirror_symmetric_about_four_planes():
+    xy, faces = patterns.plan("11")
+    tris = {tuple(sorted(map(tuple, np.round(xy[f], 9).tolist()))) for f in faces}
+    for mirror in (
+        lambda p: np.column_stack([3 - p[:, 0], p[:, 1]]),
+        lambda p: np.column_stack([p[:, 0], 3 - p[:, 1]]),
+        lambda p: p[:, ::-1],
+        lambda p: np.column_stack([3 - p[:, 1], 3 - p[:, 0]]),
+    ):
+        image = {tuple(sorted(map(tuple, np.round(mirror(xy[f]), 9).tolist()))) for f in faces}
+        assert image == tris
+
+
+def test_unknown_pattern():
+    with pytest.raises(ValueError, match="unknown pattern '7'"):
+        patterns.plan("7")

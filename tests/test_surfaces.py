@@ -1,0 +1,185 @@
+"""Target surfaces: values, exact gradients, CasADi backend, symmetry, safe parsing."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from rigidfold.surfaces import (
+    Bezier,
+    Dome,
+    ExpressionSurface,
+    HyperbolicParaboloid,
+    MirrorPlane,
+    get_surface,
+)
+
+SURFACES = {
+    "bezier0": lambda: Bezier(0),
+    "bezier7": lambda: Bezier(7),
+    "dome": Dome,
+    "hp": HyperbolicParaboloid,
+    "expr": lambda: ExpressionSurface("0.3*sin(x)*cos(y) + 0.1*x**2 - sqrt(1 + y)/3"),
+}
+
+
+@pytest.fixture(params=list(SURFACES))
+def surface(request):
+    return SURFACES[request.param]()
+
+
+def _plan_points(n=50, seed=0):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(0.1, 2.9, n), rng.uniform(0.1, 2.9, n)
+
+
+def test_gradient_matches_central_differences(surface):
+    x, y = _plan_points()
+    gx, gy = surface.gradient(x, y)
+    h = 1e-6
+    fx = (surface.height(x + h, y) - surface.height(x - h, y)) / (2 * h)
+    fy = (surface.height(x, y + h) - surface.height(x, y - h)) / (2 * h)
+    assert np.linalg.norm(gx - fx) / np.linalg.norm(fx) < 1e-6
+    assert np.linalg.norm(gy - fy) / np.linalg.norm(fy) < 1e-6
+
+
+def test_casadi_backend_equals_numpy(surface):
+    x, y = _plan_points(20, 1)
+    sx, sy = ca.SX.sym("x", 20), ca.SX.sym("y", 20)
+    fun = ca.Function("z", [sx, sy], [surface.height(sx, sy, xp=ca)])
+    assert np.allclose(np.asarray(fun(x, y)).ravel(), surface.height(x, y), rtol=1e-14)
+
+
+def test_height_keeps_array_shape(surface):
+    x = np.full((2, 3), 1.0)
+    assert np.shape(surface.height(x, x)) == (2, 3)
+
+
+def test_dome_values():
+    dome = Dome()
+    corners = np.array([0.0, 3.0, 0.0, 3.0]), np.array([0.0, 0.0, 3.0, 3.0])
+    assert np.allclose(dome.height(*corners), 0.0, atol=1e-12)
+    assert dome.height(np.array([1.5]), np.array([1.5]))[0] == pytest.approx(1.5)
+
+
+def test_hp_values():
+    hp = HyperbolicParaboloid()
+    z = hp.height(np.array([0.0, 3.0, 0.0, 3.0]), np.array([0.0, 0.0, 3.0, 3.0]))
+    assert np.allclose(z, [0.9, -0.9, -0.9, 0.9])
+    assert z.max() - z.min() == pytest.approx(1.8)
+
+
+def test_bezier_control_heights_and_convex_hull():
+    bez = Bezier(3)
+    h = np.random.default_rng(3).uniform(0, 3, (4, 4))
+    assert np.array_equal(bez.heights, h)
+    z = bez.height(np.array([0.0, 3.0, 0.0, 3.0]), np.array([0.0, 0.0, 3.0, 3.0]))
+    assert np.allclose(z, [h[0, 0], h[3, 0], h[0, 3], h[3, 3]])
+    gx, gy = np.meshgrid(np.linspace(0, 3, 31), np.linspace(0, 3, 31))
+    zz = bez.height(gx, gy)
+    assert zz.min() >= h.min() - 1e-12 and zz.max() <= h.max() + 1e-12
+    assert Bezier(3).metadata()["control_heights"] == h.tolist()
+
+
+@pytest.mark.parametrize("surface", [Dome(), HyperbolicParaboloid()], ids=["dome", "hp"])
+def test_mirror_symmetry(surface):
+    x, y = _plan_points(100, 2)
+    for plane in surface.mirror_planes:
+        image = plane.reflect(np.column_stack([x, y]))
+        assert np.allclose(surface.height(*image.T), surface.height(x, y), atol=1e-12)
+
+
+def test_hp_not_symmetric_about_midlines():
+    hp = HyperbolicParaboloid()
+    x, y = _plan_points(10, 3)
+    image = MirrorPlane(1.0, 0.0, -1.5).reflect(np.column_stack([x, y]))
+    assert not np.allclose(hp.height(*image.T), hp.height(x, y))
+
+
+def test_mirror_plane_text():
+    assert [str(p) for p in Dome.mirror_planes] == ["x = 1.5", "y = 1.5"]
+    assert [str(p) for p in HyperbolicParaboloid.mirror_planes] == ["x - y = 0", "x + y = 3"]
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "1",
+        "x",
+        "-x + 2*y",
+        "sin(x)*cos(y)",
+        "exp(-((x-1.5)**2 + (y-1.5)**2))",
+        "abs(x - y)",
+        "atan2(y, x + 1)",
+        "pi*e",
+        "max(x, y) - min(x, 1)",
+        "hypot(x, y)",
+        "sqrt(1 + x**2)",
+    ],
+)
+def test_accepted_expressions(text):
+    surface = get_surface("expr", expr=text)
+    x, y = _plan_points(5, 4)
+    assert np.all(np.isfinite(surface.height(x, y)))
+
+
+@pytest.mark.parametrize(
+    ("text", "reason"),
+    [
+        ("__import__('os')", "function '__import__' is not allowed"),
+        ("x.real", "attribute access"),
+        ("x.__class__.__bases__", "attribute access"),
+        ("(lambda: 1)()", "plain calls"),
+        ("x[0]", "subscripts"),
+        ("z + 1", "name 'z' is not allowed"),
+        ("open('f')", "function 'open' is not allowed"),
+        ("eval('1')", "function 'eval' is not allowed"),
+        ("x if y else 1", "conditional"),
+        ("x < y", "comparisons"),
+        ("x or y", "boolean"),
+        ("sin(x=1)", "keyword"),
+        ("sin(x, y)", "takes 1 argument"),
+        ("sin", "must be called"),
+        ("", "empty expression"),
+        ("x +", "invalid expression"),
+        ("1j*x", "only real numbers"),
+        ("'a'", "only real numbers"),
+        ("True", "only real numbers"),
+        ("[x]", "lists"),
+        ("x // 2", r"only \+ - \* / \*\*"),
+        ("(x := 2)", "assignment"),
+        ("f'{x}'", "f-strings"),
+        ("[i for i in x]", "lists|comprehensions"),
+    ],
+)
+def test_refused_expressions(text, reason):
+    with pytest.raises(ValueError, match=reason) as info:
+        ExpressionSurface(text)
+    assert "\n" not in str(info.value)
+
+
+def test_refused_expression_is_never_evaluated(monkeypatch):
+    from rigidfold.surfaces import expression
+
+    calls = []
+    monkeypatch.setattr(expression, "evaluate", lambda *a, **k: calls.append(a))
+    with pytest.raises(ValueError):
+        ExpressionSurface("__import__('os').system('true')")
+    assert calls == []
+
+
+@pytest.mark.parametrize("text", ["1/0", "log(x - 5)", "10.0**1000", "sqrt(-1 - x)"])
+def test_non_finite_expression_reported(text):
+    surface = ExpressionSurface(text)
+    with pytest.raises(ValueError, match="not finite at"):
+        surface.check_finite(np.array([0.0, 1.0]), np.array([0.0, 1.0]))
+
+
+def test_get_surface_errors():
+    with pytest.raises(ValueError, match="unknown surface 'cone'"):
+        get_surface("cone")
+    with pytest.raises(ValueError, match="needs an expression"):
+        get_surface("expr")
+    with pytest.raises(ValueError, match="non-negative integer"):
+        get_surface("bezier", seed=-1)
