@@ -46,6 +46,13 @@ class Settings:
         Entries of the variable map below this magnitude are dropped as round-off.
     symmetry_match_tol : float
         Distance (metres) within which a mirrored vertex must land on another vertex.
+    mechanism_rank_tol : float
+        Singular values below this times the largest one count as zero (rank of S, Eq. 16).
+    lock_tol : float
+        A free crease is locked when the norm of its rotations over all modes is below this
+        times the largest such norm (and its triangles are not coplanar).
+    hinge_stiffness, hinge_stiffness_spread : float
+        Fictitious hinge stiffnesses K_j are uniform in this mean +/- spread, Nm (Section 6.1).
     """
 
     # design parameters of problem (6)
@@ -68,6 +75,11 @@ class Settings:
     linear_rank_tol: float = 1e-10
     map_prune_tol: float = 1e-13
     symmetry_match_tol: float = 1e-6
+    # mechanism analysis
+    mechanism_rank_tol: float = 1e-9
+    lock_tol: float = 1e-7
+    hinge_stiffness: float = 1e-3
+    hinge_stiffness_spread: float = 0.5e-6
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):

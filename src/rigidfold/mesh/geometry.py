@@ -14,6 +14,15 @@ def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.einsum("...i,...i", a, b))
 
 
+def skew(v: np.ndarray) -> np.ndarray:
+    """Cross-product matrices: ``skew(v) @ w == cross(v, w)``.  (..., 3) -> (..., 3, 3)"""
+    out = np.zeros((*v.shape[:-1], 3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
 def corner_angles(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Interior angle of each triangle at each of its corners.
 

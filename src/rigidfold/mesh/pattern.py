@@ -146,6 +146,12 @@ class CreasePattern:
         return topology.edge_faces(self.faces, self.edges, self.n_vertices)
 
     @cached_property
+    def face_edges(self) -> np.ndarray:
+        """(F, 3) int: edge of each face from corner k to corner k + 1."""
+        he = topology.half_edge_edges(self.faces, self.edges, self.n_vertices)
+        return he.reshape(-1, 3)
+
+    @cached_property
     def is_boundary_edge(self) -> np.ndarray:
         """(E,) bool: True for outer edges."""
         return (self.edge_faces < 0).any(axis=1)

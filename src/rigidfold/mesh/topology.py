@@ -36,6 +36,24 @@ def edge_keys(edges: np.ndarray, n_vertices: int) -> np.ndarray:
     return lo * n_vertices + hi
 
 
+def half_edge_edges(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Edge index of every half-edge: entry ``3 f + k`` is the edge of ``faces[f, k..k+1]``.
+
+    faces : (F, 3) int, edges : (E, 2) int  ->  (3F,) int64
+    Raises ValueError when a face edge is missing from ``edges``.
+    """
+    he = half_edges(faces)
+    keys = edge_keys(edges, n_vertices)
+    order = np.argsort(keys)
+    he_keys = edge_keys(he, n_vertices)
+    pos = np.minimum(np.searchsorted(keys[order], he_keys), len(keys) - 1)
+    found = keys[order][pos] == he_keys
+    if not found.all():
+        u, v = he[np.flatnonzero(~found)[0]].tolist()
+        raise ValueError(f"edge ({u}, {v}) of a face is missing from the edge list")
+    return order[pos].astype(np.int64)
+
+
 def edge_faces(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndarray:
     """Faces on either side of each edge.
 
@@ -46,21 +64,11 @@ def edge_faces(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndar
     Raises ValueError when a face edge is missing from ``edges`` or a half-edge repeats.
     """
     he = half_edges(faces)
-    keys = edge_keys(edges, n_vertices)
-    order = np.argsort(keys)
-    he_keys = edge_keys(he, n_vertices)
-    pos = np.searchsorted(keys[order], he_keys)
-    pos = np.minimum(pos, len(keys) - 1)
-    found = keys[order][pos] == he_keys
-    if not found.all():
-        u, v = he[np.flatnonzero(~found)[0]]
-        raise ValueError(f"edge ({int(u)}, {int(v)}) of a face is missing from the edge list")
-    edge_of_he = order[pos]
+    edge_of_he = half_edge_edges(faces, edges, n_vertices)
     forward = he[:, 0] == edges[edge_of_he, 0]
     face_of_he = np.repeat(np.arange(len(faces)), 3)
     out = np.full((len(edges), 2), -1, dtype=np.int64)
-    column = np.where(forward, 0, 1)
-    slot = edge_of_he * 2 + column
+    slot = edge_of_he * 2 + np.where(forward, 0, 1)
     counts = np.bincount(slot, minlength=2 * len(edges))
     if counts.max(initial=0) > 1:
         e = int(np.argmax(counts) // 2)

@@ -1,0 +1,153 @@
+"""Mechanism analysis (Section 4.1): DOF, mechanism modes H, hinge rotations, locked creases.
+
+Two methods give the same result:
+
+* ``"kinematic"`` (default): the kernel of the small vertex-velocity constraint matrix
+  (:mod:`rigidfold.mechanism.kinematics`), mapped onto the frame's displacement space and
+  orthonormalised there. Fast: a dense SVD of about (E + 9) x 3V.
+* ``"frame"``: the paper's way, the right singular vectors of the frame compatibility matrix
+  S (6m x (6n - 6 + h)) for zero singular values. Slow for large patterns; the reference.
+
+Both return H with orthonormal columns spanning ker(S) in the frame's v-space, so the pseudo
+stiffness matrix and everything derived from it (Sections 4.2, 5) are the paper's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.frame import FrameModel
+from rigidfold.mechanism import kinematics
+from rigidfold.mesh import CreasePattern
+
+METHODS = ("kinematic", "frame")
+
+
+@dataclass(frozen=True, eq=False)
+class Mechanism:
+    """Infinitesimal mechanisms of a polyhedron's frame model.
+
+    frame : FrameModel
+    basis : (6n - 6 + h, d) float64 array, or a callable returning it: an orthonormal basis
+        H of ker(S) (Eq. 17), built on first use
+    H_phi : (h, d) float64, its hinge-rotation rows (Eq. 18); row j is free crease hinges[j]
+    rank_values : (k,) singular values (or |R_ii| of a pivoted QR) of the matrix whose kernel
+        was taken, decreasing
+    rank : int
+    locked : (h,) bool, per hinge (free crease): no rotation in any mode although folded
+    settings : Settings
+    """
+
+    frame: FrameModel
+    basis: object
+    H_phi: np.ndarray
+    rank_values: np.ndarray
+    rank: int
+    locked: np.ndarray
+    settings: Settings
+
+    @cached_property
+    def H(self) -> np.ndarray:
+        """(6n - 6 + h, d) orthonormal mechanism modes, H^T H = I (Eq. 17)."""
+        return self.basis() if callable(self.basis) else self.basis
+
+    @property
+    def pattern(self) -> CreasePattern:
+        return self.frame.pattern
+
+    @property
+    def dof(self) -> int:
+        """d = 6n - s + h - rank(S) (Eq. 16)."""
+        return self.H_phi.shape[1]
+
+    @property
+    def hinges(self) -> np.ndarray:
+        """(h,) edge indices of the free creases, in the order of H_phi's rows."""
+        return self.frame.hinges
+
+    @property
+    def H_u(self) -> np.ndarray:
+        """(6n - 6, d) nodal displacement part of the modes (Eq. 18)."""
+        return self.H[: self.H.shape[0] - self.frame.n_hinges]
+
+    @cached_property
+    def rotation_norms(self) -> np.ndarray:
+        """(h,) norm of each hinge's rotations over all modes (0 for a locked hinge)."""
+        return np.linalg.norm(self.H_phi, axis=1)
+
+    @property
+    def locked_creases(self) -> np.ndarray:
+        """Edge indices of locked free creases."""
+        return self.hinges[self.locked]
+
+    @property
+    def has_lock(self) -> bool:
+        return bool(self.locked.any())
+
+
+def analyze(
+    pattern: CreasePattern,
+    *,
+    method: str = "kinematic",
+    support_face: int | None = None,
+    settings: Settings = DEFAULTS,
+) -> Mechanism:
+    """Mechanism analysis of a polyhedron (Section 4.1).
+
+    pattern : the shape, with its fixed creases; method : "kinematic" or "frame".
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
+    frame = FrameModel.from_pattern(pattern, support_face)
+    h = frame.n_hinges
+    if method == "frame":
+        H, values, rank = _svd_kernel(frame.compatibility_matrix().toarray(), settings)
+        H_phi, basis = H[H.shape[0] - h :], H
+    else:
+        C = kinematics.constraint_matrix(pattern, frame.support_face).toarray()
+        N, values, rank = _qr_kernel(C, settings)
+        L = kinematics.frame_map(frame)
+        # H = L N R^-1 with R^T R = N^T L^T L N: orthonormal in the frame's v-space
+        R = np.linalg.cholesky(N.T @ (L.T @ (L @ N))).T if N.shape[1] else np.zeros((0, 0))
+        Rinv = scipy.linalg.solve_triangular(R, np.eye(len(R))) if len(R) else R
+        H_phi = L[L.shape[0] - h :] @ N @ Rinv
+
+        def basis() -> np.ndarray:
+            return L @ N @ Rinv
+
+    return Mechanism(frame, basis, H_phi, values, rank, _locked(frame, H_phi, settings), settings)
+
+
+def _svd_kernel(A: np.ndarray, settings: Settings) -> tuple[np.ndarray, np.ndarray, int]:
+    """Orthonormal kernel basis of A by SVD, with rank relative to the largest singular value."""
+    _, sv, vt = scipy.linalg.svd(A, full_matrices=True, lapack_driver="gesdd")
+    rank = int(np.sum(sv > settings.mechanism_rank_tol * sv[0])) if len(sv) else 0
+    return vt[rank:].T.copy(), sv, rank
+
+
+def _qr_kernel(A: np.ndarray, settings: Settings) -> tuple[np.ndarray, np.ndarray, int]:
+    """Kernel basis of A from a column-pivoted QR of A^T (rank-revealing).
+
+    With A^T P = Q R, range(A^T) is spanned by the first r columns of Q and the kernel of A by
+    the remaining ones. |R_ii| decreases; r counts those above ``mechanism_rank_tol`` times
+    |R_00|.
+    """
+    q, r, _ = scipy.linalg.qr(A.T, pivoting=True, mode="full")
+    diag = np.abs(np.diag(r))
+    rank = int(np.sum(diag > settings.mechanism_rank_tol * diag[0])) if len(diag) else 0
+    return q[:, rank:], diag, rank
+
+
+def _locked(frame: FrameModel, H_phi: np.ndarray, settings: Settings) -> np.ndarray:
+    """Free creases that rotate in no mode while their two triangles are not coplanar."""
+    folded = np.abs(frame.pattern.fold_angles[frame.hinges]) > settings.flat_angle
+    if H_phi.shape[1] == 0:
+        return folded
+    norms = np.linalg.norm(H_phi, axis=1)
+    still = norms <= settings.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)
+    return still & folded

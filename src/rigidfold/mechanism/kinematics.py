@@ -1,0 +1,144 @@
+"""Infinitesimal kinematics of a triangulated polyhedron in vertex velocities.
+
+The mechanism of the frame model is computed through an equivalent, much smaller system:
+vertex velocities ``xdot`` (3V,) that keep every edge length (the triangles are rigid), keep
+every fixed crease flat (zero fold-angle rate) and keep one support triangle still. Its
+kernel is mapped linearly onto the frame's displacement vector ``v = (u, theta, phi)``
+(see :mod:`rigidfold.frame.model`); the map is injective, so the two kernels are the same
+space of mechanisms.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sp
+
+from rigidfold.frame import FrameModel
+from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.geometry import skew
+
+
+@lru_cache(maxsize=1)
+def _fold_angle_function() -> ca.Function:
+    """rho(p_u, p_v, p_a, p_b) and its gradient (12,), as one CasADi function.
+
+    p_a is the third vertex of the triangle left of u -> v, p_b that of the right one.
+    """
+    q = ca.SX.sym("q", 12)
+    pu, pv, pa, pb = q[0:3], q[3:6], q[6:9], q[9:12]
+    na = ca.cross(pv - pu, pa - pu)
+    nb = ca.cross(pb - pv, pu - pv)  # right triangle (v, u, b), counter-clockwise
+    t = (pv - pu) / ca.norm_2(pv - pu)
+    rho = ca.atan2(-ca.dot(ca.cross(na, nb), t), ca.dot(na, nb))
+    return ca.Function("rho", [q], [rho, ca.gradient(rho, q)])
+
+
+def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_matrix:
+    """d rho_j / d x for the given interior edges.  -> (len(creases), 3V) sparse."""
+    creases = np.asarray(creases, dtype=np.int64)
+    V = pattern.n_vertices
+    if len(creases) == 0:
+        return sp.csr_matrix((0, 3 * V))
+    e = pattern.edges[creases]
+    ef = pattern.edge_faces[creases]
+    faces = pattern.faces
+    a = faces[ef[:, 0]].sum(axis=1) - e.sum(axis=1)
+    b = faces[ef[:, 1]].sum(axis=1) - e.sum(axis=1)
+    verts = np.column_stack([e[:, 0], e[:, 1], a, b])  # (n, 4)
+    q = pattern.coords[verts].reshape(len(creases), 12).T
+    _, grad = _fold_angle_function().map(len(creases))(q)
+    grad = np.asarray(grad).T  # (n, 12)
+    rows = np.repeat(np.arange(len(creases)), 12)
+    cols = (3 * verts[:, :, None] + np.arange(3)).reshape(len(creases), 12).ravel()
+    return sp.csr_matrix((grad.ravel(), (rows, cols)), shape=(len(creases), 3 * V))
+
+
+def edge_length_rates(pattern: CreasePattern) -> sp.csr_matrix:
+    """Rows d(|x_v - x_u|)/dx of every edge (the rigidity matrix).  -> (E, 3V) sparse."""
+    e = pattern.edges
+    d = pattern.coords[e[:, 1]] - pattern.coords[e[:, 0]]
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    rows = np.repeat(np.arange(len(e)), 6)
+    cols = np.concatenate([3 * e[:, :1] + np.arange(3), 3 * e[:, 1:] + np.arange(3)], axis=1)
+    vals = np.concatenate([-d, d], axis=1)
+    return sp.csr_matrix(
+        (vals.ravel(), (rows, cols.ravel())), shape=(len(e), 3 * pattern.n_vertices)
+    )
+
+
+def support_rows(pattern: CreasePattern, face: int) -> sp.csr_matrix:
+    """Rows fixing the three vertices of the support triangle (9, 3V)."""
+    cols = (3 * pattern.faces[face][:, None] + np.arange(3)).ravel()
+    return sp.csr_matrix((np.ones(9), (np.arange(9), cols)), shape=(9, 3 * pattern.n_vertices))
+
+
+def constraint_matrix(pattern: CreasePattern, support_face: int) -> sp.csr_matrix:
+    """All kinematic constraints: edge lengths, flat fixed creases, support.  (k, 3V)
+
+    Rows are scaled to unit norm; the kernel is the space of mechanisms with the support fixed.
+    """
+    fixed = fold_angle_gradients(pattern, pattern.fixed_creases)
+    norms = sp.linalg.norm(fixed, axis=1) if fixed.shape[0] else np.ones(0)
+    fixed = sp.diags(1.0 / np.maximum(norms, 1e-300)) @ fixed
+    return sp.vstack(
+        [edge_length_rates(pattern), fixed, support_rows(pattern, support_face)], format="csr"
+    )
+
+
+def angular_velocity_blocks(pattern: CreasePattern) -> np.ndarray:
+    """Angular velocity of every triangle moving rigidly, as blocks of d omega / d xdot.
+
+    With r_k = x_k - c (c the barycentre), a rigid motion gives
+    ``sum_k r_k x xdot_k = J omega`` with ``J = sum_k (|r_k|^2 I - r_k r_k^T)``.
+
+    returns : (F, 3, 3, 3); entry [f, i, k, l] is d omega_f[i] / d xdot[faces[f, k], l].
+    """
+    x = pattern.coords[pattern.faces]  # (F, 3, 3)
+    r = x - x.mean(axis=1, keepdims=True)
+    sq = np.einsum("fkd,fkd->f", r, r)
+    J = sq[:, None, None] * np.eye(3) - np.einsum("fki,fkj->fij", r, r)
+    return np.einsum("fij,fkjl->fikl", np.linalg.inv(J), skew(r))
+
+
+def frame_map(frame: FrameModel) -> sp.csr_matrix:
+    """Linear map from vertex velocities to the frame's v = (u, theta, phi).
+
+    Edge node: u is the mean velocity of the edge's ends, theta the angular velocity of the
+    triangle on the edge's left (the node's rigid side). Barycentre node: the triangle's mean
+    velocity and angular velocity. phi_j: the fold-angle rate of free crease j.
+
+    returns : (6n - 6 + h, 3V) sparse; rows of the support node removed.
+    """
+    pat = frame.pattern
+    E, F = pat.n_edges, pat.n_faces
+    W = angular_velocity_blocks(pat)  # (F, 3, 3, 3)
+    c3 = np.arange(3)
+    rows, cols, vals = [], [], []
+    # translations: edge nodes (mean of 2 vertices), barycentre nodes (mean of 3)
+    for node, verts in ((np.arange(E), pat.edges), (E + np.arange(F), pat.faces)):
+        k = verts.shape[1]
+        rows.append(np.broadcast_to(6 * node[:, None, None] + c3, (len(node), k, 3)).ravel())
+        cols.append((3 * verts[:, :, None] + c3).ravel())
+        vals.append(np.full(len(node) * k * 3, 1.0 / k))
+    # rotations: W of the node's rigid triangle
+    edge_face = np.where(pat.edge_faces[:, 0] >= 0, pat.edge_faces[:, 0], pat.edge_faces[:, 1])
+    for node, face in ((np.arange(E), edge_face), (E + np.arange(F), np.arange(F))):
+        shape = (len(node), 3, 3, 3)
+        rows.append(
+            np.broadcast_to(6 * node[:, None, None, None] + 3 + c3[:, None, None], shape).ravel()
+        )
+        cols.append(np.broadcast_to(3 * pat.faces[face][:, None, :, None] + c3, shape).ravel())
+        vals.append(W[face].ravel())
+    rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    # drop the support node's rows and close the gap
+    s0 = 6 * frame.support_node
+    keep = (rows < s0) | (rows >= s0 + 6)
+    rows = np.where(rows[keep] >= s0 + 6, rows[keep] - 6, rows[keep])
+    nodal = sp.csr_matrix(
+        (vals[keep], (rows, cols[keep])), shape=(6 * frame.n_nodes - 6, 3 * pat.n_vertices)
+    )
+    phi = fold_angle_gradients(pat, frame.hinges)
+    return sp.vstack([nodal, phi], format="csr")
