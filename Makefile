@@ -15,13 +15,14 @@ $(STAMP): $(PY) pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/rigidfold optimize --surface bezier --seed 1 --pattern 1 --out out/demo
+	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --no-deform --out out/demo
 
 test: $(STAMP)
 	$(PY) -m pytest -q
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_optimize.py
+	$(PY) benchmarks/bench_generate.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import json
+
 import casadi as ca
 import numpy as np
 import pytest
 
 from rigidfold.surfaces import (
+    SURFACES,
     Bezier,
     Dome,
     ExpressionSurface,
@@ -15,7 +18,7 @@ from rigidfold.surfaces import (
     get_surface,
 )
 
-SURFACES = {
+FACTORIES = {
     "bezier0": lambda: Bezier(0),
     "bezier7": lambda: Bezier(7),
     "dome": Dome,
@@ -24,9 +27,9 @@ SURFACES = {
 }
 
 
-@pytest.fixture(params=list(SURFACES))
+@pytest.fixture(params=list(FACTORIES))
 def surface(request):
-    return SURFACES[request.param]()
+    return FACTORIES[request.param]()
 
 
 def _plan_points(n=50, seed=0):
@@ -100,6 +103,17 @@ def test_hp_not_symmetric_about_midlines():
 def test_mirror_plane_text():
     assert [str(p) for p in Dome.mirror_planes] == ["x = 1.5", "y = 1.5"]
     assert [str(p) for p in HyperbolicParaboloid.mirror_planes] == ["x - y = 0", "x + y = 3"]
+    assert str(MirrorPlane(-2.0, 1.0, 1.0)) == "-2x + y = -1"
+
+
+def test_mirror_plane_geometry():
+    plane = MirrorPlane(2.0, 2.0, -6.0)  # x + y = 3, unnormalised
+    xy = np.array([[0.0, 0.0], [3.0, 3.0], [1.0, 2.0]])
+    assert np.allclose(plane.signed_distance(xy), [-3 / np.sqrt(2), 3 / np.sqrt(2), 0.0])
+    assert np.allclose(plane.reflect(xy), [[3.0, 3.0], [0.0, 0.0], [1.0, 2.0]])
+    assert np.allclose(plane.reflect(plane.reflect(xy)), xy)
+    with pytest.raises(ValueError, match="not a mirror plane"):
+        MirrorPlane(0.0, 0.0, 1.0)
 
 
 @pytest.mark.parametrize(
@@ -130,33 +144,45 @@ def test_accepted_expressions(text):
         ("__import__('os')", "function '__import__' is not allowed"),
         ("x.real", "attribute access"),
         ("x.__class__.__bases__", "attribute access"),
-        ("(lambda: 1)()", "plain calls"),
-        ("x[0]", "subscripts"),
+        ("__import__('os').system('true')", "attribute access is not allowed"),
+        ("(lambda: 1)()", "a lambda is not allowed"),
+        ("(1)(2)", "by plain name"),
+        ("x[0]", "subscripting is not allowed"),
         ("z + 1", "name 'z' is not allowed"),
         ("open('f')", "function 'open' is not allowed"),
         ("eval('1')", "function 'eval' is not allowed"),
         ("x if y else 1", "conditional"),
-        ("x < y", "comparisons"),
+        ("x < y", "a comparison is not allowed"),
         ("x or y", "boolean"),
         ("sin(x=1)", "keyword"),
         ("sin(x, y)", "takes 1 argument"),
+        ("atan2(x)", "takes 2 arguments"),
+        ("sin(*x)", "starred"),
         ("sin", "must be called"),
         ("", "empty expression"),
-        ("x +", "invalid expression"),
+        ("   ", "empty expression"),
+        ("x +", "invalid expression 'x \\+': "),
+        ("x\n+ 1\n+", "invalid expression"),
+        ("-" * 999 + "x", "nested deeper than"),
+        ("+".join(["x"] * 600), "longer than 1000 characters"),
         ("1j*x", "only real numbers"),
         ("'a'", "only real numbers"),
         ("True", "only real numbers"),
-        ("[x]", "lists"),
+        ("1" * 400, "too large"),
+        ("[x]", "a list is not allowed"),
         ("x // 2", r"only \+ - \* / \*\*"),
         ("(x := 2)", "assignment"),
-        ("f'{x}'", "f-strings"),
-        ("[i for i in x]", "lists|comprehensions"),
+        ("f'{x}'", "an f-string is not allowed"),
+        ("[i for i in x]", "a comprehension is not allowed"),
+        ("not x", r"only unary \+ and -"),
     ],
 )
 def test_refused_expressions(text, reason):
     with pytest.raises(ValueError, match=reason) as info:
         ExpressionSurface(text)
-    assert "\n" not in str(info.value)
+    message = str(info.value)
+    assert "\n" not in message
+    assert message.startswith(("refused expression", "invalid expression", "empty expression"))
 
 
 def test_refused_expression_is_never_evaluated(monkeypatch):
@@ -169,6 +195,39 @@ def test_refused_expression_is_never_evaluated(monkeypatch):
     assert calls == []
 
 
+def test_refused_expression_has_no_side_effect(tmp_path):
+    marker = tmp_path / "touched"
+    for text in [
+        f"__import__('pathlib').Path({str(marker)!r}).touch()",
+        f"open({str(marker)!r}, 'w')",
+        f"sin(x) + (__import__('pathlib').Path({str(marker)!r}).touch() or 0)",
+    ]:
+        with pytest.raises(ValueError, match="refused expression"):
+            ExpressionSurface(text)
+    assert not marker.exists()
+
+
+def test_expression_shapes_and_metadata():
+    surface = ExpressionSurface("  0.5 *  x*y ", mirror_planes=(MirrorPlane(1, -1, 0),))
+    assert surface.metadata() == {"name": "expr", "expression": "0.5 * x*y"}
+    assert repr(surface) == "ExpressionSurface('0.5 * x*y')"
+    assert [str(p) for p in surface.mirror_planes] == ["x - y = 0"]
+    z = surface.height(np.arange(3.0)[:, None], np.arange(4.0)[None, :])
+    assert z.shape == (3, 4) and z[2, 3] == pytest.approx(3.0)
+    gx, gy = surface.gradient(np.full((2, 3), 2.0), np.full((2, 3), 4.0))
+    assert gx.shape == gy.shape == (2, 3)
+    assert np.allclose(gx, 2.0) and np.allclose(gy, 1.0)
+    gx, gy = surface.gradient(2.0, 4.0)
+    assert np.shape(gx) == () and float(gy) == pytest.approx(1.0)
+    gx, gy = surface.gradient(np.zeros(0), np.zeros(0))
+    assert gx.shape == gy.shape == (0,)
+    constant = ExpressionSurface("2")
+    assert np.array_equal(constant.height(np.zeros(4), np.zeros(4)), np.full(4, 2.0))
+    assert np.array_equal(constant.gradient(np.zeros(4), np.zeros(4))[0], np.zeros(4))
+    with pytest.raises(TypeError, match="must be text"):
+        ExpressionSurface(1.0)
+
+
 @pytest.mark.parametrize("text", ["1/0", "log(x - 5)", "10.0**1000", "sqrt(-1 - x)"])
 def test_non_finite_expression_reported(text):
     surface = ExpressionSurface(text)
@@ -176,8 +235,30 @@ def test_non_finite_expression_reported(text):
         surface.check_finite(np.array([0.0, 1.0]), np.array([0.0, 1.0]))
 
 
+def test_finite_expression_passes_check():
+    ExpressionSurface("log(x + 1) / (y + 1)").check_finite(*_plan_points())
+
+
+def test_get_surface_and_metadata():
+    assert isinstance(get_surface("dome"), Dome)
+    assert isinstance(get_surface("hp"), HyperbolicParaboloid)
+    assert get_surface("bezier").seed == 0
+    assert get_surface("bezier", seed=5).seed == 5
+    for name in SURFACES:
+        surface = get_surface(name, seed=1, expr="x*y")
+        meta = json.loads(json.dumps(surface.metadata()))
+        assert meta["name"] == surface.name == name
+        assert "\n" not in repr(surface) and len(repr(surface)) < 80
+    assert repr(Bezier(4)) == "Bezier(4)"
+    flat = Bezier.from_heights(np.ones((4, 4)))
+    assert flat.metadata()["seed"] is None
+    assert np.allclose(flat.height(*_plan_points()), 1.0)
+    with pytest.raises(ValueError, match="finite"):
+        Bezier.from_heights(np.ones((3, 4)))
+
+
 def test_get_surface_errors():
-    with pytest.raises(ValueError, match="unknown surface 'cone'"):
+    with pytest.raises(ValueError, match=r"unknown surface 'cone' \(choose from bezier, dome"):
         get_surface("cone")
     with pytest.raises(ValueError, match="needs an expression"):
         get_surface("expr")

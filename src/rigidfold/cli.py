@@ -38,6 +38,31 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
+    gen = sub.add_parser(
+        "generate",
+        help="Steps 2-7: fix crease lines one by one down to the target DOF",
+        description="Generate developable, rigid-foldable shapes of decreasing DOF. Writes "
+        "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes.",
+    )
+    _case_options(gen)
+    gen.add_argument("--criterion", default="shat", choices=["shat", "s", "ss", "random"])
+    gen.add_argument("--target-dof", type=int, default=1)
+    gen.add_argument(
+        "--no-deform", action="store_true", help="skip the large-deformation check (Step 9)"
+    )
+    gen.add_argument("--quiet", action="store_true", help="no progress bar")
+    gen.set_defaults(func=_cmd_generate)
+
+    ana = sub.add_parser(
+        "analyze",
+        help="mechanism analysis of a FOLD shape: DOF, locked creases, fold angles",
+        description="Read a FOLD file (3D vertices_coords; polygon faces are triangulated with "
+        "fixed 'J' edges) and report its DOF and locked crease lines.",
+    )
+    ana.add_argument("file", metavar="FILE.fold")
+    ana.add_argument("--json", action="store_true", help="print one JSON object")
+    ana.set_defaults(func=_cmd_analyze)
+
     opt = sub.add_parser(
         "optimize",
         help="solve problem (6): a developable polyhedron near a target surface",
@@ -45,28 +70,29 @@ def build_parser() -> argparse.ArgumentParser:
         "Exit code 0 when the solution is accepted (F <= F_tol, constraints met), 1 when not "
         "(the files are written all the same), 2 on bad input.",
     )
-    opt.add_argument("--surface", required=True, choices=["bezier", "dome", "hp", "expr"])
-    opt.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
-    opt.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
-    opt.add_argument("--pattern", required=True, choices=["1", "2", "11"])
-    opt.add_argument(
-        "--symmetric", action="store_true", help="impose the surface's mirror planes (9)"
-    )
+    _case_options(opt)
     opt.add_argument("--fixed", help="comma-separated indices of fixed crease lines")
-    opt.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp", "slsqp-fd"])
-    opt.add_argument("--dz", type=float, default=DEFAULTS.dz, help="bound on |dz| in metres")
-    opt.add_argument("--theta-min", type=float, default=30.0, help="degrees")
-    opt.add_argument("--theta-max", type=float, default=120.0, help="degrees")
-    opt.add_argument("--rho-max", type=_positive, help="bound (12) on |fold angle|, degrees")
-    opt.add_argument("--out", required=True, metavar="DIR")
     opt.set_defaults(func=_cmd_optimize)
     return parser
 
 
-def _cmd_optimize(args: argparse.Namespace) -> int:
-    from rigidfold.case import make_case, parse_fixed, prepare_output_dir, shape_report, write_json
+def _case_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--surface", required=True, choices=["bezier", "dome", "hp", "expr"])
+    p.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
+    p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
+    p.add_argument("--pattern", required=True, choices=["1", "2", "11"])
+    p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
+    p.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp", "slsqp-fd"])
+    p.add_argument("--dz", type=float, default=DEFAULTS.dz, help="bound on |dz| in metres")
+    p.add_argument("--theta-min", type=float, default=30.0, help="degrees")
+    p.add_argument("--theta-max", type=float, default=120.0, help="degrees")
+    p.add_argument("--rho-max", type=_positive, help="bound (12) on |fold angle|, degrees")
+    p.add_argument("--out", required=True, metavar="DIR")
+
+
+def _case(args: argparse.Namespace):
+    from rigidfold.case import make_case
     from rigidfold.config import Settings
-    from rigidfold.io import write_fold
 
     if args.surface == "expr" and not args.expr:
         raise ValueError("--surface expr needs --expr TEXT, e.g. --expr '0.3*sin(x)*cos(y)'")
@@ -78,8 +104,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         theta_max_deg=args.theta_max,
         rho_bar_deg=args.rho_max,
     )
-    out = prepare_output_dir(args.out)
-    case = make_case(
+    return make_case(
         args.surface,
         args.pattern,
         seed=args.seed,
@@ -87,6 +112,14 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         symmetric=args.symmetric,
         settings=settings,
     )
+
+
+def _cmd_optimize(args: argparse.Namespace) -> int:
+    from rigidfold.case import parse_fixed, prepare_output_dir, shape_report, write_json
+    from rigidfold.io import write_fold
+
+    out = prepare_output_dir(args.out)
+    case = _case(args)
     fixed = parse_fixed(args.fixed, case.pattern)
     problem = case.problem(build_ipopt=args.solver == "ipopt")
     result = problem.solve(fixed=fixed, solver=args.solver)
@@ -105,6 +138,143 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     )
     print(f"wrote {out / 'solution.fold'} and {out / 'summary.json'}")
     return 0 if result.converged else 1
+
+
+def _cmd_generate(args: argparse.Namespace) -> int:
+    from rigidfold.generate import generate
+    from rigidfold.report import RunWriter
+
+    if args.target_dof < 0:
+        raise ValueError(f"--target-dof must be >= 0, got {args.target_dof}")
+    writer = RunWriter(args.out, _case(args), {})
+    writer.options = {
+        "criterion": args.criterion,
+        "target_dof": args.target_dof,
+        "seed": args.seed,
+        "solver": args.solver,
+        "symmetric": args.symmetric,
+        "deform": False,
+    }
+    progress = _Progress(enabled=not args.quiet, target=args.target_dof)
+
+    def on_attempt(run, attempt):
+        writer.on_attempt(run, attempt)
+        progress.update(run, attempt)
+
+    def on_solution(run, solution):
+        writer.on_solution(run, solution)
+        progress.update(run, None)
+
+    try:
+        run = generate(
+            writer.case,
+            criterion=args.criterion,
+            target_dof=args.target_dof,
+            seed=args.seed,
+            solver=args.solver,
+            on_attempt=on_attempt,
+            on_solution=on_solution,
+        )
+    except KeyboardInterrupt:
+        progress.close()
+        print(
+            f"rigidfold: interrupted; {len(writer.files)} solution(s), log.json and "
+            f"summary.json are in {writer.out}",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    progress.close()
+    writer.write_summary(run)
+    summary = run.summary()
+    print(
+        f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['final_dof']}, "
+        f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
+        f"N_exceed={summary['N_exceed']}, {summary['n_solves']} solves"
+    )
+    print(f"wrote {len(writer.files)} solutions, log.json and summary.json to {writer.out}")
+    return 0 if run.solutions else 1
+
+
+def _cmd_analyze(args: argparse.Namespace) -> int:
+    import json
+
+    import numpy as np
+
+    from rigidfold.io import read_fold
+    from rigidfold.mechanism import analyze
+
+    data = read_fold(args.file)
+    mech = analyze(data.pattern)
+    pattern = data.pattern
+    locked = [int(e) for e in mech.locked_creases]
+    report = {
+        "file": str(args.file),
+        "vertices": pattern.n_vertices,
+        "faces": pattern.n_faces,
+        "free_creases": len(mech.hinges),
+        "fixed_creases": len(pattern.fixed_creases),
+        "dof": mech.dof,
+        "locked_edges": [e for e in locked if e < data.n_file_edges],
+        "locked_vertex_pairs": [pattern.edges[e].tolist() for e in locked],
+        "fold_angles_deg": np.round(
+            np.degrees(pattern.fold_angles[: data.n_file_edges]), 6
+        ).tolist(),
+    }
+    if args.json:
+        print(json.dumps(report))
+        return 0
+    print(
+        f"{args.file}: V={pattern.n_vertices} F={pattern.n_faces} "
+        f"free creases={len(mech.hinges)} fixed={len(pattern.fixed_creases)}"
+    )
+    print(f"DOF: {mech.dof}")
+    if locked:
+        print(
+            f"locked crease lines ({len(locked)}): edges {report['locked_edges']} "
+            f"(vertex pairs {report['locked_vertex_pairs']})"
+        )
+    else:
+        print("locked crease lines: none")
+    angles = np.degrees(pattern.fold_angles[mech.hinges])
+    print(
+        "fold angles of free creases (deg, valley > 0): "
+        + ", ".join(f"{int(e)}:{a:+.3f}" for e, a in zip(mech.hinges, angles, strict=True))
+    )
+    return 0
+
+
+class _Progress:
+    """A rich progress bar on stderr over the DOF to remove; silent when disabled."""
+
+    def __init__(self, *, enabled: bool, target: int) -> None:
+        self.enabled, self.target, self.bar, self.task = enabled, target, None, None
+
+    def update(self, run, attempt) -> None:
+        if not self.enabled or run.initial_dof is None:
+            return
+        if self.bar is None:
+            from rich.console import Console
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+            self.bar = Progress(
+                TextColumn("[bold]generate"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TextColumn("{task.description}"),
+                console=Console(stderr=True),
+                transient=False,
+            )
+            self.bar.start()
+            self.task = self.bar.add_task("", total=max(run.initial_dof - self.target, 0))
+        self.bar.update(
+            self.task,
+            completed=run.n_reduce,
+            description=f"DOF {run.final_dof}  lock {run.n_lock}  exceed {run.n_exceed}",
+        )
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -51,6 +51,9 @@ class Settings:
     lock_tol : float
         A free crease is locked when the norm of its rotations over all modes is below this
         times the largest such norm (and its triangles are not coplanar).
+    lock_prediction_tol : float
+        After multiplying K_j by 1e14, a hinge whose rotations outside the stiffest mode fall
+        below this fraction of its rotations before is predicted locked (Section 4.2).
     hinge_stiffness, hinge_stiffness_spread : float
         Fictitious hinge stiffnesses K_j are uniform in this mean +/- spread, Nm (Section 6.1).
     """
@@ -78,6 +81,7 @@ class Settings:
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
     lock_tol: float = 1e-7
+    lock_prediction_tol: float = 1e-4
     hinge_stiffness: float = 1e-3
     hinge_stiffness_spread: float = 0.5e-6
 

@@ -88,6 +88,21 @@ class PseudoStiffness:
         k = float(np.mean(self.K)) if k_ref is None else k_ref
         return self.Phi * np.sqrt(k / self.eigenvalues)
 
+    def stiffened(self, j: int, factor: float = 1e14) -> PseudoStiffness:
+        """The same modes with K_j multiplied by ``factor`` (Section 4.2, Tables 2-3)."""
+        K = self.K.copy()
+        K[j] *= factor
+        return PseudoStiffness(self.H_phi, K)
+
+    def residual_rotations(self) -> np.ndarray:
+        """(h,) norm of each hinge's rotations outside the stiffest mode.
+
+        After stiffening hinge j, hinge j rotates only in the mode of the largest eigenvalue
+        (Eq. 26); a hinge p that also keeps no rotation in the other modes is locked once j is
+        fixed (Property 2).
+        """
+        return np.linalg.norm(self.Phi[:, :-1], axis=1)
+
     def psi(self) -> np.ndarray:
         """Psi (h, d): rows of Phi normalised to unit length (Eq. 31)."""
         norms = np.linalg.norm(self.Phi, axis=1, keepdims=True)

@@ -88,6 +88,23 @@ def score_creases(
     return Scores(mechanism.hinges, _share(rho), s_f, s_f_hat, stiff)
 
 
+def predicted_locks(
+    stiffness: PseudoStiffness, j: int, *, factor: float = 1e14, settings: Settings = DEFAULTS
+) -> np.ndarray:
+    """Hinges predicted to lock when hinge j is fixed (Section 4.2, Property 2).
+
+    K_j is multiplied by ``factor``; a hinge p != j whose rotations outside the stiffest mode
+    vanish (relative to its own rotations before, below ``lock_prediction_tol``) is predicted
+    locked.  returns : (k,) hinge indices (rows of H_phi)
+    """
+    before = np.linalg.norm(stiffness.Phi, axis=1)
+    after = stiffness.stiffened(j, factor).residual_rotations()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(before > 0, after / before, 0.0)
+    rel[j] = np.inf
+    return np.flatnonzero(rel < settings.lock_prediction_tol)
+
+
 def rank_candidates(
     scores: Scores,
     criterion: str,

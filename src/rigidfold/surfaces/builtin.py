@@ -22,34 +22,29 @@ class MirrorPlane:
     b: float
     c: float
 
-    def _unit(self) -> tuple[float, float, float]:
-        n = float(np.hypot(self.a, self.b))
-        if n == 0:
-            raise ValueError("a mirror plane needs (a, b) != (0, 0)")
-        return self.a / n, self.b / n, self.c / n
+    def __post_init__(self) -> None:
+        if not np.isfinite([self.a, self.b, self.c]).all() or self.a == self.b == 0:
+            raise ValueError(f"not a mirror plane: {self.a} x + {self.b} y + {self.c} = 0")
 
     def signed_distance(self, xy: np.ndarray) -> np.ndarray:
-        """Distance of plan points (N, 2) from the plane, signed.  -> (N,)"""
-        a, b, c = self._unit()
+        """Distance of plan points (N, 2) from the plane, positive where a x + b y + c > 0.  (N,)"""
         xy = np.asarray(xy, dtype=float)
-        return a * xy[:, 0] + b * xy[:, 1] + c
+        return (self.a * xy[:, 0] + self.b * xy[:, 1] + self.c) / np.hypot(self.a, self.b)
 
     def reflect(self, xy: np.ndarray) -> np.ndarray:
         """Mirror images of plan points.  (N, 2) -> (N, 2)"""
-        a, b, _ = self._unit()
-        d = self.signed_distance(xy)
-        return np.asarray(xy, dtype=float) - 2 * d[:, None] * np.array([a, b])
+        normal = np.array([self.a, self.b]) / np.hypot(self.a, self.b)
+        return np.asarray(xy, dtype=float) - 2 * self.signed_distance(xy)[:, None] * normal
 
     def __str__(self) -> str:
-        """E.g. "x = 1.5", "x - y = 0", "x + y = 3"."""
+        """E.g. "x = 1.5", "x - y = 0", "x + y = 3", "2x - y = 1"."""
         lhs = ""
         for coef, var in ((self.a, "x"), (self.b, "y")):
             if coef == 0:
                 continue
-            sign = "-" if coef < 0 else "+"
-            mag = "" if abs(coef) == 1 else f"{abs(coef):g} "
-            lhs += f" {sign} {mag}{var}" if lhs else f"{'-' if coef < 0 else ''}{mag}{var}"
-        return f"{lhs} = {-self.c + 0.0:g}"
+            sign = ("-" if coef < 0 else "") if not lhs else (" - " if coef < 0 else " + ")
+            lhs += f"{sign}{'' if abs(coef) == 1 else f'{abs(coef):g}'}{var}"
+        return f"{lhs} = {-self.c + 0.0:g}"  # + 0.0 turns -0 into 0
 
 
 class Surface(ABC):
@@ -71,7 +66,7 @@ class Surface(ABC):
         """JSON-serialisable description."""
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}({self.metadata()})"
+        return f"{type(self).__name__}()"
 
 
 def _bernstein(i: int, t):
@@ -126,16 +121,22 @@ class Bezier(Surface):
         h = self.heights
         gx = sum(du[i] * bv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
         gy = sum(bu[i] * dv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
-        return gx + 0 * u, gy + 0 * v
+        return gx, gy
 
     def metadata(self) -> dict:
         return {"name": self.name, "seed": self.seed, "control_heights": self.heights.tolist()}
+
+    def __repr__(self) -> str:
+        if self.seed is None:
+            return "Bezier.from_heights(<(4, 4) control heights>)"
+        return f"Bezier({self.seed})"
 
 
 class Dome(Surface):
     """Spherical cap through the four corners (z = 0) with its apex 1.5 m high at (1.5, 1.5).
 
-    Radius R = 2.25 m, centre (1.5, 1.5, -0.75): ``z = -0.75 + sqrt(R^2 - (x-1.5)^2 - (y-1.5)^2)``.
+    Radius R = 2.25 m, centre (1.5, 1.5, -0.75): ``z = -0.75 + sqrt(R^2 - (x-1.5)^2 - (y-1.5)^2)``,
+    defined within R of the plan centre (the plan square reaches 2.12 m from it).
     """
 
     name = "dome"

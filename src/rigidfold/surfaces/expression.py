@@ -2,9 +2,9 @@
 
 The text is parsed with :mod:`ast` and checked against a whitelist *before* anything is
 evaluated: numbers, ``x``, ``y``, ``pi``, ``e``, ``+ - * / **``, unary signs, parentheses and
-calls of whitelisted maths functions by plain name. The checked tree is then evaluated by a
-small interpreter of our own on NumPy arrays or CasADi symbols; user text never reaches
-``eval`` or ``compile``.
+calls of whitelisted maths functions by plain name with positional arguments. The checked tree
+is then evaluated by a small interpreter of our own on NumPy arrays or CasADi symbols; user
+text never reaches ``eval`` or ``compile``.
 """
 
 from __future__ import annotations
@@ -35,14 +35,18 @@ FUNCTIONS = {
     "tanh": (1, np.tanh, ca.tanh),
     "exp": (1, np.exp, ca.exp),
     "log": (1, np.log, ca.log),
+    "log10": (1, np.log10, ca.log10),
     "sqrt": (1, np.sqrt, ca.sqrt),
     "abs": (1, np.abs, ca.fabs),
-    "hypot": (2, np.hypot, lambda a, b: ca.sqrt(a * a + b * b)),
+    "hypot": (2, np.hypot, ca.hypot),
     "min": (2, np.minimum, ca.fmin),
     "max": (2, np.maximum, ca.fmax),
 }
 CONSTANTS = {"pi": math.pi, "e": math.e}
 VARIABLES = ("x", "y")
+MAX_LENGTH = 1000  # characters of text
+MAX_DEPTH = 100  # nesting depth of the syntax tree
+
 _BINARY = {
     ast.Add: operator.add,
     ast.Sub: operator.sub,
@@ -51,38 +55,45 @@ _BINARY = {
     ast.Pow: operator.pow,
 }
 _UNARY = {ast.UAdd: operator.pos, ast.USub: operator.neg}
-_WHAT = {
+_REFUSED = {  # node type -> what the error message calls it
     ast.Attribute: "attribute access",
-    ast.Subscript: "subscripts",
-    ast.Lambda: "lambdas",
-    ast.Compare: "comparisons",
-    ast.BoolOp: "boolean operators",
-    ast.IfExp: "conditional expressions",
-    ast.NamedExpr: "assignment expressions",
-    ast.JoinedStr: "f-strings",
-    ast.Starred: "starred arguments",
-    ast.List: "lists",
-    ast.Tuple: "tuples",
-    ast.Dict: "dicts",
-    ast.Set: "sets",
-    ast.ListComp: "comprehensions",
-    ast.GeneratorExp: "comprehensions",
-    ast.DictComp: "comprehensions",
-    ast.SetComp: "comprehensions",
+    ast.Subscript: "subscripting",
+    ast.Lambda: "a lambda",
+    ast.Compare: "a comparison",
+    ast.BoolOp: "a boolean operator",
+    ast.IfExp: "a conditional expression",
+    ast.NamedExpr: "an assignment expression",
+    ast.JoinedStr: "an f-string",
+    ast.Starred: "a starred argument",
+    ast.List: "a list",
+    ast.Tuple: "a tuple",
+    ast.Dict: "a dict",
+    ast.Set: "a set",
+    ast.ListComp: "a comprehension",
+    ast.SetComp: "a comprehension",
+    ast.DictComp: "a comprehension",
+    ast.GeneratorExp: "a comprehension",
 }
 
 
 def parse_expression(text: str) -> ast.Expression:
     """Parse and check ``text``; raise a one-line ValueError for anything not allowed."""
-    if not isinstance(text, str) or not text.strip():
+    if not isinstance(text, str):
+        raise TypeError(f"an expression must be text, got {type(text).__name__}")
+    if not text.strip():
         raise ValueError("empty expression: give z = f(x, y), e.g. '0.3*sin(x)*cos(y)'")
     shown = " ".join(text.split())
     if len(shown) > 60:
         shown = shown[:57] + "..."
+    if len(text) > MAX_LENGTH:
+        raise ValueError(f"refused expression {shown!r}: longer than {MAX_LENGTH} characters")
     try:
         tree = ast.parse(text.strip(), mode="eval")
-    except SyntaxError as exc:
-        raise ValueError(f"invalid expression {shown!r}: {exc.msg}") from None
+    except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
+        reason = " ".join(str(getattr(exc, "msg", exc) or "nested too deeply").split())
+        raise ValueError(f"invalid expression {shown!r}: {reason}") from None
+    if _depth(tree) > MAX_DEPTH:
+        raise ValueError(f"refused expression {shown!r}: nested deeper than {MAX_DEPTH} levels")
     called = {id(n.func) for n in ast.walk(tree) if isinstance(n, ast.Call)}
     for node in ast.walk(tree):
         if id(node) in called and isinstance(node, ast.Name):
@@ -91,6 +102,16 @@ def parse_expression(text: str) -> ast.Expression:
         if problem:
             raise ValueError(f"refused expression {shown!r}: {problem}")
     return tree
+
+
+def _depth(tree: ast.AST) -> int:
+    """Nesting depth of a syntax tree, found without recursion."""
+    deepest, stack = 0, [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+    return deepest
 
 
 def _check(node: ast.AST) -> str | None:
@@ -116,27 +137,33 @@ def _check(node: ast.AST) -> str | None:
         return None if type(node.op) in _BINARY else "only + - * / ** are allowed"
     if isinstance(node, ast.UnaryOp):
         return None if type(node.op) in _UNARY else "only unary + and - are allowed"
-    if isinstance(node, tuple(_BINARY)) or isinstance(node, tuple(_UNARY)):
+    if isinstance(node, tuple(_BINARY) + tuple(_UNARY)):
         return None
     if isinstance(node, ast.Call):
         if not isinstance(node.func, ast.Name):
-            return "only plain calls of maths functions are allowed"
+            return _check(node.func) or "only maths functions may be called, by plain name"
         name = node.func.id
         if name not in FUNCTIONS:
             return f"function '{name}' is not allowed (allowed: {', '.join(FUNCTIONS)})"
         if node.keywords:
             return f"keyword arguments are not allowed in {name}()"
+        if any(isinstance(a, ast.Starred) for a in node.args):
+            return f"starred arguments are not allowed in {name}()"
         nargs = FUNCTIONS[name][0]
-        if len(node.args) != nargs or any(isinstance(a, ast.Starred) for a in node.args):
+        if len(node.args) != nargs:
             return f"{name}() takes {nargs} argument{'s' if nargs > 1 else ''}"
         return None
-    return f"not allowed: {_WHAT.get(type(node), type(node).__name__)}"
+    return f"{_REFUSED.get(type(node), type(node).__name__ + ' syntax')} is not allowed"
 
 
 def evaluate(tree: ast.Expression, x, y, xp=np):
     """Evaluate a checked tree on NumPy arrays (xp=numpy) or CasADi symbols (xp=casadi)."""
-    backend = 1 if xp is np else 2
-    number = np.float64 if xp is np else ca.DM  # 1/0 -> inf, not an exception
+    if xp is np:
+        column, number = 1, np.float64  # NumPy scalars: 1/0 gives inf, not an exception
+    elif xp is ca:
+        column, number = 2, ca.DM
+    else:
+        raise TypeError(f"unknown backend {getattr(xp, '__name__', xp)!r} (numpy or casadi)")
     names = {"x": x, "y": y, **{k: number(v) for k, v in CONSTANTS.items()}}
 
     def ev(node):
@@ -151,45 +178,57 @@ def evaluate(tree: ast.Expression, x, y, xp=np):
         if isinstance(node, ast.UnaryOp):
             return _UNARY[type(node.op)](ev(node.operand))
         if isinstance(node, ast.Call):
-            return FUNCTIONS[node.func.id][backend](*(ev(a) for a in node.args))
-        raise ValueError(f"unexpected node {type(node).__name__}")  # excluded by parse_expression
+            return FUNCTIONS[node.func.id][column](*(ev(a) for a in node.args))
+        raise ValueError(f"unchecked node {type(node).__name__}")  # parse_expression excludes it
 
     return ev(tree)
 
 
 class ExpressionSurface(Surface):
-    """z = f(x, y) from user text; exact gradient by CasADi's automatic differentiation."""
+    """z = f(x, y) from user text; exact gradient by CasADi's automatic differentiation.
+
+    text : e.g. ``"0.3*sin(x)*cos(y) + 0.1*x**2"`` (see :data:`FUNCTIONS`, :data:`CONSTANTS`).
+    mirror_planes : the surface's mirror planes, if the user knows any (none are derived).
+    """
 
     name = "expr"
 
     def __init__(self, text: str, mirror_planes: tuple[MirrorPlane, ...] = ()) -> None:
-        self.text = " ".join(str(text).split())
         self._tree = parse_expression(text)
+        self.text = " ".join(text.split())
         self.mirror_planes = tuple(mirror_planes)
         sx, sy = ca.SX.sym("x"), ca.SX.sym("y")
         z = evaluate(self._tree, sx, sy, xp=ca) + 0 * sx
         self._gradient = ca.Function("grad", [sx, sy], [ca.gradient(z, sx), ca.gradient(z, sy)])
 
     def height(self, x, y, xp=np):
-        if xp is np:
-            with np.errstate(all="ignore"):
-                z = evaluate(self._tree, np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-                return np.broadcast_to(np.asarray(z, dtype=float), np.shape(x)).copy()
-        return evaluate(self._tree, x, y, xp=xp) + 0 * x
+        """z at plan points; NumPy x, y broadcast together, z has their shape."""
+        if xp is not np:
+            return evaluate(self._tree, x, y, xp=xp) + 0 * x
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        with np.errstate(all="ignore"):  # non-finite values are reported by check_finite
+            z = evaluate(self._tree, x, y)
+        return np.broadcast_to(np.asarray(z, dtype=float), x.shape).copy()
 
     def gradient(self, x, y):
-        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        gx, gy = self._gradient(x.ravel(), y.ravel())
+        """(dz/dx, dz/dy) at plan points, each of the broadcast shape of x and y."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        if x.size == 0:
+            return np.zeros(x.shape), np.zeros(x.shape)
+        # a 1 x n row evaluates the scalar function at n points
+        gx, gy = self._gradient(x.reshape(1, -1), y.reshape(1, -1))
         return np.asarray(gx).reshape(x.shape), np.asarray(gy).reshape(x.shape)
 
     def check_finite(self, x, y) -> None:
-        """Raise ValueError where the expression is not finite at plan points x, y (N,)."""
-        z = self.height(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        bad = ~np.isfinite(z)
-        if bad.any():
-            k = int(np.flatnonzero(bad.ravel())[0])
-            px, py = np.ravel(x)[k], np.ravel(y)[k]
+        """Raise ValueError if z is not finite at some plan point; x, y (N,)."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        bad = np.flatnonzero(~np.isfinite(self.height(x, y)))
+        if bad.size:
+            px, py = x.ravel()[bad[0]], y.ravel()[bad[0]]
             raise ValueError(f"expression {self.text!r} is not finite at (x, y) = ({px:g}, {py:g})")
 
     def metadata(self) -> dict:
         return {"name": self.name, "expression": self.text}
+
+    def __repr__(self) -> str:
+        return f"ExpressionSurface({self.text!r})"

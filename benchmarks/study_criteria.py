@@ -1,0 +1,76 @@
+"""Compare the selection criteria on random Bezier surfaces (Tables 5 and 6 of the paper).
+
+    python benchmarks/study_criteria.py [--seeds 20] [--patterns 1 2] [--jobs 2]
+
+For each pattern and criterion, runs ``generate`` (target DOF 1, no deformation check) on
+Bezier seeds 0..N-1 and prints the means of N_reduce, N_lock, N_exceed and F (the mean
+over each run's accepted solutions, then over runs), next to the paper's Tables 5 and 6
+(100 surfaces each). The full 100-surface study with its database is a separate tool.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+PAPER = {
+    ("1", "s"): (20.00, 1.13, 0.04, 1.18e-9),
+    ("1", "shat"): (20.00, 0.06, 0.01, 1.38e-9),
+    ("1", "ss"): (19.97, 24.94, 0.03, 2.19e-9),
+    ("1", "random"): (19.99, 7.32, 0.20, 2.44e-9),
+    ("2", "s"): (19.96, 2.74, 0.00, 1.17e-9),
+    ("2", "shat"): (19.97, 0.92, 0.02, 1.28e-9),
+    ("2", "ss"): (19.73, 28.60, 0.14, 1.93e-9),
+    ("2", "random"): (19.81, 13.32, 0.19, 4.41e-9),
+}
+
+
+def one_run(args: tuple[str, str, int]) -> dict:
+    from rigidfold.case import make_case
+    from rigidfold.generate import generate
+
+    pattern, criterion, seed = args
+    t0 = time.perf_counter()
+    run = generate(make_case("bezier", pattern, seed=seed), criterion=criterion, seed=seed)
+    summary = run.summary()
+    summary["wall_s"] = time.perf_counter() - t0
+    return summary
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--patterns", nargs="+", default=["1", "2"])
+    parser.add_argument("--criteria", nargs="+", default=["shat", "s", "ss", "random"])
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    header = (
+        f"{'pattern':<8}{'criterion':<10}{'N_reduce':>9}{'N_lock':>8}{'N_exceed':>9}"
+        f"{'mean F':>10}{'DOF 1':>7}{'wall s':>8}   paper: N_reduce N_lock N_exceed F"
+    )
+    print(header)
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        for pattern in args.patterns:
+            for criterion in args.criteria:
+                jobs = [(pattern, criterion, s) for s in range(args.seeds)]
+                runs = list(pool.map(one_run, jobs))
+                means = {k: statistics.mean(r[k] for r in runs) for k in ("N_reduce", "N_lock")}
+                means["N_exceed"] = statistics.mean(r["N_exceed"] for r in runs)
+                wall = statistics.median(r["wall_s"] for r in runs)
+                fs = [r["mean_F_accepted"] for r in runs if r["mean_F_accepted"] is not None]
+                reached = sum(r["final_dof"] == 1 for r in runs)
+                p = PAPER.get((pattern, criterion))
+                paper = f"{p[0]:.2f} {p[1]:.2f} {p[2]:.2f} {p[3]:.2e}" if p else ""
+                print(
+                    f"{pattern:<8}{criterion:<10}{means['N_reduce']:>9.2f}{means['N_lock']:>8.2f}"
+                    f"{means['N_exceed']:>9.2f}{statistics.mean(fs):>10.2e}"
+                    f"{reached:>4}/{len(runs):<3}{wall:>7.1f}"
+                    f"   {paper}",
+                    flush=True,
+                )
+
+
+if __name__ == "__main__":
+    main()

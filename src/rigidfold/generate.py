@@ -1,0 +1,218 @@
+"""Sequential form generation by fixing crease lines (Section 3, Steps 2-7).
+
+::
+
+    Step 2  E_fix = {}, solutions = []
+    Step 3  solve problem (6) (from the target surface, then from the last accepted shape)
+    Step 4  not accepted (F > F_tol or not converged)         -> Step 7   (N_exceed += 1)
+    Step 5  analyse the mechanism:
+              DOF >= 1, no locked crease   -> accept, Step 6
+              DOF >= 1, a locked crease    -> Step 7                       (N_lock += 1)
+              DOF = 0                      -> end when the target DOF is 0 (not counted, as
+                                              in Section 6.3); a lock when the target is >= 1
+    Step 6  rank the free creases of the last accepted shape by the criterion; fix the best
+    Step 7  E_fix = {} -> no developable polyhedron; otherwise replace the last fixed crease
+            (group) with the next candidate of that ranking
+
+Generation ends when the target DOF is reached, at DOF 0, or when no candidate succeeds.
+The NLP is built once; every solve starts from the last accepted shape.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigidfold.case import Case
+from rigidfold.mechanism import Mechanism, analyze
+from rigidfold.mechanism.stiffness import hinge_stiffness
+from rigidfold.optimize import OptimizeResult
+from rigidfold.selection import CRITERIA, crease_groups, rank_candidates, score_creases
+
+
+@dataclass
+class Attempt:
+    """One solve of problem (6) during generation, accepted or not."""
+
+    index: int
+    fixed_added: tuple[int, ...]
+    score: float | None
+    status: str
+    F: float
+    iterations: int
+    dof: int | None
+    locked: list[int]
+    outcome: str  # "accepted", "exceed", "lock", "zero_dof", "initial_failed"
+    solve_time: float
+    analysis_time: float
+    selection_time: float = 0.0
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass
+class Solution:
+    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease."""
+
+    step: int
+    result: OptimizeResult
+    mechanism: Mechanism
+
+
+@dataclass
+class Generation:
+    """Outcome of a generation run, with the paper's counters (Section 6.3)."""
+
+    initial_dof: int | None = None
+    solutions: list[Solution] = field(default_factory=list)
+    attempts: list[Attempt] = field(default_factory=list)
+    n_lock: int = 0
+    n_exceed: int = 0
+    stop_reason: str = "running"
+    build_time: float = 0.0
+
+    @property
+    def final_dof(self) -> int | None:
+        return self.solutions[-1].mechanism.dof if self.solutions else None
+
+    @property
+    def n_reduce(self) -> int:
+        """DOF reduced from the initial shape's, over accepted shapes."""
+        if not self.solutions:
+            return 0
+        return self.initial_dof - self.final_dof
+
+    def summary(self) -> dict:
+        accepted_F = [s.result.F for s in self.solutions]
+        all_F = [a.F for a in self.attempts if np.isfinite(a.F)]
+        return {
+            "stop_reason": self.stop_reason,
+            "initial_dof": self.initial_dof,
+            "final_dof": self.final_dof,
+            "N_reduce": self.n_reduce,
+            "N_lock": self.n_lock,
+            "N_exceed": self.n_exceed,
+            "n_solutions": len(self.solutions),
+            "n_solves": len(self.attempts),
+            "mean_F_accepted": float(np.mean(accepted_F)) if accepted_F else None,
+            "mean_F_all_solves": float(np.mean(all_F)) if all_F else None,
+            "time_s": {
+                "build": self.build_time,
+                "solve": sum(a.solve_time for a in self.attempts),
+                "analysis": sum(a.analysis_time for a in self.attempts),
+                "selection": sum(a.selection_time for a in self.attempts),
+            },
+        }
+
+
+def generate(
+    case: Case,
+    *,
+    criterion: str = "shat",
+    target_dof: int = 1,
+    seed: int = 0,
+    solver: str = "ipopt",
+    on_attempt: Callable[[Generation, Attempt], None] | None = None,
+    on_solution: Callable[[Generation, Solution], None] | None = None,
+) -> Generation:
+    """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
+
+    With mirror planes in the case, creases are fixed in mirror groups (2 or 4 at once).
+    A KeyboardInterrupt propagates after the callbacks of everything finished so far.
+    """
+    if criterion not in CRITERIA:
+        raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
+    if target_dof < 0:
+        raise ValueError(f"target DOF must be >= 0, got {target_dof}")
+    rng = np.random.default_rng(seed)
+    run = Generation()
+    t0 = time.perf_counter()
+    problem = case.problem(build_ipopt=solver == "ipopt")
+    run.build_time = time.perf_counter() - t0
+    groups = crease_groups(case.pattern, case.planes, case.settings) if case.planes else None
+    settings = case.settings
+
+    def attempt(
+        fixed: np.ndarray, start, added, score
+    ) -> tuple[Attempt, OptimizeResult, Mechanism]:
+        result = problem.solve(fixed=fixed, start=start, solver=solver)
+        t1 = time.perf_counter()
+        mech = analyze(result.pattern, settings=settings) if result.converged else None
+        t_an = time.perf_counter() - t1
+        if mech is None:
+            outcome = "exceed"
+        elif mech.dof == 0:
+            # the final cycle of the paper (target 0); with target >= 1 an over-reduction:
+            # every folded free crease has stopped moving, i.e. locked
+            outcome = "zero_dof" if target_dof == 0 else "lock"
+        elif mech.has_lock:
+            outcome = "lock"
+        else:
+            outcome = "accepted"
+        rec = Attempt(
+            index=len(run.attempts),
+            fixed_added=tuple(added),
+            score=score,
+            status=result.status.value,
+            F=result.F,
+            iterations=result.iterations,
+            dof=None if mech is None else mech.dof,
+            locked=[] if mech is None else mech.locked_creases.tolist(),
+            outcome=outcome,
+            solve_time=result.wall_time,
+            analysis_time=t_an,
+        )
+        run.attempts.append(rec)
+        return rec, result, mech
+
+    def record(rec: Attempt, result, mech) -> None:
+        if rec.outcome == "exceed":
+            run.n_exceed += 1
+        elif rec.outcome == "lock":
+            run.n_lock += 1
+        if on_attempt:
+            on_attempt(run, rec)
+        if rec.outcome == "accepted":
+            sol = Solution(len(run.solutions), result, mech)
+            run.solutions.append(sol)
+            if on_solution:
+                on_solution(run, sol)
+
+    # Steps 2-5 for the triangulated target surface
+    fixed = case.pattern.fixed.copy()
+    rec, result, mech = attempt(fixed, None, (), None)
+    if rec.outcome != "accepted":
+        run.stop_reason = f"no developable polyhedron from the initial shape ({rec.outcome})"
+        rec.outcome = "initial_failed"
+        record(rec, result, mech)
+        return run
+    run.initial_dof = mech.dof
+    record(rec, result, mech)
+
+    while run.final_dof > target_dof:
+        current = run.solutions[-1]
+        t1 = time.perf_counter()
+        K = hinge_stiffness(current.mechanism.frame.n_hinges, int(rng.integers(2**32)), settings)
+        scores = score_creases(current.mechanism, K=K, settings=settings)
+        ranked = rank_candidates(scores, criterion, groups=groups, rng=rng)
+        t_sel = time.perf_counter() - t1
+        for group, score in ranked:  # Step 6, then Step 7 on failure
+            trial = current.result.pattern.fixed.copy()
+            trial[list(group)] = True
+            rec, result, mech = attempt(trial, current.result.coords, group, score)
+            rec.selection_time, t_sel = t_sel, 0.0
+            record(rec, result, mech)
+            if rec.outcome in ("accepted", "zero_dof"):
+                break
+        else:
+            run.stop_reason = "no candidate crease succeeds"
+            return run
+        if rec.outcome == "zero_dof":
+            run.stop_reason = "DOF 0 reached"
+            return run
+    run.stop_reason = f"target DOF {target_dof} reached"
+    return run

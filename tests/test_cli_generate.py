@@ -1,0 +1,188 @@
+"""`rigidfold generate` and `rigidfold analyze` from the command line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import rigidfold.generate as generate_module
+from rigidfold.cli import main
+from rigidfold.io import fold_dict, read_fold, write_fold
+from rigidfold.patterns import miura
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
+    )
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    out = tmp_path_factory.mktemp("gen")
+    code = main(
+        [
+            "generate",
+            "--surface",
+            "bezier",
+            "--seed",
+            "1",
+            "--pattern",
+            "1",
+            "--target-dof",
+            "18",
+            "--quiet",
+            "--no-deform",
+            "--out",
+            str(out),
+        ]
+    )
+    assert code == 0
+    return out
+
+
+def test_generate_writes_solutions_log_and_summary(generated):
+    names = sorted(p.name for p in (generated / "solutions").iterdir())
+    assert names == [f"step_{k:02d}_dof_{21 - k:02d}.fold" for k in range(4)]
+    summary = json.loads((generated / "summary.json").read_text())
+    assert (summary["initial_dof"], summary["final_dof"], summary["N_reduce"]) == (21, 18, 3)
+    assert summary["N_lock"] == 0 and summary["N_exceed"] == 0
+    assert set(summary["time_s"]) == {"build", "solve", "analysis", "selection"}
+    log = json.loads((generated / "log.json").read_text())["attempts"]
+    assert len(log) == summary["n_solves"]
+    assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1])
+    last = read_fold(generated / "solutions" / names[-1])
+    assert len(last.pattern.fixed_creases) == 3
+    assert last.metadata["dof"] == 18
+
+
+def test_analyze_json_on_a_generated_solution(generated):
+    path = sorted((generated / "solutions").iterdir())[-1]
+    proc = run_cli("analyze", str(path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout)
+    assert report["dof"] == 18
+    assert report["locked_edges"] == []
+
+
+def test_analyze_miura_quads(tmp_path):
+    """A Miura-ori written with quad faces (as other tools do) has 1 DOF, no lock."""
+    shape = miura(4, 3)
+    data = fold_dict(shape)
+    quads = [
+        [int(v) for v in shape.faces[2 * k]] + [int(shape.faces[2 * k + 1][2])]
+        for k in range(shape.n_faces // 2)
+    ]
+    data["faces_vertices"] = quads
+    keep = [k for k, a in enumerate(data["edges_assignment"]) if a != "J"]
+    data["edges_vertices"] = [data["edges_vertices"][k] for k in keep]
+    data["edges_assignment"] = [data["edges_assignment"][k] for k in keep]
+    data["edges_foldAngle"] = [data["edges_foldAngle"][k] for k in keep]
+    path = tmp_path / "miura.fold"
+    path.write_text(json.dumps(data))
+    proc = run_cli("analyze", str(path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout)
+    assert report["dof"] == 1 and report["locked_edges"] == []
+
+
+def test_analyze_reports_locked_creases(tmp_path, capsys):
+    from conftest import degree_n_vertex
+
+    shape = degree_n_vertex(4, seed=4)
+    fixed = np.zeros(shape.n_edges, dtype=bool)
+    fixed[shape.interior_edges[0]] = True
+    write_fold(tmp_path / "v4.fold", shape.with_fixed(fixed))
+    assert main(["analyze", str(tmp_path / "v4.fold"), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["dof"] == 0
+    assert sorted(report["locked_edges"]) == sorted(shape.interior_edges[1:].tolist())
+    assert main(["analyze", str(tmp_path / "v4.fold")]) == 0
+    assert "DOF: 0" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("{not json", "invalid JSON"),
+        ('{"vertices_coords": [[0, 0, 0]]}', "faces_vertices"),
+        ("[1, 2]", "object"),
+    ],
+)
+def test_analyze_bad_files_one_line_exit_2(tmp_path, content, message):
+    path = tmp_path / "bad.fold"
+    path.write_text(content)
+    proc = run_cli("analyze", str(path))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_analyze_missing_file():
+    proc = run_cli("analyze", "no/such/file.fold")
+    assert proc.returncode == 2 and "cannot read" in proc.stderr
+
+
+def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
+    calls = {"n": 0}
+    real = generate_module.analyze
+
+    def interrupting(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(generate_module, "analyze", interrupting)
+    code = main(
+        [
+            "generate",
+            "--surface",
+            "bezier",
+            "--seed",
+            "1",
+            "--pattern",
+            "1",
+            "--quiet",
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    assert code == 130
+    assert "interrupted" in capsys.readouterr().err
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["n_solutions"] == 2
+    for path in (tmp_path / "solutions").iterdir():
+        read_fold(path)
+    assert not list(tmp_path.rglob("*.tmp"))
+
+
+def test_generate_bad_options(tmp_path):
+    proc = run_cli(
+        "generate",
+        "--surface",
+        "bezier",
+        "--pattern",
+        "1",
+        "--criterion",
+        "best",
+        "--out",
+        str(tmp_path),
+    )
+    assert proc.returncode == 2 and "invalid choice" in proc.stderr
+    proc = run_cli(
+        "generate",
+        "--surface",
+        "bezier",
+        "--pattern",
+        "1",
+        "--target-dof",
+        "-2",
+        "--out",
+        str(tmp_path),
+    )
+    assert proc.returncode == 2 and "--target-dof" in proc.stderr
