@@ -36,3 +36,20 @@ def test_ipopt_accepts_dome_and_hp(surface, symmetric):
     assert result.converged, result.message
     assert result.n_variables == (83 if symmetric else 315)
     assert result.max_violation <= DEFAULTS.constraint_tol
+
+
+@pytest.mark.slow
+def test_generate_shat_reaches_one_dof_on_20_bezier_surfaces():
+    """Section 6.3 with S-hat: at least 18 of 20 runs reach DOF 1; saved shapes are sound."""
+    from rigidfold.generate import generate
+
+    reached = 0
+    for seed in SEEDS:
+        run = generate(make_case("bezier", "1", seed=seed), criterion="shat", seed=seed)
+        reached += run.final_dof == 1
+        for sol in run.solutions:
+            assert sol.result.F <= DEFAULTS.f_tol
+            assert sol.result.max_violation <= DEFAULTS.constraint_tol
+            assert not sol.mechanism.has_lock
+            assert sol.mechanism.dof >= 1
+    assert reached >= 18, f"DOF 1 reached on {reached} of 20"

@@ -36,6 +36,12 @@ def _fold_angle_function() -> ca.Function:
     return ca.Function("rho", [q], [rho, ca.gradient(rho, q)])
 
 
+@lru_cache(maxsize=32)
+def _fold_angle_map(n: int) -> ca.Function:
+    """The fold-angle function evaluated on n creases at once (built once per n)."""
+    return _fold_angle_function().map(n)
+
+
 def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_matrix:
     """d rho_j / d x for the given interior edges.  -> (len(creases), 3V) sparse."""
     creases = np.asarray(creases, dtype=np.int64)
@@ -49,7 +55,7 @@ def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_
     b = faces[ef[:, 1]].sum(axis=1) - e.sum(axis=1)
     verts = np.column_stack([e[:, 0], e[:, 1], a, b])  # (n, 4)
     q = pattern.coords[verts].reshape(len(creases), 12).T
-    _, grad = _fold_angle_function().map(len(creases))(q)
+    _, grad = _fold_angle_map(len(creases))(q)
     grad = np.asarray(grad).T  # (n, 12)
     rows = np.repeat(np.arange(len(creases)), 12)
     cols = (3 * verts[:, :, None] + np.arange(3)).reshape(len(creases), 12).ravel()

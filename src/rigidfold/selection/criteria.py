@@ -119,15 +119,15 @@ def rank_candidates(
     returns : [(edge indices, score)], score NaN for "random".
     """
     values = scores.of(criterion)
-    index_of = {int(e): j for j, e in enumerate(scores.hinges)}
     if groups is None:
-        groups = [(int(e),) for e in scores.hinges]
-    ranked = []
-    for group in groups:
-        if not all(int(e) in index_of for e in group):
-            continue
-        g = tuple(sorted(int(e) for e in group))
-        ranked.append((g, float(np.mean([values[index_of[e]] for e in g]))))
+        ranked = [((int(e),), float(v)) for e, v in zip(scores.hinges, values, strict=True)]
+    else:
+        index_of = {int(e): j for j, e in enumerate(scores.hinges)}
+        ranked = []
+        for group in groups:
+            if all(int(e) in index_of for e in group):
+                g = tuple(sorted(int(e) for e in group))
+                ranked.append((g, float(np.mean([values[index_of[e]] for e in g]))))
     if criterion == "random":
         rng = rng or np.random.default_rng()
         order = rng.permutation(len(ranked))
