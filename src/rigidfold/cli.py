@@ -146,15 +146,15 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
     if args.target_dof < 0:
         raise ValueError(f"--target-dof must be >= 0, got {args.target_dof}")
-    writer = RunWriter(args.out, _case(args), {})
-    writer.options = {
+    options = {
         "criterion": args.criterion,
         "target_dof": args.target_dof,
         "seed": args.seed,
         "solver": args.solver,
         "symmetric": args.symmetric,
-        "deform": False,
+        "deform": False,  # Step 9 is not implemented yet
     }
+    writer = RunWriter(args.out, _case(args), options)
     progress = _Progress(enabled=not args.quiet, target=args.target_dof)
 
     def on_attempt(run, attempt):
