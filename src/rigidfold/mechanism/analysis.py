@@ -109,7 +109,7 @@ def analyze(
         H, values, rank = _svd_kernel(frame.compatibility_matrix().toarray(), settings)
         H_phi, basis = H[H.shape[0] - h :], H
     else:
-        C = kinematics.constraint_matrix(pattern, frame.support_face).toarray()
+        C = kinematics.constraint_matrix(pattern, frame.support_face)
         N, values, rank = _qr_kernel(C, settings)
         L = kinematics.frame_map(frame)
         # H = L N R^-1 with R^T R = N^T L^T L N: orthonormal in the frame's v-space

@@ -42,12 +42,10 @@ def _fold_angle_map(n: int) -> ca.Function:
     return _fold_angle_function().map(n)
 
 
-def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_matrix:
-    """d rho_j / d x for the given interior edges.  -> (len(creases), 3V) sparse."""
-    creases = np.asarray(creases, dtype=np.int64)
-    V = pattern.n_vertices
-    if len(creases) == 0:
-        return sp.csr_matrix((0, 3 * V))
+def _fold_angle_gradient_entries(
+    pattern: CreasePattern, creases: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nonzeros of d rho_j / d x: values (n, 12) and their columns in 3V (n, 12)."""
     e = pattern.edges[creases]
     ef = pattern.edge_faces[creases]
     faces = pattern.faces
@@ -56,42 +54,43 @@ def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_
     verts = np.column_stack([e[:, 0], e[:, 1], a, b])  # (n, 4)
     q = pattern.coords[verts].reshape(len(creases), 12).T
     _, grad = _fold_angle_map(len(creases))(q)
-    grad = np.asarray(grad).T  # (n, 12)
+    cols = (3 * verts[:, :, None] + np.arange(3)).reshape(len(creases), 12)
+    return np.asarray(grad).T, cols
+
+
+def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_matrix:
+    """d rho_j / d x for the given interior edges.  -> (len(creases), 3V) sparse."""
+    creases = np.asarray(creases, dtype=np.int64)
+    V = pattern.n_vertices
+    if len(creases) == 0:
+        return sp.csr_matrix((0, 3 * V))
+    grad, cols = _fold_angle_gradient_entries(pattern, creases)
     rows = np.repeat(np.arange(len(creases)), 12)
-    cols = (3 * verts[:, :, None] + np.arange(3)).reshape(len(creases), 12).ravel()
-    return sp.csr_matrix((grad.ravel(), (rows, cols)), shape=(len(creases), 3 * V))
+    return sp.csr_matrix((grad.ravel(), (rows, cols.ravel())), shape=(len(creases), 3 * V))
 
 
-def edge_length_rates(pattern: CreasePattern) -> sp.csr_matrix:
-    """Rows d(|x_v - x_u|)/dx of every edge (the rigidity matrix).  -> (E, 3V) sparse."""
+def constraint_matrix(pattern: CreasePattern, support_face: int) -> np.ndarray:
+    """All kinematic constraints: edge lengths, flat fixed creases, support.  (k, 3V) dense
+
+    Rows are scaled to unit norm; the kernel is the space of mechanisms with the support fixed.
+    The matrix is small (about (E + 9) x 3V), so it is assembled dense for the kernel step.
+    """
+    E, V = pattern.n_edges, pattern.n_vertices
+    fixed = pattern.fixed_creases
+    C = np.zeros((E + len(fixed) + 9, 3 * V))
     e = pattern.edges
     d = pattern.coords[e[:, 1]] - pattern.coords[e[:, 0]]
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    rows = np.repeat(np.arange(len(e)), 6)
-    cols = np.concatenate([3 * e[:, :1] + np.arange(3), 3 * e[:, 1:] + np.arange(3)], axis=1)
-    vals = np.concatenate([-d, d], axis=1)
-    return sp.csr_matrix(
-        (vals.ravel(), (rows, cols.ravel())), shape=(len(e), 3 * pattern.n_vertices)
-    )
-
-
-def support_rows(pattern: CreasePattern, face: int) -> sp.csr_matrix:
-    """Rows fixing the three vertices of the support triangle (9, 3V)."""
-    cols = (3 * pattern.faces[face][:, None] + np.arange(3)).ravel()
-    return sp.csr_matrix((np.ones(9), (np.arange(9), cols)), shape=(9, 3 * pattern.n_vertices))
-
-
-def constraint_matrix(pattern: CreasePattern, support_face: int) -> sp.csr_matrix:
-    """All kinematic constraints: edge lengths, flat fixed creases, support.  (k, 3V)
-
-    Rows are scaled to unit norm; the kernel is the space of mechanisms with the support fixed.
-    """
-    fixed = fold_angle_gradients(pattern, pattern.fixed_creases)
-    norms = sp.linalg.norm(fixed, axis=1) if fixed.shape[0] else np.ones(0)
-    fixed = sp.diags(1.0 / np.maximum(norms, 1e-300)) @ fixed
-    return sp.vstack(
-        [edge_length_rates(pattern), fixed, support_rows(pattern, support_face)], format="csr"
-    )
+    rows = np.arange(E)[:, None]
+    C[rows, 3 * e[:, :1] + np.arange(3)] = -d
+    C[rows, 3 * e[:, 1:] + np.arange(3)] = d
+    if len(fixed):
+        grad, cols = _fold_angle_gradient_entries(pattern, fixed)
+        grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
+        C[E + np.arange(len(fixed))[:, None], cols] = grad  # 4 distinct vertices per row
+    support = (3 * pattern.faces[support_face][:, None] + np.arange(3)).ravel()
+    C[E + len(fixed) + np.arange(9), support] = 1.0
+    return C
 
 
 def angular_velocity_blocks(pattern: CreasePattern) -> np.ndarray:
