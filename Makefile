@@ -23,6 +23,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/bench_optimize.py
 	$(PY) benchmarks/bench_generate.py
+	$(PY) benchmarks/bench_develop.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -46,6 +46,12 @@ class Settings:
         Entries of the variable map below this magnitude are dropped as round-off.
     symmetry_match_tol : float
         Distance (metres) within which a mirrored vertex must land on another vertex.
+    develop_tol : float
+        IPOPT tolerance of problem (13); tighter than ``ipopt_tol`` so that a flat pattern
+        develops onto itself to about 1e-10.
+    overlap_area_tol : float
+        Two facets of a development diagram overlap when their intersection is larger than
+        this fraction of the smaller one's area.
     mechanism_rank_tol : float
         Singular values below this times the largest one count as zero (rank of S, Eq. 16).
     lock_tol : float
@@ -78,6 +84,9 @@ class Settings:
     linear_rank_tol: float = 1e-10
     map_prune_tol: float = 1e-13
     symmetry_match_tol: float = 1e-6
+    # development diagram (Step 8)
+    develop_tol: float = 1e-12
+    overlap_area_tol: float = 1e-9
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
     lock_tol: float = 1e-7

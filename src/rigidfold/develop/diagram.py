@@ -1,0 +1,283 @@
+"""Step 8: the development diagram of a polyhedron, problem (13) of the paper.
+
+::
+
+    min_Xd   D(Xd) = sum_j (l^d_j(Xd) - l_j)^2 / sum_j l_j^2      (every edge j)
+    s.t.     n_k(Xd) . z >= 0                                     (every facet k)
+             Xd in chi^d                                          (position fixed)
+
+``Xd`` are the 2D vertex coordinates of the diagram, ``l_j`` the 3D edge lengths and
+``l^d_j`` the diagram's. Following Wang et al., the diagram is found by least squares on the
+edge lengths, from the xy projection of the 3D shape. ``n_k . z >= 0`` is imposed as the
+doubled signed area of facet k (counter-clockwise order of ``pattern.faces``) divided by the
+squared mean 3D edge length, so that every constraint is of order one.
+
+The gauge chi^d: the reference edge ``k`` is the longest boundary edge; its first vertex
+``a = edges[k, 0]`` sits at the origin and its second vertex ``b = edges[k, 1]`` on the +x
+axis (``y_b = 0``, ``x_b >= 0``). These three coordinates are eliminated, so IPOPT sees
+``2 V - 3`` variables. The model is built per call with CasADi SX (exact gradient and
+Hessian) and solved by IPOPT.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+import shapely
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.mesh import CreasePattern
+
+_IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+
+
+@dataclass(frozen=True, eq=False)
+class Development:
+    """The development diagram of a polyhedron (Step 8) and its quality.
+
+    Attributes
+    ----------
+    coords2d : (V, 2) float64
+        Vertex coordinates of the diagram (read-only); NaN where the solver produced NaN.
+    D : float
+        Objective of problem (13): relative sum of squared edge-length errors.
+    max_length_error : float
+        max_j |l^d_j - l_j| / l_j over all edges.
+    flipped : int
+        Facets whose signed area in the diagram is not positive (see :func:`count_flipped`);
+        -1 when the coordinates are not finite.
+    overlaps : int
+        Pairs of facets whose interiors overlap (see :func:`count_overlaps`); -1 when the
+        coordinates are not finite.
+    status : str
+        "converged" (IPOPT succeeded, no flipped facet, no overlap), "flipped", "overlap" or
+        "failed" (IPOPT failed or returned non-finite numbers). The status does not judge D:
+        a shape that is not developable converges to a valid diagram with a large D.
+    message : str
+        IPOPT's return status and a short verdict.
+    iterations : int
+        IPOPT iterations.
+    wall_time : float
+        Seconds spent building the model and solving it.
+    reference_edge : int
+        Edge k that fixes the position: ``edges[k, 0]`` at the origin, ``edges[k, 1]`` on +x.
+    """
+
+    coords2d: np.ndarray
+    D: float
+    max_length_error: float
+    flipped: int
+    overlaps: int
+    status: str
+    message: str
+    iterations: int
+    wall_time: float
+    reference_edge: int
+
+    def as_pattern(self, pattern: CreasePattern) -> CreasePattern:
+        """The crease pattern of the diagram: ``pattern``'s topology with z = 0.
+
+        Parameters
+        ----------
+        pattern : CreasePattern
+            The 3D shape this diagram was developed from (faces, edges and fixed mask).
+
+        Raises
+        ------
+        ValueError
+            If the diagram has flipped facets or non-finite coordinates (a CreasePattern
+            needs counter-clockwise, non-degenerate faces), or the vertex counts differ.
+        """
+        if len(self.coords2d) != pattern.n_vertices:
+            raise ValueError(
+                f"the diagram has {len(self.coords2d)} vertices, the pattern {pattern.n_vertices}"
+            )
+        if self.flipped != 0:
+            raise ValueError(
+                f"the development diagram is invalid ({self.flipped} flipped facets, or "
+                "non-finite coordinates); it is not a crease pattern"
+            )
+        coords = np.column_stack([self.coords2d, np.zeros(len(self.coords2d))])
+        return CreasePattern(coords, pattern.faces, pattern.edges, pattern.fixed)
+
+
+def signed_areas(coords2d: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Signed areas (F,) of triangles (F, 3) in the plane; positive when counter-clockwise.
+
+    coords2d : (V, 2); faces : (F, 3) int.
+    """
+    p = np.asarray(coords2d, dtype=np.float64)[np.asarray(faces)]
+    u, v = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return 0.5 * (u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+
+
+def count_flipped(
+    coords2d: np.ndarray, faces: np.ndarray, *, tol: float = DEFAULTS.degenerate_area
+) -> int:
+    """Number of triangles that are flipped or degenerate in a planar diagram.
+
+    Parameters
+    ----------
+    coords2d : (V, 2) float
+        Planar vertex coordinates.
+    faces : (F, 3) int
+        Triangles, counter-clockwise when not flipped.
+    tol : float
+        A triangle counts when its signed area is <= ``tol * (its longest edge)**2``
+        (default: ``Settings.degenerate_area``).
+    """
+    p = np.asarray(coords2d, dtype=np.float64)[np.asarray(faces)]
+    longest2 = np.max(np.sum((p - np.roll(p, 1, axis=1)) ** 2, axis=2), axis=1)
+    return int(np.count_nonzero(signed_areas(coords2d, faces) <= tol * longest2))
+
+
+def count_overlaps(
+    coords2d: np.ndarray, faces: np.ndarray, *, tol: float = DEFAULTS.overlap_area_tol
+) -> int:
+    """Number of pairs of triangles (i < j) whose interiors overlap in a planar diagram.
+
+    Candidate pairs come from a ``shapely.STRtree`` query; a pair overlaps when the area of
+    its intersection exceeds ``tol`` times the smaller triangle's area, so that
+    neighbours sharing an edge or a vertex do not count.
+
+    Parameters
+    ----------
+    coords2d : (V, 2) float
+        Planar vertex coordinates (finite).
+    faces : (F, 3) int
+        Triangles, in either orientation.
+    """
+    faces = np.asarray(faces)
+    if len(faces) < 2:
+        return 0
+    polys = shapely.polygons(np.asarray(coords2d, dtype=np.float64)[faces])
+    tree = shapely.STRtree(polys)
+    i, j = tree.query(polys, predicate="intersects")
+    keep = i < j
+    i, j = i[keep], j[keep]
+    if len(i) == 0:
+        return 0
+    areas = shapely.area(polys)
+    common = shapely.area(shapely.intersection(polys[i], polys[j]))
+    return int(np.count_nonzero(common > tol * np.minimum(areas[i], areas[j])))
+
+
+def _reference_edge(pattern: CreasePattern) -> int:
+    """The longest boundary edge (the first one on ties)."""
+    boundary = np.flatnonzero(pattern.is_boundary_edge)
+    return int(boundary[np.argmax(pattern.edge_lengths[boundary])])
+
+
+def _initial_guess(pattern: CreasePattern, a: int, b: int) -> np.ndarray:
+    """The xy projection (V, 2), moved rigidly so that a is at the origin and b on +x."""
+    xy = pattern.coords[:, :2] - pattern.coords[a, :2]
+    dx, dy = xy[b]
+    phi = np.arctan2(dy, dx)  # 0 when a and b project onto one point
+    c, s = np.cos(phi), np.sin(phi)
+    return xy @ np.array([[c, -s], [s, c]])  # rotation by -phi
+
+
+def _diagram_error(coords2d: np.ndarray, pattern: CreasePattern) -> tuple[float, float]:
+    """(D, max relative length error) of a diagram, with NumPy."""
+    l3 = pattern.edge_lengths
+    d = coords2d[pattern.edges[:, 1]] - coords2d[pattern.edges[:, 0]]
+    l2 = np.hypot(d[:, 0], d[:, 1])
+    return float(np.sum((l2 - l3) ** 2) / np.sum(l3**2)), float(np.max(np.abs(l2 - l3) / l3))
+
+
+def develop(pattern: CreasePattern, *, settings: Settings = DEFAULTS) -> Development:
+    """Generate the development diagram of a polyhedron by solving problem (13).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        The 3D shape (V vertices, E edges, F facets); all its edges enter D.
+    settings : Settings
+        IPOPT tolerance, iteration limit and barrier strategy, ``constraint_tol`` (constraint
+        violation and bound relaxation) and ``degenerate_area`` (flipped-facet threshold).
+
+    Returns
+    -------
+    Development
+        The diagram (V, 2) and its quality. Shapes that are not developable give a diagram
+        with a large D; this function does not raise for them.
+    """
+    t0 = time.perf_counter()
+    V = pattern.n_vertices
+    edges, faces = pattern.edges, pattern.faces
+    k = _reference_edge(pattern)
+    a, b = (int(v) for v in edges[k])
+
+    # chi^d: x_a = y_a = y_b = 0 are eliminated; layout of the full vector is [x (V), y (V)]
+    free = np.setdiff1d(np.arange(2 * V), [a, V + a, V + b])
+    xi = ca.SX.sym("xd", len(free))
+    full = ca.SX.zeros(2 * V)
+    full[free.tolist()] = xi
+    x, y = full[:V], full[V:]
+
+    l3 = pattern.edge_lengths
+    e0, e1 = edges[:, 0].tolist(), edges[:, 1].tolist()
+    dx, dy = x[e1] - x[e0], y[e1] - y[e0]
+    D = ca.sumsqr(ca.sqrt(dx**2 + dy**2) - ca.DM(l3)) / float(np.sum(l3**2))
+
+    f0, f1, f2 = (faces[:, m].tolist() for m in range(3))
+    ux, uy = x[f1] - x[f0], y[f1] - y[f0]
+    vx, vy = x[f2] - x[f0], y[f2] - y[f0]
+    g = (ux * vy - uy * vx) / float(np.mean(l3) ** 2)  # doubled signed area / L^2
+
+    lbx = np.full(len(free), -np.inf)
+    lbx[np.searchsorted(free, b)] = 0.0  # b on the +x half-axis
+    s = settings
+    opts = {
+        "print_time": False,
+        "error_on_fail": False,
+        "ipopt.print_level": 0,
+        "ipopt.sb": "yes",
+        "ipopt.tol": s.develop_tol,
+        "ipopt.max_iter": s.ipopt_max_iter,
+        "ipopt.mu_strategy": s.ipopt_mu_strategy,
+        "ipopt.constr_viol_tol": 0.1 * s.constraint_tol,
+        "ipopt.bound_relax_factor": 0.01 * s.constraint_tol,
+    }
+    solver = ca.nlpsol("development", "ipopt", {"x": xi, "f": D, "g": g}, opts)
+    x0 = _initial_guess(pattern, a, b).T.ravel()[free]
+    sol = solver(x0=x0, lbx=lbx, lbg=0.0, ubg=np.inf)
+    stats = solver.stats()
+    wall = time.perf_counter() - t0
+
+    ipopt_status = str(stats.get("return_status", "unknown"))
+    X = np.zeros(2 * V)
+    X[free] = np.asarray(sol["x"], dtype=np.float64).ravel()
+    coords2d = X.reshape(2, V).T.copy()
+    coords2d.flags.writeable = False
+    D_val, max_err = _diagram_error(coords2d, pattern)
+
+    if not np.isfinite(coords2d).all():
+        flipped = overlaps = -1
+        status, verdict = "failed", "non-finite coordinates"
+    else:
+        flipped = count_flipped(coords2d, faces, tol=s.degenerate_area)
+        overlaps = count_overlaps(coords2d, faces, tol=s.overlap_area_tol)
+        if ipopt_status not in _IPOPT_SUCCESS or not np.isfinite(D_val):
+            status, verdict = "failed", f"solver failure, D = {D_val:.3g}"
+        elif flipped:
+            status, verdict = "flipped", f"{flipped} flipped facets, D = {D_val:.3g}"
+        elif overlaps:
+            status, verdict = "overlap", f"{overlaps} overlapping facet pairs, D = {D_val:.3g}"
+        else:
+            status, verdict = "converged", f"D = {D_val:.3g}"
+    return Development(
+        coords2d=coords2d,
+        D=D_val,
+        max_length_error=max_err,
+        flipped=flipped,
+        overlaps=overlaps,
+        status=status,
+        message=f"IPOPT: {ipopt_status}; {verdict}",
+        iterations=int(stats.get("iter_count", 0)),
+        wall_time=wall,
+        reference_edge=k,
+    )
