@@ -46,22 +46,30 @@ def generated(tmp_path_factory):
 
 
 def test_generate_writes_solutions_log_and_summary(generated):
-    names = sorted(p.name for p in (generated / "solutions").iterdir())
+    names = sorted(p.name for p in (generated / "solutions").glob("*.fold"))
     assert names == [f"step_{k:02d}_dof_{21 - k:02d}.fold" for k in range(4)]
+    assert len(list((generated / "solutions").glob("*.svg"))) == 4
     summary = json.loads((generated / "summary.json").read_text())
     assert (summary["initial_dof"], summary["final_dof"], summary["N_reduce"]) == (21, 18, 3)
     assert summary["N_lock"] == 0 and summary["N_exceed"] == 0
-    assert set(summary["time_s"]) == {"build", "solve", "analysis", "selection"}
+    assert set(summary["time_s"]) == {"build", "solve", "analysis", "selection", "develop"}
+    dev = summary["development"]
+    assert dev["max_D"] < 1e-8 and dev["flipped"] == 0 and dev["overlaps"] == 0
+    assert len(dev["per_solution"]) == 4
     log = json.loads((generated / "log.json").read_text())["attempts"]
     assert len(log) == summary["n_solves"]
     assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1])
     last = read_fold(generated / "solutions" / names[-1])
     assert len(last.pattern.fixed_creases) == 3
     assert last.metadata["dof"] == 18
+    assert last.metadata["development"]["D"] < 1e-8
+    assert read_fold(generated / "solutions" / names[-1], frame=1).frame_classes == [
+        "creasePattern"
+    ]
 
 
 def test_analyze_json_on_a_generated_solution(generated):
-    path = sorted((generated / "solutions").iterdir())[-1]
+    path = sorted((generated / "solutions").glob("*.fold"))[-1]
     proc = run_cli("analyze", str(path), "--json")
     assert proc.returncode == 0, proc.stderr
     report = json.loads(proc.stdout)
@@ -156,7 +164,7 @@ def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     assert "interrupted" in capsys.readouterr().err
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["n_solutions"] == 2
-    for path in (tmp_path / "solutions").iterdir():
+    for path in (tmp_path / "solutions").glob("*.fold"):
         read_fold(path)
     assert not list(tmp_path.rglob("*.tmp"))
 

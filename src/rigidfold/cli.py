@@ -63,6 +63,17 @@ def build_parser() -> argparse.ArgumentParser:
     ana.add_argument("--json", action="store_true", help="print one JSON object")
     ana.set_defaults(func=_cmd_analyze)
 
+    dev = sub.add_parser(
+        "develop",
+        help="Step 8: development diagram of a FOLD shape (problem 13)",
+        description="Flatten a FOLD shape to its development diagram. Writes DIR/<name>.fold "
+        "(the input plus a 'creasePattern' frame with 2D coordinates) and DIR/<name>.svg.",
+    )
+    dev.add_argument("file", metavar="FILE.fold")
+    dev.add_argument("--out", required=True, metavar="DIR")
+    dev.add_argument("--json", action="store_true", help="print one JSON object")
+    dev.set_defaults(func=_cmd_develop)
+
     opt = sub.add_parser(
         "optimize",
         help="solve problem (6): a developable polyhedron near a target surface",
@@ -241,6 +252,47 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         + ", ".join(f"{int(e)}:{a:+.3f}" for e, a in zip(mech.hinges, angles, strict=True))
     )
     return 0
+
+
+def _cmd_develop(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from rigidfold.case import prepare_output_dir
+    from rigidfold.develop import develop
+    from rigidfold.io import crease_pattern_frame, read_fold, write_fold, write_svg
+
+    out = prepare_output_dir(args.out)
+    data = read_fold(args.file)
+    result = develop(data.pattern)
+    stem = Path(args.file).stem
+    figures = {
+        "D": result.D,
+        "max_length_error": result.max_length_error,
+        "flipped": result.flipped,
+        "overlaps": result.overlaps,
+        "status": result.status,
+        "iterations": result.iterations,
+        "wall_time_s": result.wall_time,
+    }
+    write_fold(
+        out / f"{stem}.fold",
+        data.pattern,
+        title=f"{stem} (folded form)",
+        metadata={**data.metadata, "development": figures},
+        frames=[crease_pattern_frame(result.coords2d)],
+    )
+    write_svg(out / f"{stem}.svg", data.pattern, result.coords2d, title=f"{stem}: development")
+    if args.json:
+        print(json.dumps({k: v for k, v in figures.items()}))
+    else:
+        print(
+            f"{result.status}: D = {result.D:.3e}, max |dl|/l = {result.max_length_error:.2e}, "
+            f"{result.flipped} flipped, {result.overlaps} overlapping pairs, "
+            f"{result.wall_time:.2f} s"
+        )
+        print(f"wrote {out / (stem + '.fold')} and {out / (stem + '.svg')}")
+    return 0 if result.status == "converged" else 1
 
 
 class _Progress:

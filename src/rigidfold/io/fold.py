@@ -79,6 +79,7 @@ def fold_dict(
     metadata: dict | None = None,
     creator: str = "rigidfold",
     settings: Settings = DEFAULTS,
+    frames: list[dict] | None = None,
 ) -> dict:
     """The FOLD 1.2 document of a crease pattern.
 
@@ -97,6 +98,8 @@ def fold_dict(
         ``file_creator``.
     settings : Settings
         ``settings.flat_angle`` decides which free creases are flat (``"F"``).
+    frames : list of dict, optional
+        Further frames (``file_frames``), e.g. from :func:`crease_pattern_frame`.
 
     Returns
     -------
@@ -116,14 +119,30 @@ def fold_dict(
         "vertices_coords": pattern.coords.tolist(),
         "faces_vertices": pattern.faces.tolist(),
         "edges_vertices": pattern.edges.tolist(),
-        "edges_assignment": _assignment(pattern, settings.flat_angle),
+        "edges_assignment": edge_assignments(pattern, settings.flat_angle),
         "edges_foldAngle": np.degrees(pattern.fold_angles).tolist(),
     }
     for key, value in (metadata or {}).items():
         if not isinstance(key, str):
             raise ValueError(f"metadata keys must be strings, got {key!r}")
         data[PREFIX + key] = _jsonable(value, key)
+    if frames:
+        data["file_frames"] = frames
     return data
+
+
+def crease_pattern_frame(coords2d: np.ndarray, *, title: str = "development diagram") -> dict:
+    """A FOLD frame with the 2D development diagram, inheriting topology from frame 0.
+
+    coords2d : (V, 2) float, vertex positions of the flattened sheet (metres).
+    """
+    return {
+        "frame_title": title,
+        "frame_classes": ["creasePattern"],
+        "frame_parent": 0,
+        "frame_inherit": True,
+        "vertices_coords": np.asarray(coords2d, dtype=float).tolist(),
+    }
 
 
 def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Path:
@@ -167,7 +186,7 @@ def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Pat
     return path
 
 
-def _assignment(pattern: CreasePattern, flat_angle: float) -> list[str]:
+def edge_assignments(pattern: CreasePattern, flat_angle: float = DEFAULTS.flat_angle) -> list[str]:
     """FOLD assignment letter of each edge.  -> list of E str"""
     rho = pattern.fold_angles
     letters = np.where(rho > flat_angle, "V", np.where(rho < -flat_angle, "M", "F"))

@@ -1,0 +1,60 @@
+"""`rigidfold develop`: FOLD with a creasePattern frame, SVG, JSON figures, bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rigidfold.cli import main
+from rigidfold.io import read_fold, svg_text, write_fold
+from rigidfold.patterns import miura
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
+    )
+
+
+@pytest.fixture
+def miura_file(tmp_path):
+    return write_fold(tmp_path / "miura.fold", miura(4, 3))
+
+
+def test_develop_writes_frame_and_svg(miura_file, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["develop", str(miura_file), "--out", str(out), "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["D"] < 1e-10
+    assert figures["flipped"] == 0 and figures["overlaps"] == 0
+    raw = json.loads((out / "miura.fold").read_text())
+    frame = raw["file_frames"][0]
+    assert frame["frame_classes"] == ["creasePattern"]
+    assert np.asarray(frame["vertices_coords"]).shape == (len(raw["vertices_coords"]), 2)
+    # the crease-pattern frame reads back as the flat sheet with the same edge lengths
+    flat = read_fold(out / "miura.fold", frame=1).pattern
+    folded = read_fold(out / "miura.fold").pattern
+    assert np.allclose(flat.coords[:, 2], 0.0)
+    assert np.allclose(flat.edge_lengths, folded.edge_lengths, rtol=1e-5)
+    svg = (out / "miura.svg").read_text()
+    assert svg.startswith("<svg") and svg.count("<line") == folded.n_edges
+
+
+def test_svg_colours_by_assignment():
+    shape = miura(3, 3)
+    svg = svg_text(shape, shape.coords[:, :2])
+    assert "#000000" in svg  # boundary
+    assert "stroke-dasharray" in svg  # fixed diagonals
+    assert "#d62728" in svg and "#1f77b4" in svg  # mountains and valleys
+
+
+def test_develop_bad_input(tmp_path):
+    bad = tmp_path / "bad.fold"
+    bad.write_text("{oops")
+    proc = run_cli("develop", str(bad), "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and "invalid JSON" in proc.stderr
