@@ -30,6 +30,7 @@ import shapely
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
+from rigidfold.optimize.ipopt import ipopt_options
 
 _IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
@@ -231,17 +232,7 @@ def develop(pattern: CreasePattern, *, settings: Settings = DEFAULTS) -> Develop
     lbx = np.full(len(free), -np.inf)
     lbx[np.searchsorted(free, b)] = 0.0  # b on the +x half-axis
     s = settings
-    opts = {
-        "print_time": False,
-        "error_on_fail": False,
-        "ipopt.print_level": 0,
-        "ipopt.sb": "yes",
-        "ipopt.tol": s.develop_tol,
-        "ipopt.max_iter": s.ipopt_max_iter,
-        "ipopt.mu_strategy": s.ipopt_mu_strategy,
-        "ipopt.constr_viol_tol": 0.1 * s.constraint_tol,
-        "ipopt.bound_relax_factor": 0.01 * s.constraint_tol,
-    }
+    opts = ipopt_options(s, tol=s.develop_tol)
     solver = ca.nlpsol("development", "ipopt", {"x": xi, "f": D, "g": g}, opts)
     x0 = _initial_guess(pattern, a, b).T.ravel()[free]
     sol = solver(x0=x0, lbx=lbx, lbg=0.0, ubg=np.inf)

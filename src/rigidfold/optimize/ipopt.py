@@ -5,6 +5,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from rigidfold.config import Settings
+
 _OUTCOME = {
     "Solve_Succeeded": "solved",
     "Solved_To_Acceptable_Level": "solved",
@@ -15,23 +17,30 @@ _OUTCOME = {
 }
 
 
+def ipopt_options(settings: Settings, tol: float | None = None) -> dict:
+    """CasADi ``nlpsol`` options for IPOPT from the settings (silent, exact Hessian).
+
+    Bounds are relaxed and constraints accepted only far inside ``constraint_tol``, so a
+    converged point meets every constraint to that tolerance.
+    """
+    return {
+        "print_time": False,
+        "error_on_fail": False,
+        "ipopt.print_level": 0,
+        "ipopt.sb": "yes",
+        "ipopt.tol": settings.ipopt_tol if tol is None else tol,
+        "ipopt.max_iter": settings.ipopt_max_iter,
+        "ipopt.mu_strategy": settings.ipopt_mu_strategy,
+        "ipopt.constr_viol_tol": 0.1 * settings.constraint_tol,
+        "ipopt.bound_relax_factor": 0.01 * settings.constraint_tol,
+    }
+
+
 def ipopt_solver(problem) -> ca.Function:
     """The CasADi ``nlpsol`` of a FormFindingProblem, built once and cached on it."""
     if problem._ipopt is None:
-        s = problem.settings
         nlp = {"x": problem._xi, "p": problem._w, "f": problem._F, "g": problem._g}
-        opts = {
-            "print_time": False,
-            "error_on_fail": False,
-            "ipopt.print_level": 0,
-            "ipopt.sb": "yes",
-            "ipopt.tol": s.ipopt_tol,
-            "ipopt.max_iter": s.ipopt_max_iter,
-            "ipopt.mu_strategy": s.ipopt_mu_strategy,
-            "ipopt.constr_viol_tol": 0.1 * s.constraint_tol,
-            "ipopt.bound_relax_factor": 0.01 * s.constraint_tol,
-        }
-        problem._ipopt = ca.nlpsol("form_finding", "ipopt", nlp, opts)
+        problem._ipopt = ca.nlpsol("form_finding", "ipopt", nlp, ipopt_options(problem.settings))
     return problem._ipopt
 
 
