@@ -15,6 +15,8 @@ import statistics
 import time
 from concurrent.futures import ProcessPoolExecutor
 
+import numpy as np
+
 PAPER = {
     ("1", "s"): (20.00, 1.13, 0.04, 1.18e-9),
     ("1", "shat"): (20.00, 0.06, 0.01, 1.38e-9),
@@ -27,13 +29,29 @@ PAPER = {
 }
 
 
-def one_run(args: tuple[str, str, int]) -> dict:
+def support_face(case, corner: str) -> int | None:
+    """The triangle nearest a plan point "x,y" (None: rigidfold's default, nearest the centroid)."""
+    if corner == "centroid":
+        return None
+    point = np.array([float(v) for v in corner.split(",")])
+    bary = case.pattern.coords[case.pattern.faces].mean(axis=1)[:, :2]
+    return int(np.argmin(np.linalg.norm(bary - point, axis=1)))
+
+
+def one_run(args: tuple[str, str, int, str, str]) -> dict:
     from rigidfold.case import make_case
     from rigidfold.generate import generate
 
-    pattern, criterion, seed = args
+    pattern, criterion, seed, solver, support = args
     t0 = time.perf_counter()
-    run = generate(make_case("bezier", pattern, seed=seed), criterion=criterion, seed=seed)
+    case = make_case("bezier", pattern, seed=seed)
+    run = generate(
+        case,
+        criterion=criterion,
+        seed=seed,
+        solver=solver,
+        support_face=support_face(case, support),
+    )
     summary = run.summary()
     summary["wall_s"] = time.perf_counter() - t0
     return summary
@@ -45,6 +63,12 @@ def main() -> None:
     parser.add_argument("--patterns", nargs="+", default=["1", "2"])
     parser.add_argument("--criteria", nargs="+", default=["shat", "s", "ss", "random"])
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp"])
+    parser.add_argument(
+        "--support",
+        default="centroid",
+        help='frame support: "centroid" (default) or the triangle nearest a plan point "x,y"',
+    )
     args = parser.parse_args()
     header = (
         f"{'pattern':<8}{'criterion':<10}{'N_reduce':>9}{'N_lock':>8}{'N_exceed':>9}"
@@ -54,7 +78,9 @@ def main() -> None:
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         for pattern in args.patterns:
             for criterion in args.criteria:
-                jobs = [(pattern, criterion, s) for s in range(args.seeds)]
+                jobs = [
+                    (pattern, criterion, s, args.solver, args.support) for s in range(args.seeds)
+                ]
                 runs = list(pool.map(one_run, jobs))
                 means = {k: statistics.mean(r[k] for r in runs) for k in ("N_reduce", "N_lock")}
                 means["N_exceed"] = statistics.mean(r["N_exceed"] for r in runs)

@@ -121,3 +121,9 @@ def test_section_6_2_fixing_max_sf_crease_reduces_dof_without_lock(seven_dof):
     assert result.converged
     assert mech.dof == 6
     assert not mech.has_lock
+
+
+def test_generate_uses_the_requested_support():
+    run = generate(make_case("bezier", "1", seed=1), target_dof=20, seed=1, support_face=0)
+    assert all(sol.mechanism.frame.support_face == 0 for sol in run.solutions)
+    assert run.final_dof == 20

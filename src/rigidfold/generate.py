@@ -116,12 +116,16 @@ def generate(
     target_dof: int = 1,
     seed: int = 0,
     solver: str = "ipopt",
+    support_face: int | None = None,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
 ) -> Generation:
     """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
 
     With mirror planes in the case, creases are fixed in mirror groups (2 or 4 at once).
+    ``support_face`` is the triangle whose frame node carries the s = 6 supports (default:
+    the one nearest the centroid); it sets the metric of the mechanism modes and so the
+    S^F-hat scores.
     A KeyboardInterrupt propagates after the callbacks of everything finished so far.
     """
     if criterion not in CRITERIA:
@@ -141,7 +145,11 @@ def generate(
     ) -> tuple[Attempt, OptimizeResult, Mechanism]:
         result = problem.solve(fixed=fixed, start=start, solver=solver)
         t1 = time.perf_counter()
-        mech = analyze(result.pattern, settings=settings) if result.converged else None
+        mech = (
+            analyze(result.pattern, support_face=support_face, settings=settings)
+            if result.converged
+            else None
+        )
         t_an = time.perf_counter() - t1
         if mech is None:
             outcome = "exceed"
