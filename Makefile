@@ -15,7 +15,7 @@ $(STAMP): $(PY) pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --no-deform --out out/demo
+	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --out out/demo
 
 test: $(STAMP)
 	$(PY) -m pytest -q
@@ -24,6 +24,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_optimize.py
 	$(PY) benchmarks/bench_generate.py
 	$(PY) benchmarks/bench_develop.py
+	$(PY) benchmarks/bench_deform.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -52,10 +52,21 @@ def test_generate_writes_solutions_log_and_summary(generated):
     summary = json.loads((generated / "summary.json").read_text())
     assert (summary["initial_dof"], summary["final_dof"], summary["N_reduce"]) == (21, 18, 3)
     assert summary["N_lock"] == 0 and summary["N_exceed"] == 0
-    assert set(summary["time_s"]) == {"build", "solve", "analysis", "selection", "develop"}
+    assert set(summary["time_s"]) == {
+        "build",
+        "solve",
+        "analysis",
+        "selection",
+        "develop",
+        "deform",
+        "motion",
+    }
     dev = summary["development"]
     assert dev["max_D"] < 1e-8 and dev["flipped"] == 0 and dev["overlaps"] == 0
-    assert len(dev["per_solution"]) == 4
+    assert len(summary["per_solution"]) == 4
+    # --no-deform: no Step 9, but the development and the folding motion of every solution
+    assert summary["deformation"]["checked"] == 0 and summary["time_s"]["deform"] == 0.0
+    assert summary["motion"]["traced"] == 4 and summary["motion"]["max_length_error"] < 1e-3
     log = json.loads((generated / "log.json").read_text())["attempts"]
     assert len(log) == summary["n_solves"]
     assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1])
@@ -66,6 +77,11 @@ def test_generate_writes_solutions_log_and_summary(generated):
     assert read_fold(generated / "solutions" / names[-1], frame=1).frame_classes == [
         "creasePattern"
     ]
+    raw = json.loads((generated / "solutions" / names[-1]).read_text())
+    motion = [f for f in raw["file_frames"] if f["frame_classes"] == ["foldedForm"]]
+    assert len(motion) == 11
+    assert np.abs(np.asarray(motion[0]["vertices_coords"])[:, 2]).max() < 1e-9
+    assert np.allclose(motion[-1]["vertices_coords"], last.pattern.coords, atol=1e-9)
 
 
 def test_analyze_json_on_a_generated_solution(generated):

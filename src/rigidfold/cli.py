@@ -74,6 +74,19 @@ def build_parser() -> argparse.ArgumentParser:
     dev.add_argument("--json", action="store_true", help="print one JSON object")
     dev.set_defaults(func=_cmd_develop)
 
+    dfm = sub.add_parser(
+        "deform",
+        help="Step 9: large-deformation check of a FOLD shape (OpenSees) and its folding motion",
+        description="Drive the frame model of a FOLD shape to the plane with OpenSees and trace "
+        "its folding motion. Writes DIR/<name>.fold (the input plus the development diagram and "
+        "the motion frames) and DIR/<name>_deform.json (figures and the load-step history). Exit "
+        "code 0 when the plane is reached, 1 when not, 2 on bad input.",
+    )
+    dfm.add_argument("file", metavar="FILE.fold")
+    dfm.add_argument("--out", required=True, metavar="DIR")
+    dfm.add_argument("--json", action="store_true", help="print one JSON object")
+    dfm.set_defaults(func=_cmd_deform)
+
     opt = sub.add_parser(
         "optimize",
         help="solve problem (6): a developable polyhedron near a target surface",
@@ -163,9 +176,9 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "solver": args.solver,
         "symmetric": args.symmetric,
-        "deform": False,  # Step 9 is not implemented yet
+        "deform": not args.no_deform,
     }
-    writer = RunWriter(args.out, _case(args), options)
+    writer = RunWriter(args.out, _case(args), options, deform=not args.no_deform)
     progress = _Progress(enabled=not args.quiet, target=args.target_dof)
 
     def on_attempt(run, attempt):
@@ -293,6 +306,52 @@ def _cmd_develop(args: argparse.Namespace) -> int:
         )
         print(f"wrote {out / (stem + '.fold')} and {out / (stem + '.svg')}")
     return 0 if result.status == "converged" else 1
+
+
+def _cmd_deform(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from rigidfold.case import prepare_output_dir, write_json
+    from rigidfold.deform import verify
+    from rigidfold.io import read_fold, write_fold
+
+    out = prepare_output_dir(args.out)
+    data = read_fold(args.file)
+    check = verify(data.pattern)
+    stem = Path(args.file).stem
+    figures = check.figures()
+    write_fold(
+        out / f"{stem}.fold",
+        data.pattern,
+        title=f"{stem} (folded form)",
+        metadata={**data.metadata, **{k: v for k, v in figures.items() if k != "deformation"}},
+        frames=check.fold_frames(),
+    )
+    write_json(out / f"{stem}_deform.json", figures)
+    d = check.deformation
+    keys = ("mean_dl_mm", "max_dl_mm", "mean_drho_fix_deg", "max_drho_fix_deg", "reached_plane")
+    if args.json:
+        report = {k: figures["deformation"][k] for k in keys}
+        report["steps"] = d.steps
+        report["status"] = d.status
+        report["motion"] = figures["motion"]
+        print(json.dumps(report))
+    else:
+        print(
+            f"{d.status}: {d.steps} load steps, mean/max |dl| = {d.mean_dl_mm:.4g}/"
+            f"{d.max_dl_mm:.4g} mm, mean/max |drho_fix| = {d.mean_drho_fix_deg:.4g}/"
+            f"{d.max_drho_fix_deg:.4g} deg, {d.wall_time:.2f} s"
+            + (f" ({d.message})" if d.message else "")
+        )
+        m = check.motion
+        if m is not None:
+            print(
+                f"folding motion: {m.status}, {len(m.frames)} frames, max |dl|/l = "
+                f"{m.max_length_error:.2e}" + (f" ({m.message})" if m.message else "")
+            )
+        print(f"wrote {out / (stem + '.fold')} and {out / (stem + '_deform.json')}")
+    return 0 if d.reached_plane else 1
 
 
 class _Progress:

@@ -62,6 +62,30 @@ class Settings:
         below this fraction of its rotations before is predicted locked (Section 4.2).
     hinge_stiffness, hinge_stiffness_spread : float
         Fictitious hinge stiffnesses K_j are uniform in this mean +/- spread, Nm (Section 6.1).
+
+    Large-deformation check (Step 9, paper Section 6.1) and folding motion
+    ----------------------------------------------------------------------
+    tube_diameter, tube_wall : float
+        Outside diameter and wall thickness of the frame's tubular beams, metres (20 mm, 1 mm).
+    youngs_modulus, poisson_ratio : float
+        Beam material, Pa and - (200 GPa, 0.3).
+    deform_steps : int
+        Load steps from the folded shape to the plane.
+    deform_max_halvings : int
+        A load step that does not converge is retried with half the increment this many times.
+    deform_tol, deform_max_iter : float, int
+        Newton convergence: norm of the displacement increment (metres) and iteration limit.
+    plane_tol : float
+        The plane is reached when every frame node ends within this distance (m) of z = 0.
+    motion_frames : int
+        Frames of the folding motion from flat to the designed shape.
+    motion_tol, motion_max_iter : float, int
+        Newton correction of each motion frame onto the rigid-folding constraints: residual
+        norm (metres and radians) and iteration limit.
+    motion_length_tol : float
+        Where no exact rigid-folding shape exists (an imperfect design near the flat state),
+        the least-squares shape is accepted while every edge length is within this relative
+        error.
     """
 
     # design parameters of problem (6)
@@ -93,6 +117,20 @@ class Settings:
     lock_prediction_tol: float = 1e-4
     hinge_stiffness: float = 1e-3
     hinge_stiffness_spread: float = 0.5e-6
+    # large-deformation check (Step 9) and folding motion
+    tube_diameter: float = 0.020
+    tube_wall: float = 0.001
+    youngs_modulus: float = 200e9
+    poisson_ratio: float = 0.3
+    deform_steps: int = 20
+    deform_max_halvings: int = 6
+    deform_tol: float = 1e-9
+    deform_max_iter: int = 30
+    plane_tol: float = 1e-6
+    motion_frames: int = 11
+    motion_tol: float = 1e-13
+    motion_max_iter: int = 50
+    motion_length_tol: float = 1e-3
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):

@@ -1,33 +1,39 @@
 """Files of a generation run, written as the run goes so an interrupt loses nothing.
 
-``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form plus a
-``creasePattern`` frame with its development diagram, Step 8) and ``.svg`` beside it,
-``DIR/log.json`` (every attempt) and ``DIR/summary.json`` (the paper's counters, the
-development figures and stage times). Every file is written atomically (temporary file, then
-rename), so each one on disk is always valid.
+``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form, a
+``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
+``foldedForm`` frames) and ``.svg`` beside it, ``DIR/log.json`` (every attempt) and
+``DIR/summary.json`` (the paper's counters, the development and deformation figures (Step 9)
+and stage times). Every file is written atomically (temporary file, then rename), so each one
+on disk is always valid.
 """
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
+import numpy as np
+
 from rigidfold.case import Case, prepare_output_dir, write_json
-from rigidfold.develop import develop
+from rigidfold.deform.check import verify
 from rigidfold.generate import Attempt, Generation, Solution
-from rigidfold.io import crease_pattern_frame, write_fold, write_svg
+from rigidfold.io import write_fold, write_svg
 
 
 class RunWriter:
-    """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date."""
+    """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date.
 
-    def __init__(self, out: str | Path, case: Case, options: dict) -> None:
+    ``deform``: run the large-deformation check (Step 9) on every solution; the development
+    diagram (Step 8) and the folding motion always run.
+    """
+
+    def __init__(self, out: str | Path, case: Case, options: dict, *, deform: bool = True) -> None:
         self.out = prepare_output_dir(out)
         self.solutions_dir = prepare_output_dir(self.out / "solutions")
-        self.case, self.options = case, options
+        self.case, self.options, self.deform = case, options, deform
         self.files: list[Path] = []
-        self.developments: list[dict] = []
-        self.develop_time = 0.0
+        self.checks: list[dict] = []
+        self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
 
     def on_attempt(self, run: Generation, attempt: Attempt) -> None:
         write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
@@ -35,30 +41,23 @@ class RunWriter:
 
     def on_solution(self, run: Generation, solution: Solution) -> None:
         dof = solution.mechanism.dof
-        t0 = time.perf_counter()
-        diagram = develop(solution.result.pattern, settings=self.case.settings)
-        self.develop_time += time.perf_counter() - t0
-        figures = {
-            "step": solution.step,
-            "dof": dof,
-            "D": diagram.D,
-            "max_length_error": diagram.max_length_error,
-            "flipped": diagram.flipped,
-            "overlaps": diagram.overlaps,
-            "status": diagram.status,
-        }
-        self.developments.append(figures)
+        pattern = solution.result.pattern
+        check = verify(pattern, run_deform=self.deform, settings=self.case.settings)
+        for stage, t in check.times.items():
+            self.stage_times[stage] += t
+        figures = {"step": solution.step, "dof": dof, **check.figures()}
+        self.checks.append(figures)
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_svg(
             path.with_suffix(".svg"),
-            solution.result.pattern,
-            diagram.coords2d,
+            pattern,
+            check.development.coords2d,
             title=f"step {solution.step}, DOF {dof}: development diagram",
         )
         write_fold(
             path,
-            solution.result.pattern,
-            frames=[crease_pattern_frame(diagram.coords2d)],
+            pattern,
+            frames=check.fold_frames(),
             title=f"rigidfold generate: step {solution.step}, DOF {dof}",
             metadata={
                 **self.case.metadata(),
@@ -66,7 +65,7 @@ class RunWriter:
                 "step": solution.step,
                 "dof": dof,
                 "criterion": self.options.get("criterion"),
-                "development": figures,
+                **{k: v for k, v in figures.items() if k not in ("step", "dof")},
             },
         )
         self.files.append(path)
@@ -74,19 +73,45 @@ class RunWriter:
 
     def write_summary(self, run: Generation) -> None:
         summary = run.summary()
-        summary["time_s"]["develop"] = self.develop_time
-        Ds = [d["D"] for d in self.developments]
+        summary["time_s"].update(self.stage_times)
+        dev = [c["development"] for c in self.checks]
+        deformed = [c["deformation"] for c in self.checks if c["deformation"] is not None]
+        motions = [c["motion"] for c in self.checks if c["motion"] is not None]
+
+        def stat(values, fn):
+            return float(fn(values)) if values else None
+
         write_json(
             self.out / "summary.json",
             {
                 **summary,
                 "development": {
-                    "mean_D": sum(Ds) / len(Ds) if Ds else None,
-                    "max_D": max(Ds) if Ds else None,
-                    "flipped": sum(max(d["flipped"], 0) for d in self.developments),
-                    "overlaps": sum(max(d["overlaps"], 0) for d in self.developments),
-                    "per_solution": self.developments,
+                    "mean_D": stat([d["D"] for d in dev], np.mean),
+                    "max_D": stat([d["D"] for d in dev], np.max),
+                    "flipped": sum(max(d["flipped"], 0) for d in dev),
+                    "overlaps": sum(max(d["overlaps"], 0) for d in dev),
                 },
+                "deformation": {
+                    "checked": len(deformed),
+                    "reached_plane": sum(d["reached_plane"] for d in deformed),
+                    "mean_dl_mm": stat([d["mean_dl_mm"] for d in deformed], np.mean),
+                    "max_dl_mm": stat([d["max_dl_mm"] for d in deformed], np.max),
+                    "mean_drho_fix_deg": stat([d["mean_drho_fix_deg"] for d in deformed], np.mean),
+                    "max_drho_fix_deg": stat([d["max_drho_fix_deg"] for d in deformed], np.max),
+                },
+                "motion": {
+                    "traced": sum(m["status"] == "ok" for m in motions),
+                    "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
+                },
+                "per_solution": [
+                    {k: v for k, v in c.items() if k != "deformation"}
+                    | {
+                        "deformation": None
+                        if c["deformation"] is None
+                        else {k: v for k, v in c["deformation"].items() if k != "history"}
+                    }
+                    for c in self.checks
+                ],
                 "options": self.options,
                 "case": self.case.metadata(),
                 "solutions": [str(p.relative_to(self.out)) for p in self.files],

@@ -145,6 +145,24 @@ def crease_pattern_frame(coords2d: np.ndarray, *, title: str = "development diag
     }
 
 
+def motion_frames(frames: np.ndarray, parameter: np.ndarray) -> list[dict]:
+    """FOLD frames of a folding motion, inheriting topology from frame 0.
+
+    frames : (K, V, 3) float, vertex positions from flat to folded; parameter : (K,) fraction
+    folded. Each frame is a "foldedForm" titled with its fraction.
+    """
+    return [
+        {
+            "frame_title": f"folding motion: {100 * float(s):.0f}% folded",
+            "frame_classes": ["foldedForm"],
+            "frame_parent": 0,
+            "frame_inherit": True,
+            "vertices_coords": np.asarray(x, dtype=float).tolist(),
+        }
+        for x, s in zip(frames, parameter, strict=True)
+    ]
+
+
 def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Path:
     """Write a crease pattern as a FOLD file, atomically.
 

@@ -30,7 +30,7 @@ def _fold_angle_function() -> ca.Function:
     q = ca.SX.sym("q", 12)
     pu, pv, pa, pb = q[0:3], q[3:6], q[6:9], q[9:12]
     na = ca.cross(pv - pu, pa - pu)
-    nb = ca.cross(pb - pv, pu - pv)  # right triangle (v, u, b), counter-clockwise
+    nb = ca.cross(pu - pv, pb - pv)  # right triangle (v, u, b), counter-clockwise
     t = (pv - pu) / ca.norm_2(pv - pu)
     rho = ca.atan2(-ca.dot(ca.cross(na, nb), t), ca.dot(na, nb))
     return ca.Function("rho", [q], [rho, ca.gradient(rho, q)])

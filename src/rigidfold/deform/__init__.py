@@ -1,0 +1,15 @@
+"""Step 9: large-deformation check (OpenSees), the folding motion, and both with Step 8."""
+
+from rigidfold.deform.analysis import DeformResult, TubeSection, deform
+from rigidfold.deform.check import Verification, verify
+from rigidfold.deform.motion import Motion, folding_motion
+
+__all__ = [
+    "DeformResult",
+    "Motion",
+    "TubeSection",
+    "Verification",
+    "deform",
+    "folding_motion",
+    "verify",
+]

@@ -1,0 +1,135 @@
+"""Step 9 (OpenSees large-deformation check), the folding motion and `rigidfold deform`."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rigidfold.case import make_case
+from rigidfold.cli import main
+from rigidfold.deform import TubeSection, deform, folding_motion, verify
+from rigidfold.develop import develop
+from rigidfold.generate import generate
+from rigidfold.io import read_fold, write_fold
+from rigidfold.mesh.geometry import edge_lengths
+from rigidfold.patterns import miura
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
+    )
+
+
+def locked_miura(shape):
+    """The same Miura-ori with one free crease made rigid: it can no longer unfold."""
+    fixed = shape.fixed.copy()
+    fixed[shape.free_creases[len(shape.free_creases) // 2]] = True
+    return shape.with_fixed(fixed)
+
+
+@pytest.fixture(scope="module")
+def miura_checks():
+    shape = miura(3, 3)
+    return shape, deform(shape), deform(locked_miura(shape))
+
+
+def test_tube_section_is_the_papers():
+    sec = TubeSection(0.020, 0.001, 200e9, 0.3)
+    assert sec.A == pytest.approx(math.pi / 4 * (0.020**2 - 0.018**2))
+    assert sec.I == pytest.approx(math.pi / 64 * (0.020**4 - 0.018**4))
+    assert sec.J == pytest.approx(2 * sec.I) and sec.G == pytest.approx(200e9 / 2.6)
+
+
+def test_miura_reaches_the_plane_without_deformation(miura_checks):
+    _, free, _ = miura_checks
+    assert free.reached_plane and free.steps == 20 and free.load_factor == pytest.approx(1.0)
+    assert free.mean_dl_mm < 0.1 and free.max_dl_mm < 0.1
+    assert free.max_drho_fix_deg < 1e-3
+    # the frames of the analysis go from the folded shape to the plane
+    assert np.abs(free.frames[-1][:, 2]).max() < 1e-6
+    assert len(free.history) == free.steps
+
+
+def test_locked_miura_must_deform_at_least_ten_times_more(miura_checks):
+    _, free, locked = miura_checks
+    assert locked.mean_dl_mm >= 10 * max(free.mean_dl_mm, 1e-6)
+    assert locked.mean_dl_mm > 0.1
+    assert not locked.reached_plane
+
+
+def test_miura_motion_is_exactly_rigid():
+    shape = miura(4, 3)
+    motion = folding_motion(shape, develop(shape).coords2d)
+    assert motion.status == "ok" and len(motion.drivers) == 1
+    assert np.abs(motion.frames[0][:, 2]).max() < 1e-9
+    assert np.allclose(motion.frames[-1], shape.coords, atol=1e-12)
+    assert motion.max_length_error < 1e-8
+    for frame in motion.frames:
+        assert np.allclose(edge_lengths(frame, shape.edges), shape.edge_lengths, rtol=1e-8)
+
+
+@pytest.fixture(scope="module")
+def one_dof_solution():
+    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)
+    assert run.final_dof == 1
+    return run.solutions[-1].result.pattern
+
+
+def test_generated_one_dof_shape_passes_steps_8_and_9(one_dof_solution):
+    check = verify(one_dof_solution)
+    dev, d, m = check.development, check.deformation, check.motion
+    assert dev.D < 1e-8 and dev.flipped == 0 and dev.overlaps == 0
+    assert d.reached_plane and d.mean_dl_mm < 0.25 and d.mean_drho_fix_deg < 0.05
+    assert m.status == "ok" and len(m.drivers) == 1 and m.max_length_error < 1e-3
+    assert np.abs(m.frames[0][:, 2]).max() < 1e-9
+    assert np.allclose(m.frames[-1], one_dof_solution.coords, atol=1e-9)
+    frames = check.fold_frames()
+    assert frames[0]["frame_classes"] == ["creasePattern"]
+    assert [f["frame_classes"] for f in frames[1:]] == [["foldedForm"]] * len(m.frames)
+
+
+def test_deform_cli_json_and_files(tmp_path, capsys):
+    src = write_fold(tmp_path / "miura.fold", miura(3, 3))
+    out = tmp_path / "out"
+    assert main(["deform", str(src), "--out", str(out), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["reached_plane"] is True and report["steps"] == 20
+    assert report["mean_dl_mm"] < 0.1 and report["max_drho_fix_deg"] < 1e-3
+    assert {"mean_dl_mm", "max_dl_mm", "mean_drho_fix_deg", "max_drho_fix_deg"} <= set(report)
+    history = json.loads((out / "miura_deform.json").read_text())["deformation"]["history"]
+    assert len(history) == 20 and history[-1]["load_factor"] == pytest.approx(1.0)
+    flat = read_fold(out / "miura.fold", frame=2).pattern  # first motion frame: flat
+    assert np.abs(flat.coords[:, 2]).max() < 1e-9
+
+
+def test_deform_cli_locked_shape_exits_1(tmp_path):
+    src = write_fold(tmp_path / "locked.fold", locked_miura(miura(3, 3)))
+    proc = run_cli("deform", str(src), "--out", str(tmp_path / "o"), "--json")
+    assert proc.returncode == 1
+    assert json.loads(proc.stdout)["reached_plane"] is False
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        ("{oops", "invalid JSON"),
+        (
+            '{"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], '
+            '"faces_vertices": [[0, 1, 2], [0, 1, 3], [0, 1, 2]]}',
+            "edge",
+        ),
+    ],
+)
+def test_deform_cli_bad_input(tmp_path, content, needle):
+    bad = tmp_path / "bad.fold"
+    bad.write_text(content)
+    proc = run_cli("deform", str(bad), "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and needle in proc.stderr
+    assert "Traceback" not in proc.stderr
