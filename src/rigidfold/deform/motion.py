@@ -5,16 +5,18 @@ large-deformation analysis:
 
 * unknowns: the vertex coordinates X (V, 3);
 * constraints: every edge length (rigid triangles), every fixed crease's fold angle, the
-  support triangle's nine coordinates (gauge), and ``d`` *driver* creases (d = DOF, the
-  free creases with the most independent rotations in the mechanism, chosen by a pivoted
-  QR of H_phi^T) whose fold angles go linearly from the design to 0;
-* each frame: a secant predictor, then Gauss-Newton (least-squares, minimum norm) steps.
-  A step that does not converge is halved.
+  support triangle's nine coordinates (gauge), and the *folding measure*
+  ``m(X) = sqrt(sum_j rho_j^2)`` over the free creases, which goes from the design's value
+  to 0 in equal steps;
+* each frame: a secant predictor, then Gauss-Newton (least-squares, minimum norm) steps; a
+  step that does not converge is halved.
 
-For a 1-DOF mechanism the path is the mechanism's own; with more DOF it is the one along
-which the drivers fold proportionally. The flat end is replaced by the development diagram
-(Step 8) at z = 0, and a rigid motion that goes smoothly from the identity (designed shape)
-to the map of the flat state onto the development puts the whole path in that frame.
+For a 1-DOF mechanism the system is square and the path is the mechanism's own; with more
+DOF the minimum-norm corrections follow the steepest descent of m within the mechanism. No
+single crease has to fold monotonically. The flat end is the development diagram (Step 8)
+at z = 0; a rigid motion that goes smoothly (slerp) from the identity (designed shape) to
+the best fit of the last folded frame onto the development puts the whole path in that
+frame.
 ``max_length_error`` is the largest relative edge-length error over all frames.
 """
 
@@ -28,7 +30,6 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
-from rigidfold.mechanism import analyze
 from rigidfold.mechanism.kinematics import _fold_angle_map
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import edge_lengths
@@ -39,15 +40,13 @@ class Motion:
     """Frames of the folding motion, flat first.
 
     frames : (K, V, 3) float64; frames[0] is flat (z = 0), frames[-1] the designed shape
-    parameter : (K,) fraction folded, 0 (flat) .. 1 (designed)
-    drivers : edge indices of the driver creases
+    parameter : (K,) fraction of the folding measure m = |rho_free|, 0 (flat) .. 1 (designed)
     max_length_error : largest |l - l0| / l0 over all edges and frames
     status : "ok" or "failed"; message says why it failed
     """
 
     frames: np.ndarray
     parameter: np.ndarray
-    drivers: np.ndarray
     max_length_error: float
     status: str
     message: str = ""
@@ -57,7 +56,6 @@ class Motion:
             "status": self.status,
             "message": self.message,
             "frames": len(self.frames),
-            "drivers": self.drivers.tolist(),
             "max_length_error": self.max_length_error,
         }
 
@@ -83,19 +81,28 @@ def _fold_angles_and_jacobian(stencils: np.ndarray, X: np.ndarray):
 
 
 class _Constraints:
-    """Residual r(X) and Jacobian of the rigid-folding constraints with driver targets."""
+    """Residual r(X) and Jacobian of the rigid-folding constraints plus the folding measure.
 
-    def __init__(self, pattern: CreasePattern, drivers: np.ndarray, support_face: int) -> None:
+    Rows: edge lengths (E), fixed-crease fold angles (n_fix), the support triangle (9), and
+    last ``m(X) - target`` with ``m = sqrt(sum_j rho_j^2)`` over the free creases.
+    """
+
+    def __init__(self, pattern: CreasePattern, support_face: int) -> None:
         self.pattern = pattern
         self.L0 = pattern.edge_lengths
-        self.fixed = pattern.fixed_creases
-        self.rho_fixed0 = pattern.fold_angles[self.fixed]
-        self.drivers = drivers
-        self.stencils = _crease_stencils(pattern, np.concatenate([self.fixed, drivers]))
+        fixed, free = pattern.fixed_creases, pattern.free_creases
+        self.n_fixed = len(fixed)
+        self.rho_fixed0 = pattern.fold_angles[fixed]
+        self.stencils = _crease_stencils(pattern, np.concatenate([fixed, free]))
         self.support = (3 * pattern.faces[support_face][:, None] + np.arange(3)).ravel()
         self.X0 = pattern.coords.ravel().copy()
 
-    def __call__(self, x: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def measure(self, x: np.ndarray) -> float:
+        X = x.reshape(-1, 3)
+        rho, _ = _fold_angles_and_jacobian(self.stencils[self.n_fixed :], X)
+        return float(np.linalg.norm(rho))
+
+    def __call__(self, x: np.ndarray, target: float) -> tuple[np.ndarray, np.ndarray]:
         pat, V = self.pattern, self.pattern.n_vertices
         X = x.reshape(V, 3)
         e = pat.edges
@@ -106,39 +113,39 @@ class _Constraints:
         rows = np.arange(len(e))[:, None]
         Je[rows, 3 * e[:, :1] + np.arange(3)] = -u
         Je[rows, 3 * e[:, 1:] + np.arange(3)] = u
-        if len(self.stencils):
-            rho, Jr = _fold_angles_and_jacobian(self.stencils, X)
-        else:
-            rho, Jr = np.zeros(0), np.zeros((0, 3 * V))
-        goal = np.concatenate([self.rho_fixed0, target])
+        rho, Jr = _fold_angles_and_jacobian(self.stencils, X)
+        rho_fix, rho_free = rho[: self.n_fixed], rho[self.n_fixed :]
+        m = float(np.linalg.norm(rho_free))
+        Jm = (rho_free @ Jr[self.n_fixed :]) / max(m, 1e-300)
         Js = np.zeros((9, 3 * V))
         Js[np.arange(9), self.support] = 1.0
-        r = np.concatenate([length - self.L0, rho - goal, x[self.support] - self.X0[self.support]])
-        return r, np.vstack([Je, Jr, Js])
+        r = np.concatenate(
+            [
+                length - self.L0,
+                rho_fix - self.rho_fixed0,
+                x[self.support] - self.X0[self.support],
+                [m - target],
+            ]
+        )
+        return r, np.vstack([Je, Jr[: self.n_fixed], Js, Jm[None]])
 
 
-def _choose_drivers(pattern: CreasePattern, settings: Settings) -> np.ndarray:
-    mech = analyze(pattern, settings=settings)
-    if mech.dof == 0:
-        return np.zeros(0, dtype=np.int64)
-    _, _, piv = scipy.linalg.qr(mech.H_phi.T, pivoting=True, mode="economic")
-    return mech.hinges[np.sort(piv[: mech.dof])]
+def _newton(constraints: _Constraints, x: np.ndarray, target: float, settings: Settings):
+    """Gauss-Newton onto the constraints; returns (x, accepted).
 
-
-def _newton(constraints: _Constraints, x: np.ndarray, target: np.ndarray, settings: Settings):
-    """Gauss-Newton onto the constraints; (x, accepted).
-
-    Stops when the residual or the step is below ``motion_tol``. Near the flat state an
-    imperfect design (F > 0) may have no exact rigid-folding shape; the least-squares one is
-    accepted while every edge stays within ``motion_length_tol`` of its length.
+    Stops when the residual or the step is below ``motion_tol``, or when the residual stops
+    decreasing after a few iterations. Near the flat state an imperfect design (F > 0) may
+    have no exact rigid-folding shape; the least-squares one is accepted while every edge
+    length is within ``motion_length_tol`` (relative) and every fixed-crease angle and support
+    coordinate within ``motion_length_tol`` (radians, metres) of its value.
     """
     previous = np.inf
-    for _ in range(settings.motion_max_iter):
+    for iteration in range(settings.motion_max_iter):
         r, J = constraints(x, target)
         norm = float(np.linalg.norm(r))
         if norm <= settings.motion_tol:
             return x, True
-        if norm > 0.5 * previous:  # no longer converging quadratically: a least-squares point
+        if iteration >= 5 and norm > 0.9 * previous:  # converging no more: least squares
             break
         previous = norm
         dx = scipy.linalg.lstsq(J, -r, lapack_driver="gelsd")[0]
@@ -146,8 +153,8 @@ def _newton(constraints: _Constraints, x: np.ndarray, target: np.ndarray, settin
         if np.linalg.norm(dx) <= settings.motion_tol:
             break
     r, _ = constraints(x, target)
-    E = len(constraints.L0)
-    ok = np.max(np.abs(r[:E]) / constraints.L0) <= settings.motion_length_tol
+    E, tol = len(constraints.L0), settings.motion_length_tol
+    ok = np.max(np.abs(r[:E]) / constraints.L0) <= tol and np.max(np.abs(r[E:-1])) <= tol
     return x, bool(ok and np.isfinite(r).all())
 
 
@@ -158,25 +165,29 @@ def folding_motion(
     support_face: int | None = None,
     settings: Settings = DEFAULTS,
 ) -> Motion:
-    """Trace the folding motion of ``pattern`` from its development ``flat`` (V, 2).
+    """Trace the folding motion of ``pattern`` down to its development ``flat`` (V, 2).
 
-    Returns ``settings.motion_frames`` frames from the plane to the designed shape.
+    Returns ``settings.motion_frames`` frames from the plane to the designed shape, at equal
+    steps of the folding measure m = |rho_free|.
     """
     if support_face is None:
         support_face = default_support_face(pattern)
-    drivers = _choose_drivers(pattern, settings)
-    cons = _Constraints(pattern, drivers, support_face)
-    rho0 = pattern.fold_angles[drivers]
-    n = max(int(settings.motion_frames), 2) - 1
+    cons = _Constraints(pattern, support_face)
     x = pattern.coords.ravel().copy()
+    m0 = cons.measure(x)
+    n = max(int(settings.motion_frames), 2) - 1
     velocity = np.zeros_like(x)  # dx/ds of the last step, for the secant predictor
     path, s_done, status, message = [x.copy()], 0.0, "ok", ""
-    for k in range(1, n + 1):
-        ds = k / n - s_done
+    # frames at m = (1 - k/n) m0 for k < n; the flat one (k = n) is the development (the
+    # constraints are singular at the flat state itself)
+    levels = [k / n for k in range(1, n)]
+    for level in levels if m0 > 0 else []:
+        ds = level - s_done
         halvings = 0
-        while s_done < k / n - 1e-12:
-            step = min(ds, k / n - s_done)
-            y, ok = _newton(cons, x + velocity * step, (1.0 - s_done - step) * rho0, settings)
+        while s_done < level - 1e-12:
+            step = min(ds, level - s_done)
+            guess = x + velocity * step
+            y, ok = _newton(cons, guess, (1.0 - s_done - step) * m0, settings)
             if not ok:
                 halvings += 1
                 if halvings > settings.deform_max_halvings:
@@ -185,9 +196,9 @@ def folding_motion(
                 continue
             velocity = (y - x) / step
             x, s_done = y, s_done + step
-        if s_done < k / n - 1e-12:
+        if s_done < level - 1e-12:
             status = "failed"
-            message = f"no rigid-folding shape beyond {1 - s_done:.4f} of the design's fold angles"
+            message = f"no rigid-folding shape below {1 - s_done:.4f} of the design's folding"
             break
         path.append(x.copy())
     V = pattern.n_vertices
@@ -201,23 +212,26 @@ def folding_motion(
     parameter = (
         np.linspace(0.0, 1.0, len(frames)) if status == "ok" else np.full(len(frames), np.nan)
     )
-    return Motion(frames, parameter, drivers, err, status, message)
+    return Motion(frames, parameter, err, status, message)
 
 
-def _place_flat(frames: np.ndarray, flat: np.ndarray) -> np.ndarray:
-    """Flat first; the flat frame replaced by the development at z = 0; a smooth rigid motion.
+def _place_flat(path: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """Flat first, ending at the designed shape, in the development's frame.
 
-    frames : (K, V, 3) designed -> flat in the designed shape's gauge.
+    path : (n, V, 3) the designed shape and n - 1 frames at equal folding steps, in the
+    designed shape's gauge. The development at z = 0 is appended; a rigid motion that goes
+    smoothly (slerp) from the identity to the best fit of the last folded frame onto the
+    development places every frame.
     """
-    K = len(frames)
     target = np.column_stack([flat, np.zeros(len(flat))])
-    src = frames[-1]
+    src = path[-1]
+    path = np.concatenate([path, target[None]])
     sc, tc = src.mean(axis=0), target.mean(axis=0)
     rot, _ = Rotation.align_vectors(target - tc, src - sc)
     slerp = Slerp([0.0, 1.0], Rotation.concatenate([Rotation.identity(), rot]))
-    out = np.empty_like(frames)
-    for k, s in enumerate(np.linspace(0.0, 1.0, K)):  # s: 0 designed -> 1 flat
-        c = sc + s * (tc - sc)
-        out[k] = slerp([s])[0].apply(frames[k] - sc) + c
+    K = len(path)
+    out = np.empty_like(path)
+    for k, s in enumerate(np.linspace(0.0, 1.0, K - 1)):  # s: 0 designed -> 1 last folded
+        out[k] = slerp([s])[0].apply(path[k] - sc) + sc + s * (tc - sc)
     out[-1] = target
     return out[::-1]
