@@ -25,6 +25,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_generate.py
 	$(PY) benchmarks/bench_develop.py
 	$(PY) benchmarks/bench_deform.py
+	$(PY) benchmarks/bench_study.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

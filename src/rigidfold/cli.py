@@ -87,6 +87,34 @@ def build_parser() -> argparse.ArgumentParser:
     dfm.add_argument("--json", action="store_true", help="print one JSON object")
     dfm.set_defaults(func=_cmd_deform)
 
+    stu = sub.add_parser(
+        "study",
+        help="many generate runs on Dask, results in SQLite (Tables 5-8), resumable",
+        description="Run generate for every (Bezier seed, pattern, criterion), or a preset, on "
+        "Dask workers; store each finished run in DB. Re-running the same command skips "
+        "finished runs, so a killed study resumes where it stopped.",
+    )
+    stu.add_argument("--patterns", default="1,2", help="comma-separated (default 1,2)")
+    stu.add_argument("--criteria", default="shat,s,ss,random", help="comma-separated")
+    stu.add_argument("--surfaces", type=int, default=100, help="number of Bezier seeds")
+    stu.add_argument("--first-seed", type=int, default=0)
+    stu.add_argument("--preset", help="dome or hp: Sections 6.5-6.6 instead of Bezier surfaces")
+    stu.add_argument("--db", required=True, metavar="DB", help="SQLite file (created if absent)")
+    where = stu.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=2, help="local worker processes")
+    where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
+    stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
+    stu.add_argument("--quiet", action="store_true", help="no progress bar")
+    stu.set_defaults(func=_cmd_study)
+
+    rep = sub.add_parser(
+        "study-report",
+        help="Tables 5-8 of a study database beside the paper's, with box plots",
+    )
+    rep.add_argument("db", metavar="DB")
+    rep.add_argument("--out", metavar="DIR", help="write DIR/results.md and PNG box plots")
+    rep.set_defaults(func=_cmd_study_report)
+
     opt = sub.add_parser(
         "optimize",
         help="solve problem (6): a developable polyhedron near a target surface",
@@ -352,6 +380,112 @@ def _cmd_deform(args: argparse.Namespace) -> int:
             )
         print(f"wrote {out / (stem + '.fold')} and {out / (stem + '_deform.json')}")
     return 0 if d.reached_plane else 1
+
+
+def _cmd_study(args: argparse.Namespace) -> int:
+    from rigidfold.study import Store, StudyConfig, plan, preset, run_study
+
+    if args.preset is not None:
+        keys = preset(args.preset)
+    else:
+        keys = plan(
+            [p.strip() for p in args.patterns.split(",") if p.strip()],
+            [c.strip() for c in args.criteria.split(",") if c.strip()],
+            args.surfaces,
+            args.first_seed,
+        )
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    config = StudyConfig(deform=not args.no_deform)
+    store = Store(args.db, config.as_dict())  # refuses another configuration untouched
+    bar = _StudyProgress(enabled=not args.quiet)
+    try:
+        result = run_study(
+            keys,
+            store,
+            config,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            on_done=bar.update,
+        )
+    except KeyboardInterrupt:
+        bar.close()
+        print(
+            f"rigidfold: interrupted; {len(store.done())} finished runs are in {args.db}; run the "
+            "same command to resume",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    finally:
+        bar.close()
+    print(
+        f"{result['ran']} runs done, {result['skipped']} already in {args.db}, "
+        f"{result['total']} in the study, {result['wall_s']:.1f} s"
+    )
+    store.close()
+    return 0
+
+
+def _cmd_study_report(args: argparse.Namespace) -> int:
+    from rigidfold.study import open_readonly
+    from rigidfold.study.report import markdown, write_report
+
+    store = open_readonly(args.db)
+    if args.out:
+        path = write_report(store, args.out)
+        print(path.read_text())
+        print(f"wrote {path} and its figures")
+    else:
+        print(markdown(store))
+    return 0
+
+
+class _StudyProgress:
+    """One rich bar for a study: runs done / total, failures, rate, ETA (stderr)."""
+
+    def __init__(self, *, enabled: bool) -> None:
+        self.enabled, self.bar, self.task, self.failures = enabled, None, None, 0
+
+    def update(self, key, row, finished: int, total: int) -> None:
+        if str(row.get("status", "")).startswith("error"):
+            self.failures += 1
+        if not self.enabled:
+            return
+        if self.bar is None:
+            from rich.console import Console
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeElapsedColumn,
+                TimeRemainingColumn,
+            )
+
+            self.bar = Progress(
+                TextColumn("[bold]study"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TextColumn("{task.description}"),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+            )
+            self.bar.start()
+            self.task = self.bar.add_task("", total=total, completed=finished - 1)
+        rate = self.bar.tasks[0].speed
+        self.bar.update(
+            self.task,
+            completed=finished,
+            description=f"failures {self.failures}"
+            + (f"  {rate * 60:.1f} runs/min" if rate else ""),
+        )
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+            self.bar = None
 
 
 class _Progress:

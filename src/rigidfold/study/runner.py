@@ -1,0 +1,205 @@
+"""Run a study: many ``generate`` runs on Dask, results in a SQLite store.
+
+Each run (surface seed, pattern, criterion) is one Dask task executed in a worker process;
+the client process alone writes the database, one transaction per finished run. Runs already
+in the database are skipped, so re-running the same command resumes a killed study. Dask
+reschedules the task of a worker that dies. Dask is imported only here.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.selection import CRITERIA
+from rigidfold.study.store import Key, Store
+
+PRESETS = {
+    # Sections 6.5 and 6.6: the 11 x 11 grid with S, with and without the mirror planes
+    "dome": [Key("dome", 0, "11", "s", True), Key("dome", 0, "11", "s", False)],
+    "hp": [Key("hp", 0, "11", "s", True), Key("hp", 0, "11", "s", False)],
+}
+BEZIER_PATTERNS = ("1", "2", "11")
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    """What makes the numbers of two runs comparable; stored in the database."""
+
+    deform: bool = False
+    target_dof: int = 1
+    solver: str = "ipopt"
+    settings: Settings = field(default=DEFAULTS)
+
+    def as_dict(self) -> dict:
+        return {
+            "deform": self.deform,
+            "target_dof": self.target_dof,
+            "solver": self.solver,
+            "settings": asdict(self.settings),
+        }
+
+
+def plan(
+    patterns: Sequence[str], criteria: Sequence[str], surfaces: int, first_seed: int = 0
+) -> list[Key]:
+    """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1."""
+    for p in patterns:
+        if p not in BEZIER_PATTERNS:
+            raise ValueError(f"unknown pattern {p!r} (choose from {', '.join(BEZIER_PATTERNS)})")
+    for c in criteria:
+        if c not in CRITERIA:
+            raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
+    if surfaces < 1:
+        raise ValueError(f"--surfaces must be >= 1, got {surfaces}")
+    if first_seed < 0:
+        raise ValueError(f"--first-seed must be >= 0, got {first_seed}")
+    if not patterns or not criteria:
+        raise ValueError("at least one pattern and one criterion are needed")
+    return [
+        Key("bezier", seed, p, c)
+        for p in patterns
+        for c in criteria
+        for seed in range(first_seed, first_seed + surfaces)
+    ]
+
+
+def preset(name: str) -> list[Key]:
+    if name not in PRESETS:
+        raise ValueError(f"unknown preset {name!r} (choose from {', '.join(PRESETS)})")
+    return list(PRESETS[name])
+
+
+def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
+    """Execute one run (in a worker): generate, and Steps 8-9 of every solution if asked."""
+    from rigidfold import __version__
+    from rigidfold.case import make_case
+    from rigidfold.deform import verify
+    from rigidfold.generate import generate
+
+    settings = Settings(**config["settings"])
+    t0 = time.perf_counter()
+    checks: list[dict] = []
+
+    def on_solution(run, solution) -> None:
+        if config["deform"]:
+            c = verify(solution.result.pattern, run_motion=False, settings=settings)
+            checks.append({"D": c.development.D, **c.deformation.summary(), "times": c.times})
+
+    row: dict = {"version": __version__, "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    try:
+        case = make_case(
+            key.study,
+            key.pattern,
+            seed=key.seed if key.study == "bezier" else None,
+            symmetric=key.symmetric,
+            settings=settings,
+        )
+        run = generate(
+            case,
+            criterion=key.criterion,
+            target_dof=config["target_dof"],
+            seed=key.seed,
+            solver=config["solver"],
+            on_solution=on_solution,
+        )
+    except ValueError as exc:  # a configuration that cannot run: recorded, not retried
+        row.update(status=f"error: {exc}", time_total=time.perf_counter() - t0)
+        return key, row, []
+    s = run.summary()
+    row.update(
+        status=s["stop_reason"],
+        n_reduce=s["N_reduce"],
+        n_lock=s["N_lock"],
+        n_exceed=s["N_exceed"],
+        mean_f=s["mean_F_accepted"],
+        initial_dof=s["initial_dof"],
+        final_dof=s["final_dof"],
+        n_solutions=s["n_solutions"],
+        n_solves=s["n_solves"],
+        time_build=s["time_s"]["build"],
+        time_solve=s["time_s"]["solve"],
+        time_analysis=s["time_s"]["analysis"],
+        time_selection=s["time_s"]["selection"],
+    )
+    if checks:
+        row.update(
+            mean_d=float(np.mean([c["D"] for c in checks])),
+            mean_dl_mm=float(np.mean([c["mean_dl_mm"] for c in checks])),
+            mean_drho_fix_deg=float(np.mean([c["mean_drho_fix_deg"] for c in checks])),
+            reached_plane=int(all(c["reached_plane"] for c in checks)),
+            time_develop=sum(c["times"].get("develop", 0.0) for c in checks),
+            time_deform=sum(c["times"].get("deform", 0.0) for c in checks),
+        )
+    row["time_total"] = time.perf_counter() - t0
+    return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in run.attempts]
+
+
+def run_study(
+    keys: Sequence[Key],
+    store: Store,
+    config: StudyConfig,
+    *,
+    workers: int = 2,
+    scheduler: str | None = None,
+    on_done: Callable[[Key, dict, int, int], None] | None = None,
+) -> dict:
+    """Run every key not yet in ``store``; returns counts and the wall time.
+
+    on_done(key, run_row, finished, total) is called in the client after each stored run.
+    """
+    import logging
+
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    if workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {workers}")
+    done = store.done()
+    todo = [k for k in keys if k not in done]
+    total, finished = len(keys), len(keys) - len(todo)
+    t0 = time.perf_counter()
+    if not todo:
+        return {"total": total, "ran": 0, "skipped": finished, "wall_s": 0.0}
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(scheduler, timeout="20s")
+        except OSError as exc:
+            raise ValueError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}") from None
+    try:
+        futures = [
+            client.submit(run_one, k, config.as_dict(), pure=False, key=f"run-{i}-{k.row()}")
+            for i, k in enumerate(todo)
+        ]
+        for future in as_completed(futures):
+            key, row, attempts = future.result()
+            store.add(key, row, attempts)
+            finished += 1
+            if on_done:
+                on_done(key, row, finished, total)
+            future.release()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return {
+        "total": total,
+        "ran": len(todo),
+        "skipped": total - len(todo),
+        "wall_s": time.perf_counter() - t0,
+    }

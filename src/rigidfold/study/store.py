@@ -1,0 +1,217 @@
+"""SQLite store of a study: one row per finished run, one row per solve of problem (6).
+
+Only the client process writes, and each run is one transaction (its ``runs`` row and all its
+``attempts`` rows), so a killed client or worker leaves either a whole run or nothing: a run
+without a row is simply redone, and the primary keys forbid counting one twice. The file is
+in WAL mode, so a report can read it while a study writes.
+
+The ``meta`` table holds the study *configuration* (settings, solver, target DOF, whether
+Steps 8-9 run). Opening a database with another configuration is refused before anything is
+written: its numbers would not be comparable.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from dataclasses import dataclass
+from pathlib import Path
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS runs (
+    study TEXT NOT NULL,          -- "bezier", or a preset ("dome", "hp")
+    seed INTEGER NOT NULL,        -- surface seed (0 for presets)
+    pattern TEXT NOT NULL,
+    criterion TEXT NOT NULL,
+    symmetric INTEGER NOT NULL,
+    status TEXT NOT NULL,         -- the generator's stop reason, or "error: ..."
+    n_reduce INTEGER, n_lock INTEGER, n_exceed INTEGER,
+    mean_f REAL, initial_dof INTEGER, final_dof INTEGER, n_solutions INTEGER, n_solves INTEGER,
+    mean_d REAL, mean_dl_mm REAL, mean_drho_fix_deg REAL, reached_plane INTEGER,
+    time_build REAL, time_solve REAL, time_analysis REAL, time_selection REAL,
+    time_develop REAL, time_deform REAL, time_total REAL,
+    version TEXT NOT NULL, worker TEXT,
+    PRIMARY KEY (study, seed, pattern, criterion, symmetric)
+);
+CREATE TABLE IF NOT EXISTS attempts (
+    study TEXT NOT NULL, seed INTEGER NOT NULL, pattern TEXT NOT NULL,
+    criterion TEXT NOT NULL, symmetric INTEGER NOT NULL,
+    idx INTEGER NOT NULL,
+    fixed_added TEXT NOT NULL, score REAL, status TEXT NOT NULL, f REAL, iterations INTEGER,
+    dof INTEGER, locked TEXT NOT NULL, outcome TEXT NOT NULL,
+    solve_time REAL, analysis_time REAL, selection_time REAL,
+    PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
+);
+"""
+
+RUN_FIELDS = (
+    "status",
+    "n_reduce",
+    "n_lock",
+    "n_exceed",
+    "mean_f",
+    "initial_dof",
+    "final_dof",
+    "n_solutions",
+    "n_solves",
+    "mean_d",
+    "mean_dl_mm",
+    "mean_drho_fix_deg",
+    "reached_plane",
+    "time_build",
+    "time_solve",
+    "time_analysis",
+    "time_selection",
+    "time_develop",
+    "time_deform",
+    "time_total",
+    "version",
+    "worker",
+)
+ATTEMPT_FIELDS = (
+    "idx",
+    "fixed_added",
+    "score",
+    "status",
+    "f",
+    "iterations",
+    "dof",
+    "locked",
+    "outcome",
+    "solve_time",
+    "analysis_time",
+    "selection_time",
+)
+
+
+@dataclass(frozen=True)
+class Key:
+    """Identifies one run: (study, seed, pattern, criterion, symmetric)."""
+
+    study: str
+    seed: int
+    pattern: str
+    criterion: str
+    symmetric: bool = False
+
+    def row(self) -> tuple:
+        return (self.study, self.seed, self.pattern, self.criterion, int(self.symmetric))
+
+
+class Store:
+    """A study database. ``config`` is checked against (or written to) the ``meta`` table."""
+
+    def __init__(self, path: str | Path, config: dict | None = None) -> None:
+        self.path = Path(path)
+        if self.path.is_dir():
+            raise ValueError(f"database path {str(self.path)!r} is a directory")
+        if config is not None:
+            self._check_config(config)
+        try:
+            self.db = sqlite3.connect(self.path, timeout=30)
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=NORMAL")
+            self.db.executescript(SCHEMA)
+            if config is not None:
+                self.db.execute(
+                    "INSERT OR IGNORE INTO meta VALUES ('config', ?)",
+                    (json.dumps(config, sort_keys=True),),
+                )
+            self.db.commit()
+        except sqlite3.Error as exc:
+            raise ValueError(f"cannot open study database {str(self.path)!r}: {exc}") from None
+
+    def _check_config(self, config: dict) -> None:
+        """Refuse a database of another configuration without writing anything to it."""
+        if not self.path.exists():
+            parent = self.path.parent if str(self.path.parent) else Path(".")
+            if not parent.is_dir():
+                raise ValueError(
+                    f"cannot create study database {str(self.path)!r}: no such directory"
+                )
+            return
+        try:
+            with sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30) as ro:
+                has_meta = ro.execute(
+                    "SELECT 1 FROM sqlite_master WHERE type='table' AND name='meta'"
+                ).fetchone()
+                row = (
+                    ro.execute("SELECT value FROM meta WHERE key='config'").fetchone()
+                    if has_meta
+                    else None
+                )
+            ro.close()
+        except sqlite3.Error as exc:
+            raise ValueError(
+                f"{str(self.path)!r} is not a rigidfold study database: {exc}"
+            ) from None
+        if row is None:
+            raise ValueError(f"{str(self.path)!r} is not a rigidfold study database (no config)")
+        theirs = json.loads(row[0])
+        if theirs != json.loads(json.dumps(config, sort_keys=True)):
+            diff = sorted(k for k in set(theirs) | set(config) if theirs.get(k) != config.get(k))
+            raise ValueError(
+                f"{str(self.path)!r} holds a study with another configuration "
+                f"(differs in: {', '.join(diff)}); use another --db"
+            )
+
+    def config(self) -> dict | None:
+        row = self.db.execute("SELECT value FROM meta WHERE key='config'").fetchone()
+        return None if row is None else json.loads(row[0])
+
+    def done(self) -> set[Key]:
+        """Keys of every finished run."""
+        rows = self.db.execute("SELECT study, seed, pattern, criterion, symmetric FROM runs")
+        return {Key(s, int(seed), p, c, bool(sym)) for s, seed, p, c, sym in rows}
+
+    def add(self, key: Key, run: dict, attempts: list[dict]) -> None:
+        """Write one run and its attempts in one transaction."""
+        with self.db:
+            self.db.execute(
+                f"INSERT INTO runs VALUES ({', '.join('?' * (5 + len(RUN_FIELDS)))})",
+                key.row() + tuple(run.get(f) for f in RUN_FIELDS),
+            )
+            self.db.executemany(
+                f"INSERT INTO attempts VALUES ({', '.join('?' * (5 + len(ATTEMPT_FIELDS)))})",
+                [
+                    key.row()
+                    + tuple(
+                        json.dumps(a[f]) if f in ("fixed_added", "locked") else a.get(f)
+                        for f in ATTEMPT_FIELDS
+                    )
+                    for a in attempts
+                ],
+            )
+
+    def runs(self, study: str | None = None) -> list[dict]:
+        """Every run as a dict, ordered by key."""
+        cur = self.db.execute(
+            "SELECT * FROM runs"
+            + (" WHERE study = ?" if study else "")
+            + " ORDER BY study, pattern, criterion, symmetric, seed",
+            (study,) if study else (),
+        )
+        names = [d[0] for d in cur.description]
+        return [dict(zip(names, row, strict=True)) for row in cur]
+
+    def count_attempts(self) -> int:
+        return int(self.db.execute("SELECT COUNT(*) FROM attempts").fetchone()[0])
+
+    def close(self) -> None:
+        self.db.close()
+
+
+def open_readonly(path: str | Path) -> Store:
+    """Open an existing study database for reporting (never creates one)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"no study database at {str(p)!r}")
+    store = Store.__new__(Store)
+    store.path = p
+    try:
+        store.db = sqlite3.connect(f"file:{p}?mode=ro", uri=True, timeout=30)
+        store.db.execute("SELECT 1 FROM runs LIMIT 1")
+    except sqlite3.Error as exc:
+        raise ValueError(f"{str(p)!r} is not a rigidfold study database: {exc}") from None
+    return store

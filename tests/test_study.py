@@ -1,0 +1,170 @@
+"""`rigidfold study` / `study-report`: Dask runs, SQLite store, SIGKILL and resume, bad input."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+
+import pytest
+
+from rigidfold.study import Key, Store, StudyConfig, open_readonly, plan
+from rigidfold.study.report import markdown, tables_5_6, write_report
+
+STUDY = ["--surfaces", "3", "--patterns", "1", "--criteria", "shat,s", "--no-deform"]
+
+
+def study_cmd(db, *extra: str) -> list[str]:
+    return [sys.executable, "-m", "rigidfold.cli", "study", *STUDY, "--db", str(db), *extra]
+
+
+def run(args: list[str]) -> subprocess.CompletedProcess:
+    return subprocess.run(args, capture_output=True, text=True, check=False, timeout=600)
+
+
+def n_runs(db) -> int:
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=5) as con:
+            return con.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+    except sqlite3.Error:
+        return 0
+
+
+def comparable(rows: list[dict]) -> list[dict]:
+    """Rows without the timings and the worker's name (which differ between runs)."""
+    return [
+        {k: v for k, v in r.items() if not k.startswith("time") and k != "worker"} for r in rows
+    ]
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    db = tmp_path_factory.mktemp("study") / "a.sqlite"
+    proc = run(study_cmd(db, "--workers", "2", "--quiet"))
+    assert proc.returncode == 0, proc.stderr
+    assert "6 runs done" in proc.stdout
+    return db
+
+
+def test_study_stores_every_run_once(uninterrupted):
+    store = open_readonly(uninterrupted)
+    runs = store.runs()
+    assert len(runs) == 6
+    assert {(r["seed"], r["criterion"]) for r in runs} == {
+        (s, c) for s in range(3) for c in ("shat", "s")
+    }
+    for r in runs:
+        assert r["status"] == "target DOF 1 reached" and r["final_dof"] == 1
+        assert r["n_reduce"] == 20 and r["n_solves"] >= 21
+    # one attempts row per solve of (6)
+    assert store.count_attempts() == sum(r["n_solves"] for r in runs)
+
+
+def test_rerun_skips_finished_runs(uninterrupted):
+    proc = run(study_cmd(uninterrupted, "--quiet"))
+    assert proc.returncode == 0 and "0 runs done, 6 already" in proc.stdout
+    assert n_runs(uninterrupted) == 6
+
+
+def test_sigkill_mid_study_then_resume_gives_the_same_tables(uninterrupted, tmp_path):
+    db = tmp_path / "killed.sqlite"
+    proc = subprocess.Popen(
+        study_cmd(db, "--workers", "2", "--quiet"),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,  # its own process group: client and Dask workers
+    )
+    deadline = time.monotonic() + 300
+    while n_runs(db) < 2 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.2)
+    assert proc.poll() is None, "the study finished before it could be killed"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    killed_at = n_runs(db)
+    assert 2 <= killed_at < 6
+    resumed = run(study_cmd(db, "--workers", "2", "--quiet"))
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{6 - killed_at} runs done, {killed_at} already" in resumed.stdout
+    a, b = open_readonly(uninterrupted), open_readonly(db)
+    assert comparable(b.runs()) == comparable(a.runs())
+    assert b.count_attempts() == a.count_attempts()
+    assert comparable(tables_5_6(b)) == comparable(tables_5_6(a))
+
+
+def test_report_tables_and_figures(uninterrupted, tmp_path):
+    store = open_readonly(uninterrupted)
+    rows = tables_5_6(store)
+    assert [(r["pattern"], r["criterion"], r["n"]) for r in rows] == [
+        ("1", "s", 3),
+        ("1", "shat", 3),
+    ]
+    assert rows[1]["paper"] == (20.00, 0.06, 0.01, 1.38e-9)
+    text = markdown(store)
+    assert "Table 5" in text and "| S-hat | 3 | 20.00 ± 0.00 |" in text
+    path = write_report(store, tmp_path / "report")
+    assert path.read_text().startswith("# rigidfold study report")
+    png = tmp_path / "report" / "n_lock_pattern_1.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plan_and_store_units(tmp_path):
+    keys = plan(["1", "2"], ["shat"], 2, first_seed=5)
+    assert [k.seed for k in keys] == [5, 6, 5, 6]
+    store = Store(tmp_path / "u.sqlite", StudyConfig().as_dict())
+    key = Key("bezier", 5, "1", "shat")
+    store.add(key, {"status": "x", "version": "v"}, [])
+    assert store.done() == {key}
+    with pytest.raises(sqlite3.IntegrityError):
+        store.add(key, {"status": "x", "version": "v"}, [])  # never counted twice
+    assert len(store.runs()) == 1
+
+
+@pytest.mark.parametrize(
+    ("extra", "needle"),
+    [
+        (["--criteria", "shat,best"], "unknown criterion 'best'"),
+        (["--patterns", "7"], "unknown pattern '7'"),
+        (["--preset", "moon"], "unknown preset 'moon'"),
+        (["--surfaces", "0"], "--surfaces must be >= 1"),
+        (["--workers", "0"], "--workers must be >= 1"),
+    ],
+)
+def test_bad_input_is_one_line_and_touches_nothing(tmp_path, extra, needle):
+    db = tmp_path / "x.sqlite"
+    proc = run([sys.executable, "-m", "rigidfold.cli", "study", "--db", str(db), *extra])
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and needle in proc.stderr
+    assert not db.exists()
+
+
+def test_other_configuration_is_refused_untouched(uninterrupted):
+    digest = hashlib.sha256(uninterrupted.read_bytes()).hexdigest()
+    proc = run(
+        [
+            sys.executable,
+            "-m",
+            "rigidfold.cli",
+            "study",
+            "--surfaces",
+            "3",
+            "--patterns",
+            "1",
+            "--db",
+            str(uninterrupted),
+        ]  # Steps 8-9 on: another configuration
+    )
+    assert proc.returncode == 2 and "another configuration" in proc.stderr
+    assert hashlib.sha256(uninterrupted.read_bytes()).hexdigest() == digest
+
+
+def test_unwritable_database_and_missing_report(tmp_path):
+    proc = run(
+        [sys.executable, "-m", "rigidfold.cli", "study", "--db", str(tmp_path / "no" / "x.db")]
+    )
+    assert proc.returncode == 2 and "no such directory" in proc.stderr
+    proc = run([sys.executable, "-m", "rigidfold.cli", "study-report", str(tmp_path / "n.db")])
+    assert proc.returncode == 2 and "no study database" in proc.stderr
