@@ -113,7 +113,7 @@ def test_report_tables_and_figures(uninterrupted, tmp_path):
 
 def test_plan_and_store_units(tmp_path):
     keys = plan(["1", "2"], ["shat"], 2, first_seed=5)
-    assert [k.seed for k in keys] == [5, 6, 5, 6]
+    assert [(k.seed, k.pattern) for k in keys] == [(5, "1"), (5, "2"), (6, "1"), (6, "2")]
     store = Store(tmp_path / "u.sqlite", StudyConfig().as_dict())
     key = Key("bezier", 5, "1", "shat")
     store.add(key, {"status": "x", "version": "v"}, [])

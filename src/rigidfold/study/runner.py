@@ -49,7 +49,11 @@ class StudyConfig:
 def plan(
     patterns: Sequence[str], criteria: Sequence[str], surfaces: int, first_seed: int = 0
 ) -> list[Key]:
-    """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1."""
+    """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1.
+
+    Seed-major order (every pattern and criterion of a surface before the next surface), so
+    that a study stopped early holds complete surfaces.
+    """
     for p in patterns:
         if p not in BEZIER_PATTERNS:
             raise ValueError(f"unknown pattern {p!r} (choose from {', '.join(BEZIER_PATTERNS)})")
@@ -64,9 +68,9 @@ def plan(
         raise ValueError("at least one pattern and one criterion are needed")
     return [
         Key("bezier", seed, p, c)
+        for seed in range(first_seed, first_seed + surfaces)
         for p in patterns
         for c in criteria
-        for seed in range(first_seed, first_seed + surfaces)
     ]
 
 
