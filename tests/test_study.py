@@ -168,3 +168,19 @@ def test_unwritable_database_and_missing_report(tmp_path):
     assert proc.returncode == 2 and "no such directory" in proc.stderr
     proc = run([sys.executable, "-m", "rigidfold.cli", "study-report", str(tmp_path / "n.db")])
     assert proc.returncode == 2 and "no study database" in proc.stderr
+
+
+def test_progress_prints_plain_lines_when_stderr_is_not_a_terminal(capsys):
+    from rigidfold.cli import _StudyProgress
+
+    bar = _StudyProgress(enabled=True, log_every=3600.0)
+    bar.plain = True  # as under pytest's captured stderr, a log file or nohup
+    rows = [{"status": "target DOF 1 reached"}, {"status": "error: ValueError: x"}, {}]
+    for finished, row in enumerate(rows, start=4):  # 3 runs were already in the database
+        bar.update(None, row, finished, 6)
+    lines = capsys.readouterr().err.splitlines()
+    # the first run prints, the second is within log_every, the last run always prints
+    assert len(lines) == 2
+    assert lines[0].startswith("study 4/6  failures 0")
+    assert lines[1].startswith("study 6/6  failures 1")
+    assert "runs/min" in lines[1] and "ETA" in lines[1]

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import time
 from collections.abc import Sequence
 
 from rigidfold.config import DEFAULTS
@@ -441,15 +442,43 @@ def _cmd_study_report(args: argparse.Namespace) -> int:
 
 
 class _StudyProgress:
-    """One rich bar for a study: runs done / total, failures, rate, ETA (stderr)."""
+    """One rich bar for a study: runs done / total, failures, rate, ETA (stderr).
 
-    def __init__(self, *, enabled: bool) -> None:
+    When stderr is not a terminal (a batch job, ``nohup``, a log file) a live bar would show
+    nothing until the end, so a plain line with the same figures is printed instead, at most
+    every ``log_every`` seconds and for the last run.
+    """
+
+    def __init__(self, *, enabled: bool, log_every: float = 60.0) -> None:
         self.enabled, self.bar, self.task, self.failures = enabled, None, None, 0
+        self.plain = not sys.stderr.isatty()
+        self.log_every, self.t0 = log_every, time.monotonic()
+        self.last, self.first = -math.inf, None
+
+    def _line(self, finished: int, total: int) -> None:
+        now = time.monotonic()
+        if self.first is None:  # runs already in the database before this command
+            self.first = finished - 1
+        if now - self.last < self.log_every and finished < total:
+            return
+        self.last = now
+        done, elapsed = finished - self.first, now - self.t0
+        rate = done / elapsed if elapsed > 0 else 0.0
+        eta = f"{(total - finished) / rate / 60:.0f} min" if rate > 0 else "?"
+        print(
+            f"study {finished}/{total}  failures {self.failures}  {rate * 60:.1f} runs/min  "
+            f"elapsed {elapsed / 60:.1f} min  ETA {eta}",
+            file=sys.stderr,
+            flush=True,
+        )
 
     def update(self, key, row, finished: int, total: int) -> None:
         if str(row.get("status", "")).startswith("error"):
             self.failures += 1
         if not self.enabled:
+            return
+        if self.plain:
+            self._line(finished, total)
             return
         if self.bar is None:
             from rich.console import Console
