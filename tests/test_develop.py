@@ -15,9 +15,13 @@ from rigidfold.generate import generate
 from rigidfold.patterns.miura import miura
 
 
-def diagram_lengths(dev: Development, pattern) -> np.ndarray:
-    d = dev.coords2d[pattern.edges[:, 1]] - dev.coords2d[pattern.edges[:, 0]]
+def diagram_lengths_of(xy: np.ndarray, pattern) -> np.ndarray:
+    d = xy[pattern.edges[:, 1]] - xy[pattern.edges[:, 0]]
     return np.hypot(d[:, 0], d[:, 1])
+
+
+def diagram_lengths(dev: Development, pattern) -> np.ndarray:
+    return diagram_lengths_of(dev.coords2d, pattern)
 
 
 def assert_valid(dev: Development, pattern, D_max: float) -> None:
@@ -120,6 +124,32 @@ def test_shape_with_fixed_creases():
 
 
 # ------------------------------------------------------------------ bad input
+@pytest.mark.parametrize(("nx", "ny", "height"), [(3, 3, 0.5), (4, 2, 0.9)])
+def test_unfolding_is_the_development_of_a_miura(nx, ny, height):
+    folded = miura(nx, ny, height=height)
+    xy = diagram_module.unfold(folded)
+    assert np.isfinite(xy).all()
+    np.testing.assert_allclose(diagram_lengths_of(xy, folded), folded.edge_lengths, rtol=1e-12)
+    assert (count_flipped(xy, folded.faces, tol=1e-12)) == 0
+    flat = flat_miura(nx, ny, height)
+    np.testing.assert_allclose(pdist(xy), pdist(flat.coords[:, :2]), atol=1e-12)
+
+
+def test_flipped_projection_falls_back_to_the_unfolding():
+    """The DOF-13 shape of the symmetric dome (Sec. 6.5): from its xy projection IPOPT stops
+    at a diagram with a zero-area facet (D = 3.6e-3); from the unfolding it converges."""
+    from pathlib import Path
+
+    from rigidfold.io.fold import pattern_from_fold
+
+    shape = pattern_from_fold(Path(__file__).parent / "data" / "dome_sym_dof13.fold")
+    dev = develop(shape)
+    assert_valid(dev, shape, 1e-12)
+    assert dev.start == "unfolding"
+    assert "from the projection: flipped" in dev.message
+    assert dev.max_length_error < 1e-6
+
+
 def test_non_developable_vertex_returns_a_large_D():
     pattern = degree_n_vertex(6, lift=0.5)
     assert abs(pattern.angle_defects[pattern.interior_vertices]).max() > 1e-2

@@ -38,6 +38,7 @@ class Verification:
                 "flipped": d.flipped,
                 "overlaps": d.overlaps,
                 "status": d.status,
+                "start": d.start,
             },
             "deformation": None if self.deformation is None else self.deformation.summary(),
             "motion": None if self.motion is None else self.motion.summary(),

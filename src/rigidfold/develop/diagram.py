@@ -8,7 +8,11 @@
 
 ``Xd`` are the 2D vertex coordinates of the diagram, ``l_j`` the 3D edge lengths and
 ``l^d_j`` the diagram's. Following Wang et al., the diagram is found by least squares on the
-edge lengths, from the xy projection of the 3D shape. ``n_k . z >= 0`` is imposed as the
+edge lengths, from the xy projection of the 3D shape (the paper's start). A strongly folded
+shape can project with facets flipped, and IPOPT then stops at a diagram with a facet of zero
+area; in that case (status not "converged") problem (13) is solved again from the *unfolding*
+of the facets along a spanning tree (:func:`unfold`), which is the exact development of a
+developable shape up to rounding, and the better diagram is kept. ``n_k . z >= 0`` is imposed as the
 doubled signed area of facet k (counter-clockwise order of ``pattern.faces``) divided by the
 squared mean 3D edge length, so that every constraint is of order one.
 
@@ -22,7 +26,8 @@ Hessian) and solved by IPOPT.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from collections import deque
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
@@ -65,6 +70,8 @@ class Development:
         Seconds spent building the model and solving it.
     reference_edge : int
         Edge k that fixes the position: ``edges[k, 0]`` at the origin, ``edges[k, 1]`` on +x.
+    start : str
+        Start of the kept solve: "projection" (the xy projection) or "unfolding".
     """
 
     coords2d: np.ndarray
@@ -77,6 +84,7 @@ class Development:
     iterations: int
     wall_time: float
     reference_edge: int
+    start: str = "projection"
 
     def as_pattern(self, pattern: CreasePattern) -> CreasePattern:
         """The crease pattern of the diagram: ``pattern``'s topology with z = 0.
@@ -172,9 +180,62 @@ def _reference_edge(pattern: CreasePattern) -> int:
     return int(boundary[np.argmax(pattern.edge_lengths[boundary])])
 
 
-def _initial_guess(pattern: CreasePattern, a: int, b: int) -> np.ndarray:
-    """The xy projection (V, 2), moved rigidly so that a is at the origin and b on +x."""
-    xy = pattern.coords[:, :2] - pattern.coords[a, :2]
+def unfold(pattern: CreasePattern) -> np.ndarray:
+    """A flat layout (V, 2) of the facets unfolded one by one, breadth first from facet 0.
+
+    Each facet is placed across an edge already in the plane from its two other 3D edge
+    lengths, on the side that keeps its corners counter-clockwise; a vertex keeps the place it
+    got first. For a developable polyhedron this is its development up to rounding (every
+    vertex closes up because its sector angles sum to 2 pi); otherwise the gaps show where it
+    is not developable. Used as the second start of problem (13).
+    """
+    faces, ef, fe = pattern.faces, pattern.edge_faces, pattern.face_edges
+    P = pattern.coords
+    xy = np.full((pattern.n_vertices, 2), np.nan)
+
+    def length(i: int, j: int) -> float:
+        return float(np.linalg.norm(P[j] - P[i]))
+
+    def apex(u: int, v: int, w: int) -> None:
+        """Place w left of u -> v at its 3D distances from u and v."""
+        d = xy[v] - xy[u]
+        base = float(np.hypot(*d))
+        r1, r2 = length(u, w), length(v, w)
+        along = (r1**2 - r2**2 + base**2) / (2 * base)
+        h = np.sqrt(max(r1**2 - along**2, 0.0))
+        unit = d / base
+        xy[w] = xy[u] + along * unit + h * np.array([-unit[1], unit[0]])
+
+    a, b, c = (int(v) for v in faces[0])
+    xy[a] = 0.0, 0.0
+    xy[b] = length(a, b), 0.0
+    apex(a, b, c)
+    placed = np.zeros(len(faces), dtype=bool)
+    placed[0] = True
+    queue = deque([0])
+    while queue:
+        f = queue.popleft()
+        for e in fe[f]:
+            g = int(ef[e, 1] if ef[e, 0] == f else ef[e, 0])
+            if g < 0 or placed[g]:
+                continue
+            placed[g] = True
+            queue.append(g)
+            corners = faces[g].tolist()
+            i = next(
+                k
+                for k in range(3)
+                if {corners[k], corners[(k + 1) % 3]} == set(pattern.edges[e].tolist())
+            )
+            u, v, w = corners[i], corners[(i + 1) % 3], corners[(i + 2) % 3]
+            if np.isnan(xy[w, 0]):
+                apex(u, v, w)
+    return xy
+
+
+def _initial_guess(pattern: CreasePattern, a: int, b: int, xy: np.ndarray) -> np.ndarray:
+    """A layout (V, 2) moved rigidly so that a is at the origin and b on +x."""
+    xy = xy - xy[a]
     dx, dy = xy[b]
     phi = np.arctan2(dy, dx)  # 0 when a and b project onto one point
     c, s = np.cos(phi), np.sin(phi)
@@ -207,6 +268,28 @@ def develop(pattern: CreasePattern, *, settings: Settings = DEFAULTS) -> Develop
         with a large D; this function does not raise for them.
     """
     t0 = time.perf_counter()
+    first = _solve(pattern, pattern.coords[:, :2], "projection", settings)
+    if first.status == "converged":
+        return _timed(first, t0)
+    second = _solve(pattern, unfold(pattern), "unfolding", settings)
+    best = min(first, second, key=lambda d: (d.status != "converged", d.D))
+    other = second if best is first else first
+    return _timed(
+        replace(
+            best,
+            message=f"{best.message} (start: {best.start}; from the {other.start}: "
+            f"{other.status}, D = {other.D:.3g})",
+        ),
+        t0,
+    )
+
+
+def _timed(d: Development, t0: float) -> Development:
+    return replace(d, wall_time=time.perf_counter() - t0)
+
+
+def _solve(pattern: CreasePattern, layout: np.ndarray, start: str, settings: Settings):
+    """Problem (13) from a layout (V, 2): a Development (wall_time set by the caller)."""
     V = pattern.n_vertices
     edges, faces = pattern.edges, pattern.faces
     k = _reference_edge(pattern)
@@ -234,10 +317,9 @@ def develop(pattern: CreasePattern, *, settings: Settings = DEFAULTS) -> Develop
     s = settings
     opts = ipopt_options(s, tol=s.develop_tol)
     solver = ca.nlpsol("development", "ipopt", {"x": xi, "f": D, "g": g}, opts)
-    x0 = _initial_guess(pattern, a, b).T.ravel()[free]
+    x0 = _initial_guess(pattern, a, b, layout).T.ravel()[free]
     sol = solver(x0=x0, lbx=lbx, lbg=0.0, ubg=np.inf)
     stats = solver.stats()
-    wall = time.perf_counter() - t0
 
     ipopt_status = str(stats.get("return_status", "unknown"))
     X = np.zeros(2 * V)
@@ -269,6 +351,7 @@ def develop(pattern: CreasePattern, *, settings: Settings = DEFAULTS) -> Develop
         status=status,
         message=f"IPOPT: {ipopt_status}; {verdict}",
         iterations=int(stats.get("iter_count", 0)),
-        wall_time=wall,
+        wall_time=0.0,
         reference_edge=k,
+        start=start,
     )
