@@ -1,40 +1,56 @@
-"""Benchmark of study throughput: runs per minute per worker, 1 and 2 local workers.
+"""Benchmark of study throughput: runs per minute per worker, and its scaling with workers.
 
-Run with ``python benchmarks/bench_study.py [--surfaces 4] [--workers 1 2]``.
+Run with ``python benchmarks/bench_study.py [--surfaces 8] [--workers 1 2] [--repeat 3]``.
 
 Each measurement runs a fresh study (Bezier seeds 0..N-1, pattern 1, criteria S-hat and S,
-no Steps 8-9) into a temporary database with ``rigidfold.study.run_study`` and reports the
-wall time (including the start of the Dask cluster), the throughput and the speed-up over one
-worker measured in the same process.
+no Steps 8-9) into a temporary database with ``rigidfold.study.run_study``. Printed per
+worker count, as medians over the repeats: the wall time, the part of it that starts the Dask
+cluster, the throughput over the whole wall time and over the time after the start-up
+(runs/min and runs/min/worker), and the speed-up over the first worker count, measured in
+the same process. The runs are the same at every worker count (same seeds), so the work is
+identical and only its distribution changes.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import tempfile
 from pathlib import Path
 
 from rigidfold.study import Store, StudyConfig, plan, run_study
 
 
+def measure(keys, config, workers: int) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        store = Store(Path(tmp) / "bench.sqlite", config.as_dict())
+        result = run_study(keys, store, config, workers=workers)
+        store.close()
+    return result
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--surfaces", type=int, default=4)
+    parser.add_argument("--surfaces", type=int, default=8)
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     keys = plan(["1"], ["shat", "s"], args.surfaces)
     config = StudyConfig(deform=False)
     base = None
+    print(f"{len(keys)} runs per study, medians of {args.repeat} repeats", flush=True)
     for n in args.workers:
-        with tempfile.TemporaryDirectory() as tmp:
-            store = Store(Path(tmp) / "bench.sqlite", config.as_dict())
-            result = run_study(keys, store, config, workers=n)
-            store.close()
-        rate = result["ran"] / result["wall_s"] * 60
-        base = base or rate
+        results = [measure(keys, config, n) for _ in range(args.repeat)]
+        wall = statistics.median(r["wall_s"] for r in results)
+        startup = statistics.median(r["startup_s"] for r in results)
+        rate = len(keys) / wall * 60
+        steady = statistics.median(len(keys) / (r["wall_s"] - r["startup_s"]) * 60 for r in results)
+        base = base or (rate, steady)
         print(
-            f"workers {n:<3} runs {result['ran']:<4} wall {result['wall_s']:7.1f} s  "
-            f"{rate:6.1f} runs/min  {rate / n:6.1f} runs/min/worker  speed-up {rate / base:4.2f}x",
+            f"workers {n:<3} wall {wall:6.1f} s (start-up {startup:4.1f} s)  "
+            f"{rate:6.1f} runs/min  {rate / n:6.1f} runs/min/worker  "
+            f"after start-up {steady:6.1f} runs/min  {steady / n:6.1f} runs/min/worker  "
+            f"speed-up {rate / base[0]:4.2f}x ({steady / base[1]:4.2f}x after start-up)",
             flush=True,
         )
 

@@ -13,7 +13,7 @@ import time
 import pytest
 
 from rigidfold.study import Key, Store, StudyConfig, open_readonly, plan
-from rigidfold.study.report import markdown, tables_5_6, write_report
+from rigidfold.study.report import costs, markdown, paired_comparisons, tables_5_6, write_report
 
 STUDY = ["--surfaces", "3", "--patterns", "1", "--criteria", "shat,s", "--no-deform"]
 
@@ -111,6 +111,27 @@ def test_report_tables_and_figures(uninterrupted, tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_report_pairs_costs_and_commands(uninterrupted):
+    store = open_readonly(uninterrupted)
+    runs = {(r["criterion"], r["seed"]): r["n_lock"] for r in store.runs("bezier")}
+    (pair,) = paired_comparisons(store)  # only S-hat and S ran
+    d = [runs[("shat", k)] - runs[("s", k)] for k in range(3)]
+    assert (pair["a"], pair["b"], pair["n"]) == ("shat", "s", 3)
+    assert pair["mean_diff"] == pytest.approx(sum(d) / 3)
+    assert pair["less"] + pair["equal"] + pair["more"] == 3
+    assert pair["less"] == sum(x < 0 for x in d) and 0 <= pair["p_value"] <= 1
+    cost = {c["criterion"]: c for c in costs(store)}
+    n_attempts = store.count_attempts()
+    assert sum(c["solves_per_run"] * c["runs"] for c in cost.values()) == n_attempts
+    assert all(c["iterations_per_solve"] > 0 and c["total_cpu_s"] > 0 for c in cost.values())
+    (inv,) = [r for r in store.invocations() if r["ran"] == 6]  # the fixture's command
+    assert inv["argv"][:2] == ["rigidfold", "study"] and inv["workers"] == 2
+    assert (inv["skipped"], inv["total"], inv["outcome"]) == (0, 6, "completed")
+    text = markdown(store)
+    assert "### Ordering of N_lock" in text and "| 1 | S-hat - S | 3 |" in text
+    assert "### Cost" in text and "`rigidfold study --surfaces 3" in text
+
+
 def test_plan_and_store_units(tmp_path):
     keys = plan(["1", "2"], ["shat"], 2, first_seed=5)
     assert [(k.seed, k.pattern) for k in keys] == [(5, "1"), (5, "2"), (6, "1"), (6, "2")]
@@ -184,3 +205,19 @@ def test_progress_prints_plain_lines_when_stderr_is_not_a_terminal(capsys):
     assert lines[0].startswith("study 4/6  failures 0")
     assert lines[1].startswith("study 6/6  failures 1")
     assert "runs/min" in lines[1] and "ETA" in lines[1]
+
+
+def test_report_of_several_databases(uninterrupted, tmp_path):
+    import shutil
+
+    other = tmp_path / "b.sqlite"
+    shutil.copy(uninterrupted, other)
+    stores = [open_readonly(uninterrupted), open_readonly(other)]
+    path = write_report(stores, tmp_path / "both")
+    text = path.read_text()
+    assert f"## {uninterrupted.name}" in text and "## b.sqlite" in text
+    assert text.count("### Crease pattern 1 (paper's Table 5)") == 2
+    assert "Steps 8-9 off" in text
+    for stem in (uninterrupted.stem, "b"):
+        png = tmp_path / "both" / f"{stem}_n_lock_pattern_1.png"
+        assert png.is_file() and f"]({png.name})" in text

@@ -112,7 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
         "study-report",
         help="Tables 5-8 of a study database beside the paper's, with box plots",
     )
-    rep.add_argument("db", metavar="DB")
+    rep.add_argument("db", metavar="DB", nargs="+", help="one or more study databases")
     rep.add_argument("--out", metavar="DIR", help="write DIR/results.md and PNG box plots")
     rep.set_defaults(func=_cmd_study_report)
 
@@ -315,6 +315,7 @@ def _cmd_develop(args: argparse.Namespace) -> int:
         "overlaps": result.overlaps,
         "status": result.status,
         "iterations": result.iterations,
+        "start": result.start,
         "wall_time_s": result.wall_time,
     }
     write_fold(
@@ -400,6 +401,29 @@ def _cmd_study(args: argparse.Namespace) -> int:
     config = StudyConfig(deform=not args.no_deform)
     store = Store(args.db, config.as_dict())  # refuses another configuration untouched
     bar = _StudyProgress(enabled=not args.quiet)
+    started, t0 = _utc_now(), time.perf_counter()
+
+    def n_done() -> int:
+        return len(store.done().intersection(keys))
+
+    before = n_done()
+
+    def log(outcome: str, ran: int) -> None:
+        from rigidfold import __version__
+
+        store.add_invocation(
+            started=started,
+            argv=["rigidfold", *sys.argv[1:]],
+            workers=None if args.scheduler else args.workers,
+            scheduler=args.scheduler,
+            ran=ran,
+            skipped=before,
+            total=len(keys),
+            wall_s=time.perf_counter() - t0,
+            outcome=outcome,
+            version=__version__,
+        )
+
     try:
         result = run_study(
             keys,
@@ -411,6 +435,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
         )
     except KeyboardInterrupt:
         bar.close()
+        log("interrupted", n_done() - before)
         print(
             f"rigidfold: interrupted; {len(store.done())} finished runs are in {args.db}; run the "
             "same command to resume",
@@ -419,6 +444,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
     finally:
         bar.close()
+    log("completed", result["ran"])
     print(
         f"{result['ran']} runs done, {result['skipped']} already in {args.db}, "
         f"{result['total']} in the study, {result['wall_s']:.1f} s"
@@ -431,14 +457,20 @@ def _cmd_study_report(args: argparse.Namespace) -> int:
     from rigidfold.study import open_readonly
     from rigidfold.study.report import markdown, write_report
 
-    store = open_readonly(args.db)
+    stores = [open_readonly(db) for db in args.db]
     if args.out:
-        path = write_report(store, args.out)
+        path = write_report(stores, args.out)
         print(path.read_text())
         print(f"wrote {path} and its figures")
     else:
-        print(markdown(store))
+        print(markdown(stores))
     return 0
+
+
+def _utc_now() -> str:
+    from datetime import UTC, datetime
+
+    return datetime.now(UTC).isoformat(timespec="seconds")
 
 
 class _StudyProgress:

@@ -6,6 +6,7 @@ PNG figures (matplotlib, imported only here).
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -42,6 +43,81 @@ def tables_5_6(store: Store) -> list[dict]:
             row["time_total_median"] = float(np.median([r["time_total"] for r in sel]))
             row["paper"] = TABLES_5_6.get((pattern, crit))
             rows.append(row)
+    return rows
+
+
+PAPER_ORDER = ("shat", "s", "random", "ss")  # the paper's ranking by N_lock, best first
+PAIRS = (("shat", "s"), ("s", "random"), ("random", "ss"), ("s", "ss"))
+
+
+def paired_comparisons(store: Store) -> list[dict]:
+    """N_lock of two criteria on the same surfaces (paired by seed), per pattern.
+
+    For each pair (a, b) of ``PAIRS``: the seeds both ran, the mean of N_lock(a) - N_lock(b)
+    with its standard error, how often a locked less / as often / more, and the two-sided
+    Wilcoxon signed-rank p-value (SciPy; 1.0 when every difference is zero).
+    """
+    from scipy.stats import wilcoxon
+
+    runs = [r for r in store.runs("bezier") if r["n_lock"] is not None]
+    by = {(r["pattern"], r["criterion"], r["seed"]): r["n_lock"] for r in runs}
+    out = []
+    for pattern in sorted({r["pattern"] for r in runs}):
+        for a, b in PAIRS:
+            seeds = sorted(
+                seed for (p, c, seed) in by if p == pattern and c == a and (p, b, seed) in by
+            )
+            if len(seeds) < 2:
+                continue
+            d = np.array([by[(pattern, a, k)] - by[(pattern, b, k)] for k in seeds], dtype=float)
+            p_value = 1.0 if not d.any() else float(wilcoxon(d).pvalue)
+            mean, se = _mean_se(d.tolist())
+            out.append(
+                {
+                    "pattern": pattern,
+                    "a": a,
+                    "b": b,
+                    "n": len(seeds),
+                    "mean_diff": mean,
+                    "se": se,
+                    "less": int((d < 0).sum()),
+                    "equal": int((d == 0).sum()),
+                    "more": int((d > 0).sum()),
+                    "p_value": p_value,
+                }
+            )
+    return out
+
+
+def costs(store: Store) -> list[dict]:
+    """Per (study, pattern, criterion): runs, solves of (6) per run, IPOPT iterations per
+    solve, and run times (median and total CPU seconds in the workers)."""
+    rows = []
+    runs = store.runs()
+    groups = sorted({(r["study"], r["pattern"], r["criterion"]) for r in runs})
+    for study, pattern, crit in groups:
+        sel = [
+            r for r in runs if (r["study"], r["pattern"], r["criterion"]) == (study, pattern, crit)
+        ]
+        its = store.db.execute(
+            "SELECT AVG(iterations), AVG(solve_time) FROM attempts "
+            "WHERE study = ? AND pattern = ? AND criterion = ?",
+            (study, pattern, crit),
+        ).fetchone()
+        t = [r["time_total"] for r in sel if r["time_total"] is not None]
+        rows.append(
+            {
+                "study": study,
+                "pattern": pattern,
+                "criterion": crit,
+                "runs": len(sel),
+                "solves_per_run": float(np.mean([r["n_solves"] or 0 for r in sel])),
+                "iterations_per_solve": its[0],
+                "solve_s": its[1],
+                "median_run_s": float(np.median(t)) if t else math.nan,
+                "total_cpu_s": float(np.sum(t)),
+            }
+        )
     return rows
 
 
@@ -88,9 +164,38 @@ def _fmt(x, se=None, digits=2) -> str:
     return s
 
 
-def markdown(store: Store, figures: dict[str, str] | None = None) -> str:
-    """The report as Markdown (figures: pattern -> PNG file name to link)."""
+def markdown(stores: Store | list[Store], figures: list[dict] | dict | None = None) -> str:
+    """The report of one or several databases as Markdown.
+
+    figures : per database, pattern -> PNG file name to link (from :func:`box_plots`).
+    """
+    stores = [stores] if isinstance(stores, Store) else list(stores)
+    if isinstance(figures, dict) or figures is None:
+        figures = [figures or {}] * len(stores)
     lines = [f"Paper values: {CITATION}.", ""]
+    for store, figs in zip(stores, figures, strict=True):
+        if len(stores) > 1:
+            lines += [f"## {store.path.name}", ""]
+        lines += _configuration_lines(store)
+        lines += _store_lines(store, figs)
+    return "\n".join(lines)
+
+
+def _configuration_lines(store: Store) -> list[str]:
+    config = store.config() or {}
+    versions = sorted({r["version"] for r in store.runs()})
+    if not config:
+        return []
+    return [
+        f"Configuration: solver {config.get('solver')}, target DOF {config.get('target_dof')}, "
+        f"Steps 8-9 {'on' if config.get('deform') else 'off'}; {len(store.runs())} runs, "
+        f"{store.count_attempts()} solves of (6); rigidfold {', '.join(versions) or '-'}.",
+        "",
+    ]
+
+
+def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
+    lines: list[str] = []
     t56 = tables_5_6(store)
     for pattern in sorted({r["pattern"] for r in t56}):
         rows = [r for r in t56 if r["pattern"] == pattern]
@@ -113,9 +218,12 @@ def markdown(store: Store, figures: dict[str, str] | None = None) -> str:
                 f"| {_fmt(r['mean_f'])} | {r['reached_target']}/{r['n']} "
                 f"| {_fmt(p[0])} | {_fmt(p[1])} | {_fmt(p[2])} | {_fmt(p[3])} |"
             )
-        if figures and pattern in figures:
+        if pattern in figures:
             lines += ["", f"![N_lock per criterion, pattern {pattern}]({figures[pattern]})"]
         lines.append("")
+    pairs = paired_comparisons(store)
+    if pairs:
+        lines += _ordering_lines(t56, pairs)
     t78 = tables_7_8(store)
     for name, number in (("dome", "Table 7"), ("hp", "Table 8")):
         runs = [r for r in t78 if r["preset"] == name]
@@ -139,10 +247,84 @@ def markdown(store: Store, figures: dict[str, str] | None = None) -> str:
             )
             lines.append(f"| {label} | {cells} |")
         lines.append("")
-    return "\n".join(lines)
+    lines += _cost_lines(store)
+    return lines
 
 
-def box_plots(store: Store, out: Path) -> dict[str, str]:
+def _ordering_lines(t56: list[dict], pairs: list[dict]) -> list[str]:
+    lines = ["### Ordering of N_lock", ""]
+    paper = " <= ".join(LABEL[c] for c in PAPER_ORDER)
+    for pattern in sorted({r["pattern"] for r in t56}):
+        rows = sorted(
+            (r for r in t56 if r["pattern"] == pattern), key=lambda r: (r["n_lock"], r["criterion"])
+        )
+        ours = f"{LABEL[rows[0]['criterion']]} ({rows[0]['n_lock']:.2f})"
+        for prev, r in itertools.pairwise(rows):
+            sign = "=" if r["n_lock"] == prev["n_lock"] else "<"
+            ours += f" {sign} {LABEL[r['criterion']]} ({r['n_lock']:.2f})"
+        same = [r["criterion"] for r in rows] == [
+            c for c in PAPER_ORDER if any(r["criterion"] == c for r in rows)
+        ]
+        lines.append(
+            f"- Pattern {pattern}: {ours}; "
+            + ("the paper's order." if same else f"the paper's order is {paper}.")
+        )
+    lines += [
+        "",
+        "Paired by surface (same seed): mean difference of N_lock, how often the first "
+        "criterion locked less / as often / more, and the two-sided Wilcoxon signed-rank p-value.",
+        "",
+        "| pattern | pair | surfaces | mean difference | less / equal / more | p |",
+        "|---|---|---|---|---|---|",
+    ]
+    for c in pairs:
+        lines.append(
+            f"| {c['pattern']} | {LABEL[c['a']]} - {LABEL[c['b']]} | {c['n']} "
+            f"| {_fmt(c['mean_diff'], c['se'])} | {c['less']} / {c['equal']} / {c['more']} "
+            f"| {c['p_value']:.2g} |"
+        )
+    return [*lines, ""]
+
+
+def _cost_lines(store: Store) -> list[str]:
+    lines = [
+        "### Cost",
+        "",
+        "CPU seconds in the workers (one thread each); a solve is one solution of problem (6).",
+        "",
+        "| study | pattern | criterion | runs | solves per run | IPOPT iterations per solve "
+        "| s per solve | median s per run | total CPU s |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for c in costs(store):
+        lines.append(
+            f"| {c['study']} | {c['pattern']} | {LABEL.get(c['criterion'], c['criterion'])} "
+            f"| {c['runs']} | {c['solves_per_run']:.1f} "
+            f"| {_fmt(c['iterations_per_solve'], digits=1)} "
+            f"| {_fmt(c['solve_s'], digits=3)} | {_fmt(c['median_run_s'], digits=1)} "
+            f"| {c['total_cpu_s']:.0f} |"
+        )
+    inv = store.invocations()
+    if inv:
+        lines += [
+            "",
+            "Commands that ran on this database (wall time of each command):",
+            "",
+            "| started (UTC) | command | workers | runs done / already there / in the study "
+            "| wall s | outcome | version |",
+            "|---|---|---|---|---|---|---|",
+        ]
+        for r in inv:
+            where = r["workers"] if r["workers"] is not None else f"scheduler {r['scheduler']}"
+            lines.append(
+                f"| {r['started']} | `{' '.join(r['argv'])}` | {where} "
+                f"| {r['ran']} / {r['skipped']} / {r['total']} | {r['wall_s']:.0f} "
+                f"| {r['outcome']} | {r['version']} |"
+            )
+    return [*lines, ""]
+
+
+def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
     """One PNG per pattern: N_lock per criterion. Returns pattern -> file name."""
     import matplotlib
 
@@ -165,21 +347,25 @@ def box_plots(store: Store, out: Path) -> dict[str, str]:
         ax.set_ylabel("N_lock per run")
         ax.set_title(f"Crease pattern {pattern}: locked shapes per run ({len(data[0])} surfaces)")
         fig.tight_layout()
-        name = f"n_lock_pattern_{pattern}.png"
+        name = f"{prefix}n_lock_pattern_{pattern}.png"
         fig.savefig(out / name)
         plt.close(fig)
         files[pattern] = name
     return files
 
 
-def write_report(store: Store, out: str | Path) -> Path:
-    """Write DIR/results.md and the box plots; returns the Markdown path."""
+def write_report(stores: Store | list[Store], out: str | Path) -> Path:
+    """Write DIR/results.md and the box plots of one or several databases; returns the
+    Markdown path. With several databases the figures are prefixed by the database's name."""
     from rigidfold.case import prepare_output_dir
 
+    stores = [stores] if isinstance(stores, Store) else list(stores)
     out = prepare_output_dir(out)
-    figures = box_plots(store, out)
+    figures = [
+        box_plots(s, out, prefix=f"{s.path.stem}_" if len(stores) > 1 else "") for s in stores
+    ]
     path = out / "results.md"
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text("# rigidfold study report\n\n" + markdown(store, figures) + "\n")
+    tmp.write_text("# rigidfold study report\n\n" + markdown(stores, figures) + "\n")
     tmp.replace(path)
     return path

@@ -154,7 +154,8 @@ def run_study(
     scheduler: str | None = None,
     on_done: Callable[[Key, dict, int, int], None] | None = None,
 ) -> dict:
-    """Run every key not yet in ``store``; returns counts and the wall time.
+    """Run every key not yet in ``store``; returns counts, the wall time and the part of it
+    spent starting (or connecting to) the Dask cluster (``startup_s``).
 
     on_done(key, run_row, finished, total) is called in the client after each stored run.
     """
@@ -169,7 +170,7 @@ def run_study(
     total, finished = len(keys), len(keys) - len(todo)
     t0 = time.perf_counter()
     if not todo:
-        return {"total": total, "ran": 0, "skipped": finished, "wall_s": 0.0}
+        return {"total": total, "ran": 0, "skipped": finished, "wall_s": 0.0, "startup_s": 0.0}
     cluster = None
     if scheduler is None:
         cluster = LocalCluster(
@@ -185,6 +186,7 @@ def run_study(
             client = Client(scheduler, timeout="20s")
         except OSError as exc:
             raise ValueError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}") from None
+    startup = time.perf_counter() - t0
     try:
         futures = [
             client.submit(run_one, k, config.as_dict(), pure=False, key=f"run-{i}-{k.row()}")
@@ -206,4 +208,5 @@ def run_study(
         "ran": len(todo),
         "skipped": total - len(todo),
         "wall_s": time.perf_counter() - t0,
+        "startup_s": startup,
     }

@@ -34,6 +34,13 @@ CREATE TABLE IF NOT EXISTS runs (
     version TEXT NOT NULL, worker TEXT,
     PRIMARY KEY (study, seed, pattern, criterion, symmetric)
 );
+CREATE TABLE IF NOT EXISTS invocations (  -- one row per `rigidfold study` command that ended
+    started TEXT NOT NULL,        -- UTC, ISO 8601
+    argv TEXT NOT NULL,           -- the command line (JSON list)
+    workers INTEGER, scheduler TEXT,
+    ran INTEGER NOT NULL, skipped INTEGER NOT NULL, total INTEGER NOT NULL,
+    wall_s REAL NOT NULL, outcome TEXT NOT NULL, version TEXT NOT NULL
+);
 CREATE TABLE IF NOT EXISTS attempts (
     study TEXT NOT NULL, seed INTEGER NOT NULL, pattern TEXT NOT NULL,
     criterion TEXT NOT NULL, symmetric INTEGER NOT NULL,
@@ -183,6 +190,32 @@ class Store:
                     for a in attempts
                 ],
             )
+
+    def add_invocation(self, **row) -> None:
+        """Record one ``rigidfold study`` command: started, argv, workers, scheduler, ran,
+        skipped, total, wall_s, outcome ("completed" or "interrupted"), version."""
+        names = (
+            "started", "argv", "workers", "scheduler", "ran", "skipped", "total", "wall_s",
+            "outcome", "version",
+        )  # fmt: skip
+        with self.db:
+            self.db.execute(
+                f"INSERT INTO invocations ({', '.join(names)}) VALUES "
+                f"({', '.join('?' * len(names))})",
+                tuple(json.dumps(row[n]) if n == "argv" else row[n] for n in names),
+            )
+
+    def invocations(self) -> list[dict]:
+        """Every recorded command, oldest first (none in a database from before the table)."""
+        try:
+            cur = self.db.execute("SELECT * FROM invocations ORDER BY started")
+        except sqlite3.OperationalError:
+            return []
+        names = [d[0] for d in cur.description]
+        rows = [dict(zip(names, row, strict=True)) for row in cur]
+        for r in rows:
+            r["argv"] = json.loads(r["argv"])
+        return rows
 
     def runs(self, study: str | None = None) -> list[dict]:
         """Every run as a dict, ordered by key."""
