@@ -74,6 +74,35 @@ def test_miura_motion_is_exactly_rigid():
         assert np.allclose(edge_lengths(frame, shape.edges), shape.edge_lengths, rtol=1e-8)
 
 
+def test_one_dof_path_trace_of_a_miura_reaches_the_plane():
+    from rigidfold.deform.motion import trace_one_dof_path
+
+    shape = miura(3, 3, height=0.5)
+    trace = trace_one_dof_path(shape)
+    assert trace.reached_flat and trace.measure[-1] <= 0.1
+    assert np.all(np.diff(trace.measure) < 0)  # a Miura-ori unfolds monotonically
+    for x in trace.frames_towards_flat(10):
+        frame = x.reshape(-1, 3)
+        assert np.allclose(edge_lengths(frame, shape.edges), shape.edge_lengths, rtol=1e-10)
+    assert trace_one_dof_path(locked_miura(shape)) is None  # 0 DOF: no path
+    assert trace_one_dof_path(make_case("bezier", "1", seed=0).pattern) is None  # 21 DOF
+
+
+def test_symmetric_dome_one_dof_shape_turns_back_before_the_plane():
+    """The DOF-1 shape of the symmetric dome (Sec. 6.5, criterion S): its one folding path
+    reaches 0.288 of the design's folding measure and then folds up again, so the motion
+    fails, with the reason, and so does the OpenSees check (docs/results.md)."""
+    from pathlib import Path
+
+    from rigidfold.io.fold import pattern_from_fold
+
+    shape = pattern_from_fold(Path(__file__).parent / "data" / "dome_sym_dof1.fold")
+    motion = folding_motion(shape, develop(shape).coords2d)
+    assert motion.status == "failed"
+    assert "turns back at m = 0.288" in motion.message
+    assert len(motion.frames) >= 2  # the part that was traced, kept for inspection
+
+
 @pytest.fixture(scope="module")
 def one_dof_solution():
     run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)

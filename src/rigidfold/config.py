@@ -86,6 +86,11 @@ class Settings:
         Where no exact rigid-folding shape exists (an imperfect design near the flat state),
         the least-squares shape is accepted while every edge length is within this relative
         error.
+    motion_arc_step, motion_arc_max_steps : float, int
+        When the folding measure cannot be driven to 0 on a 1-DOF shape, its one folding path
+        is traced by pseudo-arclength continuation, with steps of at most this times the mean
+        edge length, for at most this many steps, to find out whether it reaches the plane or
+        turns back.
     """
 
     # design parameters of problem (6)
@@ -131,6 +136,8 @@ class Settings:
     motion_tol: float = 1e-13
     motion_max_iter: int = 50
     motion_length_tol: float = 1e-3
+    motion_arc_step: float = 0.2
+    motion_arc_max_steps: int = 400
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):

@@ -201,6 +201,13 @@ def folding_motion(
             message = f"no rigid-folding shape below {1 - s_done:.4f} of the design's folding"
             break
         path.append(x.copy())
+    if status == "failed":
+        trace = trace_one_dof_path(pattern, support_face=support_face, settings=settings)
+        if trace is not None and trace.reached_flat:
+            path, status = trace.frames_towards_flat(n), "ok"
+            message = "traced by pseudo-arclength: " + trace.message
+        elif trace is not None:
+            message += "; " + trace.message
     V = pattern.n_vertices
     frames = np.array([p.reshape(V, 3) for p in path])
     if status == "ok":
@@ -213,6 +220,113 @@ def folding_motion(
         np.linspace(0.0, 1.0, len(frames)) if status == "ok" else np.full(len(frames), np.nan)
     )
     return Motion(frames, parameter, err, status, message)
+
+
+@dataclass
+class PathTrace:
+    """The one folding path of a 1-DOF shape, traced from the design towards the plane.
+
+    points : (K, 3V) shapes along the path (the design first), at arclength steps
+    measure : (K,) folding measure m = |rho_free| of each point over the design's
+    reached_flat : the measure fell to the last motion level (1 / (motion_frames - 1))
+    min_measure : the smallest measure on the path
+    message : what happened, in words
+    """
+
+    points: np.ndarray
+    measure: np.ndarray
+    reached_flat: bool
+    min_measure: float
+    message: str
+
+    def frames_towards_flat(self, n: int) -> list[np.ndarray]:
+        """n points equally spaced in arclength, the design first (for :func:`_place_flat`)."""
+        idx = np.unique(np.round(np.linspace(0, len(self.points) - 1, n)).astype(int))
+        return [self.points[i].copy() for i in idx]
+
+
+def trace_one_dof_path(
+    pattern: CreasePattern, *, support_face: int | None = None, settings: Settings = DEFAULTS
+) -> PathTrace | None:
+    """Follow the folding path of a 1-DOF shape by pseudo-arclength continuation.
+
+    The rigid-folding constraints (edge lengths, fixed-crease angles, support gauge) leave a
+    curve of shapes through the design when the mechanism has one DOF. Each step predicts
+    along the curve's tangent (the null vector of the constraint Jacobian, oriented to keep
+    going the same way, first towards a smaller folding measure m) and corrects by
+    Gauss-Newton in the plane normal to the tangent, so the trace passes points where m
+    stops decreasing. It stops when m reaches the last motion level (the plane is in reach),
+    when m has risen well above its minimum (the path turns back: the shape does not unfold
+    to flat along its mechanism), or after ``motion_arc_max_steps``.
+
+    returns None when the shape does not have exactly one DOF (to ``mechanism_rank_tol``).
+    """
+    if support_face is None:
+        support_face = default_support_face(pattern)
+    cons = _Constraints(pattern, support_face)
+
+    def constraints(x):
+        r, J = cons(x, 0.0)
+        return r[:-1], J[:-1]
+
+    def tangent(J, previous=None):
+        _, sv, vt = np.linalg.svd(J)
+        t = vt[-1]
+        rank = int(np.sum(sv > settings.mechanism_rank_tol * sv[0]))
+        if previous is not None and t @ previous < 0:
+            t = -t
+        return t, J.shape[1] - rank
+
+    x = pattern.coords.ravel().copy()
+    m0 = cons.measure(x)
+    if m0 <= 0:
+        return None
+    t, nullity = tangent(constraints(x)[1])
+    if nullity != 1:
+        return None
+    probe = 1e-6 * float(np.mean(pattern.edge_lengths))
+    if cons.measure(x + probe * t) > cons.measure(x - probe * t):
+        t = -t
+    h_max = settings.motion_arc_step * float(np.mean(pattern.edge_lengths))
+    h, level = h_max / 4, 1.0 / max(int(settings.motion_frames) - 1, 1)
+    points, measure = [x.copy()], [1.0]
+    message = f"no step possible after {settings.motion_arc_max_steps} steps"
+    for _ in range(settings.motion_arc_max_steps):
+        guess = x + h * t
+        y = guess.copy()
+        for _ in range(settings.motion_max_iter):
+            r, J = constraints(y)
+            if not np.isfinite(r).all() or np.linalg.norm(r) <= settings.motion_tol:
+                break
+            A = np.vstack([J, t])
+            b = -np.concatenate([r, [t @ (y - guess)]])
+            y = y + scipy.linalg.lstsq(A, b, lapack_driver="gelsy")[0]
+        if not np.isfinite(r).all() or np.linalg.norm(r) > settings.motion_tol:
+            h /= 2
+            if h < 1e-6 * h_max:
+                message = f"the path could not be continued at m = {measure[-1]:.3f}"
+                break
+            continue
+        x = y
+        t, _ = tangent(J, t)
+        points.append(x.copy())
+        measure.append(cons.measure(x) / m0)
+        h = min(2 * h, h_max)
+        m_min = min(measure)
+        if measure[-1] <= level:
+            message = (
+                f"m falls from 1 to {measure[-1]:.3f} of the design's in {len(points) - 1} steps"
+            )
+            break
+        if measure[-1] > m_min + level / 2:
+            message = (
+                f"the 1-DOF folding path turns back at m = {m_min:.3f} of the design's folding "
+                "measure (pseudo-arclength trace): the shape does not unfold to flat along its "
+                "mechanism"
+            )
+            break
+    m = np.asarray(measure)
+    return PathTrace(np.asarray(points), m, bool(m[-1] <= level), float(m.min()), message)
 
 
 def _place_flat(path: np.ndarray, flat: np.ndarray) -> np.ndarray:
