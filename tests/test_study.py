@@ -221,3 +221,19 @@ def test_report_of_several_databases(uninterrupted, tmp_path):
     for stem in (uninterrupted.stem, "b"):
         png = tmp_path / "both" / f"{stem}_n_lock_pattern_1.png"
         assert png.is_file() and f"]({png.name})" in text
+
+
+def test_settings_added_later_at_their_default_are_compatible():
+    from rigidfold.config import DEFAULTS
+    from rigidfold.study.store import config_differences
+
+    current = StudyConfig().as_dict()
+    older = {**current, "settings": dict(current["settings"])}
+    del older["settings"]["motion_arc_step"]  # a database written before this setting existed
+    assert config_differences(older, current) == []
+    changed = StudyConfig(settings=DEFAULTS.with_(motion_arc_step=0.5)).as_dict()
+    assert config_differences(older, changed) == ["settings.motion_arc_step"]
+    assert config_differences(current, older) == ["settings.motion_arc_step"]  # one removed
+    assert config_differences(current, StudyConfig(deform=True).as_dict()) == ["deform"]
+    tighter = StudyConfig(settings=DEFAULTS.with_(f_tol=1e-9)).as_dict()
+    assert config_differences(current, tighter) == ["settings.f_tol"]

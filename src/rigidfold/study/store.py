@@ -106,6 +106,32 @@ class Key:
         return (self.study, self.seed, self.pattern, self.criterion, int(self.symmetric))
 
 
+def config_differences(stored: dict, current: dict) -> list[str]:
+    """Names of the configuration entries in which ``current`` differs from ``stored``.
+
+    A setting that a later rigidfold added (absent from ``stored["settings"]``) counts as
+    equal when ``current`` has it at its default: the default is what the older code did, so
+    a study can be resumed by a newer version as long as nothing it measures has changed.
+    """
+    from dataclasses import asdict
+
+    from rigidfold.config import DEFAULTS
+
+    defaults = asdict(DEFAULTS)
+    diff = []
+    for key in sorted(set(stored) | set(current)):
+        a, b = stored.get(key), current.get(key)
+        if key == "settings" and isinstance(a, dict) and isinstance(b, dict):
+            diff += [
+                f"settings.{k}"
+                for k in sorted(set(a) | set(b))
+                if a.get(k, defaults.get(k)) != b.get(k) or k not in b
+            ]
+        elif a != b:
+            diff.append(key)
+    return diff
+
+
 class Store:
     """A study database. ``config`` is checked against (or written to) the ``meta`` table."""
 
@@ -155,9 +181,8 @@ class Store:
             ) from None
         if row is None:
             raise ValueError(f"{str(self.path)!r} is not a rigidfold study database (no config)")
-        theirs = json.loads(row[0])
-        if theirs != json.loads(json.dumps(config, sort_keys=True)):
-            diff = sorted(k for k in set(theirs) | set(config) if theirs.get(k) != config.get(k))
+        diff = config_differences(json.loads(row[0]), json.loads(json.dumps(config)))
+        if diff:
             raise ValueError(
                 f"{str(self.path)!r} holds a study with another configuration "
                 f"(differs in: {', '.join(diff)}); use another --db"
