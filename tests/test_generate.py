@@ -127,3 +127,42 @@ def test_generate_uses_the_requested_support():
     run = generate(make_case("bezier", "1", seed=1), target_dof=20, seed=1, support_face=0)
     assert all(sol.mechanism.frame.support_face == 0 for sol in run.solutions)
     assert run.final_dof == 20
+
+
+def test_zero_dof_solution_ends_generation_as_in_step5():
+    """Paper, Step 5: a 0-DOF solution goes to Step 8; it is not a lock (Section 6.3)."""
+    case = make_case("bezier", "1", seed=1)
+    run = generate(case, criterion="shat", target_dof=0, seed=1)
+    assert run.stop_reason == "DOF 0 reached"
+    assert run.attempts[-1].outcome == "zero_dof" and run.attempts[-1].dof == 0
+    assert run.final_dof == 1 and run.n_reduce == 20
+    assert all(a.outcome != "lock" or a.dof >= 1 for a in run.attempts)
+
+
+@pytest.mark.parametrize("ends", [True, False])
+def test_zero_dof_on_the_way_ends_or_counts_as_lock(monkeypatch, ends):
+    """A 0-DOF solution while seeking DOF 1 ends generation (paper) or is a lock (option)."""
+    from types import SimpleNamespace
+
+    import rigidfold.generate as gen
+
+    real = gen.analyze
+    calls = {"n": 0}
+
+    def analyze(pattern, **kw):  # the third fixing (fourth solve) comes out with DOF 0
+        calls["n"] += 1
+        if calls["n"] == 4:
+            return SimpleNamespace(dof=0, has_lock=False, locked_creases=np.array([], int))
+        return real(pattern, **kw)
+
+    monkeypatch.setattr(gen, "analyze", analyze)
+    settings = DEFAULTS.with_(zero_dof_ends=ends)
+    run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="shat", seed=1)
+    fourth = run.attempts[3]
+    assert fourth.dof == 0
+    if ends:
+        assert fourth.outcome == "zero_dof" and run.stop_reason == "DOF 0 reached"
+        assert len(run.attempts) == 4 and run.final_dof == 19 and run.n_lock == 0
+    else:
+        assert fourth.outcome == "lock" and run.n_lock >= 1
+        assert run.attempts[4].dof == 18  # Step 7: the next candidate is tried

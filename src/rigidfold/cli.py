@@ -49,6 +49,12 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument("--criterion", default="shat", choices=["shat", "s", "ss", "random"])
     gen.add_argument("--target-dof", type=int, default=1)
     gen.add_argument(
+        "--retry-zero-dof",
+        action="store_true",
+        help="treat a 0-DOF solution as a lock and try the next crease (the paper's Step 5 "
+        "ends generation there)",
+    )
+    gen.add_argument(
         "--no-deform", action="store_true", help="skip the large-deformation check (Step 9)"
     )
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -156,6 +162,7 @@ def _case(args: argparse.Namespace):
         theta_min_deg=args.theta_min,
         theta_max_deg=args.theta_max,
         rho_bar_deg=args.rho_max,
+        zero_dof_ends=not getattr(args, "retry_zero_dof", False),
     )
     return make_case(
         args.surface,

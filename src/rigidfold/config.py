@@ -26,6 +26,14 @@ class Settings:
     f_tol : float
         A solution of (6) is accepted when F <= f_tol (paper: 1e-7).
 
+    Generation (Steps 5-7)
+    ----------------------
+    zero_dof_ends : bool
+        Step 5 of the paper: a solution of (6) whose mechanism has DOF 0 ends generation (it
+        goes to Step 8; not counted in N_reduce, N_lock or N_exceed). ``False``: while the
+        target DOF is >= 1, count it as a lock and try the next candidate (Step 7) instead,
+        which reaches the target more often at the price of more solves.
+
     Tolerances
     ----------
     constraint_tol : float
@@ -99,6 +107,8 @@ class Settings:
     theta_max: float = 2 * math.pi / 3
     rho_bar: float | None = None
     f_tol: float = 1e-7
+    # generation procedure (Steps 5-7)
+    zero_dof_ends: bool = True
     # solver tolerances
     constraint_tol: float = 1e-8
     ipopt_tol: float = 1e-8

@@ -8,8 +8,9 @@
     Step 5  analyse the mechanism:
               DOF >= 1, no locked crease   -> accept, Step 6
               DOF >= 1, a locked crease    -> Step 7                       (N_lock += 1)
-              DOF = 0                      -> end when the target DOF is 0 (not counted, as
-                                              in Section 6.3); a lock when the target is >= 1
+              DOF = 0                      -> end, to Step 8 (not counted, Section 6.3);
+                                              with ``zero_dof_ends=False`` and a target DOF
+                                              >= 1: a lock, Step 7
     Step 6  rank the free creases of the last accepted shape by the criterion; fix the best
     Step 7  E_fix = {} -> no developable polyhedron; otherwise replace the last fixed crease
             (group) with the next candidate of that ranking
@@ -154,9 +155,10 @@ def generate(
         if mech is None:
             outcome = "exceed"
         elif mech.dof == 0:
-            # the final cycle of the paper (target 0); with target >= 1 an over-reduction:
-            # every folded free crease has stopped moving, i.e. locked
-            outcome = "zero_dof" if target_dof == 0 else "lock"
+            # the paper's final cycle (Step 5 -> Step 8); optionally, with a target >= 1, an
+            # over-reduction counted as a lock: every folded free crease has stopped moving
+            zero_ends = settings.zero_dof_ends or target_dof == 0
+            outcome = "zero_dof" if zero_ends else "lock"
         elif mech.has_lock:
             outcome = "lock"
         else:
