@@ -12,8 +12,15 @@ import time
 
 import pytest
 
-from rigidfold.study import Key, Store, StudyConfig, open_readonly, plan
-from rigidfold.study.report import costs, markdown, paired_comparisons, tables_5_6, write_report
+from rigidfold.study import Key, Store, StudyConfig, open_readonly, plan, preset
+from rigidfold.study.report import (
+    costs,
+    locks_by_stage,
+    markdown,
+    paired_comparisons,
+    tables_5_6,
+    write_report,
+)
 
 STUDY = ["--surfaces", "3", "--patterns", "1", "--criteria", "shat,s", "--no-deform"]
 
@@ -144,12 +151,22 @@ def test_plan_and_store_units(tmp_path):
     assert len(store.runs()) == 1
 
 
+def test_presets_can_be_combined_longest_runs_first():
+    keys = preset("dome,hp")
+    assert {(k.study, k.symmetric) for k in keys} == {
+        (s, m) for s in ("dome", "hp") for m in (True, False)
+    }
+    assert [k.symmetric for k in keys] == [False, False, True, True]
+    assert preset("hp") == sorted(preset("hp"), key=lambda k: k.symmetric)
+
+
 @pytest.mark.parametrize(
     ("extra", "needle"),
     [
         (["--criteria", "shat,best"], "unknown criterion 'best'"),
         (["--patterns", "7"], "unknown pattern '7'"),
         (["--preset", "moon"], "unknown preset 'moon'"),
+        (["--preset", "dome,moon"], "unknown preset 'moon'"),
         (["--surfaces", "0"], "--surfaces must be >= 1"),
         (["--workers", "0"], "--workers must be >= 1"),
     ],
@@ -237,3 +254,13 @@ def test_settings_added_later_at_their_default_are_compatible():
     assert config_differences(current, StudyConfig(deform=True).as_dict()) == ["deform"]
     tighter = StudyConfig(settings=DEFAULTS.with_(f_tol=1e-9)).as_dict()
     assert config_differences(current, tighter) == ["settings.f_tol"]
+
+
+def test_locks_by_stage_adds_up_to_n_lock(uninterrupted):
+    store = open_readonly(uninterrupted)
+    stages = {r["criterion"]: r for r in locks_by_stage(store)}
+    for row in tables_5_6(store):
+        st = stages[row["criterion"]]
+        assert st["runs"] == row["n"] == 3
+        assert sum(st["per_stage"]) == pytest.approx(row["n_lock"])
+    assert "### Where the locks happen" in markdown(store)

@@ -105,7 +105,9 @@ def build_parser() -> argparse.ArgumentParser:
     stu.add_argument("--criteria", default="shat,s,ss,random", help="comma-separated")
     stu.add_argument("--surfaces", type=int, default=100, help="number of Bezier seeds")
     stu.add_argument("--first-seed", type=int, default=0)
-    stu.add_argument("--preset", help="dome or hp: Sections 6.5-6.6 instead of Bezier surfaces")
+    stu.add_argument(
+        "--preset", help="dome, hp or dome,hp: Sections 6.5-6.6 instead of Bezier surfaces"
+    )
     stu.add_argument("--db", required=True, metavar="DB", help="SQLite file (created if absent)")
     where = stu.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, default=2, help="local worker processes")

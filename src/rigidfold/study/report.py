@@ -121,6 +121,55 @@ def costs(store: Store) -> list[dict]:
     return rows
 
 
+STAGES = ((6, None), (4, 5), (3, 3), (2, 2))
+"""DOF of the shape being reduced, grouped as (low, high) for :func:`locks_by_stage`."""
+
+
+def _stage_label(lo: int, hi: int | None) -> str:
+    return f">= {lo}" if hi is None else (f"{lo}" if lo == hi else f"{lo}-{hi}")
+
+
+def locks_by_stage(store: Store) -> list[dict]:
+    """Where the locks happen: per (pattern, criterion) of the Bezier study, mean N_lock per
+    run split by the DOF of the accepted shape whose crease was being fixed (:data:`STAGES`),
+    and the share of runs that ended with no candidate left."""
+    cur = store.db.execute(
+        "SELECT pattern, criterion, seed, dof, outcome FROM attempts WHERE study = 'bezier' "
+        "ORDER BY pattern, criterion, seed, idx"
+    )
+    counts: dict[tuple[str, str], dict] = {}
+    stage = None
+    last = None
+    for pattern, crit, seed, dof, outcome in cur:
+        if (pattern, crit, seed) != last:  # a new run: its first solve sets the stage
+            last, stage = (pattern, crit, seed), None
+            c = counts.setdefault((pattern, crit), {"seeds": set(), "locks": [0] * len(STAGES)})
+            c["seeds"].add(seed)
+        if outcome == "accepted":
+            stage = dof
+        elif outcome == "lock" and stage is not None:
+            for k, (lo, hi) in enumerate(STAGES):
+                if stage >= lo and (hi is None or stage <= hi):
+                    counts[(pattern, crit)]["locks"][k] += 1
+    ended = {(r["pattern"], r["criterion"]): 0 for r in store.runs("bezier")}
+    for r in store.runs("bezier"):
+        if r["status"] == "no candidate crease succeeds":
+            ended[(r["pattern"], r["criterion"])] += 1
+    out = []
+    for (pattern, crit), c in sorted(counts.items()):
+        n = len(c["seeds"])
+        out.append(
+            {
+                "pattern": pattern,
+                "criterion": crit,
+                "runs": n,
+                "per_stage": [k / n for k in c["locks"]],
+                "no_candidate": ended.get((pattern, crit), 0),
+            }
+        )
+    return out
+
+
 def tables_7_8(store: Store) -> list[dict]:
     """Per preset run (dome / hp, with / without symmetry): the rows of Tables 7 and 8."""
     out = []
@@ -224,6 +273,9 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
     pairs = paired_comparisons(store)
     if pairs:
         lines += _ordering_lines(t56, pairs)
+    stages = locks_by_stage(store)
+    if stages:
+        lines += _stage_lines(stages)
     t78 = tables_7_8(store)
     for name, number in (("dome", "Table 7"), ("hp", "Table 8")):
         runs = [r for r in t78 if r["preset"] == name]
@@ -282,6 +334,26 @@ def _ordering_lines(t56: list[dict], pairs: list[dict]) -> list[str]:
             f"| {c['pattern']} | {LABEL[c['a']]} - {LABEL[c['b']]} | {c['n']} "
             f"| {_fmt(c['mean_diff'], c['se'])} | {c['less']} / {c['equal']} / {c['more']} "
             f"| {c['p_value']:.2g} |"
+        )
+    return [*lines, ""]
+
+
+def _stage_lines(stages: list[dict]) -> list[str]:
+    heads = " | ".join(f"DOF {_stage_label(lo, hi)}" for lo, hi in STAGES)
+    lines = [
+        "### Where the locks happen",
+        "",
+        "Mean N_lock per run by the DOF of the accepted shape whose crease was being fixed, and "
+        "the runs that ended because every candidate crease locked (or missed F_tol).",
+        "",
+        f"| pattern | criterion | runs | {heads} | ended with no candidate |",
+        "|---|---|---|" + "---|" * len(STAGES) + "---|",
+    ]
+    for r in stages:
+        cells = " | ".join(f"{v:.2f}" for v in r["per_stage"])
+        lines.append(
+            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {cells} "
+            f"| {r['no_candidate']}/{r['runs']} |"
         )
     return [*lines, ""]
 

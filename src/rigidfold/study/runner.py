@@ -75,9 +75,17 @@ def plan(
 
 
 def preset(name: str) -> list[Key]:
-    if name not in PRESETS:
-        raise ValueError(f"unknown preset {name!r} (choose from {', '.join(PRESETS)})")
-    return list(PRESETS[name])
+    """The runs of one preset, or of several given as ``"dome,hp"``.
+
+    The asymmetric runs (315 variables, the longest) come first so that the symmetric ones
+    fill the workers while they run.
+    """
+    names = [n.strip() for n in name.split(",") if n.strip()]
+    for n in names or [name]:
+        if n not in PRESETS:
+            raise ValueError(f"unknown preset {n!r} (choose from {', '.join(PRESETS)})")
+    keys = [k for n in dict.fromkeys(names) for k in PRESETS[n]]
+    return sorted(keys, key=lambda k: k.symmetric)
 
 
 def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
