@@ -297,7 +297,8 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
                 f"{_fmt(r['values'][k])} | {_fmt(r['paper'][k]) if r['paper'] else '-'}"
                 for r in runs
             )
-            lines.append(f"| {label} | {cells} |")
+            cell = label.replace("|", "\\|")  # |dl| inside a Markdown table cell
+            lines.append(f"| {cell} | {cells} |")
         lines.append("")
     lines += _cost_lines(store)
     return lines
