@@ -9,7 +9,12 @@ from rigidfold import patterns
 from rigidfold.mesh import CreasePattern
 
 # Table 4 (E of pattern 2 corrected from 117 to 129, see patterns.grids.pattern2)
-TABLE4 = {"1": (49, 120, 72, 21), "2": (52, 129, 78, 21), "11": (121, 320, 200, 37)}
+TABLE4 = {
+    "1": (49, 120, 72, 21),
+    "1c": (49, 120, 72, 21),
+    "2": (52, 129, 78, 21),
+    "11": (121, 320, 200, 37),
+}
 
 
 @pytest.mark.parametrize("name", list(TABLE4))
@@ -51,3 +56,12 @@ def test_grid11_mirror_symmetric_about_four_planes():
 def test_unknown_pattern():
     with pytest.raises(ValueError, match="unknown pattern '7'"):
         patterns.plan("7")
+
+
+@pytest.mark.parametrize(("name", "flaps"), [("1", 2), ("1c", 0), ("2", 0), ("11", 0)])
+def test_corner_flaps(name, flaps):
+    """Boundary vertices of degree 2: triangles hinged on one crease (independent flaps)."""
+    xy, faces = patterns.plan(name)
+    shape = CreasePattern.from_faces(xy, faces)
+    degree = np.bincount(shape.edges.ravel(), minlength=shape.n_vertices)
+    assert int((degree == 2).sum()) == flaps

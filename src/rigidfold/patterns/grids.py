@@ -55,6 +55,18 @@ def pattern1() -> tuple[np.ndarray, np.ndarray]:
     return _grid_points(7, 0.5), _split_squares(7, towards_centre=False)
 
 
+def pattern1c() -> tuple[np.ndarray, np.ndarray]:
+    """Pattern 1 with every diagonal pointing at the centre (1.5, 1.5): V, E, F as pattern 1.
+
+    In pattern 1 the squares at the corners (0, 3) and (3, 0) are cut by a chord that leaves
+    a corner vertex of degree 2: a triangle hinged on one crease, an independent one-DOF flap
+    in every shape. Here every corner vertex has degree 3 and there is no such flap; the
+    layout is mirror-symmetric about both mid-lines and both diagonals. Which of the two the
+    paper's Figure 5 shows is not known.
+    """
+    return _grid_points(7, 0.5), _split_squares(7, towards_centre=True)
+
+
 def pattern2() -> tuple[np.ndarray, np.ndarray]:
     """Crease pattern 2: staggered rows, Delaunay triangulation, V = 52, E = 129, F = 78.
 
