@@ -26,6 +26,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_develop.py
 	$(PY) benchmarks/bench_deform.py
 	$(PY) benchmarks/bench_study.py
+	$(PY) benchmarks/bench_cpu_scaling.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
