@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -153,10 +154,11 @@ def locks_by_stage(store: Store) -> list[dict]:
             for k, (lo, hi) in enumerate(STAGES):
                 if stage >= lo and (hi is None or stage <= hi):
                     counts[(pattern, crit)]["locks"][k] += 1
-    ended = {(r["pattern"], r["criterion"]): 0 for r in store.runs("bezier")}
-    for r in store.runs("bezier"):
-        if r["status"] == "no candidate crease succeeds":
-            ended[(r["pattern"], r["criterion"])] += 1
+    ended = Counter(
+        (r["pattern"], r["criterion"])
+        for r in store.runs("bezier")
+        if r["status"] == "no candidate crease succeeds"
+    )
     out = []
     for (pattern, crit), c in sorted(counts.items()):
         n = len(c["seeds"])
@@ -166,7 +168,7 @@ def locks_by_stage(store: Store) -> list[dict]:
                 "criterion": crit,
                 "runs": n,
                 "per_stage": [k / n for k in c["locks"]],
-                "no_candidate": ended.get((pattern, crit), 0),
+                "no_candidate": ended[(pattern, crit)],
             }
         )
     return out
