@@ -22,8 +22,8 @@ from rigidfold.selection import predicted_locks, score_creases
 
 @pytest.fixture(scope="module")
 def seven_dof():
-    case = make_case("bezier", "1", seed=0)
-    run = generate(case, criterion="shat", target_dof=7, seed=0)
+    case = make_case("bezier", "1", seed=2)
+    run = generate(case, criterion="shat", target_dof=7, seed=2)
     assert run.final_dof == 7
     return case, run.solutions[-1]
 
@@ -46,8 +46,8 @@ def test_generate_pattern1_reaches_one_dof_without_locks():
 
 
 def test_generate_counts_locks_and_retries_the_next_candidate():
-    """Bezier seed 3 meets two locks on its last step; Step 7 tries the next candidates."""
-    run = generate(make_case("bezier", "1", seed=3), criterion="shat", seed=3)
+    """Bezier seed 2 meets two locks on its last step; Step 7 tries the next candidates."""
+    run = generate(make_case("bezier", "1", seed=2), criterion="shat", seed=2)
     assert run.final_dof == 1
     locks = [a for a in run.attempts if a.outcome == "lock"]
     assert run.n_lock == len(locks) >= 1

@@ -11,7 +11,7 @@ from rigidfold.mesh import CreasePattern
 # Table 4 (E of pattern 2 corrected from 117 to 129, see patterns.grids.pattern2)
 TABLE4 = {
     "1": (49, 120, 72, 21),
-    "1c": (49, 120, 72, 21),
+    "1p": (49, 120, 72, 21),
     "2": (52, 129, 78, 21),
     "11": (121, 320, 200, 37),
 }
@@ -40,8 +40,9 @@ def test_pattern2_side_angles_below_theta_min():
     assert np.degrees(shape.corner_angles.min()) == pytest.approx(26.565, abs=1e-3)
 
 
-def test_grid11_mirror_symmetric_about_four_planes():
-    xy, faces = patterns.plan("11")
+@pytest.mark.parametrize("name", ["1", "11"])
+def test_grid_mirror_symmetric_about_four_planes(name):
+    xy, faces = patterns.plan(name)
     tris = {tuple(sorted(map(tuple, np.round(xy[f], 9).tolist()))) for f in faces}
     for mirror in (
         lambda p: np.column_stack([3 - p[:, 0], p[:, 1]]),
@@ -58,7 +59,7 @@ def test_unknown_pattern():
         patterns.plan("7")
 
 
-@pytest.mark.parametrize(("name", "flaps"), [("1", 2), ("1c", 0), ("2", 0), ("11", 0)])
+@pytest.mark.parametrize(("name", "flaps"), [("1", 0), ("1p", 2), ("2", 0), ("11", 0)])
 def test_corner_flaps(name, flaps):
     """Boundary vertices of degree 2: triangles hinged on one crease (independent flaps)."""
     xy, faces = patterns.plan(name)

@@ -141,7 +141,7 @@ def _case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--surface", required=True, choices=["bezier", "dome", "hp", "expr"])
     p.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
     p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
-    p.add_argument("--pattern", required=True, choices=["1", "1c", "2", "11"])
+    p.add_argument("--pattern", required=True, choices=["1", "1p", "2", "11"])
     p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
     p.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp", "slsqp-fd"])
     p.add_argument("--dz", type=float, default=DEFAULTS.dz, help="bound on |dz| in metres")

@@ -7,12 +7,12 @@ from collections.abc import Callable
 import numpy as np
 
 from rigidfold.mesh import CreasePattern
-from rigidfold.patterns.grids import grid11, pattern1, pattern1c, pattern2
+from rigidfold.patterns.grids import grid11, pattern1, pattern1p, pattern2
 from rigidfold.patterns.miura import miura
 
 PATTERNS: dict[str, Callable[[], tuple[np.ndarray, np.ndarray]]] = {
     "1": pattern1,
-    "1c": pattern1c,
+    "1p": pattern1p,
     "2": pattern2,
     "11": grid11,
 }
@@ -45,4 +45,4 @@ def build(name: str, surface) -> CreasePattern:
     return CreasePattern.from_faces(np.column_stack([xy, z]), faces)
 
 
-__all__ = ["PATTERNS", "build", "grid11", "miura", "pattern1", "pattern1c", "pattern2", "plan"]
+__all__ = ["PATTERNS", "build", "grid11", "miura", "pattern1", "pattern1p", "pattern2", "plan"]

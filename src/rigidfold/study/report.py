@@ -17,7 +17,7 @@ from rigidfold.study.paper import CITATION, TABLE_7_8_ROWS, TABLES_5_6, TABLES_7
 from rigidfold.study.store import Store
 
 ORDER = ("s", "shat", "ss", "random")
-PAPER_PATTERN = {"1c": "1"}
+PAPER_PATTERN = {"1p": "1"}
 """Layout variants compared with the paper's table of the pattern they vary."""
 LABEL = {"s": "S", "shat": "S-hat", "ss": "S^S", "random": "random"}
 
@@ -253,7 +253,7 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
     for pattern in sorted({r["pattern"] for r in t56}):
         rows = [r for r in t56 if r["pattern"] == pattern]
         lo, hi = rows[0]["seeds"]
-        number = {"1": "Table 5", "1c": "Table 5", "2": "Table 6"}.get(pattern, "")
+        number = {"1": "Table 5", "1p": "Table 5", "2": "Table 6"}.get(pattern, "")
         lines += [
             f"### Crease pattern {pattern}" + (f" (paper's {number})" if number else ""),
             "",

@@ -25,7 +25,7 @@ PRESETS = {
     "dome": [Key("dome", 0, "11", "s", True), Key("dome", 0, "11", "s", False)],
     "hp": [Key("hp", 0, "11", "s", True), Key("hp", 0, "11", "s", False)],
 }
-BEZIER_PATTERNS = ("1", "1c", "2", "11")
+BEZIER_PATTERNS = ("1", "1p", "2", "11")
 
 
 @dataclass(frozen=True)
