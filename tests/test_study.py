@@ -10,11 +10,13 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 from rigidfold.study import Key, Store, StudyConfig, open_readonly, plan, preset
 from rigidfold.study.report import (
     costs,
+    dof_steps,
     locks_by_stage,
     markdown,
     paired_comparisons,
@@ -264,3 +266,17 @@ def test_locks_by_stage_adds_up_to_n_lock(uninterrupted):
         assert st["runs"] == row["n"] == 3
         assert sum(st["per_stage"]) == pytest.approx(row["n_lock"])
     assert "### Where the locks happen" in markdown(store)
+
+
+def test_dof_steps_add_up_to_the_dof_reduced(uninterrupted):
+    """Every accepted fix is one step; the signed steps sum to the DOF reduced per run."""
+    store = open_readonly(uninterrupted)
+    steps = {r["criterion"]: r for r in dof_steps(store)}
+    for row in tables_5_6(store):
+        st = steps[row["criterion"]]
+        assert st["runs"] == row["n"] == 3
+        runs = [r for r in store.runs("bezier") if r["criterion"] == row["criterion"]]
+        accepted_fixes = np.mean([r["n_solutions"] - 1 for r in runs])
+        assert sum(st["per_kind"].values()) == pytest.approx(accepted_fixes)
+        assert st["per_kind"]["-1"] >= 0
+    assert "### How fixing a crease changes the DOF" in markdown(store)
