@@ -1,0 +1,65 @@
+"""Diagnostic: the singular values around the DOF cut of every accepted shape of one run.
+
+Run with ``python benchmarks/rank_gap.py [--pattern 2] [--criterion ss] [--seed 7]
+[--rank-tol 1e-9]``.
+
+For each accepted solution of ``generate`` it prints the DOF, its change from the shape
+before (one more fixed crease), and the smallest singular values of the kinematic constraint
+matrix relative to the largest: the DOF counted ones plus the next two. Values near 1e-16
+are modes of the shape; values of 1e-12 to 1e-8 are near-singular directions that
+``Settings.mechanism_rank_tol`` decides about; the genuine non-zero values are 1e-5 and up.
+The shapes whose DOF stays or rises after a fix ("How fixing a crease changes the DOF" in
+the study report) are the ones to look at.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from rigidfold.case import make_case
+from rigidfold.config import DEFAULTS
+from rigidfold.generate import generate
+from rigidfold.mechanism import kinematics
+
+
+def relative_singular_values(solution) -> np.ndarray:
+    """Singular values of the constraint matrix of an accepted shape over the largest,
+    ascending, padded with zeros to the number of unknowns: (n,) float64."""
+    frame = solution.mechanism.frame
+    C = kinematics.constraint_matrix(solution.result.pattern, frame.support_face)
+    sv = np.linalg.svd(C, compute_uv=False)
+    full = np.concatenate([sv, np.zeros(max(0, C.shape[1] - len(sv)))])
+    return np.sort(full / sv[0])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--pattern", default="2")
+    parser.add_argument("--criterion", default="ss")
+    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--rank-tol", type=float, default=DEFAULTS.mechanism_rank_tol)
+    args = parser.parse_args()
+    settings = DEFAULTS.with_(mechanism_rank_tol=args.rank_tol)
+    case = make_case("bezier", args.pattern, seed=args.seed, settings=settings)
+    previous: list[int] = []
+
+    def on_solution(run, solution) -> None:
+        dof = solution.mechanism.dof
+        step = f"{dof - previous[-1]:+d}" if previous else "  "
+        previous.append(dof)
+        rel = relative_singular_values(solution)[: dof + 2]
+        values = " ".join(f"{x:.1e}" for x in rel)
+        print(f"solution {solution.step:3d}  DOF {dof:2d} ({step})  {values}", flush=True)
+
+    run = generate(case, criterion=args.criterion, seed=args.seed, on_solution=on_solution)
+    print(
+        f"pattern {args.pattern} {args.criterion} seed {args.seed} rank tol {args.rank_tol:g}: "
+        f"N_lock {run.n_lock}, N_reduce {run.n_reduce}, {len(run.attempts)} solves, "
+        f"{run.stop_reason}"
+    )
+
+
+if __name__ == "__main__":
+    main()
