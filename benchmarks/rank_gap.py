@@ -1,7 +1,7 @@
 """Diagnostic: the singular values around the DOF cut of every accepted shape of one run.
 
 Run with ``python benchmarks/rank_gap.py [--pattern 2] [--criterion ss] [--seed 7]
-[--rank-tol 1e-9]``.
+[--rank-tol 1e-9] [--solver ipopt]``.
 
 For each accepted solution of ``generate`` it prints the DOF, its change from the shape
 before (one more fixed crease), and the smallest singular values of the kinematic constraint
@@ -40,9 +40,15 @@ def main() -> None:
     parser.add_argument("--criterion", default="ss")
     parser.add_argument("--seed", type=int, default=7)
     parser.add_argument("--rank-tol", type=float, default=DEFAULTS.mechanism_rank_tol)
+    parser.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp"])
     args = parser.parse_args()
-    settings = DEFAULTS.with_(mechanism_rank_tol=args.rank_tol)
-    case = make_case("bezier", args.pattern, seed=args.seed, settings=settings)
+    if not 0 < args.rank_tol < 1:
+        parser.error(f"--rank-tol must be in (0, 1), got {args.rank_tol:g}")
+    try:
+        settings = DEFAULTS.with_(mechanism_rank_tol=args.rank_tol)
+        case = make_case("bezier", args.pattern, seed=args.seed, settings=settings)
+    except ValueError as exc:
+        parser.error(str(exc))
     previous: list[int] = []
 
     def on_solution(run, solution) -> None:
@@ -53,9 +59,19 @@ def main() -> None:
         values = " ".join(f"{x:.1e}" for x in rel)
         print(f"solution {solution.step:3d}  DOF {dof:2d} ({step})  {values}", flush=True)
 
-    run = generate(case, criterion=args.criterion, seed=args.seed, on_solution=on_solution)
+    try:
+        run = generate(
+            case,
+            criterion=args.criterion,
+            seed=args.seed,
+            solver=args.solver,
+            on_solution=on_solution,
+        )
+    except ValueError as exc:
+        parser.error(str(exc))
     print(
-        f"pattern {args.pattern} {args.criterion} seed {args.seed} rank tol {args.rank_tol:g}: "
+        f"pattern {args.pattern} {args.criterion} seed {args.seed} {args.solver} "
+        f"rank tol {args.rank_tol:g}: "
         f"N_lock {run.n_lock}, N_reduce {run.n_reduce}, {len(run.attempts)} solves, "
         f"{run.stop_reason}"
     )

@@ -55,7 +55,8 @@ def pattern1() -> tuple[np.ndarray, np.ndarray]:
     :func:`pattern1p` (all diagonals parallel) because 1p's corners (0, 3) and (3, 0) are
     triangles hinged on a single crease, independent one-DOF flaps in every shape, and
     because with this layout the random criterion locks as often as in Table 5 (mean N_lock
-    7.36 over 100 surfaces against the paper's 7.32; 99.5 with 1p; ``docs/results.md``).
+    7.59 over 100 surfaces against the paper's 7.32, ``docs/results.md``; 99.5 with 1p,
+    ``docs/earlier_results.md``).
     """
     return _grid_points(7, 0.5), _split_squares(7, towards_centre=True)
 

@@ -132,28 +132,33 @@ def _stage_label(lo: int, hi: int | None) -> str:
     return f">= {lo}" if hi is None else (f"{lo}" if lo == hi else f"{lo}-{hi}")
 
 
+def _bezier_runs(store: Store, columns: str, where: str = ""):
+    """The attempts of every Bezier run in solve order: yields ((pattern, criterion), seed,
+    [(columns...), ...]) per run, from one query."""
+    cur = store.db.execute(
+        f"SELECT pattern, criterion, seed, {columns} FROM attempts WHERE study = 'bezier' "
+        f"{where} ORDER BY pattern, criterion, seed, idx"
+    )
+    for (pattern, crit, seed), rows in itertools.groupby(cur, key=lambda r: r[:3]):
+        yield (pattern, crit), seed, [r[3:] for r in rows]
+
+
 def locks_by_stage(store: Store) -> list[dict]:
     """Where the locks happen: per (pattern, criterion) of the Bezier study, mean N_lock per
     run split by the DOF of the accepted shape whose crease was being fixed (:data:`STAGES`),
     and the share of runs that ended with no candidate left."""
-    cur = store.db.execute(
-        "SELECT pattern, criterion, seed, dof, outcome FROM attempts WHERE study = 'bezier' "
-        "ORDER BY pattern, criterion, seed, idx"
-    )
     counts: dict[tuple[str, str], dict] = {}
-    stage = None
-    last = None
-    for pattern, crit, seed, dof, outcome in cur:
-        if (pattern, crit, seed) != last:  # a new run: its first solve sets the stage
-            last, stage = (pattern, crit, seed), None
-            c = counts.setdefault((pattern, crit), {"seeds": set(), "locks": [0] * len(STAGES)})
-            c["seeds"].add(seed)
-        if outcome == "accepted":
-            stage = dof
-        elif outcome == "lock" and stage is not None:
-            for k, (lo, hi) in enumerate(STAGES):
-                if stage >= lo and (hi is None or stage <= hi):
-                    counts[(pattern, crit)]["locks"][k] += 1
+    for group, seed, attempts in _bezier_runs(store, "dof, outcome"):
+        c = counts.setdefault(group, {"seeds": set(), "locks": [0] * len(STAGES)})
+        c["seeds"].add(seed)
+        stage = None  # the DOF of the last accepted shape of this run
+        for dof, outcome in attempts:
+            if outcome == "accepted":
+                stage = dof
+            elif outcome == "lock" and stage is not None:
+                for k, (lo, hi) in enumerate(STAGES):
+                    if stage >= lo and (hi is None or stage <= hi):
+                        c["locks"][k] += 1
     ended = Counter(
         (r["pattern"], r["criterion"])
         for r in store.runs("bezier")
@@ -195,20 +200,12 @@ def dof_steps(store: Store) -> list[dict]:
     may however gain modes (e.g. creases that became coplanar), so the DOF can stay or rise
     and the run needs more than one fix per DOF reduced.
     """
-    cur = store.db.execute(
-        "SELECT pattern, criterion, seed, dof FROM attempts "
-        "WHERE study = 'bezier' AND outcome = 'accepted' ORDER BY pattern, criterion, seed, idx"
-    )
     counts: dict[tuple[str, str], dict] = {}
-    last, prev = None, None
-    for pattern, crit, seed, dof in cur:
-        c = counts.setdefault((pattern, crit), {"seeds": set(), "kinds": Counter()})
-        if (pattern, crit, seed) != last:  # a new run: its first solution has no step
-            last, prev = (pattern, crit, seed), dof
-            c["seeds"].add(seed)
-            continue
-        c["kinds"][_step_kind(dof - prev)] += 1
-        prev = dof
+    for group, seed, attempts in _bezier_runs(store, "dof", "AND outcome = 'accepted'"):
+        c = counts.setdefault(group, {"seeds": set(), "kinds": Counter()})
+        c["seeds"].add(seed)
+        dofs = [dof for (dof,) in attempts]  # the first solution has no step
+        c["kinds"].update(_step_kind(b - a) for a, b in itertools.pairwise(dofs))
     out = []
     for (pattern, crit), c in sorted(counts.items()):
         n = len(c["seeds"])
@@ -302,7 +299,7 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
     for pattern in sorted({r["pattern"] for r in t56}):
         rows = [r for r in t56 if r["pattern"] == pattern]
         lo, hi = rows[0]["seeds"]
-        number = {"1": "Table 5", "1p": "Table 5", "2": "Table 6"}.get(pattern, "")
+        number = {"1": "Table 5", "2": "Table 6"}.get(PAPER_PATTERN.get(pattern, pattern), "")
         lines += [
             f"### Crease pattern {pattern}" + (f" (paper's {number})" if number else ""),
             "",
