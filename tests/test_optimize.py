@@ -207,3 +207,91 @@ def test_bad_fixed_selection(bezier_problem):
         bezier_problem.fixed_mask([int(bezier_problem.pattern.boundary_edges[0])])
     with pytest.raises(ValueError, match="unknown solver"):
         bezier_problem.solve(solver="newton")
+
+
+# ---------------------------------------------------------------- closed-form Hessian
+@pytest.mark.parametrize(
+    ("surface", "pattern", "symmetric", "rho_bar"),
+    [
+        ("bezier", "1", False, None),
+        ("bezier", "2", False, None),
+        ("bezier", "1p", False, 1.0),
+        ("dome", "11", True, None),
+        ("hp", "11", True, 0.5),
+    ],
+)
+def test_closed_form_hessian_equals_casadi(surface, pattern, symmetric, rho_bar):
+    """The element-assembled Hessian of the Lagrangian is CasADi's exact one, to round-off."""
+    import casadi as ca
+
+    from rigidfold.optimize.hessian import ClosedFormHessian
+
+    settings = DEFAULTS.with_(rho_bar=rho_bar)
+    case = make_case(surface, pattern, seed=7, symmetric=symmetric, settings=settings)
+    problem = case.problem(build_ipopt=False)
+    xi, w = problem._xi, problem._w
+    lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", problem._g.shape[0])
+    lagrangian = lam_f * problem._F + ca.dot(lam_g, problem._g)
+    reference = ca.Function("H", [xi, w, lam_f, lam_g], [ca.triu(ca.hessian(lagrangian, xi)[0])])
+    hessian = ClosedFormHessian(problem)
+    rng = np.random.default_rng(0)
+    for trial in range(2):
+        x0 = problem.start_point() + 0.01 * rng.standard_normal(problem.n_variables)
+        weights = (rng.random(case.pattern.n_edges) < 0.3).astype(float)
+        lam = rng.standard_normal(problem._g.shape[0])
+        ref = reference(x0, weights, 1.0 + trial, lam)
+        mine = ca.DM(hessian.sparsity, hessian.values(x0, weights, 1.0 + trial, lam))
+        assert hessian.sparsity.nnz() == ref.nnz()
+        scale = float(ca.norm_inf(ref))
+        assert float(ca.norm_inf(ref - mine)) <= 1e-12 * scale
+
+
+def test_element_derivatives_match_finite_differences():
+    from rigidfold.optimize.hessian import angle_derivatives, normal_cosine_derivatives
+
+    rng = np.random.default_rng(3)
+    uv = rng.standard_normal((4, 6))
+    theta, grad, hess = angle_derivatives(uv[:, :3], uv[:, 3:])
+    cos = np.einsum("ki,ki->k", uv[:, :3], uv[:, 3:]) / (
+        np.linalg.norm(uv[:, :3], axis=1) * np.linalg.norm(uv[:, 3:], axis=1)
+    )
+    assert np.allclose(theta, np.arccos(cos))
+    h = 1e-6
+    for j in range(6):
+        step = np.zeros(6)
+        step[j] = h
+        tp, gp, _ = angle_derivatives((uv + step)[:, :3], (uv + step)[:, 3:])
+        tm, gm, _ = angle_derivatives((uv - step)[:, :3], (uv - step)[:, 3:])
+        assert np.allclose(grad[:, j], (tp - tm) / (2 * h), atol=1e-8)
+        assert np.allclose(hess[:, :, j], (gp - gm) / (2 * h), atol=1e-6)
+    pts = rng.standard_normal((3, 18))
+    _, grad, hess = normal_cosine_derivatives(
+        pts[:, :9].reshape(3, 3, 3), pts[:, 9:].reshape(3, 3, 3)
+    )
+    for j in range(18):
+        step = np.zeros(18)
+        step[j] = h
+        cp, gp, _ = normal_cosine_derivatives(
+            (pts + step)[:, :9].reshape(3, 3, 3), (pts + step)[:, 9:].reshape(3, 3, 3)
+        )
+        cm, gm, _ = normal_cosine_derivatives(
+            (pts - step)[:, :9].reshape(3, 3, 3), (pts - step)[:, 9:].reshape(3, 3, 3)
+        )
+        assert np.allclose(grad[:, j], (cp - cm) / (2 * h), atol=1e-7)
+        assert np.allclose(hess[:, :, j], (gp - gm) / (2 * h), atol=1e-5)
+
+
+def test_both_hessians_reach_the_same_solution():
+    results = {}
+    for hessian in ("closed-form", "casadi"):
+        case = make_case("bezier", "1", seed=3, settings=DEFAULTS.with_(ipopt_hessian=hessian))
+        results[hessian] = case.problem().solve()
+    a, b = results["closed-form"], results["casadi"]
+    assert a.converged and b.converged
+    assert a.iterations == b.iterations
+    assert np.abs(a.coords - b.coords).max() < 1e-8
+
+
+def test_unknown_hessian_is_refused():
+    with pytest.raises(ValueError, match="ipopt_hessian must be"):
+        DEFAULTS.with_(ipopt_hessian="bfgs")

@@ -47,6 +47,32 @@ def test_gradient_matches_central_differences(surface):
     assert np.linalg.norm(gy - fy) / np.linalg.norm(fy) < 1e-6
 
 
+def test_hessian_matches_differences_of_the_gradient(surface):
+    x, y = _plan_points()
+    fxx, fxy, fyy = surface.hessian(x, y)
+    h = 1e-6
+    gx_p, gy_p = surface.gradient(x + h, y)
+    gx_m, gy_m = surface.gradient(x - h, y)
+    hx_p, hy_p = surface.gradient(x, y + h)
+    hx_m, hy_m = surface.gradient(x, y - h)
+    for exact, fd in (
+        (fxx, (gx_p - gx_m) / (2 * h)),
+        (fxy, (gy_p - gy_m) / (2 * h)),
+        (fxy, (hx_p - hx_m) / (2 * h)),
+        (fyy, (hy_p - hy_m) / (2 * h)),
+    ):
+        assert np.abs(exact - fd).max() <= 1e-6 * max(1.0, np.abs(fd).max())
+    assert fxx.shape == x.shape
+
+
+def test_closed_form_hessian_equals_automatic_differentiation(surface):
+    from rigidfold.surfaces.builtin import Surface
+
+    x, y = _plan_points(30, 2)
+    for mine, ad in zip(surface.hessian(x, y), Surface.hessian(surface, x, y), strict=True):
+        assert np.allclose(mine, ad, rtol=1e-12, atol=1e-12)
+
+
 def test_casadi_backend_equals_numpy(surface):
     x, y = _plan_points(20, 1)
     sx, sy = ca.SX.sym("x", 20), ca.SX.sym("y", 20)

@@ -40,6 +40,10 @@ class Settings:
         Largest accepted violation of any constraint of (6) (metres or radians).
     ipopt_tol, ipopt_max_iter, ipopt_mu_strategy : float, int, str
         IPOPT's convergence tolerance, iteration limit and barrier-parameter strategy.
+    ipopt_hessian : str
+        IPOPT's Hessian of the Lagrangian: "closed-form" (element Hessians assembled with
+        NumPy, ``rigidfold.optimize.hessian``) or "casadi" (CasADi's symbolic Hessian, the
+        reference it is tested against). Both are exact; they differ by round-off.
     slsqp_ftol, slsqp_max_iter : float, int
         SciPy SLSQP's stopping tolerance and iteration limit.
     degenerate_area : float
@@ -114,6 +118,7 @@ class Settings:
     ipopt_tol: float = 1e-8
     ipopt_max_iter: int = 500
     ipopt_mu_strategy: str = "adaptive"
+    ipopt_hessian: str = "closed-form"
     slsqp_ftol: float = 1e-12
     slsqp_max_iter: int = 1000
     # geometry tolerances
@@ -164,6 +169,10 @@ class Settings:
             )
         if not self.f_tol > 0:
             raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
+        if self.ipopt_hessian not in ("closed-form", "casadi"):
+            raise ValueError(
+                f"ipopt_hessian must be 'closed-form' or 'casadi', got {self.ipopt_hessian!r}"
+            )
 
     def with_(self, **changes) -> Settings:
         """A copy with some fields changed (validated again)."""

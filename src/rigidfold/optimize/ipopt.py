@@ -37,10 +37,20 @@ def ipopt_options(settings: Settings, tol: float | None = None) -> dict:
 
 
 def ipopt_solver(problem) -> ca.Function:
-    """The CasADi ``nlpsol`` of a FormFindingProblem, built once and cached on it."""
+    """The CasADi ``nlpsol`` of a FormFindingProblem, built once and cached on it.
+
+    The Hessian of the Lagrangian is ``settings.ipopt_hessian``: "closed-form"
+    (``rigidfold.optimize.hessian``) or "casadi" (CasADi's symbolic Hessian).
+    """
     if problem._ipopt is None:
         nlp = {"x": problem._xi, "p": problem._w, "f": problem._F, "g": problem._g}
-        problem._ipopt = ca.nlpsol("form_finding", "ipopt", nlp, ipopt_options(problem.settings))
+        options = ipopt_options(problem.settings)
+        if problem.settings.ipopt_hessian == "closed-form":
+            from rigidfold.optimize.hessian import closed_form_hess_lag
+
+            problem._hess_lag = closed_form_hess_lag(problem)  # CasADi keeps no reference
+            options["hess_lag"] = problem._hess_lag
+        problem._ipopt = ca.nlpsol("form_finding", "ipopt", nlp, options)
     return problem._ipopt
 
 

@@ -87,7 +87,7 @@ class FormFindingProblem:
         self.settings = settings
         self.map: LinearMap = build_linear_map(pattern, self.planes, settings)
         self._build_model()
-        self._ipopt = None
+        self._ipopt = self._hess_lag = None
         if build_ipopt:
             from rigidfold.optimize.ipopt import ipopt_solver
 

@@ -61,6 +61,27 @@ class Surface(ABC):
     def gradient(self, x, y) -> tuple[np.ndarray, np.ndarray]:
         """(dz/dx, dz/dy) at plan points, exact.  arrays of the shape of x."""
 
+    def hessian(self, x, y) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(f_xx, f_xy, f_yy) at plan points, exact.  arrays of the broadcast shape of x, y
+
+        By CasADi's automatic differentiation of ``height`` unless a subclass gives it in
+        closed form.
+        """
+        import casadi as ca
+
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        fn = self.__dict__.get("_hessian_function")
+        if fn is None:
+            sx, sy = ca.SX.sym("x"), ca.SX.sym("y")
+            h, _ = ca.hessian(self.height(sx, sy, xp=ca) + 0 * sx, ca.vertcat(sx, sy))
+            fn = ca.Function("hessian", [sx, sy], [h[0, 0], h[0, 1], h[1, 1]])
+            self._hessian_function = fn
+        if x.size == 0:
+            return tuple(np.zeros(x.shape) for _ in range(3))
+        # a 1 x n row evaluates the scalar function at n points
+        out = fn(x.reshape(1, -1), y.reshape(1, -1))
+        return tuple(np.asarray(h, dtype=float).reshape(x.shape) for h in out)
+
     @abstractmethod
     def metadata(self) -> dict:
         """JSON-serialisable description."""
@@ -78,6 +99,17 @@ def _bernstein_derivative(i: int, t):
     lower = 0 if i == 0 else 3 * comb(2, i - 1) * t ** (i - 1) * (1 - t) ** (3 - i)
     upper = 0 if i == 3 else 3 * comb(2, i) * t**i * (1 - t) ** (2 - i)
     return lower - upper
+
+
+def _bernstein_second(i: int, t):
+    """d2/dt2 of the cubic Bernstein polynomial B_i: 6 (b_{i-2} - 2 b_{i-1} + b_i), linear b."""
+    linear = {0: 1 - t, 1: t}
+    return 6 * sum(c * linear.get(j, 0 * t) for c, j in ((1, i - 2), (-2, i - 1), (1, i)))
+
+
+def _basis(t: np.ndarray, function) -> np.ndarray:
+    """The four cubic Bernstein polynomials (or a derivative) at t (N,).  -> (N, 4)"""
+    return np.stack([function(i, t) + 0 * t for i in range(4)], axis=1)
 
 
 class Bezier(Surface):
@@ -123,6 +155,18 @@ class Bezier(Surface):
         gy = sum(bu[i] * dv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
         return gx, gy
 
+    def hessian(self, x, y):
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        u, v = x.ravel() / 3.0, y.ravel() / 3.0
+        bu, bv = _basis(u, _bernstein), _basis(v, _bernstein)  # (N, 4)
+        du, dv = _basis(u, _bernstein_derivative), _basis(v, _bernstein_derivative)
+        ddu, ddv = _basis(u, _bernstein_second), _basis(v, _bernstein_second)
+        h = self.heights
+        fxx = np.einsum("ni,ij,nj->n", ddu, h, bv) / 9.0
+        fxy = np.einsum("ni,ij,nj->n", du, h, dv) / 9.0
+        fyy = np.einsum("ni,ij,nj->n", bu, h, ddv) / 9.0
+        return tuple(f.reshape(x.shape) for f in (fxx, fxy, fyy))
+
     def metadata(self) -> dict:
         return {"name": self.name, "seed": self.seed, "control_heights": self.heights.tolist()}
 
@@ -152,6 +196,13 @@ class Dome(Surface):
         root = np.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
         return -(x - 1.5) / root, -(y - 1.5) / root
 
+    def hessian(self, x, y):
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        dx, dy = x - 1.5, y - 1.5
+        root = np.sqrt(self.radius**2 - dx**2 - dy**2)
+        cube = root**3
+        return -1 / root - dx**2 / cube, -dx * dy / cube, -1 / root - dy**2 / cube
+
     def metadata(self) -> dict:
         return {"name": self.name, "apex_m": 1.5, "radius_m": self.radius}
 
@@ -172,6 +223,10 @@ class HyperbolicParaboloid(Surface):
     def gradient(self, x, y):
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         return self.k * (y - 1.5), self.k * (x - 1.5)
+
+    def hessian(self, x, y):
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        return np.zeros(x.shape), np.full(x.shape, self.k), np.zeros(x.shape)
 
     def metadata(self) -> dict:
         return {"name": self.name, "k": self.k}
