@@ -199,6 +199,10 @@ def test_other_configuration_is_refused_untouched(uninterrupted):
     )
     assert proc.returncode == 2 and "another configuration" in proc.stderr
     assert hashlib.sha256(uninterrupted.read_bytes()).hexdigest() == digest
+    other_hessian = [*STUDY, "--hessian", "casadi", "--db", str(uninterrupted)]
+    proc = run([sys.executable, "-m", "rigidfold.cli", "study", *other_hessian])
+    assert proc.returncode == 2 and "settings.ipopt_hessian" in proc.stderr
+    assert hashlib.sha256(uninterrupted.read_bytes()).hexdigest() == digest
 
 
 def test_unwritable_database_and_missing_report(tmp_path):
@@ -256,6 +260,18 @@ def test_settings_added_later_at_their_default_are_compatible():
     assert config_differences(current, StudyConfig(deform=True).as_dict()) == ["deform"]
     tighter = StudyConfig(settings=DEFAULTS.with_(f_tol=1e-9)).as_dict()
     assert config_differences(current, tighter) == ["settings.f_tol"]
+
+
+def test_databases_from_before_the_closed_form_hessian_are_not_resumed_with_it():
+    from rigidfold.config import DEFAULTS
+    from rigidfold.study.store import config_differences
+
+    current = StudyConfig().as_dict()
+    older = {**current, "settings": dict(current["settings"])}
+    del older["settings"]["ipopt_hessian"]  # written when CasADi's Hessian was the only one
+    assert config_differences(older, current) == ["settings.ipopt_hessian"]
+    casadi = StudyConfig(settings=DEFAULTS.with_(ipopt_hessian="casadi")).as_dict()
+    assert config_differences(older, casadi) == []
 
 
 def test_locks_by_stage_adds_up_to_n_lock(uninterrupted):

@@ -113,6 +113,13 @@ def build_parser() -> argparse.ArgumentParser:
     where.add_argument("--workers", type=int, default=2, help="local worker processes")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
     stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
+    stu.add_argument(
+        "--hessian",
+        default=DEFAULTS.ipopt_hessian,
+        choices=["closed-form", "casadi"],
+        help="IPOPT's Hessian of the Lagrangian: closed-form (default) or casadi (the symbolic "
+        "reference, used by studies made before the closed form)",
+    )
     stu.add_argument("--quiet", action="store_true", help="no progress bar")
     stu.set_defaults(func=_cmd_study)
 
@@ -144,6 +151,12 @@ def _case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pattern", required=True, choices=["1", "1p", "2", "11"])
     p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
     p.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp", "slsqp-fd"])
+    p.add_argument(
+        "--hessian",
+        default=DEFAULTS.ipopt_hessian,
+        choices=["closed-form", "casadi"],
+        help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off)",
+    )
     p.add_argument("--dz", type=float, default=DEFAULTS.dz, help="bound on |dz| in metres")
     p.add_argument("--theta-min", type=float, default=30.0, help="degrees")
     p.add_argument("--theta-max", type=float, default=120.0, help="degrees")
@@ -165,6 +178,7 @@ def _case(args: argparse.Namespace):
         theta_max_deg=args.theta_max,
         rho_bar_deg=args.rho_max,
         zero_dof_ends=not getattr(args, "retry_zero_dof", False),
+        ipopt_hessian=args.hessian,
     )
     return make_case(
         args.surface,
@@ -407,7 +421,9 @@ def _cmd_study(args: argparse.Namespace) -> int:
         )
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
-    config = StudyConfig(deform=not args.no_deform)
+    config = StudyConfig(
+        deform=not args.no_deform, settings=DEFAULTS.with_(ipopt_hessian=args.hessian)
+    )
     store = Store(args.db, config.as_dict())  # refuses another configuration untouched
     bar = _StudyProgress(enabled=not args.quiet)
     started, t0 = _utc_now(), time.perf_counter()

@@ -106,12 +106,17 @@ class Key:
         return (self.study, self.seed, self.pattern, self.criterion, int(self.symmetric))
 
 
+# settings added with a default that differs from what rigidfold did before they existed
+LEGACY_SETTINGS = {"ipopt_hessian": "casadi"}
+
+
 def config_differences(stored: dict, current: dict) -> list[str]:
     """Names of the configuration entries in which ``current`` differs from ``stored``.
 
     A setting that a later rigidfold added (absent from ``stored["settings"]``) counts as
-    equal when ``current`` has it at its default: the default is what the older code did, so
-    a study can be resumed by a newer version as long as nothing it measures has changed.
+    equal when ``current`` has it at the value that reproduces the older code: its default,
+    or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes. So a
+    study can be resumed by a newer version as long as nothing it measures has changed.
     """
     from dataclasses import asdict
 
@@ -125,7 +130,7 @@ def config_differences(stored: dict, current: dict) -> list[str]:
             diff += [
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
-                if a.get(k, defaults.get(k)) != b.get(k) or k not in b
+                if a.get(k, LEGACY_SETTINGS.get(k, defaults.get(k))) != b.get(k) or k not in b
             ]
         elif a != b:
             diff.append(key)
