@@ -22,6 +22,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_optimize.py
+	$(PY) benchmarks/hessian_size.py
 	$(PY) benchmarks/bench_generate.py
 	$(PY) benchmarks/bench_develop.py
 	$(PY) benchmarks/bench_deform.py

@@ -101,15 +101,8 @@ def _bernstein_derivative(i: int, t):
     return lower - upper
 
 
-def _bernstein_second(i: int, t):
-    """d2/dt2 of the cubic Bernstein polynomial B_i: 6 (b_{i-2} - 2 b_{i-1} + b_i), linear b."""
-    linear = {0: 1 - t, 1: t}
-    return 6 * sum(c * linear.get(j, 0 * t) for c, j in ((1, i - 2), (-2, i - 1), (1, i)))
-
-
-def _basis(t: np.ndarray, function) -> np.ndarray:
-    """The four cubic Bernstein polynomials (or a derivative) at t (N,).  -> (N, 4)"""
-    return np.stack([function(i, t) + 0 * t for i in range(4)], axis=1)
+# cubic Bernstein polynomials in the power basis: B_i(t) = sum_k _POWER[k, i] t^k
+_POWER = np.array([[1, 0, 0, 0], [-3, 3, 0, 0], [3, -6, 3, 0], [-1, 3, -3, 1]], dtype=float)
 
 
 class Bezier(Surface):
@@ -156,15 +149,20 @@ class Bezier(Surface):
         return gx, gy
 
     def hessian(self, x, y):
+        # in the power basis: z = [1 u u^2 u^3] C [1 v v^2 v^3]^T with C = M h M^T
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         u, v = x.ravel() / 3.0, y.ravel() / 3.0
-        bu, bv = _basis(u, _bernstein), _basis(v, _bernstein)  # (N, 4)
-        du, dv = _basis(u, _bernstein_derivative), _basis(v, _bernstein_derivative)
-        ddu, ddv = _basis(u, _bernstein_second), _basis(v, _bernstein_second)
-        h = self.heights
-        fxx = np.einsum("ni,ij,nj->n", ddu, h, bv) / 9.0
-        fxy = np.einsum("ni,ij,nj->n", du, h, dv) / 9.0
-        fyy = np.einsum("ni,ij,nj->n", bu, h, ddv) / 9.0
+        C = _POWER @ self.heights @ _POWER.T
+        one, zero = np.ones_like(u), np.zeros_like(u)
+        pu = np.stack([one, u, u * u, u**3], 1)
+        du = np.stack([zero, one, 2 * u, 3 * u * u], 1)
+        ddu = np.stack([zero, zero, 2 * one, 6 * u], 1)
+        pv = np.stack([one, v, v * v, v**3], 1)
+        dv = np.stack([zero, one, 2 * v, 3 * v * v], 1)
+        ddv = np.stack([zero, zero, 2 * one, 6 * v], 1)
+        fxx = np.einsum("ni,ni->n", ddu @ C, pv) / 9.0
+        fxy = np.einsum("ni,ni->n", du @ C, dv) / 9.0
+        fyy = np.einsum("ni,ni->n", pu @ C, ddv) / 9.0
         return tuple(f.reshape(x.shape) for f in (fxx, fxy, fyy))
 
     def metadata(self) -> dict:
