@@ -285,8 +285,15 @@ def _configuration_lines(store: Store) -> list[str]:
     versions = sorted({r["version"] for r in store.runs()})
     if not config:
         return []
+    from rigidfold.study.store import LEGACY_SETTINGS
+
+    settings = config.get("settings") or {}
+    hessian = settings.get("ipopt_hessian", LEGACY_SETTINGS["ipopt_hessian"])
+    solver = config.get("solver")
+    if solver == "ipopt":
+        solver = f"ipopt ({hessian} Hessian)"
     return [
-        f"Configuration: solver {config.get('solver')}, target DOF {config.get('target_dof')}, "
+        f"Configuration: solver {solver}, target DOF {config.get('target_dof')}, "
         f"Steps 8-9 {'on' if config.get('deform') else 'off'}; {len(store.runs())} runs, "
         f"{store.count_attempts()} solves of (6); rigidfold {', '.join(versions) or '-'}.",
         "",
