@@ -46,8 +46,12 @@ def test_generate_pattern1_reaches_one_dof_without_locks():
 
 
 def test_generate_counts_locks_and_retries_the_next_candidate():
-    """Bezier seed 2 meets two locks on its last step; Step 7 tries the next candidates."""
-    run = generate(make_case("bezier", "1", seed=2), criterion="shat", seed=2)
+    """Bezier seed 1 (the demo) meets two locks at DOF 4; Step 7 tries the next candidates.
+
+    Which seeds lock depends on round-off (seed 2 did with CasADi's Hessian, not with the
+    closed-form one); seed 1 locks twice with both.
+    """
+    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)
     assert run.final_dof == 1
     locks = [a for a in run.attempts if a.outcome == "lock"]
     assert run.n_lock == len(locks) >= 1
