@@ -236,7 +236,7 @@ class ClosedFormHessian:
         G_row, G_col = uniq // n, uniq % n
         order = np.argsort(G_row, kind="stable")
         starts = np.searchsorted(G_row[order], np.arange(self.n_inner + 1))
-        pp, qq = [], []
+        pp, qq = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
         for r in range(self.n_inner):
             members = order[starts[r] : starts[r + 1]]
             members = members[np.argsort(G_col[members])]
