@@ -246,13 +246,18 @@ def test_report_of_several_databases(uninterrupted, tmp_path):
         assert png.is_file() and f"]({png.name})" in text
 
 
+def _without_setting(config: dict, name: str) -> dict:
+    """A study configuration as a rigidfold without setting ``name`` wrote it."""
+    settings = {k: v for k, v in config["settings"].items() if k != name}
+    return {**config, "settings": settings}
+
+
 def test_settings_added_later_at_their_default_are_compatible():
     from rigidfold.config import DEFAULTS
     from rigidfold.study.store import config_differences
 
     current = StudyConfig().as_dict()
-    older = {**current, "settings": dict(current["settings"])}
-    del older["settings"]["motion_arc_step"]  # a database written before this setting existed
+    older = _without_setting(current, "motion_arc_step")  # written before it existed
     assert config_differences(older, current) == []
     changed = StudyConfig(settings=DEFAULTS.with_(motion_arc_step=0.5)).as_dict()
     assert config_differences(older, changed) == ["settings.motion_arc_step"]
@@ -267,8 +272,7 @@ def test_databases_from_before_the_closed_form_hessian_are_not_resumed_with_it()
     from rigidfold.study.store import config_differences
 
     current = StudyConfig().as_dict()
-    older = {**current, "settings": dict(current["settings"])}
-    del older["settings"]["ipopt_hessian"]  # written when CasADi's Hessian was the only one
+    older = _without_setting(current, "ipopt_hessian")  # when CasADi's was the only Hessian
     assert config_differences(older, current) == ["settings.ipopt_hessian"]
     casadi = StudyConfig(settings=DEFAULTS.with_(ipopt_hessian="casadi")).as_dict()
     assert config_differences(older, casadi) == []

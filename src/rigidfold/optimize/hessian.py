@@ -29,6 +29,8 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
+from rigidfold.mesh.geometry import skew
+
 _B_ANGLE = np.zeros((6, 9))  # (u, v) = (b - a, c - a) from (a, b, c)
 _B_ANGLE[0:3, 0:3] = _B_ANGLE[3:6, 0:3] = -np.eye(3)
 _B_ANGLE[0:3, 3:6] = _B_ANGLE[3:6, 6:9] = np.eye(3)
@@ -41,15 +43,6 @@ def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("ki,ki->k", a, b)
-
-
-def _skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrices [a]x with [a]x b = a x b.  (K, 3) -> (K, 3, 3)"""
-    out = np.zeros((*a.shape[:-1], 3, 3))
-    out[..., 0, 1], out[..., 0, 2] = -a[..., 2], a[..., 1]
-    out[..., 1, 0], out[..., 1, 2] = a[..., 2], -a[..., 0]
-    out[..., 2, 0], out[..., 2, 1] = -a[..., 1], a[..., 0]
-    return out
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -113,9 +106,9 @@ def normal_cosine_derivatives(pa: np.ndarray, pb: np.ndarray):
         e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
         m = _cross(e1, e2)
         rows, cols = slice(3 * side, 3 * side + 3), 9 * side
-        J[:, rows, cols : cols + 3] = _skew(e2 - e1)
-        J[:, rows, cols + 3 : cols + 6] = -_skew(e2)
-        J[:, rows, cols + 6 : cols + 9] = _skew(e1)
+        J[:, rows, cols : cols + 3] = skew(e2 - e1)
+        J[:, rows, cols + 3 : cols + 6] = -skew(e2)
+        J[:, rows, cols + 6 : cols + 9] = skew(e1)
         length = np.sqrt(_dot(m, m))
         parts.append((m / length[:, None], length))
     (na, la), (nb, lb) = parts
@@ -144,8 +137,8 @@ def normal_cosine_derivatives(pa: np.ndarray, pb: np.ndarray):
     for side, g in enumerate((ga, gb)):
         o = 9 * side
         h6 = np.zeros((K, 6, 6))
-        h6[:, 0:3, 3:6] = -_skew(g)  # d2 (g . m) / de1 de2
-        h6[:, 3:6, 0:3] = _skew(g)
+        h6[:, 0:3, 3:6] = -skew(g)  # d2 (g . m) / de1 de2
+        h6[:, 3:6, 0:3] = skew(g)
         hess[:, o : o + 9, o : o + 9] += _B_ANGLE.T @ h6 @ _B_ANGLE  # (e1, e2) like (u, v)
     return c, grad, hess
 
@@ -153,9 +146,8 @@ def normal_cosine_derivatives(pa: np.ndarray, pb: np.ndarray):
 def _expand(T: sp.csr_matrix, rows: np.ndarray):
     """Nonzeros of T[rows]: (entry, column, value) for each listed P-row."""
     sub = T[rows]
-    counts = np.diff(sub.indptr)
-    entry = np.repeat(np.arange(len(rows)), counts)
-    return entry, sub.indices, sub.data, counts
+    entry = np.repeat(np.arange(len(rows)), np.diff(sub.indptr))
+    return entry, sub.indices, sub.data
 
 
 def _pairs(T: sp.csr_matrix, I: np.ndarray, J: np.ndarray):
@@ -225,7 +217,7 @@ class ClosedFormHessian:
         # Gauss-Newton part of F1: rows of grad d_v in xi, from the angle gradients
         at_inner = np.flatnonzero(self.angle_row >= 0)
         gI = angle_P[at_inner].ravel()
-        g_entry, g_col, g_w, _ = _expand(self.T, gI)
+        g_entry, g_col, g_w = _expand(self.T, gI)
         g_local = at_inner[g_entry // 9] * 9 + g_entry % 9  # index into (3F, 9) gradients
         g_row = self.angle_row[g_local // 9]
         key = g_row * n + g_col

@@ -164,17 +164,23 @@ def locks_by_stage(store: Store) -> list[dict]:
         for r in store.runs("bezier")
         if r["status"] == "no candidate crease succeeds"
     )
+    return _per_run_rows(
+        counts,
+        lambda group, c, n: {
+            "per_stage": [k / n for k in c["locks"]],
+            "no_candidate": ended[group],
+        },
+    )
+
+
+def _per_run_rows(counts: dict, fields) -> list[dict]:
+    """One row per (pattern, criterion) of ``counts`` (each with its "seeds"), sorted, with
+    ``fields(group, counts[group], number of runs)`` merged in."""
     out = []
     for (pattern, crit), c in sorted(counts.items()):
         n = len(c["seeds"])
         out.append(
-            {
-                "pattern": pattern,
-                "criterion": crit,
-                "runs": n,
-                "per_stage": [k / n for k in c["locks"]],
-                "no_candidate": ended[(pattern, crit)],
-            }
+            {"pattern": pattern, "criterion": crit, "runs": n, **fields((pattern, crit), c, n)}
         )
     return out
 
@@ -206,18 +212,9 @@ def dof_steps(store: Store) -> list[dict]:
         c["seeds"].add(seed)
         dofs = [dof for (dof,) in attempts]  # the first solution has no step
         c["kinds"].update(_step_kind(b - a) for a, b in itertools.pairwise(dofs))
-    out = []
-    for (pattern, crit), c in sorted(counts.items()):
-        n = len(c["seeds"])
-        out.append(
-            {
-                "pattern": pattern,
-                "criterion": crit,
-                "runs": n,
-                "per_kind": {k: c["kinds"][k] / n for k in STEP_KINDS},
-            }
-        )
-    return out
+    return _per_run_rows(
+        counts, lambda group, c, n: {"per_kind": {k: c["kinds"][k] / n for k in STEP_KINDS}}
+    )
 
 
 def tables_7_8(store: Store) -> list[dict]:
