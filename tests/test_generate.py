@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rigidfold.case import make_case
-from rigidfold.config import DEFAULTS
+from rigidfold.config import DEFAULTS, one_blas_thread
 from rigidfold.generate import generate
 from rigidfold.mechanism import analyze
 from rigidfold.selection import predicted_locks, score_creases
@@ -46,10 +46,11 @@ def test_generate_pattern1_reaches_one_dof_without_locks():
 
 
 def test_generate_counts_locks_and_retries_the_next_candidate():
-    """Bezier seed 1 (the demo) meets two locks at DOF 4; Step 7 tries the next candidates.
+    """Bezier seed 1 (the demo) meets locks (four, as in the Tables 5-6 study); Step 7 tries
+    the next candidates.
 
-    Which seeds lock depends on round-off (seed 2 did with CasADi's Hessian, not with the
-    closed-form one); seed 1 locks twice with both.
+    Which seeds lock depends on round-off (seed 2 did with CasADi's Hessian and two BLAS
+    threads, not with the closed-form one); seed 1 locks with both Hessians.
     """
     run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)
     assert run.final_dof == 1
@@ -60,6 +61,22 @@ def test_generate_counts_locks_and_retries_the_next_candidate():
         assert attempt.dof >= 1
         assert attempt.F <= DEFAULTS.f_tol  # a lock is not a tolerance miss
     assert run.n_reduce == 20
+
+
+def test_generate_does_not_depend_on_the_callers_blas_threads():
+    """Problem (6) has no unique minimiser, so round-off picks the shape; on this case one and
+    two BLAS threads led to different first creases before generate ran on one thread."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    case = make_case("hp", "11", symmetric=True)
+    runs = []
+    for threads in (1, 2):
+        with threadpool_limits(limits=threads, user_api="blas"):
+            run = generate(case, criterion="s", target_dof=29, seed=0)
+        runs.append([(a.fixed_added, a.dof, a.outcome, a.iterations) for a in run.attempts])
+    assert runs[0] == runs[1]
+    with one_blas_thread():
+        assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")
 
 
 def test_generate_symmetric_fixes_mirror_groups():

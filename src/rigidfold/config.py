@@ -198,3 +198,18 @@ class Settings:
 
 DEFAULTS = Settings()
 """The paper's parameters (Section 6.1) and rigidfold's default tolerances."""
+
+
+def one_blas_thread():
+    """Context manager that runs NumPy's and SciPy's BLAS and LAPACK on one thread.
+
+    Problem (6) has no unique minimiser: F is zero on a family of developable shapes (as
+    many directions as the mechanism has DOF), and round-off decides which one IPOPT
+    reaches. A multi-threaded BLAS rounds differently for each thread count, so without
+    this the same case could take another path on a machine with more cores, or in a shell
+    rather than in a study worker (Dask starts workers with one thread). The matrices here
+    are small, so one thread costs no measurable time.
+    """
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1, user_api="blas")

@@ -25,7 +25,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.result import OptimizeResult, Status
 from rigidfold.optimize.variables import LinearMap, build_linear_map
@@ -250,14 +250,15 @@ class FormFindingProblem:
         xi0 = self.start_point(start)
         w = mask.astype(float)
         t0 = time.perf_counter()
-        if solver == "ipopt":
-            from rigidfold.optimize.ipopt import run_ipopt
+        with one_blas_thread():  # which zero of F is reached depends on round-off
+            if solver == "ipopt":
+                from rigidfold.optimize.ipopt import run_ipopt
 
-            xi, iterations, outcome, message = run_ipopt(self, xi0, w)
-        else:
-            from rigidfold.optimize.slsqp import run_slsqp
+                xi, iterations, outcome, message = run_ipopt(self, xi0, w)
+            else:
+                from rigidfold.optimize.slsqp import run_slsqp
 
-            xi, iterations, outcome, message = run_slsqp(self, xi0, w, exact=solver == "slsqp")
+                xi, iterations, outcome, message = run_slsqp(self, xi0, w, exact=solver == "slsqp")
         wall = time.perf_counter() - t0
         coords = self.map.expand(xi)
         F, F1, F2 = (float(v) for v in self.objective(xi, w))

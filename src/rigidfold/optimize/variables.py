@@ -24,7 +24,7 @@ import scipy.linalg
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
 
 
@@ -137,7 +137,8 @@ def build_linear_map(
     n = gamma.shape[1]
     if gamma.shape[0] == 0:
         return LinearMap(sp.identity(n, format="csr"), np.zeros(n), np.arange(n), gamma, c)
-    q, r, piv = scipy.linalg.qr(gamma.toarray(), mode="economic", pivoting=True)
+    with one_blas_thread():  # the basis of the free variables sets the optimiser's path
+        q, r, piv = scipy.linalg.qr(gamma.toarray(), mode="economic", pivoting=True)
     diag = np.abs(np.diag(r))
     rank = int(np.sum(diag > settings.linear_rank_tol * diag[0]))
     qc = q.T @ c
