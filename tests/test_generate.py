@@ -75,8 +75,17 @@ def test_generate_does_not_depend_on_the_callers_blas_threads():
             run = generate(case, criterion="s", target_dof=29, seed=0)
         runs.append([(a.fixed_added, a.dof, a.outcome, a.iterations) for a in run.attempts])
     assert runs[0] == runs[1]
-    with one_blas_thread():
-        assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")
+
+    def blas_threads():
+        return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+    with threadpool_limits(limits=2, user_api="blas"):
+        before = blas_threads()
+        with one_blas_thread():
+            with one_blas_thread():  # nested: only the outermost sets the limit
+                assert set(blas_threads()) == {1}
+            assert set(blas_threads()) == {1}
+        assert blas_threads() == before
 
 
 def test_generate_symmetric_fixes_mirror_groups():

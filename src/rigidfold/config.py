@@ -7,7 +7,9 @@ Every numerical threshold and every default design parameter of rigidfold lives 
 
 from __future__ import annotations
 
+import contextlib
 import math
+import threading
 from dataclasses import dataclass, replace
 
 
@@ -200,6 +202,10 @@ DEFAULTS = Settings()
 """The paper's parameters (Section 6.1) and rigidfold's default tolerances."""
 
 
+_BLAS = threading.local()  # depth of one_blas_thread in this thread
+
+
+@contextlib.contextmanager
 def one_blas_thread():
     """Context manager that runs NumPy's and SciPy's BLAS and LAPACK on one thread.
 
@@ -208,8 +214,18 @@ def one_blas_thread():
     reaches. A multi-threaded BLAS rounds differently for each thread count, so without
     this the same case could take another path on a machine with more cores, or in a shell
     rather than in a study worker (Dask starts workers with one thread). The matrices here
-    are small, so one thread costs no measurable time.
+    are small, so one thread costs no measurable time. Nested uses cost nothing: only the
+    outermost one sets the limit (about 1 ms with threadpoolctl).
     """
-    from threadpoolctl import threadpool_limits
+    depth = getattr(_BLAS, "depth", 0)
+    _BLAS.depth = depth + 1
+    try:
+        if depth:
+            yield
+        else:
+            from threadpoolctl import threadpool_limits
 
-    return threadpool_limits(limits=1, user_api="blas")
+            with threadpool_limits(limits=1, user_api="blas"):
+                yield
+    finally:
+        _BLAS.depth = depth

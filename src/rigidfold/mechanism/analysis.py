@@ -20,7 +20,7 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.frame import FrameModel
 from rigidfold.mechanism import kinematics
 from rigidfold.mesh import CreasePattern
@@ -103,6 +103,11 @@ def analyze(
     """
     if method not in METHODS:
         raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
+    with one_blas_thread():  # the same rank decisions on every machine, as in generate
+        return _analyze(pattern, method, support_face, settings)
+
+
+def _analyze(pattern: CreasePattern, method: str, support_face, settings: Settings) -> Mechanism:
     frame = FrameModel.from_pattern(pattern, support_face)
     h = frame.n_hinges
     if method == "frame":
