@@ -24,6 +24,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_optimize.py
 	$(PY) benchmarks/hessian_size.py
 	$(PY) benchmarks/bench_generate.py
+	$(PY) benchmarks/blas_threads.py
 	$(PY) benchmarks/bench_develop.py
 	$(PY) benchmarks/bench_deform.py
 	$(PY) benchmarks/bench_study.py

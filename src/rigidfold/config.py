@@ -215,7 +215,8 @@ def one_blas_thread():
     this the same case could take another path on a machine with more cores, or in a shell
     rather than in a study worker (Dask starts workers with one thread). The matrices here
     are small, so one thread costs no measurable time. Nested uses cost nothing: only the
-    outermost one sets the limit (about 1 ms with threadpoolctl).
+    outermost one sets the limit (about 1 ms with threadpoolctl). Also a decorator,
+    ``@one_blas_thread()``. ``benchmarks/blas_threads.py`` measures all of this.
     """
     depth = getattr(_BLAS, "depth", 0)
     _BLAS.depth = depth + 1

@@ -111,6 +111,7 @@ class Generation:
         }
 
 
+@one_blas_thread()  # the same path on every machine (see one_blas_thread)
 def generate(
     case: Case,
     *,
@@ -134,15 +135,6 @@ def generate(
         raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
     if target_dof < 0:
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
-    with one_blas_thread():  # the same path on every machine (see one_blas_thread)
-        return _generate(
-            case, criterion, target_dof, seed, solver, support_face, on_attempt, on_solution
-        )
-
-
-def _generate(
-    case: Case, criterion, target_dof, seed, solver, support_face, on_attempt, on_solution
-) -> Generation:
     rng = np.random.default_rng(seed)
     run = Generation()
     t0 = time.perf_counter()

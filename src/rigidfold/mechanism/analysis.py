@@ -90,6 +90,7 @@ class Mechanism:
         return bool(self.locked.any())
 
 
+@one_blas_thread()  # the same rank decisions on every machine, as in generate
 def analyze(
     pattern: CreasePattern,
     *,
@@ -103,11 +104,6 @@ def analyze(
     """
     if method not in METHODS:
         raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
-    with one_blas_thread():  # the same rank decisions on every machine, as in generate
-        return _analyze(pattern, method, support_face, settings)
-
-
-def _analyze(pattern: CreasePattern, method: str, support_face, settings: Settings) -> Mechanism:
     frame = FrameModel.from_pattern(pattern, support_face)
     h = frame.n_hinges
     if method == "frame":
