@@ -191,8 +191,8 @@ def _case(args: argparse.Namespace):
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
-    from rigidfold.case import parse_fixed, prepare_output_dir, shape_report, write_json
-    from rigidfold.io import write_fold
+    from rigidfold.case import parse_fixed, shape_report
+    from rigidfold.io import prepare_output_dir, write_fold, write_json
 
     out = prepare_output_dir(args.out)
     case = _case(args)
@@ -323,9 +323,14 @@ def _cmd_develop(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from rigidfold.case import prepare_output_dir
     from rigidfold.develop import develop
-    from rigidfold.io import crease_pattern_frame, read_fold, write_fold, write_svg
+    from rigidfold.io import (
+        crease_pattern_frame,
+        prepare_output_dir,
+        read_fold,
+        write_fold,
+        write_svg,
+    )
 
     out = prepare_output_dir(args.out)
     data = read_fold(args.file)
@@ -365,9 +370,8 @@ def _cmd_deform(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from rigidfold.case import prepare_output_dir, write_json
     from rigidfold.deform import verify
-    from rigidfold.io import read_fold, write_fold
+    from rigidfold.io import prepare_output_dir, read_fold, write_fold, write_json
 
     out = prepare_output_dir(args.out)
     data = read_fold(args.file)

@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import Case, prepare_output_dir, write_json
+from rigidfold.case import Case
 from rigidfold.deform.check import verify
 from rigidfold.generate import Attempt, Generation, Solution
-from rigidfold.io import write_fold, write_svg
+from rigidfold.io import prepare_output_dir, write_fold, write_json, write_svg
 
 
 class RunWriter:
