@@ -292,6 +292,27 @@ def test_non_convex_polygon_triangulation(polygon, area):
     assert np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / 2 == pytest.approx(area)
 
 
+def test_settings_reach_the_pattern_read():
+    """corner_angle decides the corners of a pattern read from FOLD data (the boundary turns
+    by 2 atan(0.02) = 2.3 degrees at vertex 1); triangulation_area_tol the ears."""
+    fold = {
+        "vertices_coords": [[0, 0], [1, -0.02], [2, 0], [2, 1], [1, 1], [0, 1]],
+        "faces_vertices": [[0, 1, 4, 5], [1, 2, 3, 4]],
+    }
+    assert sorted(read_fold(fold).pattern.corners.tolist()) == [0, 1, 2, 3, 5]
+    blunt = DEFAULTS.with_(corner_angle=math.radians(5.0))
+    pattern = pattern_from_fold(fold, settings=blunt)
+    assert pattern.settings is blunt
+    assert sorted(pattern.corners.tolist()) == [0, 2, 3, 5]
+    thin = {
+        "vertices_coords": [[0, 0], [1, 0], [1, 0.01], [0, 0.01]],
+        "faces_vertices": [[0, 1, 2, 3]],
+    }
+    assert read_fold(thin).pattern.n_faces == 2
+    with pytest.raises(ValueError, match=r"faces_vertices\[0\]: the polygon is degenerate or"):
+        read_fold(thin, settings=DEFAULTS.with_(triangulation_area_tol=0.1))
+
+
 def test_missing_edges_are_derived():
     """Without edges_vertices, boundary edges get "B" and creases "U" (free)."""
     pattern = folded_grid()

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import degree_n_vertex, folded_grid
+from rigidfold.config import DEFAULTS
 from rigidfold.mesh import CreasePattern, geometry
 
 SHAPES = {
@@ -158,3 +159,68 @@ def test_error_messages_show_plain_numbers():
     with pytest.raises(ValueError) as info:
         CreasePattern.from_faces(np.zeros((3, 3)), np.array([[0, 1, 2]]))
     assert "np.int64" not in str(info.value)
+
+
+def test_settings_decide_corners_of_a_case():
+    """Settings(corner_angle=...) reaches the pattern that make_case builds."""
+    from rigidfold.case import make_case
+
+    assert len(make_case("dome", "1").pattern.corners) == 4
+    blunt = DEFAULTS.with_(corner_angle=np.radians(100.0))  # the square's corners turn by 90
+    case = make_case("dome", "1", settings=blunt)
+    assert case.pattern.settings is blunt
+    assert case.pattern.corners.tolist() == []
+    assert case.pattern.boundary_sides == ()
+    moved = case.pattern.with_coords(case.pattern.coords + 0.01)
+    assert moved.settings is blunt
+    assert moved.with_fixed(moved.fixed).corners.tolist() == []
+
+
+def test_mildly_bent_boundary_vertex_is_a_corner_below_corner_angle():
+    """The plan boundary turns by 2 atan(0.02) = 2.3 degrees at vertex 1."""
+    xy = np.array([[0, 0], [1, -0.02], [2, 0], [2, 1], [1, 1], [0, 1]])
+    faces = np.array([[0, 1, 4], [0, 4, 5], [1, 2, 3], [1, 3, 4]])
+    bent = CreasePattern.from_faces(xy, faces)
+    assert sorted(bent.corners.tolist()) == [0, 1, 2, 3, 5]
+    blunt = CreasePattern.from_faces(xy, faces, settings=DEFAULTS.with_(corner_angle=0.1))
+    assert sorted(blunt.corners.tolist()) == [0, 2, 3, 5]
+    assert sorted(s.inner.tolist() for s in blunt.boundary_sides) == [[], [], [1], [4]]
+
+
+def test_settings_decide_degenerate_faces():
+    """Grid triangles have area / (longest edge)^2 = 0.5 / 2 = 0.25."""
+    g = folded_grid(3, amplitude=0.0)
+    assert CreasePattern.from_faces(g.coords, g.faces, settings=DEFAULTS.with_(degenerate_area=0.2))
+    with pytest.raises(ValueError, match=r"face 0 .* is degenerate"):
+        CreasePattern.from_faces(g.coords, g.faces, settings=DEFAULTS.with_(degenerate_area=0.3))
+    with pytest.raises(ValueError, match="settings must be a Settings, got dict"):
+        CreasePattern(g.coords, g.faces, g.edges, g.fixed, {})
+
+
+def test_crease_stencils_give_the_fold_angles(shape):
+    """Stencil (u, v, a, b): a opposite u -> v on the left face, b on the right face."""
+    from rigidfold.mechanism.kinematics import fold_angles_and_gradients
+
+    creases = shape.interior_edges
+    stencils = shape.crease_stencils(creases)
+    assert stencils.shape == (len(creases), 4) and stencils.dtype == np.int64
+    for (u, v, a, b), e in zip(stencils, creases, strict=True):
+        assert (u, v) == tuple(shape.edges[e])
+        left, right = shape.faces[shape.edge_faces[e]]
+        assert {u, v, a} == set(left) and {v, u, b} == set(right)
+    rho, grad, cols = fold_angles_and_gradients(shape.coords, stencils)
+    assert np.allclose(rho, shape.fold_angles[creases], atol=1e-12)
+    assert grad.shape == cols.shape == (len(creases), 12)
+    assert np.array_equal(cols[:, 3:6], 3 * stencils[:, 1:2] + np.arange(3))
+    empty = fold_angles_and_gradients(shape.coords, shape.crease_stencils([]))
+    assert [x.shape for x in empty] == [(0,), (0, 12), (0, 12)]
+
+
+def test_mirror_pairs():
+    from rigidfold.surfaces.builtin import MirrorPlane
+
+    g = folded_grid(4)
+    mate = geometry.mirror_pairs(g.coords, MirrorPlane(1.0, 0.0, -1.5), tol=1e-9)
+    assert mate.tolist() == [3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12]
+    with pytest.raises(ValueError, match=r"not symmetric about the plane x = 1.4: vertex \d+ at"):
+        geometry.mirror_pairs(g.coords, MirrorPlane(1.0, 0.0, -1.4), tol=1e-9)

@@ -5,11 +5,8 @@ This is the entry point that validates user choices once; the CLI and the benchm
 
 from __future__ import annotations
 
-import json
 import math
-import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -74,7 +71,7 @@ def make_case(
     ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
     """
     surf = surface if isinstance(surface, Surface) else get_surface(surface, seed=seed, expr=expr)
-    shape = patterns.build(pattern, surf)
+    shape = patterns.build(pattern, surf, settings=settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
         raise ValueError(
@@ -132,39 +129,3 @@ def shape_report(case: Case, result: OptimizeResult, build_time: float) -> dict:
         else 0.0,
         "case": case.metadata(),
     }
-
-
-def prepare_output_dir(path: str | os.PathLike) -> Path:
-    """Create the output directory and check it is writable, before any computation."""
-    out = Path(path)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".rigidfold-write-test"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise ValueError(f"cannot write to output directory {str(out)!r}: {exc.strerror}") from None
-    return out
-
-
-def jsonable(value):
-    """Convert NumPy values to Python ones and non-finite floats to None (strict JSON)."""
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, np.ndarray)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, (np.integer, np.bool_)):
-        return value.item()
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    return value
-
-
-def write_json(path: Path, data: dict) -> None:
-    """Write JSON atomically (a temporary file, then rename)."""
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(json.dumps(jsonable(data), indent=2, allow_nan=False) + "\n")
-        os.replace(tmp, path)
-    except OSError as exc:
-        raise ValueError(f"cannot write {str(path)!r}: {exc.strerror}") from None

@@ -60,6 +60,11 @@ class Settings:
         A boundary vertex is a corner when the boundary turns there by more than this (radians).
     flat_angle : float
         A free crease with |rho| below this (radians) is flat ("F" in FOLD files).
+    triangulation_area_tol : float
+        Ear clipping of the polygon faces of FOLD files: a triangle whose doubled signed area
+        is below this times the squared size of its polygon (the larger side of its bounding
+        box, in the polygon's plane) is not an ear, and a vertex within that of an ear's side
+        lies on it.
     linear_rank_tol : float
         Relative threshold of the rank-revealing QR that eliminates constraints (7)-(9).
     map_prune_tol : float
@@ -162,6 +167,8 @@ class Settings:
     motion_length_tol: float = 1e-3
     motion_arc_step: float = 0.2
     motion_arc_max_steps: int = 400
+    # reading FOLD files
+    triangulation_area_tol: float = 1e-12
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):

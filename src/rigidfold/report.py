@@ -14,10 +14,17 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import Case, prepare_output_dir, write_json
+from rigidfold.case import Case
 from rigidfold.deform.check import Verification, verify
 from rigidfold.generate import Attempt, Generation, Solution
-from rigidfold.io import crease_pattern_frame, motion_frames, write_fold, write_svg
+from rigidfold.io import (
+    crease_pattern_frame,
+    motion_frames,
+    prepare_output_dir,
+    write_fold,
+    write_json,
+    write_svg,
+)
 from rigidfold.mesh import CreasePattern
 
 

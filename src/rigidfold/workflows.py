@@ -89,7 +89,13 @@ class ShapeCheck:
     written: tuple[Path, ...]
 
     def to_dict(self) -> dict:
-        return self.verification.figures()
+        """The checked stage's figures at the top level (the deformation's when Step 9 ran,
+        else the development's, without the load-step history), the others under their
+        names."""
+        figures = self.verification.figures()
+        stage = "development" if figures["deformation"] is None else "deformation"
+        top = {k: v for k, v in figures.pop(stage).items() if k != "history"}
+        return {**top, **{k: v for k, v in figures.items() if v is not None}}
 
 
 def develop_file(

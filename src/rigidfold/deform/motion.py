@@ -30,7 +30,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
-from rigidfold.mechanism.kinematics import _fold_angle_map
+from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import edge_lengths
 
@@ -60,24 +60,13 @@ class Motion:
         }
 
 
-def _crease_stencils(pattern: CreasePattern, creases: np.ndarray) -> np.ndarray:
-    """(n, 4) vertices (u, v, a, b) of each crease: its ends and the two opposite corners."""
-    e = pattern.edges[creases]
-    ef = pattern.edge_faces[creases]
-    a = pattern.faces[ef[:, 0]].sum(axis=1) - e.sum(axis=1)
-    b = pattern.faces[ef[:, 1]].sum(axis=1) - e.sum(axis=1)
-    return np.column_stack([e[:, 0], e[:, 1], a, b])
-
-
 def _fold_angles_and_jacobian(stencils: np.ndarray, X: np.ndarray):
     """Fold angles (n,) of the creases with ``stencils`` at X (V, 3), Jacobian (n, 3V) dense."""
     n = len(stencils)
-    q = X[stencils].reshape(n, 12).T
-    rho, grad = _fold_angle_map(n)(q)
-    cols = (3 * stencils[:, :, None] + np.arange(3)).reshape(n, 12)
+    rho, grad, cols = fold_angles_and_gradients(X, stencils)
     J = np.zeros((n, X.size))
-    np.add.at(J, (np.repeat(np.arange(n), 12), cols.ravel()), np.asarray(grad).T.ravel())
-    return np.asarray(rho).ravel(), J
+    np.add.at(J, (np.repeat(np.arange(n), 12), cols.ravel()), grad.ravel())
+    return rho, J
 
 
 class _Constraints:
@@ -93,7 +82,7 @@ class _Constraints:
         fixed, free = pattern.fixed_creases, pattern.free_creases
         self.n_fixed = len(fixed)
         self.rho_fixed0 = pattern.fold_angles[fixed]
-        self.stencils = _crease_stencils(pattern, np.concatenate([fixed, free]))
+        self.stencils = pattern.crease_stencils(np.concatenate([fixed, free]))
         self.support = (3 * pattern.faces[support_face][:, None] + np.arange(3)).ravel()
         self.X0 = pattern.coords.ravel().copy()
 

@@ -1,5 +1,6 @@
-"""File formats: FOLD 1.2 crease patterns and SVG drawings."""
+"""File formats (FOLD 1.2 crease patterns, SVG drawings) and atomic output files."""
 
+from rigidfold.io.files import atomic_write, jsonable, prepare_output_dir, write_json
 from rigidfold.io.fold import (
     FoldData,
     crease_pattern_frame,
@@ -13,12 +14,16 @@ from rigidfold.io.svg import svg_text, write_svg
 
 __all__ = [
     "FoldData",
+    "atomic_write",
     "crease_pattern_frame",
     "fold_dict",
+    "jsonable",
     "motion_frames",
     "pattern_from_fold",
+    "prepare_output_dir",
     "read_fold",
     "svg_text",
     "write_fold",
+    "write_json",
     "write_svg",
 ]

@@ -8,14 +8,13 @@ and ``edges_foldAngle`` (degrees, valley positive). Fixed crease lines are joins
 Custom data live under keys prefixed ``rigidfold:``.
 
 The reader accepts FOLD files from other tools too: 2D coordinates (the flat state), polygon
-faces (triangulated here, the added diagonals become ``"J"`` joins), missing edges (derived
-from the faces) and frames. Every problem with the input is a one-line ``ValueError`` that
-names the file.
+faces (triangulated by :mod:`rigidfold.mesh.triangulate`, the added diagonals become ``"J"``
+joins), missing edges (derived from the faces) and frames. Every problem with the input is a
+one-line ``ValueError`` that names the file.
 """
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import numbers
@@ -26,7 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.io.files import atomic_write, jsonable
 from rigidfold.mesh import CreasePattern, topology
+from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
 
 FOLD_SPEC = 1.2
 """The FOLD version rigidfold writes."""
@@ -92,8 +93,9 @@ def fold_dict(
     frame_class : str
         The single entry of ``frame_classes``, e.g. ``"foldedForm"`` or ``"creasePattern"``.
     metadata : dict, optional
-        Extra data; each item is stored as ``"rigidfold:<key>"``. NumPy scalars and arrays
-        become JSON numbers and lists; non-finite floats become ``null``.
+        Extra data with string keys; each item is stored as ``"rigidfold:<key>"``, cleaned by
+        :func:`rigidfold.io.jsonable` (NumPy values become JSON numbers and lists, non-finite
+        floats ``null``; anything that is not JSON data is a ValueError naming the key).
     creator : str
         ``file_creator``.
     settings : Settings
@@ -125,7 +127,7 @@ def fold_dict(
     for key, value in (metadata or {}).items():
         if not isinstance(key, str):
             raise ValueError(f"metadata keys must be strings, got {key!r}")
-        data[PREFIX + key] = _jsonable(value, key)
+        data[PREFIX + key] = jsonable(value, where=f"metadata {key!r}")
     if frames:
         data["file_frames"] = frames
     return data
@@ -164,10 +166,9 @@ def motion_frames(frames: np.ndarray, parameter: np.ndarray) -> list[dict]:
 
 
 def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Path:
-    """Write a crease pattern as a FOLD file, atomically.
+    """Write a crease pattern as a FOLD file, atomically (:func:`rigidfold.io.atomic_write`).
 
-    The text goes to ``<path>.tmp`` in the same directory, which then replaces ``path``, so an
-    interrupted run never leaves a half-written file. Tables are written one row per line.
+    Tables are written one row per line.
 
     Parameters
     ----------
@@ -187,21 +188,9 @@ def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Pat
     Raises
     ------
     ValueError
-        ``"cannot write <path>: <reason>"`` when the file cannot be written.
+        ``"cannot write '<path>': <reason>"`` when the file cannot be written.
     """
-    path = Path(path)
-    text = _dumps(fold_dict(pattern, **kwargs))
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            tmp.unlink(missing_ok=True)
-        if isinstance(exc, OSError):
-            raise ValueError(f"cannot write {path}: {exc.strerror or exc}") from None
-        raise
-    return path
+    return atomic_write(path, _dumps(fold_dict(pattern, **kwargs)))
 
 
 def edge_assignments(pattern: CreasePattern, flat_angle: float = DEFAULTS.flat_angle) -> list[str]:
@@ -211,21 +200,6 @@ def edge_assignments(pattern: CreasePattern, flat_angle: float = DEFAULTS.flat_a
     letters[pattern.fixed] = "J"
     letters[pattern.is_boundary_edge] = "B"
     return letters.tolist()
-
-
-def _jsonable(value, key: str):
-    """``value`` with NumPy types made plain Python and non-finite floats made None."""
-    if isinstance(value, np.ndarray | np.generic):
-        return _jsonable(value.tolist(), key)
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v, key) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v, key) for v in value]
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if value is None or isinstance(value, str | bool | int):
-        return value
-    raise ValueError(f"metadata {key!r} holds a {type(value).__name__}, which is not JSON data")
 
 
 def _dumps(data: dict) -> str:
@@ -242,7 +216,9 @@ def _dumps(data: dict) -> str:
 
 
 # ---------------------------------------------------------------------------------- reading
-def read_fold(source: str | os.PathLike | dict, frame: int = 0) -> FoldData:
+def read_fold(
+    source: str | os.PathLike | dict, frame: int = 0, *, settings: Settings = DEFAULTS
+) -> FoldData:
     """Read a FOLD file (or an already parsed FOLD dict) into a crease pattern.
 
     Parameters
@@ -253,6 +229,9 @@ def read_fold(source: str | os.PathLike | dict, frame: int = 0) -> FoldData:
         Frame to read: 0 is the top level, ``k >= 1`` is ``file_frames[k - 1]``, which
         inherits the keys it lacks from its ``frame_parent`` (default 0) when
         ``frame_inherit`` is true.
+    settings : Settings
+        Tolerances: ``triangulation_area_tol`` for polygon faces, and those of the pattern
+        (:attr:`CreasePattern.settings`: ``degenerate_area``, ``corner_angle``).
 
     Returns
     -------
@@ -272,14 +251,16 @@ def read_fold(source: str | os.PathLike | dict, frame: int = 0) -> FoldData:
     """
     label, raw = _load(source)
     try:
-        return _parse(raw, frame)
+        return _parse(raw, frame, settings)
     except ValueError as exc:
         raise ValueError(f"{label}: {' '.join(str(exc).split())}") from None
 
 
-def pattern_from_fold(source: str | os.PathLike | dict, frame: int = 0) -> CreasePattern:
+def pattern_from_fold(
+    source: str | os.PathLike | dict, frame: int = 0, *, settings: Settings = DEFAULTS
+) -> CreasePattern:
     """The crease pattern of a FOLD file; see :func:`read_fold`."""
-    return read_fold(source, frame).pattern
+    return read_fold(source, frame, settings=settings).pattern
 
 
 def _load(source) -> tuple[str, dict]:
@@ -308,18 +289,22 @@ def _load(source) -> tuple[str, dict]:
     return str(path), raw
 
 
-def _parse(raw: dict, frame: int) -> FoldData:
+def _parse(raw: dict, frame: int, settings: Settings) -> FoldData:
     data = _frame(raw, frame)
     coords = _coords(data)
     polygons = _polygons(data, len(coords))
     file_edges, file_assignment = _file_edges(data, len(coords))
-    triangles, diagonals = _triangulate_faces(coords, polygons)
-    triangles = _orient_up(coords, triangles)
+    triangles, diagonals = triangulate_polygons(
+        coords, polygons, area_tol=settings.triangulation_area_tol, name="faces_vertices"
+    )
+    triangles = orient_up(coords, triangles)
     edges, assignment = _complete_edges(
         file_edges, file_assignment, diagonals, triangles, len(coords)
     )
     fixed = np.array([a == "J" for a in assignment], dtype=bool)
-    pattern = CreasePattern(coords=coords, faces=triangles, edges=edges, fixed=fixed)
+    pattern = CreasePattern(
+        coords=coords, faces=triangles, edges=edges, fixed=fixed, settings=settings
+    )
     classes = data.get("frame_classes", [])
     if not isinstance(classes, list) or not all(isinstance(c, str) for c in classes):
         raise ValueError(f"frame_classes must be a list of strings, got {_short(classes)}")
@@ -419,32 +404,6 @@ def _file_edges(data: dict, n_vertices: int) -> tuple[list[tuple[int, int]], lis
     return edges, list(assignment)
 
 
-def _triangulate_faces(
-    coords: np.ndarray, polygons: list[list[int]]
-) -> tuple[np.ndarray, list[tuple[int, int]]]:
-    """Triangles (F, 3) of all faces, and the diagonals added inside polygons."""
-    triangles, diagonals = [], []
-    for k, (polygon, xy) in enumerate(zip(polygons, _plane_coords(coords, polygons), strict=True)):
-        if len(polygon) == 3:
-            triangles.append(polygon)
-            continue
-        try:
-            local_triangles, local_diagonals = _ear_clip(xy)
-        except ValueError as exc:
-            raise ValueError(f"faces_vertices[{k}]: {exc}") from None
-        triangles += [[polygon[i] for i in tri] for tri in local_triangles]
-        diagonals += [(polygon[a], polygon[b]) for a, b in local_diagonals]
-    return np.asarray(triangles, dtype=np.int64), diagonals
-
-
-def _orient_up(coords: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Reverse all triangles (F, 3) when their total signed area in plan is negative."""
-    p = coords[triangles]
-    a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    area = np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    return np.ascontiguousarray(triangles[:, ::-1]) if area < 0 else triangles
-
-
 def _complete_edges(
     file_edges: list[tuple[int, int]],
     file_assignment: list[str] | None,
@@ -487,107 +446,6 @@ def _complete_edges(
             edges.append((u, v))
             assignment.append(letter)
     return np.asarray(edges, dtype=np.int64).reshape(-1, 2), assignment
-
-
-def _ear_clip(xy: list[list[float]]) -> tuple[list[tuple[int, ...]], list[tuple[int, int]]]:
-    """Triangulate a simple polygon by ear clipping.
-
-    Of all ears, the one with the largest smallest angle is clipped first.
-
-    Parameters
-    ----------
-    xy : (n, 2) list of float
-        Polygon vertices in order, counter-clockwise, n >= 3.
-
-    Returns
-    -------
-    triangles : list of n - 2 (i, j, k)
-        Local vertex indices, counter-clockwise.
-    diagonals : list of n - 3 (i, j)
-        The added interior edges.
-
-    Raises
-    ------
-    ValueError
-        When the polygon is degenerate or self-intersecting.
-    """
-    size = max(max(p[d] for p in xy) - min(p[d] for p in xy) for d in (0, 1))
-    tol = 1e-12 * size**2
-    remaining = list(range(len(xy)))
-    triangles, diagonals = [], []
-    while len(remaining) > 3:
-        m = len(remaining)
-        best, best_quality = None, -1.0
-        for k in range(m):
-            a, b, c = remaining[k - 1], remaining[k], remaining[(k + 1) % m]
-            if _cross(xy[a], xy[b], xy[c]) <= tol:
-                continue
-            others = (i for i in remaining if i not in (a, b, c))
-            if any(_in_triangle(xy[i], xy[a], xy[b], xy[c], tol) for i in others):
-                continue
-            quality = _min_angle(xy[a], xy[b], xy[c])
-            if quality > best_quality:
-                best, best_quality = k, quality
-        if best is None:
-            raise ValueError("the polygon is degenerate or self-intersecting")
-        a, b, c = remaining[best - 1], remaining[best], remaining[(best + 1) % m]
-        triangles.append((a, b, c))
-        diagonals.append((a, c))
-        remaining.pop(best)
-    if _cross(*(xy[i] for i in remaining)) <= tol:
-        raise ValueError("the polygon is degenerate or self-intersecting")
-    triangles.append(tuple(remaining))
-    return triangles, diagonals
-
-
-def _plane_coords(coords: np.ndarray, polygons: list[list[int]]) -> list[list[list[float]]]:
-    """2D coordinates of each polygon's vertices in the plane normal to its Newell normal.
-
-    The frame (u, w) of a polygon has u x w = its normal, so the polygon runs
-    counter-clockwise in it; it need not be planar.
-
-    coords : (V, 3) float; polygons : F lists of vertex indices  ->  F lists of (n, 2) float
-    Raises ValueError for a polygon of zero area.
-    """
-    sizes = np.array([len(p) for p in polygons])
-    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-    owner = np.repeat(np.arange(len(polygons)), sizes)
-    flat = np.concatenate(polygons)
-    following = flat[starts[owner] + (np.arange(len(flat)) - starts[owner] + 1) % sizes[owner]]
-    first = coords[flat[starts[owner]]]  # relative positions: no cancellation far from 0
-    normal = np.add.reduceat(np.cross(coords[flat] - first, coords[following] - first), starts)
-    length = np.linalg.norm(normal, axis=1)
-    if (length == 0).any():
-        k = int(np.argmin(length))
-        raise ValueError(f"faces_vertices[{k}]: the polygon is degenerate (zero area)")
-    normal /= length[:, None]
-    u = np.cross(normal, np.eye(3)[np.argmin(np.abs(normal), axis=1)])
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    w = np.cross(normal, u)
-    p = coords[flat]
-    xy = np.column_stack([np.sum(p * u[owner], axis=1), np.sum(p * w[owner], axis=1)])
-    return [part.tolist() for part in np.split(xy, starts[1:])]
-
-
-def _cross(a: list[float], b: list[float], c: list[float]) -> float:
-    """Twice the signed area of the 2D triangle (a, b, c), positive when counter-clockwise."""
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-
-
-def _in_triangle(
-    p: list[float], a: list[float], b: list[float], c: list[float], tol: float
-) -> bool:
-    """True when p lies in the counter-clockwise triangle (a, b, c) or on its sides."""
-    return _cross(a, b, p) >= -tol and _cross(b, c, p) >= -tol and _cross(c, a, p) >= -tol
-
-
-def _min_angle(a: list[float], b: list[float], c: list[float]) -> float:
-    """Smallest interior angle of the 2D triangle (a, b, c), radians."""
-    angles = []
-    for p, q, r in ((a, b, c), (b, c, a), (c, a, b)):
-        dot = (q[0] - p[0]) * (r[0] - p[0]) + (q[1] - p[1]) * (r[1] - p[1])
-        angles.append(math.atan2(abs(_cross(p, q, r)), dot))
-    return min(angles)
 
 
 # ---------------------------------------------------------------------------------- helpers

@@ -7,12 +7,12 @@ coordinates drawn.
 
 from __future__ import annotations
 
-import contextlib
 import os
 from pathlib import Path
 
 import numpy as np
 
+from rigidfold.io.files import atomic_write
 from rigidfold.io.fold import edge_assignments
 from rigidfold.mesh import CreasePattern
 
@@ -62,17 +62,11 @@ def svg_text(
 def write_svg(
     path: str | os.PathLike, pattern: CreasePattern, coords2d: np.ndarray, **kwargs
 ) -> Path:
-    """Write :func:`svg_text` atomically; ValueError("cannot write ...") on OS errors."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(svg_text(pattern, coords2d, **kwargs), encoding="utf-8")
-        os.replace(tmp, path)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            tmp.unlink(missing_ok=True)
-        raise ValueError(f"cannot write {path}: {exc.strerror or exc}") from None
-    return path
+    """Write :func:`svg_text` atomically (:func:`rigidfold.io.atomic_write`).
+
+    Raises ValueError ``"cannot write '<path>': <reason>"`` when the file cannot be written.
+    """
+    return atomic_write(path, svg_text(pattern, coords2d, **kwargs))
 
 
 def _escape(text: str) -> str:

@@ -42,31 +42,43 @@ def _fold_angle_map(n: int) -> ca.Function:
     return _fold_angle_function().map(n)
 
 
-def _fold_angle_gradient_entries(
-    pattern: CreasePattern, creases: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Nonzeros of d rho_j / d x: values (n, 12) and their columns in 3V (n, 12)."""
-    e = pattern.edges[creases]
-    ef = pattern.edge_faces[creases]
-    faces = pattern.faces
-    a = faces[ef[:, 0]].sum(axis=1) - e.sum(axis=1)
-    b = faces[ef[:, 1]].sum(axis=1) - e.sum(axis=1)
-    verts = np.column_stack([e[:, 0], e[:, 1], a, b])  # (n, 4)
-    q = pattern.coords[verts].reshape(len(creases), 12).T
-    _, grad = _fold_angle_map(len(creases))(q)
-    cols = (3 * verts[:, :, None] + np.arange(3)).reshape(len(creases), 12)
-    return np.asarray(grad).T, cols
+def fold_angles_and_gradients(
+    coords: np.ndarray, stencils: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fold angles of creases and their gradients in the vertex coordinates.
+
+    Parameters
+    ----------
+    coords : (V, 3) float
+        Vertex coordinates.
+    stencils : (n, 4) int
+        Vertices (u, v, a, b) of each crease, from :meth:`CreasePattern.crease_stencils`.
+
+    Returns
+    -------
+    rho : (n,) float
+        Signed fold angles, radians (valley positive, as :attr:`CreasePattern.fold_angles`).
+    grad : (n, 12) float
+        d rho_j / d (p_u, p_v, p_a, p_b), the nonzeros of d rho_j / d x.
+    cols : (n, 12) int
+        Their columns in x = (x_0, y_0, z_0, x_1, ...) (3V,).
+    """
+    stencils = np.asarray(stencils, dtype=np.int64)
+    n = len(stencils)
+    cols = (3 * stencils[:, :, None] + np.arange(3)).reshape(n, 12)
+    if n == 0:  # CasADi cannot map over 0 creases
+        return np.zeros(0), np.zeros((0, 12)), cols
+    q = np.asarray(coords)[stencils].reshape(n, 12).T
+    rho, grad = _fold_angle_map(n)(q)
+    return np.asarray(rho).ravel(), np.asarray(grad).T, cols
 
 
 def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_matrix:
     """d rho_j / d x for the given interior edges.  -> (len(creases), 3V) sparse."""
-    creases = np.asarray(creases, dtype=np.int64)
-    V = pattern.n_vertices
-    if len(creases) == 0:
-        return sp.csr_matrix((0, 3 * V))
-    grad, cols = _fold_angle_gradient_entries(pattern, creases)
-    rows = np.repeat(np.arange(len(creases)), 12)
-    return sp.csr_matrix((grad.ravel(), (rows, cols.ravel())), shape=(len(creases), 3 * V))
+    n, V = len(creases), pattern.n_vertices
+    _, grad, cols = fold_angles_and_gradients(pattern.coords, pattern.crease_stencils(creases))
+    rows = np.repeat(np.arange(n), 12)
+    return sp.csr_matrix((grad.ravel(), (rows, cols.ravel())), shape=(n, 3 * V))
 
 
 def constraint_matrix(pattern: CreasePattern, support_face: int) -> np.ndarray:
@@ -85,7 +97,7 @@ def constraint_matrix(pattern: CreasePattern, support_face: int) -> np.ndarray:
     C[rows, 3 * e[:, :1] + np.arange(3)] = -d
     C[rows, 3 * e[:, 1:] + np.arange(3)] = d
     if len(fixed):
-        grad, cols = _fold_angle_gradient_entries(pattern, fixed)
+        _, grad, cols = fold_angles_and_gradients(pattern.coords, pattern.crease_stencils(fixed))
         grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
         C[E + np.arange(len(fixed))[:, None], cols] = grad  # 4 distinct vertices per row
     support = (3 * pattern.faces[support_face][:, None] + np.arange(3)).ravel()

@@ -1,4 +1,4 @@
-"""Geometry of a triangulated polyhedron: angles, normals, fold angles.
+"""Geometry of a triangulated polyhedron: angles, normals, fold angles, mirror images.
 
 Pure NumPy array functions. Angles use ``atan2(|a x b|, a . b)``, which is accurate for
 small and for nearly straight angles alike.
@@ -7,6 +7,7 @@ small and for nearly straight angles alike.
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 
 def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -106,3 +107,22 @@ def plan_turning_angles(coords: np.ndarray, loop: np.ndarray) -> np.ndarray:
     cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
     dot = np.einsum("ij,ij->i", d_in, d_out)
     return np.arctan2(cross, dot)
+
+
+def mirror_pairs(coords: np.ndarray, plane, tol: float) -> np.ndarray:
+    """For each vertex, the index of the vertex at its mirror image in plan.
+
+    coords : (V, 2) or (V, 3) float, only x and y are used; plane : object with
+    ``reflect(xy (N, 2)) -> (N, 2)``; tol : largest distance (metres) between a mirror image
+    and its vertex.  returns : (V,) int64
+    Raises ValueError when some vertex has no mirror image among the vertices.
+    """
+    xy = np.asarray(coords)[:, :2]
+    dist, idx = cKDTree(xy).query(plane.reflect(xy))
+    if (dist > tol).any():
+        v = int(np.argmax(dist))
+        raise ValueError(
+            f"the crease pattern is not symmetric about the plane {plane}: vertex {v} at "
+            f"({xy[v, 0]:g}, {xy[v, 1]:g}) has no mirror image"
+        )
+    return idx.astype(np.int64)

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS
+from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import geometry, topology
 
 
@@ -40,6 +40,10 @@ class CreasePattern:
     fixed : (E,) bool
         True for fixed crease lines (the paper's dividing edges, FOLD "J"); their two
         triangles belong to one planar facet.
+    settings : Settings
+        Tolerances of the model: ``degenerate_area`` (checked on construction) and
+        ``corner_angle`` (which boundary vertices are :attr:`corners`). Kept by
+        :meth:`with_coords` and :meth:`with_fixed`; not shown in the repr.
 
     Derived data are cached properties; the arrays are read-only. Construction validates
     the input once and raises ``ValueError`` naming the problem.
@@ -49,8 +53,11 @@ class CreasePattern:
     faces: np.ndarray
     edges: np.ndarray
     fixed: np.ndarray
+    settings: Settings = field(default=DEFAULTS, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.settings, Settings):
+            raise ValueError(f"settings must be a Settings, got {type(self.settings).__name__}")
         coords = np.array(self.coords, dtype=np.float64)
         if coords.ndim != 2 or coords.shape[1] != 3:
             raise ValueError(f"coords must be a (V, 3) array, got shape {coords.shape}")
@@ -77,7 +84,7 @@ class CreasePattern:
             raise ValueError(f"edge {e} is on the boundary and cannot be a fixed crease")
         areas = geometry.face_areas(coords, faces)
         longest = geometry.edge_lengths(coords, edges).max()
-        small = areas <= DEFAULTS.degenerate_area * longest**2
+        small = areas <= self.settings.degenerate_area * longest**2
         if small.any():
             f = int(np.flatnonzero(small)[0])
             raise ValueError(
@@ -92,11 +99,17 @@ class CreasePattern:
     # ------------------------------------------------------------------ constructors
     @classmethod
     def from_faces(
-        cls, coords: np.ndarray, faces: np.ndarray, fixed_edges: np.ndarray | None = None
+        cls,
+        coords: np.ndarray,
+        faces: np.ndarray,
+        fixed_edges: np.ndarray | None = None,
+        *,
+        settings: Settings = DEFAULTS,
     ) -> CreasePattern:
         """Build from vertices and triangles; edges are derived (sorted, ``u < v``).
 
-        coords : (V, 3) or (V, 2) (z = 0); faces : (F, 3); fixed_edges : (k, 2) vertex pairs.
+        coords : (V, 3) or (V, 2) (z = 0); faces : (F, 3); fixed_edges : (k, 2) vertex pairs;
+        settings : the pattern's tolerances (see the class).
         """
         coords = np.asarray(coords, dtype=np.float64)
         if coords.ndim == 2 and coords.shape[1] == 2:
@@ -114,16 +127,26 @@ class CreasePattern:
             if missing.any():
                 raise ValueError(f"fixed edge {fixed_edges[int(np.argmax(missing))]} is no edge")
             fixed = np.isin(keys, want)
-        return cls(coords=coords, faces=faces, edges=edges, fixed=fixed)
+        return cls(coords=coords, faces=faces, edges=edges, fixed=fixed, settings=settings)
 
     def with_coords(self, coords: np.ndarray) -> CreasePattern:
         """Same topology and assignment, new vertex coordinates (V, 3)."""
-        return CreasePattern(coords=coords, faces=self.faces, edges=self.edges, fixed=self.fixed)
+        return CreasePattern(
+            coords=coords,
+            faces=self.faces,
+            edges=self.edges,
+            fixed=self.fixed,
+            settings=self.settings,
+        )
 
     def with_fixed(self, fixed: np.ndarray) -> CreasePattern:
         """Same shape, a new fixed-crease mask (E,) bool."""
         return CreasePattern(
-            coords=self.coords, faces=self.faces, edges=self.edges, fixed=np.asarray(fixed, bool)
+            coords=self.coords,
+            faces=self.faces,
+            edges=self.edges,
+            fixed=np.asarray(fixed, bool),
+            settings=self.settings,
         )
 
     # ------------------------------------------------------------------ sizes
@@ -201,9 +224,10 @@ class CreasePattern:
 
     @cached_property
     def corners(self) -> np.ndarray:
-        """Boundary vertices where the plan boundary turns (the paper's V_c), in loop order."""
+        """Boundary vertices where the plan boundary turns by more than
+        ``settings.corner_angle`` (the paper's V_c), in loop order."""
         turn = geometry.plan_turning_angles(self.coords, self.boundary_loop)
-        return self.boundary_loop[np.abs(turn) > DEFAULTS.corner_angle]
+        return self.boundary_loop[np.abs(turn) > self.settings.corner_angle]
 
     @cached_property
     def boundary_sides(self) -> tuple[BoundarySide, ...]:
@@ -229,6 +253,12 @@ class CreasePattern:
         b1, b2 = (y1 - y0) / length, -(x1 - x0) / length
         line = (float(b1), float(b2), float(-(b1 * x0 + b2 * y0)))
         return BoundarySide(start, end, np.asarray(inner, dtype=np.int64), line)
+
+    def crease_stencils(self, creases: np.ndarray) -> np.ndarray:
+        """(n, 4) int vertices (u, v, a, b) that the fold angles of ``creases`` (n,) depend on:
+        each crease's ends and the opposite corners of its left and right triangles."""
+        creases = np.asarray(creases, dtype=np.int64)
+        return topology.crease_stencils(self.faces, self.edges, self.edge_faces, creases)
 
     @cached_property
     def facets(self) -> np.ndarray:

@@ -81,6 +81,25 @@ def edge_faces(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndar
     return out
 
 
+def crease_stencils(
+    faces: np.ndarray, edges: np.ndarray, edge_faces_: np.ndarray, creases: np.ndarray
+) -> np.ndarray:
+    """The four vertices that a crease's fold angle depends on.
+
+    Row j is ``(u, v, a, b)``: the ends ``edges[c] = (u, v)`` of crease ``c = creases[j]``,
+    ``a`` the third vertex of the face left of u -> v (``edge_faces_[c, 0]``) and ``b`` that of
+    the face right of it.
+
+    faces : (F, 3) int, edges : (E, 2) int, edge_faces_ : (E, 2) int, creases : (n,) int
+    indices of interior edges  ->  (n, 4) int64
+    """
+    e = edges[creases]
+    ef = edge_faces_[creases]
+    a = faces[ef[:, 0]].sum(axis=1) - e.sum(axis=1)
+    b = faces[ef[:, 1]].sum(axis=1) - e.sum(axis=1)
+    return np.column_stack([e[:, 0], e[:, 1], a, b]).astype(np.int64, copy=False)
+
+
 def boundary_loop(edges: np.ndarray, boundary: np.ndarray, n_vertices: int) -> np.ndarray:
     """Ordered vertices of the single boundary loop of a disc.
 

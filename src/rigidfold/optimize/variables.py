@@ -22,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.geometry import mirror_pairs
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,23 +70,6 @@ class LinearMap:
         return float(np.abs(self.gamma @ p - self.c).max())
 
 
-def mirror_pairs(pattern: CreasePattern, plane, tol: float) -> np.ndarray:
-    """For each vertex, the index of the vertex at its mirror image in plan.
-
-    plane : object with ``reflect(xy (N, 2)) -> (N, 2)``.  returns : (V,) int
-    Raises ValueError when some vertex has no mirror image in the pattern.
-    """
-    xy = pattern.coords[:, :2]
-    dist, idx = cKDTree(xy).query(plane.reflect(xy))
-    if (dist > tol).any():
-        v = int(np.argmax(dist))
-        raise ValueError(
-            f"the crease pattern is not symmetric about the plane {plane}: vertex {v} at "
-            f"({xy[v, 0]:g}, {xy[v, 1]:g}) has no mirror image"
-        )
-    return idx.astype(np.int64)
-
-
 def assemble_constraints(
     pattern: CreasePattern, planes: Sequence = (), settings: Settings = DEFAULTS
 ) -> tuple[sp.csr_matrix, np.ndarray]:
@@ -113,7 +96,7 @@ def assemble_constraints(
     for plane in planes:  # (9)
         norm = np.hypot(plane.a, plane.b)
         a, b, c = plane.a / norm, plane.b / norm, plane.c / norm
-        mate = mirror_pairs(pattern, plane, settings.symmetry_match_tol)
+        mate = mirror_pairs(pattern.coords, plane, settings.symmetry_match_tol)
         for i, j in enumerate(mate):
             # reflection of vertex i is vertex j: p_j = p_i - 2 (a x_i + b y_i + c) (a, b, 0)
             add([(X + j, 1.0), (X + i, -(1 - 2 * a * a)), (Y + i, 2 * a * b)], -2 * a * c)

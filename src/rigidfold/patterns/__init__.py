@@ -6,6 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns.grids import grid11, pattern1, pattern1p, pattern2
 from rigidfold.patterns.miura import miura
@@ -27,10 +28,11 @@ def plan(name: str) -> tuple[np.ndarray, np.ndarray]:
     return PATTERNS[key]()
 
 
-def build(name: str, surface) -> CreasePattern:
+def build(name: str, surface, *, settings: Settings = DEFAULTS) -> CreasePattern:
     """Crease pattern ``name`` with each vertex lifted onto ``surface`` (Step 1).
 
-    surface : a :class:`rigidfold.surfaces.Surface` (anything with ``height(x, y)``).
+    surface : a :class:`rigidfold.surfaces.Surface` (anything with ``height(x, y)``);
+    settings : the pattern's tolerances (:attr:`CreasePattern.settings`).
     """
     xy, faces = plan(name)
     check = getattr(surface, "check_finite", None)
@@ -42,7 +44,7 @@ def build(name: str, surface) -> CreasePattern:
         raise ValueError(
             f"surface {surface!r} is not finite at (x, y) = ({xy[bad, 0]:g}, {xy[bad, 1]:g})"
         )
-    return CreasePattern.from_faces(np.column_stack([xy, z]), faces)
+    return CreasePattern.from_faces(np.column_stack([xy, z]), faces, settings=settings)
 
 
 __all__ = ["PATTERNS", "build", "grid11", "miura", "pattern1", "pattern1p", "pattern2", "plan"]

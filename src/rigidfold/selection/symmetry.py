@@ -10,8 +10,8 @@ from scipy.sparse.csgraph import connected_components
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.geometry import mirror_pairs
 from rigidfold.mesh.topology import edge_keys
-from rigidfold.optimize.variables import mirror_pairs
 
 
 def crease_groups(
@@ -26,7 +26,7 @@ def crease_groups(
     order = np.argsort(keys)
     a, b = [np.arange(E)], [np.arange(E)]
     for plane in planes:
-        image = mirror_pairs(pattern, plane, settings.symmetry_match_tol)[pattern.edges]
+        image = mirror_pairs(pattern.coords, plane, settings.symmetry_match_tol)[pattern.edges]
         pos = np.searchsorted(keys[order], edge_keys(image, V))
         a.append(np.arange(E))
         b.append(order[np.minimum(pos, E - 1)])

@@ -505,7 +505,7 @@ def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
 def write_report(stores: Store | list[Store], out: str | Path) -> Path:
     """Write DIR/results.md and the box plots of one or several databases; returns the
     Markdown path. With several databases the figures are prefixed by the database's name."""
-    from rigidfold.case import prepare_output_dir
+    from rigidfold.io import atomic_write, prepare_output_dir
 
     stores = [stores] if isinstance(stores, Store) else list(stores)
     out = prepare_output_dir(out)
@@ -513,7 +513,4 @@ def write_report(stores: Store | list[Store], out: str | Path) -> Path:
         box_plots(s, out, prefix=f"{s.path.stem}_" if len(stores) > 1 else "") for s in stores
     ]
     path = out / "results.md"
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text("# rigidfold study report\n\n" + markdown(stores, figures) + "\n")
-    tmp.replace(path)
-    return path
+    return atomic_write(path, "# rigidfold study report\n\n" + markdown(stores, figures) + "\n")

@@ -1,0 +1,127 @@
+"""Output files: the output directory, atomic writes and JSON data.
+
+Every file rigidfold writes goes through :func:`atomic_write`: the content goes to a new,
+uniquely named temporary file beside the target, is flushed to disk and then renamed onto
+the target, so an interrupted run never leaves a half-written file and a reader never sees
+one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import secrets
+from pathlib import Path
+
+import numpy as np
+
+_TEMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+
+
+def prepare_output_dir(path: str | os.PathLike) -> Path:
+    """Create the output directory and check it is writable, before any computation.
+
+    The check creates and removes a new, uniquely named file in it.
+
+    Raises ValueError ``"cannot write to output directory 'PATH': reason"``.
+    """
+    out = Path(path)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        fd, probe = _create_temp(out, ".rigidfold-write-test")
+        os.close(fd)
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
+    return out
+
+
+def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
+    """Write ``data`` (str: as UTF-8) to ``path`` atomically; returns ``path`` as a Path.
+
+    A new temporary file is created beside ``path`` (exclusive creation, not following
+    symbolic links), written, flushed and synced to disk, then renamed onto ``path``. On any
+    error the temporary file is removed and ``path`` is left as it was.
+
+    Raises ValueError ``"cannot write 'PATH': reason"`` when the file cannot be written, and
+    for data that is neither str nor bytes.
+    """
+    path = Path(path)
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    elif not isinstance(data, bytes):
+        raise ValueError(
+            f"cannot write '{path}': data must be str or bytes, got {type(data).__name__}"
+        )
+    tmp = None
+    try:
+        fd, tmp = _create_temp(path.parent, path.name)
+        with os.fdopen(fd, "wb") as file:
+            file.write(data)
+            file.flush()
+            os.fsync(file.fileno())
+        os.replace(tmp, path)
+    except BaseException as exc:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise ValueError(f"cannot write '{path}': {_reason(exc)}") from None
+        raise
+    return path
+
+
+def write_json(path: str | os.PathLike, data, *, indent: int | None = 2) -> Path:
+    """Write ``jsonable(data)`` as strict JSON text atomically (see :func:`atomic_write`).
+
+    Raises ValueError for an unwritable file or data that is not JSON data.
+    """
+    path = Path(path)
+    clean = jsonable(data, where=f"the JSON data of '{path}'")
+    return atomic_write(path, json.dumps(clean, indent=indent, allow_nan=False) + "\n")
+
+
+def jsonable(value, *, where: str = "the value"):
+    """``value`` as plain JSON data (what ``json.dumps(..., allow_nan=False)`` accepts).
+
+    * NumPy arrays and scalars become Python lists and numbers (``tolist()``), then as below;
+    * non-finite floats (NaN, +-inf) become None (JSON ``null``);
+    * tuples become lists; dicts get ``str(key)`` keys (keys are not checked otherwise);
+    * str, int, bool, None and finite floats stay as they are (subclasses such as
+      :class:`rigidfold.status.Outcome` members included).
+
+    Raises ValueError ``"<where> holds a <type>, which is not JSON data"`` for anything else
+    (sets, arbitrary objects).
+    """
+    if isinstance(value, np.ndarray | np.generic):
+        return jsonable(value.tolist(), where=where)
+    if isinstance(value, dict):
+        return {str(k): jsonable(v, where=where) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(v, where=where) for v in value]
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if value is None or isinstance(value, str | bool | int):
+        return value
+    raise ValueError(f"{where} holds a {type(value).__name__}, which is not JSON data")
+
+
+def _create_temp(directory: Path, stem: str) -> tuple[int, Path]:
+    """A new file ``.<stem>.<random>.tmp`` in ``directory``: (open descriptor, path).
+
+    Created exclusively (an existing file or symbolic link of that name is an error, then a
+    new name is tried) with the permissions the umask allows, like any new file.
+    """
+    for _ in range(100):
+        tmp = directory / f".{stem[:200]}.{secrets.token_hex(6)}.tmp"
+        try:
+            return os.open(tmp, _TEMP_FLAGS, 0o666), tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary file name in {directory}")
+
+
+def _reason(exc: OSError) -> str:
+    return str(exc.strerror or exc)
