@@ -16,7 +16,6 @@ import statistics
 
 from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
-from rigidfold.optimize.ipopt import ipopt_solver
 
 BACKENDS = ("casadi", "closed-form")
 
@@ -44,10 +43,10 @@ def main() -> None:
         for _ in range(args.repeats):
             for backend, problem in problems.items():
                 result = problem.solve()
-                stats = ipopt_solver(problem).stats()
+                stats = problem.solver("ipopt").nlpsol.stats()
                 solve[backend].append(result.wall_time)
                 per_call[backend].append(stats["t_wall_nlp_hess_l"] / stats["n_call_nlp_hess_l"])
-        symbolic = ipopt_solver(problems["casadi"]).get_function("nlp_hess_l")
+        symbolic = problems["casadi"].solver("ipopt").nlpsol.get_function("nlp_hess_l")
         print(
             f"pattern {name:<3} n={problems['casadi'].n_variables}  Hessian nnz "
             f"{symbolic.sparsity_out(0).nnz()}, {symbolic.n_instructions()} SX instructions; "

@@ -247,16 +247,17 @@ def _assert_closed_form_hessian_is_exact(problem) -> None:
 
     from rigidfold.optimize.hessian import ClosedFormHessian
 
-    xi, w = problem._xi, problem._w
-    lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", problem._g.shape[0])
-    lagrangian = lam_f * problem._F + ca.dot(lam_g, problem._g)
+    nlp = problem.nlp
+    xi, w = nlp.x, nlp.p
+    lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", nlp.g.shape[0])
+    lagrangian = lam_f * nlp.f + ca.dot(lam_g, nlp.g)
     reference = ca.Function("H", [xi, w, lam_f, lam_g], [ca.triu(ca.hessian(lagrangian, xi)[0])])
     hessian = ClosedFormHessian(problem)
     rng = np.random.default_rng(0)
     for trial in range(2):
         x0 = problem.start_point() + 0.01 * rng.standard_normal(problem.n_variables)
         weights = (rng.random(problem.pattern.n_edges) < 0.3).astype(float)
-        lam = rng.standard_normal(problem._g.shape[0])
+        lam = rng.standard_normal(nlp.g.shape[0])
         ref = reference(x0, weights, 1.0 + trial, lam)
         mine = ca.DM(hessian.sparsity, hessian.values(x0, weights, 1.0 + trial, lam))
         assert hessian.sparsity.nnz() == ref.nnz()

@@ -25,11 +25,16 @@ cost (``benchmarks/hessian_size.py``).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
 from rigidfold.mesh.geometry import skew
+
+if TYPE_CHECKING:
+    from rigidfold.optimize.problem import FormFindingProblem
 
 _B_ANGLE = np.zeros((6, 9))  # (u, v) = (b - a, c - a) from (a, b, c)
 _B_ANGLE[0:3, 0:3] = _B_ANGLE[3:6, 0:3] = -np.eye(3)
@@ -177,7 +182,7 @@ class ClosedFormHessian:
     nonzeros (nnz,) in CasADi's (column-major) order.
     """
 
-    def __init__(self, problem) -> None:
+    def __init__(self, problem: FormFindingProblem) -> None:
         pat, lin = problem.pattern, problem.map
         V, n = pat.n_vertices, lin.n_variables
         self.V, self.n, self.T, self.t = V, n, lin.T.tocsr(), lin.t
@@ -199,7 +204,7 @@ class ClosedFormHessian:
         ef = pat.edge_faces[interior]
         self.interior = interior
         self.edge_corners = np.concatenate([faces[ef[:, 0]], faces[ef[:, 1]]], axis=1)  # (Ei, 6)
-        self.dz_vertices = problem._dz_vertices
+        self.dz_vertices = problem.nlp.dz_vertices
         self.n_dz = len(self.dz_vertices)
         self.n_theta = 3 * F
 
@@ -339,7 +344,7 @@ class _HessianCallback(ca.Callback):
         return 0
 
 
-def closed_form_hess_lag(problem) -> ca.Function:
+def closed_form_hess_lag(problem: FormFindingProblem) -> ca.Function:
     """IPOPT's ``hess_lag`` Function for a FormFindingProblem (keep a reference to it)."""
     hessian = ClosedFormHessian(problem)
-    return _HessianCallback(hessian, problem.pattern.n_edges, problem._g.shape[0])
+    return _HessianCallback(hessian, problem.nlp.p.shape[0], problem.nlp.g.shape[0])

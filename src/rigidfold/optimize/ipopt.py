@@ -2,18 +2,25 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import casadi as ca
 import numpy as np
 
 from rigidfold.config import Settings
+from rigidfold.optimize.hessian import closed_form_hess_lag
+from rigidfold.optimize.solver import SolverOutcome, SolverRun
+
+if TYPE_CHECKING:
+    from rigidfold.optimize.problem import FormFindingProblem
 
 _OUTCOME = {
-    "Solve_Succeeded": "solved",
-    "Solved_To_Acceptable_Level": "solved",
-    "Infeasible_Problem_Detected": "infeasible",
-    "Maximum_Iterations_Exceeded": "iteration_limit",
-    "Maximum_CpuTime_Exceeded": "iteration_limit",
-    "Maximum_WallTime_Exceeded": "iteration_limit",
+    "Solve_Succeeded": SolverOutcome.SOLVED,
+    "Solved_To_Acceptable_Level": SolverOutcome.SOLVED,
+    "Infeasible_Problem_Detected": SolverOutcome.INFEASIBLE,
+    "Maximum_Iterations_Exceeded": SolverOutcome.ITERATION_LIMIT,
+    "Maximum_CpuTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
+    "Maximum_WallTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
 }
 
 
@@ -36,33 +43,38 @@ def ipopt_options(settings: Settings, tol: float | None = None) -> dict:
     }
 
 
-def ipopt_solver(problem) -> ca.Function:
-    """The CasADi ``nlpsol`` of a FormFindingProblem, built once and cached on it.
+class IpoptSolver:
+    """IPOPT on the NLP of a FormFindingProblem, built once (at construction) and kept.
 
     The Hessian of the Lagrangian is ``settings.ipopt_hessian``: "closed-form"
-    (``rigidfold.optimize.hessian``) or "casadi" (CasADi's symbolic Hessian).
+    (``rigidfold.optimize.hessian``, a callback this object keeps alive, as CasADi keeps no
+    reference to it) or "casadi" (CasADi's symbolic Hessian).
+
+    nlpsol : ca.Function
+        CasADi's IPOPT solver; ``nlpsol.stats()`` holds the statistics of the last solve.
     """
-    if problem._ipopt is None:
-        nlp = {"x": problem._xi, "p": problem._w, "f": problem._F, "g": problem._g}
+
+    def __init__(self, problem: FormFindingProblem) -> None:
+        nlp = problem.nlp
+        self._lbg, self._ubg = nlp.lbg, nlp.ubg
         options = ipopt_options(problem.settings)
+        self._hess_lag = None
         if problem.settings.ipopt_hessian == "closed-form":
-            from rigidfold.optimize.hessian import closed_form_hess_lag
+            self._hess_lag = closed_form_hess_lag(problem)
+            options["hess_lag"] = self._hess_lag
+        self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 
-            problem._hess_lag = closed_form_hess_lag(problem)  # CasADi keeps no reference
-            options["hess_lag"] = problem._hess_lag
-        problem._ipopt = ca.nlpsol("form_finding", "ipopt", nlp, options)
-    return problem._ipopt
+    def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
+        """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
-
-def run_ipopt(problem, xi0: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, int, str, str]:
-    """Solve from ``xi0`` with fixed-crease weights ``w``.
-
-    returns : (xi (n,), iterations, outcome, IPOPT's return status)
-    """
-    solver = ipopt_solver(problem)
-    sol = solver(x0=xi0, p=w, lbg=problem.lbg, ubg=problem.ubg)
-    stats = solver.stats()
-    status = str(stats.get("return_status", "unknown"))
-    outcome = _OUTCOME.get(status, "failed")
-    xi = np.asarray(sol["x"], dtype=float).ravel()
-    return xi, int(stats.get("iter_count", 0)), outcome, f"IPOPT: {status}"
+        The run's message is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``.
+        """
+        sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
+        stats = self.nlpsol.stats()
+        status = str(stats.get("return_status", "unknown"))
+        return SolverRun(
+            xi=np.asarray(sol["x"], dtype=float).ravel(),
+            iterations=int(stats.get("iter_count", 0)),
+            outcome=_OUTCOME.get(status, SolverOutcome.FAILED),
+            message=f"IPOPT: {status}",
+        )

@@ -1,56 +1,38 @@
-"""Problem (6): developability (F1) and flatness (F2) with exact derivatives from CasADi.
+"""Problem (6) for one crease pattern, target surface, symmetry and settings, and its solvers.
 
-::
-
-    min_xi   F = F1 + F2
-    F1 = sum_{i in V_in} (2 pi - sum_k theta_ik)^2
-    F2 = sum_{j in E_fix} |n_j1 x n_j2|^2
-    s.t.     |z_i - f(x_i, y_i)| <= dz                  (every vertex that can move)
-             theta_min <= theta_ik <= theta_max          (every sector angle)
-             |rho_j| <= rho_bar                          (free creases, optional, Eq. 12)
-             P = T xi + t                                (Eqs. 7-11, eliminated)
-
-The model is built once per pattern, surface, symmetry and settings as CasADi SX
-expressions; the fixed-crease mask is a *parameter* ``w`` (E,), so fixing another crease
-needs no rebuild. Angles are ``atan2(|a x b|, a . b)``. Constraint (12) is imposed in the
-equivalent smooth form ``n_j1 . n_j2 >= cos(rho_bar)``.
+The NLP (``rigidfold.optimize.nlp``) is built once per problem; the solvers are objects
+(``rigidfold.optimize.solver``) built from it on first use, named in ``SOLVER_FACTORIES``, and
+kept on the problem, so IPOPT is set up once however many solves follow.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
+from functools import partial
+from types import MappingProxyType
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sp
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
+from rigidfold.optimize.ipopt import IpoptSolver
+from rigidfold.optimize.nlp import NLP, build_nlp
 from rigidfold.optimize.result import OptimizeResult, Status
+from rigidfold.optimize.slsqp import SlsqpSolver
+from rigidfold.optimize.solver import Solver, SolverOutcome
 from rigidfold.optimize.variables import LinearMap, build_linear_map
 
-SOLVERS = ("ipopt", "slsqp", "slsqp-fd")
-
-
-def to_casadi(matrix: sp.spmatrix) -> ca.DM:
-    """A SciPy sparse matrix as a sparse CasADi DM."""
-    csc = sp.csc_matrix(matrix)
-    csc.sort_indices()
-    sparsity = ca.Sparsity(csc.shape[0], csc.shape[1], csc.indptr.tolist(), csc.indices.tolist())
-    return ca.DM(sparsity, csc.data)
-
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+#: name -> solver factory ``(problem) -> Solver``; the one list of solver names
+SOLVER_FACTORIES: Mapping[str, Callable[[FormFindingProblem], Solver]] = MappingProxyType(
+    {
+        "ipopt": IpoptSolver,
+        "slsqp": partial(SlsqpSolver, exact=True),
+        "slsqp-fd": partial(SlsqpSolver, exact=False),
+    }
+)
+SOLVERS = tuple(SOLVER_FACTORIES)
 
 
 class FormFindingProblem:
@@ -67,8 +49,22 @@ class FormFindingProblem:
     settings : Settings
         Design parameters (dz, theta bounds, rho_bar, F_tol) and tolerances.
     build_ipopt : bool
-        Build IPOPT's NLP (exact Hessian of the Lagrangian) now, so that ``build_time`` covers
-        it; otherwise it is built on the first IPOPT solve.
+        Build the IPOPT solver (exact Hessian of the Lagrangian) now, so that ``build_time``
+        covers it; otherwise it is built on the first IPOPT solve.
+
+    Attributes
+    ----------
+    map : LinearMap
+        The elimination (7)-(11), ``P = T xi + t``.
+    nlp : NLP
+        Problem (6) as CasADi symbols, expressions and bounds.
+    objective : ca.Function (xi, w) -> (F, F1, F2)
+    objective_gradient : ca.Function (xi, w) -> (F, dF (n,))
+    constraints : ca.Function (xi, w) -> g (m,)
+    constraint_jacobian : ca.Function (xi, w) -> (g (m,), dg (m, n))
+    angles : ca.Function xi -> theta (3F,)
+    build_time : float
+        Seconds spent building the model (and IPOPT with ``build_ipopt``).
     """
 
     def __init__(
@@ -86,88 +82,24 @@ class FormFindingProblem:
         self.planes = tuple(planes)
         self.settings = settings
         self.map: LinearMap = build_linear_map(pattern, self.planes, settings)
-        self._build_model()
-        self._ipopt = self._hess_lag = None
-        if build_ipopt:
-            from rigidfold.optimize.ipopt import ipopt_solver
-
-            ipopt_solver(self)
-        self.build_time = time.perf_counter() - t0
-
-    # ------------------------------------------------------------------ model
-    def _build_model(self) -> None:
-        pat, s = self.pattern, self.settings
-        V, E = pat.n_vertices, pat.n_edges
-        faces, ef = pat.faces, pat.edge_faces
-        interior = pat.interior_edges
-        xi = ca.SX.sym("xi", self.map.n_variables)
-        w = ca.SX.sym("w", E)
-        P = ca.mtimes(to_casadi(self.map.T), xi) + ca.DM(self.map.t)
-        x, y, z = P[:V], P[V : 2 * V], P[2 * V :]
-
-        def at(idx: np.ndarray):
-            i = idx.tolist()
-            return (x[i], y[i], z[i])
-
-        corners = [at(faces[:, k]) for k in range(3)]
-        angles = []
-        for k in range(3):
-            u = _sub(corners[(k + 1) % 3], corners[k])
-            v = _sub(corners[(k + 2) % 3], corners[k])
-            c = _cross(u, v)
-            angles.append(ca.atan2(ca.sqrt(_dot(c, c)), _dot(u, v)))
-        theta = ca.vertcat(*angles)  # (3F,), entry k*F + f is the angle at faces[f, k]
-
-        inner = pat.interior_vertices
-        row_of = np.full(V, -1)
-        row_of[inner] = np.arange(len(inner))
-        vert = faces.T.ravel()  # vertex of angle k*F + f
-        keep = row_of[vert] >= 0
-        A = sp.coo_matrix(
-            (np.ones(keep.sum()), (row_of[vert[keep]], np.flatnonzero(keep))),
-            shape=(len(inner), 3 * len(faces)),
+        self.nlp: NLP = build_nlp(pattern, surface, self.map, settings)
+        nlp = self.nlp
+        xi, w, names = nlp.x, nlp.p, ["xi", "w"]
+        self.objective = ca.Function(
+            "F", [xi, w], [nlp.f, nlp.f1, nlp.f2], names, ["F", "F1", "F2"]
         )
-        defect = 2 * np.pi - ca.mtimes(to_casadi(A), theta)
-        F1 = ca.sumsqr(defect)
-
-        nrm = _cross(_sub(corners[1], corners[0]), _sub(corners[2], corners[0]))
-        length = ca.sqrt(_dot(nrm, nrm))
-        unit = tuple(c / length for c in nrm)
-        ia, ib = ef[interior, 0].tolist(), ef[interior, 1].tolist()
-        na = tuple(c[ia] for c in unit)
-        nb = tuple(c[ib] for c in unit)
-        cr = _cross(na, nb)
-        flat = _dot(cr, cr)  # |n_a x n_b|^2 per interior edge
-        w_int = w[interior.tolist()]
-        F2 = ca.dot(w_int, flat)
-        F = F1 + F2
-
-        # dz constraint on every vertex that is not completely fixed by (7)-(9)
-        T = self.map.T.tocsr()
-        moves = np.diff(T.indptr).reshape(3, V).sum(axis=0) > 0
-        self._dz_vertices = np.flatnonzero(moves)
-        mv = self._dz_vertices.tolist()
-        height = self.surface.height(x[mv], y[mv], xp=ca)
-        g = [z[mv] - height, theta]
-        lbg = [np.full(len(mv), -s.dz), np.full(theta.shape[0], s.theta_min)]
-        ubg = [np.full(len(mv), s.dz), np.full(theta.shape[0], s.theta_max)]
-        if s.rho_bar is not None:
-            g.append((1 - w_int) * (np.cos(s.rho_bar) - _dot(na, nb)))
-            lbg.append(np.full(len(interior), -np.inf))
-            ubg.append(np.zeros(len(interior)))
-
-        self._xi, self._w = xi, w
-        self._F, self._g = F, ca.vertcat(*g)
-        self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
-        self.objective = ca.Function("F", [xi, w], [F, F1, F2], ["xi", "w"], ["F", "F1", "F2"])
-        self.constraints = ca.Function("g", [xi, w], [self._g], ["xi", "w"], ["g"])
-        self.angles = ca.Function("theta", [xi], [theta], ["xi"], ["theta"])
+        self.constraints = ca.Function("g", [xi, w], [nlp.g], names, ["g"])
+        self.angles = ca.Function("theta", [xi], [nlp.theta], ["xi"], ["theta"])
         self.objective_gradient = ca.Function(
-            "dF", [xi, w], [F, ca.gradient(F, xi)], ["xi", "w"], ["F", "dF"]
+            "dF", [xi, w], [nlp.f, ca.gradient(nlp.f, xi)], names, ["F", "dF"]
         )
         self.constraint_jacobian = ca.Function(
-            "dg", [xi, w], [self._g, ca.jacobian(self._g, xi)], ["xi", "w"], ["g", "dg"]
+            "dg", [xi, w], [nlp.g, ca.jacobian(nlp.g, xi)], names, ["g", "dg"]
         )
+        self._solvers: dict[str, Solver] = {}
+        if build_ipopt:
+            self.solver("ipopt")
+        self.build_time = time.perf_counter() - t0
 
     def derivative_functions(self) -> dict[str, ca.Function]:
         """Exact derivatives of each part of (6), for checks and for callers that need them.
@@ -175,13 +107,11 @@ class FormFindingProblem:
         Keys: "F1", "F2" -> Function(xi, w) -> (value, gradient (n,), Hessian (n, n));
         "theta" -> Function(xi, lam) -> (angles (3F,), Jacobian (3F, n), Hessian of lam . theta).
         """
-        xi, w = self._xi, self._w
-        _, F1, F2 = self.objective(xi, w)
+        xi, w, theta = self.nlp.x, self.nlp.p, self.nlp.theta
         out = {}
-        for name, expr in (("F1", F1), ("F2", F2)):
+        for name, expr in (("F1", self.nlp.f1), ("F2", self.nlp.f2)):
             hess, grad = ca.hessian(expr, xi)
             out[name] = ca.Function(f"d{name}", [xi, w], [expr, grad, hess])
-        theta = self.angles(xi)
         lam = ca.SX.sym("lam", theta.shape[0])
         hess, _ = ca.hessian(ca.dot(lam, theta), xi)
         out["theta"] = ca.Function("dtheta", [xi, lam], [theta, ca.jacobian(theta, xi), hess])
@@ -229,7 +159,7 @@ class FormFindingProblem:
         dz = coords[:, 2] - np.asarray(self.surface.height(coords[:, 0], coords[:, 1]))
         theta = shape.corner_angles
         parts = [
-            np.abs(dz[self._dz_vertices]).max(initial=0.0) - s.dz,
+            np.abs(dz[self.nlp.dz_vertices]).max(initial=0.0) - s.dz,
             s.theta_min - theta.min(),
             theta.max() - s.theta_max,
             self.map.residual(coords),
@@ -240,30 +170,34 @@ class FormFindingProblem:
         return max(0.0, *parts)
 
     # ------------------------------------------------------------------ solve
+    def solver(self, name: str) -> Solver:
+        """The solver ``name`` (one of ``SOLVERS``) of this problem, built on first use and kept."""
+        if name not in SOLVER_FACTORIES:
+            raise ValueError(f"unknown solver {name!r} (choose from {', '.join(SOLVERS)})")
+        if name not in self._solvers:
+            self._solvers[name] = SOLVER_FACTORIES[name](self)
+        return self._solvers[name]
+
     def solve(
         self, fixed=None, start: np.ndarray | None = None, solver: str = "ipopt"
     ) -> OptimizeResult:
-        """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed."""
-        if solver not in SOLVERS:
-            raise ValueError(f"unknown solver {solver!r} (choose from {', '.join(SOLVERS)})")
+        """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
+
+        ``solver`` is one of ``SOLVERS``; the result's ``wall_time`` is that of the solve alone.
+        """
+        backend = self.solver(solver)
         mask = self.fixed_mask(fixed)
         xi0 = self.start_point(start)
         w = mask.astype(float)
         t0 = time.perf_counter()
         with one_blas_thread():  # which zero of F is reached depends on round-off
-            if solver == "ipopt":
-                from rigidfold.optimize.ipopt import run_ipopt
-
-                xi, iterations, outcome, message = run_ipopt(self, xi0, w)
-            else:
-                from rigidfold.optimize.slsqp import run_slsqp
-
-                xi, iterations, outcome, message = run_slsqp(self, xi0, w, exact=solver == "slsqp")
+            run = backend.solve(xi0, w)
         wall = time.perf_counter() - t0
+        xi = run.xi
         coords = self.map.expand(xi)
         F, F1, F2 = (float(v) for v in self.objective(xi, w))
         viol = self.violation(coords, mask)
-        status, verdict = classify(outcome, F, viol, self.settings)
+        status, verdict = classify(run.outcome, F, viol, self.settings)
         return OptimizeResult(
             pattern=CreasePattern(coords, self.pattern.faces, self.pattern.edges, mask),
             F=F,
@@ -271,27 +205,29 @@ class FormFindingProblem:
             F2=F2,
             max_violation=viol,
             status=status,
-            message=f"{message}; {verdict}",
-            iterations=iterations,
+            message=f"{run.message}; {verdict}",
+            iterations=run.iterations,
             wall_time=wall,
             solver=solver,
             n_variables=self.n_variables,
         )
 
 
-def classify(outcome: str, F: float, violation: float, settings: Settings) -> tuple[Status, str]:
+def classify(
+    outcome: SolverOutcome, F: float, violation: float, settings: Settings
+) -> tuple[Status, str]:
     """rigidfold's verdict on a solver run.
 
-    outcome : "solved", "infeasible", "iteration_limit" or "failed" (the solver's own flag).
+    outcome : the solver's own flag (a ``SolverOutcome``, or its value).
     A point with F <= F_tol that meets every constraint is accepted whatever the solver said.
     """
     feasible = violation <= settings.constraint_tol
     if feasible and F <= settings.f_tol:
         return Status.CONVERGED, f"accepted: F = {F:.3g} <= F_tol = {settings.f_tol:.3g}"
-    if outcome == "infeasible" or (outcome == "solved" and not feasible):
+    if outcome == SolverOutcome.INFEASIBLE or (outcome == SolverOutcome.SOLVED and not feasible):
         return Status.INFEASIBLE, f"constraint violation {violation:.3g}"
-    if outcome == "iteration_limit":
+    if outcome == SolverOutcome.ITERATION_LIMIT:
         return Status.ITERATION_LIMIT, f"stopped at F = {F:.3g}"
-    if outcome == "solved":
+    if outcome == SolverOutcome.SOLVED:
         return Status.TOLERANCE_NOT_MET, f"F = {F:.3g} > F_tol = {settings.f_tol:.3g}"
     return Status.FAILED, f"F = {F:.3g}, constraint violation {violation:.3g}"

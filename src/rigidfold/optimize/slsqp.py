@@ -7,53 +7,87 @@ paper did (its baseline: 72 s per solve for 115 variables).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.optimize import minimize
+
+from rigidfold.optimize.solver import SolverOutcome, SolverRun
+
+if TYPE_CHECKING:
+    from rigidfold.optimize.problem import FormFindingProblem
 
 # SciPy's SLSQP exit modes (scipy/optimize/_slsqp_py.py)
-_OUTCOME = {0: "solved", 9: "iteration_limit", 3: "infeasible", 4: "infeasible"}
+_OUTCOME = {
+    0: SolverOutcome.SOLVED,
+    9: SolverOutcome.ITERATION_LIMIT,
+    3: SolverOutcome.INFEASIBLE,
+    4: SolverOutcome.INFEASIBLE,
+}
 
 
-def run_slsqp(
-    problem, xi0: np.ndarray, w: np.ndarray, *, exact: bool = True
-) -> tuple[np.ndarray, int, str, str]:
-    """Solve from ``xi0`` with fixed-crease weights ``w``.
+class SlsqpSolver:
+    """SLSQP on a FormFindingProblem, with exact (``exact=True``) or SciPy's finite-difference
+    derivatives.
 
-    returns : (xi (n,), iterations, outcome, SciPy's message)
+    The two-sided constraints of (6) become SLSQP's one-sided ``g >= 0`` rows here, once.
     """
-    s = problem.settings
-    lo_rows = np.flatnonzero(np.isfinite(problem.lbg))
-    hi_rows = np.flatnonzero(np.isfinite(problem.ubg))
-    lo, hi = problem.lbg[lo_rows], problem.ubg[hi_rows]
 
-    def objective(xi):
-        return float(problem.objective(xi, w)[0])
+    def __init__(self, problem: FormFindingProblem, *, exact: bool = True) -> None:
+        lbg, ubg = problem.nlp.lbg, problem.nlp.ubg
+        self.exact = exact
+        self._settings = problem.settings
+        self._objective = problem.objective
+        self._objective_gradient = problem.objective_gradient
+        self._constraints = problem.constraints
+        self._constraint_jacobian = problem.constraint_jacobian
+        self._lo_rows = np.flatnonzero(np.isfinite(lbg))
+        self._hi_rows = np.flatnonzero(np.isfinite(ubg))
+        self._lo, self._hi = lbg[self._lo_rows], ubg[self._hi_rows]
 
-    def objective_and_gradient(xi):
-        f, grad = problem.objective_gradient(xi, w)
-        return float(f), np.asarray(grad, dtype=float).ravel()
+    def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
+        """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
-    def inequalities(xi):  # >= 0
-        g = np.asarray(problem.constraints(xi, w), dtype=float).ravel()
-        return np.concatenate([g[lo_rows] - lo, hi - g[hi_rows]])
+        The run's message is SciPy's, e.g. ``"SLSQP: Optimization terminated successfully"``.
+        """
+        from scipy.optimize import minimize  # only when SLSQP runs: not on the import path
 
-    def inequality_jacobian(xi):
-        jac = problem.constraint_jacobian(xi, w)[1].full()
-        return np.vstack([jac[lo_rows], -jac[hi_rows]])
+        lo_rows, hi_rows, lo, hi = self._lo_rows, self._hi_rows, self._lo, self._hi
 
-    constraint = {"type": "ineq", "fun": inequalities}
-    options = {"maxiter": s.slsqp_max_iter, "ftol": s.slsqp_ftol}
-    if exact:
-        constraint["jac"] = inequality_jacobian
-        res = minimize(
-            objective_and_gradient,
-            xi0,
-            jac=True,
-            method="SLSQP",
-            constraints=[constraint],
-            options=options,
+        def objective(xi):
+            return float(self._objective(xi, w)[0])
+
+        def objective_and_gradient(xi):
+            f, grad = self._objective_gradient(xi, w)
+            return float(f), np.asarray(grad, dtype=float).ravel()
+
+        def inequalities(xi):  # >= 0
+            g = np.asarray(self._constraints(xi, w), dtype=float).ravel()
+            return np.concatenate([g[lo_rows] - lo, hi - g[hi_rows]])
+
+        def inequality_jacobian(xi):
+            jac = self._constraint_jacobian(xi, w)[1].full()
+            return np.vstack([jac[lo_rows], -jac[hi_rows]])
+
+        s = self._settings
+        constraint = {"type": "ineq", "fun": inequalities}
+        options = {"maxiter": s.slsqp_max_iter, "ftol": s.slsqp_ftol}
+        if self.exact:
+            constraint["jac"] = inequality_jacobian
+            res = minimize(
+                objective_and_gradient,
+                xi0,
+                jac=True,
+                method="SLSQP",
+                constraints=[constraint],
+                options=options,
+            )
+        else:
+            res = minimize(
+                objective, xi0, method="SLSQP", constraints=[constraint], options=options
+            )
+        return SolverRun(
+            xi=np.asarray(res.x, dtype=float),
+            iterations=int(res.nit),
+            outcome=_OUTCOME.get(int(res.status), SolverOutcome.FAILED),
+            message=f"SLSQP: {res.message}",
         )
-    else:
-        res = minimize(objective, xi0, method="SLSQP", constraints=[constraint], options=options)
-    outcome = _OUTCOME.get(int(res.status), "failed")
-    return np.asarray(res.x, dtype=float), int(res.nit), outcome, f"SLSQP: {res.message}"
