@@ -66,39 +66,36 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.set_defaults(func=_cmd_generate)
 
-    ana = sub.add_parser(
+    _file_command(
+        sub,
         "analyze",
+        _cmd_analyze,
         help="mechanism analysis of a FOLD shape: DOF, locked creases, fold angles",
         description="Read a FOLD file (3D vertices_coords; polygon faces are triangulated with "
         "fixed 'J' edges) and report its DOF and locked crease lines.",
     )
-    ana.add_argument("file", metavar="FILE.fold")
-    ana.add_argument("--json", action="store_true", help="print one JSON object")
-    ana.set_defaults(func=_cmd_analyze)
-
-    dev = sub.add_parser(
+    _file_command(
+        sub,
         "develop",
+        _cmd_develop,
+        out=True,
         help="Step 8: development diagram of a FOLD shape (problem 13)",
         description="Flatten a FOLD shape to its development diagram. Writes DIR/<name>.fold "
-        "(the input plus a 'creasePattern' frame with 2D coordinates) and DIR/<name>.svg.",
+        "(the input plus a 'creasePattern' frame with 2D coordinates) and DIR/<name>.svg. Exit "
+        "code 0 when the development converged, 1 when not, 2 on bad input.",
     )
-    dev.add_argument("file", metavar="FILE.fold")
-    dev.add_argument("--out", required=True, metavar="DIR")
-    dev.add_argument("--json", action="store_true", help="print one JSON object")
-    dev.set_defaults(func=_cmd_develop)
-
-    dfm = sub.add_parser(
+    _file_command(
+        sub,
         "deform",
+        _cmd_deform,
+        out=True,
         help="Step 9: large-deformation check of a FOLD shape (OpenSees) and its folding motion",
         description="Drive the frame model of a FOLD shape to the plane with OpenSees and trace "
         "its folding motion. Writes DIR/<name>.fold (the input plus the development diagram and "
-        "the motion frames) and DIR/<name>_deform.json (figures and the load-step history). Exit "
-        "code 0 when the plane is reached, 1 when not, 2 on bad input.",
+        "the motion frames), DIR/<name>.svg (the development diagram) and DIR/<name>_deform.json "
+        "(figures and the load-step history). Exit code 0 when the plane is reached, 1 when "
+        "not, 2 on bad input.",
     )
-    dfm.add_argument("file", metavar="FILE.fold")
-    dfm.add_argument("--out", required=True, metavar="DIR")
-    dfm.add_argument("--json", action="store_true", help="print one JSON object")
-    dfm.set_defaults(func=_cmd_deform)
 
     stu = sub.add_parser(
         "study",
@@ -155,6 +152,16 @@ def build_parser() -> argparse.ArgumentParser:
     opt.add_argument("--fixed", help="comma-separated indices of fixed crease lines")
     opt.set_defaults(func=_cmd_optimize)
     return parser
+
+
+def _file_command(sub, name: str, func, *, out: bool = False, **text: str) -> None:
+    """A command on one FOLD file: FILE.fold [--out DIR] [--json]."""
+    p = sub.add_parser(name, **text)
+    p.add_argument("file", metavar="FILE.fold")
+    if out:
+        p.add_argument("--out", required=True, metavar="DIR")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=func)
 
 
 def _case_options(p: argparse.ArgumentParser) -> None:
