@@ -204,7 +204,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         out / "solution.fold",
         result.pattern,
         title=f"rigidfold optimize: {case.surface.name} on pattern {case.pattern_name}",
-        metadata={**case.metadata(), **result.summary()},
+        metadata={**case.metadata(), **result.to_dict()},
     )
     write_json(out / "summary.json", report)
     print(
@@ -261,7 +261,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
     progress.close()
     writer.write_summary(run)
-    summary = run.summary()
+    summary = run.to_dict()
     print(
         f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['final_dof']}, "
         f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
@@ -336,16 +336,7 @@ def _cmd_develop(args: argparse.Namespace) -> int:
     data = read_fold(args.file)
     result = develop(data.pattern)
     stem = Path(args.file).stem
-    figures = {
-        "D": result.D,
-        "max_length_error": result.max_length_error,
-        "flipped": result.flipped,
-        "overlaps": result.overlaps,
-        "status": result.status,
-        "iterations": result.iterations,
-        "start": result.start,
-        "wall_time_s": result.wall_time,
-    }
+    figures = result.to_dict()
     write_fold(
         out / f"{stem}.fold",
         data.pattern,
@@ -377,7 +368,7 @@ def _cmd_deform(args: argparse.Namespace) -> int:
     data = read_fold(args.file)
     check = verify(data.pattern)
     stem = Path(args.file).stem
-    figures = check.figures()
+    figures = check.to_dict()
     write_fold(
         out / f"{stem}.fold",
         data.pattern,
@@ -483,10 +474,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 
 def _cmd_study_report(args: argparse.Namespace) -> int:
-    from rigidfold.study import open_readonly
+    from rigidfold.study import Store
     from rigidfold.study.report import markdown, write_report
 
-    stores = [open_readonly(db) for db in args.db]
+    stores = [Store(db, readonly=True) for db in args.db]
     if args.out:
         path = write_report(stores, args.out)
         print(path.read_text())
@@ -534,7 +525,7 @@ class _StudyProgress:
         )
 
     def update(self, key, row, finished: int, total: int) -> None:
-        if str(row.get("status", "")).startswith("error"):
+        if row.get("error"):
             self.failures += 1
         if not self.enabled:
             return

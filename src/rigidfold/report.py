@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.deform.check import verify
+from rigidfold.deform import MotionStatus, verify
 from rigidfold.generate import Attempt, Generation, Solution
 from rigidfold.io import prepare_output_dir, write_fold, write_json, write_svg
 
@@ -45,7 +45,7 @@ class RunWriter:
         check = verify(pattern, run_deform=self.deform, settings=self.case.settings)
         for stage, t in check.times.items():
             self.stage_times[stage] += t
-        figures = {"step": solution.step, "dof": dof, **check.figures()}
+        figures = {"step": solution.step, "dof": dof, **check.to_dict()}
         self.checks.append(figures)
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_svg(
@@ -61,7 +61,7 @@ class RunWriter:
             title=f"rigidfold generate: step {solution.step}, DOF {dof}",
             metadata={
                 **self.case.metadata(),
-                **solution.result.summary(),
+                **solution.result.to_dict(),
                 "step": solution.step,
                 "dof": dof,
                 "criterion": self.options.get("criterion"),
@@ -72,7 +72,7 @@ class RunWriter:
         self.write_summary(run)
 
     def write_summary(self, run: Generation) -> None:
-        summary = run.summary()
+        summary = run.to_dict()
         summary["time_s"].update(self.stage_times)
         dev = [c["development"] for c in self.checks]
         deformed = [c["deformation"] for c in self.checks if c["deformation"] is not None]
@@ -100,7 +100,7 @@ class RunWriter:
                     "max_drho_fix_deg": stat([d["max_drho_fix_deg"] for d in deformed], np.max),
                 },
                 "motion": {
-                    "traced": sum(m["status"] == "ok" for m in motions),
+                    "traced": sum(m["status"] == MotionStatus.OK for m in motions),
                     "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
                 },
                 "per_solution": [
