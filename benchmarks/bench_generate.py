@@ -48,7 +48,7 @@ def bench_generate(seeds: int) -> None:
         run = generate(make_case("bezier", "1", seed=seed), criterion="shat", seed=seed)
         walls.append(time.perf_counter() - t0)
         solves.append(len(run.attempts))
-        s = run.summary()
+        s = run.to_dict()
         print(
             f"  seed {seed}: {walls[-1]:6.2f} s, DOF {s['initial_dof']} -> {s['final_dof']}, "
             f"{s['n_solves']} solves, N_lock {s['N_lock']}, N_exceed {s['N_exceed']}",

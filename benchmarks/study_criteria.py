@@ -52,7 +52,7 @@ def one_run(args: tuple[str, str, int, str, str]) -> dict:
         solver=solver,
         support_face=support_face(case, support),
     )
-    summary = run.summary()
+    summary = run.to_dict()
     summary["wall_s"] = time.perf_counter() - t0
     return summary
 

@@ -18,6 +18,7 @@ from rigidfold.generate import generate
 from rigidfold.io import read_fold, write_fold
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
+from rigidfold.report import verification_frames
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
@@ -118,7 +119,7 @@ def test_generated_one_dof_shape_passes_steps_8_and_9(one_dof_solution):
     assert m.status == "ok" and m.max_length_error < 1e-3
     assert np.abs(m.frames[0][:, 2]).max() < 1e-9
     assert np.allclose(m.frames[-1], one_dof_solution.coords, atol=1e-9)
-    frames = check.fold_frames()
+    frames = verification_frames(check)
     assert frames[0]["frame_classes"] == ["creasePattern"]
     assert [f["frame_classes"] for f in frames[1:]] == [["foldedForm"]] * len(m.frames)
 
@@ -162,3 +163,82 @@ def test_deform_cli_bad_input(tmp_path, content, needle):
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and needle in proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_load_factor_tol_and_penalty_settings_take_effect(miura_checks):
+    from rigidfold.config import DEFAULTS
+    from rigidfold.deform import DeformStatus
+
+    shape, free, _ = miura_checks
+    half = deform(shape, settings=DEFAULTS.with_(deform_load_tol=0.51))  # ends at 0.5
+    assert half.steps == 10 and half.load_factor == pytest.approx(0.5)
+    assert half.status is DeformStatus.FAILED and "from the plane" in half.message
+    loose = deform(shape, settings=DEFAULTS.with_(deform_penalty=1.0))  # pins barely hold
+    assert loose.history != free.history
+
+
+def count_calls(monkeypatch, module, name: str, result=None) -> dict:
+    """Replace ``module.name`` by a wrapper that counts its calls (returning ``result``
+    instead of calling it, when given)."""
+    real, calls = getattr(module, name), {"n": 0}
+
+    def wrapper(*args, **kwargs):
+        calls["n"] += 1
+        return real(*args, **kwargs) if result is None else result(*args)
+
+    monkeypatch.setattr(module, name, wrapper)
+    return calls
+
+
+def test_motion_halvings_have_their_own_setting(monkeypatch):
+    from rigidfold.config import DEFAULTS
+    from rigidfold.deform import motion as motion_module
+
+    shape = miura(3, 3)
+    calls = count_calls(monkeypatch, motion_module, "_newton", lambda c, x, t, s: (x, False))
+    monkeypatch.setattr(motion_module, "trace_one_dof_path", lambda *a, **k: None)
+    settings = DEFAULTS.with_(motion_max_halvings=2, deform_max_halvings=6)
+    m = folding_motion(shape, np.zeros((shape.n_vertices, 2)), settings=settings)
+    assert m.status == "failed" and calls["n"] == 3  # the first step and two halvings
+
+
+def test_motion_level_tol_takes_effect(monkeypatch):
+    from rigidfold.config import DEFAULTS
+    from rigidfold.deform import motion as motion_module
+
+    shape = miura(3, 3)
+    calls = count_calls(monkeypatch, motion_module, "_newton")
+    flat = develop(shape).coords2d
+    m = folding_motion(shape, flat, settings=DEFAULTS.with_(motion_level_tol=1.0))
+    assert m.status == "ok" and calls["n"] == 0  # every level counts as reached
+    assert folding_motion(shape, flat).status == "ok" and calls["n"] > 0
+
+
+def test_motion_stall_settings_take_effect(monkeypatch):
+    from rigidfold.config import DEFAULTS
+    from rigidfold.deform import motion as motion_module
+
+    shape = miura(3, 3)
+    cons = motion_module._Constraints(shape, 0)
+    calls = count_calls(monkeypatch, motion_module._Constraints, "__call__")
+    x = shape.coords.ravel().copy()
+    # a negative folding measure cannot be reached: Newton stalls
+    stall = DEFAULTS.with_(motion_stall_iter=1, motion_stall_ratio=0.0)
+    _, ok = motion_module._newton(cons, x, -1.0, stall)
+    assert not ok and calls["n"] == 3  # iterations 0 and 1, then the final residual
+    calls["n"] = 0
+    motion_module._newton(cons, x, -1.0, DEFAULTS)
+    assert calls["n"] > 3
+
+
+def test_path_trace_settings_take_effect(monkeypatch):
+    from rigidfold.config import DEFAULTS
+    from rigidfold.deform.motion import trace_one_dof_path
+
+    shape = miura(3, 3, height=0.5)
+    turned = trace_one_dof_path(shape, settings=DEFAULTS.with_(motion_turn_back=-1.0))
+    assert not turned.reached_flat and "turns back" in turned.message
+    assert len(turned.points) == 2  # the first step already counts as turning back
+    stuck = DEFAULTS.with_(motion_max_iter=1, motion_arc_min_step=1.0)
+    trace = trace_one_dof_path(shape, settings=stuck)
+    assert "could not be continued" in trace.message and len(trace.points) == 1

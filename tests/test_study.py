@@ -13,7 +13,8 @@ import time
 import numpy as np
 import pytest
 
-from rigidfold.study import Key, Store, StudyConfig, open_readonly, plan, preset
+from rigidfold.generate import Stop
+from rigidfold.study import Key, Store, StudyConfig, plan, preset
 from rigidfold.study.report import (
     costs,
     dof_steps,
@@ -60,7 +61,7 @@ def uninterrupted(tmp_path_factory):
 
 
 def test_study_stores_every_run_once(uninterrupted):
-    store = open_readonly(uninterrupted)
+    store = Store(uninterrupted, readonly=True)
     runs = store.runs()
     assert len(runs) == 6
     assert {(r["seed"], r["criterion"]) for r in runs} == {
@@ -98,14 +99,14 @@ def test_sigkill_mid_study_then_resume_gives_the_same_tables(uninterrupted, tmp_
     resumed = run(study_cmd(db, "--workers", "2", "--quiet"))
     assert resumed.returncode == 0, resumed.stderr
     assert f"{6 - killed_at} runs done, {killed_at} already" in resumed.stdout
-    a, b = open_readonly(uninterrupted), open_readonly(db)
+    a, b = Store(uninterrupted, readonly=True), Store(db, readonly=True)
     assert comparable(b.runs()) == comparable(a.runs())
     assert b.count_attempts() == a.count_attempts()
     assert comparable(tables_5_6(b)) == comparable(tables_5_6(a))
 
 
 def test_report_tables_and_figures(uninterrupted, tmp_path):
-    store = open_readonly(uninterrupted)
+    store = Store(uninterrupted, readonly=True)
     rows = tables_5_6(store)
     assert [(r["pattern"], r["criterion"], r["n"]) for r in rows] == [
         ("1", "s", 3),
@@ -121,7 +122,7 @@ def test_report_tables_and_figures(uninterrupted, tmp_path):
 
 
 def test_report_pairs_costs_and_commands(uninterrupted):
-    store = open_readonly(uninterrupted)
+    store = Store(uninterrupted, readonly=True)
     runs = {(r["criterion"], r["seed"]): r["n_lock"] for r in store.runs("bezier")}
     (pair,) = paired_comparisons(store)  # only S-hat and S ran
     d = [runs[("shat", k)] - runs[("s", k)] for k in range(3)]
@@ -219,7 +220,11 @@ def test_progress_prints_plain_lines_when_stderr_is_not_a_terminal(capsys):
 
     bar = _StudyProgress(enabled=True, log_every=3600.0)
     bar.plain = True  # as under pytest's captured stderr, a log file or nohup
-    rows = [{"status": "target DOF 1 reached"}, {"status": "error: ValueError: x"}, {}]
+    rows = [
+        {"status": "target DOF 1 reached"},
+        {"status": "error: ValueError: x", "error": "ValueError: x"},
+        {},
+    ]
     for finished, row in enumerate(rows, start=4):  # 3 runs were already in the database
         bar.update(None, row, finished, 6)
     lines = capsys.readouterr().err.splitlines()
@@ -235,7 +240,7 @@ def test_report_of_several_databases(uninterrupted, tmp_path):
 
     other = tmp_path / "b.sqlite"
     shutil.copy(uninterrupted, other)
-    stores = [open_readonly(uninterrupted), open_readonly(other)]
+    stores = [Store(uninterrupted, readonly=True), Store(other, readonly=True)]
     path = write_report(stores, tmp_path / "both")
     text = path.read_text()
     assert f"## {uninterrupted.name}" in text and "## b.sqlite" in text
@@ -279,7 +284,7 @@ def test_databases_from_before_the_closed_form_hessian_are_not_resumed_with_it()
 
 
 def test_locks_by_stage_adds_up_to_n_lock(uninterrupted):
-    store = open_readonly(uninterrupted)
+    store = Store(uninterrupted, readonly=True)
     stages = {r["criterion"]: r for r in locks_by_stage(store)}
     for row in tables_5_6(store):
         st = stages[row["criterion"]]
@@ -290,7 +295,7 @@ def test_locks_by_stage_adds_up_to_n_lock(uninterrupted):
 
 def test_dof_steps_add_up_to_the_dof_reduced(uninterrupted):
     """Every accepted fix is one step; the signed steps sum to the DOF reduced per run."""
-    store = open_readonly(uninterrupted)
+    store = Store(uninterrupted, readonly=True)
     steps = {r["criterion"]: r for r in dof_steps(store)}
     for row in tables_5_6(store):
         st = steps[row["criterion"]]
@@ -300,3 +305,108 @@ def test_dof_steps_add_up_to_the_dof_reduced(uninterrupted):
         assert sum(st["per_kind"].values()) == pytest.approx(accepted_fixes)
         assert st["per_kind"]["-1"] >= 0
     assert "### How fixing a crease changes the DOF" in markdown(store)
+
+
+# the schema of the study databases written before the outcome enums (rigidfold 3cb7e52)
+OLD_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS runs (
+    study TEXT NOT NULL,          -- "bezier", or a preset ("dome", "hp")
+    seed INTEGER NOT NULL,        -- surface seed (0 for presets)
+    pattern TEXT NOT NULL,
+    criterion TEXT NOT NULL,
+    symmetric INTEGER NOT NULL,
+    status TEXT NOT NULL,         -- the generator's stop reason, or "error: ..."
+    n_reduce INTEGER, n_lock INTEGER, n_exceed INTEGER,
+    mean_f REAL, initial_dof INTEGER, final_dof INTEGER, n_solutions INTEGER, n_solves INTEGER,
+    mean_d REAL, mean_dl_mm REAL, mean_drho_fix_deg REAL, reached_plane INTEGER,
+    time_build REAL, time_solve REAL, time_analysis REAL, time_selection REAL,
+    time_develop REAL, time_deform REAL, time_total REAL,
+    version TEXT NOT NULL, worker TEXT,
+    PRIMARY KEY (study, seed, pattern, criterion, symmetric)
+);
+CREATE TABLE IF NOT EXISTS invocations (  -- one row per `rigidfold study` command that ended
+    started TEXT NOT NULL,        -- UTC, ISO 8601
+    argv TEXT NOT NULL,           -- the command line (JSON list)
+    workers INTEGER, scheduler TEXT,
+    ran INTEGER NOT NULL, skipped INTEGER NOT NULL, total INTEGER NOT NULL,
+    wall_s REAL NOT NULL, outcome TEXT NOT NULL, version TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS attempts (
+    study TEXT NOT NULL, seed INTEGER NOT NULL, pattern TEXT NOT NULL,
+    criterion TEXT NOT NULL, symmetric INTEGER NOT NULL,
+    idx INTEGER NOT NULL,
+    fixed_added TEXT NOT NULL, score REAL, status TEXT NOT NULL, f REAL, iterations INTEGER,
+    dof INTEGER, locked TEXT NOT NULL, outcome TEXT NOT NULL,
+    solve_time REAL, analysis_time REAL, selection_time REAL,
+    PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
+);
+"""
+
+
+OLD_STATUSES = {  # the status texts that every earlier version wrote, and how they read
+    0: ("target DOF 1 reached", Stop.TARGET_REACHED),
+    1: ("DOF 0 reached", Stop.ZERO_DOF),
+    2: ("no candidate crease succeeds", Stop.NO_CANDIDATE),
+    3: ("no developable polyhedron from the initial shape (exceed)", Stop.INITIAL_FAILED),
+    4: ("error: unknown pattern '7'", None),
+}
+
+
+def old_database(path) -> None:
+    """A study database as an earlier rigidfold wrote it: its schema, rows by plain SQL."""
+    import json
+
+    con = sqlite3.connect(path)
+    con.executescript(OLD_SCHEMA)
+    con.execute(
+        "INSERT INTO meta VALUES ('config', ?)",
+        (json.dumps(StudyConfig().as_dict(), sort_keys=True),),
+    )
+    for seed, (status, _) in OLD_STATUSES.items():
+        figures = (20, seed, 0, 1e-9, 21, 1, 21, 22) if status[0] != "e" else (None,) * 8
+        con.execute(
+            f"INSERT INTO runs VALUES ({', '.join('?' * 27)})",
+            ("bezier", seed, "1", "s", 0, status, *figures, *(None,) * 10, 10.0 + seed, "0", "w"),
+        )
+        attempts = [(0, "accepted", 3), (1, "lock", 2), (2, "accepted", 2)] if seed < 4 else []
+        for idx, outcome, dof in attempts:
+            solve = (idx, "[]", None, "converged", 1e-9, 7, dof, "[]", outcome, 0.1, 0.01, 0.0)
+            con.execute(
+                f"INSERT INTO attempts VALUES ({', '.join('?' * 17)})",
+                ("bezier", seed, "1", "s", 0, *solve),
+            )
+    con.commit()
+    con.close()
+
+
+def test_databases_of_earlier_versions_read_and_resume_the_same(tmp_path):
+    from rigidfold.study import run_stop
+
+    db = tmp_path / "old.sqlite"
+    old_database(db)
+    store = Store(db, readonly=True)
+    assert [run_stop(r["status"]) for r in store.runs()] == [s for _, s in OLD_STATUSES.values()]
+    (row,) = tables_5_6(store)
+    assert (row["n"], row["reached_target"], row["n_lock"]) == (4, 1, 1.5)
+    (stage,) = locks_by_stage(store)
+    assert stage["no_candidate"] == 1 and sum(stage["per_stage"]) == pytest.approx(1.0)
+    assert "| S | 4 | 20.00 ± 0.00 |" in markdown(store)
+    store.close()
+    # a newer rigidfold resumes it: its runs go into the old table
+    store = Store(db, StudyConfig().as_dict())
+    new = {"status": Stop.TARGET_REACHED.reason("1"), "n_reduce": 20, "time_total": 5.0}
+    store.add(Key("bezier", 5, "1", "s"), new | {"version": "new"}, [])
+    store.close()
+    (row,) = tables_5_6(Store(db, readonly=True))
+    assert (row["n"], row["reached_target"]) == (5, 2)
+    with pytest.raises(ValueError, match="not the stop reason"):
+        run_stop("stopped somehow")
+
+
+def test_readonly_store_takes_no_configuration(uninterrupted, tmp_path):
+    with pytest.raises(ValueError, match="no configuration"):
+        Store(uninterrupted, StudyConfig().as_dict(), readonly=True)
+    with pytest.raises(ValueError, match="no study database"):
+        Store(tmp_path / "none.sqlite", readonly=True)
+    assert not (tmp_path / "none.sqlite").exists()

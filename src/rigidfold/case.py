@@ -113,7 +113,7 @@ def shape_report(case: Case, result: OptimizeResult, build_time: float) -> dict:
     angles = np.degrees(shape.corner_angles)
     free = shape.free_creases
     return {
-        **result.summary(),
+        **result.to_dict(),
         "build_time_s": build_time,
         "V": shape.n_vertices,
         "E": shape.n_edges,

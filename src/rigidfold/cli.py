@@ -118,9 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     stu.add_argument("--db", required=True, metavar="DB", help="SQLite file (created if absent)")
     where = stu.add_mutually_exclusive_group()
-    where.add_argument(
-        "--workers", type=int, default=plan.workers, help="local worker processes"
-    )
+    where.add_argument("--workers", type=int, default=plan.workers, help="local worker processes")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
     stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
     stu.add_argument(
@@ -264,7 +262,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         )
         return EXIT_INTERRUPTED
     progress.close()
-    summary = run.summary()
+    summary = run.to_dict()
     print(
         f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['final_dof']}, "
         f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
@@ -344,7 +342,7 @@ def _cmd_deform(args: argparse.Namespace) -> int:
 
 def _cmd_study(args: argparse.Namespace) -> int:
     from rigidfold.progress import StudyProgress
-    from rigidfold.study import StudyConfig, plan, preset, run_study_command
+    from rigidfold.study import StudyConfig, StudyInterrupted, plan, preset, run_study_command
 
     if args.preset is not None:
         keys = preset(args.preset)
@@ -364,11 +362,11 @@ def _cmd_study(args: argparse.Namespace) -> int:
             argv=["rigidfold", *sys.argv[1:]],
             on_done=bar.update,
         )
-    except KeyboardInterrupt:
+    except StudyInterrupted as stop:
         bar.close()
         print(
-            f"rigidfold: interrupted; the finished runs are in {args.db}; run the same command "
-            "to resume",
+            f"rigidfold: interrupted; {stop.finished} finished runs are in {args.db}; run the "
+            "same command to resume",
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
@@ -382,10 +380,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 
 def _cmd_study_report(args: argparse.Namespace) -> int:
-    from rigidfold.study import open_readonly
+    from rigidfold.study import Store
     from rigidfold.study.report import markdown, write_report
 
-    stores = [open_readonly(db) for db in args.db]
+    stores = [Store(db, readonly=True) for db in args.db]
     if args.out:
         path = write_report(stores, args.out)
         print(path.read_text())

@@ -12,7 +12,6 @@ import math
 import threading
 from dataclasses import dataclass, replace
 
-
 HESSIANS = ("closed-form", "casadi")
 """The Hessians of the Lagrangian IPOPT can use (``Settings.ipopt_hessian``)."""
 
@@ -116,6 +115,30 @@ class Settings:
         is traced by pseudo-arclength continuation, with steps of at most this times the mean
         edge length, for at most this many steps, to find out whether it reaches the plane or
         turns back.
+    deform_penalty : float
+        Penalty factor of the pins of the frame model (OpenSees ``Penalty`` handler), times
+        E A / (mean edge length).
+    deform_load_tol : float
+        The analysis has reached the plane when the load factor is within this of 1.
+    motion_max_halvings : int
+        A step of the folding motion that does not converge is retried with half the step
+        this many times.
+    motion_level_tol : float
+        A motion frame is reached when the folding measure done is within this fraction of the
+        design's measure of the frame's level.
+    motion_stall_iter, motion_stall_ratio : int, float
+        The Newton correction of a motion frame stops converging (and takes the least-squares
+        shape) when, after this many iterations, the residual norm exceeds this ratio times
+        the previous iteration's.
+    motion_probe : float
+        Step (times the mean edge length) of the probe that orients the 1-DOF path towards a
+        smaller folding measure.
+    motion_arc_min_step : float
+        The pseudo-arclength trace gives up when its step falls below this fraction of the
+        largest step.
+    motion_turn_back : float
+        The 1-DOF path turns back (does not reach the plane) when its folding measure rises
+        this many motion levels (1 / (motion_frames - 1) of the design's) above its minimum.
     """
 
     # design parameters of problem (6)
@@ -167,6 +190,15 @@ class Settings:
     motion_length_tol: float = 1e-3
     motion_arc_step: float = 0.2
     motion_arc_max_steps: int = 400
+    deform_penalty: float = 1e6
+    deform_load_tol: float = 1e-12
+    motion_max_halvings: int = 6
+    motion_level_tol: float = 1e-12
+    motion_stall_iter: int = 5
+    motion_stall_ratio: float = 0.9
+    motion_probe: float = 1e-6
+    motion_arc_min_step: float = 1e-6
+    motion_turn_back: float = 0.5
     # reading FOLD files
     triangulation_area_tol: float = 1e-12
 

@@ -31,29 +31,86 @@ from rigidfold.case import Case
 from rigidfold.config import one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.mechanism.stiffness import hinge_stiffness
-from rigidfold.optimize import OptimizeResult
+from rigidfold.optimize import SOLVERS, OptimizeResult, Status
 from rigidfold.selection import CRITERIA, crease_groups, rank_candidates, score_creases
+from rigidfold.status import Outcome
+
+
+class AttemptOutcome(Outcome):
+    """What generation made of one solve of problem (6) (Steps 4-5)."""
+
+    ACCEPTED = "accepted", "DOF >= 1, F <= F_tol and no locked crease: a solution (Step 6)"
+    EXCEED = "exceed", "the solve missed F <= F_tol or did not converge (Step 4, N_exceed)"
+    LOCK = "lock", "the mechanism has a locked crease (Step 5, N_lock)"
+    ZERO_DOF = "zero_dof", "the mechanism has DOF 0: generation ends (Step 5 -> Step 8)"
+    INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
+
+
+class Stop(Outcome):
+    """How a generation run ended; ``Generation.stop_reason`` words it with its detail."""
+
+    RUNNING = "running", "generation has not ended"
+    TARGET_REACHED = "target_reached", "the target DOF is reached"
+    ZERO_DOF = "zero_dof", "a solution has DOF 0 (Step 5 -> Step 8)"
+    NO_CANDIDATE = "no_candidate", "no candidate crease succeeds (Step 7)"
+    INITIAL_FAILED = "initial_failed", "no developable polyhedron from the initial shape"
+
+    def reason(self, detail: str = "") -> str:
+        """The stop reason's words with the run's ``detail`` (see :data:`STOP_REASONS`)."""
+        return STOP_REASONS[self].format(detail)
+
+    @classmethod
+    def from_reason(cls, text: str) -> tuple[Stop, str]:
+        """The member and detail of a stop reason: the inverse of :meth:`reason`.
+
+        Raises ValueError when ``text`` is none of :data:`STOP_REASONS`.
+        """
+        for stop, template in STOP_REASONS.items():
+            head, slot, tail = template.partition("{}")
+            fits = text.startswith(head) and text.endswith(tail)
+            if fits and (len(text) >= len(head) + len(tail) if slot else text == template):
+                return stop, text[len(head) : len(text) - len(tail)]
+        raise ValueError(f"{text!r} is not the stop reason of a generation run")
+
+
+STOP_REASONS = {
+    Stop.RUNNING: "running",
+    Stop.TARGET_REACHED: "target DOF {} reached",
+    Stop.ZERO_DOF: "DOF 0 reached",
+    Stop.NO_CANDIDATE: "no candidate crease succeeds",
+    Stop.INITIAL_FAILED: "no developable polyhedron from the initial shape ({})",
+}
+"""The words of each :class:`Stop`, ``{}`` standing for the detail (the target DOF, or the
+outcome of the initial solve). Every rigidfold version has written these texts to
+summary.json and to study databases."""
 
 
 @dataclass
 class Attempt:
-    """One solve of problem (6) during generation, accepted or not."""
+    """One solve of problem (6) during generation, accepted or not.
+
+    status : Status
+        How the solve ended.
+    outcome : AttemptOutcome
+        What generation made of it.
+    """
 
     index: int
     fixed_added: tuple[int, ...]
     score: float | None
-    status: str
+    status: Status
     F: float
     iterations: int
     dof: int | None
     locked: list[int]
-    outcome: str  # "accepted", "exceed", "lock", "zero_dof", "initial_failed"
+    outcome: AttemptOutcome
     solve_time: float
     analysis_time: float
     selection_time: float = 0.0
 
     def to_dict(self) -> dict:
-        return dict(self.__dict__)
+        """JSON-serialisable fields (the enums as their values)."""
+        return self.__dict__ | {"status": self.status.value, "outcome": self.outcome.value}
 
 
 @dataclass
@@ -67,15 +124,26 @@ class Solution:
 
 @dataclass
 class Generation:
-    """Outcome of a generation run, with the paper's counters (Section 6.3)."""
+    """Outcome of a generation run, with the paper's counters (Section 6.3).
+
+    stop : Stop
+        How the run ended; ``stop_detail`` is the target DOF (TARGET_REACHED) or the outcome
+        of the initial solve (INITIAL_FAILED), "" otherwise.
+    """
 
     initial_dof: int | None = None
     solutions: list[Solution] = field(default_factory=list)
     attempts: list[Attempt] = field(default_factory=list)
     n_lock: int = 0
     n_exceed: int = 0
-    stop_reason: str = "running"
+    stop: Stop = Stop.RUNNING
+    stop_detail: str = ""
     build_time: float = 0.0
+
+    @property
+    def stop_reason(self) -> str:
+        """How the run ended, in words: e.g. "target DOF 1 reached" (see :data:`STOP_REASONS`)."""
+        return self.stop.reason(self.stop_detail)
 
     @property
     def final_dof(self) -> int | None:
@@ -88,10 +156,12 @@ class Generation:
             return 0
         return self.initial_dof - self.final_dof
 
-    def summary(self) -> dict:
+    def to_dict(self) -> dict:
+        """JSON-serialisable counters, stop and times of the run."""
         accepted_F = [s.result.F for s in self.solutions]
         all_F = [a.F for a in self.attempts if np.isfinite(a.F)]
         return {
+            "stop": self.stop.value,
             "stop_reason": self.stop_reason,
             "initial_dof": self.initial_dof,
             "final_dof": self.final_dof,
@@ -115,16 +185,18 @@ class Generation:
 def generate(
     case: Case,
     *,
-    criterion: str = "shat",
-    target_dof: int = 1,
+    criterion: str = CRITERIA[0],
+    target_dof: int | None = None,
     seed: int = 0,
-    solver: str = "ipopt",
+    solver: str = SOLVERS[0],
     support_face: int | None = None,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
 ) -> Generation:
     """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
 
+    criterion : one of ``CRITERIA`` (default: the first, S-hat); target_dof : default
+    ``case.settings.target_dof``; solver : one of ``SOLVERS`` (default: the first, IPOPT).
     With mirror planes in the case, creases are fixed in mirror groups (2 or 4 at once).
     ``support_face`` is the triangle whose frame node carries the s = 6 supports (default:
     the one nearest the centroid); it sets the metric of the mechanism modes and so the
@@ -133,6 +205,8 @@ def generate(
     """
     if criterion not in CRITERIA:
         raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
+    if target_dof is None:
+        target_dof = case.settings.target_dof
     if target_dof < 0:
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
     rng = np.random.default_rng(seed)
@@ -155,21 +229,21 @@ def generate(
         )
         t_an = time.perf_counter() - t1
         if mech is None:
-            outcome = "exceed"
+            outcome = AttemptOutcome.EXCEED
         elif mech.dof == 0:
             # the paper's final cycle (Step 5 -> Step 8); optionally, with a target >= 1, an
             # over-reduction counted as a lock: every folded free crease has stopped moving
             zero_ends = settings.zero_dof_ends or target_dof == 0
-            outcome = "zero_dof" if zero_ends else "lock"
+            outcome = AttemptOutcome.ZERO_DOF if zero_ends else AttemptOutcome.LOCK
         elif mech.has_lock:
-            outcome = "lock"
+            outcome = AttemptOutcome.LOCK
         else:
-            outcome = "accepted"
+            outcome = AttemptOutcome.ACCEPTED
         rec = Attempt(
             index=len(run.attempts),
             fixed_added=tuple(added),
             score=score,
-            status=result.status.value,
+            status=result.status,
             F=result.F,
             iterations=result.iterations,
             dof=None if mech is None else mech.dof,
@@ -182,13 +256,13 @@ def generate(
         return rec, result, mech
 
     def record(rec: Attempt, result, mech) -> None:
-        if rec.outcome == "exceed":
+        if rec.outcome is AttemptOutcome.EXCEED:
             run.n_exceed += 1
-        elif rec.outcome == "lock":
+        elif rec.outcome is AttemptOutcome.LOCK:
             run.n_lock += 1
         if on_attempt:
             on_attempt(run, rec)
-        if rec.outcome == "accepted":
+        if rec.outcome is AttemptOutcome.ACCEPTED:
             sol = Solution(len(run.solutions), result, mech)
             run.solutions.append(sol)
             if on_solution:
@@ -197,9 +271,9 @@ def generate(
     # Steps 2-5 for the triangulated target surface
     fixed = case.pattern.fixed.copy()
     rec, result, mech = attempt(fixed, None, (), None)
-    if rec.outcome != "accepted":
-        run.stop_reason = f"no developable polyhedron from the initial shape ({rec.outcome})"
-        rec.outcome = "initial_failed"
+    if rec.outcome is not AttemptOutcome.ACCEPTED:
+        run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
+        rec.outcome = AttemptOutcome.INITIAL_FAILED
         record(rec, result, mech)
         return run
     run.initial_dof = mech.dof
@@ -218,13 +292,13 @@ def generate(
             rec, result, mech = attempt(trial, current.result.coords, group, score)
             rec.selection_time, t_sel = t_sel, 0.0
             record(rec, result, mech)
-            if rec.outcome in ("accepted", "zero_dof"):
+            if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
                 break
         else:
-            run.stop_reason = "no candidate crease succeeds"
+            run.stop = Stop.NO_CANDIDATE
             return run
-        if rec.outcome == "zero_dof":
-            run.stop_reason = "DOF 0 reached"
+        if rec.outcome is AttemptOutcome.ZERO_DOF:
+            run.stop = Stop.ZERO_DOF
             return run
-    run.stop_reason = f"target DOF {target_dof} reached"
+    run.stop, run.stop_detail = Stop.TARGET_REACHED, str(target_dof)
     return run

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.deform.check import Verification, verify
+from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.generate import Attempt, Generation, Solution
 from rigidfold.io import (
     crease_pattern_frame,
@@ -32,13 +32,18 @@ def verification_frames(check: Verification) -> list[dict]:
     """FOLD ``file_frames`` of a checked shape: its development diagram (``creasePattern``),
     then its folding motion from flat to folded (``foldedForm``) when it was traced."""
     frames = [crease_pattern_frame(check.development.coords2d)]
-    if check.motion is not None and check.motion.status == "ok":
+    if check.motion is not None and check.motion.status is MotionStatus.OK:
         frames += motion_frames(check.motion.frames, check.motion.parameter)
     return frames
 
 
 def write_checked_shape(
-    path: Path, pattern: CreasePattern, check: Verification, *, title: str, metadata: dict,
+    path: Path,
+    pattern: CreasePattern,
+    check: Verification,
+    *,
+    title: str,
+    metadata: dict,
     svg_title: str,
 ) -> list[Path]:
     """Write a shape checked by Steps 8-9: ``path`` (FOLD: the folded form, its development
@@ -50,7 +55,7 @@ def write_checked_shape(
         pattern,
         frames=verification_frames(check),
         title=title,
-        metadata={**metadata, **check.figures()},
+        metadata={**metadata, **check.to_dict()},
     )
     return [fold, svg]
 
@@ -80,7 +85,7 @@ class RunWriter:
         check = verify(pattern, run_deform=self.deform, settings=self.case.settings)
         for stage, t in check.times.items():
             self.stage_times[stage] += t
-        figures = {"step": solution.step, "dof": dof, **check.figures()}
+        figures = {"step": solution.step, "dof": dof, **check.to_dict()}
         self.checks.append(figures)
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
@@ -91,7 +96,7 @@ class RunWriter:
             svg_title=f"step {solution.step}, DOF {dof}: development diagram",
             metadata={
                 **self.case.metadata(),
-                **solution.result.summary(),
+                **solution.result.to_dict(),
                 "step": solution.step,
                 "dof": dof,
                 "criterion": self.options.get("criterion"),
@@ -101,7 +106,7 @@ class RunWriter:
         self.write_summary(run)
 
     def write_summary(self, run: Generation) -> None:
-        summary = run.summary()
+        summary = run.to_dict()
         summary["time_s"].update(self.stage_times)
         dev = [c["development"] for c in self.checks]
         deformed = [c["deformation"] for c in self.checks if c["deformation"] is not None]
@@ -129,7 +134,7 @@ class RunWriter:
                     "max_drho_fix_deg": stat([d["max_drho_fix_deg"] for d in deformed], np.max),
                 },
                 "motion": {
-                    "traced": sum(m["status"] == "ok" for m in motions),
+                    "traced": sum(m["status"] == MotionStatus.OK for m in motions),
                     "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
                 },
                 "per_solution": [

@@ -92,7 +92,7 @@ class ShapeCheck:
         """The checked stage's figures at the top level (the deformation's when Step 9 ran,
         else the development's, without the load-step history), the others under their
         names."""
-        figures = self.verification.figures()
+        figures = self.verification.to_dict()
         stage = "development" if figures["deformation"] is None else "deformation"
         top = {k: v for k, v in figures.pop(stage).items() if k != "history"}
         return {**top, **{k: v for k, v in figures.items() if v is not None}}
@@ -129,7 +129,7 @@ def _check_file(path, out, *, deform: bool, settings: Settings) -> ShapeCheck:
         svg_title=f"{stem}: development",
     )
     if deform:
-        written.append(write_json(out_dir / f"{stem}_deform.json", check.figures()))
+        written.append(write_json(out_dir / f"{stem}_deform.json", check.to_dict()))
     return ShapeCheck(str(path), check, tuple(written))
 
 
@@ -161,7 +161,7 @@ def optimize_case(
         out_dir / "solution.fold",
         result.pattern,
         title=f"rigidfold optimize: {case.surface.name} on pattern {case.pattern_name}",
-        metadata={**case.metadata(), **result.summary()},
+        metadata={**case.metadata(), **result.to_dict()},
     )
     summary = write_json(out_dir / "summary.json", report)
     return OptimizeOutput(result, problem.build_time, report, (fold, summary))

@@ -1,12 +1,14 @@
 """Step 9: large-deformation check (OpenSees), the folding motion, and both with Step 8."""
 
-from rigidfold.deform.analysis import DeformResult, TubeSection, deform
+from rigidfold.deform.analysis import DeformResult, DeformStatus, TubeSection, deform
 from rigidfold.deform.check import Verification, verify
-from rigidfold.deform.motion import Motion, folding_motion
+from rigidfold.deform.motion import Motion, MotionStatus, folding_motion
 
 __all__ = [
     "DeformResult",
+    "DeformStatus",
     "Motion",
+    "MotionStatus",
     "TubeSection",
     "Verification",
     "deform",

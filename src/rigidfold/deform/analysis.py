@@ -39,6 +39,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
 from rigidfold.mesh import CreasePattern
+from rigidfold.status import Outcome
 
 
 @dataclass(frozen=True)
@@ -78,11 +79,18 @@ class TubeSection:
         return self.E / (2 * (1 + self.nu))
 
 
+class DeformStatus(Outcome):
+    """How the large-deformation check ended."""
+
+    REACHED_PLANE = "reached_plane", "the frame was driven to the plane"
+    FAILED = "failed", "the frame did not reach the plane"
+
+
 @dataclass
 class DeformResult:
     """Outcome of the large-deformation check.
 
-    status : "reached_plane" or "failed"; message says why it failed.
+    status : DeformStatus; message (the detail) says why it failed.
     load_factor : fraction of the forced displacements applied when the analysis stopped.
     history : one dict per converged load step (load factor, mean and max |Delta l| in mm,
         max |Delta rho_fix| in degrees).
@@ -91,7 +99,7 @@ class DeformResult:
     frames : list of (V, 3) vertex positions, one per converged step, folded -> flat.
     """
 
-    status: str
+    status: DeformStatus
     message: str
     load_factor: float
     steps: int
@@ -103,7 +111,7 @@ class DeformResult:
 
     @property
     def reached_plane(self) -> bool:
-        return self.status == "reached_plane"
+        return self.status is DeformStatus.REACHED_PLANE
 
     @property
     def mean_dl_mm(self) -> float:
@@ -122,9 +130,10 @@ class DeformResult:
     def max_drho_fix_deg(self) -> float:
         return float(np.degrees(np.max(self.drho_max_per_fixed, initial=0.0)))
 
-    def summary(self) -> dict:
+    def to_dict(self) -> dict:
+        """JSON-serialisable figures of the check (not its history or frames)."""
         return {
-            "status": self.status,
+            "status": self.status.value,
             "message": self.message,
             "reached_plane": self.reached_plane,
             "load_factor": self.load_factor,
@@ -220,8 +229,9 @@ def deform(
     """Drive the frame model of ``pattern`` to the plane z = ``plane_z`` (Step 9).
 
     A step that does not converge is retried with half the increment up to
-    ``deform_max_halvings`` times; then the analysis stops with status "failed" and the figures
-    of the converged steps.
+    ``deform_max_halvings`` times; then the analysis stops with status FAILED and the figures
+    of the converged steps. The equalDOF pins are enforced with the penalty
+    ``deform_penalty * E A / mean edge length``.
     """
     import openseespy.opensees as ops  # heavy: only when an analysis runs
 
@@ -266,7 +276,7 @@ def deform(
     ops.pattern("Plain", 1, 1)
     for node in np.unique(np.concatenate([lay.bary, lay.face_edge_node.ravel()])):
         ops.sp(tag(node), 3, float(plane_z - lay.coords[node, 2]))
-    penalty = 1e6 * sec.E * sec.A / float(np.mean(pattern.edge_lengths))
+    penalty = settings.deform_penalty * sec.E * sec.A / float(np.mean(pattern.edge_lengths))
     ops.constraints("Penalty", penalty, penalty)
     ops.numberer("RCM")
     ops.system("UmfPack")
@@ -288,14 +298,14 @@ def deform(
         return lay.coords + np.array([ops.nodeDisp(t)[:3] for t in tags])
 
     lam, step, halvings = 0.0, 1.0 / settings.deform_steps, 0
-    status, message = "reached_plane", ""
-    while lam < 1.0 - 1e-12:
+    status, message = DeformStatus.REACHED_PLANE, ""
+    while lam < 1.0 - settings.deform_load_tol:
         inc = min(step, 1.0 - lam)
         ops.integrator("LoadControl", inc)
         if ops.analyze(1) != 0:
             halvings += 1
             if halvings > settings.deform_max_halvings:
-                status = "failed"
+                status = DeformStatus.FAILED
                 message = f"no convergence at load factor {lam:.4f} (step {inc:.2e})"
                 break
             step = inc / 2
@@ -318,10 +328,10 @@ def deform(
                 "max_drho_fix_deg": float(np.degrees(drho.max(initial=0.0))),
             }
         )
-    if status == "reached_plane":
+    if status is DeformStatus.REACHED_PLANE:
         z_off = float(np.max(np.abs(nodes_now()[:, 2] - plane_z)))
         if z_off > settings.plane_tol:
-            status = "failed"
+            status = DeformStatus.FAILED
             message = f"a frame node ends {z_off:.3g} m from the plane"
     ops.wipe()
     return DeformResult(

@@ -14,8 +14,7 @@ from dataclasses import dataclass
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.analysis import DeformResult, deform
 from rigidfold.deform.motion import Motion, folding_motion
-from rigidfold.develop import Development, develop
-from rigidfold.io import crease_pattern_frame, motion_frames
+from rigidfold.develop import Development, DevelopStatus, develop
 from rigidfold.mesh import CreasePattern
 
 
@@ -28,32 +27,17 @@ class Verification:
     motion: Motion | None
     times: dict
 
-    def figures(self) -> dict:
+    def to_dict(self) -> dict:
         """JSON-ready figures of every stage (for log.json, summary.json and the CLI)."""
-        d = self.development
         out = {
-            "development": {
-                "D": d.D,
-                "max_length_error": d.max_length_error,
-                "flipped": d.flipped,
-                "overlaps": d.overlaps,
-                "status": d.status,
-                "start": d.start,
-            },
-            "deformation": None if self.deformation is None else self.deformation.summary(),
-            "motion": None if self.motion is None else self.motion.summary(),
+            "development": self.development.to_dict(),
+            "deformation": None if self.deformation is None else self.deformation.to_dict(),
+            "motion": None if self.motion is None else self.motion.to_dict(),
             "time_s": dict(self.times),
         }
         if self.deformation is not None:
             out["deformation"]["history"] = self.deformation.history
         return out
-
-    def fold_frames(self) -> list[dict]:
-        """FOLD ``file_frames``: the development diagram, then the motion (flat -> folded)."""
-        frames = [crease_pattern_frame(self.development.coords2d)]
-        if self.motion is not None and self.motion.status == "ok":
-            frames += motion_frames(self.motion.frames, self.motion.parameter)
-        return frames
 
 
 def verify(
@@ -75,7 +59,7 @@ def verify(
         deformation = deform(pattern, support_face=support_face, settings=settings)
         times["deform"] = time.perf_counter() - t0
     motion = None
-    if run_motion and development.status == "converged":
+    if run_motion and development.status is DevelopStatus.CONVERGED:
         t0 = time.perf_counter()
         motion = folding_motion(
             pattern, development.coords2d, support_face=support_face, settings=settings

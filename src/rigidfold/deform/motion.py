@@ -33,6 +33,14 @@ from rigidfold.frame.model import default_support_face
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import edge_lengths
+from rigidfold.status import Outcome
+
+
+class MotionStatus(Outcome):
+    """How the folding motion was traced."""
+
+    OK = "ok", "the motion is traced from the plane to the designed shape"
+    FAILED = "failed", "no rigid-folding path to the plane was found"
 
 
 @dataclass
@@ -42,18 +50,19 @@ class Motion:
     frames : (K, V, 3) float64; frames[0] is flat (z = 0), frames[-1] the designed shape
     parameter : (K,) fraction of the folding measure m = |rho_free|, 0 (flat) .. 1 (designed)
     max_length_error : largest |l - l0| / l0 over all edges and frames
-    status : "ok" or "failed"; message says why it failed
+    status : MotionStatus; message (the detail) says how it was traced or why it failed
     """
 
     frames: np.ndarray
     parameter: np.ndarray
     max_length_error: float
-    status: str
+    status: MotionStatus
     message: str = ""
 
-    def summary(self) -> dict:
+    def to_dict(self) -> dict:
+        """JSON-serialisable figures of the motion (not its frames)."""
         return {
-            "status": self.status,
+            "status": self.status.value,
             "message": self.message,
             "frames": len(self.frames),
             "max_length_error": self.max_length_error,
@@ -105,7 +114,7 @@ class _Constraints:
         rho, Jr = _fold_angles_and_jacobian(self.stencils, X)
         rho_fix, rho_free = rho[: self.n_fixed], rho[self.n_fixed :]
         m = float(np.linalg.norm(rho_free))
-        Jm = (rho_free @ Jr[self.n_fixed :]) / max(m, 1e-300)
+        Jm = (rho_free @ Jr[self.n_fixed :]) / m if m > 0 else np.zeros(3 * V)
         Js = np.zeros((9, 3 * V))
         Js[np.arange(9), self.support] = 1.0
         r = np.concatenate(
@@ -122,20 +131,21 @@ class _Constraints:
 def _newton(constraints: _Constraints, x: np.ndarray, target: float, settings: Settings):
     """Gauss-Newton onto the constraints; returns (x, accepted).
 
-    Stops when the residual or the step is below ``motion_tol``, or when the residual stops
-    decreasing after a few iterations. Near the flat state an imperfect design (F > 0) may
-    have no exact rigid-folding shape; the least-squares one is accepted while every edge
-    length is within ``motion_length_tol`` (relative) and every fixed-crease angle and support
-    coordinate within ``motion_length_tol`` (radians, metres) of its value.
+    Stops when the residual or the step is below ``motion_tol``, or when, after
+    ``motion_stall_iter`` iterations, an iteration no longer reduces the residual below
+    ``motion_stall_ratio`` times the previous one. Near the flat state an imperfect design
+    (F > 0) may have no exact rigid-folding shape; the least-squares one is accepted while
+    every edge length is within ``motion_length_tol`` (relative) and every fixed-crease angle
+    and support coordinate within ``motion_length_tol`` (radians, metres) of its value.
     """
-    previous = np.inf
+    previous, stall = np.inf, settings.motion_stall_ratio
     for iteration in range(settings.motion_max_iter):
         r, J = constraints(x, target)
         norm = float(np.linalg.norm(r))
         if norm <= settings.motion_tol:
             return x, True
-        if iteration >= 5 and norm > 0.9 * previous:  # converging no more: least squares
-            break
+        if iteration >= settings.motion_stall_iter and norm > stall * previous:
+            break  # converging no more: least squares
         previous = norm
         dx = scipy.linalg.lstsq(J, -r, lapack_driver="gelsd")[0]
         x = x + dx
@@ -157,7 +167,9 @@ def folding_motion(
     """Trace the folding motion of ``pattern`` down to its development ``flat`` (V, 2).
 
     Returns ``settings.motion_frames`` frames from the plane to the designed shape, at equal
-    steps of the folding measure m = |rho_free|.
+    steps of the folding measure m = |rho_free|. A step that does not converge is retried
+    with half the step up to ``motion_max_halvings`` times; then the 1-DOF path is traced
+    (:func:`trace_one_dof_path`).
     """
     if support_face is None:
         support_face = default_support_face(pattern)
@@ -166,47 +178,49 @@ def folding_motion(
     m0 = cons.measure(x)
     n = max(int(settings.motion_frames), 2) - 1
     velocity = np.zeros_like(x)  # dx/ds of the last step, for the secant predictor
-    path, s_done, status, message = [x.copy()], 0.0, "ok", ""
+    path, s_done, status, message = [x.copy()], 0.0, MotionStatus.OK, ""
     # frames at m = (1 - k/n) m0 for k < n; the flat one (k = n) is the development (the
     # constraints are singular at the flat state itself)
     levels = [k / n for k in range(1, n)]
     for level in levels if m0 > 0 else []:
         ds = level - s_done
         halvings = 0
-        while s_done < level - 1e-12:
+        while s_done < level - settings.motion_level_tol:
             step = min(ds, level - s_done)
             guess = x + velocity * step
             y, ok = _newton(cons, guess, (1.0 - s_done - step) * m0, settings)
             if not ok:
                 halvings += 1
-                if halvings > settings.deform_max_halvings:
+                if halvings > settings.motion_max_halvings:
                     break
                 ds = step / 2
                 continue
             velocity = (y - x) / step
             x, s_done = y, s_done + step
-        if s_done < level - 1e-12:
-            status = "failed"
+        if s_done < level - settings.motion_level_tol:
+            status = MotionStatus.FAILED
             message = f"no rigid-folding shape below {1 - s_done:.4f} of the design's folding"
             break
         path.append(x.copy())
-    if status == "failed":
+    if status is MotionStatus.FAILED:
         trace = trace_one_dof_path(pattern, support_face=support_face, settings=settings)
         if trace is not None and trace.reached_flat:
-            path, status = trace.frames_towards_flat(n), "ok"
+            path, status = trace.frames_towards_flat(n), MotionStatus.OK
             message = "traced by pseudo-arclength: " + trace.message
         elif trace is not None:
             message += "; " + trace.message
     V = pattern.n_vertices
     frames = np.array([p.reshape(V, 3) for p in path])
-    if status == "ok":
+    if status is MotionStatus.OK:
         frames = _place_flat(frames, flat)
     else:
         frames = frames[::-1]
     L0 = pattern.edge_lengths
     err = max(float(np.max(np.abs(edge_lengths(f, pattern.edges) - L0) / L0)) for f in frames)
     parameter = (
-        np.linspace(0.0, 1.0, len(frames)) if status == "ok" else np.full(len(frames), np.nan)
+        np.linspace(0.0, 1.0, len(frames))
+        if status is MotionStatus.OK
+        else np.full(len(frames), np.nan)
     )
     return Motion(frames, parameter, err, status, message)
 
@@ -245,8 +259,11 @@ def trace_one_dof_path(
     going the same way, first towards a smaller folding measure m) and corrects by
     Gauss-Newton in the plane normal to the tangent, so the trace passes points where m
     stops decreasing. It stops when m reaches the last motion level (the plane is in reach),
-    when m has risen well above its minimum (the path turns back: the shape does not unfold
-    to flat along its mechanism), or after ``motion_arc_max_steps``.
+    when m has risen above its minimum by ``motion_turn_back`` levels (the path turns back:
+    the shape does not unfold to flat along its mechanism), when the step falls below
+    ``motion_arc_min_step`` times the largest, or after ``motion_arc_max_steps``. The
+    direction that decreases m first is found with a probe step of ``motion_probe`` times the
+    mean edge length.
 
     returns None when the shape does not have exactly one DOF (to ``mechanism_rank_tol``).
     """
@@ -273,7 +290,7 @@ def trace_one_dof_path(
     t, nullity = tangent(constraints(x)[1])
     if nullity != 1:
         return None
-    probe = 1e-6 * float(np.mean(pattern.edge_lengths))
+    probe = settings.motion_probe * float(np.mean(pattern.edge_lengths))
     if cons.measure(x + probe * t) > cons.measure(x - probe * t):
         t = -t
     h_max = settings.motion_arc_step * float(np.mean(pattern.edge_lengths))
@@ -292,7 +309,7 @@ def trace_one_dof_path(
             y = y + scipy.linalg.lstsq(A, b, lapack_driver="gelsy")[0]
         if not np.isfinite(r).all() or np.linalg.norm(r) > settings.motion_tol:
             h /= 2
-            if h < 1e-6 * h_max:
+            if h < settings.motion_arc_min_step * h_max:
                 message = f"the path could not be continued at m = {measure[-1]:.3f}"
                 break
             continue
@@ -307,7 +324,7 @@ def trace_one_dof_path(
                 f"m falls from 1 to {measure[-1]:.3f} of the design's in {len(points) - 1} steps"
             )
             break
-        if measure[-1] > m_min + level / 2:
+        if measure[-1] > m_min + level * settings.motion_turn_back:
             message = (
                 f"the 1-DOF folding path turns back at m = {m_min:.3f} of the design's folding "
                 "measure (pseudo-arclength trace): the shape does not unfold to flat along its "

@@ -36,8 +36,18 @@ import shapely
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.ipopt import ipopt_options
+from rigidfold.status import Outcome
 
 _IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+
+
+class DevelopStatus(Outcome):
+    """How a development diagram came out (problem (13) and the checks of the diagram)."""
+
+    CONVERGED = "converged", "IPOPT succeeded; no facet is flipped and none overlap"
+    FLIPPED = "flipped", "a facet of the diagram is flipped or degenerate"
+    OVERLAP = "overlap", "two facets of the diagram overlap"
+    FAILED = "failed", "IPOPT failed or returned non-finite numbers"
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,12 +68,11 @@ class Development:
     overlaps : int
         Pairs of facets whose interiors overlap (see :func:`count_overlaps`); -1 when the
         coordinates are not finite.
-    status : str
-        "converged" (IPOPT succeeded, no flipped facet, no overlap), "flipped", "overlap" or
-        "failed" (IPOPT failed or returned non-finite numbers). The status does not judge D:
-        a shape that is not developable converges to a valid diagram with a large D.
+    status : DevelopStatus
+        CONVERGED, FLIPPED, OVERLAP or FAILED (see the members' messages). The status does not
+        judge D: a shape that is not developable converges to a valid diagram with a large D.
     message : str
-        IPOPT's return status and a short verdict.
+        The detail: IPOPT's return status and a short verdict.
     iterations : int
         IPOPT iterations.
     wall_time : float
@@ -79,12 +88,26 @@ class Development:
     max_length_error: float
     flipped: int
     overlaps: int
-    status: str
+    status: DevelopStatus
     message: str
     iterations: int
     wall_time: float
     reference_edge: int
     start: str = "projection"
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable figures of the diagram (not its coordinates)."""
+        return {
+            "D": self.D,
+            "max_length_error": self.max_length_error,
+            "flipped": self.flipped,
+            "overlaps": self.overlaps,
+            "status": self.status.value,
+            "iterations": self.iterations,
+            "start": self.start,
+            "wall_time_s": self.wall_time,
+            "message": self.message,
+        }
 
     def as_pattern(self, pattern: CreasePattern) -> CreasePattern:
         """The crease pattern of the diagram: ``pattern``'s topology with z = 0.
@@ -269,10 +292,10 @@ def develop(pattern: CreasePattern, *, settings: Settings = DEFAULTS) -> Develop
     """
     t0 = time.perf_counter()
     first = _solve(pattern, pattern.coords[:, :2], "projection", settings)
-    if first.status == "converged":
+    if first.status is DevelopStatus.CONVERGED:
         return _timed(first, t0)
     second = _solve(pattern, unfold(pattern), "unfolding", settings)
-    best = min(first, second, key=lambda d: (d.status != "converged", d.D))
+    best = min(first, second, key=lambda d: (d.status is not DevelopStatus.CONVERGED, d.D))
     other = second if best is first else first
     return _timed(
         replace(
@@ -330,18 +353,19 @@ def _solve(pattern: CreasePattern, layout: np.ndarray, start: str, settings: Set
 
     if not np.isfinite(coords2d).all():
         flipped = overlaps = -1
-        status, verdict = "failed", "non-finite coordinates"
+        status, verdict = DevelopStatus.FAILED, "non-finite coordinates"
     else:
         flipped = count_flipped(coords2d, faces, tol=s.degenerate_area)
         overlaps = count_overlaps(coords2d, faces, tol=s.overlap_area_tol)
         if ipopt_status not in _IPOPT_SUCCESS or not np.isfinite(D_val):
-            status, verdict = "failed", f"solver failure, D = {D_val:.3g}"
+            status, verdict = DevelopStatus.FAILED, f"solver failure, D = {D_val:.3g}"
         elif flipped:
-            status, verdict = "flipped", f"{flipped} flipped facets, D = {D_val:.3g}"
+            status, verdict = DevelopStatus.FLIPPED, f"{flipped} flipped facets, D = {D_val:.3g}"
         elif overlaps:
-            status, verdict = "overlap", f"{overlaps} overlapping facet pairs, D = {D_val:.3g}"
+            status = DevelopStatus.OVERLAP
+            verdict = f"{overlaps} overlapping facet pairs, D = {D_val:.3g}"
         else:
-            status, verdict = "converged", f"D = {D_val:.3g}"
+            status, verdict = DevelopStatus.CONVERGED, f"D = {D_val:.3g}"
     return Development(
         coords2d=coords2d,
         D=D_val,

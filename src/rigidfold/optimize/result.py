@@ -2,29 +2,28 @@
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 import numpy as np
 
 from rigidfold.mesh import CreasePattern
+from rigidfold.status import Outcome
 
 
-class Status(enum.Enum):
-    """Outcome of a solve, judged by rigidfold (not only by the solver's own flag).
+class Status(Outcome):
+    """Outcome of a solve, judged by rigidfold (not only by the solver's own flag)."""
 
-    CONVERGED          F <= F_tol and every constraint met to ``constraint_tol``.
-    TOLERANCE_NOT_MET  the solver stopped at a feasible point with F > F_tol.
-    INFEASIBLE         the solver reports infeasibility, or the point violates a constraint.
-    ITERATION_LIMIT    the iteration (or time) limit was reached before F <= F_tol.
-    FAILED             any other solver failure (e.g. a line-search or evaluation error).
-    """
-
-    CONVERGED = "converged"
-    TOLERANCE_NOT_MET = "tolerance_not_met"
-    INFEASIBLE = "infeasible"
-    ITERATION_LIMIT = "iteration_limit"
-    FAILED = "failed"
+    CONVERGED = "converged", "F <= F_tol and every constraint met to constraint_tol"
+    TOLERANCE_NOT_MET = "tolerance_not_met", "the solver stopped at a feasible point with F > F_tol"
+    INFEASIBLE = (
+        "infeasible",
+        "the solver reports infeasibility, or the point violates a constraint",
+    )
+    ITERATION_LIMIT = (
+        "iteration_limit",
+        "the iteration (or time) limit was reached before F <= F_tol",
+    )
+    FAILED = "failed", "any other solver failure (e.g. a line-search or evaluation error)"
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,8 +39,9 @@ class OptimizeResult:
     max_violation : float
         Largest violation of any constraint of (6) (metres for dz and (7)-(9), radians for angles).
     status : Status
+        How the solve ended (``status.message`` says what that means).
     message : str
-        The solver's own words and rigidfold's verdict.
+        The detail: the solver's own words and rigidfold's verdict.
     iterations : int
     wall_time : float
         Seconds spent in the solve (not in building the model).
@@ -71,7 +71,7 @@ class OptimizeResult:
     def converged(self) -> bool:
         return self.status is Status.CONVERGED
 
-    def summary(self) -> dict:
+    def to_dict(self) -> dict:
         """JSON-serialisable figures of the solve."""
         return {
             "status": self.status.value,

@@ -13,10 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.generate import AttemptOutcome, Stop
+from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import CITATION, TABLE_7_8_ROWS, TABLES_5_6, TABLES_7_8
-from rigidfold.study.store import Store
+from rigidfold.study.runner import PRESETS
+from rigidfold.study.store import Store, run_stop
 
-ORDER = ("s", "shat", "ss", "random")
+ORDER = tuple(sorted(CRITERIA, key=[c for _, c in TABLES_5_6].index))
+"""The criteria in the order of the rows of the paper's Tables 5 and 6."""
 PAPER_PATTERN = {"1p": "1"}
 """Layout variants compared with the paper's table of the pattern they vary."""
 LABEL = {"s": "S", "shat": "S-hat", "ss": "S^S", "random": "random"}
@@ -33,7 +37,7 @@ def _mean_se(values: list[float]) -> tuple[float, float]:
 def tables_5_6(store: Store) -> list[dict]:
     """Per (pattern, criterion) of the Bezier study: n, mean and standard error of N_reduce,
     N_lock, N_exceed and F, the runs that reached the target, and the paper's values."""
-    runs = [r for r in store.runs("bezier") if not r["status"].startswith("error")]
+    runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
     rows = []
     for pattern in sorted({r["pattern"] for r in runs}):
         for crit in [c for c in ORDER if any(r["criterion"] == c for r in runs)]:
@@ -41,7 +45,7 @@ def tables_5_6(store: Store) -> list[dict]:
             row = {"pattern": pattern, "criterion": crit, "n": len(sel)}
             for name in ("n_reduce", "n_lock", "n_exceed", "mean_f"):
                 row[name], row[name + "_se"] = _mean_se([r[name] for r in sel])
-            row["reached_target"] = sum(r["status"].startswith("target DOF") for r in sel)
+            row["reached_target"] = sum(run_stop(r["status"]) is Stop.TARGET_REACHED for r in sel)
             row["seeds"] = (min(r["seed"] for r in sel), max(r["seed"] for r in sel))
             row["time_total_median"] = float(np.median([r["time_total"] for r in sel]))
             row["paper"] = TABLES_5_6.get((PAPER_PATTERN.get(pattern, pattern), crit))
@@ -102,11 +106,7 @@ def costs(store: Store) -> list[dict]:
         sel = [
             r for r in runs if (r["study"], r["pattern"], r["criterion"]) == (study, pattern, crit)
         ]
-        its = store.db.execute(
-            "SELECT AVG(iterations), AVG(solve_time) FROM attempts "
-            "WHERE study = ? AND pattern = ? AND criterion = ?",
-            (study, pattern, crit),
-        ).fetchone()
+        its = store.solve_means(study, pattern, crit)
         t = [r["time_total"] for r in sel if r["time_total"] is not None]
         rows.append(
             {
@@ -132,37 +132,26 @@ def _stage_label(lo: int, hi: int | None) -> str:
     return f">= {lo}" if hi is None else (f"{lo}" if lo == hi else f"{lo}-{hi}")
 
 
-def _bezier_runs(store: Store, columns: str, where: str = ""):
-    """The attempts of every Bezier run in solve order: yields ((pattern, criterion), seed,
-    [(columns...), ...]) per run, from one query."""
-    cur = store.db.execute(
-        f"SELECT pattern, criterion, seed, {columns} FROM attempts WHERE study = 'bezier' "
-        f"{where} ORDER BY pattern, criterion, seed, idx"
-    )
-    for (pattern, crit, seed), rows in itertools.groupby(cur, key=lambda r: r[:3]):
-        yield (pattern, crit), seed, [r[3:] for r in rows]
-
-
 def locks_by_stage(store: Store) -> list[dict]:
     """Where the locks happen: per (pattern, criterion) of the Bezier study, mean N_lock per
     run split by the DOF of the accepted shape whose crease was being fixed (:data:`STAGES`),
     and the share of runs that ended with no candidate left."""
     counts: dict[tuple[str, str], dict] = {}
-    for group, seed, attempts in _bezier_runs(store, "dof, outcome"):
+    for group, seed, attempts in store.attempt_runs("bezier", ("dof", "outcome")):
         c = counts.setdefault(group, {"seeds": set(), "locks": [0] * len(STAGES)})
         c["seeds"].add(seed)
         stage = None  # the DOF of the last accepted shape of this run
         for dof, outcome in attempts:
-            if outcome == "accepted":
+            if outcome == AttemptOutcome.ACCEPTED:
                 stage = dof
-            elif outcome == "lock" and stage is not None:
+            elif outcome == AttemptOutcome.LOCK and stage is not None:
                 for k, (lo, hi) in enumerate(STAGES):
                     if stage >= lo and (hi is None or stage <= hi):
                         c["locks"][k] += 1
     ended = Counter(
         (r["pattern"], r["criterion"])
         for r in store.runs("bezier")
-        if r["status"] == "no candidate crease succeeds"
+        if run_stop(r["status"]) is Stop.NO_CANDIDATE
     )
     return _per_run_rows(
         counts,
@@ -207,7 +196,9 @@ def dof_steps(store: Store) -> list[dict]:
     and the run needs more than one fix per DOF reduced.
     """
     counts: dict[tuple[str, str], dict] = {}
-    for group, seed, attempts in _bezier_runs(store, "dof", "AND outcome = 'accepted'"):
+    for group, seed, attempts in store.attempt_runs(
+        "bezier", ("dof",), outcome=AttemptOutcome.ACCEPTED
+    ):
         c = counts.setdefault(group, {"seeds": set(), "kinds": Counter()})
         c["seeds"].add(seed)
         dofs = [dof for (dof,) in attempts]  # the first solution has no step
@@ -221,7 +212,7 @@ def tables_7_8(store: Store) -> list[dict]:
     """Per preset run (dome / hp, with / without symmetry): the rows of Tables 7 and 8."""
     out = []
     for r in store.runs():
-        if r["study"] not in ("dome", "hp"):
+        if r["study"] not in PRESETS:
             continue
         values = (
             r["n_lock"],

@@ -17,15 +17,16 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.optimize import SOLVERS
+from rigidfold.patterns import PATTERNS
 from rigidfold.selection import CRITERIA
-from rigidfold.study.store import Key, Store
+from rigidfold.study.store import ERROR_PREFIX, Key, Store
 
 PRESETS = {
     # Sections 6.5 and 6.6: the 11 x 11 grid with S, with and without the mirror planes
     "dome": [Key("dome", 0, "11", "s", True), Key("dome", 0, "11", "s", False)],
     "hp": [Key("hp", 0, "11", "s", True), Key("hp", 0, "11", "s", False)],
 }
-BEZIER_PATTERNS = ("1", "1p", "2", "11")
 
 
 @dataclass(frozen=True)
@@ -33,8 +34,8 @@ class StudyConfig:
     """What makes the numbers of two runs comparable; stored in the database."""
 
     deform: bool = False
-    target_dof: int = 1
-    solver: str = "ipopt"
+    target_dof: int = DEFAULTS.target_dof
+    solver: str = SOLVERS[0]
     settings: Settings = field(default=DEFAULTS)
 
     def as_dict(self) -> dict:
@@ -49,14 +50,15 @@ class StudyConfig:
 def plan(
     patterns: Sequence[str], criteria: Sequence[str], surfaces: int, first_seed: int = 0
 ) -> list[Key]:
-    """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1.
+    """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1,
+    on any of the library's crease patterns (``rigidfold.patterns.PATTERNS``) and criteria.
 
     Seed-major order (every pattern and criterion of a surface before the next surface), so
     that a study stopped early holds complete surfaces.
     """
     for p in patterns:
-        if p not in BEZIER_PATTERNS:
-            raise ValueError(f"unknown pattern {p!r} (choose from {', '.join(BEZIER_PATTERNS)})")
+        if p not in PATTERNS:
+            raise ValueError(f"unknown pattern {p!r} (choose from {', '.join(PATTERNS)})")
     for c in criteria:
         if c not in CRITERIA:
             raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
@@ -89,7 +91,11 @@ def preset(name: str) -> list[Key]:
 
 
 def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
-    """Execute one run (in a worker): generate, and Steps 8-9 of every solution if asked."""
+    """Execute one run (in a worker): generate, and Steps 8-9 of every solution if asked.
+
+    The run's row holds the ``runs`` columns, and ``error`` (the message) for a run that
+    could not run; its status is then "error: <message>".
+    """
     from rigidfold import __version__
     from rigidfold.case import make_case
     from rigidfold.deform import verify
@@ -102,7 +108,7 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
     def on_solution(run, solution) -> None:
         if config["deform"]:
             c = verify(solution.result.pattern, run_motion=False, settings=settings)
-            checks.append({"D": c.development.D, **c.deformation.summary(), "times": c.times})
+            checks.append({"D": c.development.D, **c.deformation.to_dict(), "times": c.times})
 
     row: dict = {"version": __version__, "worker": f"{socket.gethostname()}:{os.getpid()}"}
     try:
@@ -122,9 +128,11 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
             on_solution=on_solution,
         )
     except ValueError as exc:  # a configuration that cannot run: recorded, not retried
-        row.update(status=f"error: {exc}", time_total=time.perf_counter() - t0)
+        row.update(
+            status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
+        )
         return key, row, []
-    s = run.summary()
+    s = run.to_dict()
     row.update(
         status=s["stop_reason"],
         n_reduce=s["N_reduce"],

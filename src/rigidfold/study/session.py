@@ -88,12 +88,10 @@ def run_study_command(
 
     def done(key: Key, row: dict, finished: int, total: int) -> None:
         if on_done:
-            on_done(run_failed(row), finished, total)
+            on_done(bool(row.get("error")), finished, total)
 
     try:
-        result = run_study(
-            keys, store, config, workers=workers, scheduler=scheduler, on_done=done
-        )
+        result = run_study(keys, store, config, workers=workers, scheduler=scheduler, on_done=done)
     except KeyboardInterrupt:
         finished = len(store.done() & planned)
         record("interrupted", finished - before)

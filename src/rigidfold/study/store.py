@@ -8,14 +8,21 @@ in WAL mode, so a report can read it while a study writes.
 The ``meta`` table holds the study *configuration* (settings, solver, target DOF, whether
 Steps 8-9 run). Opening a database with another configuration is refused before anything is
 written: its numbers would not be comparable.
+
+A run's ``status`` column holds the generator's stop reason (``Generation.stop_reason``) or
+"error: <message>"; :func:`run_stop` reads it back as a :class:`~rigidfold.generate.Stop`.
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import sqlite3
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+from rigidfold.generate import Stop
 
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -92,6 +99,22 @@ ATTEMPT_FIELDS = (
 )
 
 
+ERROR_PREFIX = "error: "
+"""Start of the ``status`` of a run that could not run (a configuration error)."""
+
+
+def run_stop(status: str) -> Stop | None:
+    """How a stored run ended, from its ``status``: a Stop, or None for "error: <message>".
+
+    The one place that interprets the column. Every rigidfold version has written there the
+    generator's ``stop_reason`` (the same words since the first) or "error: <message>", so
+    this reads databases of any version. Raises ValueError for any other text.
+    """
+    if status.startswith(ERROR_PREFIX):
+        return None
+    return Stop.from_reason(status)[0]
+
+
 @dataclass(frozen=True)
 class Key:
     """Identifies one run: (study, seed, pattern, criterion, symmetric)."""
@@ -138,10 +161,21 @@ def config_differences(stored: dict, current: dict) -> list[str]:
 
 
 class Store:
-    """A study database. ``config`` is checked against (or written to) the ``meta`` table."""
+    """A study database. ``config`` is checked against (or written to) the ``meta`` table.
 
-    def __init__(self, path: str | Path, config: dict | None = None) -> None:
+    ``readonly=True`` opens an existing database for reporting: it never creates one nor
+    writes to it (and takes no ``config``).
+    """
+
+    def __init__(
+        self, path: str | Path, config: dict | None = None, *, readonly: bool = False
+    ) -> None:
         self.path = Path(path)
+        if readonly:
+            if config is not None:
+                raise ValueError("a study database opened read-only takes no configuration")
+            self._open_readonly()
+            return
         if self.path.is_dir():
             raise ValueError(f"database path {str(self.path)!r} is a directory")
         if config is not None:
@@ -159,6 +193,17 @@ class Store:
             self.db.commit()
         except sqlite3.Error as exc:
             raise ValueError(f"cannot open study database {str(self.path)!r}: {exc}") from None
+
+    def _open_readonly(self) -> None:
+        if not self.path.is_file():
+            raise ValueError(f"no study database at {str(self.path)!r}")
+        try:
+            self.db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30)
+            self.db.execute("SELECT 1 FROM runs LIMIT 1")
+        except sqlite3.Error as exc:
+            raise ValueError(
+                f"{str(self.path)!r} is not a rigidfold study database: {exc}"
+            ) from None
 
     def _check_config(self, config: dict) -> None:
         """Refuse a database of another configuration without writing anything to it."""
@@ -261,20 +306,38 @@ class Store:
     def count_attempts(self) -> int:
         return int(self.db.execute("SELECT COUNT(*) FROM attempts").fetchone()[0])
 
+    def solve_means(
+        self, study: str, pattern: str, criterion: str
+    ) -> tuple[float | None, float | None]:
+        """Mean IPOPT iterations and mean seconds per solve of (6) over the attempts of
+        (study, pattern, criterion); None for both when it has none."""
+        return self.db.execute(
+            "SELECT AVG(iterations), AVG(solve_time) FROM attempts "
+            "WHERE study = ? AND pattern = ? AND criterion = ?",
+            (study, pattern, criterion),
+        ).fetchone()
+
+    def attempt_runs(
+        self, study: str, columns: Sequence[str], *, outcome: str | None = None
+    ) -> Iterator[tuple[tuple[str, str], int, list[tuple]]]:
+        """The attempts of every run of ``study`` in solve order, from one query.
+
+        Yields ``((pattern, criterion), seed, rows)`` per run, ``rows`` holding ``columns``
+        (names of :data:`ATTEMPT_FIELDS`) of each attempt, only those with ``outcome`` (an
+        :class:`~rigidfold.generate.AttemptOutcome` value) when given.
+        """
+        unknown = [c for c in columns if c not in ATTEMPT_FIELDS]
+        if unknown:
+            raise ValueError(f"unknown attempt columns {unknown} (choose from {ATTEMPT_FIELDS})")
+        cur = self.db.execute(
+            f"SELECT pattern, criterion, seed, {', '.join(columns)} FROM attempts "
+            "WHERE study = ?"
+            + (" AND outcome = ?" if outcome is not None else "")
+            + " ORDER BY pattern, criterion, seed, idx",
+            (study,) if outcome is None else (study, outcome),
+        )
+        for (pattern, crit, seed), rows in itertools.groupby(cur, key=lambda r: r[:3]):
+            yield (pattern, crit), seed, [r[3:] for r in rows]
+
     def close(self) -> None:
         self.db.close()
-
-
-def open_readonly(path: str | Path) -> Store:
-    """Open an existing study database for reporting (never creates one)."""
-    p = Path(path)
-    if not p.is_file():
-        raise ValueError(f"no study database at {str(p)!r}")
-    store = Store.__new__(Store)
-    store.path = p
-    try:
-        store.db = sqlite3.connect(f"file:{p}?mode=ro", uri=True, timeout=30)
-        store.db.execute("SELECT 1 FROM runs LIMIT 1")
-    except sqlite3.Error as exc:
-        raise ValueError(f"{str(p)!r} is not a rigidfold study database: {exc}") from None
-    return store
