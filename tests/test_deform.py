@@ -18,6 +18,7 @@ from rigidfold.generate import generate
 from rigidfold.io import read_fold, write_fold
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
+from rigidfold.report import verification_frames
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
@@ -118,7 +119,7 @@ def test_generated_one_dof_shape_passes_steps_8_and_9(one_dof_solution):
     assert m.status == "ok" and m.max_length_error < 1e-3
     assert np.abs(m.frames[0][:, 2]).max() < 1e-9
     assert np.allclose(m.frames[-1], one_dof_solution.coords, atol=1e-9)
-    frames = check.fold_frames()
+    frames = verification_frames(check)
     assert frames[0]["frame_classes"] == ["creasePattern"]
     assert [f["frame_classes"] for f in frames[1:]] == [["foldedForm"]] * len(m.frames)
 

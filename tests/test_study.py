@@ -216,9 +216,9 @@ def test_unwritable_database_and_missing_report(tmp_path):
 
 
 def test_progress_prints_plain_lines_when_stderr_is_not_a_terminal(capsys):
-    from rigidfold.cli import _StudyProgress
+    from rigidfold.progress import StudyProgress
 
-    bar = _StudyProgress(enabled=True, log_every=3600.0)
+    bar = StudyProgress(enabled=True, log_every=3600.0)
     bar.plain = True  # as under pytest's captured stderr, a log file or nohup
     rows = [
         {"status": "target DOF 1 reached"},
@@ -226,7 +226,7 @@ def test_progress_prints_plain_lines_when_stderr_is_not_a_terminal(capsys):
         {},
     ]
     for finished, row in enumerate(rows, start=4):  # 3 runs were already in the database
-        bar.update(None, row, finished, 6)
+        bar.update(bool(row.get("error")), finished, 6)
     lines = capsys.readouterr().err.splitlines()
     # the first run prints, the second is within log_every, the last run always prints
     assert len(lines) == 2

@@ -7,12 +7,18 @@ file) is reported as one line on stderr with exit code 2, never a traceback.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
-import time
 from collections.abc import Sequence
 
-from rigidfold.config import DEFAULTS
+from rigidfold.config import DEFAULTS, HESSIANS
+from rigidfold.io import jsonable
+from rigidfold.optimize import SOLVERS
+from rigidfold.patterns import PATTERNS
+from rigidfold.selection import CRITERIA
+from rigidfold.study import STUDY_DEFAULTS
+from rigidfold.surfaces import SURFACES
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
@@ -46,8 +52,8 @@ def build_parser() -> argparse.ArgumentParser:
         "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes.",
     )
     _case_options(gen)
-    gen.add_argument("--criterion", default="shat", choices=["shat", "s", "ss", "random"])
-    gen.add_argument("--target-dof", type=int, default=1)
+    gen.add_argument("--criterion", default=CRITERIA[0], choices=CRITERIA)
+    gen.add_argument("--target-dof", type=int, default=DEFAULTS.target_dof)
     gen.add_argument(
         "--retry-zero-dof",
         action="store_true",
@@ -60,39 +66,36 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.set_defaults(func=_cmd_generate)
 
-    ana = sub.add_parser(
+    _file_command(
+        sub,
         "analyze",
+        _cmd_analyze,
         help="mechanism analysis of a FOLD shape: DOF, locked creases, fold angles",
         description="Read a FOLD file (3D vertices_coords; polygon faces are triangulated with "
         "fixed 'J' edges) and report its DOF and locked crease lines.",
     )
-    ana.add_argument("file", metavar="FILE.fold")
-    ana.add_argument("--json", action="store_true", help="print one JSON object")
-    ana.set_defaults(func=_cmd_analyze)
-
-    dev = sub.add_parser(
+    _file_command(
+        sub,
         "develop",
+        _cmd_develop,
+        out=True,
         help="Step 8: development diagram of a FOLD shape (problem 13)",
         description="Flatten a FOLD shape to its development diagram. Writes DIR/<name>.fold "
-        "(the input plus a 'creasePattern' frame with 2D coordinates) and DIR/<name>.svg.",
+        "(the input plus a 'creasePattern' frame with 2D coordinates) and DIR/<name>.svg. Exit "
+        "code 0 when the development converged, 1 when not, 2 on bad input.",
     )
-    dev.add_argument("file", metavar="FILE.fold")
-    dev.add_argument("--out", required=True, metavar="DIR")
-    dev.add_argument("--json", action="store_true", help="print one JSON object")
-    dev.set_defaults(func=_cmd_develop)
-
-    dfm = sub.add_parser(
+    _file_command(
+        sub,
         "deform",
+        _cmd_deform,
+        out=True,
         help="Step 9: large-deformation check of a FOLD shape (OpenSees) and its folding motion",
         description="Drive the frame model of a FOLD shape to the plane with OpenSees and trace "
         "its folding motion. Writes DIR/<name>.fold (the input plus the development diagram and "
-        "the motion frames) and DIR/<name>_deform.json (figures and the load-step history). Exit "
-        "code 0 when the plane is reached, 1 when not, 2 on bad input.",
+        "the motion frames), DIR/<name>.svg (the development diagram) and DIR/<name>_deform.json "
+        "(figures and the load-step history). Exit code 0 when the plane is reached, 1 when "
+        "not, 2 on bad input.",
     )
-    dfm.add_argument("file", metavar="FILE.fold")
-    dfm.add_argument("--out", required=True, metavar="DIR")
-    dfm.add_argument("--json", action="store_true", help="print one JSON object")
-    dfm.set_defaults(func=_cmd_deform)
 
     stu = sub.add_parser(
         "study",
@@ -101,22 +104,27 @@ def build_parser() -> argparse.ArgumentParser:
         "Dask workers; store each finished run in DB. Re-running the same command skips "
         "finished runs, so a killed study resumes where it stopped.",
     )
-    stu.add_argument("--patterns", default="1,2", help="comma-separated (default 1,2)")
-    stu.add_argument("--criteria", default="shat,s,ss,random", help="comma-separated")
-    stu.add_argument("--surfaces", type=int, default=100, help="number of Bezier seeds")
-    stu.add_argument("--first-seed", type=int, default=0)
+    plan = STUDY_DEFAULTS
+    stu.add_argument(
+        "--patterns", default=",".join(plan.patterns), help="comma-separated (default %(default)s)"
+    )
+    stu.add_argument(
+        "--criteria", default=",".join(plan.criteria), help="comma-separated (default %(default)s)"
+    )
+    stu.add_argument("--surfaces", type=int, default=plan.surfaces, help="number of Bezier seeds")
+    stu.add_argument("--first-seed", type=int, default=plan.first_seed)
     stu.add_argument(
         "--preset", help="dome, hp or dome,hp: Sections 6.5-6.6 instead of Bezier surfaces"
     )
     stu.add_argument("--db", required=True, metavar="DB", help="SQLite file (created if absent)")
     where = stu.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, default=2, help="local worker processes")
+    where.add_argument("--workers", type=int, default=plan.workers, help="local worker processes")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
     stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
     stu.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
-        choices=["closed-form", "casadi"],
+        choices=HESSIANS,
         help="IPOPT's Hessian of the Lagrangian: closed-form (default) or casadi (the symbolic "
         "reference, used by studies made before the closed form)",
     )
@@ -144,22 +152,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _file_command(sub, name: str, func, *, out: bool = False, **text: str) -> None:
+    """A command on one FOLD file: FILE.fold [--out DIR] [--json]."""
+    p = sub.add_parser(name, **text)
+    p.add_argument("file", metavar="FILE.fold")
+    if out:
+        p.add_argument("--out", required=True, metavar="DIR")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=func)
+
+
 def _case_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--surface", required=True, choices=["bezier", "dome", "hp", "expr"])
+    p.add_argument("--surface", required=True, choices=SURFACES)
     p.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
     p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
-    p.add_argument("--pattern", required=True, choices=["1", "1p", "2", "11"])
+    p.add_argument("--pattern", required=True, choices=list(PATTERNS))
     p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
-    p.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp", "slsqp-fd"])
+    p.add_argument("--solver", default=SOLVERS[0], choices=SOLVERS)
     p.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
-        choices=["closed-form", "casadi"],
+        choices=HESSIANS,
         help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off)",
     )
     p.add_argument("--dz", type=float, default=DEFAULTS.dz, help="bound on |dz| in metres")
-    p.add_argument("--theta-min", type=float, default=30.0, help="degrees")
-    p.add_argument("--theta-max", type=float, default=120.0, help="degrees")
+    for bound in ("min", "max"):
+        default = math.degrees(getattr(DEFAULTS, f"theta_{bound}"))
+        p.add_argument(
+            f"--theta-{bound}",
+            type=float,
+            help=f"bound on every sector angle, degrees (default {default:g})",
+        )
     p.add_argument("--rho-max", type=_positive, help="bound (12) on |fold angle|, degrees")
     p.add_argument("--out", required=True, metavar="DIR")
 
@@ -191,34 +214,23 @@ def _case(args: argparse.Namespace):
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
-    from rigidfold.case import parse_fixed, shape_report
-    from rigidfold.io import prepare_output_dir, write_fold, write_json
+    from rigidfold.workflows import optimize_case
 
-    out = prepare_output_dir(args.out)
-    case = _case(args)
-    fixed = parse_fixed(args.fixed, case.pattern)
-    problem = case.problem(build_ipopt=args.solver == "ipopt")
-    result = problem.solve(fixed=fixed, solver=args.solver)
-    report = shape_report(case, result, problem.build_time)
-    write_fold(
-        out / "solution.fold",
-        result.pattern,
-        title=f"rigidfold optimize: {case.surface.name} on pattern {case.pattern_name}",
-        metadata={**case.metadata(), **result.to_dict()},
-    )
-    write_json(out / "summary.json", report)
+    out = optimize_case(_case(args), args.out, fixed=args.fixed, solver=args.solver)
+    result = out.result
     print(
         f"{result.status.value}: F = {result.F:.3e} (F1 = {result.F1:.2e}, F2 = {result.F2:.2e}), "
         f"{result.iterations} iterations, {result.wall_time:.2f} s solve + "
-        f"{problem.build_time:.2f} s build, {result.n_variables} variables"
+        f"{out.build_time:.2f} s build, {result.n_variables} variables"
     )
-    print(f"wrote {out / 'solution.fold'} and {out / 'summary.json'}")
+    print(f"wrote {' and '.join(str(p) for p in out.written)}")
     return 0 if result.converged else 1
 
 
 def _cmd_generate(args: argparse.Namespace) -> int:
-    from rigidfold.generate import generate
+    from rigidfold.progress import GenerateProgress
     from rigidfold.report import RunWriter
+    from rigidfold.workflows import generate_case
 
     if args.target_dof < 0:
         raise ValueError(f"--target-dof must be >= 0, got {args.target_dof}")
@@ -231,25 +243,15 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         "deform": not args.no_deform,
     }
     writer = RunWriter(args.out, _case(args), options, deform=not args.no_deform)
-    progress = _Progress(enabled=not args.quiet, target=args.target_dof)
-
-    def on_attempt(run, attempt):
-        writer.on_attempt(run, attempt)
-        progress.update(run, attempt)
-
-    def on_solution(run, solution):
-        writer.on_solution(run, solution)
-        progress.update(run, None)
-
+    progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
     try:
-        run = generate(
-            writer.case,
+        run = generate_case(
+            writer,
             criterion=args.criterion,
             target_dof=args.target_dof,
             seed=args.seed,
             solver=args.solver,
-            on_attempt=on_attempt,
-            on_solution=on_solution,
+            progress=progress.update,
         )
     except KeyboardInterrupt:
         progress.close()
@@ -260,7 +262,6 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         )
         return EXIT_INTERRUPTED
     progress.close()
-    writer.write_summary(run)
     summary = run.to_dict()
     print(
         f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['final_dof']}, "
@@ -272,46 +273,27 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    import json
+    from rigidfold.workflows import analyze_file
 
-    import numpy as np
-
-    from rigidfold.io import read_fold
-    from rigidfold.mechanism import analyze
-
-    data = read_fold(args.file)
-    mech = analyze(data.pattern)
-    pattern = data.pattern
-    locked = [int(e) for e in mech.locked_creases]
-    report = {
-        "file": str(args.file),
-        "vertices": pattern.n_vertices,
-        "faces": pattern.n_faces,
-        "free_creases": len(mech.hinges),
-        "fixed_creases": len(pattern.fixed_creases),
-        "dof": mech.dof,
-        "locked_edges": [e for e in locked if e < data.n_file_edges],
-        "locked_vertex_pairs": [pattern.edges[e].tolist() for e in locked],
-        "fold_angles_deg": np.round(
-            np.degrees(pattern.fold_angles[: data.n_file_edges]), 6
-        ).tolist(),
-    }
+    analysis = analyze_file(args.file)
+    report = analysis.to_dict()
     if args.json:
         print(json.dumps(report))
         return 0
+    mech = analysis.mechanism
     print(
-        f"{args.file}: V={pattern.n_vertices} F={pattern.n_faces} "
-        f"free creases={len(mech.hinges)} fixed={len(pattern.fixed_creases)}"
+        f"{args.file}: V={report['vertices']} F={report['faces']} "
+        f"free creases={report['free_creases']} fixed={report['fixed_creases']}"
     )
     print(f"DOF: {mech.dof}")
-    if locked:
+    if len(mech.locked_creases):
         print(
-            f"locked crease lines ({len(locked)}): edges {report['locked_edges']} "
+            f"locked crease lines ({len(mech.locked_creases)}): edges {report['locked_edges']} "
             f"(vertex pairs {report['locked_vertex_pairs']})"
         )
     else:
         print("locked crease lines: none")
-    angles = np.degrees(pattern.fold_angles[mech.hinges])
+    angles = analysis.fold_angles_deg(mech.hinges)
     print(
         "fold angles of free creases (deg, valley > 0): "
         + ", ".join(f"{int(e)}:{a:+.3f}" for e, a in zip(mech.hinges, angles, strict=True))
@@ -320,156 +302,80 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def _cmd_develop(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
+    from rigidfold.workflows import develop_file
 
-    from rigidfold.develop import develop
-    from rigidfold.io import (
-        crease_pattern_frame,
-        prepare_output_dir,
-        read_fold,
-        write_fold,
-        write_svg,
-    )
-
-    out = prepare_output_dir(args.out)
-    data = read_fold(args.file)
-    result = develop(data.pattern)
-    stem = Path(args.file).stem
-    figures = result.to_dict()
-    write_fold(
-        out / f"{stem}.fold",
-        data.pattern,
-        title=f"{stem} (folded form)",
-        metadata={**data.metadata, "development": figures},
-        frames=[crease_pattern_frame(result.coords2d)],
-    )
-    write_svg(out / f"{stem}.svg", data.pattern, result.coords2d, title=f"{stem}: development")
+    checked = develop_file(args.file, args.out)
+    d = checked.verification.development
     if args.json:
-        print(json.dumps({k: v for k, v in figures.items()}))
+        print(json.dumps(jsonable(checked.to_dict())))
     else:
         print(
-            f"{result.status}: D = {result.D:.3e}, max |dl|/l = {result.max_length_error:.2e}, "
-            f"{result.flipped} flipped, {result.overlaps} overlapping pairs, "
-            f"{result.wall_time:.2f} s"
+            f"{d.status}: D = {d.D:.3e}, max |dl|/l = {d.max_length_error:.2e}, "
+            f"{d.flipped} flipped, {d.overlaps} overlapping pairs, {d.wall_time:.2f} s"
         )
-        print(f"wrote {out / (stem + '.fold')} and {out / (stem + '.svg')}")
-    return 0 if result.status == "converged" else 1
+        print(f"wrote {' and '.join(str(p) for p in checked.written)}")
+    return 0 if d.status == "converged" else 1
 
 
 def _cmd_deform(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
+    from rigidfold.workflows import deform_file
 
-    from rigidfold.deform import verify
-    from rigidfold.io import prepare_output_dir, read_fold, write_fold, write_json
-
-    out = prepare_output_dir(args.out)
-    data = read_fold(args.file)
-    check = verify(data.pattern)
-    stem = Path(args.file).stem
-    figures = check.to_dict()
-    write_fold(
-        out / f"{stem}.fold",
-        data.pattern,
-        title=f"{stem} (folded form)",
-        metadata={**data.metadata, **{k: v for k, v in figures.items() if k != "deformation"}},
-        frames=check.fold_frames(),
-    )
-    write_json(out / f"{stem}_deform.json", figures)
-    d = check.deformation
-    keys = ("mean_dl_mm", "max_dl_mm", "mean_drho_fix_deg", "max_drho_fix_deg", "reached_plane")
+    checked = deform_file(args.file, args.out)
     if args.json:
-        report = {k: figures["deformation"][k] for k in keys}
-        report["steps"] = d.steps
-        report["status"] = d.status
-        report["motion"] = figures["motion"]
-        print(json.dumps(report))
-    else:
+        print(json.dumps(jsonable(checked.to_dict())))
+        return 0 if checked.verification.deformation.reached_plane else 1
+    d, m = checked.verification.deformation, checked.verification.motion
+    print(
+        f"{d.status}: {d.steps} load steps, mean/max |dl| = {d.mean_dl_mm:.4g}/"
+        f"{d.max_dl_mm:.4g} mm, mean/max |drho_fix| = {d.mean_drho_fix_deg:.4g}/"
+        f"{d.max_drho_fix_deg:.4g} deg, {d.wall_time:.2f} s"
+        + (f" ({d.message})" if d.message else "")
+    )
+    if m is not None:
         print(
-            f"{d.status}: {d.steps} load steps, mean/max |dl| = {d.mean_dl_mm:.4g}/"
-            f"{d.max_dl_mm:.4g} mm, mean/max |drho_fix| = {d.mean_drho_fix_deg:.4g}/"
-            f"{d.max_drho_fix_deg:.4g} deg, {d.wall_time:.2f} s"
-            + (f" ({d.message})" if d.message else "")
+            f"folding motion: {m.status}, {len(m.frames)} frames, max |dl|/l = "
+            f"{m.max_length_error:.2e}" + (f" ({m.message})" if m.message else "")
         )
-        m = check.motion
-        if m is not None:
-            print(
-                f"folding motion: {m.status}, {len(m.frames)} frames, max |dl|/l = "
-                f"{m.max_length_error:.2e}" + (f" ({m.message})" if m.message else "")
-            )
-        print(f"wrote {out / (stem + '.fold')} and {out / (stem + '_deform.json')}")
+    print(f"wrote {', '.join(str(p) for p in checked.written)}")
     return 0 if d.reached_plane else 1
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
-    from rigidfold.study import Store, StudyConfig, plan, preset, run_study
+    from rigidfold.progress import StudyProgress
+    from rigidfold.study import StudyConfig, StudyInterrupted, plan, preset, run_study_command
 
     if args.preset is not None:
         keys = preset(args.preset)
     else:
-        keys = plan(
-            [p.strip() for p in args.patterns.split(",") if p.strip()],
-            [c.strip() for c in args.criteria.split(",") if c.strip()],
-            args.surfaces,
-            args.first_seed,
-        )
-    if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        keys = plan(_names(args.patterns), _names(args.criteria), args.surfaces, args.first_seed)
     config = StudyConfig(
         deform=not args.no_deform, settings=DEFAULTS.with_(ipopt_hessian=args.hessian)
     )
-    store = Store(args.db, config.as_dict())  # refuses another configuration untouched
-    bar = _StudyProgress(enabled=not args.quiet)
-    started, t0 = _utc_now(), time.perf_counter()
-
-    def n_done() -> int:
-        return len(store.done().intersection(keys))
-
-    before = n_done()
-
-    def log(outcome: str, ran: int) -> None:
-        from rigidfold import __version__
-
-        store.add_invocation(
-            started=started,
-            argv=["rigidfold", *sys.argv[1:]],
-            workers=None if args.scheduler else args.workers,
-            scheduler=args.scheduler,
-            ran=ran,
-            skipped=before,
-            total=len(keys),
-            wall_s=time.perf_counter() - t0,
-            outcome=outcome,
-            version=__version__,
-        )
-
+    bar = StudyProgress(enabled=not args.quiet)
     try:
-        result = run_study(
+        result = run_study_command(
             keys,
-            store,
+            args.db,
             config,
             workers=args.workers,
             scheduler=args.scheduler,
+            argv=["rigidfold", *sys.argv[1:]],
             on_done=bar.update,
         )
-    except KeyboardInterrupt:
+    except StudyInterrupted as stop:
         bar.close()
-        log("interrupted", n_done() - before)
         print(
-            f"rigidfold: interrupted; {len(store.done())} finished runs are in {args.db}; run the "
+            f"rigidfold: interrupted; {stop.finished} finished runs are in {args.db}; run the "
             "same command to resume",
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
     finally:
         bar.close()
-    log("completed", result["ran"])
     print(
         f"{result['ran']} runs done, {result['skipped']} already in {args.db}, "
         f"{result['total']} in the study, {result['wall_s']:.1f} s"
     )
-    store.close()
     return 0
 
 
@@ -487,120 +393,9 @@ def _cmd_study_report(args: argparse.Namespace) -> int:
     return 0
 
 
-def _utc_now() -> str:
-    from datetime import UTC, datetime
-
-    return datetime.now(UTC).isoformat(timespec="seconds")
-
-
-class _StudyProgress:
-    """One rich bar for a study: runs done / total, failures, rate, ETA (stderr).
-
-    When stderr is not a terminal (a batch job, ``nohup``, a log file) a live bar would show
-    nothing until the end, so a plain line with the same figures is printed instead, at most
-    every ``log_every`` seconds and for the last run.
-    """
-
-    def __init__(self, *, enabled: bool, log_every: float = 60.0) -> None:
-        self.enabled, self.bar, self.task, self.failures = enabled, None, None, 0
-        self.plain = not sys.stderr.isatty()
-        self.log_every, self.t0 = log_every, time.monotonic()
-        self.last, self.first = -math.inf, None
-
-    def _line(self, finished: int, total: int) -> None:
-        now = time.monotonic()
-        if self.first is None:  # runs already in the database before this command
-            self.first = finished - 1
-        if now - self.last < self.log_every and finished < total:
-            return
-        self.last = now
-        done, elapsed = finished - self.first, now - self.t0
-        rate = done / elapsed if elapsed > 0 else 0.0
-        eta = f"{(total - finished) / rate / 60:.0f} min" if rate > 0 else "?"
-        print(
-            f"study {finished}/{total}  failures {self.failures}  {rate * 60:.1f} runs/min  "
-            f"elapsed {elapsed / 60:.1f} min  ETA {eta}",
-            file=sys.stderr,
-            flush=True,
-        )
-
-    def update(self, key, row, finished: int, total: int) -> None:
-        if row.get("error"):
-            self.failures += 1
-        if not self.enabled:
-            return
-        if self.plain:
-            self._line(finished, total)
-            return
-        if self.bar is None:
-            from rich.console import Console
-            from rich.progress import (
-                BarColumn,
-                MofNCompleteColumn,
-                Progress,
-                TextColumn,
-                TimeElapsedColumn,
-                TimeRemainingColumn,
-            )
-
-            self.bar = Progress(
-                TextColumn("[bold]study"),
-                BarColumn(),
-                MofNCompleteColumn(),
-                TextColumn("{task.description}"),
-                TimeElapsedColumn(),
-                TextColumn("ETA"),
-                TimeRemainingColumn(),
-                console=Console(stderr=True),
-            )
-            self.bar.start()
-            self.task = self.bar.add_task("", total=total, completed=finished - 1)
-        rate = self.bar.tasks[0].speed
-        self.bar.update(
-            self.task,
-            completed=finished,
-            description=f"failures {self.failures}"
-            + (f"  {rate * 60:.1f} runs/min" if rate else ""),
-        )
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
-            self.bar = None
-
-
-class _Progress:
-    """A rich progress bar on stderr over the DOF to remove; silent when disabled."""
-
-    def __init__(self, *, enabled: bool, target: int) -> None:
-        self.enabled, self.target, self.bar, self.task = enabled, target, None, None
-
-    def update(self, run, attempt) -> None:
-        if not self.enabled or run.initial_dof is None:
-            return
-        if self.bar is None:
-            from rich.console import Console
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
-
-            self.bar = Progress(
-                TextColumn("[bold]generate"),
-                BarColumn(),
-                MofNCompleteColumn(),
-                TextColumn("{task.description}"),
-                console=Console(stderr=True),
-                transient=False,
-            )
-            self.bar.start()
-            self.task = self.bar.add_task("", total=max(run.initial_dof - self.target, 0))
-        self.bar.update(
-            self.task,
-            completed=run.n_reduce,
-            description=f"DOF {run.final_dof}  lock {run.n_lock}  exceed {run.n_exceed}",
-        )
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
+def _names(text: str) -> list[str]:
+    """Comma-separated names, blanks dropped."""
+    return [t.strip() for t in text.split(",") if t.strip()]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

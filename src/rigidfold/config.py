@@ -12,6 +12,9 @@ import math
 import threading
 from dataclasses import dataclass, replace
 
+HESSIANS = ("closed-form", "casadi")
+"""The Hessians of the Lagrangian IPOPT can use (``Settings.ipopt_hessian``)."""
+
 
 @dataclass(frozen=True)
 class Settings:
@@ -30,6 +33,8 @@ class Settings:
 
     Generation (Steps 5-7)
     ----------------------
+    target_dof : int
+        Generation stops when an accepted shape has this DOF (paper: 1).
     zero_dof_ends : bool
         Step 5 of the paper: a solution of (6) whose mechanism has DOF 0 ends generation (it
         goes to Step 8; not counted in N_reduce, N_lock or N_exceed). ``False``: while the
@@ -143,6 +148,7 @@ class Settings:
     rho_bar: float | None = None
     f_tol: float = 1e-7
     # generation procedure (Steps 5-7)
+    target_dof: int = 1
     zero_dof_ends: bool = True
     # solver tolerances
     constraint_tol: float = 1e-8
@@ -209,11 +215,13 @@ class Settings:
             raise ValueError(
                 f"rho_bar must lie in (0, 180) degrees, got {math.degrees(self.rho_bar):g}"
             )
+        if not (isinstance(self.target_dof, int) and self.target_dof >= 0):
+            raise ValueError(f"target DOF must be an integer >= 0, got {self.target_dof!r}")
         if not self.f_tol > 0:
             raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
-        if self.ipopt_hessian not in ("closed-form", "casadi"):
+        if self.ipopt_hessian not in HESSIANS:
             raise ValueError(
-                f"ipopt_hessian must be 'closed-form' or 'casadi', got {self.ipopt_hessian!r}"
+                f"ipopt_hessian must be one of {', '.join(HESSIANS)}, got {self.ipopt_hessian!r}"
             )
 
     def with_(self, **changes) -> Settings:
@@ -224,18 +232,19 @@ class Settings:
     def from_degrees(
         cls,
         *,
-        theta_min_deg: float = 30.0,
-        theta_max_deg: float = 120.0,
+        theta_min_deg: float | None = None,
+        theta_max_deg: float | None = None,
         rho_bar_deg: float | None = None,
         **kwargs,
     ) -> Settings:
-        """Build settings with angles given in degrees (as on the command line)."""
-        return cls(
-            theta_min=math.radians(theta_min_deg),
-            theta_max=math.radians(theta_max_deg),
-            rho_bar=None if rho_bar_deg is None else math.radians(rho_bar_deg),
-            **kwargs,
-        )
+        """Build settings with angles given in degrees (as on the command line); an angle
+        that is None keeps its default (exactly, not through a round trip in degrees)."""
+        angles = {"theta_min": theta_min_deg, "theta_max": theta_max_deg}
+        for name, degrees in angles.items():
+            if degrees is not None:
+                kwargs[name] = math.radians(degrees)
+        rho_bar = None if rho_bar_deg is None else math.radians(rho_bar_deg)
+        return cls(rho_bar=rho_bar, **kwargs)
 
 
 DEFAULTS = Settings()

@@ -31,7 +31,7 @@ from rigidfold.case import Case
 from rigidfold.config import one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.mechanism.stiffness import hinge_stiffness
-from rigidfold.optimize import OptimizeResult, Status
+from rigidfold.optimize import SOLVERS, OptimizeResult, Status
 from rigidfold.selection import CRITERIA, crease_groups, rank_candidates, score_creases
 from rigidfold.status import Outcome
 
@@ -185,16 +185,18 @@ class Generation:
 def generate(
     case: Case,
     *,
-    criterion: str = "shat",
-    target_dof: int = 1,
+    criterion: str = CRITERIA[0],
+    target_dof: int | None = None,
     seed: int = 0,
-    solver: str = "ipopt",
+    solver: str = SOLVERS[0],
     support_face: int | None = None,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
 ) -> Generation:
     """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
 
+    criterion : one of ``CRITERIA`` (default: the first, S-hat); target_dof : default
+    ``case.settings.target_dof``; solver : one of ``SOLVERS`` (default: the first, IPOPT).
     With mirror planes in the case, creases are fixed in mirror groups (2 or 4 at once).
     ``support_face`` is the triangle whose frame node carries the s = 6 supports (default:
     the one nearest the centroid); it sets the metric of the mechanism modes and so the
@@ -203,6 +205,8 @@ def generate(
     """
     if criterion not in CRITERIA:
         raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
+    if target_dof is None:
+        target_dof = case.settings.target_dof
     if target_dof < 0:
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
     rng = np.random.default_rng(seed)

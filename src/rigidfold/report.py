@@ -15,9 +15,49 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.deform import MotionStatus, verify
+from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.generate import Attempt, Generation, Solution
-from rigidfold.io import prepare_output_dir, write_fold, write_json, write_svg
+from rigidfold.io import (
+    crease_pattern_frame,
+    motion_frames,
+    prepare_output_dir,
+    write_fold,
+    write_json,
+    write_svg,
+)
+from rigidfold.mesh import CreasePattern
+
+
+def verification_frames(check: Verification) -> list[dict]:
+    """FOLD ``file_frames`` of a checked shape: its development diagram (``creasePattern``),
+    then its folding motion from flat to folded (``foldedForm``) when it was traced."""
+    frames = [crease_pattern_frame(check.development.coords2d)]
+    if check.motion is not None and check.motion.status is MotionStatus.OK:
+        frames += motion_frames(check.motion.frames, check.motion.parameter)
+    return frames
+
+
+def write_checked_shape(
+    path: Path,
+    pattern: CreasePattern,
+    check: Verification,
+    *,
+    title: str,
+    metadata: dict,
+    svg_title: str,
+) -> list[Path]:
+    """Write a shape checked by Steps 8-9: ``path`` (FOLD: the folded form, its development
+    diagram and motion frames, ``metadata`` and every figure of the check) and
+    the development diagram beside it as SVG. Returns [FOLD, SVG]."""
+    svg = write_svg(path.with_suffix(".svg"), pattern, check.development.coords2d, title=svg_title)
+    fold = write_fold(
+        path,
+        pattern,
+        frames=verification_frames(check),
+        title=title,
+        metadata={**metadata, **check.to_dict()},
+    )
+    return [fold, svg]
 
 
 class RunWriter:
@@ -48,24 +88,18 @@ class RunWriter:
         figures = {"step": solution.step, "dof": dof, **check.to_dict()}
         self.checks.append(figures)
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
-        write_svg(
-            path.with_suffix(".svg"),
-            pattern,
-            check.development.coords2d,
-            title=f"step {solution.step}, DOF {dof}: development diagram",
-        )
-        write_fold(
+        write_checked_shape(
             path,
             pattern,
-            frames=check.fold_frames(),
+            check,
             title=f"rigidfold generate: step {solution.step}, DOF {dof}",
+            svg_title=f"step {solution.step}, DOF {dof}: development diagram",
             metadata={
                 **self.case.metadata(),
                 **solution.result.to_dict(),
                 "step": solution.step,
                 "dof": dof,
                 "criterion": self.options.get("criterion"),
-                **{k: v for k, v in figures.items() if k not in ("step", "dof")},
             },
         )
         self.files.append(path)

@@ -13,9 +13,8 @@ from dataclasses import dataclass
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.analysis import DeformResult, deform
-from rigidfold.deform.motion import Motion, MotionStatus, folding_motion
+from rigidfold.deform.motion import Motion, folding_motion
 from rigidfold.develop import Development, DevelopStatus, develop
-from rigidfold.io import crease_pattern_frame, motion_frames
 from rigidfold.mesh import CreasePattern
 
 
@@ -39,13 +38,6 @@ class Verification:
         if self.deformation is not None:
             out["deformation"]["history"] = self.deformation.history
         return out
-
-    def fold_frames(self) -> list[dict]:
-        """FOLD ``file_frames``: the development diagram, then the motion (flat -> folded)."""
-        frames = [crease_pattern_frame(self.development.coords2d)]
-        if self.motion is not None and self.motion.status is MotionStatus.OK:
-            frames += motion_frames(self.motion.frames, self.motion.parameter)
-        return frames
 
 
 def verify(

@@ -199,7 +199,9 @@ class FormFindingProblem:
         viol = self.violation(coords, mask)
         status, verdict = classify(run.outcome, F, viol, self.settings)
         return OptimizeResult(
-            pattern=CreasePattern(coords, self.pattern.faces, self.pattern.edges, mask),
+            pattern=CreasePattern(
+                coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings
+            ),
             F=F,
             F1=F1,
             F2=F2,

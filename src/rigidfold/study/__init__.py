@@ -1,16 +1,26 @@
 """Studies of many generation runs: Dask execution, SQLite store, reports (Tables 5-8)."""
 
 from rigidfold.study.runner import PRESETS, StudyConfig, plan, preset, run_one, run_study
+from rigidfold.study.session import (
+    STUDY_DEFAULTS,
+    StudyInterrupted,
+    StudyPlan,
+    run_study_command,
+)
 from rigidfold.study.store import Key, Store, run_stop
 
 __all__ = [
     "PRESETS",
+    "STUDY_DEFAULTS",
     "Key",
     "Store",
     "StudyConfig",
+    "StudyInterrupted",
+    "StudyPlan",
     "plan",
     "preset",
     "run_one",
     "run_stop",
     "run_study",
+    "run_study_command",
 ]

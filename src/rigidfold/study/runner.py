@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import PATTERNS
 from rigidfold.selection import CRITERIA
 from rigidfold.study.store import ERROR_PREFIX, Key, Store
@@ -33,8 +34,8 @@ class StudyConfig:
     """What makes the numbers of two runs comparable; stored in the database."""
 
     deform: bool = False
-    target_dof: int = 1
-    solver: str = "ipopt"
+    target_dof: int = DEFAULTS.target_dof
+    solver: str = SOLVERS[0]
     settings: Settings = field(default=DEFAULTS)
 
     def as_dict(self) -> dict:

@@ -1,0 +1,117 @@
+"""Progress on stderr for long commands: a rich bar on a terminal, plain lines otherwise.
+
+:class:`GenerateProgress` follows a generation run (DOF removed so far, locks, exceeds);
+:class:`StudyProgress` follows a study (runs done, failures, rate, ETA). Both are silent when
+disabled, and import rich only when they first draw.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+
+def _rich_bar(label: str, *columns: str, eta: bool = False):
+    """A started rich Progress on stderr: label, bar, n/total, description, elapsed [, ETA]."""
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    parts = [TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn()]
+    parts.append(TextColumn("{task.description}"))
+    if eta:
+        parts += [TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn()]
+    bar = Progress(*parts, console=Console(stderr=True), transient=False)
+    bar.start()
+    return bar
+
+
+class GenerateProgress:
+    """A bar over the DOF to remove; call :meth:`update` after every attempt and solution.
+
+    run : rigidfold.generate.Generation (``initial_dof``, ``n_reduce``, ``final_dof``,
+    ``n_lock``, ``n_exceed`` are read).
+    """
+
+    def __init__(self, *, enabled: bool, target: int) -> None:
+        self.enabled, self.target, self.bar, self.task = enabled, target, None, None
+
+    def update(self, run, attempt=None) -> None:
+        if not self.enabled or run.initial_dof is None:
+            return
+        if self.bar is None:
+            self.bar = _rich_bar("generate")
+            self.task = self.bar.add_task("", total=max(run.initial_dof - self.target, 0))
+        self.bar.update(
+            self.task,
+            completed=run.n_reduce,
+            description=f"DOF {run.final_dof}  lock {run.n_lock}  exceed {run.n_exceed}",
+        )
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+            self.bar = None
+
+
+class StudyProgress:
+    """One bar for a study: runs done / total, failures, rate, ETA (stderr).
+
+    When stderr is not a terminal (a batch job, ``nohup``, a log file) a live bar would show
+    nothing until the end, so a plain line with the same figures is printed instead, at most
+    every ``log_every`` seconds and for the last run.
+    """
+
+    def __init__(self, *, enabled: bool, log_every: float = 60.0) -> None:
+        self.enabled, self.bar, self.task, self.failures = enabled, None, None, 0
+        self.plain = not sys.stderr.isatty()
+        self.log_every, self.t0 = log_every, time.monotonic()
+        self.last, self.first = -math.inf, None
+
+    def _line(self, finished: int, total: int) -> None:
+        now = time.monotonic()
+        if self.first is None:  # runs already in the database before this command
+            self.first = finished - 1
+        if now - self.last < self.log_every and finished < total:
+            return
+        self.last = now
+        done, elapsed = finished - self.first, now - self.t0
+        rate = done / elapsed if elapsed > 0 else 0.0
+        eta = f"{(total - finished) / rate / 60:.0f} min" if rate > 0 else "?"
+        print(
+            f"study {finished}/{total}  failures {self.failures}  {rate * 60:.1f} runs/min  "
+            f"elapsed {elapsed / 60:.1f} min  ETA {eta}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    def update(self, failed: bool, finished: int, total: int) -> None:
+        """One more run ended (``failed``: with an error); ``finished`` of ``total`` done."""
+        self.failures += bool(failed)
+        if not self.enabled:
+            return
+        if self.plain:
+            self._line(finished, total)
+            return
+        if self.bar is None:
+            self.bar = _rich_bar("study", eta=True)
+            self.task = self.bar.add_task("", total=total, completed=finished - 1)
+        rate = self.bar.tasks[0].speed
+        self.bar.update(
+            self.task,
+            completed=finished,
+            description=f"failures {self.failures}"
+            + (f"  {rate * 60:.1f} runs/min" if rate else ""),
+        )
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+            self.bar = None

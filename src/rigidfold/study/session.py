@@ -1,0 +1,102 @@
+"""One ``rigidfold study`` command: open the store, run what is missing, record the command.
+
+:func:`run_study_command` is the library side of ``rigidfold study``: it opens (or creates)
+the database, refusing one of another configuration untouched, runs every planned run not
+yet in it on Dask (:func:`rigidfold.study.runner.run_study`), and records the command in the
+``invocations`` table whether it completed or was interrupted.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+from rigidfold.selection import CRITERIA
+from rigidfold.study.paper import TABLES_5_6
+from rigidfold.study.runner import StudyConfig, run_study
+from rigidfold.study.store import Key, Store
+
+
+@dataclass(frozen=True)
+class StudyPlan:
+    """Defaults of a Bezier study: the runs of the paper's Tables 5-6 on two local workers.
+
+    patterns, criteria : names; surfaces : Bezier seeds per (pattern, criterion), from
+    ``first_seed``; workers : local Dask worker processes.
+    """
+
+    patterns: tuple[str, ...] = tuple(sorted({pattern for pattern, _ in TABLES_5_6}))
+    criteria: tuple[str, ...] = CRITERIA
+    surfaces: int = 100
+    first_seed: int = 0
+    workers: int = 2
+
+
+STUDY_DEFAULTS = StudyPlan()
+
+
+class StudyInterrupted(KeyboardInterrupt):
+    """A study stopped by the user; ``finished`` runs of the study are in the database."""
+
+    def __init__(self, finished: int) -> None:
+        super().__init__(finished)
+        self.finished = finished
+
+
+def run_study_command(
+    keys: Sequence[Key],
+    db: str | Path,
+    config: StudyConfig,
+    *,
+    workers: int = STUDY_DEFAULTS.workers,
+    scheduler: str | None = None,
+    argv: Sequence[str] = (),
+    on_done: Callable[[bool, int, int], None] | None = None,
+) -> dict:
+    """Run the study ``keys`` into the database ``db``; returns :func:`run_study`'s counts.
+
+    on_done(failed, finished, total) after each stored run (``failed``: the run ended in an
+    error, recorded in the database). A KeyboardInterrupt is recorded and re-raised as
+    :class:`StudyInterrupted`.
+    """
+    from rigidfold import __version__
+
+    if workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {workers}")
+    store = Store(db, config.as_dict())  # refuses another configuration untouched
+    started = datetime.now(UTC).isoformat(timespec="seconds")
+    t0 = time.perf_counter()
+    planned = set(keys)
+    before = len(store.done() & planned)
+
+    def record(outcome: str, ran: int) -> None:
+        store.add_invocation(
+            started=started,
+            argv=list(argv),
+            workers=None if scheduler else workers,
+            scheduler=scheduler,
+            ran=ran,
+            skipped=before,
+            total=len(keys),
+            wall_s=time.perf_counter() - t0,
+            outcome=outcome,
+            version=__version__,
+        )
+
+    def done(key: Key, row: dict, finished: int, total: int) -> None:
+        if on_done:
+            on_done(bool(row.get("error")), finished, total)
+
+    try:
+        result = run_study(keys, store, config, workers=workers, scheduler=scheduler, on_done=done)
+    except KeyboardInterrupt:
+        finished = len(store.done() & planned)
+        record("interrupted", finished - before)
+        store.close()
+        raise StudyInterrupted(finished) from None
+    record("completed", result["ran"])
+    store.close()
+    return result
