@@ -133,7 +133,7 @@ class Development:
                 "non-finite coordinates); it is not a crease pattern"
             )
         coords = np.column_stack([self.coords2d, np.zeros(len(self.coords2d))])
-        return CreasePattern(coords, pattern.faces, pattern.edges, pattern.fixed)
+        return pattern.with_coords(coords)
 
 
 def signed_areas(coords2d: np.ndarray, faces: np.ndarray) -> np.ndarray:
