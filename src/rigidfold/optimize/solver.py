@@ -54,43 +54,22 @@ class SolverRun:
 class SolverProblem(Protocol):
     """What the solvers and the closed-form Hessian read from a built problem (6).
 
-    The CasADi Functions take ``(xi (n,), w (E,))``; see ``FormFindingProblem``.
+    objective : ca.Function (xi, w) -> (F, F1, F2)
+    objective_gradient : ca.Function (xi, w) -> (F, dF (n,))
+    constraints : ca.Function (xi, w) -> g (m,)
+    constraint_jacobian : ca.Function (xi, w) -> (g (m,), dg (m, n))
+    (see ``FormFindingProblem``, which satisfies it).
     """
 
-    @property
-    def pattern(self) -> CreasePattern: ...
-
-    @property
-    def surface(self) -> TargetSurface: ...
-
-    @property
-    def settings(self) -> Settings: ...
-
-    @property
-    def map(self) -> LinearMap: ...
-
-    @property
-    def nlp(self) -> NLP: ...
-
-    @property
-    def objective(self) -> ca.Function:
-        """(xi, w) -> (F, F1, F2)"""
-        ...
-
-    @property
-    def objective_gradient(self) -> ca.Function:
-        """(xi, w) -> (F, dF (n,))"""
-        ...
-
-    @property
-    def constraints(self) -> ca.Function:
-        """(xi, w) -> g (m,)"""
-        ...
-
-    @property
-    def constraint_jacobian(self) -> ca.Function:
-        """(xi, w) -> (g (m,), dg (m, n))"""
-        ...
+    pattern: CreasePattern
+    surface: TargetSurface
+    settings: Settings
+    map: LinearMap
+    nlp: NLP
+    objective: ca.Function
+    objective_gradient: ca.Function
+    constraints: ca.Function
+    constraint_jacobian: ca.Function
 
 
 class Solver(Protocol):
