@@ -14,6 +14,7 @@ from rigidfold import patterns
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
+from rigidfold.protocols import SymmetryPlane, TargetSurface
 from rigidfold.surfaces import Surface, get_surface
 
 
@@ -21,14 +22,15 @@ from rigidfold.surfaces import Surface, get_surface
 class Case:
     """Everything problem (6) needs, validated.
 
-    surface : Surface; pattern_name : str; pattern : CreasePattern (the triangulated target
-    surface); planes : mirror planes used for constraint (9); settings : Settings.
+    surface : TargetSurface (a Surface); pattern_name : str; pattern : CreasePattern (the
+    triangulated target surface); planes : mirror planes (SymmetryPlane) used for constraint
+    (9); settings : Settings.
     """
 
-    surface: Surface
+    surface: TargetSurface
     pattern_name: str
     pattern: CreasePattern
-    planes: tuple
+    planes: tuple[SymmetryPlane, ...]
     settings: Settings
 
     def problem(self, *, build_ipopt: bool = True) -> FormFindingProblem:

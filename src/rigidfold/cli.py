@@ -321,10 +321,11 @@ def _cmd_deform(args: argparse.Namespace) -> int:
     from rigidfold.workflows import deform_file
 
     checked = deform_file(args.file, args.out)
+    d, m = checked.verification.deformation, checked.verification.motion
+    assert d is not None  # deform_file runs the analysis
     if args.json:
         print(json.dumps(jsonable(checked.to_dict())))
-        return 0 if checked.verification.deformation.reached_plane else 1
-    d, m = checked.verification.deformation, checked.verification.motion
+        return 0 if d.reached_plane else 1
     print(
         f"{d.status}: {d.steps} load steps, mean/max |dl| = {d.mean_dl_mm:.4g}/"
         f"{d.max_dl_mm:.4g} mm, mean/max |drho_fix| = {d.mean_drho_fix_deg:.4g}/"

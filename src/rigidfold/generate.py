@@ -154,7 +154,8 @@ class Generation:
         """DOF reduced from the initial shape's, over accepted shapes."""
         if not self.solutions:
             return 0
-        return self.initial_dof - self.final_dof
+        assert self.initial_dof is not None  # set before the first solution is recorded
+        return self.initial_dof - self.solutions[-1].mechanism.dof
 
     def to_dict(self) -> dict:
         """JSON-serialisable counters, stop and times of the run."""
@@ -219,7 +220,7 @@ def generate(
 
     def attempt(
         fixed: np.ndarray, start, added, score
-    ) -> tuple[Attempt, OptimizeResult, Mechanism]:
+    ) -> tuple[Attempt, OptimizeResult, Mechanism | None]:
         result = problem.solve(fixed=fixed, start=start, solver=solver)
         t1 = time.perf_counter()
         mech = (
@@ -276,10 +277,11 @@ def generate(
         rec.outcome = AttemptOutcome.INITIAL_FAILED
         record(rec, result, mech)
         return run
+    assert mech is not None  # an accepted attempt was analysed
     run.initial_dof = mech.dof
     record(rec, result, mech)
 
-    while run.final_dof > target_dof:
+    while run.solutions[-1].mechanism.dof > target_dof:  # run.final_dof, never None here
         current = run.solutions[-1]
         t1 = time.perf_counter()
         K = hinge_stiffness(current.mechanism.frame.n_hinges, int(rng.integers(2**32)), settings)

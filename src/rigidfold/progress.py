@@ -10,9 +10,13 @@ from __future__ import annotations
 import math
 import sys
 import time
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # rich is imported only when a bar is first drawn
+    from rich.progress import Progress, TaskID
 
 
-def _rich_bar(label: str, *columns: str, eta: bool = False):
+def _rich_bar(label: str, *columns: str, eta: bool = False) -> Progress:
     """A started rich Progress on stderr: label, bar, n/total, description, elapsed [, ETA]."""
     from rich.console import Console
     from rich.progress import (
@@ -41,7 +45,9 @@ class GenerateProgress:
     """
 
     def __init__(self, *, enabled: bool, target: int) -> None:
-        self.enabled, self.target, self.bar, self.task = enabled, target, None, None
+        self.enabled, self.target = enabled, target
+        self.bar: Progress | None = None
+        self.task: TaskID | None = None
 
     def update(self, run, attempt=None) -> None:
         if not self.enabled or run.initial_dof is None:
@@ -49,6 +55,7 @@ class GenerateProgress:
         if self.bar is None:
             self.bar = _rich_bar("generate")
             self.task = self.bar.add_task("", total=max(run.initial_dof - self.target, 0))
+        assert self.task is not None  # added with the bar
         self.bar.update(
             self.task,
             completed=run.n_reduce,
@@ -70,10 +77,13 @@ class StudyProgress:
     """
 
     def __init__(self, *, enabled: bool, log_every: float = 60.0) -> None:
-        self.enabled, self.bar, self.task, self.failures = enabled, None, None, 0
+        self.enabled, self.failures = enabled, 0
+        self.bar: Progress | None = None
+        self.task: TaskID | None = None
         self.plain = not sys.stderr.isatty()
         self.log_every, self.t0 = log_every, time.monotonic()
-        self.last, self.first = -math.inf, None
+        self.last = -math.inf
+        self.first: int | None = None
 
     def _line(self, finished: int, total: int) -> None:
         now = time.monotonic()
@@ -103,6 +113,7 @@ class StudyProgress:
         if self.bar is None:
             self.bar = _rich_bar("study", eta=True)
             self.task = self.bar.add_task("", total=total, completed=finished - 1)
+        assert self.task is not None  # added with the bar
         rate = self.bar.tasks[0].speed
         self.bar.update(
             self.task,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Any
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.analysis import DeformResult, deform
@@ -27,9 +28,9 @@ class Verification:
     motion: Motion | None
     times: dict
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready figures of every stage (for log.json, summary.json and the CLI)."""
-        out = {
+        out: dict[str, Any] = {
             "development": self.development.to_dict(),
             "deformation": None if self.deformation is None else self.deformation.to_dict(),
             "motion": None if self.motion is None else self.motion.to_dict(),

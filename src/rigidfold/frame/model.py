@@ -145,9 +145,9 @@ class FrameModel:
             for j in range(3):
                 put(6 * k + 3 + i, 6 * a + 3 + j, cross[:, i, j])
         hinged = np.flatnonzero(self.member_hinge >= 0)
-        j = self.member_hinge[hinged]
+        hinge = self.member_hinge[hinged]
         for axis in range(3):
-            put(6 * hinged + axis, 6 * self.n_nodes + j, -self.hinge_axes[j, axis])
+            put(6 * hinged + axis, 6 * self.n_nodes + hinge, -self.hinge_axes[hinge, axis])
         S = sp.coo_matrix(
             (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
             shape=(6 * m, 6 * self.n_nodes + self.n_hinges),

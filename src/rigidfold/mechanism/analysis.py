@@ -14,6 +14,7 @@ stiffness matrix and everything derived from it (Sections 4.2, 5) are the paper'
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -44,7 +45,7 @@ class Mechanism:
     """
 
     frame: FrameModel
-    basis: object
+    basis: np.ndarray | Callable[[], np.ndarray]
     H_phi: np.ndarray
     rank_values: np.ndarray
     rank: int
@@ -106,6 +107,7 @@ def analyze(
         raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
     frame = FrameModel.from_pattern(pattern, support_face)
     h = frame.n_hinges
+    basis: np.ndarray | Callable[[], np.ndarray]
     if method == "frame":
         H, values, rank = _svd_kernel(frame.compatibility_matrix().toarray(), settings)
         H_phi, basis = H[H.shape[0] - h :], H
@@ -118,8 +120,10 @@ def analyze(
         Rinv = scipy.linalg.solve_triangular(R, np.eye(len(R))) if len(R) else R
         H_phi = L[L.shape[0] - h :] @ N @ Rinv
 
-        def basis() -> np.ndarray:
+        def modes() -> np.ndarray:
             return L @ N @ Rinv
+
+        basis = modes
 
     return Mechanism(frame, basis, H_phi, values, rank, _locked(frame, H_phi, settings), settings)
 

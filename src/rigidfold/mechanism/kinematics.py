@@ -133,23 +133,26 @@ def frame_map(frame: FrameModel) -> sp.csr_matrix:
     E, F = pat.n_edges, pat.n_faces
     W = angular_velocity_blocks(pat)  # (F, 3, 3, 3)
     c3 = np.arange(3)
-    rows, cols, vals = [], [], []
+    row_parts: list[np.ndarray] = []
+    col_parts: list[np.ndarray] = []
+    val_parts: list[np.ndarray] = []
     # translations: edge nodes (mean of 2 vertices), barycentre nodes (mean of 3)
     for node, verts in ((np.arange(E), pat.edges), (E + np.arange(F), pat.faces)):
         k = verts.shape[1]
-        rows.append(np.broadcast_to(6 * node[:, None, None] + c3, (len(node), k, 3)).ravel())
-        cols.append((3 * verts[:, :, None] + c3).ravel())
-        vals.append(np.full(len(node) * k * 3, 1.0 / k))
+        row_parts.append(np.broadcast_to(6 * node[:, None, None] + c3, (len(node), k, 3)).ravel())
+        col_parts.append((3 * verts[:, :, None] + c3).ravel())
+        val_parts.append(np.full(len(node) * k * 3, 1.0 / k))
     # rotations: W of the node's rigid triangle
     edge_face = np.where(pat.edge_faces[:, 0] >= 0, pat.edge_faces[:, 0], pat.edge_faces[:, 1])
     for node, face in ((np.arange(E), edge_face), (E + np.arange(F), np.arange(F))):
         shape = (len(node), 3, 3, 3)
-        rows.append(
+        row_parts.append(
             np.broadcast_to(6 * node[:, None, None, None] + 3 + c3[:, None, None], shape).ravel()
         )
-        cols.append(np.broadcast_to(3 * pat.faces[face][:, None, :, None] + c3, shape).ravel())
-        vals.append(W[face].ravel())
-    rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+        col_parts.append(np.broadcast_to(3 * pat.faces[face][:, None, :, None] + c3, shape).ravel())
+        val_parts.append(W[face].ravel())
+    rows, cols = np.concatenate(row_parts), np.concatenate(col_parts)
+    vals = np.concatenate(val_parts)
     # drop the support node's rows and close the gap
     s0 = 6 * frame.support_node
     keep = (rows < s0) | (rows >= s0 + 6)

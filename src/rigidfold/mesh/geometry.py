@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from rigidfold.protocols import SymmetryPlane
+
 
 def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Unsigned angle between vectors.  a, b : (..., 3) -> (...,) radians in [0, pi]"""
@@ -109,11 +111,11 @@ def plan_turning_angles(coords: np.ndarray, loop: np.ndarray) -> np.ndarray:
     return np.arctan2(cross, dot)
 
 
-def mirror_pairs(coords: np.ndarray, plane, tol: float) -> np.ndarray:
+def mirror_pairs(coords: np.ndarray, plane: SymmetryPlane, tol: float) -> np.ndarray:
     """For each vertex, the index of the vertex at its mirror image in plan.
 
-    coords : (V, 2) or (V, 3) float, only x and y are used; plane : object with
-    ``reflect(xy (N, 2)) -> (N, 2)``; tol : largest distance (metres) between a mirror image
+    coords : (V, 2) or (V, 3) float, only x and y are used; plane : a SymmetryPlane
+    (``reflect(xy (N, 2)) -> (N, 2)``); tol : largest distance (metres) between a mirror image
     and its vertex.  returns : (V,) int64
     Raises ValueError when some vertex has no mirror image among the vertices.
     """

@@ -177,7 +177,7 @@ class CreasePattern:
     @cached_property
     def is_boundary_edge(self) -> np.ndarray:
         """(E,) bool: True for outer edges."""
-        return (self.edge_faces < 0).any(axis=1)
+        return np.any(self.edge_faces < 0, axis=1)
 
     @cached_property
     def boundary_edges(self) -> np.ndarray:
@@ -238,7 +238,9 @@ class CreasePattern:
             return ()
         k0 = next(i for i, v in enumerate(loop) if v in corners)
         loop = loop[k0:] + loop[:k0] + [loop[k0]]
-        sides, start, inner = [], loop[0], []
+        sides: list[BoundarySide] = []
+        inner: list[int] = []
+        start = loop[0]
         for v in loop[1:]:
             if v in corners:
                 sides.append(self._side(start, v, inner))

@@ -104,7 +104,8 @@ def ear_clip(
     size = max(max(p[d] for p in xy) - min(p[d] for p in xy) for d in (0, 1))
     tol = area_tol * size**2
     remaining = list(range(len(xy)))
-    triangles, diagonals = [], []
+    triangles: list[tuple[int, ...]] = []
+    diagonals: list[tuple[int, int]] = []
     while len(remaining) > 3:
         m = len(remaining)
         best, best_quality = None, -1.0

@@ -25,16 +25,12 @@ cost (``benchmarks/hessian_size.py``).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
 from rigidfold.mesh.geometry import skew
-
-if TYPE_CHECKING:
-    from rigidfold.optimize.problem import FormFindingProblem
+from rigidfold.optimize.solver import SolverProblem
 
 _B_ANGLE = np.zeros((6, 9))  # (u, v) = (b - a, c - a) from (a, b, c)
 _B_ANGLE[0:3, 0:3] = _B_ANGLE[3:6, 0:3] = -np.eye(3)
@@ -182,7 +178,7 @@ class ClosedFormHessian:
     nonzeros (nnz,) in CasADi's (column-major) order.
     """
 
-    def __init__(self, problem: FormFindingProblem) -> None:
+    def __init__(self, problem: SolverProblem) -> None:
         pat, lin = problem.pattern, problem.map
         V, n = pat.n_vertices, lin.n_variables
         self.V, self.n, self.T, self.t = V, n, lin.T.tocsr(), lin.t
@@ -344,7 +340,7 @@ class _HessianCallback(ca.Callback):
         return 0
 
 
-def closed_form_hess_lag(problem: FormFindingProblem) -> ca.Function:
-    """IPOPT's ``hess_lag`` Function for a FormFindingProblem (keep a reference to it)."""
+def closed_form_hess_lag(problem: SolverProblem) -> ca.Function:
+    """IPOPT's ``hess_lag`` Function for a SolverProblem (keep a reference to it)."""
     hessian = ClosedFormHessian(problem)
     return _HessianCallback(hessian, problem.nlp.p.shape[0], problem.nlp.g.shape[0])

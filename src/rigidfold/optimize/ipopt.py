@@ -2,17 +2,12 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import casadi as ca
 import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
-from rigidfold.optimize.solver import SolverOutcome, SolverRun
-
-if TYPE_CHECKING:
-    from rigidfold.optimize.problem import FormFindingProblem
+from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
 
 _OUTCOME = {
     "Solve_Succeeded": SolverOutcome.SOLVED,
@@ -54,7 +49,7 @@ class IpoptSolver:
         CasADi's IPOPT solver; ``nlpsol.stats()`` holds the statistics of the last solve.
     """
 
-    def __init__(self, problem: FormFindingProblem) -> None:
+    def __init__(self, problem: SolverProblem) -> None:
         nlp = problem.nlp
         self._lbg, self._ubg = nlp.lbg, nlp.ubg
         options = ipopt_options(problem.settings)

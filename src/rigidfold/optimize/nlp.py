@@ -27,6 +27,7 @@ import scipy.sparse as sp
 from rigidfold.config import Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.variables import LinearMap
+from rigidfold.protocols import TargetSurface
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,10 +91,12 @@ def _sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-def build_nlp(pattern: CreasePattern, surface, lmap: LinearMap, settings: Settings) -> NLP:
+def build_nlp(
+    pattern: CreasePattern, surface: TargetSurface, lmap: LinearMap, settings: Settings
+) -> NLP:
     """Problem (6) for a crease pattern, target surface, linear map (7)-(11) and settings.
 
-    surface : rigidfold.surfaces.Surface
+    surface : TargetSurface (e.g. a rigidfold.surfaces.Surface)
         Its ``height`` must accept CasADi symbols (``xp=casadi``).
     """
     s = settings

@@ -21,11 +21,12 @@ from rigidfold.optimize.ipopt import IpoptSolver
 from rigidfold.optimize.nlp import NLP, build_nlp
 from rigidfold.optimize.result import OptimizeResult, Status
 from rigidfold.optimize.slsqp import SlsqpSolver
-from rigidfold.optimize.solver import Solver, SolverOutcome
+from rigidfold.optimize.solver import Solver, SolverOutcome, SolverProblem
 from rigidfold.optimize.variables import LinearMap, build_linear_map
+from rigidfold.protocols import SymmetryPlane, TargetSurface
 
 #: name -> solver factory ``(problem) -> Solver``; the one list of solver names
-SOLVER_FACTORIES: Mapping[str, Callable[[FormFindingProblem], Solver]] = MappingProxyType(
+SOLVER_FACTORIES: Mapping[str, Callable[[SolverProblem], Solver]] = MappingProxyType(
     {
         "ipopt": IpoptSolver,
         "slsqp": partial(SlsqpSolver, exact=True),
@@ -38,13 +39,15 @@ SOLVERS = tuple(SOLVER_FACTORIES)
 class FormFindingProblem:
     """Problem (6) for one crease pattern, target surface, symmetry and settings.
 
+    A ``SolverProblem``: the solvers of ``SOLVER_FACTORIES`` are built from it.
+
     Parameters
     ----------
     pattern : CreasePattern
         The initial shape (Step 1); its plan boundary sides and corners define (7) and (8).
-    surface : rigidfold.surfaces.Surface
+    surface : TargetSurface (e.g. a rigidfold.surfaces.Surface)
         Target surface z = f(x, y); its ``height`` must accept CasADi symbols (``xp=casadi``).
-    planes : sequence of mirror planes
+    planes : sequence of SymmetryPlane
         Vertical planes of symmetry (9); each has ``a, b, c`` and ``reflect``.
     settings : Settings
         Design parameters (dz, theta bounds, rho_bar, F_tol) and tolerances.
@@ -70,16 +73,16 @@ class FormFindingProblem:
     def __init__(
         self,
         pattern: CreasePattern,
-        surface,
+        surface: TargetSurface,
         *,
-        planes: Sequence = (),
+        planes: Sequence[SymmetryPlane] = (),
         settings: Settings = DEFAULTS,
         build_ipopt: bool = True,
     ) -> None:
         t0 = time.perf_counter()
         self.pattern = pattern
         self.surface = surface
-        self.planes = tuple(planes)
+        self.planes: tuple[SymmetryPlane, ...] = tuple(planes)
         self.settings = settings
         self.map: LinearMap = build_linear_map(pattern, self.planes, settings)
         self.nlp: NLP = build_nlp(pattern, surface, self.map, settings)

@@ -7,14 +7,9 @@ paper did (its baseline: 72 s per solve for 115 variables).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from rigidfold.optimize.solver import SolverOutcome, SolverRun
-
-if TYPE_CHECKING:
-    from rigidfold.optimize.problem import FormFindingProblem
+from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
 
 # SciPy's SLSQP exit modes (scipy/optimize/_slsqp_py.py)
 _OUTCOME = {
@@ -32,7 +27,7 @@ class SlsqpSolver:
     The two-sided constraints of (6) become SLSQP's one-sided ``g >= 0`` rows here, once.
     """
 
-    def __init__(self, problem: FormFindingProblem, *, exact: bool = True) -> None:
+    def __init__(self, problem: SolverProblem, *, exact: bool = True) -> None:
         lbg, ubg = problem.nlp.lbg, problem.nlp.ubg
         self.exact = exact
         self._settings = problem.settings

@@ -3,7 +3,9 @@
 A solver is built once per ``FormFindingProblem`` (``problem.solver(name)``) and keeps what
 it builds (IPOPT's ``nlpsol``, its Hessian callback); each ``solve`` runs it from one start
 with one set of fixed creases. rigidfold's own verdict on the run (``Status``) is made by
-``rigidfold.optimize.problem.classify`` from the solver's ``SolverOutcome``.
+``rigidfold.optimize.problem.classify`` from the solver's ``SolverOutcome``. What a solver
+(and the closed-form Hessian) reads from the problem is the Protocol ``SolverProblem``, which
+``FormFindingProblem`` satisfies.
 """
 
 from __future__ import annotations
@@ -11,8 +13,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
+import casadi as ca
 import numpy as np
 
+from rigidfold.config import Settings
+from rigidfold.mesh import CreasePattern
+from rigidfold.optimize.nlp import NLP
+from rigidfold.optimize.variables import LinearMap
+from rigidfold.protocols import TargetSurface
 from rigidfold.status import Outcome
 
 
@@ -43,8 +51,29 @@ class SolverRun:
     message: str
 
 
+class SolverProblem(Protocol):
+    """What the solvers and the closed-form Hessian read from a built problem (6).
+
+    objective : ca.Function (xi, w) -> (F, F1, F2)
+    objective_gradient : ca.Function (xi, w) -> (F, dF (n,))
+    constraints : ca.Function (xi, w) -> g (m,)
+    constraint_jacobian : ca.Function (xi, w) -> (g (m,), dg (m, n))
+    (see ``FormFindingProblem``, which satisfies it).
+    """
+
+    pattern: CreasePattern
+    surface: TargetSurface
+    settings: Settings
+    map: LinearMap
+    nlp: NLP
+    objective: ca.Function
+    objective_gradient: ca.Function
+    constraints: ca.Function
+    constraint_jacobian: ca.Function
+
+
 class Solver(Protocol):
-    """A solver of problem (6), built for one ``FormFindingProblem``."""
+    """A solver of problem (6), built for one ``SolverProblem`` (a ``FormFindingProblem``)."""
 
     def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,)."""

@@ -26,6 +26,7 @@ import scipy.sparse as sp
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import mirror_pairs
+from rigidfold.protocols import SymmetryPlane
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,12 +72,15 @@ class LinearMap:
 
 
 def assemble_constraints(
-    pattern: CreasePattern, planes: Sequence = (), settings: Settings = DEFAULTS
+    pattern: CreasePattern, planes: Sequence[SymmetryPlane] = (), settings: Settings = DEFAULTS
 ) -> tuple[sp.csr_matrix, np.ndarray]:
     """Gamma (m, 3V) and c (m,) of constraints (7), (8) and (9) for the pattern's shape."""
     V = pattern.n_vertices
     X, Y, Z = 0, V, 2 * V  # offsets of x, y and z in P
-    rows, cols, vals, rhs = [], [], [], []
+    rows: list[int] = []
+    cols: list[int] = []
+    vals: list[float] = []
+    rhs: list[float] = []
 
     def add(entries: list[tuple[int, float]], value: float) -> None:
         r = len(rhs)
@@ -109,7 +113,7 @@ def assemble_constraints(
 
 
 def build_linear_map(
-    pattern: CreasePattern, planes: Sequence = (), settings: Settings = DEFAULTS
+    pattern: CreasePattern, planes: Sequence[SymmetryPlane] = (), settings: Settings = DEFAULTS
 ) -> LinearMap:
     """Eliminate (7)-(9) from the pattern's coordinates (Eqs. 10-11).
 

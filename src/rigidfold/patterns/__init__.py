@@ -10,6 +10,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns.grids import grid11, pattern1, pattern1p, pattern2
 from rigidfold.patterns.miura import miura
+from rigidfold.protocols import TargetSurface
 
 PATTERNS: dict[str, Callable[[], tuple[np.ndarray, np.ndarray]]] = {
     "1": pattern1,
@@ -28,10 +29,11 @@ def plan(name: str) -> tuple[np.ndarray, np.ndarray]:
     return PATTERNS[key]()
 
 
-def build(name: str, surface, *, settings: Settings = DEFAULTS) -> CreasePattern:
+def build(name: str, surface: TargetSurface, *, settings: Settings = DEFAULTS) -> CreasePattern:
     """Crease pattern ``name`` with each vertex lifted onto ``surface`` (Step 1).
 
-    surface : a :class:`rigidfold.surfaces.Surface` (anything with ``height(x, y)``);
+    surface : a :class:`rigidfold.surfaces.Surface` (any ``TargetSurface``; its optional
+        ``check_finite(x, y)`` is called first);
     settings : the pattern's tolerances (:attr:`CreasePattern.settings`).
     """
     xy, faces = plan(name)

@@ -26,8 +26,8 @@ def miura(
     """
     if nx < 1 or ny < 1:
         raise ValueError(f"a Miura-ori needs at least 1 x 1 cells, got {nx} x {ny}")
-    i, j = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="xy")
-    i, j = i.ravel(), j.ravel()
+    gi, gj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="xy")
+    i, j = gi.ravel(), gj.ravel()
     coords = np.column_stack([i * length + (j % 2) * offset, j * width, (i % 2) * height])
     quads, diagonals = [], []
     for q in range(ny):

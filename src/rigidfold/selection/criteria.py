@@ -119,6 +119,7 @@ def rank_candidates(
     returns : [(edge indices, score)], score NaN for "random".
     """
     values = scores.of(criterion)
+    ranked: list[tuple[tuple[int, ...], float]]
     if groups is None:
         ranked = [((int(e),), float(v)) for e, v in zip(scores.hinges, values, strict=True)]
     else:

@@ -12,10 +12,11 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import mirror_pairs
 from rigidfold.mesh.topology import edge_keys
+from rigidfold.protocols import SymmetryPlane
 
 
 def crease_groups(
-    pattern: CreasePattern, planes: Sequence, settings: Settings = DEFAULTS
+    pattern: CreasePattern, planes: Sequence[SymmetryPlane], settings: Settings = DEFAULTS
 ) -> list[tuple[int, ...]]:
     """Orbits of the interior edges under the mirror planes (1, 2 or 4 creases each).
 

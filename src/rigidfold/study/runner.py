@@ -108,6 +108,7 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
     def on_solution(run, solution) -> None:
         if config["deform"]:
             c = verify(solution.result.pattern, run_motion=False, settings=settings)
+            assert c.deformation is not None  # verify runs the analysis by default
             checks.append({"D": c.development.D, **c.deformation.to_dict(), "times": c.times})
 
     row: dict = {"version": __version__, "worker": f"{socket.gethostname()}:{os.getpid()}"}

@@ -10,13 +10,15 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from math import comb
+from types import ModuleType
+from typing import Any
 
 import numpy as np
 
 
 @dataclass(frozen=True)
 class MirrorPlane:
-    """Vertical plane ``a x + b y + c = 0`` (metres)."""
+    """Vertical plane ``a x + b y + c = 0`` (metres); a ``rigidfold.protocols.SymmetryPlane``."""
 
     a: float
     b: float
@@ -48,20 +50,20 @@ class MirrorPlane:
 
 
 class Surface(ABC):
-    """A target surface z = f(x, y)."""
+    """A target surface z = f(x, y); satisfies :class:`rigidfold.protocols.TargetSurface`."""
 
     name: str = "surface"
     mirror_planes: tuple[MirrorPlane, ...] = ()
 
     @abstractmethod
-    def height(self, x, y, xp=np):
+    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
         """z at plan points; x, y are arrays of one shape (or CasADi symbols with xp=casadi)."""
 
     @abstractmethod
-    def gradient(self, x, y) -> tuple[np.ndarray, np.ndarray]:
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         """(dz/dx, dz/dy) at plan points, exact.  arrays of the shape of x."""
 
-    def hessian(self, x, y) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(f_xx, f_xy, f_yy) at plan points, exact.  arrays of the broadcast shape of x, y
 
         By CasADi's automatic differentiation of ``height`` unless a subclass gives it in
@@ -77,13 +79,14 @@ class Surface(ABC):
             fn = ca.Function("hessian", [sx, sy], [h[0, 0], h[0, 1], h[1, 1]])
             self._hessian_function = fn
         if x.size == 0:
-            return tuple(np.zeros(x.shape) for _ in range(3))
+            return np.zeros(x.shape), np.zeros(x.shape), np.zeros(x.shape)
         # a 1 x n row evaluates the scalar function at n points
         out = fn(x.reshape(1, -1), y.reshape(1, -1))
-        return tuple(np.asarray(h, dtype=float).reshape(x.shape) for h in out)
+        fxx, fxy, fyy = (np.asarray(h, dtype=float).reshape(x.shape) for h in out)
+        return fxx, fxy, fyy
 
     @abstractmethod
-    def metadata(self) -> dict:
+    def metadata(self) -> dict[str, Any]:
         """JSON-serialisable description."""
 
     def __repr__(self) -> str:
@@ -119,7 +122,7 @@ class Bezier(Surface):
     def __init__(self, seed: int = 0) -> None:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             raise ValueError(f"the Bezier seed must be a non-negative integer, got {seed!r}")
-        self.seed = int(seed)
+        self.seed: int | None = int(seed)
         self.heights = np.random.default_rng(self.seed).uniform(0.0, 3.0, size=(4, 4))
 
     @classmethod
@@ -132,13 +135,13 @@ class Bezier(Surface):
         surface.seed, surface.heights = None, h
         return surface
 
-    def height(self, x, y, xp=np):
+    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
         u, v = x / 3.0, y / 3.0
         bu = [_bernstein(i, u) for i in range(4)]
         bv = [_bernstein(j, v) for j in range(4)]
         return sum(bu[i] * bv[j] * float(self.heights[i, j]) for i in range(4) for j in range(4))
 
-    def gradient(self, x, y):
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         u, v = np.asarray(x, dtype=float) / 3.0, np.asarray(y, dtype=float) / 3.0
         bu, bv = [_bernstein(i, u) for i in range(4)], [_bernstein(j, v) for j in range(4)]
         du = [_bernstein_derivative(i, u) for i in range(4)]
@@ -148,7 +151,7 @@ class Bezier(Surface):
         gy = sum(bu[i] * dv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
         return gx, gy
 
-    def hessian(self, x, y):
+    def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         # in the power basis: z = [1 u u^2 u^3] C [1 v v^2 v^3]^T with C = M h M^T
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         u, v = x.ravel() / 3.0, y.ravel() / 3.0
@@ -163,9 +166,9 @@ class Bezier(Surface):
         fxx = np.einsum("ni,ni->n", ddu @ C, pv) / 9.0
         fxy = np.einsum("ni,ni->n", du @ C, dv) / 9.0
         fyy = np.einsum("ni,ni->n", pu @ C, ddv) / 9.0
-        return tuple(f.reshape(x.shape) for f in (fxx, fxy, fyy))
+        return fxx.reshape(x.shape), fxy.reshape(x.shape), fyy.reshape(x.shape)
 
-    def metadata(self) -> dict:
+    def metadata(self) -> dict[str, Any]:
         return {"name": self.name, "seed": self.seed, "control_heights": self.heights.tolist()}
 
     def __repr__(self) -> str:
@@ -186,22 +189,22 @@ class Dome(Surface):
     centre_z = -0.75
     mirror_planes = (MirrorPlane(1.0, 0.0, -1.5), MirrorPlane(0.0, 1.0, -1.5))
 
-    def height(self, x, y, xp=np):
+    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
         return self.centre_z + xp.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
 
-    def gradient(self, x, y):
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         root = np.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
         return -(x - 1.5) / root, -(y - 1.5) / root
 
-    def hessian(self, x, y):
+    def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         dx, dy = x - 1.5, y - 1.5
         root = np.sqrt(self.radius**2 - dx**2 - dy**2)
         cube = root**3
         return -1 / root - dx**2 / cube, -dx * dy / cube, -1 / root - dy**2 / cube
 
-    def metadata(self) -> dict:
+    def metadata(self) -> dict[str, Any]:
         return {"name": self.name, "apex_m": 1.5, "radius_m": self.radius}
 
 
@@ -215,16 +218,16 @@ class HyperbolicParaboloid(Surface):
     k = 0.4
     mirror_planes = (MirrorPlane(1.0, -1.0, 0.0), MirrorPlane(1.0, 1.0, -3.0))
 
-    def height(self, x, y, xp=np):
+    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
         return self.k * (x - 1.5) * (y - 1.5)
 
-    def gradient(self, x, y):
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         return self.k * (y - 1.5), self.k * (x - 1.5)
 
-    def hessian(self, x, y):
+    def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         return np.zeros(x.shape), np.full(x.shape, self.k), np.zeros(x.shape)
 
-    def metadata(self) -> dict:
+    def metadata(self) -> dict[str, Any]:
         return {"name": self.name, "k": self.k}

@@ -12,6 +12,9 @@ from __future__ import annotations
 import ast
 import math
 import operator
+from collections.abc import Callable
+from types import ModuleType
+from typing import Any, Literal
 
 import casadi as ca
 import numpy as np
@@ -19,7 +22,7 @@ import numpy as np
 from rigidfold.surfaces.builtin import MirrorPlane, Surface
 
 # function name -> (number of arguments, NumPy implementation, CasADi implementation)
-FUNCTIONS = {
+FUNCTIONS: dict[str, tuple[int, Callable[..., Any], Callable[..., Any]]] = {
     "sin": (1, np.sin, ca.sin),
     "cos": (1, np.cos, ca.cos),
     "tan": (1, np.tan, ca.tan),
@@ -47,14 +50,17 @@ VARIABLES = ("x", "y")
 MAX_LENGTH = 1000  # characters of text
 MAX_DEPTH = 100  # nesting depth of the syntax tree
 
-_BINARY = {
+_BINARY: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
     ast.Add: operator.add,
     ast.Sub: operator.sub,
     ast.Mult: operator.mul,
     ast.Div: operator.truediv,
     ast.Pow: operator.pow,
 }
-_UNARY = {ast.UAdd: operator.pos, ast.USub: operator.neg}
+_UNARY: dict[type[ast.unaryop], Callable[[Any], Any]] = {
+    ast.UAdd: operator.pos,
+    ast.USub: operator.neg,
+}
 _REFUSED = {  # node type -> what the error message calls it
     ast.Attribute: "attribute access",
     ast.Subscript: "subscripting",
@@ -156,8 +162,10 @@ def _check(node: ast.AST) -> str | None:
     return f"{_REFUSED.get(type(node), type(node).__name__ + ' syntax')} is not allowed"
 
 
-def evaluate(tree: ast.Expression, x, y, xp=np):
+def evaluate(tree: ast.Expression, x: Any, y: Any, xp: ModuleType = np) -> Any:
     """Evaluate a checked tree on NumPy arrays (xp=numpy) or CasADi symbols (xp=casadi)."""
+    column: Literal[1, 2]
+    number: Callable[[Any], Any]
     if xp is np:
         column, number = 1, np.float64  # NumPy scalars: 1/0 gives inf, not an exception
     elif xp is ca:
@@ -166,10 +174,11 @@ def evaluate(tree: ast.Expression, x, y, xp=np):
         raise TypeError(f"unknown backend {getattr(xp, '__name__', xp)!r} (numpy or casadi)")
     names = {"x": x, "y": y, **{k: number(v) for k, v in CONSTANTS.items()}}
 
-    def ev(node):
+    def ev(node: ast.AST) -> Any:
         if isinstance(node, ast.Expression):
             return ev(node.body)
         if isinstance(node, ast.Constant):
+            assert isinstance(node.value, (int, float))  # parse_expression admits only these
             return number(node.value)
         if isinstance(node, ast.Name):
             return names[node.id]
@@ -178,6 +187,7 @@ def evaluate(tree: ast.Expression, x, y, xp=np):
         if isinstance(node, ast.UnaryOp):
             return _UNARY[type(node.op)](ev(node.operand))
         if isinstance(node, ast.Call):
+            assert isinstance(node.func, ast.Name)  # parse_expression admits no other call
             return FUNCTIONS[node.func.id][column](*(ev(a) for a in node.args))
         raise ValueError(f"unchecked node {type(node).__name__}")  # parse_expression excludes it
 
@@ -201,7 +211,7 @@ class ExpressionSurface(Surface):
         z = evaluate(self._tree, sx, sy, xp=ca) + 0 * sx
         self._gradient = ca.Function("grad", [sx, sy], [ca.gradient(z, sx), ca.gradient(z, sy)])
 
-    def height(self, x, y, xp=np):
+    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
         """z at plan points; NumPy x, y broadcast together, z has their shape."""
         if xp is not np:
             return evaluate(self._tree, x, y, xp=xp) + 0 * x
@@ -210,7 +220,7 @@ class ExpressionSurface(Surface):
             z = evaluate(self._tree, x, y)
         return np.broadcast_to(np.asarray(z, dtype=float), x.shape).copy()
 
-    def gradient(self, x, y):
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         """(dz/dx, dz/dy) at plan points, each of the broadcast shape of x and y."""
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         if x.size == 0:
@@ -219,7 +229,7 @@ class ExpressionSurface(Surface):
         gx, gy = self._gradient(x.reshape(1, -1), y.reshape(1, -1))
         return np.asarray(gx).reshape(x.shape), np.asarray(gy).reshape(x.shape)
 
-    def check_finite(self, x, y) -> None:
+    def check_finite(self, x: Any, y: Any) -> None:
         """Raise ValueError if z is not finite at some plan point; x, y (N,)."""
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         bad = np.flatnonzero(~np.isfinite(self.height(x, y)))
@@ -227,7 +237,7 @@ class ExpressionSurface(Surface):
             px, py = x.ravel()[bad[0]], y.ravel()[bad[0]]
             raise ValueError(f"expression {self.text!r} is not finite at (x, y) = ({px:g}, {py:g})")
 
-    def metadata(self) -> dict:
+    def metadata(self) -> dict[str, Any]:
         return {"name": self.name, "expression": self.text}
 
     def __repr__(self) -> str:
