@@ -181,7 +181,9 @@ def _case_options(p: argparse.ArgumentParser) -> None:
         help="metres, of a grid: pattern (default {:g}x{:g})".format(*DEFAULT_SIZE),
     )
     p.add_argument(
-        "--diagonals", choices=DIAGONALS, help="of a grid: pattern's cells (default centre)"
+        "--diagonals",
+        choices=DIAGONALS,
+        help=f"of a grid: pattern's cells (default {DIAGONALS[0]})",
     )
     p.add_argument(
         "--edge-length",
