@@ -19,7 +19,8 @@ TABLE4 = {
 
 @pytest.mark.parametrize("name", list(TABLE4))
 def test_table4_sizes_and_initial_dof(name):
-    xy, faces = patterns.plan(name)
+    plan = patterns.parse_pattern(name)
+    xy, faces = plan.xy, plan.faces
     shape = CreasePattern.from_faces(xy, faces)
     V, E, F, dof = TABLE4[name]
     assert (shape.n_vertices, shape.n_edges, shape.n_faces) == (V, E, F)
@@ -35,14 +36,16 @@ def test_table4_sizes_and_initial_dof(name):
 
 
 def test_pattern2_side_angles_below_theta_min():
-    xy, faces = patterns.plan("2")
+    plan = patterns.parse_pattern("2")
+    xy, faces = plan.xy, plan.faces
     shape = CreasePattern.from_faces(xy, faces)
     assert np.degrees(shape.corner_angles.min()) == pytest.approx(26.565, abs=1e-3)
 
 
 @pytest.mark.parametrize("name", ["1", "11"])
 def test_grid_mirror_symmetric_about_four_planes(name):
-    xy, faces = patterns.plan(name)
+    plan = patterns.parse_pattern(name)
+    xy, faces = plan.xy, plan.faces
     tris = {tuple(sorted(map(tuple, np.round(xy[f], 9).tolist()))) for f in faces}
     for mirror in (
         lambda p: np.column_stack([3 - p[:, 0], p[:, 1]]),
@@ -56,13 +59,14 @@ def test_grid_mirror_symmetric_about_four_planes(name):
 
 def test_unknown_pattern():
     with pytest.raises(ValueError, match="unknown pattern '7'"):
-        patterns.plan("7")
+        patterns.parse_pattern("7")
 
 
 @pytest.mark.parametrize(("name", "flaps"), [("1", 0), ("1p", 2), ("2", 0), ("11", 0)])
 def test_corner_flaps(name, flaps):
     """Boundary vertices of degree 2: triangles hinged on one crease (independent flaps)."""
-    xy, faces = patterns.plan(name)
+    plan = patterns.parse_pattern(name)
+    xy, faces = plan.xy, plan.faces
     shape = CreasePattern.from_faces(xy, faces)
     degree = np.bincount(shape.edges.ravel(), minlength=shape.n_vertices)
     assert int((degree == 2).sum()) == flaps

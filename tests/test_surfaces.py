@@ -24,6 +24,10 @@ FACTORIES = {
     "dome": Dome,
     "hp": HyperbolicParaboloid,
     "expr": lambda: ExpressionSurface("0.3*sin(x)*cos(y) + 0.1*x**2 - sqrt(1 + y)/3"),
+    # scaled to a pattern's plan box (which holds the sample points in [0, 3]^2)
+    "bezier-box": lambda: Bezier(2, box=(12.0, 8.0)),
+    "dome-box": lambda: Dome(box=(3.5, 6.0)),
+    "hp-box": lambda: HyperbolicParaboloid(box=(4.0, 7.0)),
 }
 
 
@@ -127,8 +131,8 @@ def test_hp_not_symmetric_about_midlines():
 
 
 def test_mirror_plane_text():
-    assert [str(p) for p in Dome.mirror_planes] == ["x = 1.5", "y = 1.5"]
-    assert [str(p) for p in HyperbolicParaboloid.mirror_planes] == ["x - y = 0", "x + y = 3"]
+    assert [str(p) for p in Dome().mirror_planes] == ["x = 1.5", "y = 1.5"]
+    assert [str(p) for p in HyperbolicParaboloid().mirror_planes] == ["x - y = 0", "x + y = 3"]
     assert str(MirrorPlane(-2.0, 1.0, 1.0)) == "-2x + y = -1"
 
 

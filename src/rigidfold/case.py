@@ -22,13 +22,14 @@ from rigidfold.surfaces import Surface, get_surface
 class Case:
     """Everything problem (6) needs, validated.
 
-    surface : TargetSurface (a Surface); pattern_name : str; pattern : CreasePattern (the
-    triangulated target surface); planes : mirror planes (SymmetryPlane) used for constraint
-    (9); settings : Settings.
+    surface : TargetSurface (a Surface); plan : the crease pattern in plan and how it was made
+    (its spec, size, diagonals, edge length); pattern : CreasePattern (the plan lifted onto the
+    target surface); planes : mirror planes (SymmetryPlane) used for constraint (9);
+    settings : Settings.
     """
 
     surface: TargetSurface
-    pattern_name: str
+    plan: patterns.Plan
     pattern: CreasePattern
     planes: tuple[SymmetryPlane, ...]
     settings: Settings
@@ -44,11 +45,12 @@ class Case:
         )
 
     def metadata(self) -> dict:
-        """JSON-serialisable description of the case."""
+        """JSON-serialisable description of the case: the surface, the pattern spec with its
+        plan size, diagonals, edge length and footprint, the symmetry and the design bounds."""
         s = self.settings
         return {
             "surface": self.surface.metadata(),
-            "pattern": self.pattern_name,
+            **self.plan.metadata(),
             "symmetry_planes": [str(p) for p in self.planes],
             "dz_m": s.dz,
             "theta_min_deg": math.degrees(s.theta_min),
@@ -65,22 +67,36 @@ def make_case(
     seed: int | None = None,
     expr: str | None = None,
     symmetric: bool = False,
+    size: str | tuple[float, float] | None = None,
+    diagonals: str | None = None,
+    edge_length: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> Case:
     """Validate the user's choices and build the initial triangulated shape.
 
-    surface : a name ("bezier", "dome", "hp", "expr") or a Surface; pattern : "1", "2" or "11".
+    surface : a name ("bezier", "dome", "hp", "expr") or a Surface. A named built-in surface
+        is scaled to the bounding box of the pattern's plan (the paper's surfaces on the 3 m
+        square); an "expr" surface and a Surface object are used as they are.
+    pattern : a spec of :func:`rigidfold.patterns.parse_pattern` ("1", "1p", "2", "11",
+        "grid:NXxNY", "mesh:POLYGON"), with its ``size``, ``diagonals`` and ``edge_length``.
     ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
     """
-    surf = surface if isinstance(surface, Surface) else get_surface(surface, seed=seed, expr=expr)
-    shape = patterns.build(pattern, surf, settings=settings)
+    plan = patterns.parse_pattern(
+        pattern, size=size, diagonals=diagonals, edge_length=edge_length, settings=settings
+    )
+    surf = (
+        surface
+        if isinstance(surface, Surface)
+        else get_surface(surface, seed=seed, expr=expr, box=plan.box)
+    )
+    shape = patterns.build(plan, surf, settings=settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
         raise ValueError(
             f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
             "(dome or hp)"
         )
-    return Case(surf, str(pattern), shape, planes, settings)
+    return Case(surf, plan, shape, planes, settings)
 
 
 def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:

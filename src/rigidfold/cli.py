@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from rigidfold.config import DEFAULTS, HESSIANS
 from rigidfold.io import jsonable
 from rigidfold.optimize import SOLVERS
-from rigidfold.patterns import PATTERNS
+from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.selection import CRITERIA
 from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACES
@@ -166,7 +166,32 @@ def _case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--surface", required=True, choices=SURFACES)
     p.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
     p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
-    p.add_argument("--pattern", required=True, choices=list(PATTERNS))
+    p.add_argument(
+        "--pattern",
+        required=True,
+        help=f"crease pattern: {FORMS}. 1, 1p, 2, 11: the paper's, on 3 m x 3 m; grid:NXxNY: "
+        "NX x NY vertices over --size with --diagonals; mesh:POLYGON: a quality triangulation "
+        "of the polygon 'x1,y1;x2,y2;...' in metres, or of a file of 'x,y' lines, with "
+        "--edge-length. The plan is placed with the lower-left corner of its bounding box at "
+        "(0, 0); the built-in surfaces scale to that box, --expr is in metres as given",
+    )
+    p.add_argument(
+        "--size",
+        metavar="WxH",
+        help="metres, of a grid: pattern (default {:g}x{:g})".format(*DEFAULT_SIZE),
+    )
+    p.add_argument(
+        "--diagonals",
+        choices=DIAGONALS,
+        help=f"of a grid: pattern's cells (default {DIAGONALS[0]})",
+    )
+    p.add_argument(
+        "--edge-length",
+        type=_positive,
+        metavar="L",
+        help="target edge length in metres of a mesh: pattern (default sqrt(footprint area) / "
+        f"{DEFAULTS.mesh_divisions:g})",
+    )
     p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
     p.add_argument("--solver", default=SOLVERS[0], choices=SOLVERS)
     p.add_argument(
@@ -209,6 +234,9 @@ def _case(args: argparse.Namespace):
         seed=args.seed,
         expr=args.expr,
         symmetric=args.symmetric,
+        size=args.size,
+        diagonals=args.diagonals,
+        edge_length=args.edge_length,
         settings=settings,
     )
 

@@ -139,6 +139,19 @@ class Settings:
     motion_turn_back : float
         The 1-DOF path turns back (does not reach the plane) when its folding measure rises
         this many motion levels (1 / (motion_frames - 1) of the design's) above its minimum.
+
+    Crease patterns (``rigidfold.patterns``)
+    ----------------------------------------
+    mesh_divisions : float
+        Default target edge length of a ``mesh:`` pattern: sqrt(footprint area) divided by
+        this (0.5 m on the paper's 3 m x 3 m square, the spacing of pattern 1).
+    mesh_angle_cap : float
+        A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
+        (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    max_pattern_faces : int
+        Largest number of triangles a ``grid:`` or ``mesh:`` pattern may have (a mesh's is
+        estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
+        is refused instead of building a problem that cannot be solved.
     """
 
     # design parameters of problem (6)
@@ -201,6 +214,10 @@ class Settings:
     motion_turn_back: float = 0.5
     # reading FOLD files
     triangulation_area_tol: float = 1e-12
+    # crease patterns
+    mesh_divisions: float = 6.0
+    mesh_angle_cap: float = math.radians(33.0)
+    max_pattern_faces: int = 20000
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):

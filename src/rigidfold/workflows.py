@@ -160,7 +160,7 @@ def optimize_case(
     fold = write_fold(
         out_dir / "solution.fold",
         result.pattern,
-        title=f"rigidfold optimize: {case.surface.name} on pattern {case.pattern_name}",
+        title=f"rigidfold optimize: {case.surface.name} on pattern {case.plan.spec}",
         metadata={**case.metadata(), **result.to_dict()},
     )
     summary = write_json(out_dir / "summary.json", report)

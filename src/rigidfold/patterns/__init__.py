@@ -1,42 +1,38 @@
-"""The paper's crease patterns, lifted onto a target surface."""
+"""Crease patterns in plan (the paper's, grids and footprint meshes), lifted onto a surface."""
 
 from __future__ import annotations
-
-from collections.abc import Callable
 
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
-from rigidfold.patterns.grids import grid11, pattern1, pattern1p, pattern2
+from rigidfold.patterns.footprint import check_footprint, footprint_mesh, read_footprint
+from rigidfold.patterns.grids import DIAGONALS, grid, grid11, pattern1, pattern1p, pattern2
 from rigidfold.patterns.miura import miura
+from rigidfold.patterns.spec import (
+    DEFAULT_SIZE,
+    FORMS,
+    PATTERNS,
+    Plan,
+    parse_pattern,
+    parse_size,
+)
 from rigidfold.protocols import TargetSurface
 
-PATTERNS: dict[str, Callable[[], tuple[np.ndarray, np.ndarray]]] = {
-    "1": pattern1,
-    "1p": pattern1p,
-    "2": pattern2,
-    "11": grid11,
-}
-"""Pattern name -> function returning plan vertices (V, 2) and triangles (F, 3)."""
 
+def build(
+    pattern: str | Plan, surface: TargetSurface, *, settings: Settings = DEFAULTS
+) -> CreasePattern:
+    """Crease pattern ``pattern`` with each vertex lifted onto ``surface`` (Step 1).
 
-def plan(name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Plan vertices (V, 2) and CCW triangles (F, 3) of a named pattern."""
-    key = str(name)
-    if key not in PATTERNS:
-        raise ValueError(f"unknown pattern {name!r} (choose from {', '.join(PATTERNS)})")
-    return PATTERNS[key]()
-
-
-def build(name: str, surface: TargetSurface, *, settings: Settings = DEFAULTS) -> CreasePattern:
-    """Crease pattern ``name`` with each vertex lifted onto ``surface`` (Step 1).
-
+    pattern : a :class:`Plan` or a spec for :func:`parse_pattern` (its default size,
+        diagonals and edge length);
     surface : a :class:`rigidfold.surfaces.Surface` (any ``TargetSurface``; its optional
         ``check_finite(x, y)`` is called first);
     settings : the pattern's tolerances (:attr:`CreasePattern.settings`).
     """
-    xy, faces = plan(name)
+    plan = pattern if isinstance(pattern, Plan) else parse_pattern(pattern, settings=settings)
+    xy = plan.xy
     check = getattr(surface, "check_finite", None)
     if check is not None:
         check(xy[:, 0], xy[:, 1])
@@ -46,7 +42,25 @@ def build(name: str, surface: TargetSurface, *, settings: Settings = DEFAULTS) -
         raise ValueError(
             f"surface {surface!r} is not finite at (x, y) = ({xy[bad, 0]:g}, {xy[bad, 1]:g})"
         )
-    return CreasePattern.from_faces(np.column_stack([xy, z]), faces, settings=settings)
+    return CreasePattern.from_faces(np.column_stack([xy, z]), plan.faces, settings=settings)
 
 
-__all__ = ["PATTERNS", "build", "grid11", "miura", "pattern1", "pattern1p", "pattern2", "plan"]
+__all__ = [
+    "DEFAULT_SIZE",
+    "DIAGONALS",
+    "FORMS",
+    "PATTERNS",
+    "Plan",
+    "build",
+    "check_footprint",
+    "footprint_mesh",
+    "grid",
+    "grid11",
+    "miura",
+    "parse_pattern",
+    "parse_size",
+    "pattern1",
+    "pattern1p",
+    "pattern2",
+    "read_footprint",
+]

@@ -1,6 +1,7 @@
 """The crease patterns of the paper (Sections 6.3-6.6, Table 4), in plan.
 
-All patterns cover the 3 m x 3 m square [0, 3]^2. Each function returns the plan vertices
+The paper's patterns cover the 3 m x 3 m square [0, 3]^2; :func:`grid` makes grids of any
+vertex counts, size and diagonals. Each function returns the plan vertices
 ``(V, 2)`` and counter-clockwise triangles ``(F, 3)``; :func:`rigidfold.patterns.build` lifts
 them onto a target surface.
 
@@ -13,32 +14,65 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import Delaunay
 
-
-def _grid_points(n: int, spacing: float) -> np.ndarray:
-    """Vertices of an n x n grid, index ``j * n + i`` at (i * spacing, j * spacing)."""
-    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="xy")
-    return np.column_stack([i.ravel() * spacing, j.ravel() * spacing])
+DIAGONALS = ("centre", "parallel", "alternate")
+"""How :func:`grid` splits each rectangle: see its docstring."""
 
 
-def _split_squares(n: int, towards_centre: bool) -> np.ndarray:
-    """Triangles of an n x n vertex grid, each square cut by one diagonal.
+def grid(
+    nx: int, ny: int, width: float = 3.0, height: float = 3.0, diagonals: str = "centre"
+) -> tuple[np.ndarray, np.ndarray]:
+    """An nx x ny vertex grid over [0, width] x [0, height], each rectangle cut by a diagonal.
 
-    ``towards_centre=False``: every diagonal runs from the square's lower-left to its
-    upper-right corner. ``towards_centre=True``: every diagonal points at the grid's centre,
-    which makes the triangulation mirror-symmetric about both mid-lines and both diagonals.
+    Vertex ``j * nx + i`` lies at ``(i * width / (nx - 1), j * height / (ny - 1))`` (the
+    last column at x = width and the last row at y = height exactly); the
+    triangles come cell by cell, row by row from y = 0, two per cell. ``diagonals``:
+
+    * ``"centre"``: every diagonal points at the grid's centre, which makes the layout
+      mirror-symmetric about both mid-lines (and, on a square grid, both diagonals) and gives
+      every corner degree 3. With an even vertex count along x, the middle column of cells
+      straddles the mid-line x = width / 2 and no diagonal there can point at the centre:
+      they rise (lower-left to upper-right) above the centre and fall below it, which keeps
+      the mirror symmetry about y = height / 2 (and likewise for an even count along y; the
+      one centre cell of two even counts rises). Two even counts leave no mirror symmetry;
+    * ``"parallel"``: every diagonal runs from the cell's lower-left to its upper-right
+      corner (pattern 1p): the corners (0, height) and (width, 0) have degree 2;
+    * ``"alternate"``: the diagonals alternate cell by cell like a checkerboard, lower-left to
+      upper-right in the cell at the origin; with odd vertex counts every corner has degree
+      3, with an even count two corners have degree 2.
+
+    ``grid(7, 7)`` is pattern 1 and ``grid(11, 11)`` the 11 x 11 grid, coordinate for
+    coordinate and triangle for triangle.
     """
+    for n in (nx, ny):
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+            raise ValueError(f"a grid needs at least 2 x 2 vertices, got {nx!r} x {ny!r}")
+    for name, size in (("width", width), ("height", height)):
+        if not (np.isfinite(size) and size > 0):
+            raise ValueError(f"a grid's {name} must be a positive number of metres, got {size!r}")
+    if diagonals not in DIAGONALS:
+        raise ValueError(f"unknown diagonals {diagonals!r} (choose from {', '.join(DIAGONALS)})")
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="xy")
+    x = np.where(i == nx - 1, width, i * (width / (nx - 1)))  # the far sides exactly
+    y = np.where(j == ny - 1, height, j * (height / (ny - 1)))
+    return np.column_stack([x.ravel(), y.ravel()]), _split_cells(nx, ny, diagonals)
+
+
+def _split_cells(nx: int, ny: int, diagonals: str) -> np.ndarray:
+    """Triangles (F, 3) of an nx x ny vertex grid, each cell cut by one diagonal."""
     tris = []
-    c = (n - 1) / 2
-    for j in range(n - 1):
-        for i in range(n - 1):
-            a, b = j * n + i, j * n + i + 1  # lower-left, lower-right
-            d, e = a + n, b + n  # upper-left, upper-right
-            rising = True
-            if towards_centre:
-                # the square's centre lies in the quadrant given by the signs below; the
-                # diagonal through it that points at the grid centre rises when both signs agree
-                sx, sy = np.sign(i + 0.5 - c), np.sign(j + 0.5 - c)
-                rising = sx == sy
+    cx, cy = (nx - 1) / 2, (ny - 1) / 2
+    for j in range(ny - 1):
+        for i in range(nx - 1):
+            a, b = j * nx + i, j * nx + i + 1  # lower-left, lower-right
+            d, e = a + nx, b + nx  # upper-left, upper-right
+            if diagonals == "centre":
+                # the cell's centre lies in the quadrant given by the signs below; the
+                # diagonal through it that points at the grid centre rises when both signs
+                # agree; a cell on a mid-line (a zero sign) rises on the upper or right half
+                sx, sy = np.sign(i + 0.5 - cx), np.sign(j + 0.5 - cy)
+                rising = sx == sy if sx and sy else sx + sy >= 0
+            else:
+                rising = diagonals == "parallel" or (i + j) % 2 == 0
             if rising:  # diagonal a-e
                 tris += [(a, b, e), (a, e, d)]
             else:  # diagonal b-d
@@ -58,7 +92,7 @@ def pattern1() -> tuple[np.ndarray, np.ndarray]:
     7.59 over 100 surfaces against the paper's 7.32, ``docs/results.md``; 99.5 with 1p,
     ``docs/earlier_results.md``).
     """
-    return _grid_points(7, 0.5), _split_squares(7, towards_centre=True)
+    return grid(7, 7)
 
 
 def pattern1p() -> tuple[np.ndarray, np.ndarray]:
@@ -69,7 +103,7 @@ def pattern1p() -> tuple[np.ndarray, np.ndarray]:
     triangle there is hinged on one crease, a one-DOF flap independent of the rest of the
     mechanism. Kept as the other reading of the paper's Figure 5.
     """
-    return _grid_points(7, 0.5), _split_squares(7, towards_centre=False)
+    return grid(7, 7, diagonals="parallel")
 
 
 def pattern2() -> tuple[np.ndarray, np.ndarray]:
@@ -90,7 +124,7 @@ def pattern2() -> tuple[np.ndarray, np.ndarray]:
         rows.append(np.column_stack([xs, np.full(len(xs), y)]))
     pts = np.concatenate(rows)
     tri = Delaunay(pts).simplices.astype(np.int64)
-    return pts, _counter_clockwise(pts, tri)
+    return pts, counter_clockwise(pts, tri)
 
 
 def grid11() -> tuple[np.ndarray, np.ndarray]:
@@ -99,10 +133,11 @@ def grid11() -> tuple[np.ndarray, np.ndarray]:
     Every square's diagonal points towards the centre (1.5, 1.5): the triangulation is
     mirror-symmetric about x = 1.5, y = 1.5 and both diagonals of the square.
     """
-    return _grid_points(11, 0.3), _split_squares(11, towards_centre=True)
+    return grid(11, 11)
 
 
-def _counter_clockwise(pts: np.ndarray, tri: np.ndarray) -> np.ndarray:
+def counter_clockwise(pts: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Triangles (F, 3) of plan points (V, 2), each reordered counter-clockwise seen from +z."""
     p = pts[tri]
     cross = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (
         p[:, 2, 0] - p[:, 0, 0]

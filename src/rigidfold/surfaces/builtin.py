@@ -1,4 +1,8 @@
-"""Target surfaces z = f(x, y) over the 3 m x 3 m plan square (Step 1).
+"""Target surfaces z = f(x, y) over a plan box [0, W] x [0, H] (Step 1).
+
+The built-in surfaces are defined on the paper's 3 m x 3 m square and scale to the bounding
+box of a larger or smaller pattern (``box=(W, H)``, each documented below); on the default
+box ``(3, 3)`` they are exactly the paper's.
 
 ``height(x, y, xp=numpy)`` is written with arithmetic and ``xp.<function>`` calls only, so the
 same code evaluates NumPy arrays and builds CasADi symbolic expressions (``xp=casadi``) for
@@ -109,52 +113,57 @@ _POWER = np.array([[1, 0, 0, 0], [-3, 3, 0, 0], [3, -6, 3, 0], [-1, 3, -3, 1]], 
 
 
 class Bezier(Surface):
-    """Bicubic Bezier patch over [0, 3]^2 with random control heights.
+    """Bicubic Bezier patch over the plan box [0, W] x [0, H] with random control heights.
 
-    Control point (i, j) lies at plan position (x, y) = (i, j), i, j = 0..3, so u = x / 3,
-    v = y / 3 and ``z = sum_ij B_i(u) B_j(v) h[i, j]`` with ``B_i(t) = C(3, i) t^i (1-t)^(3-i)``.
-    The heights are ``h = numpy.random.default_rng(seed).uniform(0, 3, size=(4, 4))``; h[i, j]
-    belongs to the control point at (x = i, y = j). (The paper gives no formula.)
+    Control point (i, j) lies at plan position (x, y) = (i W / 3, j H / 3), i, j = 0..3, so
+    u = x / W, v = y / H and ``z = sum_ij B_i(u) B_j(v) h[i, j]`` with
+    ``B_i(t) = C(3, i) t^i (1-t)^(3-i)``. The heights (metres, whatever the box) are
+    ``h = numpy.random.default_rng(seed).uniform(0, 3, size=(4, 4))``; h[i, j] belongs to the
+    control point at (x = i W / 3, y = j H / 3). The paper's box is 3 x 3: control points at
+    (i, j). (The paper gives no formula.)
     """
 
     name = "bezier"
 
-    def __init__(self, seed: int = 0) -> None:
+    def __init__(self, seed: int = 0, *, box: tuple[float, float] = (3.0, 3.0)) -> None:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             raise ValueError(f"the Bezier seed must be a non-negative integer, got {seed!r}")
         self.seed: int | None = int(seed)
         self.heights = np.random.default_rng(self.seed).uniform(0.0, 3.0, size=(4, 4))
+        self.box = _box(box)
 
     @classmethod
-    def from_heights(cls, heights: np.ndarray) -> Bezier:
-        """A patch with given control heights h (4, 4)."""
+    def from_heights(cls, heights: np.ndarray, *, box: tuple[float, float] = (3.0, 3.0)) -> Bezier:
+        """A patch with given control heights h (4, 4) over the plan box (W, H)."""
         h = np.asarray(heights, dtype=float)
         if h.shape != (4, 4) or not np.isfinite(h).all():
             raise ValueError(f"Bezier control heights must be a finite (4, 4) array, got {h.shape}")
         surface = cls.__new__(cls)
-        surface.seed, surface.heights = None, h
+        surface.seed, surface.heights, surface.box = None, h, _box(box)
         return surface
 
     def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
-        u, v = x / 3.0, y / 3.0
+        u, v = x / self.box[0], y / self.box[1]
         bu = [_bernstein(i, u) for i in range(4)]
         bv = [_bernstein(j, v) for j in range(4)]
         return sum(bu[i] * bv[j] * float(self.heights[i, j]) for i in range(4) for j in range(4))
 
     def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
-        u, v = np.asarray(x, dtype=float) / 3.0, np.asarray(y, dtype=float) / 3.0
+        width, height = self.box
+        u, v = np.asarray(x, dtype=float) / width, np.asarray(y, dtype=float) / height
         bu, bv = [_bernstein(i, u) for i in range(4)], [_bernstein(j, v) for j in range(4)]
         du = [_bernstein_derivative(i, u) for i in range(4)]
         dv = [_bernstein_derivative(j, v) for j in range(4)]
         h = self.heights
-        gx = sum(du[i] * bv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
-        gy = sum(bu[i] * dv[j] * h[i, j] for i in range(4) for j in range(4)) / 3.0
+        gx = sum(du[i] * bv[j] * h[i, j] for i in range(4) for j in range(4)) / width
+        gy = sum(bu[i] * dv[j] * h[i, j] for i in range(4) for j in range(4)) / height
         return gx, gy
 
     def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         # in the power basis: z = [1 u u^2 u^3] C [1 v v^2 v^3]^T with C = M h M^T
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        u, v = x.ravel() / 3.0, y.ravel() / 3.0
+        width, height = self.box
+        u, v = x.ravel() / width, y.ravel() / height
         C = _POWER @ self.heights @ _POWER.T
         one, zero = np.ones_like(u), np.zeros_like(u)
         pu = np.stack([one, u, u * u, u**3], 1)
@@ -163,71 +172,132 @@ class Bezier(Surface):
         pv = np.stack([one, v, v * v, v**3], 1)
         dv = np.stack([zero, one, 2 * v, 3 * v * v], 1)
         ddv = np.stack([zero, zero, 2 * one, 6 * v], 1)
-        fxx = np.einsum("ni,ni->n", ddu @ C, pv) / 9.0
-        fxy = np.einsum("ni,ni->n", du @ C, dv) / 9.0
-        fyy = np.einsum("ni,ni->n", pu @ C, ddv) / 9.0
+        fxx = np.einsum("ni,ni->n", ddu @ C, pv) / (width * width)
+        fxy = np.einsum("ni,ni->n", du @ C, dv) / (width * height)
+        fyy = np.einsum("ni,ni->n", pu @ C, ddv) / (height * height)
         return fxx.reshape(x.shape), fxy.reshape(x.shape), fyy.reshape(x.shape)
 
     def metadata(self) -> dict[str, Any]:
-        return {"name": self.name, "seed": self.seed, "control_heights": self.heights.tolist()}
+        return {
+            "name": self.name,
+            "seed": self.seed,
+            "control_heights": self.heights.tolist(),
+            "plan_box_m": list(self.box),
+        }
 
     def __repr__(self) -> str:
         if self.seed is None:
-            return "Bezier.from_heights(<(4, 4) control heights>)"
-        return f"Bezier({self.seed})"
+            args = ", ".join(["<(4, 4) control heights>", *_box_args(self.box)])
+            return f"Bezier.from_heights({args})"
+        return f"Bezier({', '.join([str(self.seed), *_box_args(self.box)])})"
 
 
 class Dome(Surface):
-    """Spherical cap through the four corners (z = 0) with its apex 1.5 m high at (1.5, 1.5).
+    """Spherical cap through the four corners (z = 0) of the plan box, apex over its centre.
 
-    Radius R = 2.25 m, centre (1.5, 1.5, -0.75): ``z = -0.75 + sqrt(R^2 - (x-1.5)^2 - (y-1.5)^2)``,
-    defined within R of the plan centre (the plan square reaches 2.12 m from it).
+    On the paper's 3 m x 3 m box: apex 1.5 m high at (1.5, 1.5), radius R = 2.25 m, centre
+    (1.5, 1.5, -0.75): ``z = -0.75 + sqrt(R^2 - (x-1.5)^2 - (y-1.5)^2)``, defined within R of
+    the plan centre (the plan square reaches 2.12 m from it). On a box (W, H) this dome is
+    scaled by s = (half diagonal of the box) / (half diagonal of the 3 m square) about the
+    box's centre (W / 2, H / 2), so that it still passes through the four corners: R = 2.25 s,
+    apex 1.5 s. Mirror planes x = W / 2 and y = H / 2.
     """
 
     name = "dome"
-    radius = 2.25
-    centre_z = -0.75
-    mirror_planes = (MirrorPlane(1.0, 0.0, -1.5), MirrorPlane(0.0, 1.0, -1.5))
+
+    def __init__(self, *, box: tuple[float, float] = (3.0, 3.0)) -> None:
+        self.box = _box(box)
+        scale = _scale(self.box)
+        self.cx, self.cy = self.box[0] / 2, self.box[1] / 2
+        self.radius = 2.25 * scale
+        self.centre_z = -0.75 * scale
+        self.apex = 1.5 * scale
+        self.mirror_planes = (MirrorPlane(1.0, 0.0, -self.cx), MirrorPlane(0.0, 1.0, -self.cy))
 
     def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
-        return self.centre_z + xp.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
+        return self.centre_z + xp.sqrt(self.radius**2 - (x - self.cx) ** 2 - (y - self.cy) ** 2)
 
     def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        root = np.sqrt(self.radius**2 - (x - 1.5) ** 2 - (y - 1.5) ** 2)
-        return -(x - 1.5) / root, -(y - 1.5) / root
+        root = np.sqrt(self.radius**2 - (x - self.cx) ** 2 - (y - self.cy) ** 2)
+        return -(x - self.cx) / root, -(y - self.cy) / root
 
     def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        dx, dy = x - 1.5, y - 1.5
+        dx, dy = x - self.cx, y - self.cy
         root = np.sqrt(self.radius**2 - dx**2 - dy**2)
         cube = root**3
         return -1 / root - dx**2 / cube, -dx * dy / cube, -1 / root - dy**2 / cube
 
     def metadata(self) -> dict[str, Any]:
-        return {"name": self.name, "apex_m": 1.5, "radius_m": self.radius}
+        return {
+            "name": self.name,
+            "apex_m": self.apex,
+            "radius_m": self.radius,
+            "plan_box_m": list(self.box),
+        }
+
+    def __repr__(self) -> str:
+        return f"Dome({', '.join(_box_args(self.box))})"
 
 
 class HyperbolicParaboloid(Surface):
-    """z = 0.4 (x - 1.5)(y - 1.5): 1.8 m between the lowest and the highest corner.
+    """z = 0.4 (x - 1.5)(y - 1.5) on the 3 m square: 1.8 m between its lowest and highest corner.
 
-    Its mirror planes are the diagonals x = y and x + y = 3 (z changes sign across x = 1.5).
+    On a box (W, H) it is scaled like :class:`Dome`, by s about the box's centre (cx, cy) =
+    (W / 2, H / 2): ``z = (0.4 / s) (x - cx)(y - cy)``. Its mirror planes are the lines
+    x - y = cx - cy and x + y = cx + cy through the centre (on the 3 m square, the diagonals
+    x = y and x + y = 3; z changes sign across x = cx).
     """
 
     name = "hp"
-    k = 0.4
-    mirror_planes = (MirrorPlane(1.0, -1.0, 0.0), MirrorPlane(1.0, 1.0, -3.0))
+
+    def __init__(self, *, box: tuple[float, float] = (3.0, 3.0)) -> None:
+        self.box = _box(box)
+        self.k = 0.4 / _scale(self.box)
+        self.cx, self.cy = self.box[0] / 2, self.box[1] / 2
+        self.mirror_planes = (
+            MirrorPlane(1.0, -1.0, self.cy - self.cx),
+            MirrorPlane(1.0, 1.0, -(self.cx + self.cy)),
+        )
 
     def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
-        return self.k * (x - 1.5) * (y - 1.5)
+        return self.k * (x - self.cx) * (y - self.cy)
 
     def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        return self.k * (y - 1.5), self.k * (x - 1.5)
+        return self.k * (y - self.cy), self.k * (x - self.cx)
 
     def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         return np.zeros(x.shape), np.full(x.shape, self.k), np.zeros(x.shape)
 
     def metadata(self) -> dict[str, Any]:
-        return {"name": self.name, "k": self.k}
+        return {"name": self.name, "k": self.k, "plan_box_m": list(self.box)}
+
+    def __repr__(self) -> str:
+        return f"HyperbolicParaboloid({', '.join(_box_args(self.box))})"
+
+
+_PAPER_BOX = (3.0, 3.0)
+
+
+def _box(box: tuple[float, float]) -> tuple[float, float]:
+    """(W, H) checked: two positive finite numbers of metres."""
+    try:
+        width, height = (float(v) for v in box)
+    except (TypeError, ValueError):
+        raise ValueError(f"a plan box is (W, H) in metres, got {box!r}") from None
+    if not (np.isfinite([width, height]).all() and width > 0 and height > 0):
+        raise ValueError(f"a plan box needs a positive finite width and height, got {box!r}")
+    return width, height
+
+
+def _scale(box: tuple[float, float]) -> float:
+    """Half diagonal of ``box`` over that of the paper's 3 m square (exactly 1 on it)."""
+    return float(np.hypot(*box) / np.hypot(*_PAPER_BOX))
+
+
+def _box_args(box: tuple[float, float]) -> list[str]:
+    """["box=(W, H)"] for a ``__repr__``, or [] for the paper's square."""
+    return [] if box == _PAPER_BOX else [f"box=({box[0]:g}, {box[1]:g})"]

@@ -1,0 +1,163 @@
+"""Crease patterns over any simple polygon: a quality constrained Delaunay triangulation.
+
+The footprint is a simple polygon in metres, given as text ``"x1,y1; x2,y2; ..."`` or as a
+file of one ``x,y`` (or ``x y``) pair per line. :func:`footprint_mesh` triangulates it with
+Jonathan Shewchuk's Triangle (the ``triangle`` package): constrained to the polygon's sides,
+no angle below the design's theta_min where the geometry allows, and no triangle larger than
+the equilateral triangle of the target edge length. The points that Triangle adds on the
+boundary lie on the polygon's sides, so every side stays straight and constraint (7) keeps
+it straight.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.patterns.grids import counter_clockwise
+
+_PAIR = re.compile(r"^\s*(\S+?)\s*(?:,|\s)\s*(\S+)\s*$")
+
+
+def read_footprint(text: str, settings: Settings = DEFAULTS) -> np.ndarray:
+    """Polygon vertices (N, 2) from ``"x1,y1; x2,y2; ..."`` or from a file of such pairs.
+
+    Text with a ``;`` is the polygon itself; anything else names a file of one ``x,y`` or
+    ``x y`` pair per line (blank lines and lines starting with ``#`` are skipped). A last
+    point equal to the first (a closed outline, as CAD and GIS tools write them) is dropped.
+    The polygon is checked by :func:`check_footprint`.
+    """
+    if ";" in text:
+        lines, where = text.split(";"), "footprint: point"
+    else:
+        path = Path(text).expanduser()
+        if not path.is_file():
+            raise ValueError(
+                f"mesh footprint {text!r} is neither 'x1,y1;x2,y2;...' nor an existing file"
+            )
+        try:
+            lines = path.read_text(encoding="utf-8").splitlines()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ValueError(f"cannot read footprint file {os.fspath(path)!r}: {exc}") from None
+        where = f"footprint file {os.fspath(path)!r}: line"
+    points = []
+    for k, line in enumerate(lines, 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        match = _PAIR.match(line)
+        try:
+            if match is None:
+                raise ValueError
+            points.append((float(match[1]), float(match[2])))
+        except ValueError:
+            raise ValueError(
+                f"{where} {k} is not an 'x,y' pair of numbers: {line.strip()!r}"
+            ) from None
+    xy = np.asarray(points, dtype=float).reshape(-1, 2)
+    if len(xy) > 3 and np.array_equal(xy[0], xy[-1]):
+        xy = xy[:-1]
+    return check_footprint(xy, settings)
+
+
+def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray:
+    """The polygon (N, 2) counter-clockwise (a clockwise one reversed, its first point kept
+    first), or a one-line ValueError saying what is wrong.
+
+    Refused: fewer than 3 points, non-finite coordinates, a repeated point, zero area and a
+    self-intersecting outline (sides that cross or touch anywhere but at shared corners);
+    zero area is a convex hull smaller than ``settings.degenerate_area`` times the squared
+    larger side of the bounding box.
+    """
+    import shapely
+
+    xy = np.asarray(xy, dtype=float)
+    if xy.ndim != 2 or xy.shape[1] != 2 or len(xy) < 3:
+        raise ValueError(f"a footprint needs at least 3 (x, y) points, got {len(xy)}")
+    if not np.isfinite(xy).all():
+        bad = int(np.flatnonzero(~np.isfinite(xy).all(axis=1))[0])
+        raise ValueError(f"footprint point {bad + 1} is not finite: {_point(xy[bad])}")
+    unique, counts = np.unique(xy, axis=0, return_counts=True)
+    if (counts > 1).any():
+        again = unique[counts > 1][0]
+        repeats = np.flatnonzero((xy == again).all(axis=1)) + 1
+        raise ValueError(
+            f"footprint point {_point(again)} is repeated (points {', '.join(map(str, repeats))})"
+        )
+    hull = shapely.MultiPoint(xy).convex_hull.area
+    if hull <= settings.degenerate_area * np.ptp(xy, axis=0).max() ** 2:
+        raise ValueError(f"the footprint {_points(xy)} has zero area (its points lie on a line)")
+    reason = shapely.is_valid_reason(shapely.Polygon(xy))
+    if reason != "Valid Geometry":
+        where = reason[reason.find("[") :] if "[" in reason else ""
+        raise ValueError(
+            f"the footprint {_points(xy)} is not a simple polygon: its sides intersect "
+            f"at {where or 'a point'}"
+        )
+    return xy if _signed_area(xy) > 0 else np.concatenate([xy[:1], xy[:0:-1]])
+
+
+def default_edge_length(xy: np.ndarray, settings: Settings = DEFAULTS) -> float:
+    """sqrt(footprint area) / ``settings.mesh_divisions``: 0.5 m on the paper's 3 m square."""
+    return math.sqrt(abs(_signed_area(np.asarray(xy, dtype=float)))) / settings.mesh_divisions
+
+
+def footprint_mesh(
+    xy: np.ndarray, edge_length: float, settings: Settings = DEFAULTS
+) -> tuple[np.ndarray, np.ndarray]:
+    """Quality triangulation of a checked counter-clockwise footprint (N, 2).
+
+    Each side is first divided into ``round(length / edge_length)`` (at least 1) equal
+    pieces; Triangle then adds points until no angle is below min(theta_min,
+    ``settings.mesh_angle_cap``) (except at the footprint's own corners sharper than that)
+    and no triangle is larger than the equilateral triangle of side ``edge_length``. The
+    footprint's corners come first, in order, then the points on its sides, then the inner
+    points. Returns the plan vertices (V, 2) and counter-clockwise triangles (F, 3).
+    """
+    import triangle
+
+    if not (math.isfinite(edge_length) and edge_length > 0):
+        raise ValueError(f"the edge length must be a positive number of metres, got {edge_length}")
+    area = abs(_signed_area(xy))
+    triangle_area = math.sqrt(3) / 4 * edge_length**2
+    if area / triangle_area > settings.max_pattern_faces:
+        raise ValueError(
+            f"edge length {edge_length:g} m makes about {area / triangle_area:.0f} triangles on "
+            f"a footprint of {area:g} m^2, more than {settings.max_pattern_faces}"
+        )
+    ends = np.roll(xy, -1, axis=0)
+    pieces = np.maximum(1, np.rint(np.hypot(*(ends - xy).T) / edge_length).astype(int))
+    points, outline = [xy], []
+    for k, n in enumerate(pieces):  # corner k, then the inner points of its side
+        first = sum(len(q) for q in points)
+        points.append(xy[k] + (ends[k] - xy[k]) * (np.arange(1, n)[:, None] / n))
+        outline += [k, *range(first, first + n - 1)]
+    angle = min(settings.theta_min, settings.mesh_angle_cap)
+    out = triangle.triangulate(
+        {
+            "vertices": np.concatenate(points),
+            "segments": np.column_stack([outline, np.roll(outline, -1)]),
+        },
+        # Triangle reads no exponent: plain decimals (shortest round-tripping digits)
+        f"pq{math.degrees(angle):.6f}a{np.format_float_positional(triangle_area)}Q",
+    )
+    vertices = np.asarray(out["vertices"], dtype=float)
+    return vertices, counter_clockwise(vertices, np.asarray(out["triangles"], dtype=np.int64))
+
+
+def _signed_area(xy: np.ndarray) -> float:
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def _point(p: np.ndarray) -> str:
+    return f"({p[0]:g}, {p[1]:g})"
+
+
+def _points(xy: np.ndarray) -> str:
+    shown = "; ".join(f"{x:g},{y:g}" for x, y in xy[:6])
+    return f"'{shown}{'; ...' if len(xy) > 6 else ''}'"
