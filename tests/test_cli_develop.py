@@ -58,3 +58,18 @@ def test_develop_bad_input(tmp_path):
     proc = run_cli("develop", str(bad), "--out", str(tmp_path / "o"))
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and "invalid JSON" in proc.stderr
+
+
+def test_develop_reads_a_y_up_file(miura_file, tmp_path, capsys):
+    """--up y turns a file drawn y-up (its (x, y, z) is rigidfold's (x, -z, y)) z-up."""
+    raw = json.loads(miura_file.read_text())
+    raw["vertices_coords"] = [[x, z, -y] for x, y, z in raw["vertices_coords"]]
+    turned = tmp_path / "miura_y.fold"
+    turned.write_text(json.dumps(raw))
+    assert main(["develop", str(turned), "--out", str(tmp_path / "y"), "--up", "y", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["D"] < 1e-10
+    out = json.loads((tmp_path / "y" / "miura_y.fold").read_text())
+    assert out["vertices_coords"] == raw["vertices_coords"]  # the input as it was
+    assert out["rigidfold:input"]["up"] == "y"
+    folded = read_fold(tmp_path / "y" / "miura_y.fold", frame=2).pattern  # rigidfold's, z up
+    np.testing.assert_allclose(folded.coords, read_fold(miura_file).pattern.coords, atol=1e-15)

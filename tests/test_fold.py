@@ -213,6 +213,7 @@ def test_round_trip(tmp_path, name):
     assert data.metadata == meta
     assert data.frame_classes == ["foldedForm"]
     assert data.raw["file_creator"] == "rigidfold"
+    assert (data.unit, data.scale, data.up, data.unitless) == ("m", 1.0, "z", False)
 
 
 def test_round_trip_through_dict_and_pattern_from_fold():
@@ -240,6 +241,7 @@ def test_miura_quads_are_triangulated_with_joins():
     assert p.n_facets == 4
     assert data.frame_classes == ["creasePattern"]
     assert data.metadata == {}
+    assert (data.unit, data.scale, data.unitless) == ("unit", 1.0, True)
 
 
 def test_miura_diagonals_are_the_shorter_ones():

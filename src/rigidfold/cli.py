@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from rigidfold.config import DEFAULTS, HESSIANS
-from rigidfold.io import jsonable
+from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.selection import CRITERIA
@@ -158,6 +158,13 @@ def _file_command(sub, name: str, func, *, out: bool = False, **text: str) -> No
     p.add_argument("file", metavar="FILE.fold")
     if out:
         p.add_argument("--out", required=True, metavar="DIR")
+    p.add_argument(
+        "--up",
+        default=UP_AXES[0],
+        choices=UP_AXES,
+        help="the file's up axis: y for files drawn y-up (Blender, Origami Simulator); "
+        "coordinates are read in the file's frame_unit and converted to metres",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=func)
 
@@ -303,7 +310,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from rigidfold.workflows import analyze_file
 
-    analysis = analyze_file(args.file)
+    analysis = analyze_file(args.file, up=args.up)
     report = analysis.to_dict()
     if args.json:
         print(json.dumps(report))
@@ -314,6 +321,8 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         f"free creases={report['free_creases']} fixed={report['fixed_creases']}"
     )
     print(f"DOF: {mech.dof}")
+    for note in analysis.notes:
+        print(f"note: {note}")
     if len(mech.locked_creases):
         print(
             f"locked crease lines ({len(mech.locked_creases)}): edges {report['locked_edges']} "
@@ -332,7 +341,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 def _cmd_develop(args: argparse.Namespace) -> int:
     from rigidfold.workflows import develop_file
 
-    checked = develop_file(args.file, args.out)
+    checked = develop_file(args.file, args.out, up=args.up)
     d = checked.verification.development
     if args.json:
         print(json.dumps(jsonable(checked.to_dict())))
@@ -348,7 +357,7 @@ def _cmd_develop(args: argparse.Namespace) -> int:
 def _cmd_deform(args: argparse.Namespace) -> int:
     from rigidfold.workflows import deform_file
 
-    checked = deform_file(args.file, args.out)
+    checked = deform_file(args.file, args.out, up=args.up)
     d, m = checked.verification.deformation, checked.verification.motion
     assert d is not None  # deform_file runs the analysis
     if args.json:

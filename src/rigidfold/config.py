@@ -64,6 +64,10 @@ class Settings:
         is below this times the squared size of its polygon (the larger side of its bounding
         box, in the polygon's plane) is not an ear, and a vertex within that of an ear's side
         lies on it.
+    plan_area_tol : float
+        A sheet whose signed area in plan (its faces projected onto the xy plane) is within
+        this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
+        a closed box, a flat-folded state): refused, since rigidfold needs z up.
     linear_rank_tol : float
         Relative threshold of the rank-revealing QR that eliminates constraints (7)-(9).
     map_prune_tol : float
@@ -218,6 +222,8 @@ class Settings:
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
     max_pattern_faces: int = 20000
+    # the plan of a crease pattern
+    plan_area_tol: float = 1e-6
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):

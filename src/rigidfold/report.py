@@ -18,9 +18,12 @@ from rigidfold.case import Case
 from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.generate import Attempt, Generation, Solution
 from rigidfold.io import (
+    FoldData,
     crease_pattern_frame,
     motion_frames,
     prepare_output_dir,
+    round_trip_dict,
+    write_document,
     write_fold,
     write_json,
     write_svg,
@@ -32,9 +35,17 @@ def verification_frames(check: Verification) -> list[dict]:
     """FOLD ``file_frames`` of a checked shape: its development diagram (``creasePattern``),
     then its folding motion from flat to folded (``foldedForm``) when it was traced."""
     frames = [crease_pattern_frame(check.development.coords2d)]
-    if check.motion is not None and check.motion.status is MotionStatus.OK:
-        frames += motion_frames(check.motion.frames, check.motion.parameter)
+    motion = _traced_motion(check)
+    if motion is not None:
+        frames += motion_frames(*motion)
     return frames
+
+
+def _traced_motion(check: Verification) -> tuple[np.ndarray, np.ndarray] | None:
+    """(frames (K, V, 3), parameter (K,)) of the folding motion, None unless it was traced."""
+    if check.motion is None or check.motion.status is not MotionStatus.OK:
+        return None
+    return check.motion.frames, check.motion.parameter
 
 
 def write_checked_shape(
@@ -45,17 +56,33 @@ def write_checked_shape(
     title: str,
     metadata: dict,
     svg_title: str,
+    source: FoldData | None = None,
 ) -> list[Path]:
-    """Write a shape checked by Steps 8-9: ``path`` (FOLD: the folded form, its development
-    diagram and motion frames, ``metadata`` and every figure of the check) and
-    the development diagram beside it as SVG. Returns [FOLD, SVG]."""
-    svg = write_svg(path.with_suffix(".svg"), pattern, check.development.coords2d, title=svg_title)
-    fold = write_fold(
-        path,
-        pattern,
-        frames=verification_frames(check),
-        title=title,
-        metadata={**metadata, **check.to_dict()},
+    """Write a shape checked by Steps 8-9: ``path`` (FOLD) and the development diagram
+    beside it as SVG. Returns [FOLD, SVG].
+
+    Without ``source`` the FOLD is written from scratch: the folded form titled ``title``,
+    its development diagram and motion frames (:func:`verification_frames`), ``metadata``
+    and every figure of the check. With ``source`` (the FOLD file read, whose pattern is
+    ``pattern``) it is that file's document, kept whole, plus rigidfold's frames
+    (development diagram, motion, folded form) and keys
+    (:func:`rigidfold.io.round_trip_dict`), and the SVG keeps the file's crease assignment.
+    """
+    coords2d = check.development.coords2d
+    figures = {**metadata, **check.to_dict()}
+    if source is None:
+        letters = None
+        fold = write_fold(
+            path, pattern, frames=verification_frames(check), title=title, metadata=figures
+        )
+    else:
+        letters = source.shape_assignment()
+        document = round_trip_dict(
+            source, coords2d, motion=_traced_motion(check), title=title, metadata=figures
+        )
+        fold = write_document(path, document)
+    svg = write_svg(
+        path.with_suffix(".svg"), pattern, coords2d, title=svg_title, assignment=letters
     )
     return [fold, svg]
 

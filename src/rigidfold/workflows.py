@@ -32,8 +32,21 @@ from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
 from rigidfold.report import RunWriter, write_checked_shape
 
-
 # ------------------------------------------------------------------------------ analyze
+FLAT_NOTE = (
+    "a flat state is singular: its first-order DOF overstates the rigid-folding DOF; for the "
+    "folded-state answer, fold it slightly first (analyze a folded form of it), or run "
+    "rigidfold generate or optimize on a target surface"
+)
+"""What ``analyze`` says of a flat sheet."""
+
+UNITLESS_NOTE = (
+    'the file gives no physical unit (frame_unit "unit" or none): its coordinates were read '
+    "as metres"
+)
+"""What ``analyze`` says of a file without a physical unit."""
+
+
 @dataclass(frozen=True, eq=False)
 class ShapeAnalysis:
     """Mechanism analysis of a shape read from a FOLD file.
@@ -44,6 +57,24 @@ class ShapeAnalysis:
     file: str
     data: FoldData
     mechanism: Mechanism
+
+    @property
+    def flat(self) -> bool:
+        """True for a flat sheet: every fold angle within ``settings.flat_angle`` of 0 (the
+        pattern's settings). Its DOF is first-order only (:data:`FLAT_NOTE`)."""
+        pattern = self.data.pattern
+        return bool(np.all(np.abs(pattern.fold_angles) <= pattern.settings.flat_angle))
+
+    @property
+    def notes(self) -> list[str]:
+        """What to know about the answer: :data:`UNITLESS_NOTE`, :data:`FLAT_NOTE`, when
+        they apply."""
+        notes = []
+        if self.data.unitless:
+            notes.append(UNITLESS_NOTE)
+        if self.flat:
+            notes.append(FLAT_NOTE)
+        return notes
 
     @property
     def locked_edges(self) -> list[int]:
@@ -67,12 +98,19 @@ class ShapeAnalysis:
             "locked_edges": self.locked_edges,
             "locked_vertex_pairs": [pattern.edges[e].tolist() for e in mech.locked_creases],
             "fold_angles_deg": np.round(self.fold_angles_deg(np.arange(n_file)), 6).tolist(),
+            "unit": self.data.unit,
+            "flat": self.flat,
+            "notes": self.notes,
         }
 
 
-def analyze_file(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> ShapeAnalysis:
-    """DOF, locked creases and fold angles of the shape in a FOLD file."""
-    data = read_fold(path)
+def analyze_file(
+    path: str | os.PathLike, *, up: str = "z", settings: Settings = DEFAULTS
+) -> ShapeAnalysis:
+    """DOF, locked creases and fold angles of the shape in a FOLD file (read with ``up``,
+    see :func:`rigidfold.io.read_fold`). The DOF is first-order: for a flat sheet it
+    overstates the rigid-folding DOF, which :attr:`ShapeAnalysis.flat` and ``notes`` say."""
+    data = read_fold(path, up=up, settings=settings)
     return ShapeAnalysis(str(path), data, analyze(data.pattern, settings=settings))
 
 
@@ -99,34 +137,49 @@ class ShapeCheck:
 
 
 def develop_file(
-    path: str | os.PathLike, out: str | os.PathLike, *, settings: Settings = DEFAULTS
+    path: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    up: str = "z",
+    settings: Settings = DEFAULTS,
 ) -> ShapeCheck:
-    """Step 8 of a FOLD shape: ``OUT/<name>.fold`` (the input plus its development diagram
-    as a ``creasePattern`` frame) and ``OUT/<name>.svg``."""
-    return _check_file(path, out, deform=False, settings=settings)
+    """Step 8 of a FOLD shape (read with ``up``): ``OUT/<name>.fold`` (the input, kept
+    whole, plus rigidfold's development diagram as a ``creasePattern`` frame, its folded form
+    and its figures; see :func:`rigidfold.io.round_trip_dict`) and ``OUT/<name>.svg``."""
+    return _check_file(path, out, deform=False, up=up, settings=settings)
 
 
 def deform_file(
-    path: str | os.PathLike, out: str | os.PathLike, *, settings: Settings = DEFAULTS
+    path: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    up: str = "z",
+    settings: Settings = DEFAULTS,
 ) -> ShapeCheck:
-    """Steps 8-9 and the folding motion of a FOLD shape: ``OUT/<name>.fold`` (the input plus
-    its development diagram and motion frames), ``OUT/<name>.svg`` and
-    ``OUT/<name>_deform.json`` (every figure and the load-step history)."""
-    return _check_file(path, out, deform=True, settings=settings)
+    """Steps 8-9 and the folding motion of a FOLD shape (read with ``up``):
+    ``OUT/<name>.fold`` (the input, kept whole, plus rigidfold's development diagram, motion
+    frames, folded form and figures), ``OUT/<name>.svg`` and ``OUT/<name>_deform.json``
+    (every figure and the load-step history)."""
+    return _check_file(path, out, deform=True, up=up, settings=settings)
 
 
-def _check_file(path, out, *, deform: bool, settings: Settings) -> ShapeCheck:
+def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> ShapeCheck:
+    """Read, check and write back a FOLD shape. The output FOLD is the input document with
+    rigidfold's frames (in metres, ``frame_unit: "m"``, z up) and ``rigidfold:`` keys added:
+    nothing of the input is dropped or rewritten, so its unit, orientation, polygons and
+    assignments stay as they were (:func:`rigidfold.io.round_trip_dict`)."""
     out_dir = prepare_output_dir(out)
-    data = read_fold(path)
+    data = read_fold(path, up=up, settings=settings)
     check = verify(data.pattern, run_deform=deform, run_motion=deform, settings=settings)
     stem = Path(path).stem
     written = write_checked_shape(
         out_dir / f"{stem}.fold",
         data.pattern,
         check,
-        title=f"{stem} (folded form)",
-        metadata=data.metadata,
+        title=f"{stem}: the folded form checked, triangulated (metres, z up)",
+        metadata={},
         svg_title=f"{stem}: development",
+        source=data,
     )
     if deform:
         written.append(write_json(out_dir / f"{stem}_deform.json", check.to_dict()))

@@ -2,17 +2,23 @@
 
 from rigidfold.io.files import atomic_write, jsonable, prepare_output_dir, write_json
 from rigidfold.io.fold import (
+    UNITS,
+    UP_AXES,
     FoldData,
     crease_pattern_frame,
     fold_dict,
     motion_frames,
     pattern_from_fold,
     read_fold,
+    round_trip_dict,
+    write_document,
     write_fold,
 )
 from rigidfold.io.svg import svg_text, write_svg
 
 __all__ = [
+    "UNITS",
+    "UP_AXES",
     "FoldData",
     "atomic_write",
     "crease_pattern_frame",
@@ -22,7 +28,9 @@ __all__ = [
     "pattern_from_fold",
     "prepare_output_dir",
     "read_fold",
+    "round_trip_dict",
     "svg_text",
+    "write_document",
     "write_fold",
     "write_json",
     "write_svg",

@@ -9,8 +9,14 @@ Custom data live under keys prefixed ``rigidfold:``.
 
 The reader accepts FOLD files from other tools too: 2D coordinates (the flat state), polygon
 faces (triangulated by :mod:`rigidfold.mesh.triangulate`, the added diagonals become ``"J"``
-joins), missing edges (derived from the faces) and frames. Every problem with the input is a
-one-line ``ValueError`` that names the file.
+joins), missing edges (derived from the faces) and frames. Every length inside rigidfold is
+metres: coordinates in another ``frame_unit`` (:data:`UNITS`) are converted on reading, and a
+file drawn y-up (Blender, Origami Simulator) is turned z-up with ``up="y"``. Every problem
+with the input is a one-line ``ValueError`` that names the file.
+
+rigidfold writes its own models from scratch (:func:`fold_dict`, :func:`write_fold`); a shape
+read from a file goes back as that file's document, kept whole, plus rigidfold's frames and
+keys (:func:`round_trip_dict`, :func:`write_document`).
 """
 
 from __future__ import annotations
@@ -26,7 +32,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.io.files import atomic_write, jsonable
-from rigidfold.mesh import CreasePattern, topology
+from rigidfold.mesh import CreasePattern, geometry, topology
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
 
 FOLD_SPEC = 1.2
@@ -37,6 +43,22 @@ PREFIX = "rigidfold:"
 
 ASSIGNMENTS = frozenset("BMVFUCJ")
 """Edge assignments of FOLD 1.2: boundary, mountain, valley, flat, unassigned, cut, join."""
+
+UNITS = {
+    "unit": 1.0,
+    "m": 1.0,
+    "cm": 1e-2,
+    "mm": 1e-3,
+    "um": 1e-6,
+    "nm": 1e-9,
+    "in": 0.0254,
+    "pt": 0.0254 / 72,
+}
+"""Metres per unit of each ``frame_unit`` of FOLD 1.2. ``"unit"`` (no physical unit, the
+default when a file gives none) is read as metres."""
+
+UP_AXES = ("z", "y")
+"""The up axes a FOLD file can be read with (``read_fold(up=...)``, ``--up``)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +83,14 @@ class FoldData:
         The whole FOLD document as parsed from JSON.
     frame_classes : list of str
         The frame's ``frame_classes`` (e.g. ``["foldedForm"]``), empty when absent.
+    unit : str
+        The frame's ``frame_unit``, ``"unit"`` when the file gives none.
+    scale : float
+        Metres per file unit (:data:`UNITS`): the pattern's coordinates are the file's times
+        this (then turned, for a y-up file).
+    up : str
+        The file's up axis: ``"z"``, or ``"y"`` for a file read y-up, whose (x, y, z) became
+        (x, -z, y) so that its +y is rigidfold's +z (a rotation: right-handed still).
     """
 
     pattern: CreasePattern
@@ -69,6 +99,25 @@ class FoldData:
     metadata: dict
     raw: dict = field(repr=False)
     frame_classes: list[str]
+    unit: str
+    scale: float
+    up: str
+
+    @property
+    def unitless(self) -> bool:
+        """True when the file gives no physical unit (its coordinates were read as metres)."""
+        return self.unit == "unit"
+
+    def shape_assignment(self) -> list[str]:
+        """FOLD letter of every pattern edge for rigidfold's output frames (list of E str).
+
+        The file's letter where it gives one (so a ``"M"`` or ``"V"`` crease of a flat
+        crease pattern, folded 180 degrees in the file's intent, stays ``"M"`` or ``"V"``);
+        an unassigned crease (``"U"``, in the file or derived from the faces) gets what the
+        shape's fold angle says (:func:`edge_assignments`); added diagonals are ``"J"``.
+        """
+        measured = edge_assignments(self.pattern, self.pattern.settings.flat_angle)
+        return [m if a == "U" else a for a, m in zip(self.assignment, measured, strict=True)]
 
 
 # ---------------------------------------------------------------------------------- writing
@@ -117,20 +166,89 @@ def fold_dict(
         "file_classes": ["singleModel"],
         "frame_classes": [frame_class],
         "frame_title": title,
-        "frame_unit": "m",
-        "vertices_coords": pattern.coords.tolist(),
-        "faces_vertices": pattern.faces.tolist(),
-        "edges_vertices": pattern.edges.tolist(),
-        "edges_assignment": edge_assignments(pattern, settings.flat_angle),
-        "edges_foldAngle": np.degrees(pattern.fold_angles).tolist(),
+        **_model_keys(pattern, edge_assignments(pattern, settings.flat_angle)),
+        **_prefixed(metadata),
     }
-    for key, value in (metadata or {}).items():
-        if not isinstance(key, str):
-            raise ValueError(f"metadata keys must be strings, got {key!r}")
-        data[PREFIX + key] = jsonable(value, where=f"metadata {key!r}")
     if frames:
         data["file_frames"] = frames
     return data
+
+
+def round_trip_dict(
+    source: FoldData,
+    coords2d: np.ndarray,
+    *,
+    motion: tuple[np.ndarray, np.ndarray] | None = None,
+    title: str = "folded form",
+    metadata: dict | None = None,
+) -> dict:
+    """The FOLD document a shape was read from, kept whole, plus rigidfold's frames and keys.
+
+    Every key and frame of the input stays as it is: its ``file_*`` keys, ``file_frames``,
+    polygons, ``edges_assignment``, ``edges_foldAngle``, ``faceOrders``, custom namespaces, all
+    in the input's own unit and orientation (only a non-finite number, which JSON cannot hold,
+    becomes ``null``). rigidfold adds:
+
+    * ``"rigidfold:<key>"`` at the top level for each ``metadata`` item (as in
+      :func:`fold_dict`), replacing any of an earlier run, and ``"rigidfold:input"``: the
+      file's unit, metres per unit and up axis as read;
+    * after the input's frames, its own, each with ``frame_unit: "m"`` (given or inherited,
+      so that a reader that follows ``frame_inherit`` gets metres), z up, titled
+      ``"rigidfold: ..."``:
+
+      1. the development diagram (``creasePattern``, ``frame_parent`` 0, not inheriting):
+         rigidfold's triangulated model, self-contained. ``vertices_coords`` (V, 2) the
+         development, ``faces_vertices`` (F, 3) counter-clockwise, ``edges_vertices``
+         (E, 2) (the file's edges first, in file order, then added diagonals and derived
+         edges: the pattern's edge indices), ``edges_assignment``
+         (:meth:`FoldData.shape_assignment`: the file's letters kept, never a folded
+         ``"M"``/``"V"`` turned ``"F"``) and ``edges_foldAngle`` (the shape's fold angles,
+         degrees);
+      2. the folding motion, ``motion = (frames (K, V, 3), parameter (K,))`` when given, as
+         :func:`motion_frames` inheriting from 1;
+      3. the folded form (``foldedForm``, inheriting from 1): ``vertices_coords`` (V, 3) of
+         the shape checked, in metres, z up.
+
+    Parameters
+    ----------
+    source : FoldData
+        The file read (:func:`read_fold`, frame 0); its pattern is the shape.
+    coords2d : (V, 2) float
+        The development diagram (metres).
+    motion : ((K, V, 3) float, (K,) float), optional
+        The folding motion's vertex positions and fraction folded.
+    title : str
+        What the folded-form frame is, after ``"rigidfold: "``.
+    metadata : dict, optional
+        rigidfold's figures; see :func:`fold_dict`.
+    """
+    pattern = source.pattern
+    first = 1 + len(source.raw.get("file_frames", []))
+    diagram = {
+        "frame_title": "rigidfold: development diagram",
+        "frame_classes": ["creasePattern"],
+        "frame_parent": 0,
+        "frame_inherit": False,
+        **_model_keys(pattern, source.shape_assignment()),
+        "vertices_coords": np.asarray(coords2d, dtype=float).tolist(),
+    }
+    moving = [] if motion is None else motion_frames(*motion, parent=first)
+    folded = {
+        "frame_title": f"rigidfold: {title}",
+        "frame_classes": ["foldedForm"],
+        "frame_parent": first,
+        "frame_inherit": True,
+        "vertices_coords": pattern.coords.tolist(),
+    }
+    for frame in moving:
+        frame["frame_title"] = f"rigidfold: {frame['frame_title']}"
+    read = {"unit": source.unit, "metres_per_unit": source.scale, "up": source.up}
+    kept = jsonable(source.raw, where="the FOLD document read")
+    return {
+        **kept,
+        **_prefixed({**(metadata or {}), "input": read}),
+        "file_frames": [*kept.get("file_frames", []), diagram, *moving, folded],
+    }
 
 
 def crease_pattern_frame(coords2d: np.ndarray, *, title: str = "development diagram") -> dict:
@@ -147,8 +265,8 @@ def crease_pattern_frame(coords2d: np.ndarray, *, title: str = "development diag
     }
 
 
-def motion_frames(frames: np.ndarray, parameter: np.ndarray) -> list[dict]:
-    """FOLD frames of a folding motion, inheriting topology from frame 0.
+def motion_frames(frames: np.ndarray, parameter: np.ndarray, *, parent: int = 0) -> list[dict]:
+    """FOLD frames of a folding motion, inheriting topology from frame ``parent``.
 
     frames : (K, V, 3) float, vertex positions from flat to folded; parameter : (K,) fraction
     folded. Each frame is a "foldedForm" titled with its fraction.
@@ -157,7 +275,7 @@ def motion_frames(frames: np.ndarray, parameter: np.ndarray) -> list[dict]:
         {
             "frame_title": f"folding motion: {100 * float(s):.0f}% folded",
             "frame_classes": ["foldedForm"],
-            "frame_parent": 0,
+            "frame_parent": parent,
             "frame_inherit": True,
             "vertices_coords": np.asarray(x, dtype=float).tolist(),
         }
@@ -190,7 +308,14 @@ def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Pat
     ValueError
         ``"cannot write '<path>': <reason>"`` when the file cannot be written.
     """
-    return atomic_write(path, _dumps(fold_dict(pattern, **kwargs)))
+    return write_document(path, fold_dict(pattern, **kwargs))
+
+
+def write_document(path: str | os.PathLike, document: dict) -> Path:
+    """Write a FOLD document (JSON data, e.g. from :func:`round_trip_dict`) atomically, one
+    top-level key per line and tables one row per line. Returns ``path``; ValueError
+    ``"cannot write '<path>': <reason>"`` when the file cannot be written."""
+    return atomic_write(path, _dumps(document))
 
 
 def edge_assignments(pattern: CreasePattern, flat_angle: float = DEFAULTS.flat_angle) -> list[str]:
@@ -200,6 +325,30 @@ def edge_assignments(pattern: CreasePattern, flat_angle: float = DEFAULTS.flat_a
     letters[pattern.fixed] = "J"
     letters[pattern.is_boundary_edge] = "B"
     return letters.tolist()
+
+
+def _model_keys(pattern: CreasePattern, assignment: list[str]) -> dict:
+    """The FOLD keys of a pattern's geometry and topology, in metres (``frame_unit: "m"``):
+    coordinates (V, 3), faces (F, 3), edges (E, 2), ``assignment`` (E letters) and the fold
+    angles in degrees (E,)."""
+    return {
+        "frame_unit": "m",
+        "vertices_coords": pattern.coords.tolist(),
+        "faces_vertices": pattern.faces.tolist(),
+        "edges_vertices": pattern.edges.tolist(),
+        "edges_assignment": assignment,
+        "edges_foldAngle": np.degrees(pattern.fold_angles).tolist(),
+    }
+
+
+def _prefixed(metadata: dict | None) -> dict:
+    """``{"rigidfold:<key>": jsonable(value)}`` of string-keyed metadata."""
+    keys = {}
+    for key, value in (metadata or {}).items():
+        if not isinstance(key, str):
+            raise ValueError(f"metadata keys must be strings, got {key!r}")
+        keys[PREFIX + key] = jsonable(value, where=f"metadata {key!r}")
+    return keys
 
 
 def _dumps(data: dict) -> str:
@@ -217,9 +366,13 @@ def _dumps(data: dict) -> str:
 
 # ---------------------------------------------------------------------------------- reading
 def read_fold(
-    source: str | os.PathLike | dict, frame: int = 0, *, settings: Settings = DEFAULTS
+    source: str | os.PathLike | dict,
+    frame: int = 0,
+    *,
+    up: str = "z",
+    settings: Settings = DEFAULTS,
 ) -> FoldData:
-    """Read a FOLD file (or an already parsed FOLD dict) into a crease pattern.
+    """Read a FOLD file (or an already parsed FOLD dict) into a crease pattern, in metres.
 
     Parameters
     ----------
@@ -229,38 +382,52 @@ def read_fold(
         Frame to read: 0 is the top level, ``k >= 1`` is ``file_frames[k - 1]``, which
         inherits the keys it lacks from its ``frame_parent`` (default 0) when
         ``frame_inherit`` is true.
+    up : str
+        The file's up axis (:data:`UP_AXES`): ``"z"``, or ``"y"`` for a file drawn y-up
+        (Blender, Origami Simulator), whose (x, y, z) becomes (x, -z, y).
     settings : Settings
-        Tolerances: ``triangulation_area_tol`` for polygon faces, and those of the pattern
-        (:attr:`CreasePattern.settings`: ``degenerate_area``, ``corner_angle``).
+        Tolerances: ``triangulation_area_tol`` for polygon faces, ``plan_area_tol`` for the
+        plan, and those of the pattern (:attr:`CreasePattern.settings`: ``degenerate_area``,
+        ``corner_angle``).
 
     Returns
     -------
     FoldData
-        The triangulated pattern and what the file says about it. 2D coordinates get z = 0;
-        polygon faces are ear-clipped in their best-fit plane, each diagonal an added ``"J"``
-        edge; edges that the file omits are derived from the faces. If the faces are
-        consistently oriented but clockwise seen from +z in total, all are reversed. Edges
-        assigned ``"J"`` are fixed creases, all other interior edges free creases.
+        The triangulated pattern and what the file says about it. Coordinates are converted
+        from the frame's ``frame_unit`` (:data:`UNITS`; none or ``"unit"``: read as metres,
+        :attr:`FoldData.unitless`) to metres; 2D coordinates get z = 0; polygon faces are
+        ear-clipped in their best-fit plane, each diagonal an added ``"J"`` edge; edges that
+        the file omits are derived from the faces. If the faces are consistently oriented
+        but clockwise seen from +z in total, all are reversed. Edges assigned ``"J"`` are
+        fixed creases, all other interior edges free creases.
 
     Raises
     ------
     ValueError
         One line naming the file and the problem: unreadable file, invalid JSON, missing or
-        malformed keys, non-finite coordinates, indices out of range, cut edges (``"C"``),
-        a boundary edge assigned ``"J"``, a surface that is not an oriented disc.
+        malformed keys, an unknown ``frame_unit``, non-finite coordinates, indices out of
+        range, cut edges (``"C"``), a boundary edge assigned ``"J"``, faces whose projection
+        onto the xy plane has zero area (a y-up file, a closed or flat-folded sheet), a
+        surface that is not an oriented disc.
     """
+    if up not in UP_AXES:
+        raise ValueError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
     label, raw = _load(source)
     try:
-        return _parse(raw, frame, settings)
+        return _parse(raw, frame, up, settings)
     except ValueError as exc:
         raise ValueError(f"{label}: {' '.join(str(exc).split())}") from None
 
 
 def pattern_from_fold(
-    source: str | os.PathLike | dict, frame: int = 0, *, settings: Settings = DEFAULTS
+    source: str | os.PathLike | dict,
+    frame: int = 0,
+    *,
+    up: str = "z",
+    settings: Settings = DEFAULTS,
 ) -> CreasePattern:
     """The crease pattern of a FOLD file; see :func:`read_fold`."""
-    return read_fold(source, frame, settings=settings).pattern
+    return read_fold(source, frame, up=up, settings=settings).pattern
 
 
 def _load(source) -> tuple[str, dict]:
@@ -289,15 +456,24 @@ def _load(source) -> tuple[str, dict]:
     return str(path), raw
 
 
-def _parse(raw: dict, frame: int, settings: Settings) -> FoldData:
+def _parse(raw: dict, frame: int, up: str, settings: Settings) -> FoldData:
     data = _frame(raw, frame)
-    coords = _coords(data)
+    unit = data.get("frame_unit", "unit")
+    if not isinstance(unit, str) or unit not in UNITS:
+        raise ValueError(
+            f"frame_unit {_short(unit)} is not a unit rigidfold knows; use one of "
+            f"{', '.join(UNITS)}"
+        )
+    coords = _coords(data) * UNITS[unit]
+    if up == "y":
+        coords = coords[:, [0, 2, 1]] * [1.0, -1.0, 1.0]
     polygons = _polygons(data, len(coords))
     file_edges, file_assignment = _file_edges(data, len(coords))
     triangles, diagonals = triangulate_polygons(
         coords, polygons, area_tol=settings.triangulation_area_tol, name="faces_vertices"
     )
     triangles = orient_up(coords, triangles)
+    _check_plan(coords, triangles, up, settings.plan_area_tol)
     edges, assignment = _complete_edges(
         file_edges, file_assignment, diagonals, triangles, len(coords)
     )
@@ -319,6 +495,29 @@ def _parse(raw: dict, frame: int, settings: Settings) -> FoldData:
         },
         raw=raw,
         frame_classes=list(classes),
+        unit=unit,
+        scale=UNITS[unit],
+        up=up,
+    )
+
+
+def _check_plan(coords: np.ndarray, triangles: np.ndarray, up: str, tol: float) -> None:
+    """ValueError when the triangles' projection onto the xy plane has (near) zero area:
+    a y-up file, a vertical sheet, a closed box or a flat-folded state, which reversing the
+    faces would not mend (:class:`CreasePattern` checks the sign)."""
+    plan = geometry.projected_area(coords, triangles)
+    if abs(plan) > tol * geometry.face_areas(coords, triangles).sum():
+        return
+    if up == "z":
+        raise ValueError(
+            "the faces' projection onto the xy plane has zero area: rigidfold needs z up and "
+            "a sheet that covers an area in plan (not closed, not folded flat); is the file "
+            "y-up? (--up y)"
+        )
+    raise ValueError(
+        "read y-up, the faces' projection onto the file's xz plane has zero area: rigidfold "
+        "needs the file's y axis up and a sheet that covers an area in plan (not closed, not "
+        "folded flat); is the file z-up? (--up z)"
     )
 
 

@@ -1,8 +1,8 @@
 """SVG drawing of a crease pattern (a development diagram or the plan of a shape).
 
 Mountain folds red, valley folds blue, the boundary black, fixed creases grey dashed, flat
-free creases light grey. The assignment comes from the 3D shape; the positions from the 2D
-coordinates drawn.
+free creases light grey. The assignment comes from the 3D shape (or is given, e.g. a FOLD
+file's own letters); the positions from the 2D coordinates drawn.
 """
 
 from __future__ import annotations
@@ -26,9 +26,18 @@ STYLE = {
 
 
 def svg_text(
-    pattern: CreasePattern, coords2d: np.ndarray, *, width_px: float = 600.0, title: str = ""
+    pattern: CreasePattern,
+    coords2d: np.ndarray,
+    *,
+    width_px: float = 600.0,
+    title: str = "",
+    assignment: list[str] | None = None,
 ) -> str:
-    """SVG document drawing the edges of ``pattern`` at ``coords2d`` (V, 2), y upwards."""
+    """SVG document drawing the edges of ``pattern`` at ``coords2d`` (V, 2), y upwards.
+
+    ``assignment`` : E letters of :data:`STYLE` (default: :func:`edge_assignments` of the
+    shape); ``"U"`` (unassigned) is drawn as ``"F"``.
+    """
     xy = np.asarray(coords2d, dtype=float)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     span = max(float((hi - lo).max()), 1e-12)
@@ -38,7 +47,10 @@ def svg_text(
     px = (xy[:, 0] - lo[0]) * scale + margin
     py = height_px - ((xy[:, 1] - lo[1]) * scale + margin)
     lines = []
-    kinds = edge_assignments(pattern)
+    kinds = [
+        "F" if a == "U" else a
+        for a in (edge_assignments(pattern) if assignment is None else assignment)
+    ]
     order = sorted(range(pattern.n_edges), key=lambda e: "FJMVB".index(kinds[e]))
     for e in order:
         u, v = pattern.edges[e]

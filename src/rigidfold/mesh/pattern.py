@@ -41,8 +41,8 @@ class CreasePattern:
         True for fixed crease lines (the paper's dividing edges, FOLD "J"); their two
         triangles belong to one planar facet.
     settings : Settings
-        Tolerances of the model: ``degenerate_area`` (checked on construction) and
-        ``corner_angle`` (which boundary vertices are :attr:`corners`). Kept by
+        Tolerances of the model: ``degenerate_area`` and ``plan_area_tol`` (checked on
+        construction) and ``corner_angle`` (which boundary vertices are :attr:`corners`). Kept by
         :meth:`with_coords` and :meth:`with_fixed`; not shown in the repr.
 
     Derived data are cached properties; the arrays are read-only. Construction validates
@@ -90,10 +90,16 @@ class CreasePattern:
             raise ValueError(
                 f"face {f} {tuple(faces[f].tolist())} is degenerate (area {areas[f]:.3g} m^2)"
             )
-        if geometry.projected_area(coords, faces) <= 0:
+        plan, surface = geometry.projected_area(coords, faces), float(areas.sum())
+        if abs(plan) <= self.settings.plan_area_tol * surface:
+            raise ValueError(
+                f"the faces' projection onto the xy plane has zero area ({plan:.3g} m^2 for "
+                f"{surface:.3g} m^2 of faces): rigidfold needs a sheet with z up"
+            )
+        if plan < 0:
             raise ValueError(
                 "faces must be counter-clockwise seen from +z: the sheet's projected area is "
-                "negative (reverse the vertex order of every face)"
+                f"negative ({plan:.3g} m^2; reverse the vertex order of every face)"
             )
 
     # ------------------------------------------------------------------ constructors
