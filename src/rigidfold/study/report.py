@@ -208,6 +208,116 @@ def dof_steps(store: Store) -> list[dict]:
     )
 
 
+def criterion_summary(store: Store) -> list[dict]:
+    """The figures to compare criteria, and studies with and without look-ahead: per
+    (pattern, criterion) of the Bezier study, mean N_reduce, N_lock, N_exceed and F, solves
+    of (6) per run, candidates skipped by the look-ahead per run (None where the database
+    does not store it), and the mean selection and total seconds per run."""
+    runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
+    skipped: dict[tuple[str, str], list[int]] = {}
+    for group, _, attempts in store.attempt_runs("bezier", ("skipped",)):
+        values = [s for (s,) in attempts if s is not None]
+        if values:
+            skipped.setdefault(group, []).append(sum(values))
+    rows = []
+    for pattern, crit in sorted({(r["pattern"], r["criterion"]) for r in runs}):
+        sel = [r for r in runs if (r["pattern"], r["criterion"]) == (pattern, crit)]
+        row: dict = {"pattern": pattern, "criterion": crit, "runs": len(sel)}
+        for name in ("n_reduce", "n_lock", "n_exceed", "mean_f", "n_solves"):
+            row[name] = _mean_se([r[name] for r in sel])[0]
+        done = skipped.get((pattern, crit))
+        row["skipped_per_run"] = float(np.sum(done)) / len(sel) if done else None
+        row["selection_s"] = _mean_se([r["time_selection"] for r in sel])[0]
+        row["run_s"] = _mean_se([r["time_total"] for r in sel])[0]
+        rows.append(row)
+    return rows
+
+
+FOLD_BINS = (0.1, 1.0, 5.0)
+"""Bounds (degrees) of the bins of |fold angle| of locked creases (:func:`locked_fold_angles`)."""
+
+
+def _bin_labels() -> list[str]:
+    edges = [f"{b:g}" for b in FOLD_BINS]
+    return [f"< {edges[0]}", *(f"{a}-{b}" for a, b in itertools.pairwise(edges)), f">= {edges[-1]}"]
+
+
+def locked_fold_angles(store: Store) -> list[dict]:
+    """How folded the locked creases are: per (pattern, criterion) of the Bezier study, the
+    locks (attempts with outcome "lock"), the locked creases whose fold angle at the locked
+    shape is stored, their count per bin of |angle| (:data:`FOLD_BINS`, degrees) and the median
+    |angle|. Locks of databases from before the angles were stored are counted but not
+    binned."""
+    counts: dict[tuple[str, str], dict] = {}
+    for group, seed, attempts in store.attempt_runs(
+        "bezier", ("locked_fold_deg",), outcome=AttemptOutcome.LOCK
+    ):
+        c = counts.setdefault(group, {"seeds": set(), "locks": 0, "angles": []})
+        c["seeds"].add(seed)
+        c["locks"] += len(attempts)
+        c["angles"] += [abs(a) for (angles,) in attempts for a in angles or ()]
+
+    def fields(group, c, n) -> dict:
+        angles = np.asarray(c["angles"], dtype=float)
+        bins = np.searchsorted(FOLD_BINS, angles, side="right")
+        return {
+            "locks": c["locks"],
+            "creases": len(angles),
+            "bins": np.bincount(bins, minlength=len(FOLD_BINS) + 1).tolist(),
+            "median_deg": float(np.median(angles)) if len(angles) else None,
+        }
+
+    return _per_run_rows(counts, fields)
+
+
+LOCK_CAUSES = ("predicted", "flat before", "missed")
+"""Why a lock happened, from the forecast at the shape before the fix (:func:`lock_causes`)."""
+
+
+def _lock_cause(predicted: list[bool], left: list[float | None]) -> tuple[str, float | None]:
+    """The cause of one lock and, for "missed", the smallest rotation left (relative) that
+    the forecast gave a locked crease it did not predict."""
+    unpredicted = [x for p, x in zip(predicted, left, strict=True) if not p]
+    if not unpredicted:
+        return "predicted", None
+    folded = [x for x in unpredicted if x is not None]
+    return ("missed", min(folded)) if folded else ("flat before", None)
+
+
+def lock_causes(store: Store) -> list[dict]:
+    """Why the locks happen: per (pattern, criterion) of the Bezier study, the locks by cause
+    (:data:`LOCK_CAUSES`): every locked crease was predicted by the first-order forecast at
+    the shape before the fix (without look-ahead: a lock it would have skipped; with it: a
+    candidate tried once every other had failed); a locked crease it did not predict was flat
+    there (no forecast is made for flat creases); or it was folded and kept rotations at first
+    order, and the re-optimised shape locked it ("missed", with the median of the smallest
+    rotation left, relative, that the forecast gave such a crease). Locks without the forecast
+    stored (earlier databases) count as "unknown"."""
+    counts: dict[tuple[str, str], dict] = {}
+    for group, seed, attempts in store.attempt_runs(
+        "bezier", ("locked_predicted", "locked_left"), outcome=AttemptOutcome.LOCK
+    ):
+        c = counts.setdefault(group, {"seeds": set(), "causes": Counter(), "left": []})
+        c["seeds"].add(seed)
+        for predicted, left in attempts:
+            if not predicted:
+                c["causes"]["unknown"] += 1
+                continue
+            cause, smallest = _lock_cause(predicted, left)
+            c["causes"][cause] += 1
+            if smallest is not None:
+                c["left"].append(smallest)
+
+    def fields(group, c, n) -> dict:
+        return {
+            "locks": sum(c["causes"].values()),
+            "causes": {k: c["causes"][k] for k in (*LOCK_CAUSES, "unknown")},
+            "missed_left_median": float(np.median(c["left"])) if c["left"] else None,
+        }
+
+    return _per_run_rows(counts, fields)
+
+
 def tables_7_8(store: Store) -> list[dict]:
     """Per preset run (dome / hp, with / without symmetry): the rows of Tables 7 and 8."""
     out = []
@@ -280,9 +390,13 @@ def _configuration_lines(store: Store) -> list[str]:
     solver = config.get("solver")
     if solver == "ipopt":
         solver = f"ipopt ({hessian} Hessian)"
+    from rigidfold.study.store import LEGACY_CONFIG
+
+    lookahead = config.get("lookahead", LEGACY_CONFIG["lookahead"])
     return [
         f"Configuration: solver {solver}, target DOF {config.get('target_dof')}, "
-        f"Steps 8-9 {'on' if config.get('deform') else 'off'}; {len(store.runs())} runs, "
+        f"Steps 8-9 {'on' if config.get('deform') else 'off'}, "
+        f"look-ahead {'on' if lookahead else 'off'}; {len(store.runs())} runs, "
         f"{store.count_attempts()} solves of (6); rigidfold {', '.join(versions) or '-'}.",
         "",
     ]
@@ -324,6 +438,15 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
     steps = dof_steps(store)
     if steps:
         lines += _step_lines(steps)
+    summary = criterion_summary(store)
+    if summary:
+        lines += _summary_lines(summary)
+    angles = locked_fold_angles(store)
+    if angles:
+        lines += _angle_lines(angles)
+    causes = lock_causes(store)
+    if causes:
+        lines += _cause_lines(causes)
     t78 = tables_7_8(store)
     for name, number in (("dome", "Table 7"), ("hp", "Table 8")):
         runs = [r for r in t78 if r["preset"] == name]
@@ -422,6 +545,75 @@ def _step_lines(steps: list[dict]) -> list[str]:
     for r in steps:
         cells = " | ".join(f"{r['per_kind'][k]:.2f}" for k in STEP_KINDS)
         lines.append(f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {cells} |")
+    return [*lines, ""]
+
+
+def _summary_lines(rows: list[dict]) -> list[str]:
+    lines = [
+        "### Summary per criterion",
+        "",
+        "Means per run; skipped: candidates the look-ahead skipped (predicted to lock, not "
+        "solved); selection: ranking (and look-ahead) time, CPU ms per run; run: CPU s per "
+        "run in the workers.",
+        "",
+        "| pattern | criterion | runs | N_reduce | N_lock | N_exceed | mean F | solves "
+        "| skipped | selection ms | run s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        sel = r["selection_s"] * 1e3 if r["selection_s"] is not None else None
+        lines.append(
+            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {_fmt(r['n_reduce'])} "
+            f"| {_fmt(r['n_lock'])} | {_fmt(r['n_exceed'])} | {_fmt(r['mean_f'])} "
+            f"| {_fmt(r['n_solves'], digits=1)} | {_fmt(r['skipped_per_run'])} "
+            f"| {_fmt(sel, digits=1)} | {_fmt(r['run_s'], digits=1)} |"
+        )
+    return [*lines, ""]
+
+
+def _angle_lines(rows: list[dict]) -> list[str]:
+    labels = _bin_labels()
+    lines = [
+        "### Fold angles of the locked creases",
+        "",
+        "Locked creases of every lock by |fold angle| at the locked shape (degrees): nearly "
+        "flat creases or real folds.",
+        "",
+        "| pattern | criterion | runs | locks | locked creases | "
+        + " | ".join(labels)
+        + " | median |",
+        "|---|---|---|---|---|" + "---|" * len(labels) + "---|",
+    ]
+    for r in rows:
+        cells = " | ".join(str(b) if r["creases"] else "-" for b in r["bins"])
+        lines.append(
+            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {r['locks']} "
+            f"| {r['creases']} | {cells} | {_fmt(r['median_deg'], digits=3)} |"
+        )
+    return [*lines, ""]
+
+
+def _cause_lines(rows: list[dict]) -> list[str]:
+    lines = [
+        "### Why the locks happen",
+        "",
+        "Each lock against the first-order forecast at the shape before the fix: every locked "
+        "crease predicted (without look-ahead: a lock it would skip; with it: tried once every "
+        "other candidate had failed), a locked crease flat before (not forecast), or missed "
+        "(the re-optimised shape locked a crease that kept rotations at first order; median of "
+        "its rotation left relative to the largest, against ``lookahead_tol``).",
+        "",
+        "| pattern | criterion | runs | locks | "
+        + " | ".join(LOCK_CAUSES)
+        + " | unknown | missed: rotation left |",
+        "|---|---|---|---|" + "---|" * len(LOCK_CAUSES) + "---|---|",
+    ]
+    for r in rows:
+        cells = " | ".join(str(r["causes"][k]) for k in (*LOCK_CAUSES, "unknown"))
+        lines.append(
+            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {r['locks']} | {cells} "
+            f"| {_fmt(r['missed_left_median'])} |"
+        )
     return [*lines, ""]
 
 
