@@ -132,18 +132,37 @@ def test_bad_candidates_are_refused(demo_dof5):
             lock_forecast(demo_dof5, [bad])
 
 
-def test_lookahead_order_defers_the_skipped_candidates():
-    skip = np.array([True, False, True, True, False, True])
-    assert list(lookahead_order(skip)) == [
-        (1, (0,)),
-        (4, (2, 3)),
-        (0, ()),
-        (2, ()),
-        (3, ()),
-        (5, ()),
-    ]
-    assert list(lookahead_order(np.ones(3, bool))) == [(0, ()), (1, ()), (2, ())]
-    assert list(lookahead_order(np.zeros(2, bool))) == [(0, ()), (1, ())]
+def test_lookahead_order_skips_then_defers_block_by_block(demo_dof5):
+    """The lazy order is the same for any block size: the candidates not predicted to lock
+    in their order (each with the skipped ones before it), then the skipped ones."""
+    candidates = [(int(e),) for e in demo_dof5.hinges]
+    full = lock_forecast(demo_dof5, candidates)
+    skip = full.predicts_lock
+    expected, passed = [], []
+    for k in range(len(candidates)):
+        if skip[k]:
+            passed.append(k)
+        else:
+            expected.append((k, passed))
+            passed = []
+    expected += [(k, []) for k in np.flatnonzero(skip)]
+    for block in (1, 3, 8, 100):
+        order = list(lookahead_order(demo_dof5, candidates, block=block))
+        assert [(k, [i for i, _ in p]) for k, _, p in order] == expected
+        for k, locks, p in order:
+            assert locks.tolist() == full.locks(k).tolist()
+            assert all(lk.tolist() == full.locks(i).tolist() for i, lk in p)
+    with pytest.raises(ValueError, match="block must be >= 1"):
+        next(lookahead_order(demo_dof5, candidates, block=0))
+
+
+def test_a_fix_to_dof0_is_not_skipped_where_dof0_ends():
+    mech = analyze(degree_n_vertex(3))
+    candidates = [(int(e),) for e in mech.hinges]
+    assert [p for _, _, p in lookahead_order(mech, candidates)] == [[]] * len(candidates)
+    order = list(lookahead_order(mech, candidates, dof0_ends=False))
+    assert [k for k, _, _ in order] == list(range(len(candidates)))
+    assert order[0][2] == [] and len(order[0][1]) == len(candidates) - 1
 
 
 @pytest.fixture(scope="module")
@@ -180,13 +199,13 @@ def test_every_lock_logs_its_fold_angles_and_whether_it_was_predicted(demo_runs)
 
 
 def test_all_candidates_predicted_falls_back_to_the_criterions_order(monkeypatch, demo_runs):
-    import rigidfold.generate as gen
+    import rigidfold.selection.lookahead as module
 
     def everything_locks(mechanism, candidates=None, *, settings=DEFAULTS):
         forecast = lock_forecast(mechanism, candidates, settings=settings)
         return dataclasses.replace(forecast, locked=np.ones_like(forecast.locked))
 
-    monkeypatch.setattr(gen, "lock_forecast", everything_locks)
+    monkeypatch.setattr(module, "lock_forecast", everything_locks)
     run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1, lookahead=True)
     without = demo_runs[False]
     assert [a.fixed_added for a in run.attempts] == [a.fixed_added for a in without.attempts]

@@ -18,20 +18,22 @@
 Generation ends when the target DOF is reached, at DOF 0, or when no candidate succeeds.
 The NLP is built once; every solve starts from the last accepted shape.
 
-With ``lookahead=True`` (any criterion), Step 6 first forecasts, at the last accepted shape,
-the creases each candidate would lock at first order
-(:func:`rigidfold.selection.lock_forecast`); candidates predicted to lock are skipped and the
-others keep the criterion's order. The skipped ones are not dropped: they are tried, in the
-criterion's order, only once every other candidate has failed (so when all are predicted to
-lock, the criterion's full order), and generation never ends where it would not without
-look-ahead (:func:`rigidfold.selection.lookahead_order`). A candidate whose fix leaves DOF 0
-is not skipped where DOF 0 ends generation.
+With ``lookahead=True`` (any criterion), Step 6 forecasts, at the last accepted shape, the
+creases each candidate would lock at first order (:func:`rigidfold.selection.lock_forecast`,
+block by block of the ranking as the candidates are reached); candidates predicted to lock
+are skipped and the others keep the criterion's order. The skipped ones are not dropped: they
+are tried, in the criterion's order, only once every other candidate has failed (so when all
+are predicted to lock, the criterion's full order), and generation never ends where it would
+not without look-ahead (:func:`rigidfold.selection.lookahead_order`). A candidate whose fix
+leaves DOF 0 is not skipped where DOF 0 ends generation. Every lock, with or without
+look-ahead, is logged with the forecast of its candidate and the locked creases' fold angles
+(:class:`Attempt`).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,7 +45,6 @@ from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
 from rigidfold.selection import (
     CRITERIA,
-    LockForecast,
     crease_groups,
     lock_forecast,
     lookahead_order,
@@ -116,9 +117,9 @@ class Attempt:
         With look-ahead: the candidates passed over just before this one because they were
         predicted to lock, each as ``{"fixed": [edges], "locks": [edges it would lock]}``.
     predicted_locks : list of int or None
-        The creases this candidate was predicted to lock (non-empty only where every other
-        candidate had failed); None where no forecast was made (without look-ahead, unless
-        the attempt locked; the initial solve).
+        With look-ahead: the creases this candidate was predicted to lock (non-empty only
+        where every other candidate had failed); None without look-ahead and for the initial
+        solve.
     locked_predicted, locked_left : list of bool, list of float or None
         Per crease of ``locked`` (after a fix): whether the forecast at the shape before
         predicted it, and the rotation it was forecast to keep, relative to the largest
@@ -336,34 +337,39 @@ def generate(
         K = hinge_stiffness(current.mechanism.frame.n_hinges, int(rng.integers(2**32)), settings)
         scores = score_creases(current.mechanism, K=K, settings=settings)
         ranked = rank_candidates(scores, criterion, groups=groups, rng=rng)
-        forecast = None
-        order: Iterable[tuple[int, tuple[int, ...]]] = ((k, ()) for k in range(len(ranked)))
-        if lookahead:
-            forecast = lock_forecast(current.mechanism, [g for g, _ in ranked], settings=settings)
-            ends = zero_ends & (forecast.dof_after == 0)
-            order = lookahead_order(forecast.predicts_lock & ~ends)
+        order: Iterator[tuple[int, np.ndarray | None, list[tuple[int, np.ndarray]]]] = (
+            lookahead_order(
+                current.mechanism, [g for g, _ in ranked], settings=settings, dof0_ends=zero_ends
+            )
+            if lookahead
+            else ((k, None, []) for k in range(len(ranked)))
+        )
         t_sel = time.perf_counter() - t1
-        for k, passed in order:  # Step 6, then Step 7 on failure
+        while True:  # Step 6, then Step 7 on failure
+            t1 = time.perf_counter()
+            k, predicted, passed = next(order, (None, None, []))  # look-ahead: lazy forecast
+            t_sel += time.perf_counter() - t1
+            if k is None:
+                run.stop = Stop.NO_CANDIDATE
+                return run
             group, score = ranked[k]
             trial = current.result.pattern.fixed.copy()
             trial[list(group)] = True
             rec, result, mech = attempt(trial, current.result.coords, group, score)
             rec.selection_time, t_sel = t_sel, 0.0
-            if forecast is not None:
-                rec.predicted_locks = forecast.locks(k).tolist()
+            if predicted is not None:
+                rec.predicted_locks = predicted.tolist()
                 rec.skipped = len(passed)
                 rec.skipped_locks = [
-                    {"fixed": list(ranked[i][0]), "locks": forecast.locks(i).tolist()}
-                    for i in passed
+                    {"fixed": list(ranked[i][0]), "locks": locks.tolist()} for i, locks in passed
                 ]
             if rec.locked:
-                _explain_lock(rec, current.mechanism, forecast, k, settings)
+                rec.locked_predicted, rec.locked_left = _explain_lock(
+                    rec, current.mechanism, settings
+                )
             record(rec, result, mech)
             if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
                 break
-        else:
-            run.stop = Stop.NO_CANDIDATE
-            return run
         if rec.outcome is AttemptOutcome.ZERO_DOF:
             run.stop = Stop.ZERO_DOF
             return run
@@ -372,13 +378,10 @@ def generate(
 
 
 def _explain_lock(
-    rec: Attempt, before: Mechanism, forecast: LockForecast | None, k: int, settings: Settings
-) -> None:
-    """Fill ``locked_predicted`` and ``locked_left`` of an attempt that locked creases, from
-    the forecast at the shape ``before`` the fix (made here for this candidate alone when
-    generation ran without look-ahead)."""
-    if forecast is None:
-        forecast, k = lock_forecast(before, [rec.fixed_added], settings=settings), 0
-    predicted = set(forecast.locks(k).tolist())
-    rec.locked_predicted = [e in predicted for e in rec.locked]
-    rec.locked_left = forecast.left(k, rec.locked)
+    rec: Attempt, before: Mechanism, settings: Settings
+) -> tuple[list[bool], list[float | None]]:
+    """``locked_predicted`` and ``locked_left`` of an attempt that locked creases: the
+    forecast of its candidate at the shape ``before`` the fix."""
+    forecast = lock_forecast(before, [rec.fixed_added], settings=settings)
+    predicted = set(forecast.locks(0).tolist())
+    return [e in predicted for e in rec.locked], forecast.left(0, rec.locked)

@@ -21,17 +21,20 @@ free crease outside G is locked, as the analysis says of a 0-DOF shape. With
 ``lookahead_tol == lock_tol`` (the default) the forecast is what :func:`~rigidfold.mechanism.
 analyze` finds after fixing the candidate at the same geometry (``tests/test_lookahead.py``).
 
-Creases whose row is ~0 (norm <= ``lock_tol`` times the largest, i.e. still in every mode:
-flat creases that do not rotate; a folded one would already be a lock) constrain nothing
-when fixed: they are dropped from a candidate's rows, so a candidate made only of them keeps
-the DOF and locks nothing; they are never predicted locked (a folded one is locked already,
-a flat one never counts). Within a group, rows that are linearly dependent (singular values
-of the normalised rows below ``mechanism_rank_tol`` times the largest) count once.
+Creases whose row is ~0 (norm <= ``lock_tol`` times the largest: still in every mode)
+constrain nothing when fixed: they are dropped from a candidate's rows, so a candidate made
+only of them keeps the DOF and locks no other crease. A flat one is never predicted locked;
+a folded one (a shape that is locked already, never one ``generate`` accepted) is predicted
+locked whatever is fixed, as the analysis finds it. Within a group, rows that are linearly
+dependent (singular values of the normalised rows below ``mechanism_rank_tol`` times the
+largest) count once.
 
 One GEMM of the unit candidate rows with H_phi, (n, d) x (d, h), gives every squared
 residual ``|H_phi[p]|^2 - |projection|^2``; the few whose lock decision lies within the
 round-off of that subtraction are recomputed from the difference vectors, so a parallel pair
-is told from a nearly parallel one to round-off.
+is told from a nearly parallel one to round-off. :func:`lookahead_order` forecasts the
+ranking block by block as generation asks for the next candidate: it usually fixes the first
+it tries, so a selection pays for a few candidates' forecast, not all h.
 """
 
 from __future__ import annotations
@@ -225,21 +228,44 @@ def _rows(groups: tuple[tuple[int, ...], ...], hinges: np.ndarray, n_edges: int)
     return members
 
 
-def lookahead_order(skip: np.ndarray) -> Iterator[tuple[int, tuple[int, ...]]]:
-    """The order to try n ranked candidates when those with ``skip`` are predicted to lock.
+def lookahead_order(
+    mechanism: Mechanism,
+    candidates: Sequence[Sequence[int]],
+    *,
+    settings: Settings = DEFAULTS,
+    dof0_ends: bool = True,
+    block: int = 8,
+) -> Iterator[tuple[int, np.ndarray, list[tuple[int, np.ndarray]]]]:
+    """The order to try ranked candidates with look-ahead: skip those predicted to lock.
 
-    skip : (n,) bool, in the criterion's order.
-    yields : (k, passed): first every candidate not skipped, in the criterion's order, each
-        with ``passed``, the skipped candidates ranked between it and the one before; then
-        the skipped ones, in the criterion's order (passed = ()). A skipped candidate is thus
-        solved only once every other one has failed, so that generation with look-ahead
-        never ends where it would not without (when every candidate is predicted to lock,
-        this is the criterion's full order). Lazy: generation usually stops at the first.
+    candidates : in the criterion's order (best first); dof0_ends : a fix that leaves DOF 0
+    ends generation (``Settings.zero_dof_ends``, or a target DOF 0), so such a candidate is
+    not skipped although every crease locks at DOF 0.
+    yields : (k, locks, passed): first every candidate not predicted to lock, in the
+        criterion's order, with ``passed``, the (index, locks) of the skipped candidates ranked
+        between it and the one before; then the skipped ones, in the criterion's order
+        (passed = []). ``locks``: the edges candidate k is predicted to lock. A skipped
+        candidate is thus solved only once every other has failed, so generation with
+        look-ahead never ends where it would not without (when every candidate is predicted
+        to lock, this is the criterion's full order).
+
+    Lazy: the forecast (:func:`lock_forecast`) is made ``block`` candidates at a time as the
+    iteration reaches them.
     """
-    skip = np.asarray(skip, dtype=bool)
-    start = 0
-    for k in np.flatnonzero(~skip).tolist():
-        yield k, tuple(range(start, k))
-        start = k + 1
-    for k in np.flatnonzero(skip).tolist():
-        yield k, ()
+    if block < 1:
+        raise ValueError(f"block must be >= 1, got {block}")
+    skipped: list[tuple[int, np.ndarray]] = []
+    passed: list[tuple[int, np.ndarray]] = []
+    for start in range(0, len(candidates), block):
+        forecast = lock_forecast(mechanism, candidates[start : start + block], settings=settings)
+        ends = dof0_ends & (forecast.dof_after == 0)
+        for i, skip in enumerate((forecast.predicts_lock & ~ends).tolist()):
+            item = (start + i, forecast.locks(i))
+            if skip:
+                passed.append(item)
+                skipped.append(item)
+            else:
+                yield (*item, passed)
+                passed = []
+    for item in skipped:
+        yield (*item, [])
