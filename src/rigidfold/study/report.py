@@ -383,15 +383,13 @@ def _configuration_lines(store: Store) -> list[str]:
     versions = sorted({r["version"] for r in store.runs()})
     if not config:
         return []
-    from rigidfold.study.store import LEGACY_SETTINGS
+    from rigidfold.study.store import LEGACY_CONFIG, LEGACY_SETTINGS
 
     settings = config.get("settings") or {}
     hessian = settings.get("ipopt_hessian", LEGACY_SETTINGS["ipopt_hessian"])
     solver = config.get("solver")
     if solver == "ipopt":
         solver = f"ipopt ({hessian} Hessian)"
-    from rigidfold.study.store import LEGACY_CONFIG
-
     lookahead = config.get("lookahead", LEGACY_CONFIG["lookahead"])
     return [
         f"Configuration: solver {solver}, target DOF {config.get('target_dof')}, "
@@ -432,21 +430,17 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
     pairs = paired_comparisons(store)
     if pairs:
         lines += _ordering_lines(t56, pairs)
-    stages = locks_by_stage(store)
-    if stages:
-        lines += _stage_lines(stages)
-    steps = dof_steps(store)
-    if steps:
-        lines += _step_lines(steps)
-    summary = criterion_summary(store)
-    if summary:
-        lines += _summary_lines(summary)
-    angles = locked_fold_angles(store)
-    if angles:
-        lines += _angle_lines(angles)
-    causes = lock_causes(store)
-    if causes:
-        lines += _cause_lines(causes)
+    sections = (
+        (locks_by_stage, _stage_lines),
+        (dof_steps, _step_lines),
+        (criterion_summary, _summary_lines),
+        (locked_fold_angles, _angle_lines),
+        (lock_causes, _cause_lines),
+    )
+    for compute, write in sections:
+        found = compute(store)
+        if found:
+            lines += write(found)
     t78 = tables_7_8(store)
     for name, number in (("dome", "Table 7"), ("hp", "Table 8")):
         runs = [r for r in t78 if r["preset"] == name]
@@ -510,111 +504,129 @@ def _ordering_lines(t56: list[dict], pairs: list[dict]) -> list[str]:
     return [*lines, ""]
 
 
-def _stage_lines(stages: list[dict]) -> list[str]:
-    heads = " | ".join(f"DOF {_stage_label(lo, hi)}" for lo, hi in STAGES)
-    lines = [
-        "### Where the locks happen",
-        "",
+SECTION_TEXT = {
+    "Where the locks happen": (
         "Mean N_lock per run by the DOF of the accepted shape whose crease was being fixed, and "
-        "the runs that ended because every candidate crease locked (or missed F_tol).",
-        "",
-        f"| pattern | criterion | runs | {heads} | ended with no candidate |",
-        "|---|---|---|" + "---|" * len(STAGES) + "---|",
-    ]
-    for r in stages:
-        cells = " | ".join(f"{v:.2f}" for v in r["per_stage"])
-        lines.append(
-            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {cells} "
-            f"| {r['no_candidate']}/{r['runs']} |"
-        )
-    return [*lines, ""]
-
-
-def _step_lines(steps: list[dict]) -> list[str]:
-    lines = [
-        "### How fixing a crease changes the DOF",
-        "",
+        "the runs that ended because every candidate crease locked (or missed F_tol)."
+    ),
+    "How fixing a crease changes the DOF": (
         "Mean number of accepted solutions per run by the change of DOF from the shape before "
         "(one more fixed crease): a generic shape loses one mode (-1); after a 0 or + step the "
         "re-optimised shape has as many or more modes, and the run needs more than one fix per "
-        "DOF reduced.",
-        "",
-        "| pattern | criterion | runs | " + " | ".join(f"DOF {k}" for k in STEP_KINDS) + " |",
-        "|---|---|---|" + "---|" * len(STEP_KINDS),
-    ]
-    for r in steps:
-        cells = " | ".join(f"{r['per_kind'][k]:.2f}" for k in STEP_KINDS)
-        lines.append(f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {cells} |")
-    return [*lines, ""]
-
-
-def _summary_lines(rows: list[dict]) -> list[str]:
-    lines = [
-        "### Summary per criterion",
-        "",
+        "DOF reduced."
+    ),
+    "Summary per criterion": (
         "Means per run; skipped: candidates the look-ahead skipped (predicted to lock, not "
         "solved); selection: ranking (and look-ahead) time, CPU ms per run; run: CPU s per "
-        "run in the workers.",
-        "",
-        "| pattern | criterion | runs | N_reduce | N_lock | N_exceed | mean F | solves "
-        "| skipped | selection ms | run s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for r in rows:
-        sel = r["selection_s"] * 1e3 if r["selection_s"] is not None else None
-        lines.append(
-            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {_fmt(r['n_reduce'])} "
-            f"| {_fmt(r['n_lock'])} | {_fmt(r['n_exceed'])} | {_fmt(r['mean_f'])} "
-            f"| {_fmt(r['n_solves'], digits=1)} | {_fmt(r['skipped_per_run'])} "
-            f"| {_fmt(sel, digits=1)} | {_fmt(r['run_s'], digits=1)} |"
-        )
-    return [*lines, ""]
-
-
-def _angle_lines(rows: list[dict]) -> list[str]:
-    labels = _bin_labels()
-    lines = [
-        "### Fold angles of the locked creases",
-        "",
+        "run in the workers."
+    ),
+    "Fold angles of the locked creases": (
         "Locked creases of every lock by |fold angle| at the locked shape (degrees): nearly "
-        "flat creases or real folds.",
-        "",
-        "| pattern | criterion | runs | locks | locked creases | "
-        + " | ".join(labels)
-        + " | median |",
-        "|---|---|---|---|---|" + "---|" * len(labels) + "---|",
-    ]
-    for r in rows:
-        cells = " | ".join(str(b) if r["creases"] else "-" for b in r["bins"])
-        lines.append(
-            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {r['locks']} "
-            f"| {r['creases']} | {cells} | {_fmt(r['median_deg'], digits=3)} |"
-        )
-    return [*lines, ""]
-
-
-def _cause_lines(rows: list[dict]) -> list[str]:
-    lines = [
-        "### Why the locks happen",
-        "",
+        "flat creases or real folds."
+    ),
+    "Why the locks happen": (
         "Each lock against the first-order forecast at the shape before the fix: every locked "
         "crease predicted (without look-ahead: a lock it would skip; with it: tried once every "
         "other candidate had failed), a locked crease flat before (not forecast), or missed "
         "(the re-optimised shape locked a crease that kept rotations at first order; median of "
-        "its rotation left relative to the largest, against ``lookahead_tol``).",
+        "its rotation left relative to the largest, against `lookahead_tol`)."
+    ),
+}
+"""The paragraph under the title of each section written by :func:`_section`."""
+
+
+def _section(title: str, head: list[str], rows: list[list]) -> list[str]:
+    """A Markdown section of the report: its title, its paragraph (:data:`SECTION_TEXT`) and a
+    table (``head``: the column titles, ``rows``: one list of cells each)."""
+    return [
+        f"### {title}",
         "",
-        "| pattern | criterion | runs | locks | "
-        + " | ".join(LOCK_CAUSES)
-        + " | unknown | missed: rotation left |",
-        "|---|---|---|---|" + "---|" * len(LOCK_CAUSES) + "---|---|",
+        SECTION_TEXT[title],
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+        *("| " + " | ".join(str(cell) for cell in row) + " |" for row in rows),
+        "",
     ]
-    for r in rows:
-        cells = " | ".join(str(r["causes"][k]) for k in (*LOCK_CAUSES, "unknown"))
-        lines.append(
-            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {r['locks']} | {cells} "
-            f"| {_fmt(r['missed_left_median'])} |"
-        )
-    return [*lines, ""]
+
+
+GROUP_HEAD = ("pattern", "criterion", "runs")
+
+
+def _group_cells(r: dict) -> list:
+    """The first cells of a per-(pattern, criterion) row: :data:`GROUP_HEAD`."""
+    return [r["pattern"], LABEL[r["criterion"]], r["runs"]]
+
+
+def _stage_lines(stages: list[dict]) -> list[str]:
+    return _section(
+        "Where the locks happen",
+        [
+            *GROUP_HEAD,
+            *(f"DOF {_stage_label(lo, hi)}" for lo, hi in STAGES),
+            "ended with no candidate",
+        ],
+        [
+            _group_cells(r)
+            + [f"{v:.2f}" for v in r["per_stage"]]
+            + [f"{r['no_candidate']}/{r['runs']}"]
+            for r in stages
+        ],
+    )
+
+
+def _step_lines(steps: list[dict]) -> list[str]:
+    return _section(
+        "How fixing a crease changes the DOF",
+        [*GROUP_HEAD, *(f"DOF {k}" for k in STEP_KINDS)],
+        [_group_cells(r) + [f"{r['per_kind'][k]:.2f}" for k in STEP_KINDS] for r in steps],
+    )
+
+
+def _summary_lines(rows: list[dict]) -> list[str]:
+    return _section(
+        "Summary per criterion",
+        [
+            *GROUP_HEAD,
+            *("N_reduce", "N_lock", "N_exceed", "mean F", "solves", "skipped"),
+            *("selection ms", "run s"),
+        ],
+        [
+            _group_cells(r)
+            + [_fmt(r[k]) for k in ("n_reduce", "n_lock", "n_exceed", "mean_f")]
+            + [_fmt(r["n_solves"], digits=1), _fmt(r["skipped_per_run"])]
+            + [_fmt(r["selection_s"] * 1e3, digits=1), _fmt(r["run_s"], digits=1)]
+            for r in rows
+        ],
+    )
+
+
+def _angle_lines(rows: list[dict]) -> list[str]:
+    return _section(
+        "Fold angles of the locked creases",
+        [*GROUP_HEAD, "locks", "locked creases", *_bin_labels(), "median"],
+        [
+            _group_cells(r)
+            + [r["locks"], r["creases"]]
+            + [b if r["creases"] else "-" for b in r["bins"]]
+            + [_fmt(r["median_deg"], digits=3)]
+            for r in rows
+        ],
+    )
+
+
+def _cause_lines(rows: list[dict]) -> list[str]:
+    return _section(
+        "Why the locks happen",
+        [*GROUP_HEAD, "locks", *LOCK_CAUSES, "unknown", "missed: rotation left"],
+        [
+            _group_cells(r)
+            + [r["locks"]]
+            + [r["causes"][k] for k in (*LOCK_CAUSES, "unknown")]
+            + [_fmt(r["missed_left_median"])]
+            for r in rows
+        ],
+    )
 
 
 def _cost_lines(store: Store) -> list[str]:
