@@ -249,13 +249,12 @@ def locked_fold_angles(store: Store) -> list[dict]:
     |angle|. Locks of databases from before the angles were stored are counted but not
     binned."""
     counts: dict[tuple[str, str], dict] = {}
-    for group, seed, attempts in store.attempt_runs(
-        "bezier", ("locked_fold_deg",), outcome=AttemptOutcome.LOCK
-    ):
+    for group, seed, attempts in store.attempt_runs("bezier", ("outcome", "locked_fold_deg")):
         c = counts.setdefault(group, {"seeds": set(), "locks": 0, "angles": []})
         c["seeds"].add(seed)
-        c["locks"] += len(attempts)
-        c["angles"] += [abs(a) for (angles,) in attempts for a in angles or ()]
+        locks = [angles for outcome, angles in attempts if outcome == AttemptOutcome.LOCK]
+        c["locks"] += len(locks)
+        c["angles"] += [abs(a) for angles in locks for a in angles or ()]
 
     def fields(group, c, n) -> dict:
         angles = np.asarray(c["angles"], dtype=float)
@@ -294,12 +293,11 @@ def lock_causes(store: Store) -> list[dict]:
     rotation left, relative, that the forecast gave such a crease). Locks without the forecast
     stored (earlier databases) count as "unknown"."""
     counts: dict[tuple[str, str], dict] = {}
-    for group, seed, attempts in store.attempt_runs(
-        "bezier", ("locked_predicted", "locked_left"), outcome=AttemptOutcome.LOCK
-    ):
+    columns = ("outcome", "locked_predicted", "locked_left")
+    for group, seed, attempts in store.attempt_runs("bezier", columns):
         c = counts.setdefault(group, {"seeds": set(), "causes": Counter(), "left": []})
         c["seeds"].add(seed)
-        for predicted, left in attempts:
+        for _, predicted, left in (a for a in attempts if a[0] == AttemptOutcome.LOCK):
             if not predicted:
                 c["causes"]["unknown"] += 1
                 continue
