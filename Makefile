@@ -29,6 +29,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_deform.py
 	$(PY) benchmarks/bench_study.py
 	$(PY) benchmarks/bench_cpu_scaling.py
+	$(PY) benchmarks/bench_lookahead.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import signal
 import sqlite3
@@ -16,8 +17,12 @@ import pytest
 from rigidfold.generate import Stop
 from rigidfold.study import Key, Store, StudyConfig, plan, preset
 from rigidfold.study.report import (
+    FOLD_BINS,
     costs,
+    criterion_summary,
     dof_steps,
+    lock_causes,
+    locked_fold_angles,
     locks_by_stage,
     markdown,
     paired_comparisons,
@@ -410,3 +415,89 @@ def test_readonly_store_takes_no_configuration(uninterrupted, tmp_path):
     with pytest.raises(ValueError, match="no study database"):
         Store(tmp_path / "none.sqlite", readonly=True)
     assert not (tmp_path / "none.sqlite").exists()
+
+
+def test_locked_fold_angles_and_lock_causes(uninterrupted):
+    """Every lock of the study logs its creases' fold angles and its cause; without look-ahead
+    the forecast at the shape before predicted the demo's locks (nearly flat creases)."""
+    store = Store(uninterrupted, readonly=True)
+    n_lock = {r["criterion"]: r["n_lock"] * r["n"] for r in tables_5_6(store)}
+    angles = {r["criterion"]: r for r in locked_fold_angles(store)}
+    causes = {r["criterion"]: r for r in lock_causes(store)}
+    assert n_lock["shat"] >= 1  # seed 1, the demo, locks
+    for crit, locks in n_lock.items():
+        if not locks:
+            continue
+        assert angles[crit]["locks"] == causes[crit]["locks"] == locks
+        assert sum(angles[crit]["bins"]) == angles[crit]["creases"] >= locks
+        assert len(angles[crit]["bins"]) == len(FOLD_BINS) + 1
+        assert causes[crit]["causes"]["unknown"] == 0
+    assert causes["shat"]["causes"]["predicted"] >= 1
+    assert angles["shat"]["median_deg"] < 1.0
+    summary = {r["criterion"]: r for r in criterion_summary(store)}
+    assert summary["shat"]["n_lock"] == pytest.approx(n_lock["shat"] / 3)
+    assert summary["shat"]["skipped_per_run"] == 0 and summary["shat"]["selection_s"] > 0
+    text = markdown(store)
+    for head in ("Summary per criterion", "Fold angles of the locked creases", "Why the locks"):
+        assert f"### {head}" in text
+    assert "look-ahead off" in text
+
+
+def test_lookahead_study_has_its_own_database(uninterrupted, tmp_path):
+    digest = hashlib.sha256(uninterrupted.read_bytes()).hexdigest()
+    proc = run(study_cmd(uninterrupted, "--lookahead"))
+    assert proc.returncode == 2 and "differs in: lookahead" in proc.stderr
+    assert hashlib.sha256(uninterrupted.read_bytes()).hexdigest() == digest
+    db = tmp_path / "lookahead.sqlite"
+    one = ["--surfaces", "1", "--first-seed", "1", "--patterns", "1", "--criteria", "shat"]
+    args = ["rigidfold.cli", "study", *one, "--no-deform", "--lookahead", "--workers", "1"]
+    proc = run([sys.executable, "-m", *args, "--quiet", "--db", str(db)])
+    assert proc.returncode == 0, proc.stderr
+    store = Store(db, readonly=True)
+    assert store.config()["lookahead"] is True
+    (row,) = criterion_summary(store)
+    assert row["n_lock"] == 0 and row["n_reduce"] == 20 and row["skipped_per_run"] >= 3
+    assert "look-ahead on" in markdown(store)
+
+
+def test_old_databases_resume_with_the_new_attempt_columns(tmp_path):
+    """A database from before the look-ahead (no lookahead in its config, no new columns):
+    read as it is, refused with --lookahead, resumed without it (columns added)."""
+    db = tmp_path / "old.sqlite"
+    old_database(db)
+    con = sqlite3.connect(db)
+    config = StudyConfig().as_dict()
+    del config["lookahead"]  # as written before the option existed
+    con.execute("UPDATE meta SET value = ? WHERE key = 'config'", (json.dumps(config),))
+    con.commit()
+    con.close()
+    store = Store(db, readonly=True)
+    (angles,) = locked_fold_angles(store)
+    assert (angles["locks"], angles["creases"]) == (4, 0)
+    (causes,) = lock_causes(store)
+    assert causes["causes"]["unknown"] == 4
+    assert criterion_summary(store)[0]["skipped_per_run"] is None
+    assert "look-ahead off" in markdown(store)
+    store.close()
+    digest = hashlib.sha256(db.read_bytes()).hexdigest()
+    with pytest.raises(ValueError, match="differs in: lookahead"):
+        Store(db, StudyConfig(lookahead=True).as_dict())
+    assert hashlib.sha256(db.read_bytes()).hexdigest() == digest
+    store = Store(db, StudyConfig().as_dict())
+    attempt = {
+        "idx": 0, "fixed_added": [], "status": "converged", "locked": [3, 4],
+        "outcome": "lock", "skipped": 2, "skipped_locks": [{"fixed": [1], "locks": [2]}],
+        "predicted_locks": [], "locked_predicted": [False, False], "locked_left": [None, 0.5],
+        "locked_fold_deg": [0.05, -7.0],
+    }  # fmt: skip
+    new = {"status": Stop.TARGET_REACHED.reason("1"), "n_reduce": 20, "version": "new"}
+    store.add(Key("bezier", 5, "1", "s"), new, [attempt])
+    store.close()
+    store = Store(db, readonly=True)
+    (angles,) = locked_fold_angles(store)
+    assert (angles["locks"], angles["creases"], angles["bins"]) == (5, 2, [1, 0, 0, 1])
+    (causes,) = lock_causes(store)
+    assert causes["causes"] == {"predicted": 0, "flat before": 0, "missed": 1, "unknown": 4}
+    assert causes["missed_left_median"] == 0.5
+    runs = {seed: rows for _, seed, rows in store.attempt_runs("bezier", ("skipped_locks",))}
+    assert runs[5] == [([{"fixed": [1], "locks": [2]}],)] and runs[0][0] == (None,)

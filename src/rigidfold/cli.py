@@ -21,6 +21,10 @@ from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACES
 
 EXIT_USAGE = 2
+LOOKAHEAD_HELP = (
+    "skip the candidate creases whose fix would lock another crease at first order (tried "
+    "only once every other candidate failed)"
+)
 EXIT_INTERRUPTED = 130
 
 
@@ -54,6 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     _case_options(gen)
     gen.add_argument("--criterion", default=CRITERIA[0], choices=CRITERIA)
     gen.add_argument("--target-dof", type=int, default=DEFAULTS.target_dof)
+    gen.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     gen.add_argument(
         "--retry-zero-dof",
         action="store_true",
@@ -121,6 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
     where.add_argument("--workers", type=int, default=plan.workers, help="local worker processes")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
     stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
+    stu.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     stu.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
@@ -274,6 +280,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         "target_dof": args.target_dof,
         "seed": args.seed,
         "solver": args.solver,
+        "lookahead": args.lookahead,
         "symmetric": args.symmetric,
         "deform": not args.no_deform,
     }
@@ -286,6 +293,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
             target_dof=args.target_dof,
             seed=args.seed,
             solver=args.solver,
+            lookahead=args.lookahead,
             progress=progress.update,
         )
     except KeyboardInterrupt:
@@ -387,7 +395,9 @@ def _cmd_study(args: argparse.Namespace) -> int:
     else:
         keys = plan(_names(args.patterns), _names(args.criteria), args.surfaces, args.first_seed)
     config = StudyConfig(
-        deform=not args.no_deform, settings=DEFAULTS.with_(ipopt_hessian=args.hessian)
+        deform=not args.no_deform,
+        settings=DEFAULTS.with_(ipopt_hessian=args.hessian),
+        lookahead=args.lookahead,
     )
     bar = StudyProgress(enabled=not args.quiet)
     try:

@@ -85,6 +85,14 @@ class Settings:
     lock_tol : float
         A free crease is locked when the norm of its rotations over all modes is below this
         times the largest such norm (and its triangles are not coplanar).
+    lookahead_tol : float
+        Look-ahead (``generate(..., lookahead=True)``, :mod:`rigidfold.selection.lookahead`):
+        fixing a candidate is predicted to lock a folded free crease when the crease keeps,
+        in the first-order mechanisms left after the fix, rotations of norm at most this
+        times the largest any free crease keeps: the ``lock_tol`` test applied before the
+        solve. At ``lock_tol`` (the default) the forecast is the analysis of the fixed shape
+        at the same geometry; a larger value also skips candidates that leave a crease
+        nearly still.
     lock_prediction_tol : float
         After multiplying K_j by 1e14, a hinge whose rotations outside the stiffest mode fall
         below this fraction of its rotations before is predicted locked (Section 4.2).
@@ -188,6 +196,7 @@ class Settings:
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
     lock_tol: float = 1e-7
+    lookahead_tol: float = 1e-7
     lock_prediction_tol: float = 1e-4
     hinge_stiffness: float = 1e-3
     hinge_stiffness_spread: float = 0.5e-6

@@ -17,22 +17,40 @@
 
 Generation ends when the target DOF is reached, at DOF 0, or when no candidate succeeds.
 The NLP is built once; every solve starts from the last accepted shape.
+
+With ``lookahead=True`` (any criterion), Step 6 forecasts, at the last accepted shape, the
+creases each candidate would lock at first order (:func:`rigidfold.selection.lock_forecast`,
+block by block of the ranking as the candidates are reached); candidates predicted to lock
+are skipped and the others keep the criterion's order. The skipped ones are not dropped: they
+are tried, in the criterion's order, only once every other candidate has failed (so when all
+are predicted to lock, the criterion's full order), and generation never ends where it would
+not without look-ahead (:func:`rigidfold.selection.lookahead_order`). A candidate whose fix
+leaves DOF 0 is not skipped where DOF 0 ends generation. Every lock, with or without
+look-ahead, is logged with the forecast of its candidate and the locked creases' fold angles
+(:class:`Attempt`).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.config import one_blas_thread
+from rigidfold.config import Settings, one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
-from rigidfold.selection import CRITERIA, crease_groups, rank_candidates, score_creases
+from rigidfold.selection import (
+    CRITERIA,
+    crease_groups,
+    lock_forecast,
+    lookahead_order,
+    rank_candidates,
+    score_creases,
+)
 from rigidfold.status import Outcome
 
 
@@ -93,6 +111,22 @@ class Attempt:
         How the solve ended.
     outcome : AttemptOutcome
         What generation made of it.
+    locked : list of int
+        The creases locked at the shape found (every folded free crease at DOF 0).
+    skipped, skipped_locks : int, list of dict
+        With look-ahead: the candidates passed over just before this one because they were
+        predicted to lock, each as ``{"fixed": [edges], "locks": [edges it would lock]}``.
+    predicted_locks : list of int or None
+        With look-ahead: the creases this candidate was predicted to lock (non-empty only
+        where every other candidate had failed); None without look-ahead and for the initial
+        solve.
+    locked_predicted, locked_left : list of bool, list of float or None
+        Per crease of ``locked`` (after a fix): whether the forecast at the shape before
+        predicted it, and the rotation it was forecast to keep, relative to the largest
+        (:attr:`rigidfold.selection.LockForecast.rotation_left`; None for a crease flat
+        before). Made with and without look-ahead.
+    locked_fold_deg : list of float
+        Per crease of ``locked``: its fold angle at the shape found, degrees.
     """
 
     index: int
@@ -107,6 +141,12 @@ class Attempt:
     solve_time: float
     analysis_time: float
     selection_time: float = 0.0
+    skipped: int = 0
+    skipped_locks: list[dict] = field(default_factory=list)
+    predicted_locks: list[int] | None = None
+    locked_predicted: list[bool] = field(default_factory=list)
+    locked_left: list[float | None] = field(default_factory=list)
+    locked_fold_deg: list[float] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""
@@ -150,6 +190,11 @@ class Generation:
         return self.solutions[-1].mechanism.dof if self.solutions else None
 
     @property
+    def n_skipped(self) -> int:
+        """Candidates skipped by the look-ahead (predicted to lock, not solved)."""
+        return sum(a.skipped for a in self.attempts)
+
+    @property
     def n_reduce(self) -> int:
         """DOF reduced from the initial shape's, over accepted shapes."""
         if not self.solutions:
@@ -171,6 +216,7 @@ class Generation:
             "N_exceed": self.n_exceed,
             "n_solutions": len(self.solutions),
             "n_solves": len(self.attempts),
+            "n_skipped": self.n_skipped,
             "mean_F_accepted": float(np.mean(accepted_F)) if accepted_F else None,
             "mean_F_all_solves": float(np.mean(all_F)) if all_F else None,
             "time_s": {
@@ -191,6 +237,7 @@ def generate(
     seed: int = 0,
     solver: str = SOLVERS[0],
     support_face: int | None = None,
+    lookahead: bool = False,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
 ) -> Generation:
@@ -201,7 +248,8 @@ def generate(
     With mirror planes in the case, creases are fixed in mirror groups (2 or 4 at once).
     ``support_face`` is the triangle whose frame node carries the s = 6 supports (default:
     the one nearest the centroid); it sets the metric of the mechanism modes and so the
-    S^F-hat scores.
+    S^F-hat scores. ``lookahead``: skip the candidates predicted to lock (see the module's
+    text); the forecast's cost is part of the selection time.
     A KeyboardInterrupt propagates after the callbacks of everything finished so far.
     """
     if criterion not in CRITERIA:
@@ -217,6 +265,7 @@ def generate(
     run.build_time = time.perf_counter() - t0
     groups = crease_groups(case.pattern, case.planes, case.settings) if case.planes else None
     settings = case.settings
+    zero_ends = settings.zero_dof_ends or target_dof == 0
 
     def attempt(
         fixed: np.ndarray, start, added, score
@@ -234,12 +283,12 @@ def generate(
         elif mech.dof == 0:
             # the paper's final cycle (Step 5 -> Step 8); optionally, with a target >= 1, an
             # over-reduction counted as a lock: every folded free crease has stopped moving
-            zero_ends = settings.zero_dof_ends or target_dof == 0
             outcome = AttemptOutcome.ZERO_DOF if zero_ends else AttemptOutcome.LOCK
         elif mech.has_lock:
             outcome = AttemptOutcome.LOCK
         else:
             outcome = AttemptOutcome.ACCEPTED
+        locked = [] if mech is None else mech.locked_creases.tolist()
         rec = Attempt(
             index=len(run.attempts),
             fixed_added=tuple(added),
@@ -248,10 +297,11 @@ def generate(
             F=result.F,
             iterations=result.iterations,
             dof=None if mech is None else mech.dof,
-            locked=[] if mech is None else mech.locked_creases.tolist(),
+            locked=locked,
             outcome=outcome,
             solve_time=result.wall_time,
             analysis_time=t_an,
+            locked_fold_deg=np.degrees(result.pattern.fold_angles[locked]).tolist(),
         )
         run.attempts.append(rec)
         return rec, result, mech
@@ -287,20 +337,51 @@ def generate(
         K = hinge_stiffness(current.mechanism.frame.n_hinges, int(rng.integers(2**32)), settings)
         scores = score_creases(current.mechanism, K=K, settings=settings)
         ranked = rank_candidates(scores, criterion, groups=groups, rng=rng)
+        order: Iterator[tuple[int, np.ndarray | None, list[tuple[int, np.ndarray]]]] = (
+            lookahead_order(
+                current.mechanism, [g for g, _ in ranked], settings=settings, dof0_ends=zero_ends
+            )
+            if lookahead
+            else ((k, None, []) for k in range(len(ranked)))
+        )
         t_sel = time.perf_counter() - t1
-        for group, score in ranked:  # Step 6, then Step 7 on failure
+        while True:  # Step 6, then Step 7 on failure
+            t1 = time.perf_counter()
+            k, predicted, passed = next(order, (None, None, []))  # look-ahead: lazy forecast
+            t_sel += time.perf_counter() - t1
+            if k is None:
+                run.stop = Stop.NO_CANDIDATE
+                return run
+            group, score = ranked[k]
             trial = current.result.pattern.fixed.copy()
             trial[list(group)] = True
             rec, result, mech = attempt(trial, current.result.coords, group, score)
             rec.selection_time, t_sel = t_sel, 0.0
+            if predicted is not None:
+                rec.predicted_locks = predicted.tolist()
+                rec.skipped = len(passed)
+                rec.skipped_locks = [
+                    {"fixed": list(ranked[i][0]), "locks": locks.tolist()} for i, locks in passed
+                ]
+            if rec.locked:
+                rec.locked_predicted, rec.locked_left = _explain_lock(
+                    rec, current.mechanism, settings
+                )
             record(rec, result, mech)
             if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
                 break
-        else:
-            run.stop = Stop.NO_CANDIDATE
-            return run
         if rec.outcome is AttemptOutcome.ZERO_DOF:
             run.stop = Stop.ZERO_DOF
             return run
     run.stop, run.stop_detail = Stop.TARGET_REACHED, str(target_dof)
     return run
+
+
+def _explain_lock(
+    rec: Attempt, before: Mechanism, settings: Settings
+) -> tuple[list[bool], list[float | None]]:
+    """``locked_predicted`` and ``locked_left`` of an attempt that locked creases: the
+    forecast of its candidate at the shape ``before`` the fix."""
+    forecast = lock_forecast(before, [rec.fixed_added], settings=settings)
+    predicted = set(forecast.locks(0).tolist())
+    return [e in predicted for e in rec.locked], forecast.left(0, rec.locked)

@@ -127,6 +127,7 @@ class RunWriter:
                 "step": solution.step,
                 "dof": dof,
                 "criterion": self.options.get("criterion"),
+                "lookahead": self.options.get("lookahead", False),
             },
         )
         self.files.append(path)

@@ -228,10 +228,12 @@ def generate_case(
     target_dof: int,
     seed: int,
     solver: str,
+    lookahead: bool = False,
     progress: Callable[[Generation, Attempt | None], None] | None = None,
 ) -> Generation:
     """Steps 2-9 on ``writer.case``, every attempt and solution written by ``writer`` as it
     comes (so an interrupt loses nothing); ``progress(run, attempt)`` after each of them.
+    ``lookahead``: skip the candidates predicted to lock (``generate``'s option).
     ``summary.json`` is written once more at the end."""
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
@@ -250,6 +252,7 @@ def generate_case(
         target_dof=target_dof,
         seed=seed,
         solver=solver,
+        lookahead=lookahead,
         on_attempt=on_attempt,
         on_solution=on_solution,
     )

@@ -7,13 +7,27 @@ from rigidfold.selection.criteria import (
     rank_candidates,
     score_creases,
 )
+from rigidfold.selection.lookahead import (
+    LockForecast,
+    exact_residuals,
+    group_bases,
+    lock_forecast,
+    lookahead_order,
+    squared_residuals,
+)
 from rigidfold.selection.symmetry import crease_groups
 
 __all__ = [
     "CRITERIA",
+    "LockForecast",
     "Scores",
     "crease_groups",
+    "exact_residuals",
+    "group_bases",
+    "lock_forecast",
+    "lookahead_order",
     "predicted_locks",
     "rank_candidates",
     "score_creases",
+    "squared_residuals",
 ]

@@ -208,6 +208,114 @@ def dof_steps(store: Store) -> list[dict]:
     )
 
 
+def criterion_summary(store: Store) -> list[dict]:
+    """The figures to compare criteria, and studies with and without look-ahead: per
+    (pattern, criterion) of the Bezier study, mean N_reduce, N_lock, N_exceed and F, solves
+    of (6) per run, candidates skipped by the look-ahead per run (None where the database
+    does not store it), and the mean selection and total seconds per run."""
+    runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
+    skipped: dict[tuple[str, str], list[int]] = {}
+    for group, _, attempts in store.attempt_runs("bezier", ("skipped",)):
+        values = [s for (s,) in attempts if s is not None]
+        if values:
+            skipped.setdefault(group, []).append(sum(values))
+    rows = []
+    for pattern, crit in sorted({(r["pattern"], r["criterion"]) for r in runs}):
+        sel = [r for r in runs if (r["pattern"], r["criterion"]) == (pattern, crit)]
+        row: dict = {"pattern": pattern, "criterion": crit, "runs": len(sel)}
+        for name in ("n_reduce", "n_lock", "n_exceed", "mean_f", "n_solves"):
+            row[name] = _mean_se([r[name] for r in sel])[0]
+        done = skipped.get((pattern, crit))
+        row["skipped_per_run"] = float(np.sum(done)) / len(sel) if done else None
+        row["selection_s"] = _mean_se([r["time_selection"] for r in sel])[0]
+        row["run_s"] = _mean_se([r["time_total"] for r in sel])[0]
+        rows.append(row)
+    return rows
+
+
+FOLD_BINS = (0.1, 1.0, 5.0)
+"""Bounds (degrees) of the bins of |fold angle| of locked creases (:func:`locked_fold_angles`)."""
+
+
+def _bin_labels() -> list[str]:
+    edges = [f"{b:g}" for b in FOLD_BINS]
+    return [f"< {edges[0]}", *(f"{a}-{b}" for a, b in itertools.pairwise(edges)), f">= {edges[-1]}"]
+
+
+def locked_fold_angles(store: Store) -> list[dict]:
+    """How folded the locked creases are: per (pattern, criterion) of the Bezier study, the
+    locks (attempts with outcome "lock"), the locked creases whose fold angle at the locked
+    shape is stored, their count per bin of |angle| (:data:`FOLD_BINS`, degrees) and the median
+    |angle|. Locks of databases from before the angles were stored are counted but not
+    binned."""
+    counts: dict[tuple[str, str], dict] = {}
+    for group, seed, attempts in store.attempt_runs("bezier", ("outcome", "locked_fold_deg")):
+        c = counts.setdefault(group, {"seeds": set(), "locks": 0, "angles": []})
+        c["seeds"].add(seed)
+        locks = [angles for outcome, angles in attempts if outcome == AttemptOutcome.LOCK]
+        c["locks"] += len(locks)
+        c["angles"] += [abs(a) for angles in locks for a in angles or ()]
+
+    def fields(group, c, n) -> dict:
+        angles = np.asarray(c["angles"], dtype=float)
+        bins = np.searchsorted(FOLD_BINS, angles, side="right")
+        return {
+            "locks": c["locks"],
+            "creases": len(angles),
+            "bins": np.bincount(bins, minlength=len(FOLD_BINS) + 1).tolist(),
+            "median_deg": float(np.median(angles)) if len(angles) else None,
+        }
+
+    return _per_run_rows(counts, fields)
+
+
+LOCK_CAUSES = ("predicted", "flat before", "missed")
+"""Why a lock happened, from the forecast at the shape before the fix (:func:`lock_causes`)."""
+
+
+def _lock_cause(predicted: list[bool], left: list[float | None]) -> tuple[str, float | None]:
+    """The cause of one lock and, for "missed", the smallest rotation left (relative) that
+    the forecast gave a locked crease it did not predict."""
+    unpredicted = [x for p, x in zip(predicted, left, strict=True) if not p]
+    if not unpredicted:
+        return "predicted", None
+    folded = [x for x in unpredicted if x is not None]
+    return ("missed", min(folded)) if folded else ("flat before", None)
+
+
+def lock_causes(store: Store) -> list[dict]:
+    """Why the locks happen: per (pattern, criterion) of the Bezier study, the locks by cause
+    (:data:`LOCK_CAUSES`): every locked crease was predicted by the first-order forecast at
+    the shape before the fix (without look-ahead: a lock it would have skipped; with it: a
+    candidate tried once every other had failed); a locked crease it did not predict was flat
+    there (no forecast is made for flat creases); or it was folded and kept rotations at first
+    order, and the re-optimised shape locked it ("missed", with the median of the smallest
+    rotation left, relative, that the forecast gave such a crease). Locks without the forecast
+    stored (earlier databases) count as "unknown"."""
+    counts: dict[tuple[str, str], dict] = {}
+    columns = ("outcome", "locked_predicted", "locked_left")
+    for group, seed, attempts in store.attempt_runs("bezier", columns):
+        c = counts.setdefault(group, {"seeds": set(), "causes": Counter(), "left": []})
+        c["seeds"].add(seed)
+        for _, predicted, left in (a for a in attempts if a[0] == AttemptOutcome.LOCK):
+            if not predicted:
+                c["causes"]["unknown"] += 1
+                continue
+            cause, smallest = _lock_cause(predicted, left)
+            c["causes"][cause] += 1
+            if smallest is not None:
+                c["left"].append(smallest)
+
+    def fields(group, c, n) -> dict:
+        return {
+            "locks": sum(c["causes"].values()),
+            "causes": {k: c["causes"][k] for k in (*LOCK_CAUSES, "unknown")},
+            "missed_left_median": float(np.median(c["left"])) if c["left"] else None,
+        }
+
+    return _per_run_rows(counts, fields)
+
+
 def tables_7_8(store: Store) -> list[dict]:
     """Per preset run (dome / hp, with / without symmetry): the rows of Tables 7 and 8."""
     out = []
@@ -273,16 +381,18 @@ def _configuration_lines(store: Store) -> list[str]:
     versions = sorted({r["version"] for r in store.runs()})
     if not config:
         return []
-    from rigidfold.study.store import LEGACY_SETTINGS
+    from rigidfold.study.store import LEGACY_CONFIG, LEGACY_SETTINGS
 
     settings = config.get("settings") or {}
     hessian = settings.get("ipopt_hessian", LEGACY_SETTINGS["ipopt_hessian"])
     solver = config.get("solver")
     if solver == "ipopt":
         solver = f"ipopt ({hessian} Hessian)"
+    lookahead = config.get("lookahead", LEGACY_CONFIG["lookahead"])
     return [
         f"Configuration: solver {solver}, target DOF {config.get('target_dof')}, "
-        f"Steps 8-9 {'on' if config.get('deform') else 'off'}; {len(store.runs())} runs, "
+        f"Steps 8-9 {'on' if config.get('deform') else 'off'}, "
+        f"look-ahead {'on' if lookahead else 'off'}; {len(store.runs())} runs, "
         f"{store.count_attempts()} solves of (6); rigidfold {', '.join(versions) or '-'}.",
         "",
     ]
@@ -318,12 +428,17 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
     pairs = paired_comparisons(store)
     if pairs:
         lines += _ordering_lines(t56, pairs)
-    stages = locks_by_stage(store)
-    if stages:
-        lines += _stage_lines(stages)
-    steps = dof_steps(store)
-    if steps:
-        lines += _step_lines(steps)
+    sections = (
+        (locks_by_stage, _stage_lines),
+        (dof_steps, _step_lines),
+        (criterion_summary, _summary_lines),
+        (locked_fold_angles, _angle_lines),
+        (lock_causes, _cause_lines),
+    )
+    for compute, write in sections:
+        found = compute(store)
+        if found:
+            lines += write(found)
     t78 = tables_7_8(store)
     for name, number in (("dome", "Table 7"), ("hp", "Table 8")):
         runs = [r for r in t78 if r["preset"] == name]
@@ -387,42 +502,129 @@ def _ordering_lines(t56: list[dict], pairs: list[dict]) -> list[str]:
     return [*lines, ""]
 
 
-def _stage_lines(stages: list[dict]) -> list[str]:
-    heads = " | ".join(f"DOF {_stage_label(lo, hi)}" for lo, hi in STAGES)
-    lines = [
-        "### Where the locks happen",
-        "",
+SECTION_TEXT = {
+    "Where the locks happen": (
         "Mean N_lock per run by the DOF of the accepted shape whose crease was being fixed, and "
-        "the runs that ended because every candidate crease locked (or missed F_tol).",
-        "",
-        f"| pattern | criterion | runs | {heads} | ended with no candidate |",
-        "|---|---|---|" + "---|" * len(STAGES) + "---|",
-    ]
-    for r in stages:
-        cells = " | ".join(f"{v:.2f}" for v in r["per_stage"])
-        lines.append(
-            f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {cells} "
-            f"| {r['no_candidate']}/{r['runs']} |"
-        )
-    return [*lines, ""]
-
-
-def _step_lines(steps: list[dict]) -> list[str]:
-    lines = [
-        "### How fixing a crease changes the DOF",
-        "",
+        "the runs that ended because every candidate crease locked (or missed F_tol)."
+    ),
+    "How fixing a crease changes the DOF": (
         "Mean number of accepted solutions per run by the change of DOF from the shape before "
         "(one more fixed crease): a generic shape loses one mode (-1); after a 0 or + step the "
         "re-optimised shape has as many or more modes, and the run needs more than one fix per "
-        "DOF reduced.",
+        "DOF reduced."
+    ),
+    "Summary per criterion": (
+        "Means per run; skipped: candidates the look-ahead skipped (predicted to lock, not "
+        "solved); selection: ranking (and look-ahead) time, CPU ms per run; run: CPU s per "
+        "run in the workers."
+    ),
+    "Fold angles of the locked creases": (
+        "Locked creases of every lock by |fold angle| at the locked shape (degrees): nearly "
+        "flat creases or real folds."
+    ),
+    "Why the locks happen": (
+        "Each lock against the first-order forecast at the shape before the fix: every locked "
+        "crease predicted (without look-ahead: a lock it would skip; with it: tried once every "
+        "other candidate had failed), a locked crease flat before (not forecast), or missed "
+        "(the re-optimised shape locked a crease that kept rotations at first order; median of "
+        "its rotation left relative to the largest, against `lookahead_tol`)."
+    ),
+}
+"""The paragraph under the title of each section written by :func:`_section`."""
+
+
+def _section(title: str, head: list[str], rows: list[list]) -> list[str]:
+    """A Markdown section of the report: its title, its paragraph (:data:`SECTION_TEXT`) and a
+    table (``head``: the column titles, ``rows``: one list of cells each)."""
+    return [
+        f"### {title}",
         "",
-        "| pattern | criterion | runs | " + " | ".join(f"DOF {k}" for k in STEP_KINDS) + " |",
-        "|---|---|---|" + "---|" * len(STEP_KINDS),
+        SECTION_TEXT[title],
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+        *("| " + " | ".join(str(cell) for cell in row) + " |" for row in rows),
+        "",
     ]
-    for r in steps:
-        cells = " | ".join(f"{r['per_kind'][k]:.2f}" for k in STEP_KINDS)
-        lines.append(f"| {r['pattern']} | {LABEL[r['criterion']]} | {r['runs']} | {cells} |")
-    return [*lines, ""]
+
+
+GROUP_HEAD = ("pattern", "criterion", "runs")
+
+
+def _group_cells(r: dict) -> list:
+    """The first cells of a per-(pattern, criterion) row: :data:`GROUP_HEAD`."""
+    return [r["pattern"], LABEL[r["criterion"]], r["runs"]]
+
+
+def _stage_lines(stages: list[dict]) -> list[str]:
+    return _section(
+        "Where the locks happen",
+        [
+            *GROUP_HEAD,
+            *(f"DOF {_stage_label(lo, hi)}" for lo, hi in STAGES),
+            "ended with no candidate",
+        ],
+        [
+            _group_cells(r)
+            + [f"{v:.2f}" for v in r["per_stage"]]
+            + [f"{r['no_candidate']}/{r['runs']}"]
+            for r in stages
+        ],
+    )
+
+
+def _step_lines(steps: list[dict]) -> list[str]:
+    return _section(
+        "How fixing a crease changes the DOF",
+        [*GROUP_HEAD, *(f"DOF {k}" for k in STEP_KINDS)],
+        [_group_cells(r) + [f"{r['per_kind'][k]:.2f}" for k in STEP_KINDS] for r in steps],
+    )
+
+
+def _summary_lines(rows: list[dict]) -> list[str]:
+    return _section(
+        "Summary per criterion",
+        [
+            *GROUP_HEAD,
+            *("N_reduce", "N_lock", "N_exceed", "mean F", "solves", "skipped"),
+            *("selection ms", "run s"),
+        ],
+        [
+            _group_cells(r)
+            + [_fmt(r[k]) for k in ("n_reduce", "n_lock", "n_exceed", "mean_f")]
+            + [_fmt(r["n_solves"], digits=1), _fmt(r["skipped_per_run"])]
+            + [_fmt(r["selection_s"] * 1e3, digits=1), _fmt(r["run_s"], digits=1)]
+            for r in rows
+        ],
+    )
+
+
+def _angle_lines(rows: list[dict]) -> list[str]:
+    return _section(
+        "Fold angles of the locked creases",
+        [*GROUP_HEAD, "locks", "locked creases", *_bin_labels(), "median"],
+        [
+            _group_cells(r)
+            + [r["locks"], r["creases"]]
+            + [b if r["creases"] else "-" for b in r["bins"]]
+            + [_fmt(r["median_deg"], digits=3)]
+            for r in rows
+        ],
+    )
+
+
+def _cause_lines(rows: list[dict]) -> list[str]:
+    return _section(
+        "Why the locks happen",
+        [*GROUP_HEAD, "locks", *LOCK_CAUSES, "unknown", "missed: rotation left"],
+        [
+            _group_cells(r)
+            + [r["locks"]]
+            + [r["causes"][k] for k in (*LOCK_CAUSES, "unknown")]
+            + [_fmt(r["missed_left_median"])]
+            for r in rows
+        ],
+    )
 
 
 def _cost_lines(store: Store) -> list[str]:

@@ -31,12 +31,17 @@ PRESETS = {
 
 @dataclass(frozen=True)
 class StudyConfig:
-    """What makes the numbers of two runs comparable; stored in the database."""
+    """What makes the numbers of two runs comparable; stored in the database.
+
+    lookahead : generate skips the candidates predicted to lock (``generate(lookahead=...)``);
+    a database written before the option existed ran without it and resumes with False.
+    """
 
     deform: bool = False
     target_dof: int = DEFAULTS.target_dof
     solver: str = SOLVERS[0]
     settings: Settings = field(default=DEFAULTS)
+    lookahead: bool = False
 
     def as_dict(self) -> dict:
         return {
@@ -44,6 +49,7 @@ class StudyConfig:
             "target_dof": self.target_dof,
             "solver": self.solver,
             "settings": asdict(self.settings),
+            "lookahead": self.lookahead,
         }
 
 
@@ -126,6 +132,7 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
             target_dof=config["target_dof"],
             seed=key.seed,
             solver=config["solver"],
+            lookahead=config["lookahead"],
             on_solution=on_solution,
         )
     except ValueError as exc:  # a configuration that cannot run: recorded, not retried

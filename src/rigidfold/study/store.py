@@ -55,9 +55,34 @@ CREATE TABLE IF NOT EXISTS attempts (
     fixed_added TEXT NOT NULL, score REAL, status TEXT NOT NULL, f REAL, iterations INTEGER,
     dof INTEGER, locked TEXT NOT NULL, outcome TEXT NOT NULL,
     solve_time REAL, analysis_time REAL, selection_time REAL,
+    skipped INTEGER,              -- candidates skipped by the look-ahead just before (NULL: older)
+    skipped_locks TEXT, predicted_locks TEXT,  -- JSON, see generate.Attempt
+    locked_predicted TEXT, locked_left TEXT, locked_fold_deg TEXT,  -- JSON, per locked crease
     PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
 );
 """
+
+ADDED_ATTEMPT_COLUMNS = {
+    "skipped": "INTEGER",
+    "skipped_locks": "TEXT",
+    "predicted_locks": "TEXT",
+    "locked_predicted": "TEXT",
+    "locked_left": "TEXT",
+    "locked_fold_deg": "TEXT",
+}
+"""Columns of ``attempts`` added after the first databases (the look-ahead, issue 18): added
+by ALTER TABLE when such a database is opened for writing, read as NULL from one opened
+read-only."""
+JSON_ATTEMPT_FIELDS = (
+    "fixed_added",
+    "locked",
+    "skipped_locks",
+    "predicted_locks",
+    "locked_predicted",
+    "locked_left",
+    "locked_fold_deg",
+)
+"""Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
 
 RUN_FIELDS = (
     "status",
@@ -96,6 +121,7 @@ ATTEMPT_FIELDS = (
     "solve_time",
     "analysis_time",
     "selection_time",
+    *ADDED_ATTEMPT_COLUMNS,
 )
 
 
@@ -131,6 +157,8 @@ class Key:
 
 # settings added with a default that differs from what rigidfold did before they existed
 LEGACY_SETTINGS = {"ipopt_hessian": "casadi"}
+# configuration entries added later, at the value that reproduces the studies made before
+LEGACY_CONFIG = {"lookahead": False}
 
 
 def config_differences(stored: dict, current: dict) -> list[str]:
@@ -138,8 +166,10 @@ def config_differences(stored: dict, current: dict) -> list[str]:
 
     A setting that a later rigidfold added (absent from ``stored["settings"]``) counts as
     equal when ``current`` has it at the value that reproduces the older code: its default,
-    or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes. So a
-    study can be resumed by a newer version as long as nothing it measures has changed.
+    or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes; so
+    does an entry of the configuration itself at its value in ``LEGACY_CONFIG`` (e.g.
+    ``lookahead`` false). So a study can be resumed by a newer version as long as nothing it
+    measures has changed.
     """
     from dataclasses import asdict
 
@@ -148,7 +178,7 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     defaults = asdict(DEFAULTS)
     diff = []
     for key in sorted(set(stored) | set(current)):
-        a, b = stored.get(key), current.get(key)
+        a, b = stored.get(key, LEGACY_CONFIG.get(key)), current.get(key)
         if key == "settings" and isinstance(a, dict) and isinstance(b, dict):
             diff += [
                 f"settings.{k}"
@@ -185,6 +215,11 @@ class Store:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")
             self.db.executescript(SCHEMA)
+            have = self._columns("attempts")
+            for name, kind in ADDED_ATTEMPT_COLUMNS.items():
+                if name not in have:  # a database of an earlier version: same rows, new columns
+                    self.db.execute(f"ALTER TABLE attempts ADD COLUMN {name} {kind}")
+            self._attempt_columns = self._columns("attempts")
             if config is not None:
                 self.db.execute(
                     "INSERT OR IGNORE INTO meta VALUES ('config', ?)",
@@ -200,6 +235,7 @@ class Store:
         try:
             self.db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30)
             self.db.execute("SELECT 1 FROM runs LIMIT 1")
+            self._attempt_columns = self._columns("attempts")
         except sqlite3.Error as exc:
             raise ValueError(
                 f"{str(self.path)!r} is not a rigidfold study database: {exc}"
@@ -238,6 +274,10 @@ class Store:
                 f"(differs in: {', '.join(diff)}); use another --db"
             )
 
+    def _columns(self, table: str) -> set[str]:
+        """Names of the columns of ``table`` in this file."""
+        return {row[1] for row in self.db.execute(f"PRAGMA table_info({table})")}
+
     def config(self) -> dict | None:
         row = self.db.execute("SELECT value FROM meta WHERE key='config'").fetchone()
         return None if row is None else json.loads(row[0])
@@ -254,12 +294,13 @@ class Store:
                 f"INSERT INTO runs VALUES ({', '.join('?' * (5 + len(RUN_FIELDS)))})",
                 key.row() + tuple(run.get(f) for f in RUN_FIELDS),
             )
+            names = ("study", "seed", "pattern", "criterion", "symmetric", *ATTEMPT_FIELDS)
             self.db.executemany(
-                f"INSERT INTO attempts VALUES ({', '.join('?' * (5 + len(ATTEMPT_FIELDS)))})",
+                f"INSERT INTO attempts ({', '.join(names)}) VALUES ({', '.join('?' * len(names))})",
                 [
                     key.row()
                     + tuple(
-                        json.dumps(a[f]) if f in ("fixed_added", "locked") else a.get(f)
+                        json.dumps(a.get(f)) if f in JSON_ATTEMPT_FIELDS else a.get(f)
                         for f in ATTEMPT_FIELDS
                     )
                     for a in attempts
@@ -324,20 +365,34 @@ class Store:
 
         Yields ``((pattern, criterion), seed, rows)`` per run, ``rows`` holding ``columns``
         (names of :data:`ATTEMPT_FIELDS`) of each attempt, only those with ``outcome`` (an
-        :class:`~rigidfold.generate.AttemptOutcome` value) when given.
+        :class:`~rigidfold.generate.AttemptOutcome` value) when given. JSON columns
+        (:data:`JSON_ATTEMPT_FIELDS`) come decoded; a column that a database of an earlier
+        version lacks (opened read-only) reads as None.
         """
         unknown = [c for c in columns if c not in ATTEMPT_FIELDS]
         if unknown:
             raise ValueError(f"unknown attempt columns {unknown} (choose from {ATTEMPT_FIELDS})")
+        selected = [c if c in self._attempt_columns else f"NULL AS {c}" for c in columns]
+        decode = [c in JSON_ATTEMPT_FIELDS for c in columns]
         cur = self.db.execute(
-            f"SELECT pattern, criterion, seed, {', '.join(columns)} FROM attempts "
+            f"SELECT pattern, criterion, seed, {', '.join(selected)} FROM attempts "
             "WHERE study = ?"
             + (" AND outcome = ?" if outcome is not None else "")
             + " ORDER BY pattern, criterion, seed, idx",
             (study,) if outcome is None else (study, outcome),
         )
         for (pattern, crit, seed), rows in itertools.groupby(cur, key=lambda r: r[:3]):
-            yield (pattern, crit), seed, [r[3:] for r in rows]
+            yield (
+                (pattern, crit),
+                seed,
+                [
+                    tuple(
+                        json.loads(v) if json_ and v is not None else v
+                        for v, json_ in zip(r[3:], decode, strict=True)
+                    )
+                    for r in rows
+                ],
+            )
 
     def close(self) -> None:
         self.db.close()

@@ -1,0 +1,227 @@
+"""The first-order look-ahead (Property 2): its forecast against the mechanism analysis of
+the fixed shape at the same geometry, and generation that skips the candidates it predicts
+to lock."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import json
+
+import numpy as np
+import pytest
+
+from conftest import degree_n_vertex, folded_grid
+from rigidfold.case import make_case
+from rigidfold.config import DEFAULTS
+from rigidfold.generate import generate
+from rigidfold.mechanism import analyze
+from rigidfold.selection import lock_forecast, lookahead_order
+
+PARALLEL = {87, 89, 103, 108}  # the demo's four creases with parallel rows at DOF 5 (issue 18)
+
+
+@pytest.fixture(scope="module")
+def demo_dof5():
+    """The demo's shape at DOF 5 (pattern 1, Bezier seed 1, S-hat), where it meets 4 locks."""
+    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1, target_dof=5)
+    assert run.final_dof == 5
+    return run.solutions[-1].mechanism
+
+
+def locks_after_fixing(mech, group) -> tuple[list[int], int]:
+    """The locked creases and DOF that the analysis finds with ``group`` fixed, same shape."""
+    pattern = mech.pattern
+    fixed = pattern.fixed.copy()
+    fixed[list(group)] = True
+    after = analyze(pattern.with_fixed(fixed))
+    return sorted(after.locked_creases.tolist()), after.dof
+
+
+def assert_forecast_is_the_analysis(mech, candidates=None) -> np.ndarray:
+    forecast = lock_forecast(mech, candidates)
+    for k, group in enumerate(forecast.candidates):
+        locked, dof = locks_after_fixing(mech, group)
+        assert sorted(forecast.locks(k).tolist()) == locked, group
+        assert forecast.dof_after[k] == dof, group
+    return forecast.predicts_lock
+
+
+def test_forecast_equals_the_analysis_of_each_fix_at_the_same_geometry(demo_dof5):
+    predicts = assert_forecast_is_the_analysis(demo_dof5)
+    forecast = lock_forecast(demo_dof5)
+    assert predicts.sum() == 16 and len(predicts) == 80  # as counted in issue 18
+    for e in PARALLEL:
+        k = forecast.candidates.index((e,))
+        assert set(forecast.locks(k).tolist()) == PARALLEL - {e}
+    # |Psi_j . Psi_p| = 1 for the four: their rows are parallel
+    rows = demo_dof5.H_phi[np.isin(demo_dof5.hinges, sorted(PARALLEL))]
+    psi = rows / np.linalg.norm(rows, axis=1, keepdims=True)
+    assert np.abs(psi @ psi.T) == pytest.approx(np.ones((4, 4)), abs=1e-12)
+    left = forecast.rotation_left
+    assert np.isfinite(left[:, forecast.folded]).all()
+    assert forecast.to_dict()["candidates"][0].keys() == {"fixed", "dof_after", "locks"}
+
+
+def test_groups_count_dependent_rows_once(demo_dof5):
+    """Pairs fixed together: two parallel rows are one constraint (DOF - 1), others two."""
+    singles = [int(e) for e in demo_dof5.hinges[:8]]
+    pairs = list(itertools.combinations(singles[:4] + sorted(PARALLEL), 2))
+    assert_forecast_is_the_analysis(demo_dof5, pairs)
+    forecast = lock_forecast(demo_dof5, [(87, 89), (87, 89, 103, 108), (87, singles[0])])
+    assert forecast.dof_after.tolist() == [4, 4, 3]
+    assert sorted(forecast.locks(0).tolist()) == [103, 108]
+    assert len(forecast.locks(1)) == 0
+
+
+def test_mirror_groups_of_a_symmetric_run():
+    case = make_case("hp", "11", symmetric=True)
+    run = generate(case, criterion="s", seed=0, target_dof=11)
+    mech = run.solutions[-1].mechanism
+    from rigidfold.selection import crease_groups
+
+    free = set(mech.hinges.tolist())
+    groups = [g for g in crease_groups(case.pattern, case.planes) if set(g) <= free]
+    forecast = lock_forecast(mech, groups)
+    assert forecast.predicts_lock.sum() >= 3
+    picked = [g for k, g in enumerate(groups) if forecast.predicts_lock[k]] + groups[:6]
+    assert_forecast_is_the_analysis(mech, picked)
+
+
+def test_creases_that_do_not_rotate_lock_nothing_when_fixed(demo_dof5):
+    """At the shape with 108 fixed, 87, 89 and 103 are locked (rows ~0): fixing one of them
+    changes nothing, and they stay locked whatever is fixed, as the analysis says."""
+    fixed = demo_dof5.pattern.fixed.copy()
+    fixed[108] = True
+    locked_shape = analyze(demo_dof5.pattern.with_fixed(fixed))
+    assert set(locked_shape.locked_creases.tolist()) == PARALLEL - {108}
+    still = [(87,), (89,), (103,)]
+    others = [(int(e),) for e in locked_shape.hinges[:20]]
+    assert_forecast_is_the_analysis(locked_shape, still + others)
+    forecast = lock_forecast(locked_shape, still)
+    assert (forecast.dof_after == locked_shape.dof).all()
+
+
+def test_flat_creases_are_never_forecast_and_stay_finite():
+    pattern = folded_grid(4, amplitude=0.0)
+    coords = pattern.coords.copy()
+    coords[5, 2] = 0.2  # one vertex lifted: only its creases fold
+    pattern = pattern.with_coords(coords)
+    mech = analyze(pattern)
+    forecast = lock_forecast(mech)
+    flat = ~forecast.folded
+    assert flat.any() and (~flat).any()
+    assert not forecast.locked[:, flat].any()
+    assert np.isnan(forecast.rotation_left[:, flat]).all()
+    assert np.isfinite(forecast.residual_sq).all()
+    assert_forecast_is_the_analysis(mech)
+
+
+def test_a_rigid_vertex_has_nothing_to_forecast():
+    mech = analyze(degree_n_vertex(3))
+    assert mech.dof == 0
+    forecast = lock_forecast(mech)
+    assert (forecast.dof_after == 0).all()
+    assert_forecast_is_the_analysis(mech)
+
+
+def test_bad_candidates_are_refused(demo_dof5):
+    fixed_edge = int(demo_dof5.pattern.fixed_creases[0])
+    for bad in ([fixed_edge], [], [10**6]):
+        with pytest.raises(ValueError, match="is not a set of free creases"):
+            lock_forecast(demo_dof5, [bad])
+
+
+def test_lookahead_order_skips_then_defers_block_by_block(demo_dof5):
+    """The lazy order is the same for any block size: the candidates not predicted to lock
+    in their order (each with the skipped ones before it), then the skipped ones."""
+    candidates = [(int(e),) for e in demo_dof5.hinges]
+    full = lock_forecast(demo_dof5, candidates)
+    skip = full.predicts_lock
+    expected, passed = [], []
+    for k in range(len(candidates)):
+        if skip[k]:
+            passed.append(k)
+        else:
+            expected.append((k, passed))
+            passed = []
+    expected += [(k, []) for k in np.flatnonzero(skip)]
+    for block in (1, 3, 8, 100):
+        order = list(lookahead_order(demo_dof5, candidates, block=block))
+        assert [(k, [i for i, _ in p]) for k, _, p in order] == expected
+        for k, locks, p in order:
+            assert locks.tolist() == full.locks(k).tolist()
+            assert all(lk.tolist() == full.locks(i).tolist() for i, lk in p)
+    with pytest.raises(ValueError, match="block must be >= 1"):
+        next(lookahead_order(demo_dof5, candidates, block=0))
+
+
+def test_a_fix_to_dof0_is_not_skipped_where_dof0_ends():
+    mech = analyze(degree_n_vertex(3))
+    candidates = [(int(e),) for e in mech.hinges]
+    assert [p for _, _, p in lookahead_order(mech, candidates)] == [[]] * len(candidates)
+    order = list(lookahead_order(mech, candidates, dof0_ends=False))
+    assert [k for k, _, _ in order] == list(range(len(candidates)))
+    assert order[0][2] == [] and len(order[0][1]) == len(candidates) - 1
+
+
+@pytest.fixture(scope="module")
+def demo_runs():
+    case = make_case("bezier", "1", seed=1)
+    return {la: generate(case, criterion="shat", seed=1, lookahead=la) for la in (False, True)}
+
+
+def test_demo_with_lookahead_meets_no_lock(demo_runs):
+    without, with_ = demo_runs[False], demo_runs[True]
+    assert without.n_lock == 4 and with_.n_lock == 0
+    assert with_.final_dof == 1 and with_.n_reduce == 20
+    assert with_.n_skipped >= 3 and with_.to_dict()["n_skipped"] == with_.n_skipped
+    assert len(with_.attempts) < len(without.attempts)
+    logged = [a.to_dict() for a in with_.attempts]
+    json.dumps(logged)
+    skipping = [a for a in with_.attempts if a.skipped]
+    for a in skipping:
+        assert len(a.skipped_locks) == a.skipped
+        for s in a.skipped_locks:
+            assert set(s["fixed"]) <= PARALLEL and set(s["locks"]) == PARALLEL - set(s["fixed"])
+    assert all(a.predicted_locks == [] for a in with_.attempts[1:])
+
+
+def test_every_lock_logs_its_fold_angles_and_whether_it_was_predicted(demo_runs):
+    locks = [a for a in demo_runs[False].attempts if a.outcome == "lock"]
+    for a in locks:
+        assert set(a.locked) | set(a.fixed_added) == PARALLEL
+        assert a.locked_predicted == [True] * 3
+        assert len(a.locked_fold_deg) == 3 and max(map(abs, a.locked_fold_deg)) < 1.0
+        assert max(a.locked_left) <= DEFAULTS.lookahead_tol
+        assert a.predicted_locks is None  # no forecast of the attempts without a lock
+        assert {"skipped", "locked_predicted", "locked_fold_deg"} <= a.to_dict().keys()
+
+
+def test_all_candidates_predicted_falls_back_to_the_criterions_order(monkeypatch, demo_runs):
+    import rigidfold.selection.lookahead as module
+
+    def everything_locks(mechanism, candidates=None, *, settings=DEFAULTS):
+        forecast = lock_forecast(mechanism, candidates, settings=settings)
+        return dataclasses.replace(forecast, locked=np.ones_like(forecast.locked))
+
+    monkeypatch.setattr(module, "lock_forecast", everything_locks)
+    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1, lookahead=True)
+    without = demo_runs[False]
+    assert [a.fixed_added for a in run.attempts] == [a.fixed_added for a in without.attempts]
+    assert run.n_lock == without.n_lock and run.n_skipped == 0
+
+
+def test_generate_command_passes_lookahead_to_the_log(tmp_path):
+    from rigidfold.cli import main
+
+    out = tmp_path / "gen"
+    case = ["--surface", "bezier", "--seed", "1", "--pattern", "1", "--target-dof", "20"]
+    assert (
+        main(["generate", *case, "--lookahead", "--no-deform", "--quiet", "--out", str(out)]) == 0
+    )
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["options"]["lookahead"] is True and summary["n_skipped"] == 0
+    (first, second) = json.loads((out / "log.json").read_text())["attempts"]
+    assert first["predicted_locks"] is None and second["predicted_locks"] == []
+    assert second["skipped"] == 0 and second["skipped_locks"] == []
