@@ -73,3 +73,11 @@ def test_develop_reads_a_y_up_file(miura_file, tmp_path, capsys):
     assert out["rigidfold:input"]["up"] == "y"
     folded = read_fold(tmp_path / "y" / "miura_y.fold", frame=2).pattern  # rigidfold's, z up
     np.testing.assert_allclose(folded.coords, read_fold(miura_file).pattern.coords, atol=1e-15)
+
+
+def test_develop_refuses_to_replace_its_input(miura_file, tmp_path):
+    before = miura_file.read_bytes()
+    proc = run_cli("develop", str(miura_file), "--out", str(miura_file.parent))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and "would replace the input" in proc.stderr
+    assert miura_file.read_bytes() == before

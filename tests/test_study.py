@@ -501,3 +501,15 @@ def test_old_databases_resume_with_the_new_attempt_columns(tmp_path):
     assert causes["missed_left_median"] == 0.5
     runs = {seed: rows for _, seed, rows in store.attempt_runs("bezier", ("skipped_locks",))}
     assert runs[5] == [([{"fixed": [1], "locks": [2]}],)] and runs[0][0] == (None,)
+
+
+def test_report_figures_never_follow_a_link(uninterrupted, tmp_path):
+    outside = tmp_path / "outside.png"
+    outside.write_bytes(b"keep")
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "n_lock_pattern_1.png").symlink_to(outside)
+    write_report(Store(uninterrupted, readonly=True), out)
+    assert outside.read_bytes() == b"keep"
+    png = out / "n_lock_pattern_1.png"
+    assert not png.is_symlink() and png.read_bytes().startswith(b"\x89PNG")

@@ -169,9 +169,16 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
     nothing of the input is dropped or rewritten, so its unit, orientation, polygons and
     assignments stay as they were (:func:`rigidfold.io.round_trip_dict`)."""
     out_dir = prepare_output_dir(out)
+    stem = Path(path).stem
+    names = [f"{stem}.fold", f"{stem}.svg"] + ([f"{stem}_deform.json"] if deform else [])
+    for name in names:  # before any work: a file written must never replace the input
+        if (out_dir / name).resolve() == Path(path).resolve():
+            raise ValueError(
+                f"the output {str(out_dir / name)!r} would replace the input file; "
+                "choose another output directory"
+            )
     data = read_fold(path, up=up, settings=settings)
     check = verify(data.pattern, run_deform=deform, run_motion=deform, settings=settings)
-    stem = Path(path).stem
     written = write_checked_shape(
         out_dir / f"{stem}.fold",
         data.pattern,

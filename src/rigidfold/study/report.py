@@ -6,6 +6,7 @@ PNG figures (matplotlib, imported only here).
 
 from __future__ import annotations
 
+import io
 import itertools
 import math
 from collections import Counter
@@ -14,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.generate import AttemptOutcome, Stop
+from rigidfold.io import atomic_write, prepare_output_dir
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import CITATION, TABLE_7_8_ROWS, TABLES_5_6, TABLES_7_8
 from rigidfold.study.runner import PRESETS
@@ -689,8 +691,10 @@ def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
         ax.set_title(f"Crease pattern {pattern}: locked shapes per run ({len(data[0])} surfaces)")
         fig.tight_layout()
         name = f"{prefix}n_lock_pattern_{pattern}.png"
-        fig.savefig(out / name)
+        png = io.BytesIO()
+        fig.savefig(png, format="png")
         plt.close(fig)
+        atomic_write(out / name, png.getvalue())  # like every other file: no link followed
         files[pattern] = name
     return files
 
@@ -698,7 +702,6 @@ def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
 def write_report(stores: Store | list[Store], out: str | Path) -> Path:
     """Write DIR/results.md and the box plots of one or several databases; returns the
     Markdown path. With several databases the figures are prefixed by the database's name."""
-    from rigidfold.io import atomic_write, prepare_output_dir
 
     stores = [stores] if isinstance(stores, Store) else list(stores)
     out = prepare_output_dir(out)
