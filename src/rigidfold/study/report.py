@@ -688,7 +688,7 @@ def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
         ax.boxplot(data, tick_labels=[LABEL[c] for c in crits])
         ax.set_yscale("symlog", linthresh=1.0)
         ax.set_ylabel("N_lock per run")
-        ax.set_title(f"Crease pattern {pattern}: locked shapes per run ({len(data[0])} surfaces)")
+        ax.set_title(f"Pattern {pattern}: N_lock per run, {len(data[0])} surfaces", fontsize=10)
         fig.tight_layout()
         name = f"{prefix}n_lock_pattern_{pattern}.png"
         png = io.BytesIO()
