@@ -505,8 +505,7 @@ def _check_plan(coords: np.ndarray, triangles: np.ndarray, up: str, tol: float) 
     """ValueError when the triangles' projection onto the xy plane has (near) zero area:
     a y-up file, a vertical sheet, a closed box or a flat-folded state, which reversing the
     faces would not mend (:class:`CreasePattern` checks the sign)."""
-    plan = geometry.projected_area(coords, triangles)
-    if abs(plan) > tol * geometry.face_areas(coords, triangles).sum():
+    if not geometry.plan_area(coords, triangles, tol)[2]:
         return
     if up == "z":
         raise ValueError(

@@ -65,6 +65,14 @@ def projected_area(coords: np.ndarray, faces: np.ndarray) -> float:
     return 0.5 * float(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]))
 
 
+def plan_area(coords: np.ndarray, faces: np.ndarray, tol: float) -> tuple[float, float, bool]:
+    """(signed projected area, surface area, whether the projection has zero area): the plan
+    is zero when ``|projected| <= tol * surface`` (a vertical, closed or flat-folded sheet)."""
+    plan = projected_area(coords, faces)
+    surface = float(face_areas(coords, faces).sum())
+    return plan, surface, abs(plan) <= tol * surface
+
+
 def edge_lengths(coords: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Edge lengths.  edges : (E, 2) int  ->  (E,) float"""
     return np.linalg.norm(coords[edges[:, 1]] - coords[edges[:, 0]], axis=1)

@@ -90,8 +90,8 @@ class CreasePattern:
             raise ValueError(
                 f"face {f} {tuple(faces[f].tolist())} is degenerate (area {areas[f]:.3g} m^2)"
             )
-        plan, surface = geometry.projected_area(coords, faces), float(areas.sum())
-        if abs(plan) <= self.settings.plan_area_tol * surface:
+        plan, surface, zero = geometry.plan_area(coords, faces, self.settings.plan_area_tol)
+        if zero:
             raise ValueError(
                 f"the faces' projection onto the xy plane has zero area ({plan:.3g} m^2 for "
                 f"{surface:.3g} m^2 of faces): rigidfold needs a sheet with z up"
