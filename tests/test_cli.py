@@ -76,7 +76,7 @@ def test_optimize_symmetric_expression(tmp_path):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--surface", "cone", "--pattern", "1"], "invalid choice: 'cone'"),
+        (["--surface", "cone", "--pattern", "1"], "unknown surface 'cone' (choose from bezier"),
         (["--surface", "bezier", "--pattern", "9"], "unknown pattern '9'"),
         (["--surface", "bezier", "--pattern", "1", "--dz", "0"], "dz must be a positive"),
         (["--surface", "bezier", "--pattern", "1", "--dz", "-1"], "dz must be a positive"),

@@ -486,7 +486,22 @@ BAD_DICTS = {
     "lower-case letter": (set_item("edges_assignment", 2, "m"), r"edges_assignment\[2\]"),
     "list as letter": (set_item("edges_assignment", 2, ["M"]), r"edges_assignment\[2\]"),
     "cut": (set_item("edges_assignment", 3, "C"), r'edge 3 is a cut \("C"\)'),
-    "boundary join": (set_item("edges_assignment", 0, "J"), 'edge 0 is assigned "J"'),
+    "boundary join": (
+        set_item("edges_assignment", 0, "J"),
+        r'edge 0 is a fixed crease \("J" or rigidfold:fixed\) but lies on the boundary',
+    ),
+    "fixed marks not booleans": (
+        set_key("edges_rigidfold:fixed", [1] * 12),
+        "edges_rigidfold:fixed must be a list of 12 booleans",
+    ),
+    "fixed marks too short": (
+        set_key("edges_rigidfold:fixed", [False] * 11),
+        "edges_rigidfold:fixed must be a list of 12 booleans",
+    ),
+    "boundary marked fixed": (
+        set_key("edges_rigidfold:fixed", [True] + [False] * 11),
+        "edge 0 is a fixed crease",
+    ),
     "duplicate edge": (set_item("edges_vertices", 1, [1, 0]), "contains edge .* twice"),
     "edge in no face": (set_item("edges_vertices", 1, [0, 4]), "belongs to no face"),
     "non-manifold": (

@@ -7,15 +7,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from rigidfold import patterns
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.io.fold import read_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
 from rigidfold.protocols import SymmetryPlane, TargetSurface
-from rigidfold.surfaces import Surface, get_surface
+from rigidfold.surfaces import Surface, get_surface, placed_mesh
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,25 +72,43 @@ def make_case(
     size: str | tuple[float, float] | None = None,
     diagonals: str | None = None,
     edge_length: float | None = None,
+    scale: float | None = None,
+    up: str = "z",
+    rigid_panels: bool = False,
     settings: Settings = DEFAULTS,
 ) -> Case:
     """Validate the user's choices and build the initial triangulated shape.
 
-    surface : a name ("bezier", "dome", "hp", "expr") or a Surface. A named built-in surface
-        is scaled to the bounding box of the pattern's plan (the paper's surfaces on the 3 m
-        square); an "expr" surface and a Surface object are used as they are.
+    surface : a spec of :func:`rigidfold.surfaces.get_surface` ("bezier", "dome", "hp",
+        "expr", "mesh:FILE"), "fold:FILE" (the 3D shape of a FOLD file's top frame, in
+        metres, fitted like a mesh) or a Surface. A named built-in surface is scaled to the
+        bounding box of the pattern's plan (the paper's surfaces on the 3 m square); a mesh
+        is placed with its plan's lower-left corner at (0, 0); an "expr" surface and a
+        Surface object are used as they are.
     pattern : a spec of :func:`rigidfold.patterns.parse_pattern` ("1", "1p", "2", "11",
-        "grid:NXxNY", "mesh:POLYGON"), with its ``size``, ``diagonals`` and ``edge_length``.
+        "grid:NXxNY", "mesh:POLYGON", "FILE.fold", "FILE.svg"), with its ``size``,
+        ``diagonals``, ``edge_length``, ``scale`` and ``rigid_panels``.
+    up : the up axis (``"z"`` or ``"y"``) of a FOLD pattern and of a mesh or FOLD surface.
     ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
     """
     plan = patterns.parse_pattern(
-        pattern, size=size, diagonals=diagonals, edge_length=edge_length, settings=settings
+        pattern,
+        size=size,
+        diagonals=diagonals,
+        edge_length=edge_length,
+        scale=scale,
+        up=up,
+        rigid_panels=rigid_panels,
+        settings=settings,
     )
-    surf = (
-        surface
-        if isinstance(surface, Surface)
-        else get_surface(surface, seed=seed, expr=expr, box=plan.box)
-    )
+    if isinstance(surface, Surface):
+        surf = surface
+    elif str(surface).partition(":")[0].strip().lower() == "fold":
+        path = str(surface).partition(":")[2].strip()
+        shape = read_fold(path, up=up, settings=settings).pattern
+        surf = placed_mesh(shape.coords, shape.faces, source=Path(path).name, settings=settings)
+    else:
+        surf = get_surface(surface, seed=seed, expr=expr, box=plan.box, up=up, settings=settings)
     shape = patterns.build(plan, surf, settings=settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:

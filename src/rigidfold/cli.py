@@ -18,7 +18,7 @@ from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.selection import CRITERIA
 from rigidfold.study import STUDY_DEFAULTS
-from rigidfold.surfaces import SURFACES
+from rigidfold.surfaces import SURFACE_FORMS
 
 EXIT_USAGE = 2
 LOOKAHEAD_HELP = (
@@ -176,7 +176,15 @@ def _file_command(sub, name: str, func, *, out: bool = False, **text: str) -> No
 
 
 def _case_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--surface", required=True, choices=SURFACES)
+    p.add_argument(
+        "--surface",
+        required=True,
+        metavar="SURFACE",
+        help=f"target surface: {SURFACE_FORMS}. bezier, dome, hp: the paper's, scaled to the "
+        "pattern's plan; expr: z = f(x, y) of --expr in metres; mesh:FILE: an OBJ, STL, PLY or "
+        "OFF mesh, fitted by a smooth surface; fold:FILE: the 3D shape of a FOLD file. A mesh "
+        "is placed like the pattern, the lower-left corner of its plan at (0, 0)",
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
     p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
     p.add_argument(
@@ -185,13 +193,36 @@ def _case_options(p: argparse.ArgumentParser) -> None:
         help=f"crease pattern: {FORMS}. 1, 1p, 2, 11: the paper's, on 3 m x 3 m; grid:NXxNY: "
         "NX x NY vertices over --size with --diagonals; mesh:POLYGON: a quality triangulation "
         "of the polygon 'x1,y1;x2,y2;...' in metres, or of a file of 'x,y' lines, with "
-        "--edge-length. The plan is placed with the lower-left corner of its bounding box at "
-        "(0, 0); the built-in surfaces scale to that box, --expr is in metres as given",
+        "--edge-length; FILE.fold, FILE.svg: a crease pattern drawn in another tool (SVG in "
+        "Origami Simulator's colours: red mountain, blue valley, black boundary, yellow flat), "
+        "in its own unit or, drawn without one, fitted into --size. The plan is placed with "
+        "the lower-left corner of its bounding box at (0, 0); the built-in surfaces scale to "
+        "that box, --expr is in metres as given",
     )
     p.add_argument(
         "--size",
         metavar="WxH",
-        help="metres, of a grid: pattern (default {:g}x{:g})".format(*DEFAULT_SIZE),
+        help="metres, of a grid: pattern, or the box a FOLD or SVG file drawn without units is "
+        "fitted into, aspect ratio kept (default {:g}x{:g})".format(*DEFAULT_SIZE),
+    )
+    p.add_argument(
+        "--scale",
+        type=_positive,
+        metavar="M_PER_UNIT",
+        help="metres per unit of a FOLD or SVG file drawn without units (instead of --size)",
+    )
+    p.add_argument(
+        "--rigid-panels",
+        action="store_true",
+        help="a FOLD or SVG file's polygon faces are rigid flat panels: the diagonals that "
+        "triangulate them start as fixed creases (default: free creases)",
+    )
+    p.add_argument(
+        "--up",
+        default=UP_AXES[0],
+        choices=UP_AXES,
+        help="the up axis of a FOLD pattern and of a mesh: or fold: surface: y for files drawn "
+        "y-up (Blender, Origami Simulator)",
     )
     p.add_argument(
         "--diagonals",
@@ -250,6 +281,9 @@ def _case(args: argparse.Namespace):
         size=args.size,
         diagonals=args.diagonals,
         edge_length=args.edge_length,
+        scale=args.scale,
+        up=args.up,
+        rigid_panels=args.rigid_panels,
         settings=settings,
     )
 

@@ -370,6 +370,7 @@ def read_fold(
     frame: int = 0,
     *,
     up: str = "z",
+    rigid_panels: bool = True,
     settings: Settings = DEFAULTS,
 ) -> FoldData:
     """Read a FOLD file (or an already parsed FOLD dict) into a crease pattern, in metres.
@@ -385,6 +386,10 @@ def read_fold(
     up : str
         The file's up axis (:data:`UP_AXES`): ``"z"``, or ``"y"`` for a file drawn y-up
         (Blender, Origami Simulator), whose (x, y, z) becomes (x, -z, y).
+    rigid_panels : bool
+        True (a shape): every polygon face is a rigid planar panel, the diagonals added to
+        triangulate it are fixed creases (``"J"``). False (a crease pattern to be lifted onto
+        a surface): they are free creases (``"U"``).
     settings : Settings
         Tolerances: ``triangulation_area_tol`` for polygon faces, ``plan_area_tol`` for the
         plan, and those of the pattern (:attr:`CreasePattern.settings`: ``degenerate_area``,
@@ -396,25 +401,26 @@ def read_fold(
         The triangulated pattern and what the file says about it. Coordinates are converted
         from the frame's ``frame_unit`` (:data:`UNITS`; none or ``"unit"``: read as metres,
         :attr:`FoldData.unitless`) to metres; 2D coordinates get z = 0; polygon faces are
-        ear-clipped in their best-fit plane, each diagonal an added ``"J"`` edge; edges that
-        the file omits are derived from the faces. If the faces are consistently oriented
-        but clockwise seen from +z in total, all are reversed. Edges assigned ``"J"`` are
-        fixed creases, all other interior edges free creases.
+        ear-clipped in their best-fit plane, each diagonal an added edge (see
+        ``rigid_panels``); edges that the file omits are derived from the faces. If the faces
+        are consistently oriented but clockwise seen from +z in total, all are reversed. Edges
+        assigned ``"J"`` or marked true in ``edges_rigidfold:fixed`` (a list of booleans, one
+        per file edge) are fixed creases, all other interior edges free creases.
 
     Raises
     ------
     ValueError
         One line naming the file and the problem: unreadable file, invalid JSON, missing or
         malformed keys, an unknown ``frame_unit``, non-finite coordinates, indices out of
-        range, cut edges (``"C"``), a boundary edge assigned ``"J"``, faces whose projection
-        onto the xy plane has zero area (a y-up file, a closed or flat-folded sheet), a
-        surface that is not an oriented disc.
+        range, cut edges (``"C"``), a boundary edge assigned ``"J"`` or marked fixed, faces
+        whose projection onto the xy plane has zero area (a y-up file, a closed or
+        flat-folded sheet), a surface that is not an oriented disc.
     """
     if up not in UP_AXES:
         raise ValueError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
     label, raw = _load(source)
     try:
-        return _parse(raw, frame, up, settings)
+        return _parse(raw, frame, up, rigid_panels, settings)
     except ValueError as exc:
         raise ValueError(f"{label}: {' '.join(str(exc).split())}") from None
 
@@ -456,7 +462,7 @@ def _load(source) -> tuple[str, dict]:
     return str(path), raw
 
 
-def _parse(raw: dict, frame: int, up: str, settings: Settings) -> FoldData:
+def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Settings) -> FoldData:
     data = _frame(raw, frame)
     unit = data.get("frame_unit", "unit")
     if not isinstance(unit, str) or unit not in UNITS:
@@ -469,13 +475,14 @@ def _parse(raw: dict, frame: int, up: str, settings: Settings) -> FoldData:
         coords = coords[:, [0, 2, 1]] * [1.0, -1.0, 1.0]
     polygons = _polygons(data, len(coords))
     file_edges, file_assignment = _file_edges(data, len(coords))
+    file_assignment = _mark_fixed(data, file_edges, file_assignment)
     triangles, diagonals = triangulate_polygons(
         coords, polygons, area_tol=settings.triangulation_area_tol, name="faces_vertices"
     )
     triangles = orient_up(coords, triangles)
     _check_plan(coords, triangles, up, settings.plan_area_tol)
     edges, assignment = _complete_edges(
-        file_edges, file_assignment, diagonals, triangles, len(coords)
+        file_edges, file_assignment, diagonals, "J" if rigid_panels else "U", triangles, len(coords)
     )
     fixed = np.array([a == "J" for a in assignment], dtype=bool)
     pattern = CreasePattern(
@@ -602,18 +609,41 @@ def _file_edges(data: dict, n_vertices: int) -> tuple[list[tuple[int, int]], lis
     return edges, list(assignment)
 
 
+def _mark_fixed(
+    data: dict, file_edges: list[tuple[int, int]], assignment: list[str] | None
+) -> list[str] | None:
+    """The file's assignment with the edges marked in ``edges_rigidfold:fixed`` made ``"J"``
+    (the others of a file without assignments are ``""``, derived by :func:`_complete_edges`)."""
+    key = f"edges_{PREFIX}fixed"
+    if key not in data:
+        return assignment
+    marks = data[key]
+    if not (
+        isinstance(marks, list)
+        and len(marks) == len(file_edges)
+        and all(isinstance(m, bool) for m in marks)
+    ):
+        raise ValueError(
+            f"{key} must be a list of {len(file_edges)} booleans (one per edge in "
+            f"edges_vertices), got {_kind(marks)}"
+        )
+    letters = list(assignment) if assignment is not None else [""] * len(file_edges)
+    return ["J" if m else a for m, a in zip(marks, letters, strict=True)]
+
+
 def _complete_edges(
     file_edges: list[tuple[int, int]],
     file_assignment: list[str] | None,
     diagonals: list[tuple[int, int]],
+    diagonal_letter: str,
     triangles: np.ndarray,
     n_vertices: int,
 ) -> tuple[np.ndarray, list[str]]:
     """Edges (E, 2) and their assignments: file edges, then diagonals, then derived edges.
 
     Edges derived from the triangles, and file edges without an assignment, are ``"B"`` when
-    one triangle uses them and ``"U"`` otherwise; diagonals are ``"J"``. Raises ValueError for
-    a boundary edge assigned ``"J"``.
+    one triangle uses them and ``"U"`` otherwise; diagonals are ``diagonal_letter``. Raises
+    ValueError for a boundary edge assigned ``"J"``.
     """
 
     def key(u: int, v: int) -> int:
@@ -627,16 +657,16 @@ def _complete_edges(
     def derived(u: int, v: int) -> str:
         return "B" if key(u, v) in boundary else "U"
 
-    if file_assignment is None:
-        assignment = [derived(u, v) for u, v in file_edges]
-    else:
-        assignment = list(file_assignment)
+    letters = file_assignment or [""] * len(file_edges)
+    assignment = [a or derived(u, v) for a, (u, v) in zip(letters, file_edges, strict=True)]
     for e, (u, v) in enumerate(file_edges):
         if assignment[e] == "J" and key(u, v) in boundary:
-            raise ValueError(f'edge {e} is assigned "J" (a fixed crease) but lies on the boundary')
+            raise ValueError(
+                f'edge {e} is a fixed crease ("J" or {PREFIX}fixed) but lies on the boundary'
+            )
     edges = list(file_edges)
     known = {key(u, v) for u, v in edges}
-    candidates = [(u, v, "J") for u, v in diagonals]
+    candidates = [(u, v, diagonal_letter) for u, v in diagonals]
     candidates += [(u, v, derived(u, v)) for u, v in topology.edges_from_faces(triangles).tolist()]
     for u, v, letter in candidates:
         if key(u, v) not in known:

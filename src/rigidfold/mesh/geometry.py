@@ -58,11 +58,19 @@ def face_areas(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
 
 
-def projected_area(coords: np.ndarray, faces: np.ndarray) -> float:
-    """Signed area of the faces projected on the xy plane (positive when CCW from +z)."""
+def plan_face_areas(coords: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Signed areas of the triangles projected on the xy plane, positive when CCW from +z.
+
+    coords : (V, 2) or (V, 3) float; faces : (F, 3) int  ->  (F,) float
+    """
     p = coords[faces, :2]
     a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    return 0.5 * float(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]))
+    return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+
+
+def projected_area(coords: np.ndarray, faces: np.ndarray) -> float:
+    """Signed area of the faces projected on the xy plane (positive when CCW from +z)."""
+    return float(np.sum(plan_face_areas(coords, faces)))
 
 
 def plan_area(coords: np.ndarray, faces: np.ndarray, tol: float) -> tuple[float, float, bool]:

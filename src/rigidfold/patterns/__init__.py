@@ -1,4 +1,5 @@
-"""Crease patterns in plan (the paper's, grids and footprint meshes), lifted onto a surface."""
+"""Crease patterns in plan (the paper's, grids, footprint meshes, FOLD and SVG files), lifted
+onto a surface."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
+from rigidfold.patterns.files import FILE_FORMATS, PatternFile, is_pattern_file, read_pattern_file
 from rigidfold.patterns.footprint import check_footprint, footprint_mesh, read_footprint
 from rigidfold.patterns.grids import DIAGONALS, grid, grid11, pattern1, pattern1p, pattern2
 from rigidfold.patterns.miura import miura
@@ -42,20 +44,25 @@ def build(
         raise ValueError(
             f"surface {surface!r} is not finite at (x, y) = ({xy[bad, 0]:g}, {xy[bad, 1]:g})"
         )
-    return CreasePattern.from_faces(np.column_stack([xy, z]), plan.faces, settings=settings)
+    return CreasePattern.from_faces(
+        np.column_stack([xy, z]), plan.faces, plan.fixed, settings=settings
+    )
 
 
 __all__ = [
     "DEFAULT_SIZE",
     "DIAGONALS",
+    "FILE_FORMATS",
     "FORMS",
     "PATTERNS",
+    "PatternFile",
     "Plan",
     "build",
     "check_footprint",
     "footprint_mesh",
     "grid",
     "grid11",
+    "is_pattern_file",
     "miura",
     "parse_pattern",
     "parse_size",
@@ -63,4 +70,5 @@ __all__ = [
     "pattern1p",
     "pattern2",
     "read_footprint",
+    "read_pattern_file",
 ]

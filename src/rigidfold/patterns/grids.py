@@ -17,6 +17,10 @@ from scipy.spatial import Delaunay
 DIAGONALS = ("centre", "parallel", "alternate")
 """How :func:`grid` splits each rectangle: see its docstring."""
 
+DEFAULT_SIZE = (3.0, 3.0)
+"""Width and height (metres) of a ``grid:`` pattern without a size, and the box a drawing
+without units is fitted into: the paper's square."""
+
 
 def grid(
     nx: int, ny: int, width: float = 3.0, height: float = 3.0, diagonals: str = "centre"

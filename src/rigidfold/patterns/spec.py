@@ -1,4 +1,5 @@
-"""Pattern specs: the paper's names, ``grid:NXxNY`` and ``mesh:POLYGON``, parsed into a plan.
+"""Pattern specs: the paper's names, ``grid:NXxNY``, ``mesh:POLYGON`` and FOLD or SVG files,
+parsed into a plan.
 
 Every plan is placed with the lower-left corner of its bounding box at (0, 0), the frame in
 which the target surfaces are given (``rigidfold.surfaces``).
@@ -8,13 +9,22 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.patterns.files import is_pattern_file, read_pattern_file
 from rigidfold.patterns.footprint import default_edge_length, footprint_mesh, read_footprint
-from rigidfold.patterns.grids import DIAGONALS, grid, grid11, pattern1, pattern1p, pattern2
+from rigidfold.patterns.grids import (
+    DEFAULT_SIZE,
+    DIAGONALS,
+    grid,
+    grid11,
+    pattern1,
+    pattern1p,
+    pattern2,
+)
 
 PATTERNS: dict[str, Callable[[], tuple[np.ndarray, np.ndarray]]] = {
     "1": pattern1,
@@ -24,11 +34,8 @@ PATTERNS: dict[str, Callable[[], tuple[np.ndarray, np.ndarray]]] = {
 }
 """The paper's patterns: name -> function returning plan vertices (V, 2) and triangles (F, 3)."""
 
-FORMS = f"{', '.join(PATTERNS)}, grid:NXxNY or mesh:POLYGON"
+FORMS = f"{', '.join(PATTERNS)}, grid:NXxNY, mesh:POLYGON, FILE.fold or FILE.svg"
 """The forms of a pattern spec, for messages and help texts."""
-
-DEFAULT_SIZE = (3.0, 3.0)
-"""Width and height (metres) of a ``grid:`` pattern without a size: the paper's square."""
 
 _COUNTS = re.compile(r"\s*(\d+)\s*[xX]\s*(\d+)\s*")
 
@@ -37,21 +44,25 @@ _COUNTS = re.compile(r"\s*(\d+)\s*[xX]\s*(\d+)\s*")
 class Plan:
     """A crease pattern in plan, and how it was made.
 
-    spec : str, the pattern as given ("1", "grid:15x9", "mesh:0,0;12,0;12,8;0,8");
+    spec : str, the pattern as given ("1", "grid:15x9", "mesh:0,0;12,0;12,8;0,8", "cp.fold");
     xy : (V, 2) float64 plan vertices, the lower-left corner of their bounding box at (0, 0);
     faces : (F, 3) int64 triangles, counter-clockwise seen from +z;
+    fixed : (k, 2) int64 vertex pairs of the crease lines that start fixed (a file's);
     diagonals : str of a ``grid:`` pattern, else None;
     edge_length : float, the target edge length (metres) of a ``mesh:`` pattern, else None;
     footprint : (N, 2) float64 counter-clockwise polygon of a ``mesh:`` pattern, placed as
-        ``xy``, else None.
+        ``xy``, else None;
+    source : dict of a pattern read from a file (:attr:`files.PatternFile.source`), else None.
     """
 
     spec: str
     xy: np.ndarray
     faces: np.ndarray
+    fixed: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     diagonals: str | None = None
     edge_length: float | None = None
     footprint: np.ndarray | None = None
+    source: dict | None = None
 
     @property
     def box(self) -> tuple[float, float]:
@@ -67,6 +78,7 @@ class Plan:
             "diagonals": self.diagonals,
             "edge_length_m": self.edge_length,
             "footprint_m": None if self.footprint is None else self.footprint.tolist(),
+            "pattern_file": self.source,
         }
 
 
@@ -76,6 +88,9 @@ def parse_pattern(
     size: str | tuple[float, float] | None = None,
     diagonals: str | None = None,
     edge_length: float | None = None,
+    scale: float | None = None,
+    up: str = "z",
+    rigid_panels: bool = False,
     settings: Settings = DEFAULTS,
 ) -> Plan:
     """The plan of a pattern spec; a one-line ValueError naming what was received if bad.
@@ -85,15 +100,26 @@ def parse_pattern(
         ``mesh:POLYGON``, a quality triangulation of a simple polygon given as
         ``x1,y1;x2,y2;...`` in metres or as a file of ``x,y`` lines
         (:func:`footprint.footprint_mesh`), translated so that its bounding box starts at
-        (0, 0).
-    size : "WxH" or (W, H) in metres, of a ``grid:`` pattern only (default 3 x 3);
+        (0, 0); ``FILE.fold`` or ``FILE.svg``, a crease pattern drawn in another tool
+        (:func:`files.read_pattern_file`), scaled and translated likewise.
+    size : "WxH" or (W, H) in metres, of a ``grid:`` pattern (default 3 x 3), or the box a
+        file drawn without units is fitted into (default 3 x 3);
+    scale : metres per unit of a file drawn without units (instead of fitting it into size);
+    up : the up axis of a FOLD file, ``"z"`` or ``"y"`` (ignored by the other forms);
+    rigid_panels : a file's polygon faces are rigid panels (their added diagonals fixed);
     diagonals : "centre" (default), "parallel" or "alternate", of a ``grid:`` pattern only;
     edge_length : target edge length in metres of a ``mesh:`` pattern only (default
         :func:`footprint.default_edge_length`);
     settings : theta_min and the pattern limits (``mesh_*``, ``max_pattern_faces``).
     """
     text = str(spec).strip()
-    given = {"size": size, "diagonals": diagonals, "edge length": edge_length}
+    given = {
+        "size": size,
+        "diagonals": diagonals,
+        "edge length": edge_length,
+        "scale": scale,
+        "rigid panels": rigid_panels or None,
+    }
     kind, colon, rest = text.partition(":")
     kind = kind.strip().lower()
     if not colon and text in PATTERNS:
@@ -123,6 +149,17 @@ def parse_pattern(
         length = default_edge_length(outline, settings) if edge_length is None else edge_length
         xy, faces = footprint_mesh(outline, length, settings)
         return Plan(text, xy, faces, edge_length=float(length), footprint=outline)
+    if is_pattern_file(text):
+        _refuse_options(text, given, keep=("size", "scale", "rigid panels"))
+        read = read_pattern_file(
+            text,
+            size=None if size is None else parse_size(size),
+            scale=scale,
+            up=up,
+            rigid_panels=rigid_panels,
+            settings=settings,
+        )
+        return Plan(text, read.xy, read.faces, fixed=read.fixed, source=read.source)
     raise ValueError(f"unknown pattern {spec!r} (choose from {FORMS})")
 
 
@@ -148,5 +185,6 @@ def _refuse_options(text: str, given: dict, keep: tuple[str, ...]) -> None:
     if extra:
         raise ValueError(
             f"pattern {text!r} takes no {' or '.join(extra)} (a size and diagonals are for "
-            "grid:NXxNY patterns, an edge length for mesh:POLYGON)"
+            "grid:NXxNY patterns, an edge length for mesh:POLYGON, a size, scale and rigid "
+            "panels for FOLD and SVG files)"
         )

@@ -1,0 +1,159 @@
+"""Crease patterns drawn in other tools: FOLD files and SVG drawings, read as plans.
+
+A FOLD file (Origami Simulator, Rabbit Ear, a CAD exporter, rigidfold itself) gives its
+``vertices_coords`` in plan: a flat crease pattern as drawn, a 3D folded form by its
+projection onto the xy plane (``up="y"`` first turns a y-up file). An SVG drawing in Origami
+Simulator's colours (:mod:`rigidfold.io.svg_read`) gives its lines, split where they cross.
+Polygon faces are triangulated; the diagonals added are free creases, or fixed creases when
+the faces are rigid panels (``rigid_panels``). ``"J"`` edges and edges marked in
+``edges_rigidfold:fixed`` of a FOLD file start as fixed creases.
+
+Every length is metres. A file with a physical unit (FOLD ``frame_unit``, SVG ``width`` in
+mm, cm, in or pt) keeps its size. A drawing without one is scaled to fit inside ``size``
+(default 3 m x 3 m) with its aspect ratio kept, or by ``scale`` metres per drawing unit.
+Then the plan is translated so that the lower-left corner of its bounding box is at (0, 0).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.io.fold import read_fold
+from rigidfold.mesh import geometry
+from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
+from rigidfold.patterns.grids import DEFAULT_SIZE
+
+FILE_FORMATS = {".fold": "FOLD", ".svg": "SVG"}
+"""File name suffixes read as crease patterns, and their formats."""
+
+
+@dataclass(frozen=True, eq=False)
+class PatternFile:
+    """A crease pattern read from a file, in metres, placed at (0, 0).
+
+    xy : (V, 2) float64 plan vertices, the lower-left corner of their bounding box at (0, 0);
+    faces : (F, 3) int64 triangles, counter-clockwise seen from +z;
+    fixed : (k, 2) int64 vertex pairs of the crease lines that start fixed;
+    source : dict, what was read and how: file name, format, unit, metres per unit, up axis,
+        rigid panels, and the size the drawing was fitted into (None when not fitted).
+    """
+
+    xy: np.ndarray
+    faces: np.ndarray
+    fixed: np.ndarray
+    source: dict
+
+
+def is_pattern_file(spec: str) -> bool:
+    """True when a pattern spec names a file by one of the suffixes of :data:`FILE_FORMATS`."""
+    return Path(spec.strip()).suffix.lower() in FILE_FORMATS
+
+
+def read_pattern_file(
+    path: str | os.PathLike,
+    *,
+    size: tuple[float, float] | None = None,
+    scale: float | None = None,
+    up: str = "z",
+    rigid_panels: bool = False,
+    settings: Settings = DEFAULTS,
+) -> PatternFile:
+    """The plan of a FOLD or SVG crease pattern; a one-line ValueError naming the file if bad.
+
+    path : a ``.fold`` or ``.svg`` file;
+    size : (W, H) metres that a drawing without units is fitted into (default 3 x 3);
+    scale : metres per unit of a drawing without units (instead of fitting it into ``size``);
+    up : the up axis of a FOLD file (``"z"`` or ``"y"``; an SVG drawing is a plan already);
+    rigid_panels : the diagonals added to triangulate polygon faces are fixed creases (the
+        faces are rigid flat panels) instead of free ones;
+    settings : the tolerances of reading and triangulating (``triangulation_area_tol``,
+        ``degenerate_area``, ``plan_area_tol``).
+    """
+    path = Path(path)
+    kind = FILE_FORMATS.get(path.suffix.lower())
+    if kind is None:
+        raise ValueError(
+            f"a crease pattern file is {' or '.join(FILE_FORMATS)}, got {os.fspath(path)!r}"
+        )
+    if kind == "FOLD":
+        data = read_fold(path, up=up, rigid_panels=rigid_panels, settings=settings)
+        xy = data.pattern.coords[:, :2]
+        faces = data.pattern.faces
+        fixed = data.pattern.edges[data.pattern.fixed]
+        unit, per_unit = data.unit, data.scale
+    else:
+        from rigidfold.io.svg_read import read_svg
+
+        drawing = read_svg(path, settings=settings)
+        unit, per_unit = drawing.unit, drawing.scale
+        xy = drawing.xy * per_unit
+        coords = np.column_stack([xy, np.zeros(len(xy))])
+        triangles, diagonals = triangulate_polygons(
+            coords,
+            drawing.polygons,
+            area_tol=settings.triangulation_area_tol,
+            name=f"{path}: face",
+        )
+        faces = orient_up(coords, triangles)
+        fixed = np.asarray(diagonals if rigid_panels else [], dtype=np.int64).reshape(-1, 2)
+    xy, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale)
+    _check_unfolded(xy, faces, path, settings)
+    source = {
+        "file": path.name,
+        "format": kind,
+        "unit": unit,
+        "metres_per_unit": per_unit,
+        "up": up if kind == "FOLD" else None,
+        "rigid_panels": rigid_panels,
+        "fitted_into_m": fitted,
+    }
+    return PatternFile(xy - xy.min(axis=0), np.asarray(faces, dtype=np.int64), fixed, source)
+
+
+def _scaled(
+    xy: np.ndarray,
+    path: Path,
+    unit: str,
+    per_unit: float,
+    size: tuple[float, float] | None,
+    scale: float | None,
+) -> tuple[np.ndarray, list[float] | None, float]:
+    """(plan in metres, the size fitted into or None, metres per file unit) of a plan read
+    in metres (a drawing without units: one metre per unit)."""
+    width, height = np.ptp(xy, axis=0)
+    if unit != "unit":
+        if size is not None or scale is not None:
+            raise ValueError(
+                f"{path} is drawn in {unit} ({width:.6g} m x {height:.6g} m): --size and "
+                "--scale are for drawings without units"
+            )
+        return xy, None, per_unit
+    if size is not None and scale is not None:
+        raise ValueError(f"{path}: give --size or --scale, not both")
+    if scale is not None:
+        if not (np.isfinite(scale) and scale > 0):
+            raise ValueError(f"a scale is metres per drawing unit, > 0, got {scale!r}")
+        return xy * scale, None, float(scale)
+    box = DEFAULT_SIZE if size is None else size
+    factor = float(min(box[0] / width, box[1] / height))
+    return xy * factor, list(box), factor
+
+
+def _check_unfolded(xy: np.ndarray, faces: np.ndarray, path: Path, settings: Settings) -> None:
+    """ValueError when a triangle is upside down or edge-on in plan: a folded form whose
+    faces overlap in plan, which cannot be lifted onto a surface z = f(x, y)."""
+    area = geometry.plan_face_areas(xy, faces)
+    longest = float(np.ptp(xy, axis=0).max())
+    bad = np.flatnonzero(area <= settings.degenerate_area * longest**2)
+    if bad.size:
+        f = int(bad[0])
+        how = "upside down (the sheet overlaps itself)" if area[f] < 0 else "vertical (edge-on)"
+        raise ValueError(
+            f"{path}: face {f} {tuple(faces[f].tolist())} is {how} in plan: a folded form "
+            "cannot be lifted onto a surface z = f(x, y); give its crease pattern"
+        )
