@@ -10,6 +10,7 @@ import sqlite3
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -150,6 +151,10 @@ def test_report_pairs_costs_and_commands(uninterrupted):
 def test_plan_and_store_units(tmp_path):
     keys = plan(["1", "2"], ["shat"], 2, first_seed=5)
     assert [(k.seed, k.pattern) for k in keys] == [(5, "1"), (5, "2"), (6, "1"), (6, "2")]
+    twist = str(Path(__file__).parent / "data" / "fold_examples" / "squaretwist.fold")
+    assert [k.pattern for k in plan(["grid:5x4", twist], ["s"], 1)] == ["grid:5x4", twist]
+    with pytest.raises(ValueError, match="a grid pattern is grid:NXxNY"):
+        plan(["grid:5"], ["s"], 1)
     store = Store(tmp_path / "u.sqlite", StudyConfig().as_dict())
     key = Key("bezier", 5, "1", "shat")
     store.add(key, {"status": "x", "version": "v"}, [])

@@ -111,7 +111,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     plan = STUDY_DEFAULTS
     stu.add_argument(
-        "--patterns", default=",".join(plan.patterns), help="comma-separated (default %(default)s)"
+        "--patterns",
+        default=",".join(plan.patterns),
+        help="comma-separated pattern specs with their defaults (the paper's names, "
+        "grid:NXxNY, mesh:FILE, FILE.fold, FILE.svg; default %(default)s)",
     )
     stu.add_argument(
         "--criteria", default=",".join(plan.criteria), help="comma-separated (default %(default)s)"

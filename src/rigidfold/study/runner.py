@@ -18,7 +18,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.optimize import SOLVERS
-from rigidfold.patterns import PATTERNS
+from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
 from rigidfold.study.store import ERROR_PREFIX, Key, Store
 
@@ -57,14 +57,15 @@ def plan(
     patterns: Sequence[str], criteria: Sequence[str], surfaces: int, first_seed: int = 0
 ) -> list[Key]:
     """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1,
-    on any of the library's crease patterns (``rigidfold.patterns.PATTERNS``) and criteria.
+    on crease patterns given by spec (:func:`rigidfold.patterns.parse_pattern` with its
+    defaults: the paper's names, ``grid:NXxNY`` on 3 m x 3 m, ``mesh:FILE``, ``FILE.fold``,
+    ``FILE.svg`` fitted into 3 m x 3 m) and criteria.
 
     Seed-major order (every pattern and criterion of a surface before the next surface), so
     that a study stopped early holds complete surfaces.
     """
     for p in patterns:
-        if p not in PATTERNS:
-            raise ValueError(f"unknown pattern {p!r} (choose from {', '.join(PATTERNS)})")
+        parse_pattern(p)
     for c in criteria:
         if c not in CRITERIA:
             raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
