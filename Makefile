@@ -15,7 +15,7 @@ $(STAMP): $(PY) pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --out out/demo
+	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --out out/demo --overwrite
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -116,3 +117,51 @@ def test_output_path_that_is_a_file(tmp_path):
 def test_help_lists_optimize():
     proc = run_cli("--help")
     assert proc.returncode == 0 and "optimize" in proc.stdout
+
+
+def test_closed_pipe_is_no_traceback():
+    """``rigidfold analyze X --json | head -c 0``: the reader is gone before anything is
+    written."""
+    fold = Path(__file__).parent / "data" / "fold_examples" / "squaretwist.fold"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rigidfold.cli", "analyze", str(fold), "--json"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.close()
+    with proc.stderr:
+        err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141
+    assert "Traceback" not in err and "BrokenPipe" not in err and err == ""
+
+
+def test_version_and_quiet_exit():
+    from rigidfold import __version__
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", "--version"], capture_output=True, text=True
+    )
+    assert proc.returncode == 0 and proc.stdout.strip() == f"rigidfold {__version__}"
+
+
+@pytest.mark.parametrize("verbose", [False, True])
+def test_what_opensees_prints_at_exit_is_hidden_unless_verbose(tmp_path, verbose):
+    fold = Path(__file__).parent / "data" / "fold_examples" / "squaretwist.fold"
+    flags = ["--verbose"] if verbose else []
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "rigidfold.cli",
+            *flags,
+            "deform",
+            str(fold),
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert ("Process 0 Terminating" in proc.stderr) is verbose

@@ -11,6 +11,7 @@ import pytest
 
 import rigidfold.generate as generate_module
 from rigidfold.cli import main
+from rigidfold.config import DEFAULTS
 from rigidfold.io import fold_dict, read_fold, write_fold
 from rigidfold.patterns import miura
 
@@ -67,6 +68,15 @@ def test_generate_writes_solutions_log_and_summary(generated):
     # --no-deform: no Step 9, but the development and the folding motion of every solution
     assert summary["deformation"]["checked"] == 0 and summary["time_s"]["deform"] == 0.0
     assert summary["motion"]["traced"] == 4 and summary["motion"]["max_length_error"] < 1e-3
+    assert summary["verdict"] == {
+        "outcome": "passed",
+        "message": "the target DOF was reached and every check that ran passed",
+        "shortfalls": [],
+        "final_design": "solutions/step_03_dof_18.fold",
+    }
+    for entry in summary["per_solution"]:
+        fit = entry["fit"]
+        assert 0 <= fit["rms_dz_m"] <= fit["max_abs_dz_m"] <= DEFAULTS.dz + 1e-6
     log = json.loads((generated / "log.json").read_text())["attempts"]
     assert len(log) == summary["n_solves"]
     assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1])
@@ -210,3 +220,45 @@ def test_generate_bad_options(tmp_path):
         str(tmp_path),
     )
     assert proc.returncode == 2 and "--target-dof" in proc.stderr
+
+
+SHORT_RUN = ["--surface", "dome", "--pattern", "grid:3x3", "--no-deform", "--quiet"]
+"""A run that stops at DOF 3 (no candidate crease succeeds) in a few seconds."""
+
+
+def test_generate_that_falls_short_exits_1_and_says_why(tmp_path, capsys):
+    assert main(["generate", *SHORT_RUN, "--out", str(tmp_path)]) == 1
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    final = tmp_path / "solutions" / "step_02_dof_03.fold"
+    assert last == (
+        "fell short: target DOF 1 not reached: final DOF 3 (no candidate crease succeeds); "
+        f"final design: {final}"
+    )
+    assert final.is_file()
+    verdict = json.loads((tmp_path / "summary.json").read_text())["verdict"]
+    assert verdict["outcome"] == "fell_short"
+    assert verdict["final_design"] == "solutions/step_02_dof_03.fold"
+
+
+def test_an_earlier_run_is_refused_unless_overwrite(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["generate", *SHORT_RUN, "--out", str(out)]) == 1
+    (out / "notes.txt").write_text("mine")
+    stale = out / "solutions" / "step_99_dof_99.fold"
+    stale.write_text("{}")
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    (outside / "keep.txt").write_text("keep")
+    (out / "figures").symlink_to(outside, target_is_directory=True)
+    capsys.readouterr()
+    assert main(["generate", *SHORT_RUN, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert (
+        len(err) == 1
+        and "holds an earlier run (summary.json, log.json, solutions, figures)" in err[0]
+    )
+    assert stale.exists()  # refused: nothing touched
+    assert main(["generate", *SHORT_RUN, "--out", str(out), "--overwrite"]) == 1
+    assert not stale.exists() and (out / "notes.txt").read_text() == "mine"
+    assert not (out / "figures").exists() and (outside / "keep.txt").read_text() == "keep"
+    assert len(list((out / "solutions").glob("*.fold"))) == 3

@@ -7,11 +7,14 @@ file) is reported as one line on stderr with exit code 2, never a traceback.
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
 import math
+import os
 import sys
 from collections.abc import Sequence
 
+from rigidfold import __version__
 from rigidfold.config import DEFAULTS, HESSIANS
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
@@ -26,6 +29,7 @@ LOOKAHEAD_HELP = (
     "only once every other candidate failed)"
 )
 EXIT_INTERRUPTED = 130
+EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE
 
 
 class _Parser(argparse.ArgumentParser):
@@ -47,13 +51,23 @@ def build_parser() -> argparse.ArgumentParser:
         prog="rigidfold",
         description="Form generation of developable, rigid-foldable origami.",
     )
+    parser.add_argument("--version", action="version", version=f"rigidfold {__version__}")
+    parser.add_argument(
+        "--verbose",
+        action="store_true",
+        help="let through what OpenSees prints when the process ends (hidden by default)",
+    )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     gen = sub.add_parser(
         "generate",
         help="Steps 2-7: fix crease lines one by one down to the target DOF",
         description="Generate developable, rigid-foldable shapes of decreasing DOF. Writes "
-        "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes.",
+        "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes; the "
+        "last line names the final design. Exit code 0 when the target DOF was reached and "
+        "every check that ran (development diagram, folding motion, large deformation) "
+        "passed, 1 when the run fell short (the files are written all the same; the last line "
+        "says what fell short), 2 on bad input, 130 when interrupted.",
     )
     _case_options(gen)
     gen.add_argument("--criterion", default=CRITERIA[0], choices=CRITERIA)
@@ -69,6 +83,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-deform", action="store_true", help="skip the large-deformation check (Step 9)"
     )
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
+    gen.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the files of an earlier run in DIR (refused otherwise); other files in "
+        "DIR are kept",
+    )
     gen.set_defaults(func=_cmd_generate)
 
     _file_command(
@@ -307,7 +327,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
 def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.progress import GenerateProgress
-    from rigidfold.report import RunWriter
+    from rigidfold.report import RunOutcome, RunWriter
     from rigidfold.workflows import generate_case
 
     if args.target_dof < 0:
@@ -321,7 +341,9 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         "symmetric": args.symmetric,
         "deform": not args.no_deform,
     }
-    writer = RunWriter(args.out, _case(args), options, deform=not args.no_deform)
+    writer = RunWriter(
+        args.out, _case(args), options, deform=not args.no_deform, overwrite=args.overwrite
+    )
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
     try:
         run = generate_case(
@@ -348,8 +370,14 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
         f"N_exceed={summary['N_exceed']}, {summary['n_solves']} solves"
     )
-    print(f"wrote {len(writer.files)} solutions, log.json and summary.json to {writer.out}")
-    return 0 if run.solutions else 1
+    print(
+        f"wrote {_count(len(writer.files), 'solution')}, log.json and summary.json to {writer.out}"
+    )
+    verdict = writer.verdict
+    assert verdict is not None  # generate_case ends with writer.finish
+    final = "none" if verdict.final_design is None else writer.out / verdict.final_design
+    print(f"{verdict.outcome.value.replace('_', ' ')}: {verdict.message}; final design: {final}")
+    return 0 if verdict.outcome is RunOutcome.PASSED else 1
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
@@ -478,6 +506,11 @@ def _cmd_study_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _count(n: int, noun: str) -> str:
+    """ "1 solution", "3 solutions"."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def _names(text: str) -> list[str]:
     """Comma-separated names, blanks dropped."""
     return [t.strip() for t in text.split(",") if t.strip()]
@@ -486,14 +519,42 @@ def _names(text: str) -> list[str]:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if not args.verbose:
+        _quiet_exit()
     try:
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, not while Python exits
+        return code
     except ValueError as exc:
         print(f"rigidfold: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("rigidfold: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # the reader went away (``rigidfold analyze X --json | head -1``): stop quietly
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_PIPE
+
+
+_QUIET_EXIT: list[bool] = []
+
+
+def _quiet_exit() -> None:
+    """Silence standard error once Python has finished, so that what OpenSees prints while the
+    process ends ("Process 0 Terminating") does not reach the terminal (``--verbose`` keeps
+    it). Registered first, the hook runs after every other exit handler."""
+    if _QUIET_EXIT:
+        return
+    _QUIET_EXIT.append(True)
+
+    def silence() -> None:
+        sys.stderr.flush()
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stderr.fileno())
+
+    atexit.register(silence)
 
 
 if __name__ == "__main__":

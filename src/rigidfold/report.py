@@ -10,13 +10,16 @@ on disk is always valid.
 
 from __future__ import annotations
 
+import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.deform import MotionStatus, Verification, verify
-from rigidfold.generate import Attempt, Generation, Solution
+from rigidfold.deform import DeformStatus, MotionStatus, Verification, verify
+from rigidfold.develop import DevelopStatus
+from rigidfold.generate import Attempt, Generation, Solution, Stop
 from rigidfold.io import (
     FoldData,
     crease_pattern_frame,
@@ -29,6 +32,118 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
+from rigidfold.status import Outcome
+
+RUN_FILES = ("summary.json", "log.json", "report.html")
+"""The files a generation run writes at the top of its directory."""
+
+RUN_DIRS = ("solutions", "figures", "final")
+"""The directories a generation run writes (solution files, figures, exports)."""
+
+
+class RunOutcome(Outcome):
+    """Whether a generation run delivered: the command's exit code follows it (0 or 1)."""
+
+    PASSED = "passed", "the target DOF was reached and every check that ran passed"
+    FELL_SHORT = "fell_short", "the run fell short"
+
+
+@dataclass(frozen=True)
+class RunVerdict:
+    """The verdict on a finished generation run.
+
+    outcome : RunOutcome; shortfalls : what fell short, one sentence each (empty when
+    passed); final_design : the last solution written (the lowest DOF), None without any.
+    """
+
+    outcome: RunOutcome
+    shortfalls: tuple[str, ...]
+    final_design: Path | None
+
+    @property
+    def message(self) -> str:
+        """One line: what fell short, or that everything passed."""
+        return "; ".join(self.shortfalls) if self.shortfalls else self.outcome.message
+
+    def to_dict(self) -> dict:
+        return {
+            "outcome": self.outcome.value,
+            "message": self.message,
+            "shortfalls": list(self.shortfalls),
+            "final_design": None if self.final_design is None else self.final_design.as_posix(),
+        }
+
+
+def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: int) -> RunVerdict:
+    """The verdict on ``run``: passed when it reached ``target`` (Stop.TARGET_REACHED, or
+    DOF 0 for a target of 0) and every check of every solution that ran passed (development
+    diagram converged, folding motion traced, large deformation reached the plane).
+
+    checks : the figures of each solution's check (``Verification.to_dict()`` with its
+    ``step``), in the order of ``files`` (their FOLD paths, relative to the run's DIR).
+    """
+    short = []
+    reached = run.stop is Stop.TARGET_REACHED or (run.stop is Stop.ZERO_DOF and target == 0)
+    if not run.solutions:
+        short.append(f"no solution: {run.stop_reason}")
+    elif not reached:
+        short.append(
+            f"target DOF {target} not reached: final DOF {run.solutions[-1].mechanism.dof} "
+            f"({run.stop_reason})"
+        )
+    failed: dict[str, list[str]] = {"development": [], "motion": [], "deformation": []}
+    for check, path in zip(checks, files, strict=True):
+        if check["development"]["status"] != DevelopStatus.CONVERGED:
+            failed["development"].append(path.name)
+        if check["motion"] is not None and check["motion"]["status"] != MotionStatus.OK:
+            failed["motion"].append(path.name)
+        deformed = check["deformation"]
+        if deformed is not None and deformed["status"] != DeformStatus.REACHED_PLANE:
+            failed["deformation"].append(path.name)
+    what = {
+        "development": "development diagram (Step 8) failed",
+        "motion": "folding motion not traced",
+        "deformation": "large deformation (Step 9) did not reach the plane",
+    }
+    for stage, names in failed.items():
+        if names:
+            short.append(f"{what[stage]} for {', '.join(names)}")
+    return RunVerdict(
+        RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
+        tuple(short),
+        files[-1] if files else None,
+    )
+
+
+def clear_earlier_run(out: str | Path, *, overwrite: bool) -> Path:
+    """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
+
+    Only rigidfold's own run files (:data:`RUN_FILES`, :data:`RUN_DIRS`) count and are
+    removed; other files in ``out`` stay. A symbolic link among them is removed itself, never
+    followed. Returns ``out`` as a Path. Raises ValueError naming what was found.
+    """
+    out = Path(out)
+    found = [
+        out / n for n in (*RUN_FILES, *RUN_DIRS) if (out / n).is_symlink() or (out / n).exists()
+    ]
+    if not found:
+        return out
+    if not overwrite:
+        raise ValueError(
+            f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
+            "give --overwrite to replace it, or another --out"
+        )
+    try:
+        for path in found:
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+    except OSError as exc:
+        raise ValueError(
+            f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"
+        ) from None
+    return out
 
 
 def verification_frames(check: Verification) -> list[dict]:
@@ -91,16 +206,27 @@ class RunWriter:
     """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date.
 
     ``deform``: run the large-deformation check (Step 9) on every solution; the development
-    diagram (Step 8) and the folding motion always run.
+    diagram (Step 8) and the folding motion always run. ``overwrite``: replace the files of an
+    earlier run in ``out`` (:func:`clear_earlier_run`), which are refused otherwise.
+    ``options["target_dof"]`` is the target the verdict (:meth:`finish`) judges by.
     """
 
-    def __init__(self, out: str | Path, case: Case, options: dict, *, deform: bool = True) -> None:
-        self.out = prepare_output_dir(out)
+    def __init__(
+        self,
+        out: str | Path,
+        case: Case,
+        options: dict,
+        *,
+        deform: bool = True,
+        overwrite: bool = False,
+    ) -> None:
+        self.out = prepare_output_dir(clear_earlier_run(out, overwrite=overwrite))
         self.solutions_dir = prepare_output_dir(self.out / "solutions")
         self.case, self.options, self.deform = case, options, deform
         self.files: list[Path] = []
         self.checks: list[dict] = []
         self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
+        self.verdict: RunVerdict | None = None
 
     def on_attempt(self, run: Generation, attempt: Attempt) -> None:
         write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
@@ -112,7 +238,11 @@ class RunWriter:
         check = verify(pattern, run_deform=self.deform, settings=self.case.settings)
         for stage, t in check.times.items():
             self.stage_times[stage] += t
-        figures = {"step": solution.step, "dof": dof, **check.to_dict()}
+        dz = pattern.coords[:, 2] - np.asarray(
+            self.case.surface.height(pattern.coords[:, 0], pattern.coords[:, 1]), dtype=float
+        )
+        fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
+        figures = {"step": solution.step, "dof": dof, "fit": fit, **check.to_dict()}
         self.checks.append(figures)
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
@@ -132,6 +262,17 @@ class RunWriter:
         )
         self.files.append(path)
         self.write_summary(run)
+
+    def finish(self, run: Generation) -> RunVerdict:
+        """The verdict on the finished run (:func:`run_verdict`), written into summary.json."""
+        self.verdict = run_verdict(
+            run,
+            self.checks,
+            [p.relative_to(self.out) for p in self.files],
+            self.options["target_dof"],
+        )
+        self.write_summary(run)
+        return self.verdict
 
     def write_summary(self, run: Generation) -> None:
         summary = run.to_dict()
@@ -177,5 +318,6 @@ class RunWriter:
                 "options": self.options,
                 "case": self.case.metadata(),
                 "solutions": [str(p.relative_to(self.out)) for p in self.files],
+                "verdict": None if self.verdict is None else self.verdict.to_dict(),
             },
         )

@@ -241,7 +241,8 @@ def generate_case(
     """Steps 2-9 on ``writer.case``, every attempt and solution written by ``writer`` as it
     comes (so an interrupt loses nothing); ``progress(run, attempt)`` after each of them.
     ``lookahead``: skip the candidates predicted to lock (``generate``'s option).
-    ``summary.json`` is written once more at the end."""
+    ``summary.json`` is written once more at the end, with the run's verdict
+    (``writer.verdict``, :func:`rigidfold.report.run_verdict`)."""
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
         writer.on_attempt(run, attempt)
@@ -263,5 +264,5 @@ def generate_case(
         on_attempt=on_attempt,
         on_solution=on_solution,
     )
-    writer.write_summary(run)
+    writer.finish(run)
     return run
