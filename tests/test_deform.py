@@ -119,9 +119,16 @@ def test_generated_one_dof_shape_passes_steps_8_and_9(one_dof_solution):
     assert m.status == "ok" and m.max_length_error < 1e-3
     assert np.abs(m.frames[0][:, 2]).max() < 1e-9
     assert np.allclose(m.frames[-1], one_dof_solution.coords, atol=1e-9)
-    frames = verification_frames(check)
+    frames = verification_frames(one_dof_solution, check)
     assert frames[0]["frame_classes"] == ["creasePattern"]
     assert [f["frame_classes"] for f in frames[1:]] == [["foldedForm"]] * len(m.frames)
+    # every motion frame carries its own fold angles: 0 flat, the design's when folded
+    angles = np.array([f["edges_foldAngle"] for f in frames[1:]])
+    assert np.abs(angles[0]).max() < 1e-6
+    assert np.allclose(angles[-1], np.degrees(one_dof_solution.fold_angles), atol=1e-6)
+    assert np.all(np.abs(angles[1:-1]).max(axis=1) < np.abs(angles[-1]).max() + 1e-6)
+    letters = [f["edges_assignment"] for f in frames[1:]]
+    assert all(row == letters[-1] for row in letters) and "M" in letters[0]
 
 
 def test_deform_cli_json_and_files(tmp_path, capsys):

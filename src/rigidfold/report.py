@@ -146,13 +146,14 @@ def clear_earlier_run(out: str | Path, *, overwrite: bool) -> Path:
     return out
 
 
-def verification_frames(check: Verification) -> list[dict]:
-    """FOLD ``file_frames`` of a checked shape: its development diagram (``creasePattern``),
-    then its folding motion from flat to folded (``foldedForm``) when it was traced."""
+def verification_frames(pattern: CreasePattern, check: Verification) -> list[dict]:
+    """FOLD ``file_frames`` of a checked shape ``pattern``: its development diagram
+    (``creasePattern``), then its folding motion from flat to folded (``foldedForm``, each
+    frame with its own fold angles) when it was traced."""
     frames = [crease_pattern_frame(check.development.coords2d)]
     motion = _traced_motion(check)
     if motion is not None:
-        frames += motion_frames(*motion)
+        frames += motion_frames(pattern, *motion)
     return frames
 
 
@@ -188,7 +189,7 @@ def write_checked_shape(
     if source is None:
         letters = None
         fold = write_fold(
-            path, pattern, frames=verification_frames(check), title=title, metadata=figures
+            path, pattern, frames=verification_frames(pattern, check), title=title, metadata=figures
         )
     else:
         letters = source.shape_assignment()

@@ -232,7 +232,11 @@ def round_trip_dict(
         **_model_keys(pattern, source.shape_assignment()),
         "vertices_coords": np.asarray(coords2d, dtype=float).tolist(),
     }
-    moving = [] if motion is None else motion_frames(*motion, parent=first)
+    moving = (
+        []
+        if motion is None
+        else motion_frames(pattern, *motion, parent=first, assignment=source.shape_assignment())
+    )
     folded = {
         "frame_title": f"rigidfold: {title}",
         "frame_classes": ["foldedForm"],
@@ -265,12 +269,25 @@ def crease_pattern_frame(coords2d: np.ndarray, *, title: str = "development diag
     }
 
 
-def motion_frames(frames: np.ndarray, parameter: np.ndarray, *, parent: int = 0) -> list[dict]:
+def motion_frames(
+    pattern: CreasePattern,
+    frames: np.ndarray,
+    parameter: np.ndarray,
+    *,
+    parent: int = 0,
+    assignment: list[str] | None = None,
+) -> list[dict]:
     """FOLD frames of a folding motion, inheriting topology from frame ``parent``.
 
+    pattern : the folded design (its faces, edges and the crease letters of the motion);
     frames : (K, V, 3) float, vertex positions from flat to folded; parameter : (K,) fraction
-    folded. Each frame is a "foldedForm" titled with its fraction.
+    folded; assignment : E letters every frame carries (default :func:`edge_assignments` of
+    the design, so that a crease still flat in a frame keeps its mountain or valley letter).
+    Each frame is a "foldedForm" titled with its fraction, with its own ``edges_foldAngle``
+    (E,) in degrees, measured on that frame, and ``edges_assignment``: a viewer that follows
+    ``frame_inherit`` does not take the folded design's angles for the flat frame's.
     """
+    letters = edge_assignments(pattern) if assignment is None else list(assignment)
     return [
         {
             "frame_title": f"folding motion: {100 * float(s):.0f}% folded",
@@ -278,6 +295,8 @@ def motion_frames(frames: np.ndarray, parameter: np.ndarray, *, parent: int = 0)
             "frame_parent": parent,
             "frame_inherit": True,
             "vertices_coords": np.asarray(x, dtype=float).tolist(),
+            "edges_assignment": letters,
+            "edges_foldAngle": np.degrees(pattern.with_coords(x).fold_angles).tolist(),
         }
         for x, s in zip(frames, parameter, strict=True)
     ]
