@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS
 from rigidfold.io import UNITS, SvgDrawing, read_svg
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
@@ -31,6 +31,11 @@ def write(tmp_path: Path, body: str, size: str = 'width="100" height="100"') -> 
 def points(xy: np.ndarray) -> list[tuple[float, float]]:
     """Vertex positions as a sorted list, rounded against round-off of transforms."""
     return sorted((round(x, 9) + 0.0, round(y, 9) + 0.0) for x, y in xy)
+
+
+def counts(drawing: SvgDrawing) -> tuple[int, int, int]:
+    """(vertices, edges, faces)."""
+    return len(drawing.xy), len(drawing.edges), len(drawing.polygons)
 
 
 def check_planar(drawing: SvgDrawing) -> None:
@@ -62,6 +67,20 @@ def check_planar(drawing: SvgDrawing) -> None:
 
 
 # --------------------------------------------------------------------------- drawings
+def t_junction(end: str, y: float) -> tuple:
+    """A case of :data:`CASES`: a valley from the left side ending (at ``end``) on a vertical
+    mountain at x = 50, whose vertex there gets ``y`` (y up)."""
+    return (
+        SQUARE
+        + '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
+        + f'<line x1="0" y1="50" {end} stroke="#00f"/>',
+        'width="100" height="100"',
+        (8, 10, 3),
+        {"B": 7, "M": 2, "V": 1},
+        [(0, -100), (0, -50), (0, 0), (50, -100), (50, y), (50, 0), (100, -100), (100, 0)],
+    )
+
+
 CASES = {
     "square with one diagonal": (
         SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="#0000ff"/>',
@@ -79,24 +98,8 @@ CASES = {
         {"B": 4, "M": 2, "V": 2},
         [(0, -100), (0, 0), (50, -50), (100, -100), (100, 0)],
     ),
-    "T-junction": (
-        SQUARE
-        + '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
-        + '<line x1="0" y1="50" x2="50" y2="50" stroke="#00f"/>',
-        'width="100" height="100"',
-        (8, 10, 3),
-        {"B": 7, "M": 2, "V": 1},
-        [(0, -100), (0, -50), (0, 0), (50, -100), (50, -50), (50, 0), (100, -100), (100, 0)],
-    ),
-    "T-junction missed by 1e-3": (
-        SQUARE
-        + '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
-        + '<line x1="0" y1="50" x2="49.999" y2="50.001" stroke="#00f"/>',
-        'width="100" height="100"',
-        (8, 10, 3),
-        {"B": 7, "M": 2, "V": 1},
-        [(0, -100), (0, -50), (0, 0), (50, -100), (50, -50.001), (50, 0), (100, -100), (100, 0)],
-    ),
+    "T-junction": t_junction('x2="50" y2="50"', -50),
+    "T-junction missed by 1e-3": t_junction('x2="49.999" y2="50.001"', -50.001),
     "rect boundary away from the origin, polyline crease": (
         '<rect x="10" y="20" width="80" height="40" stroke="black" fill="white"/>'
         + '<polyline points="10,20 50,40 90,20" stroke="blue" fill="none"/>',
@@ -149,14 +152,10 @@ CASES = {
 
 @pytest.mark.parametrize("case", CASES)
 def test_drawings(tmp_path, case):
-    body, size, (n_vertices, n_edges, n_faces), letters, xy = CASES[case]
+    body, size, sizes, letters, xy = CASES[case]
     drawing = read_svg(write(tmp_path, body, size))
     check_planar(drawing)
-    assert (len(drawing.xy), len(drawing.edges), len(drawing.polygons)) == (
-        n_vertices,
-        n_edges,
-        n_faces,
-    )
+    assert counts(drawing) == sizes
     assert Counter(drawing.assignment) == letters
     assert points(drawing.xy) == xy
     assert (drawing.unit, drawing.scale) == ("unit", 1.0)
@@ -359,30 +358,25 @@ def test_merge_tolerance_is_a_setting(tmp_path):
     with pytest.raises(ValueError, match=r"a crease ends inside a face at \(99\.5, 50\)"):
         read_svg(path)
     drawing = read_svg(path, settings=DEFAULTS.with_(svg_merge_tol=5e-3))
-    assert (len(drawing.xy), len(drawing.edges), len(drawing.polygons)) == (6, 7, 2)
-    assert isinstance(DEFAULTS.with_(svg_merge_tol=5e-3), Settings)
+    assert counts(drawing) == (6, 7, 2)
 
 
 # --------------------------------------------------------------------------- Origami Simulator
 OS_FILES = {
-    # file: (V, E, faces, assignment counts)
-    "simpleVertex.svg": (9, 12, 4, {"B": 8, "M": 3, "V": 1}),
-    "singlesquaretwist.svg": (16, 24, 9, {"B": 12, "M": 4, "V": 8}),
-    "miura-ori.svg": (182, 337, 156, {"B": 50, "M": 137, "V": 150}),
+    # file: ((V, E, faces), assignment counts)
+    "simpleVertex.svg": ((9, 12, 4), {"B": 8, "M": 3, "V": 1}),
+    "singlesquaretwist.svg": ((16, 24, 9), {"B": 12, "M": 4, "V": 8}),
+    "miura-ori.svg": ((182, 337, 156), {"B": 50, "M": 137, "V": 150}),
 }
 
 
 @pytest.mark.parametrize("name", OS_FILES)
 def test_origami_simulator_files(name):
     """Origami Simulator's own crease patterns read, and triangulate into crease patterns."""
-    n_vertices, n_edges, n_faces, letters = OS_FILES[name]
+    sizes, letters = OS_FILES[name]
     drawing = read_svg(DATA / name)
     check_planar(drawing)
-    assert (len(drawing.xy), len(drawing.edges), len(drawing.polygons)) == (
-        n_vertices,
-        n_edges,
-        n_faces,
-    )
+    assert counts(drawing) == sizes
     assert Counter(drawing.assignment) == letters
     assert (drawing.unit, drawing.scale) == ("unit", 1.0)
     crease = np.array([a in "MV" for a in drawing.assignment])
@@ -393,7 +387,7 @@ def test_origami_simulator_files(name):
     )
     pattern = CreasePattern.from_faces(coords, orient_up(coords, triangles))
     assert len(pattern.faces) == sum(len(p) - 2 for p in drawing.polygons)
-    assert len(pattern.edges) == n_edges + len(diagonals)
+    assert len(pattern.edges) == len(drawing.edges) + len(diagonals)
 
 
 def test_origami_simulator_curved_file():
