@@ -64,6 +64,13 @@ class Settings:
         is below this times the squared size of its polygon (the larger side of its bounding
         box, in the polygon's plane) is not an ear, and a vertex within that of an ear's side
         lies on it.
+    svg_merge_tol : float
+        Crease patterns drawn in SVG (:func:`rigidfold.io.read_svg`): points closer than this
+        times the diagonal of the drawing's bounding box are one vertex, a line that ends
+        within it of another line ends on it, and a line shorter than it is dropped. Round-off
+        of drawing programs (about 1e-3 px) lies far below the default; Origami Simulator
+        merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals, and a carelessly
+        drawn pattern may need 1e-3, which would also merge real features of some designs.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -227,6 +234,8 @@ class Settings:
     motion_turn_back: float = 0.5
     # reading FOLD files
     triangulation_area_tol: float = 1e-12
+    # reading SVG drawings
+    svg_merge_tol: float = 1e-4
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)

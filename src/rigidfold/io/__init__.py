@@ -1,4 +1,5 @@
-"""File formats (FOLD 1.2 crease patterns, SVG drawings) and atomic output files."""
+"""File formats (FOLD 1.2 crease patterns, SVG drawings and crease patterns drawn in SVG) and
+atomic output files."""
 
 from rigidfold.io.files import atomic_write, jsonable, prepare_output_dir, write_json
 from rigidfold.io.fold import (
@@ -15,11 +16,13 @@ from rigidfold.io.fold import (
     write_fold,
 )
 from rigidfold.io.svg import svg_text, write_svg
+from rigidfold.io.svg_read import SvgDrawing, read_svg
 
 __all__ = [
     "UNITS",
     "UP_AXES",
     "FoldData",
+    "SvgDrawing",
     "atomic_write",
     "crease_pattern_frame",
     "fold_dict",
@@ -28,6 +31,7 @@ __all__ = [
     "pattern_from_fold",
     "prepare_output_dir",
     "read_fold",
+    "read_svg",
     "round_trip_dict",
     "svg_text",
     "write_document",

@@ -1,0 +1,398 @@
+"""Crease patterns drawn in SVG (Origami Simulator's colours): rigidfold.io.read_svg."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+
+from rigidfold.config import DEFAULTS
+from rigidfold.io import UNITS, SvgDrawing, read_svg
+from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
+
+DATA = Path(__file__).parent / "data" / "origami_simulator"
+
+SQUARE = '<rect x="0" y="0" width="100" height="100" fill="none" stroke="#000"/>'
+"""The boundary of most cases: a 100 x 100 square, corners (0, 0) to (100, 100) in SVG."""
+
+
+def write(tmp_path: Path, body: str, size: str = 'width="100" height="100"') -> Path:
+    path = tmp_path / "pattern.svg"
+    path.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" {size}>{body}</svg>\n')
+    return path
+
+
+def points(xy: np.ndarray) -> list[tuple[float, float]]:
+    """Vertex positions as a sorted list, rounded against round-off of transforms."""
+    return sorted((round(x, 9) + 0.0, round(y, 9) + 0.0) for x, y in xy)
+
+
+def counts(drawing: SvgDrawing) -> tuple[int, int, int]:
+    """(vertices, edges, faces)."""
+    return len(drawing.xy), len(drawing.edges), len(drawing.polygons)
+
+
+def check_planar(drawing: SvgDrawing) -> None:
+    """What every drawing read must satisfy: faces counter-clockwise and simple, their
+    sides edges, every edge a side of one face (boundary) or two (creases), a disc."""
+    xy, edges = drawing.xy, drawing.edges
+    assert xy.shape == (len(xy), 2) and xy.dtype == np.float64
+    assert edges.shape == (len(edges), 2) and edges.dtype == np.int64
+    assert len(drawing.assignment) == len(edges)
+    assert drawing.fold_angles is not None and drawing.fold_angles.shape == (len(edges),)
+    keys = {frozenset(e) for e in edges.tolist()}
+    assert len(keys) == len(edges)
+    sides: Counter = Counter()
+    for polygon in drawing.polygons:
+        assert len(polygon) >= 3 and len(set(polygon)) == len(polygon)
+        x, y = xy[polygon].T
+        assert np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0
+        sides.update(frozenset(p) for p in zip(polygon, np.roll(polygon, -1).tolist(), strict=True))
+    assert set(sides) == keys
+    for (u, v), letter in zip(edges.tolist(), drawing.assignment, strict=True):
+        assert sides[frozenset((u, v))] == (1 if letter == "B" else 2)
+    assert len(xy) - len(edges) + len(drawing.polygons) == 1
+    boundary = shapely.polygonize(
+        shapely.linestrings(xy[edges[np.array(drawing.assignment) == "B"]])
+    )
+    faces = sum(shapely.Polygon(xy[p]).area for p in drawing.polygons)
+    assert faces == pytest.approx(boundary.area, rel=1e-12)
+    assert set(np.unique(edges)) == set(range(len(xy)))
+
+
+# --------------------------------------------------------------------------- drawings
+def t_junction(end: str, y: float) -> tuple:
+    """A case of :data:`CASES`: a valley from the left side ending (at ``end``) on a vertical
+    mountain at x = 50, whose vertex there gets ``y`` (y up)."""
+    return (
+        SQUARE
+        + '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
+        + f'<line x1="0" y1="50" {end} stroke="#00f"/>',
+        'width="100" height="100"',
+        (8, 10, 3),
+        {"B": 7, "M": 2, "V": 1},
+        [(0, -100), (0, -50), (0, 0), (50, -100), (50, y), (50, 0), (100, -100), (100, 0)],
+    )
+
+
+CASES = {
+    "square with one diagonal": (
+        SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="#0000ff"/>',
+        'width="100" height="100"',
+        (4, 5, 2),
+        {"B": 4, "V": 1},
+        [(0, -100), (0, 0), (100, -100), (100, 0)],
+    ),
+    "crossing diagonals are split": (
+        SQUARE
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>'
+        + '<line x1="100" y1="0" x2="0" y2="100" stroke="rgb(0, 0, 255)"/>',
+        'width="100" height="100"',
+        (5, 8, 4),
+        {"B": 4, "M": 2, "V": 2},
+        [(0, -100), (0, 0), (50, -50), (100, -100), (100, 0)],
+    ),
+    "T-junction": t_junction('x2="50" y2="50"', -50),
+    "T-junction missed by 1e-3": t_junction('x2="49.999" y2="50.001"', -50.001),
+    "rect boundary away from the origin, polyline crease": (
+        '<rect x="10" y="20" width="80" height="40" stroke="black" fill="white"/>'
+        + '<polyline points="10,20 50,40 90,20" stroke="blue" fill="none"/>',
+        'width="100" height="100"',
+        (5, 6, 2),
+        {"B": 4, "V": 2},
+        [(10, -60), (10, -20), (50, -40), (90, -60), (90, -20)],
+    ),
+    "Illustrator path with H, V, z and relative moves": (
+        '<path fill="#FFFFFF" stroke="#000000" stroke-miterlimit="10" d="M100,100H0V0h100V100z"/>'
+        + '<path fill="none" stroke="#FF0000" d="M0,50h100 M50,0v50"/>'
+        + '<path fill="none" stroke="#0000FF" d="M50,50v50"/>',
+        'width="100px" height="100px" viewBox="0 0 100 100"',
+        (9, 12, 4),
+        {"B": 8, "M": 3, "V": 1},
+        [(x, y) for x in (0, 50, 100) for y in (-100, -50, 0)],
+    ),
+    "group with a transform and inherited stroke": (
+        '<g transform="translate(10, 20) scale(2)" stroke="black" fill="none">'
+        + '<polygon points="0,0 40,0 40,40 0,40"/>'
+        + '<line x1="0" y1="0" x2="40" y2="40" style="stroke:magenta"/>'
+        + '<g style="stroke: yellow"><line x1="40" y1="0" x2="0" y2="40"/></g></g>',
+        'width="100" height="100"',
+        (5, 8, 4),
+        {"B": 4, "U": 2, "F": 2},
+        [(10, -100), (10, -20), (50, -60), (90, -100), (90, -20)],
+    ),
+    "a crease drawn in two straight pieces is one line": (
+        SQUARE
+        + '<line x1="0" y1="50" x2="50" y2="50" stroke="red"/>'
+        + '<line x1="50" y1="50" x2="100" y2="50" stroke="red"/>',
+        'width="100" height="100"',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+        [(0, -100), (0, -50), (0, 0), (100, -100), (100, -50), (100, 0)],
+    ),
+    "repeats kept once, a crease over the boundary is boundary": (
+        SQUARE
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>'
+        + '<line x1="100" y1="100" x2="0" y2="0" stroke="red"/>'
+        + '<line x1="0" y1="0" x2="100" y2="0" stroke="blue"/>'
+        + '<text x="5" y="5">label</text><circle cx="50" cy="20" r="3" fill="black"/>',
+        'width="100" height="100"',
+        (4, 5, 2),
+        {"B": 4, "M": 1},
+        [(0, -100), (0, 0), (100, -100), (100, 0)],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_drawings(tmp_path, case):
+    body, size, sizes, letters, xy = CASES[case]
+    drawing = read_svg(write(tmp_path, body, size))
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    assert points(drawing.xy) == xy
+    assert (drawing.unit, drawing.scale) == ("unit", 1.0)
+
+
+def test_square_with_one_diagonal_in_detail(tmp_path):
+    """Vertices in order of first use, edges in drawing order, faces counter-clockwise."""
+    drawing = read_svg(write(tmp_path, CASES["square with one diagonal"][0]))
+    assert drawing.xy.tolist() == [[0, 0], [100, 0], [100, -100], [0, -100]]
+    assert drawing.edges.tolist() == [[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]]
+    assert drawing.assignment == ["B", "B", "B", "B", "V"]
+    assert sorted(sorted(p) for p in drawing.polygons) == [[0, 1, 2], [0, 2, 3]]
+    np.testing.assert_array_equal(drawing.fold_angles, [0, 0, 0, 0, 180])
+
+
+def test_fold_angles_from_opacity(tmp_path):
+    """Origami Simulator: stroke opacity (times opacity) is the fraction of 180 degrees;
+    valleys positive, mountains negative, facet lines 0, undriven creases NaN."""
+    body = (
+        SQUARE
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="red" stroke-opacity="0.5"/>'
+        + '<line x1="100" y1="0" x2="50" y2="50" stroke="blue" style="opacity:0.25"/>'
+        + '<line x1="50" y1="50" x2="0" y2="100" stroke="#ff00ff"/>'
+    )
+    drawing = read_svg(write(tmp_path, body))
+    keys = map(tuple, np.sort(drawing.edges, axis=1).tolist())
+    angles = dict(zip(keys, drawing.fold_angles, strict=True))
+    assert angles[(0, 4)] == angles[(2, 4)] == -90
+    assert angles[(1, 4)] == 45
+    assert math.isnan(angles[(3, 4)])
+    assert drawing.assignment.count("U") == 1
+
+
+@pytest.mark.parametrize(
+    ("size", "unit", "scale"),
+    [
+        ('width="200mm" height="100mm" viewBox="0 0 400 200"', "mm", 0.5e-3),
+        ('width="20cm" height="10cm" viewBox="0 0 200 100"', "cm", 1e-3),
+        ('width="4in" height="2in" viewBox="0 0 4 2"', "in", 0.0254),
+        ('width="72pt" height="36pt" viewBox="0 0 72 36"', "pt", 0.0254 / 72),
+        ('width="200mm" height="100mm"', "mm", 0.0254 / 96),
+        ('width="400px" height="200px" viewBox="0 0 200 100"', "unit", 1.0),
+        ("", "unit", 1.0),
+    ],
+)
+def test_units(tmp_path, size, unit, scale):
+    """A physical width gives the unit and the metres per user unit; coordinates stay in user
+    units (the viewBox's), whatever the width."""
+    body = '<rect x="1" y="1" width="2" height="1" stroke="black"/>'
+    drawing = read_svg(write(tmp_path, body, size))
+    assert drawing.unit == unit and (unit == "unit" or unit in UNITS)
+    assert drawing.scale == pytest.approx(scale, rel=1e-12)
+    assert points(drawing.xy) == [(1, -2), (1, -1), (3, -2), (3, -1)]
+
+
+def test_viewbox_offset_is_kept(tmp_path):
+    """The drawing's own coordinates: a viewBox that starts at (10, 20) moves nothing."""
+    size = 'width="100mm" height="100mm" viewBox="10 20 100 100"'
+    body = '<rect x="10" y="20" width="5" height="5" stroke="#000"/>'
+    drawing = read_svg(write(tmp_path, body, size))
+    assert points(drawing.xy) == [(10, -25), (10, -20), (15, -25), (15, -20)]
+    assert (drawing.unit, drawing.scale) == ("mm", pytest.approx(1e-3))
+
+
+# --------------------------------------------------------------------------- refusals
+ERRORS = {
+    "no lines": ('<text x="0" y="10">hello</text>', r"no lines drawn: a crease pattern is <line>"),
+    "curve with id": (
+        SQUARE + '<path id="wave" d="M0,50 Q50,0 100,50" stroke="red" fill="none"/>',
+        r'<path id="wave"> has a curved piece \(QuadraticBezier\): creases and the boundary '
+        r"must be straight lines",
+    ),
+    "circle without id": (
+        SQUARE + '<circle cx="50" cy="50" r="10" stroke="blue"/>',
+        r"<circle> \(drawn element 2\) has a curved piece \(Arc\)",
+    ),
+    "rounded rect": (
+        '<rect x="0" y="0" width="100" height="100" rx="5" stroke="black"/>',
+        r"<rect> \(drawn element 1\) has a curved piece \(Arc\)",
+    ),
+    "no boundary": (
+        '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>',
+        r"no boundary: no black lines",
+    ),
+    "lines of no length": (
+        '<line x1="5" y1="5" x2="5" y2="5" stroke="black"/>',
+        r"the lines drawn have no length",
+    ),
+    "boundary of no area": (
+        '<rect x="50" y="50" width="0.001" height="0.001" stroke="black"/>'
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>',
+        r"the boundary \(black\) encloses no area",
+    ),
+    "boundary not closed": (
+        '<polyline points="0,0 100,0 100,100 0,100" stroke="black" fill="none"/>',
+        r"the boundary \(black\) is not closed: it ends at \((0, 0|0, 100)\)",
+    ),
+    "boundary branches": (
+        SQUARE + '<line x1="50" y1="0" x2="50" y2="100" stroke="black"/>',
+        r"the boundary \(black\) is not one outline: 3 black lines meet at \(50, (0|100)\)",
+    ),
+    "two sheets": (
+        SQUARE + '<rect x="200" y="0" width="10" height="10" stroke="black"/>',
+        r"the boundary \(black\) is 2 separate outlines, not one sheet",
+    ),
+    "hole": (
+        SQUARE + '<rect x="40" y="40" width="20" height="20" stroke="black"/>',
+        r"the black outline through \(\d+, \d+\) lies inside another: holes are not supported",
+    ),
+    "cut": (
+        SQUARE + '<line x1="0" y1="50" x2="100" y2="50" stroke="#00ff00" id="slit"/>',
+        r'<line id="slit"> is green, a cut: cuts are not supported',
+    ),
+    "crease outside": (
+        SQUARE + '<line x1="100" y1="0" x2="150" y2="0" stroke="red"/>',
+        r"the crease from \((100, 0|150, 0)\) to \((100, 0|150, 0)\) lies outside the boundary",
+    ),
+    "dangling crease": (
+        SQUARE + '<line x1="0" y1="50" x2="60" y2="50" stroke="red"/>',
+        r"a crease ends inside a face at \(60, 50\): creases must end on another line \(an end "
+        r"within 0\.0141 drawing units of a line is joined to it\)",
+    ),
+    "crease crossing out of the boundary": (
+        SQUARE + '<line x1="50" y1="50" x2="150" y2="50" stroke="blue"/>',
+        r"the crease from \((100, 50|150, 50)\) to \((100, 50|150, 50)\) lies outside",
+    ),
+    "floating crease loop": (
+        SQUARE + '<polygon points="40,40 60,40 50,60" stroke="red" fill="none"/>',
+        r"creases around \(\d+, \d+\) are not connected to the boundary: the face around them "
+        r"would have a hole",
+    ),
+    "crease loop hanging on one line": (
+        SQUARE
+        + '<polygon points="40,40 60,40 50,60" stroke="red" fill="none"/>'
+        + '<line x1="50" y1="0" x2="50" y2="40" stroke="blue"/>',
+        r"a face is not a simple polygon: its outline passes twice through \(50, (0|40)\)",
+    ),
+    "unknown colour": (
+        SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="cyan"/>',
+        r"<line> \(drawn element 2\) has stroke colour cyan \(#00ffff\), none of Origami "
+        r"Simulator's: black boundary, red mountain, blue valley, yellow flat, magenta undriven",
+    ),
+    "grey": (
+        SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="#888888"/>',
+        r"<line> \(drawn element 2\) has stroke colour #888888, none of",
+    ),
+    "opacity not a number": (
+        SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="red" opacity="half"/>',
+        r"<line> \(drawn element 2\) has an opacity that is not a number",
+    ),
+    "one line in two colours": (
+        SQUARE
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>'
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="blue"/>',
+        r"the line from \(0, 0\) to \(100, 100\) is drawn both red and blue",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", ERRORS)
+def test_refusals(tmp_path, case):
+    body, message = ERRORS[case]
+    path = write(tmp_path, body)
+    with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {message}") as info:
+        read_svg(path)
+    assert "\n" not in str(info.value)
+
+
+def test_unequal_scales_in_physical_units(tmp_path):
+    size = 'width="100mm" height="100mm" viewBox="0 0 100 50" preserveAspectRatio="none"'
+    path = write(tmp_path, SQUARE, size)
+    with pytest.raises(ValueError, match="the width, height and viewBox scale x and y differ"):
+        read_svg(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("this is no XML", r"not an SVG file: .*pattern\.svg: syntax error"),
+        ("<html><body/></html>", r"not an SVG file: .*pattern\.svg: the root element is not <svg>"),
+    ],
+)
+def test_not_svg(tmp_path, text, message):
+    path = tmp_path / "pattern.svg"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        read_svg(path)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ValueError, match=r"cannot read .*absent\.svg: No such file"):
+        read_svg(tmp_path / "absent.svg")
+
+
+def test_merge_tolerance_is_a_setting(tmp_path):
+    """A crease end 0.5 units short of a line (3.5e-3 of the diagonal) dangles by default and
+    is joined to the line with a larger svg_merge_tol."""
+    body = SQUARE + '<line x1="0" y1="50" x2="99.5" y2="50" stroke="red"/>'
+    path = write(tmp_path, body)
+    with pytest.raises(ValueError, match=r"a crease ends inside a face at \(99\.5, 50\)"):
+        read_svg(path)
+    drawing = read_svg(path, settings=DEFAULTS.with_(svg_merge_tol=5e-3))
+    assert counts(drawing) == (6, 7, 2)
+
+
+# --------------------------------------------------------------------------- Origami Simulator
+OS_FILES = {
+    # file: ((V, E, faces), assignment counts)
+    "simpleVertex.svg": ((9, 12, 4), {"B": 8, "M": 3, "V": 1}),
+    "singlesquaretwist.svg": ((16, 24, 9), {"B": 12, "M": 4, "V": 8}),
+    "miura-ori.svg": ((182, 337, 156), {"B": 50, "M": 137, "V": 150}),
+}
+
+
+@pytest.mark.parametrize("name", OS_FILES)
+def test_origami_simulator_files(name):
+    """Origami Simulator's own crease patterns read, and triangulate into crease patterns."""
+    sizes, letters = OS_FILES[name]
+    drawing = read_svg(DATA / name)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    assert (drawing.unit, drawing.scale) == ("unit", 1.0)
+    crease = np.array([a in "MV" for a in drawing.assignment])
+    np.testing.assert_array_equal(np.abs(drawing.fold_angles[crease]), 180)
+    coords = np.column_stack([drawing.xy, np.zeros(len(drawing.xy))])
+    triangles, diagonals = triangulate_polygons(
+        coords, drawing.polygons, area_tol=DEFAULTS.triangulation_area_tol
+    )
+    pattern = CreasePattern.from_faces(coords, orient_up(coords, triangles))
+    assert len(pattern.faces) == sum(len(p) - 2 for p in drawing.polygons)
+    assert len(pattern.edges) == len(drawing.edges) + len(diagonals)
+
+
+def test_origami_simulator_curved_file():
+    with pytest.raises(
+        ValueError,
+        match=r"wavy_pleats\.svg: <path> \(drawn element 2\) has a curved piece \(CubicBezier\)",
+    ):
+        read_svg(DATA / "wavy_pleats.svg")
