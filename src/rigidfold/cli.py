@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 from rigidfold import __version__
 from rigidfold.config import DEFAULTS, HESSIANS
+from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
@@ -122,6 +123,35 @@ def build_parser() -> argparse.ArgumentParser:
         "not, 2 on bad input.",
     )
 
+    exp = _file_command(
+        sub,
+        "export",
+        _cmd_export,
+        out=True,
+        help="3D, CAD and cut-sheet files of a FOLD design: OBJ, STL, PLY, GLB, DXF, SVG, CSV",
+        description="Export a FOLD design (a solution of rigidfold generate, or any FOLD shape): "
+        "its folded form as OBJ, STL, PLY and GLB (metres, one group or node per panel), its "
+        "development diagram as a cut sheet in DXF and SVG (millimetres at 1:1) and its panel "
+        "and crease schedule as CSV, into DIR/<name>.*. The diagram is the file's "
+        "'creasePattern' frame, or computed (Step 8) when it has none. Exit code 0 when "
+        "written, 1 when the computed diagram did not converge (written all the same), 2 on "
+        "bad input.",
+    )
+    exp.add_argument(
+        "--to",
+        default=",".join(EXPORT_FORMATS),
+        metavar="FORMATS",
+        help=f"comma-separated, from {','.join(EXPORT_FORMATS)} (default: all)",
+    )
+    exp.add_argument(
+        "--convention",
+        default=CONVENTIONS[0],
+        choices=CONVENTIONS,
+        help="of the SVG cut sheet: rigidfold's (layers, labels, legend, scale bar) or "
+        "origami-simulator (red/blue/black lines, fold angle as stroke opacity, opens in "
+        "Origami Simulator)",
+    )
+
     stu = sub.add_parser(
         "study",
         help="many generate runs on Dask, results in SQLite (Tables 5-8), resumable",
@@ -181,8 +211,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _file_command(sub, name: str, func, *, out: bool = False, **text: str) -> None:
-    """A command on one FOLD file: FILE.fold [--out DIR] [--json]."""
+def _file_command(
+    sub, name: str, func, *, out: bool = False, **text: str
+) -> argparse.ArgumentParser:
+    """A command on one FOLD file: FILE.fold [--out DIR] [--up AXIS] [--json]; returns its
+    parser."""
     p = sub.add_parser(name, **text)
     p.add_argument("file", metavar="FILE.fold")
     if out:
@@ -196,6 +229,7 @@ def _file_command(sub, name: str, func, *, out: bool = False, **text: str) -> No
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=func)
+    return p
 
 
 def _case_options(p: argparse.ArgumentParser) -> None:
@@ -449,6 +483,21 @@ def _cmd_deform(args: argparse.Namespace) -> int:
         )
     print(f"wrote {', '.join(str(p) for p in checked.written)}")
     return 0 if d.reached_plane else 1
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from rigidfold.workflows import export_file
+
+    done = export_file(args.file, args.out, formats=args.to, convention=args.convention, up=args.up)
+    if args.json:
+        print(json.dumps(jsonable(done.to_dict())))
+    else:
+        dev = done.design.development
+        verdict = "" if dev is None else f" ({dev.status}: D = {dev.D:.3e})"
+        panels = done.design.pattern.n_facets
+        print(f"{args.file}: {panels} panels; development diagram: {done.design.diagram}{verdict}")
+        print(f"wrote {', '.join(str(p) for p in done.written)}")
+    return 0 if done.diagram_ok else 1
 
 
 def _cmd_study(args: argparse.Namespace) -> int:

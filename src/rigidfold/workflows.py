@@ -11,6 +11,7 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``deform_file``        Steps 8-9 and the folding motion of a FOLD shape
 ``optimize_case``      one solve of problem (6): ``solution.fold`` and ``summary.json``
 ``generate_case``      Steps 2-9 into a :class:`rigidfold.report.RunWriter`
+``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
 =====================  ====================================================================
 """
 
@@ -26,6 +27,16 @@ import numpy as np
 from rigidfold.case import Case, parse_fixed, shape_report
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.check import Verification, verify
+from rigidfold.develop import DevelopStatus
+from rigidfold.exports import (
+    CONVENTIONS,
+    EXPORT_FORMATS,
+    Design,
+    check_convention,
+    export_design,
+    parse_formats,
+    read_design,
+)
 from rigidfold.generate import Attempt, Generation, generate
 from rigidfold.io import FoldData, prepare_output_dir, read_fold, write_fold, write_json
 from rigidfold.mechanism import Mechanism, analyze
@@ -266,3 +277,72 @@ def generate_case(
     )
     writer.finish(run)
     return run
+
+
+# ------------------------------------------------------------------------------ export
+@dataclass(frozen=True, eq=False)
+class DesignExport:
+    """The exports of a design read from a FOLD file.
+
+    file : str; design : Design (the folded form and its development diagram, and where the
+    diagram came from); formats : the formats written; convention : the SVG's; written : the
+    files, in :data:`rigidfold.exports.EXPORT_FORMATS` order.
+    """
+
+    file: str
+    design: Design
+    formats: tuple[str, ...]
+    convention: str
+    written: tuple[Path, ...]
+
+    @property
+    def diagram_ok(self) -> bool:
+        """False when the diagram was computed and Step 8 did not converge (the cut sheet
+        then has flipped or overlapping facets)."""
+        dev = self.design.development
+        return dev is None or dev.status is DevelopStatus.CONVERGED
+
+    def to_dict(self) -> dict:
+        dev = self.design.development
+        pattern = self.design.pattern
+        return {
+            "file": self.file,
+            "formats": list(self.formats),
+            "convention": self.convention,
+            "diagram": self.design.diagram,
+            "development": None if dev is None else dev.to_dict(),
+            "vertices": pattern.n_vertices,
+            "faces": pattern.n_faces,
+            "panels": pattern.n_facets,
+            "written": [str(p) for p in self.written],
+        }
+
+
+def export_file(
+    path: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    formats: str | tuple[str, ...] = EXPORT_FORMATS,
+    convention: str = CONVENTIONS[0],
+    up: str = "z",
+    settings: Settings = DEFAULTS,
+) -> DesignExport:
+    """Export the design in a FOLD file (read with ``up``; its development diagram from its
+    ``creasePattern`` frame, or computed: :func:`rigidfold.exports.read_design`) to
+    ``OUT/<name>.*`` in ``formats`` (:func:`rigidfold.exports.parse_formats`), the SVG cut
+    sheet in ``convention`` (:func:`rigidfold.exports.export_design`)."""
+    chosen = parse_formats(formats)
+    check_convention(convention)
+    out_dir = prepare_output_dir(out)
+    design = read_design(path, up=up, settings=settings)
+    stem = Path(path).stem
+    written = export_design(
+        design.pattern,
+        design.coords2d,
+        out_dir,
+        chosen,
+        name=stem,
+        title=f"{stem}: rigidfold design",
+        convention=convention,
+    )
+    return DesignExport(str(path), design, chosen, convention, tuple(written))
