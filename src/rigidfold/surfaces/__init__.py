@@ -1,4 +1,5 @@
-"""Target surfaces z = f(x, y) (Step 1): Bezier, dome, hyperbolic paraboloid, user text.
+"""Target surfaces z = f(x, y) (Step 1): Bezier, dome, hyperbolic paraboloid, user text,
+triangle meshes.
 
 The built-in ones are given on the paper's 3 m x 3 m square and scale to a pattern's plan box."""
 
@@ -6,6 +7,7 @@ from __future__ import annotations
 
 from rigidfold.surfaces.builtin import Bezier, Dome, HyperbolicParaboloid, MirrorPlane, Surface
 from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
+from rigidfold.surfaces.mesh import MESH_FORMATS, MeshSurface, mesh_surface, read_mesh
 
 SURFACES = ("bezier", "dome", "hp", "expr")
 
@@ -33,13 +35,17 @@ def get_surface(
 
 
 __all__ = [
+    "MESH_FORMATS",
     "SURFACES",
     "Bezier",
     "Dome",
     "ExpressionSurface",
     "HyperbolicParaboloid",
+    "MeshSurface",
     "MirrorPlane",
     "Surface",
     "get_surface",
+    "mesh_surface",
     "parse_expression",
+    "read_mesh",
 ]
