@@ -8,12 +8,14 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from conftest import dome_mesh
 from rigidfold.surfaces import (
     SURFACES,
     Bezier,
     Dome,
     ExpressionSurface,
     HyperbolicParaboloid,
+    MeshSurface,
     MirrorPlane,
     get_surface,
 )
@@ -28,6 +30,7 @@ FACTORIES = {
     "bezier-box": lambda: Bezier(2, box=(12.0, 8.0)),
     "dome-box": lambda: Dome(box=(3.5, 6.0)),
     "hp-box": lambda: HyperbolicParaboloid(box=(4.0, 7.0)),
+    "mesh": lambda: MeshSurface(*dome_mesh(41)),
 }
 
 

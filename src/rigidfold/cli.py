@@ -407,6 +407,9 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     print(
         f"wrote {_count(len(writer.files), 'solution')}, log.json and summary.json to {writer.out}"
     )
+    if writer.exports:
+        names = ", ".join(p.name for p in writer.exports)
+        print(f"exported the final design to {writer.out / 'final'}: {names}")
     verdict = writer.verdict
     assert verdict is not None  # generate_case ends with writer.finish
     final = "none" if verdict.final_design is None else writer.out / verdict.final_design

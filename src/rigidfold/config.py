@@ -74,7 +74,8 @@ class Settings:
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
-        a closed box, a flat-folded state): refused, since rigidfold needs z up.
+        a closed box, a flat-folded state): refused, since rigidfold needs z up. The same
+        test refuses the triangle mesh of a target surface (``MeshSurface``).
     linear_rank_tol : float
         Relative threshold of the rank-revealing QR that eliminates constraints (7)-(9).
     map_prune_tol : float
@@ -171,6 +172,19 @@ class Settings:
         Largest number of triangles a ``grid:`` or ``mesh:`` pattern may have (a mesh's is
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
         is refused instead of building a problem that cannot be solved.
+
+    Target surfaces from triangle meshes (``rigidfold.surfaces.MeshSurface``)
+    -------------------------------------------------------------------------
+    surface_grid_nodes : int
+        The mesh is sampled by vertical ray casting at this many grid nodes along the longer
+        side of its plan box (along the shorter side at the same spacing, at least 4), and a
+        bicubic spline is fitted to the samples: 65 nodes are 47 mm apart on a 3 m box. From
+        4 to 513 (a finer grid costs seconds and gigabytes to fit). A grid finer than the
+        mesh's triangles makes the spline follow their facets; a coarser one smooths them.
+    surface_footprint_tol : float
+        A plan point within this fraction of the longer side of the mesh's plan box of its
+        footprint (its triangles seen from above) counts as inside it: pattern vertices
+        farther out are refused (``MeshSurface.check_finite``).
     """
 
     # design parameters of problem (6)
@@ -240,6 +254,9 @@ class Settings:
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
     max_pattern_faces: int = 20000
+    # target surfaces from triangle meshes
+    surface_grid_nodes: int = 65
+    surface_footprint_tol: float = 1e-5
     # the plan of a crease pattern
     plan_area_tol: float = 1e-6
 
@@ -260,6 +277,12 @@ class Settings:
             raise ValueError(f"target DOF must be an integer >= 0, got {self.target_dof!r}")
         if not self.f_tol > 0:
             raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
+        nodes = self.surface_grid_nodes
+        if isinstance(nodes, bool) or not isinstance(nodes, int) or not 4 <= nodes <= 513:
+            raise ValueError(f"surface_grid_nodes must be an integer from 4 to 513, got {nodes!r}")
+        tol = self.surface_footprint_tol
+        if not (math.isfinite(tol) and tol >= 0):
+            raise ValueError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
         if self.ipopt_hessian not in HESSIANS:
             raise ValueError(
                 f"ipopt_hessian must be one of {', '.join(HESSIANS)}, got {self.ipopt_hessian!r}"

@@ -19,6 +19,7 @@ import numpy as np
 from rigidfold.case import Case
 from rigidfold.deform import DeformStatus, MotionStatus, Verification, verify
 from rigidfold.develop import DevelopStatus
+from rigidfold.exports import export_design
 from rigidfold.generate import Attempt, Generation, Solution, Stop
 from rigidfold.io import (
     FoldData,
@@ -228,6 +229,8 @@ class RunWriter:
         self.checks: list[dict] = []
         self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
         self.verdict: RunVerdict | None = None
+        self.final: tuple[CreasePattern, np.ndarray] | None = None
+        self.exports: list[Path] = []
 
     def on_attempt(self, run: Generation, attempt: Attempt) -> None:
         write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
@@ -245,6 +248,7 @@ class RunWriter:
         fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
         figures = {"step": solution.step, "dof": dof, "fit": fit, **check.to_dict()}
         self.checks.append(figures)
+        self.final = (pattern, check.development.coords2d)
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
             path,
@@ -265,13 +269,21 @@ class RunWriter:
         self.write_summary(run)
 
     def finish(self, run: Generation) -> RunVerdict:
-        """The verdict on the finished run (:func:`run_verdict`), written into summary.json."""
+        """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
+        and the final design exported to ``DIR/final/`` in every format of
+        :func:`rigidfold.exports.export_design`, named after its solution file."""
         self.verdict = run_verdict(
             run,
             self.checks,
             [p.relative_to(self.out) for p in self.files],
             self.options["target_dof"],
         )
+        if self.final is not None:
+            pattern, coords2d = self.final
+            stem = self.files[-1].stem
+            self.exports = export_design(
+                pattern, coords2d, self.out / "final", name=stem, title=f"rigidfold: {stem}"
+            )
         self.write_summary(run)
         return self.verdict
 
@@ -320,5 +332,6 @@ class RunWriter:
                 "case": self.case.metadata(),
                 "solutions": [str(p.relative_to(self.out)) for p in self.files],
                 "verdict": None if self.verdict is None else self.verdict.to_dict(),
+                "exports": [str(p.relative_to(self.out)) for p in self.exports],
             },
         )

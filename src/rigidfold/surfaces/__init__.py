@@ -13,6 +13,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.surfaces.builtin import Bezier, Dome, HyperbolicParaboloid, MirrorPlane, Surface
 from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
+from rigidfold.surfaces.mesh import MESH_FORMATS, MeshSurface, mesh_surface, read_mesh
 
 SURFACES = ("bezier", "dome", "hp", "expr")
 """The named surfaces."""
@@ -47,39 +48,39 @@ def get_surface(
         return ExpressionSurface(expr)
     kind, colon, path = str(name).partition(":")
     if colon and kind.strip().lower() == "mesh" and path.strip():
-        from rigidfold.surfaces.mesh import read_mesh
-
-        vertices, triangles = read_mesh(path.strip(), up=up)
+        vertices, triangles = read_mesh(path.strip(), up=up, settings=settings)
         return placed_mesh(vertices, triangles, source=Path(path.strip()).name, settings=settings)
     raise ValueError(f"unknown surface {name!r} (choose from {SURFACE_FORMS})")
 
 
 def placed_mesh(
     vertices: np.ndarray, triangles: np.ndarray, *, source: str, settings: Settings = DEFAULTS
-) -> Surface:
+) -> MeshSurface:
     """The smooth fit (:class:`rigidfold.surfaces.mesh.MeshSurface`) of a triangle mesh
     translated in plan so that the lower-left corner of its bounding box is at (0, 0), the
     frame of the crease patterns; heights as given.
 
     vertices : (N, 3) float metres, z up; triangles : (M, 3) int; source : the file's name.
     """
-    from rigidfold.surfaces.mesh import MeshSurface
-
     vertices = np.array(vertices, dtype=float)
     vertices[:, :2] -= vertices[:, :2].min(axis=0)
     return MeshSurface(vertices, triangles, source=source, settings=settings)
 
 
 __all__ = [
+    "MESH_FORMATS",
     "SURFACES",
     "SURFACE_FORMS",
     "Bezier",
     "Dome",
     "ExpressionSurface",
     "HyperbolicParaboloid",
+    "MeshSurface",
     "MirrorPlane",
     "Surface",
     "get_surface",
+    "mesh_surface",
     "parse_expression",
     "placed_mesh",
+    "read_mesh",
 ]
