@@ -70,8 +70,9 @@ def test_generate_writes_solutions_log_and_summary(generated):
     assert summary["motion"]["traced"] == 4 and summary["motion"]["max_length_error"] < 1e-3
     assert summary["verdict"] == {
         "outcome": "passed",
-        "message": "the target DOF was reached and every check that ran passed",
+        "message": "the target DOF was reached and every check of the final design passed",
         "shortfalls": [],
+        "warnings": [],
         "final_design": "solutions/step_03_dof_18.fold",
     }
     for entry in summary["per_solution"]:
@@ -255,7 +256,7 @@ def test_an_earlier_run_is_refused_unless_overwrite(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert (
         len(err) == 1
-        and "holds an earlier run (summary.json, log.json, solutions, figures)" in err[0]
+        and "holds an earlier run (summary.json, log.json, solutions, figures, final)" in err[0]
     )
     assert stale.exists()  # refused: nothing touched
     assert main(["generate", *SHORT_RUN, "--out", str(out), "--overwrite"]) == 1

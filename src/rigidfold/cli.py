@@ -65,10 +65,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="Steps 2-7: fix crease lines one by one down to the target DOF",
         description="Generate developable, rigid-foldable shapes of decreasing DOF. Writes "
         "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes; the "
-        "last line names the final design. Exit code 0 when the target DOF was reached and "
-        "every check that ran (development diagram, folding motion, large deformation) "
-        "passed, 1 when the run fell short (the files are written all the same; the last line "
-        "says what fell short), 2 on bad input, 130 when interrupted.",
+        "last line names the final design (the last solution). Exit code 0 when the target DOF "
+        "was reached and every check that ran on the final design (development diagram, "
+        "folding motion, large deformation) passed, 1 when the run fell short (the files are "
+        "written all the same; the last line says what fell short, and notes the checks that "
+        "failed on earlier solutions), 2 on bad input, 130 when interrupted.",
     )
     _case_options(gen)
     gen.add_argument("--criterion", default=CRITERIA[0], choices=CRITERIA)

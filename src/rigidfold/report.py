@@ -45,7 +45,7 @@ RUN_DIRS = ("solutions", "figures", "final")
 class RunOutcome(Outcome):
     """Whether a generation run delivered: the command's exit code follows it (0 or 1)."""
 
-    PASSED = "passed", "the target DOF was reached and every check that ran passed"
+    PASSED = "passed", "the target DOF was reached and every check of the final design passed"
     FELL_SHORT = "fell_short", "the run fell short"
 
 
@@ -54,31 +54,57 @@ class RunVerdict:
     """The verdict on a finished generation run.
 
     outcome : RunOutcome; shortfalls : what fell short, one sentence each (empty when
-    passed); final_design : the last solution written (the lowest DOF), None without any.
+    passed); warnings : checks that failed on earlier solutions, which are not the design
+    delivered (one sentence each); final_design : the last solution written (the lowest DOF),
+    None without any.
     """
 
     outcome: RunOutcome
     shortfalls: tuple[str, ...]
+    warnings: tuple[str, ...]
     final_design: Path | None
 
     @property
     def message(self) -> str:
-        """One line: what fell short, or that everything passed."""
-        return "; ".join(self.shortfalls) if self.shortfalls else self.outcome.message
+        """One line: what fell short, or that everything passed; then the warnings."""
+        head = "; ".join(self.shortfalls) if self.shortfalls else self.outcome.message
+        return "; ".join([head, *(f"note: {w}" for w in self.warnings)])
 
     def to_dict(self) -> dict:
         return {
             "outcome": self.outcome.value,
             "message": self.message,
             "shortfalls": list(self.shortfalls),
+            "warnings": list(self.warnings),
             "final_design": None if self.final_design is None else self.final_design.as_posix(),
         }
 
 
+_CHECKS = {
+    "development": "development diagram (Step 8) failed",
+    "motion": "folding motion not traced",
+    "deformation": "large deformation (Step 9) did not reach the plane",
+}
+
+
+def _failed_checks(check: dict) -> list[str]:
+    """The stages of :data:`_CHECKS` that ran on one solution and failed."""
+    failed = []
+    if check["development"]["status"] != DevelopStatus.CONVERGED:
+        failed.append("development")
+    if check["motion"] is not None and check["motion"]["status"] != MotionStatus.OK:
+        failed.append("motion")
+    deformed = check["deformation"]
+    if deformed is not None and deformed["status"] != DeformStatus.REACHED_PLANE:
+        failed.append("deformation")
+    return failed
+
+
 def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: int) -> RunVerdict:
     """The verdict on ``run``: passed when it reached ``target`` (Stop.TARGET_REACHED, or
-    DOF 0 for a target of 0) and every check of every solution that ran passed (development
-    diagram converged, folding motion traced, large deformation reached the plane).
+    DOF 0 for a target of 0) and every check that ran on the final design (the last
+    solution) passed: development diagram converged, folding motion traced, large
+    deformation reached the plane. A check that failed on an earlier solution is a warning.
 
     checks : the figures of each solution's check (``Verification.to_dict()`` with its
     ``step``), in the order of ``files`` (their FOLD paths, relative to the run's DIR).
@@ -92,26 +118,17 @@ def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: 
             f"target DOF {target} not reached: final DOF {run.solutions[-1].mechanism.dof} "
             f"({run.stop_reason})"
         )
-    failed: dict[str, list[str]] = {"development": [], "motion": [], "deformation": []}
-    for check, path in zip(checks, files, strict=True):
-        if check["development"]["status"] != DevelopStatus.CONVERGED:
-            failed["development"].append(path.name)
-        if check["motion"] is not None and check["motion"]["status"] != MotionStatus.OK:
-            failed["motion"].append(path.name)
-        deformed = check["deformation"]
-        if deformed is not None and deformed["status"] != DeformStatus.REACHED_PLANE:
-            failed["deformation"].append(path.name)
-    what = {
-        "development": "development diagram (Step 8) failed",
-        "motion": "folding motion not traced",
-        "deformation": "large deformation (Step 9) did not reach the plane",
-    }
-    for stage, names in failed.items():
-        if names:
-            short.append(f"{what[stage]} for {', '.join(names)}")
+    if checks:
+        short += [f"{_CHECKS[s]} for the final design" for s in _failed_checks(checks[-1])]
+    earlier: dict[str, list[str]] = {stage: [] for stage in _CHECKS}
+    for check, path in zip(checks[:-1], files[:-1], strict=True):
+        for stage in _failed_checks(check):
+            earlier[stage].append(path.name)
+    warnings = tuple(f"{_CHECKS[s]} for {', '.join(n)}" for s, n in earlier.items() if n)
     return RunVerdict(
         RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
         tuple(short),
+        warnings,
         files[-1] if files else None,
     )
 
