@@ -71,6 +71,17 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.set_defaults(func=_cmd_generate)
 
+    rpt = sub.add_parser(
+        "report",
+        help="DIR/report.html of a generate run: the answer, 3D view, figures and tables",
+        description="Write DIR/report.html (one self-contained page that opens offline: the "
+        "final design in 3D with its folding motion, the figures, the tables of summary.json) "
+        "and DIR/figures/*.png for the generate run in DIR.",
+    )
+    rpt.add_argument("dir", metavar="DIR", help="the --out directory of rigidfold generate")
+    rpt.add_argument("--json", action="store_true", help="print one JSON object")
+    rpt.set_defaults(func=_cmd_report)
+
     _file_command(
         sub,
         "analyze",
@@ -313,6 +324,21 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     )
     print(f"wrote {len(writer.files)} solutions, log.json and summary.json to {writer.out}")
     return 0 if run.solutions else 1
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from rigidfold.workflows import report_run
+
+    report = report_run(args.dir)
+    if args.json:
+        print(json.dumps(jsonable(report.to_dict())))
+    else:
+        info = report.to_dict()
+        print(
+            f"wrote {info['report']} ({info['size_bytes'] / 1e6:.1f} MB) and "
+            f"{len(report.figures)} figures in {report.html.parent / 'figures'}"
+        )
+    return 0
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
