@@ -240,3 +240,27 @@ def test_run_without_step_9_says_not_run(tmp_path):
     }
     assert "deformation.png" not in [p.name for p in report.figures]
     assert "Every check passed (large deformation not run)" in report.html.read_text()
+
+
+def test_run_without_solution_and_unfinished_run(copy):
+    summary = json.loads((copy / "summary.json").read_text())
+    log = json.loads((copy / "log.json").read_text())
+    first = {**log["attempts"][0], "outcome": "initial_failed", "dof": None}
+    (copy / "log.json").write_text(json.dumps({"attempts": [first]}))
+    failed = {
+        **summary,
+        "stop": "initial_failed",
+        "stop_reason": "no developable polyhedron from the initial shape (exceed)",
+        "final_dof": None,
+        "solutions": [],
+        "per_solution": [],
+    }
+    (copy / "summary.json").write_text(json.dumps(failed))
+    report = report_run(copy)
+    assert [p.name for p in report.figures] == ["dof_and_F.png"]
+    text = html.unescape(report.html.read_text())
+    assert '<p class="verdict bad">No solution; target DOF 6 not reached: no developable' in text
+    assert "<dt>final design</dt><dd>none</dd>" in text and "Plotly" not in text
+    (copy / "summary.json").write_text(json.dumps({**summary, "stop": "running"}))
+    text = report_run(copy).html.read_text()
+    assert '"verdict none">Every check passed; the run has not finished' in text

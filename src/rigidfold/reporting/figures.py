@@ -195,19 +195,21 @@ def _fit(plt, run: RunData, fit: np.ndarray):
 def _fold_angles(plt, design: Design):
     kinds = np.asarray(design.assignment)
     creases = np.flatnonzero(kinds != "B")
-    fig, ax = plt.subplots(figsize=(6.4, 3.4), dpi=120)
+    fig, ax = plt.subplots(figsize=(6.4, 3.8), dpi=120)
+    span = max(int(creases.max(initial=0)) + 1, 1)
+    width_pt = float(np.clip(0.7 * 380 / span, 0.6, 6.0))  # ~70% of the axes' 380 pt per crease
     for letter in ("F", "M", "V", "J"):
         label, colour, _, _ = KINDS[letter]
         sel = creases[kinds[creases] == letter]
         if len(sel) and letter == "J":  # fixed flat: a tick where the bar would be
             ax.plot(sel, design.fold_deg[sel], "|", ms=9, mew=2, color=colour, label=label)
-        elif len(sel):
-            ax.bar(sel, design.fold_deg[sel], width=0.8, color=colour, label=label)
+        elif len(sel):  # bars as lines: one artist however many creases
+            ax.vlines(sel, 0.0, design.fold_deg[sel], color=colour, lw=width_pt, label=label)
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("crease (edge index)")
     ax.set_ylabel("fold angle (deg)")
     ax.grid(alpha=0.3, axis="y")
-    ax.legend(fontsize=8, ncol=4)
+    ax.legend(fontsize=8, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     ax.set_title(f"Fold angles of the final design, DOF {design.dof} (valley > 0)")
     return (
         fig,

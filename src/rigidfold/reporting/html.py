@@ -84,20 +84,23 @@ def _answer(run: RunData) -> list[str]:
     checks = run.checks()
     failed = [c.name for c in checks if c.passed is False]
     not_run = [c.name for c in checks if c.passed is None]
-    reached = s.get("stop") == "target_reached"
+    stop, target = s.get("stop"), run.target_dof
     if final is None:
-        verdict, css = "No solution: " + str(s.get("stop_reason")), "bad"
+        verdict = "No solution"
     elif failed:
-        verdict, css = "Failed: " + ", ".join(failed), "bad"
+        verdict = "Failed: " + ", ".join(failed)
     else:
         verdict = "Every check passed" + (f" ({', '.join(not_run)} not run)" if not_run else "")
-        css = "ok" if not not_run else "none"
-    target = run.target_dof
-    stop = (
-        f"target DOF {target} reached"
-        if reached
-        else f"target DOF {target} not reached: {s.get('stop_reason')}"
-    )
+    if stop == "target_reached":
+        outcome = f"target DOF {target} reached"
+    elif stop == "running":
+        outcome = "the run has not finished: this is its state so far"
+    else:
+        outcome = f"target DOF {target} not reached: {s.get('stop_reason')}"
+    # green: all done and passed; grey: passed, but a stage did not run or the run goes on
+    css = "bad" if final is None or failed or stop not in ("target_reached", "running") else "ok"
+    if css == "ok" and (not_run or stop == "running"):
+        css = "none"
     items = [
         ("final DOF", "–" if s.get("final_dof") is None else str(s["final_dof"])),
         ("target DOF", "–" if target is None else str(target)),
@@ -105,7 +108,7 @@ def _answer(run: RunData) -> list[str]:
         ("final design", "none" if final is None else final.name),
     ]
     out = [
-        f'<p class="verdict {css}">{_e(verdict)}; {_e(stop)}.</p>',
+        f'<p class="verdict {css}">{_e(verdict)}; {_e(outcome)}.</p>',
         '<dl class="answer">',
         *(f"<div><dt>{_e(k)}</dt><dd>{_e(v)}</dd></div>" for k, v in items),
         "</dl>",
@@ -113,8 +116,6 @@ def _answer(run: RunData) -> list[str]:
         *(_check_item(c) for c in checks),
         "</ul>",
     ]
-    if s.get("stop") == "running":
-        out.append('<p class="note">The run has not finished: this is its state so far.</p>')
     if run.surface_note:
         out.append(f'<p class="note">{_e(run.surface_note)}: the fit is not shown.</p>')
     return out
