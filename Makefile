@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint format clean
+.PHONY: demo test browser bench lint format clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -16,9 +16,18 @@ $(STAMP): $(PY) pyproject.toml
 
 demo: $(STAMP)
 	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --out out/demo --overwrite
+	@echo "open the report: out/demo/report.html"
 
-test: $(STAMP)
+test: $(STAMP) browser
 	$(PY) -m pytest -q
+
+# headless Chromium for the browser test of the report; where it cannot be installed (no
+# apt-get, not root) that test skips and says why
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
+	  (command -v apt-get >/dev/null 2>&1 && apt-get update -qq && \
+	   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium) || \
+	  echo "note: Chromium is not installed and could not be; the browser test of the report will skip"
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_optimize.py
@@ -30,6 +39,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_study.py
 	$(PY) benchmarks/bench_cpu_scaling.py
 	$(PY) benchmarks/bench_lookahead.py
+	$(PY) benchmarks/bench_report.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 
@@ -250,16 +251,21 @@ def test_an_earlier_run_is_refused_unless_overwrite(tmp_path, capsys):
     outside = tmp_path / "elsewhere"
     outside.mkdir()
     (outside / "keep.txt").write_text("keep")
+    shutil.rmtree(out / "figures")  # the report's figures: a link to elsewhere instead
     (out / "figures").symlink_to(outside, target_is_directory=True)
     capsys.readouterr()
     assert main(["generate", *SHORT_RUN, "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert (
         len(err) == 1
-        and "holds an earlier run (summary.json, log.json, solutions, figures, final)" in err[0]
+        and "holds an earlier run (summary.json, log.json, report.html, solutions, figures, final)"
+        in err[0]
     )
     assert stale.exists()  # refused: nothing touched
     assert main(["generate", *SHORT_RUN, "--out", str(out), "--overwrite"]) == 1
     assert not stale.exists() and (out / "notes.txt").read_text() == "mine"
-    assert not (out / "figures").exists() and (outside / "keep.txt").read_text() == "keep"
+    # the link was removed, not followed; the new run's figures are a directory of their own
+    assert not (out / "figures").is_symlink() and (out / "figures").is_dir()
+    assert [p.name for p in outside.iterdir()] == ["keep.txt"]
+    assert (outside / "keep.txt").read_text() == "keep"
     assert len(list((out / "solutions").glob("*.fold"))) == 3

@@ -86,12 +86,28 @@ def build_parser() -> argparse.ArgumentParser:
     )
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.add_argument(
+        "--no-report",
+        action="store_true",
+        help="do not write DIR/report.html at the end (rigidfold report DIR writes it later)",
+    )
+    gen.add_argument(
         "--overwrite",
         action="store_true",
         help="replace the files of an earlier run in DIR (refused otherwise); other files in "
         "DIR are kept",
     )
     gen.set_defaults(func=_cmd_generate)
+
+    rpt = sub.add_parser(
+        "report",
+        help="DIR/report.html of a generate run: the answer, 3D view, figures and tables",
+        description="Write DIR/report.html (one self-contained page that opens offline: the "
+        "final design in 3D with its folding motion, the figures, the tables of summary.json) "
+        "and DIR/figures/*.png for the generate run in DIR.",
+    )
+    rpt.add_argument("dir", metavar="DIR", help="the --out directory of rigidfold generate")
+    rpt.add_argument("--json", action="store_true", help="print one JSON object")
+    rpt.set_defaults(func=_cmd_report)
 
     _file_command(
         sub,
@@ -389,6 +405,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
             solver=args.solver,
             lookahead=args.lookahead,
             progress=progress.update,
+            report=not args.no_report,
         )
     except KeyboardInterrupt:
         progress.close()
@@ -411,11 +428,28 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     if writer.exports:
         names = ", ".join(p.name for p in writer.exports)
         print(f"exported the final design to {writer.out / 'final'}: {names}")
+    if not args.no_report:
+        print(f"report: {writer.out / 'report.html'}")
     verdict = writer.verdict
     assert verdict is not None  # generate_case ends with writer.finish
     final = "none" if verdict.final_design is None else writer.out / verdict.final_design
     print(f"{verdict.outcome.value.replace('_', ' ')}: {verdict.message}; final design: {final}")
     return 0 if verdict.outcome is RunOutcome.PASSED else 1
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from rigidfold.workflows import report_run
+
+    report = report_run(args.dir)
+    if args.json:
+        print(json.dumps(jsonable(report.to_dict())))
+    else:
+        info = report.to_dict()
+        print(
+            f"wrote {info['report']} ({info['size_bytes'] / 1e6:.1f} MB) and "
+            f"{len(report.figures)} figures in {report.html.parent / 'figures'}"
+        )
+    return 0
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:

@@ -12,12 +12,14 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``optimize_case``      one solve of problem (6): ``solution.fold`` and ``summary.json``
 ``generate_case``      Steps 2-9 into a :class:`rigidfold.report.RunWriter`
 ``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
+``report_run``         ``DIR/report.html`` and ``DIR/figures/`` of a generate run
 =====================  ====================================================================
 """
 
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,10 +40,18 @@ from rigidfold.exports import (
     read_design,
 )
 from rigidfold.generate import Attempt, Generation, generate
-from rigidfold.io import FoldData, prepare_output_dir, read_fold, write_fold, write_json
+from rigidfold.io import (
+    FoldData,
+    atomic_write,
+    prepare_output_dir,
+    read_fold,
+    write_fold,
+    write_json,
+)
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
 from rigidfold.report import RunWriter, write_checked_shape
+from rigidfold.reporting import RunData, load_run, page, render_figures, view_figure
 
 # ------------------------------------------------------------------------------ analyze
 FLAT_NOTE = (
@@ -248,12 +258,14 @@ def generate_case(
     solver: str,
     lookahead: bool = False,
     progress: Callable[[Generation, Attempt | None], None] | None = None,
+    report: bool = True,
 ) -> Generation:
     """Steps 2-9 on ``writer.case``, every attempt and solution written by ``writer`` as it
     comes (so an interrupt loses nothing); ``progress(run, attempt)`` after each of them.
     ``lookahead``: skip the candidates predicted to lock (``generate``'s option).
     ``summary.json`` is written once more at the end, with the run's verdict
-    (``writer.verdict``, :func:`rigidfold.report.run_verdict`)."""
+    (``writer.verdict``, :func:`rigidfold.report.run_verdict`); then, with ``report``,
+    ``DIR/report.html`` (:func:`report_run`)."""
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
         writer.on_attempt(run, attempt)
@@ -276,6 +288,8 @@ def generate_case(
         on_solution=on_solution,
     )
     writer.finish(run)
+    if report:
+        report_run(writer.out)
     return run
 
 
@@ -346,3 +360,46 @@ def export_file(
         convention=convention,
     )
     return DesignExport(str(path), design, chosen, convention, tuple(written))
+
+
+# -------------------------------------------------------------------------------- report
+@dataclass(frozen=True, eq=False)
+class RunReport:
+    """The report of a generate run: the run read back, the files written and the time.
+
+    run : RunData; html : ``DIR/report.html``; figures : the PNG files in ``DIR/figures/``;
+    seconds : wall time of reading, drawing and writing.
+    """
+
+    run: RunData
+    html: Path
+    figures: tuple[Path, ...]
+    seconds: float
+
+    def to_dict(self) -> dict:
+        final = self.run.final
+        return {
+            "report": str(self.html),
+            "size_bytes": self.html.stat().st_size,
+            "figures": [str(p) for p in self.figures],
+            "final_design": None if final is None else final.name,
+            "final_dof": self.run.summary.get("final_dof"),
+            "N_lock": self.run.summary.get("N_lock"),
+            "checks": {c.name: c.word for c in self.run.checks()},
+            "seconds": self.seconds,
+        }
+
+
+def report_run(directory: str | os.PathLike) -> RunReport:
+    """Write ``DIR/report.html`` (one self-contained page: the answer, the 3D view with the
+    folding motion, the figures, the tables) and ``DIR/figures/*.png`` for the generate run
+    in ``directory``. ValueError (one line) when it is not a generate run."""
+    t0 = time.perf_counter()
+    run = load_run(directory)
+    figure_dir = prepare_output_dir(run.directory / "figures")
+    figures = render_figures(run)
+    view = None if run.final is None else view_figure(run.final, run.surface)
+    text = page(run, figures, view)
+    written = tuple(atomic_write(figure_dir / f.name, f.png) for f in figures)
+    html = atomic_write(run.directory / "report.html", text)
+    return RunReport(run, html, written, time.perf_counter() - t0)

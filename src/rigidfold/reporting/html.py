@@ -1,0 +1,307 @@
+"""The report page of a generate run: one self-contained HTML file.
+
+It opens with the answer (final DOF against the target, N_lock, the verdict of every check,
+the final design's file), then the interactive 3D view (plotly, its JavaScript embedded),
+the figures (PNG as ``data:`` URIs) and the tables of ``summary.json`` and ``log.json``.
+Nothing in the page is fetched: no CDN, no web font, no external image.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+from importlib.metadata import PackageNotFoundError, version
+
+import numpy as np
+
+from rigidfold.reporting.figures import Figure
+from rigidfold.reporting.run import Check, RunData
+
+CSS = """
+body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, Arial, sans-serif;
+  margin: 0 auto; max-width: 1100px; padding: 1em 1.5em 3em; color: #222; line-height: 1.4; }
+h1 { font-size: 1.5em; margin-bottom: 0.1em; }
+h2 { font-size: 1.2em; border-bottom: 1px solid #ddd; padding-bottom: 0.2em; margin-top: 2em; }
+.sub { color: #666; margin-top: 0; }
+.answer { display: flex; flex-wrap: wrap; gap: 0.8em; margin: 1em 0; }
+.answer div { border: 1px solid #ddd; border-radius: 6px; padding: 0.5em 0.9em; min-width: 9em; }
+.answer dt { font-size: 0.8em; color: #666; }
+.answer dd { margin: 0; font-size: 1.3em; font-weight: 600; }
+.verdict { font-size: 1.1em; font-weight: 600; padding: 0.5em 0.9em; border-radius: 6px; }
+.ok { background: #e6f4ea; color: #1e6b34; } .bad { background: #fce8e6; color: #a50e0e; }
+.none { background: #f1f3f4; color: #555; }
+.passed { color: #1e6b34; } .FAILED { color: #a50e0e; } .notrun { color: #777; }
+.note { color: #8a5300; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.9em; }
+th, td { border: 1px solid #ddd; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
+th { background: #f6f6f6; } td { max-width: 40em; }
+td.n { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+figure { margin: 1.2em 0; } figure img { max-width: 100%; border: 1px solid #eee; }
+figcaption { color: #555; font-size: 0.9em; max-width: 48em; }
+.tables { display: flex; flex-wrap: wrap; gap: 0 2em; align-items: flex-start; }
+.tables h3 { font-size: 1em; margin-bottom: 0.2em; }
+#view3d + p { margin-top: 0.2em; }
+code { background: #f4f4f4; padding: 0 0.25em; border-radius: 3px; }
+"""
+
+PLOT_CONFIG = {"displaylogo": False, "responsive": True, "scrollZoom": True}
+"""plotly's options: no link to plotly's site; zoom with the wheel."""
+
+
+def page(run: RunData, figures: list[Figure], view: dict | None) -> str:
+    """The whole HTML document of ``run`` with its ``figures`` and 3D ``view`` (a plotly
+    figure dict, None when the run has no solution)."""
+    s = run.summary
+    case = s.get("case") or {}
+    surface = (case.get("surface") or {}).get("name", "?")
+    options = s.get("options") or {}
+    title = f"rigidfold generate: {surface} surface, pattern {case.get('pattern', '?')}"
+    parts = [
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">',
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
+        f"<title>{_e(title)}</title>\n<style>{CSS}</style>\n</head>\n<body>",
+        f"<h1>{_e(title)}</h1>",
+        f'<p class="sub">criterion {_e(options.get("criterion", "?"))}, seed '
+        f"{_e(options.get('seed', '?'))}, run directory <code>{_e(run.directory.name)}</code>"
+        "</p>",
+        *_answer(run),
+        '<h2 id="view">Final design in 3D</h2>',
+        *_view(run, view),
+        '<h2 id="figures">Figures</h2>',
+        *(_figure(f) for f in figures),
+        '<h2 id="tables">Tables</h2>',
+        *_tables(run),
+        f'<p class="sub">Written by rigidfold {_e(_version())} from summary.json, log.json '
+        "and the solution files; the figures are also in figures/.</p>",
+        "</body>\n</html>\n",
+    ]
+    return "\n".join(parts)
+
+
+def _answer(run: RunData) -> list[str]:
+    s, final = run.summary, run.final
+    checks = run.checks()
+    failed = [c.name for c in checks if c.passed is False]
+    not_run = [c.name for c in checks if c.passed is None]
+    stop, target = s.get("stop"), run.target_dof
+    if final is None:
+        verdict = "No solution"
+    elif failed:
+        verdict = "Failed: " + ", ".join(failed)
+    else:
+        verdict = "Every check passed" + (f" ({', '.join(not_run)} not run)" if not_run else "")
+    if stop == "target_reached":
+        outcome = f"target DOF {target} reached"
+    elif stop == "running":
+        outcome = "the run has not finished: this is its state so far"
+    else:
+        outcome = f"target DOF {target} not reached: {s.get('stop_reason')}"
+    # green: all done and passed; grey: passed, but a stage did not run or the run goes on
+    css = "bad" if final is None or failed or stop not in ("target_reached", "running") else "ok"
+    if css == "ok" and (not_run or stop == "running"):
+        css = "none"
+    given = s.get("verdict")  # the verdict generate judged its exit code by, when finished
+    if given is not None:
+        passed = given["outcome"] == "passed"
+        verdict, outcome = ("Passed" if passed else "Fell short"), given["message"]
+        css = "ok" if passed else "bad"
+    items = [
+        ("final DOF", "–" if s.get("final_dof") is None else str(s["final_dof"])),
+        ("target DOF", "–" if target is None else str(target)),
+        ("N_lock", str(s.get("N_lock"))),
+        ("final design", "none" if final is None else final.name),
+    ]
+    out = [
+        f'<p class="verdict {css}">{_e(verdict)}; {_e(outcome)}.</p>',
+        '<dl class="answer">',
+        *(f"<div><dt>{_e(k)}</dt><dd>{_e(v)}</dd></div>" for k, v in items),
+        "</dl>",
+        "<ul>",
+        *(_check_item(c) for c in checks),
+        "</ul>",
+    ]
+    if run.surface_note:
+        out.append(f'<p class="note">{_e(run.surface_note)}: the fit is not shown.</p>')
+    return out
+
+
+def _check_item(check: Check) -> str:
+    word = check.word
+    return (
+        f'<li><span class="{word.replace(" ", "")}"><b>{_e(check.name)}</b>: {_e(word)}</span> '
+        f"— {_e(check.detail)}</li>"
+    )
+
+
+def _view(run: RunData, view: dict | None) -> list[str]:
+    if view is None:
+        return ['<p class="note">The run has no solution to show.</p>']
+    import plotly.io
+
+    final = run.final
+    assert final is not None
+    motion = (
+        "Drag to turn, scroll to zoom; the slider below folds the sheet from flat (0%) to the "
+        "design (100%), each frame placed to best fit the design."
+        if view["frames"]
+        else "Drag to turn, scroll to zoom. The folding motion was not traced for this design."
+    )
+    colour = (
+        "Colour: z - target(x, y) in mm at each vertex (purple below the target, orange above), "
+        "a property of the design carried along the motion; the target surface is the grey "
+        "overlay."
+        if run.surface is not None
+        else "Colour: height z."
+    )
+    div = plotly.io.to_html(
+        view,
+        config=PLOT_CONFIG,
+        auto_play=False,
+        include_plotlyjs=True,
+        full_html=False,
+        div_id="view3d",
+        default_width="100%",
+        validate=False,
+    )
+    return [div, f"<p class='sub'>{_e(motion)} {_e(colour)}</p>"]
+
+
+def _figure(figure: Figure) -> str:
+    data = base64.b64encode(figure.png).decode("ascii")
+    return (
+        f'<figure id="{_e(figure.name)}"><img alt="{_e(figure.title)}" '
+        f'src="data:image/png;base64,{data}">'
+        f"<figcaption><b>{_e(figure.title)}.</b> {_e(figure.caption)} "
+        f"(<code>figures/{_e(figure.name)}</code>)</figcaption></figure>"
+    )
+
+
+def _tables(run: RunData) -> list[str]:
+    s = run.summary
+    run_keys = (
+        "stop_reason initial_dof final_dof N_reduce N_lock N_exceed n_solutions n_solves "
+        "n_skipped mean_F_accepted mean_F_all_solves"
+    ).split()
+    blocks = [("Run", _pairs({k: s.get(k) for k in run_keys if k in s}))]
+    for key, head in (
+        ("development", "Development (Step 8), all solutions"),
+        ("deformation", "Large deformation (Step 9), all solutions"),
+        ("motion", "Folding motion, all solutions"),
+        ("time_s", "Time (s)"),
+        ("options", "Options"),
+        ("case", "Case"),
+    ):
+        if isinstance(s.get(key), dict):
+            blocks.append((head, _pairs(s[key])))
+    return [
+        '<div class="tables">',
+        *(f"<div><h3>{_e(head)}</h3>{table}</div>" for head, table in blocks),
+        "</div>",
+        "<h3>Solutions</h3>",
+        _solutions(run),
+        *_attempts(run),
+    ]
+
+
+def _solutions(run: RunData) -> str:
+    fit = run.fit() * 1e3
+    head = [
+        "step",
+        "DOF",
+        "file",
+        "development",
+        "D",
+        "motion",
+        "large deformation",
+        "max |dl| (mm)",
+        "max |drho_fix| (deg)",
+        "max |z - target| (mm)",
+        "RMS (mm)",
+    ]
+    rows = []
+    for k, r in enumerate(run.summary["per_solution"]):
+        dev, mot, dfm = r.get("development") or {}, r.get("motion") or {}, r.get("deformation")
+        name = run.designs[k].name if k < len(run.designs) else ""
+        rows.append(
+            [
+                r.get("step"),
+                r.get("dof"),
+                name,
+                dev.get("status"),
+                dev.get("D"),
+                mot.get("status", "not run"),
+                "not run" if not dfm else dfm.get("status"),
+                None if not dfm else dfm.get("max_dl_mm"),
+                None if not dfm else dfm.get("max_drho_fix_deg"),
+                *(fit[k] if k < len(fit) else (None, None)),
+            ]
+        )
+    return _grid(head, rows)
+
+
+def _attempts(run: RunData) -> list[str]:
+    head = ["attempt", "fixed added", "outcome", "DOF", "F", "iterations", "locked creases"]
+    rows = [
+        [
+            a.get("index"),
+            a.get("fixed_added"),
+            a.get("outcome"),
+            a.get("dof"),
+            a.get("F"),
+            a.get("iterations"),
+            a.get("locked"),
+        ]
+        for a in run.attempts
+    ]
+    return [
+        f"<details><summary>Attempts ({len(rows)}, log.json)</summary>",
+        _grid(head, rows),
+        "</details>",
+    ]
+
+
+def _pairs(data: dict) -> str:
+    body = "".join(f"<tr><th>{_e(k)}</th><td>{_e(_fmt(v))}</td></tr>" for k, v in data.items())
+    return f"<table>{body}</table>"
+
+
+def _grid(head: list[str], rows: list[list]) -> str:
+    top = "".join(f"<th>{_e(h)}</th>" for h in head)
+    body = "".join("<tr>" + "".join(_cell(v) for v in row) + "</tr>" for row in rows)
+    return f"<table><tr>{top}</tr>{body}</table>"
+
+
+def _cell(value) -> str:
+    numeric = isinstance(value, int | float | np.number) and not isinstance(value, bool)
+    return f'<td class="n">{_e(_fmt(value))}</td>' if numeric else f"<td>{_e(_fmt(value))}</td>"
+
+
+def _fmt(value) -> str:
+    """A JSON value in a few words: numbers to 4 significant digits, long lists cut."""
+    if value is None:
+        return "–"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int | np.integer):
+        return str(value)
+    if isinstance(value, float | np.floating):
+        return "–" if not math.isfinite(value) else f"{value:.4g}"
+    if isinstance(value, dict):
+        return "; ".join(f"{k}: {_fmt(v)}" for k, v in value.items())
+    if isinstance(value, list | tuple):
+        shown = ", ".join(_fmt(v) for v in value[:12])
+        more = f", … ({len(value)} in all)" if len(value) > 12 else ""
+        return f"[{shown}{more}]"
+    return str(value)
+
+
+def _e(value) -> str:
+    return html.escape(str(value), quote=True)
+
+
+def _version() -> str:
+    try:
+        return version("rigidfold")
+    except PackageNotFoundError:
+        return "(not installed)"

@@ -1,0 +1,288 @@
+"""A finished (or running) ``rigidfold generate`` directory, read back for its report.
+
+:func:`load_run` reads ``DIR/summary.json``, ``DIR/log.json`` and every solution's FOLD file
+(``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its development diagram as a
+``creasePattern`` frame, the folding motion as ``foldedForm`` frames, and the figures of
+Steps 8-9 with the large-deformation history under ``rigidfold:deformation``), and rebuilds
+the target surface from the case's metadata where it can. Anything that is not a generate
+run is a one-line ``ValueError``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.io import read_fold
+from rigidfold.protocols import TargetSurface
+from rigidfold.surfaces import Bezier, get_surface
+
+_PERCENT = re.compile(r"([0-9.]+)% folded")
+"""The fraction folded in a motion frame's title (:func:`rigidfold.io.motion_frames`)."""
+
+SUMMARY_KEYS = ("stop", "stop_reason", "final_dof", "N_lock", "solutions", "per_solution", "case")
+"""Keys every ``summary.json`` of ``rigidfold generate`` has (those the report reads)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Design:
+    """One accepted solution of the run, read from its FOLD file.
+
+    name : str, the file's path relative to the run directory; step, dof : int.
+    coords : (V, 3) float64, the folded form in metres (z up); faces : (F, 3) int64;
+    edges : (E, 2) int64; assignment : E FOLD letters (``B`` boundary, ``M`` mountain, ``V``
+    valley, ``F`` flat, ``J`` fixed); fold_deg : (E,) float64, fold angles in degrees (valley
+    > 0). coords2d : (V, 2) float64 development diagram, or None when the file has none.
+    motion : (K, V, 3) float64, the folding motion from flat to folded ((0, V, 3) when it was
+    not traced); fraction : (K,) fraction folded of each motion frame. history : the
+    large-deformation load steps (dicts of ``load_factor``, ``mean_dl_mm``, ``max_dl_mm``,
+    ``max_drho_fix_deg``), empty when Step 9 did not run.
+    """
+
+    name: str
+    step: int
+    dof: int
+    coords: np.ndarray
+    faces: np.ndarray
+    edges: np.ndarray
+    assignment: list[str]
+    fold_deg: np.ndarray
+    coords2d: np.ndarray | None
+    motion: np.ndarray
+    fraction: np.ndarray
+    history: list[dict]
+
+    def dz(self, surface: TargetSurface) -> np.ndarray:
+        """(V,) float64: z minus the target's height at each vertex's (x, y), metres."""
+        x, y, z = self.coords.T
+        return z - np.broadcast_to(np.asarray(surface.height(x, y), dtype=float), z.shape)
+
+
+def read_design(path: Path, name: str) -> Design:
+    """The :class:`Design` in the FOLD file ``path`` (``name``: its path in the run)."""
+    data = read_fold(path)
+    pattern, meta = data.pattern, data.metadata
+    n_v = pattern.n_vertices
+    coords2d, motion, fraction = None, [], []
+    for k, frame in enumerate(data.raw.get("file_frames") or []):
+        classes = frame.get("frame_classes") or []
+        if "creasePattern" in classes:
+            coords2d = _frame_coords(frame, n_v, 2, f"{path}: file_frames[{k}]")
+        elif "foldedForm" in classes:
+            motion.append(_frame_coords(frame, n_v, 3, f"{path}: file_frames[{k}]"))
+            share = _PERCENT.search(str(frame.get("frame_title", "")))
+            fraction.append(float(share.group(1)) / 100 if share else np.nan)
+    if np.isnan(fraction).any():  # frames of another writer: evenly spaced
+        fraction = np.linspace(0.0, 1.0, len(motion)).tolist()
+    deformation = meta.get("deformation") or {}
+    return Design(
+        name=name,
+        step=int(meta.get("step", -1)),
+        dof=int(meta.get("dof", -1)),
+        coords=pattern.coords,
+        faces=pattern.faces,
+        edges=pattern.edges,
+        assignment=["F" if a == "U" else a for a in data.assignment],
+        fold_deg=np.degrees(pattern.fold_angles),
+        coords2d=coords2d,
+        motion=np.asarray(motion, dtype=float).reshape(-1, n_v, 3),
+        fraction=np.asarray(fraction, dtype=float),
+        history=list(deformation.get("history") or []),
+    )
+
+
+def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndarray:
+    """(V, dim) float64 ``vertices_coords`` of a frame (2D frames padded with z = 0 to 3D
+    when ``dim`` is 3)."""
+    try:
+        xy = np.asarray(frame["vertices_coords"], dtype=float)
+    except (KeyError, TypeError, ValueError):
+        raise ValueError(f"{where} has no numeric vertices_coords") from None
+    if xy.ndim != 2 or xy.shape[0] != n_vertices or xy.shape[1] not in (2, 3):
+        raise ValueError(
+            f"{where}: vertices_coords of shape {xy.shape}, expected ({n_vertices}, 2|3)"
+        )
+    if not np.isfinite(xy).all():
+        raise ValueError(f"{where}: non-finite vertices_coords")
+    if dim == 3 and xy.shape[1] == 2:
+        xy = np.column_stack([xy, np.zeros(n_vertices)])
+    return xy[:, :dim]
+
+
+def target_surface(metadata: dict) -> tuple[TargetSurface | None, str]:
+    """(surface, "") rebuilt from ``summary.json``'s ``case.surface``, or (None, why not).
+
+    A Bezier surface is rebuilt from its control heights, the dome and the hyperbolic
+    paraboloid from their plan box, an expression from its text: the surface the run used.
+    """
+    name = metadata.get("name")
+    try:
+        box = tuple(float(v) for v in metadata.get("plan_box_m") or (3.0, 3.0))
+        if name == "bezier" and metadata.get("control_heights") is not None:
+            heights = np.asarray(metadata["control_heights"], dtype=float)
+            return Bezier.from_heights(heights, box=(box[0], box[1])), ""
+        if name in ("dome", "hp"):
+            return get_surface(name, box=(box[0], box[1])), ""
+        if name == "expr":
+            return get_surface("expr", expr=metadata.get("expression")), ""
+    except (TypeError, ValueError) as exc:
+        return None, f"the target surface could not be rebuilt ({' '.join(str(exc).split())})"
+    return None, f"the target surface {name!r} cannot be rebuilt from summary.json"
+
+
+@dataclass(frozen=True, eq=False)
+class Check:
+    """One verification stage over the run's solutions.
+
+    name : str; passed : True, False, or None when the stage did not run; detail : str.
+    """
+
+    name: str
+    passed: bool | None
+    detail: str
+
+    @property
+    def word(self) -> str:
+        """ "passed", "FAILED" or "not run"."""
+        return {True: "passed", False: "FAILED", None: "not run"}[self.passed]
+
+
+@dataclass(frozen=True, eq=False)
+class RunData:
+    """Everything the report shows of one generate run.
+
+    directory : Path; summary : dict (``summary.json``); attempts : list of dict (``log.json``);
+    designs : every solution in order (the last is the final design); surface : the target
+    surface, or None with ``surface_note`` saying why.
+    """
+
+    directory: Path
+    summary: dict
+    attempts: list[dict]
+    designs: tuple[Design, ...]
+    surface: TargetSurface | None
+    surface_note: str
+
+    @property
+    def final(self) -> Design | None:
+        """The final design (the last solution), None when the run has no solution."""
+        return self.designs[-1] if self.designs else None
+
+    @property
+    def target_dof(self) -> int | None:
+        return (self.summary.get("options") or {}).get("target_dof")
+
+    def fit(self) -> np.ndarray:
+        """(S, 2) float64: max and RMS of |z - target| per solution, metres (NaN without a
+        surface)."""
+        out = np.full((len(self.designs), 2), np.nan)
+        if self.surface is not None:
+            for k, design in enumerate(self.designs):
+                dz = np.abs(design.dz(self.surface))
+                out[k] = dz.max(), np.sqrt(np.mean(dz**2))
+        return out
+
+    def checks(self) -> list[Check]:
+        """Development (Step 8), folding motion and large deformation (Step 9) over every
+        solution, from ``summary.json``'s ``per_solution``."""
+        rows = self.summary["per_solution"]
+        n = len(rows)
+        dev = [r.get("development") or {} for r in rows]
+        bad = [
+            r.get("step") for r, d in zip(rows, dev, strict=True) if d.get("status") != "converged"
+        ]
+        max_d = max((d.get("D") or 0.0 for d in dev), default=0.0)
+        checks = [
+            Check(
+                "development",
+                None if n == 0 else not bad,
+                f"{n - len(bad)}/{n} converged, "
+                f"{sum(max(d.get('flipped') or 0, 0) for d in dev)} flipped, "
+                f"{sum(max(d.get('overlaps') or 0, 0) for d in dev)} overlapping, "
+                f"max D = {max_d:.2g}" + _steps(bad),
+            )
+        ]
+        motions = [(r.get("step"), r["motion"]) for r in rows if r.get("motion") is not None]
+        bad = [s for s, m in motions if m.get("status") != "ok"]
+        err = max((m.get("max_length_error") or 0.0 for _, m in motions), default=0.0)
+        checks.append(
+            Check(
+                "folding motion",
+                None if not motions else not bad,
+                f"{len(motions) - len(bad)}/{n} traced, max |dl|/l = {err:.2g}" + _steps(bad)
+                if motions
+                else "no motion was traced",
+            )
+        )
+        deformed = [(r.get("step"), r["deformation"]) for r in rows if r.get("deformation")]
+        bad = [s for s, d in deformed if not d.get("reached_plane")]
+        checks.append(
+            Check(
+                "large deformation",
+                None if not deformed else not bad,
+                f"{len(deformed) - len(bad)}/{n} reached the plane, max |dl| = "
+                f"{max(d.get('max_dl_mm') or 0.0 for _, d in deformed):.3g} mm, max |drho_fix| "
+                f"= {max(d.get('max_drho_fix_deg') or 0.0 for _, d in deformed):.3g} deg"
+                + _steps(bad)
+                if deformed
+                else "Step 9 did not run (--no-deform)",
+            )
+        )
+        return checks
+
+
+def _steps(bad: list) -> str:
+    return f" (failed at step {', '.join(map(str, bad))})" if bad else ""
+
+
+def load_run(directory: str | os.PathLike) -> RunData:
+    """Read the generate run in ``directory`` (see the module's text).
+
+    Raises ValueError (one line) when ``directory`` is not a generate run: no directory, no
+    or malformed ``summary.json`` / ``log.json``, or a listed solution file that is missing
+    or not a FOLD file.
+    """
+    root = Path(directory)
+    if not root.is_dir():
+        raise ValueError(f"{str(root)!r} is not a directory (give the --out of rigidfold generate)")
+    summary = _json_object(root, "summary.json")
+    missing = [k for k in SUMMARY_KEYS if k not in summary]
+    if missing:
+        raise ValueError(
+            f"{str(root / 'summary.json')!r} is not the summary of rigidfold generate "
+            f"(no {', '.join(missing)})"
+        )
+    attempts = _json_object(root, "log.json").get("attempts")
+    if not isinstance(attempts, list):
+        raise ValueError(f"{str(root / 'log.json')!r} has no list of attempts")
+    names = summary["solutions"]
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise ValueError(f"{str(root / 'summary.json')!r}: 'solutions' is not a list of files")
+    designs = []
+    for name in names:
+        path = root / name
+        if not path.is_file():
+            raise ValueError(f"solution file {str(path)!r} listed in summary.json is missing")
+        designs.append(read_design(path, name))
+    surface, note = target_surface((summary.get("case") or {}).get("surface") or {})
+    return RunData(root, summary, attempts, tuple(designs), surface, note)
+
+
+def _json_object(root: Path, name: str) -> dict:
+    path = root / name
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ValueError(
+            f"{str(root)!r} is not a rigidfold generate run: it has no {name}"
+        ) from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{str(path)!r} is not a JSON object")
+    return data

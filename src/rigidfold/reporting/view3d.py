@@ -1,0 +1,215 @@
+"""The interactive 3D view of a final design: a plotly figure (as a plain dict).
+
+The folded form is a ``mesh3d`` coloured by the signed distance to the target surface
+(z - target(x, y), mm), its crease lines drawn by kind (the colours of
+:data:`rigidfold.reporting.figures.KINDS`), the target surface a translucent overlay, and the
+folding motion from flat to folded a slider with play and pause buttons. Each motion frame
+is turned and moved as a rigid body to best fit the folded form, so the sheet folds in place.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigidfold.protocols import TargetSurface
+from rigidfold.reporting.figures import KINDS
+from rigidfold.reporting.run import Design
+
+GRID = 40
+"""Samples per side of the target surface overlay."""
+
+SURFACE_COLOUR = "#8c8c8c"
+MESH_SCALE = [
+    [k / 10, c]
+    for k, c in enumerate(
+        "#2d004b #542788 #8073ac #b2abd2 #d8daeb #f7f7f7 #fee0b6 #fdb863 #e08214 #b35806 "
+        "#7f3b08".split()
+    )
+]
+"""Colour scale of z - target (ColorBrewer PuOr): purple below the target, orange above,
+white on it. Given as colours: plotly.js knows only a few scales by name."""
+
+
+def best_fit(frames: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """(K, V, 3) ``frames`` each turned and moved (a proper rotation) to best fit ``target``
+    (V, 3) in the least-squares sense (Kabsch)."""
+    centre = target.mean(axis=0)
+    moved = frames - frames.mean(axis=1, keepdims=True)
+    h = np.einsum("kvi,vj->kij", moved, target - centre)
+    u, _, vt = np.linalg.svd(h)
+    sign = np.sign(np.linalg.det(np.einsum("kij,kjl->kil", u, vt)))
+    u[:, :, 2] *= sign[:, None]
+    rotation = np.einsum("kij,kjl->kil", u, vt)
+    return np.einsum("kvi,kij->kvj", moved, rotation) + centre
+
+
+def _lines(coords: np.ndarray, edges: np.ndarray) -> tuple[list, list, list]:
+    """x, y, z lists of the segments ``edges`` at ``coords``, None between segments."""
+    if len(edges) == 0:
+        return [], [], []
+    seg = np.full((len(edges), 3, 3), np.nan)
+    seg[:, :2] = coords[edges]
+    x, y, z = (
+        [None if np.isnan(v) else float(v) for v in axis]
+        for axis in np.round(seg, 5).reshape(-1, 3).T
+    )
+    return x, y, z
+
+
+def _shape_traces(coords: np.ndarray, design: Design, kinds: np.ndarray) -> list[dict]:
+    """The moving traces at ``coords``: the mesh, then one line trace per crease kind."""
+    x, y, z = np.round(coords, 5).T
+    traces = [{"type": "mesh3d", "x": x.tolist(), "y": y.tolist(), "z": z.tolist()}]
+    for letter in KINDS:
+        lx, ly, lz = _lines(coords, design.edges[kinds == letter])
+        traces.append({"type": "scatter3d", "x": lx, "y": ly, "z": lz})
+    return traces
+
+
+def view_figure(design: Design, surface: TargetSurface | None) -> dict:
+    """The plotly figure dict of ``design`` (see the module's text); without ``surface`` the
+    mesh is coloured by height and no overlay is drawn."""
+    kinds = np.asarray(design.assignment)
+    coords = design.coords
+    if surface is not None:
+        colour = design.dz(surface) * 1e3
+        bound = max(float(np.abs(colour).max()), 1e-6)
+        scale = {"cmin": -bound, "cmax": bound, "colorscale": MESH_SCALE}
+        title = "z - target (mm)"
+    else:
+        colour = coords[:, 2]
+        scale = {"colorscale": "Viridis"}
+        title = "z (m)"
+    traces = _shape_traces(coords, design, kinds)
+    traces[0].update(
+        i=design.faces[:, 0].tolist(),
+        j=design.faces[:, 1].tolist(),
+        k=design.faces[:, 2].tolist(),
+        intensity=np.round(colour, 4).tolist(),
+        intensitymode="vertex",
+        colorbar={"title": {"text": title}, "len": 0.6, "x": 1.0},
+        flatshading=True,
+        lighting={"ambient": 0.65, "diffuse": 0.5, "specular": 0.05},
+        name="folded form",
+        hovertemplate="x %{x:.3f} m<br>y %{y:.3f} m<br>z %{z:.3f} m<extra></extra>",
+        **scale,
+    )
+    for trace, (label, line, width, style) in zip(traces[1:], KINDS.values(), strict=True):
+        trace.update(
+            mode="lines",
+            name=label,
+            line={
+                "color": line,
+                "width": 2 * width + 1,
+                "dash": "dash" if style == "--" else "solid",
+            },
+            hoverinfo="skip",
+        )
+    moving = list(range(len(traces)))
+    placed = best_fit(design.motion, coords) if len(design.motion) > 1 else design.motion[:0]
+    frames = [
+        {
+            "name": f"{100 * share:.0f}%",
+            "data": _shape_traces(shape, design, kinds),
+            "traces": moving,
+        }
+        for shape, share in zip(placed, design.fraction, strict=True)
+    ]
+    points = [coords, placed.reshape(-1, 3)]
+    if surface is not None:
+        overlay, samples = _surface_trace(surface, coords)
+        traces.append(overlay)
+        points.append(samples)
+    return {"data": traces, "layout": _layout(np.vstack(points), design, frames), "frames": frames}
+
+
+def _surface_trace(surface: TargetSurface, coords: np.ndarray) -> tuple[dict, np.ndarray]:
+    """The target over the design's plan bounding box, translucent, one grey; and its
+    finite samples (n, 3)."""
+    (x0, y0), (x1, y1) = coords[:, :2].min(axis=0), coords[:, :2].max(axis=0)
+    gx, gy = np.meshgrid(np.linspace(x0, x1, GRID), np.linspace(y0, y1, GRID))
+    with np.errstate(invalid="ignore"):
+        gz = np.broadcast_to(np.asarray(surface.height(gx, gy), dtype=float), gx.shape)
+    z = [[float(v) if np.isfinite(v) else None for v in row] for row in np.round(gz, 5)]
+    samples = np.column_stack([gx.ravel(), gy.ravel(), gz.ravel()])
+    trace = {
+        "type": "surface",
+        "x": np.round(gx[0], 5).tolist(),
+        "y": np.round(gy[:, 0], 5).tolist(),
+        "z": z,
+        "opacity": 0.3,
+        "colorscale": [[0, SURFACE_COLOUR], [1, SURFACE_COLOUR]],
+        "showscale": False,
+        "name": "target surface",
+        "showlegend": True,
+        "hoverinfo": "skip",
+    }
+    return trace, samples[np.isfinite(samples[:, 2])]
+
+
+def _layout(points: np.ndarray, design: Design, frames: list[dict]) -> dict:
+    """Fixed axes around every frame (so the view does not jump), legend, and the slider."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    pad = 0.03 * float((hi - lo).max())
+    lo, hi = lo - pad, hi + pad
+    span = hi - lo
+    ratio = span / span.max()
+    axis = {"showbackground": False, "gridcolor": "#dddddd"}
+    layout = {
+        "height": 640,
+        "margin": {"l": 0, "r": 0, "t": 30, "b": 70},
+        "legend": {"x": 0.0, "y": 1.0, "bgcolor": "rgba(255,255,255,0.7)"},
+        "scene": {
+            "xaxis": {**axis, "title": {"text": "x (m)"}, "range": [lo[0], hi[0]]},
+            "yaxis": {**axis, "title": {"text": "y (m)"}, "range": [lo[1], hi[1]]},
+            "zaxis": {**axis, "title": {"text": "z (m)"}, "range": [lo[2], hi[2]]},
+            "aspectmode": "manual",
+            "aspectratio": dict(zip("xyz", (float(r) for r in ratio), strict=True)),
+            "camera": {"eye": {"x": 1.25, "y": -1.25, "z": 0.8}},
+        },
+        "title": {"text": f"{design.name}: DOF {design.dof}", "x": 0.5},
+    }
+    if frames:
+        animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}}
+        layout["sliders"] = [
+            {
+                "active": len(frames) - 1,
+                "currentvalue": {"prefix": "folded: "},
+                "x": 0.12,
+                "len": 0.88,
+                "y": 0.0,
+                "yanchor": "top",
+                "pad": {"t": 10},
+                "steps": [
+                    {"label": f["name"], "method": "animate", "args": [[f["name"]], animate]}
+                    for f in frames
+                ],
+            }
+        ]
+        layout["updatemenus"] = [
+            {
+                "type": "buttons",
+                "direction": "left",
+                "x": 0.11,
+                "y": 0.0,
+                "xanchor": "right",
+                "yanchor": "top",
+                "pad": {"t": 45},
+                "buttons": [
+                    {
+                        "label": "fold",
+                        "method": "animate",
+                        "args": [
+                            None,
+                            {
+                                **animate,
+                                "frame": {"duration": 250, "redraw": True},
+                                "fromcurrent": False,
+                            },
+                        ],
+                    },
+                    {"label": "pause", "method": "animate", "args": [[None], animate]},
+                ],
+            }
+        ]
+    return layout
