@@ -72,8 +72,18 @@ def build_parser() -> argparse.ArgumentParser:
         "failed on earlier solutions), 2 on bad input, 130 when interrupted.",
     )
     _case_options(gen)
-    gen.add_argument("--criterion", default=CRITERIA[0], choices=CRITERIA)
-    gen.add_argument("--target-dof", type=int, default=DEFAULTS.target_dof)
+    gen.add_argument(
+        "--criterion",
+        default=CRITERIA[0],
+        choices=CRITERIA,
+        help="how the next crease to fix is chosen (Section 5; default %(default)s)",
+    )
+    gen.add_argument(
+        "--target-dof",
+        type=int,
+        default=DEFAULTS.target_dof,
+        help="stop at this DOF (default %(default)s)",
+    )
     gen.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     gen.add_argument(
         "--retry-zero-dof",
@@ -259,7 +269,14 @@ def _case_options(p: argparse.ArgumentParser) -> None:
         "OFF mesh, fitted by a smooth surface; fold:FILE: the 3D shape of a FOLD file. A mesh "
         "is placed like the pattern, the lower-left corner of its plan at (0, 0)",
     )
-    p.add_argument("--seed", type=int, default=0, help="seed of the random Bezier surface")
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of the random Bezier surface; generate also draws from it the random hinge "
+        "stiffnesses of the S-hat and S^S criteria and the order of the random criterion "
+        "(default 0)",
+    )
     p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
     p.add_argument(
         "--pattern",
@@ -311,14 +328,25 @@ def _case_options(p: argparse.ArgumentParser) -> None:
         f"{DEFAULTS.mesh_divisions:g})",
     )
     p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
-    p.add_argument("--solver", default=SOLVERS[0], choices=SOLVERS)
+    p.add_argument(
+        "--solver",
+        default=SOLVERS[0],
+        choices=SOLVERS,
+        help="solver of problem (6) (default %(default)s)",
+    )
     p.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
         choices=HESSIANS,
-        help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off)",
+        help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off; default "
+        "%(default)s)",
     )
-    p.add_argument("--dz", type=float, default=DEFAULTS.dz, help="bound on |dz| in metres")
+    p.add_argument(
+        "--dz",
+        type=float,
+        default=DEFAULTS.dz,
+        help="bound on |z - f(x, y)| in metres (default %(default)s)",
+    )
     for bound in ("min", "max"):
         default = math.degrees(getattr(DEFAULTS, f"theta_{bound}"))
         p.add_argument(
