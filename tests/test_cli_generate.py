@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -195,6 +196,7 @@ def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     for path in (tmp_path / "solutions").glob("*.fold"):
         read_fold(path)
     assert not list(tmp_path.rglob("*.tmp"))
+    assert not (tmp_path / ".rigidfold-run.lock").exists()  # released on interrupt too
 
 
 def test_generate_bad_options(tmp_path):
@@ -269,3 +271,21 @@ def test_an_earlier_run_is_refused_unless_overwrite(tmp_path, capsys):
     assert [p.name for p in outside.iterdir()] == ["keep.txt"]
     assert (outside / "keep.txt").read_text() == "keep"
     assert len(list((out / "solutions").glob("*.fold"))) == 3
+
+
+def test_a_directory_in_use_by_a_running_generate_is_refused(tmp_path, capsys):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / ".rigidfold-run.lock").write_text(f"{os.getpid()}\n")  # a live process holds it
+    for extra in ([], ["--overwrite"]):
+        assert main(["generate", *SHORT_RUN, "--out", str(out), *extra]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"in use by another rigidfold run (pid {os.getpid()})" in err[0]
+    assert sorted(p.name for p in out.iterdir()) == [".rigidfold-run.lock"]
+    # a lock whose process is gone is taken over, and released at the end
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True
+    )
+    (out / ".rigidfold-run.lock").write_text(dead.stdout)
+    assert main(["generate", *SHORT_RUN, "--out", str(out)]) == 1
+    assert not (out / ".rigidfold-run.lock").exists() and (out / "summary.json").is_file()

@@ -10,6 +10,7 @@ on disk is always valid.
 
 from __future__ import annotations
 
+import os
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
@@ -133,6 +134,56 @@ def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: 
     )
 
 
+LOCK_NAME = ".rigidfold-run.lock"
+"""The file that marks a directory as in use by a running ``generate`` (it holds the pid)."""
+
+
+def lock_run_dir(out: Path) -> Path:
+    """Claim ``out`` for one run: create :data:`LOCK_NAME` in it (exclusive creation, no link
+    followed) holding this process's id. A lock left by a process that no longer runs is
+    taken over. Returns the lock's path; ValueError when another live run holds it."""
+    path = out / LOCK_NAME
+    for _ in range(2):
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+        except FileExistsError:
+            pid = _lock_owner(path)
+            if pid is not None and _alive(pid):
+                raise ValueError(
+                    f"output directory '{out}' is in use by another rigidfold run (pid {pid}); "
+                    "wait for it to end, or use another --out"
+                ) from None
+            path.unlink(missing_ok=True)  # stale: its run is gone
+            continue
+        except OSError as exc:
+            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+        with os.fdopen(fd, "w") as file:
+            file.write(f"{os.getpid()}\n")
+        return path
+    raise ValueError(f"cannot lock output directory '{out}': its lock keeps coming back")
+
+
+def _lock_owner(path: Path) -> int | None:
+    """The pid written in a lock file, None when it cannot be read (a link, garbage)."""
+    try:
+        if path.is_symlink():
+            return None
+        return int(path.read_text().strip())
+    except (OSError, ValueError):
+        return None
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process with this id runs (on this machine)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def clear_earlier_run(out: str | Path, *, overwrite: bool) -> Path:
     """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
 
@@ -239,8 +290,14 @@ class RunWriter:
         deform: bool = True,
         overwrite: bool = False,
     ) -> None:
-        self.out = prepare_output_dir(clear_earlier_run(out, overwrite=overwrite))
-        self.solutions_dir = prepare_output_dir(self.out / "solutions")
+        self.out = prepare_output_dir(out)
+        self.lock = lock_run_dir(self.out)
+        try:
+            clear_earlier_run(self.out, overwrite=overwrite)
+            self.solutions_dir = prepare_output_dir(self.out / "solutions")
+        except ValueError:
+            self.release()
+            raise
         self.case, self.options, self.deform = case, options, deform
         self.files: list[Path] = []
         self.checks: list[dict] = []
@@ -248,6 +305,10 @@ class RunWriter:
         self.verdict: RunVerdict | None = None
         self.final: tuple[CreasePattern, np.ndarray] | None = None
         self.exports: list[Path] = []
+
+    def release(self) -> None:
+        """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""
+        self.lock.unlink(missing_ok=True)
 
     def on_attempt(self, run: Generation, attempt: Attempt) -> None:
         write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})

@@ -265,7 +265,8 @@ def generate_case(
     ``lookahead``: skip the candidates predicted to lock (``generate``'s option).
     ``summary.json`` is written once more at the end, with the run's verdict
     (``writer.verdict``, :func:`rigidfold.report.run_verdict`); then, with ``report``,
-    ``DIR/report.html`` (:func:`report_run`)."""
+    ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is released at the
+    end, however the run ends."""
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
         writer.on_attempt(run, attempt)
@@ -277,19 +278,22 @@ def generate_case(
         if progress:
             progress(run, None)
 
-    run = generate(
-        writer.case,
-        criterion=criterion,
-        target_dof=target_dof,
-        seed=seed,
-        solver=solver,
-        lookahead=lookahead,
-        on_attempt=on_attempt,
-        on_solution=on_solution,
-    )
-    writer.finish(run)
-    if report:
-        report_run(writer.out)
+    try:
+        run = generate(
+            writer.case,
+            criterion=criterion,
+            target_dof=target_dof,
+            seed=seed,
+            solver=solver,
+            lookahead=lookahead,
+            on_attempt=on_attempt,
+            on_solution=on_solution,
+        )
+        writer.finish(run)
+        if report:
+            report_run(writer.out)
+    finally:
+        writer.release()
     return run
 
 
