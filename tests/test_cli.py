@@ -165,3 +165,16 @@ def test_what_opensees_prints_at_exit_is_hidden_unless_verbose(tmp_path, verbose
     )
     assert proc.returncode == 0, proc.stderr
     assert ("Process 0 Terminating" in proc.stderr) is verbose
+
+
+def test_develop_of_a_sheet_folded_flat_prints_nothing_from_casadi(tmp_path):
+    """simple.fold has creases folded 180 degrees: the start of problem (13) puts vertices on
+    one point, where CasADi used to print NaN-gradient warnings."""
+    fold = Path(__file__).parent / "data" / "fold_examples" / "simple.fold"
+    proc = subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", "develop", str(fold), "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert proc.stdout.startswith("converged: D = ")
