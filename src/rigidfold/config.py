@@ -59,6 +59,11 @@ class Settings:
         A boundary vertex is a corner when the boundary turns there by more than this (radians).
     flat_angle : float
         A free crease with |rho| below this (radians) is flat ("F" in FOLD files).
+    max_json_depth : int
+        Deepest nesting of lists and objects accepted in a JSON file read (FOLD files, a run's
+        summary.json) or data written as JSON: a deeper document is refused with a one-line
+        error instead of exhausting Python's recursion limit (FOLD data nests 4 levels,
+        rigidfold's own files about 10).
     triangulation_area_tol : float
         Ear clipping of the polygon faces of FOLD files: a triangle whose doubled signed area
         is below this times the squared size of its polygon (the larger side of its bounding
@@ -247,6 +252,7 @@ class Settings:
     motion_arc_min_step: float = 1e-6
     motion_turn_back: float = 0.5
     # reading FOLD files
+    max_json_depth: int = 100
     triangulation_area_tol: float = 1e-12
     # reading SVG drawings
     svg_merge_tol: float = 1e-4

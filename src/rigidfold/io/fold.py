@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
-from rigidfold.io.files import atomic_write, jsonable
+from rigidfold.io.files import atomic_write, check_json_depth, jsonable, parse_json
 from rigidfold.mesh import CreasePattern, geometry, topology
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
 
@@ -429,7 +429,8 @@ def read_fold(
     Raises
     ------
     ValueError
-        One line naming the file and the problem: unreadable file, invalid JSON, missing or
+        One line naming the file and the problem: unreadable file, invalid JSON, JSON nested
+        deeper than ``settings.max_json_depth`` (checked at its default), missing or
         malformed keys, an unknown ``frame_unit``, non-finite coordinates, indices out of
         range, cut edges (``"C"``), a boundary edge assigned ``"J"`` or marked fixed, faces
         whose projection onto the xy plane has zero area (a y-up file, a closed or
@@ -458,6 +459,10 @@ def pattern_from_fold(
 def _load(source) -> tuple[str, dict]:
     """(label for messages, parsed FOLD document) of a path or dict."""
     if isinstance(source, dict):
+        try:
+            check_json_depth(source)
+        except ValueError as exc:
+            raise ValueError(f"FOLD data: {exc}") from None
         return "FOLD data", source
     if not isinstance(source, str | os.PathLike):
         raise ValueError(f"read_fold needs a file path or a dict, got {type(source).__name__}")
@@ -469,11 +474,13 @@ def _load(source) -> tuple[str, dict]:
     except UnicodeDecodeError:
         raise ValueError(f"not a FOLD file: {path}: not UTF-8 text") from None
     try:
-        raw = json.loads(text)
+        raw = parse_json(text)
     except json.JSONDecodeError as exc:
         raise ValueError(
             f"not a FOLD file: {path}: invalid JSON at line {exc.lineno} column {exc.colno}"
         ) from None
+    except ValueError as exc:
+        raise ValueError(f"not a FOLD file: {path}: {exc}") from None
     if not isinstance(raw, dict):
         raise ValueError(
             f"not a FOLD file: {path}: the top level is {_kind(raw)}, not a JSON object"

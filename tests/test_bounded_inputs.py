@@ -1,0 +1,64 @@
+"""Bounded inputs (issue 17): deep JSON, seeds, study size, small CLI defects; each refused
+at once with one line on stderr, exit code 2, no traceback."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from rigidfold.config import DEFAULTS
+from rigidfold.io import jsonable, read_fold, write_json
+
+TRIANGLE = {"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces_vertices": [[0, 1, 2]]}
+
+
+def run_cli(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        check=False,
+        timeout=120,
+    )
+
+
+def one_line_error(proc: subprocess.CompletedProcess, message: str) -> None:
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert message in lines[0], lines[0]
+
+
+# ---------------------------------------------------------------- defect 4: deeply nested JSON
+@pytest.mark.parametrize("where", ["top", "rigidfold-key"])
+def test_deeply_nested_fold_file_is_refused(tmp_path, where):
+    path = tmp_path / "deep.fold"
+    if where == "top":
+        path.write_text("[" * 100_000 + "]" * 100_000)
+    else:
+        text = json.dumps(TRIANGLE)[:-1] + ', "rigidfold:x": ' + "[" * 600 + "]" * 600 + "}"
+        path.write_text(text)
+    proc = run_cli("analyze", str(path))
+    one_line_error(proc, f"nested deeper than {DEFAULTS.max_json_depth} levels")
+    with pytest.raises(ValueError, match=r"deep\.fold: nested deeper"):
+        read_fold(path)
+
+
+def test_deeply_nested_data_is_not_written(tmp_path):
+    deep: list = []
+    for _ in range(100_000):
+        deep = [deep]
+    with pytest.raises(ValueError, match="nested deeper than"):
+        jsonable({"a": deep})
+    with pytest.raises(ValueError, match="nested deeper than"):
+        write_json(tmp_path / "x.json", {"a": deep})
+    with pytest.raises(ValueError, match="FOLD data: nested deeper than"):
+        read_fold({**TRIANGLE, "rigidfold:x": deep})
+    assert list(tmp_path.iterdir()) == []
+    # rigidfold's own data nests far less than the limit
+    assert jsonable({"a": [[[1.0]]]}) == {"a": [[[1.0]]]}
