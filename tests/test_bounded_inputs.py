@@ -62,3 +62,31 @@ def test_deeply_nested_data_is_not_written(tmp_path):
     assert list(tmp_path.iterdir()) == []
     # rigidfold's own data nests far less than the limit
     assert jsonable({"a": [[[1.0]]]}) == {"a": [[[1.0]]]}
+
+
+# --------------------------------------------------------------- defect 6: seeds out of range
+@pytest.mark.parametrize("seed", ["10000000000000000000000", "-1", str(2**63)])
+def test_seed_out_of_range_is_refused_at_once(tmp_path, seed):
+    out = tmp_path / "o"
+    proc = run_cli(
+        "optimize", "--surface", "bezier", "--pattern", "1", "--seed", seed, "--out", str(out)
+    )
+    one_line_error(
+        proc, f"argument --seed: seed must be a non-negative integer below 2**63, got {seed}"
+    )
+    proc = run_cli("study", "--surfaces", "1", "--first-seed", seed, "--db", str(tmp_path / "s.db"))
+    one_line_error(proc, "argument --first-seed: seed must be a non-negative integer below 2**63")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_seeds_are_checked_by_the_library():
+    from rigidfold.case import make_case
+    from rigidfold.study import plan
+
+    with pytest.raises(ValueError, match=r"seed must be a non-negative integer below 2\*\*63"):
+        make_case("bezier", "1", seed=2**63)
+    with pytest.raises(ValueError, match="--first-seed must be a non-negative integer"):
+        plan(["1"], ["s"], 1, first_seed=10**22)
+    with pytest.raises(ValueError, match="the last seed"):
+        plan(["1"], ["s"], 2, first_seed=2**63 - 1)
+    assert plan(["1"], ["s"], 1, first_seed=2**63 - 1)[0].seed == 2**63 - 1

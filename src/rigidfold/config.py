@@ -9,11 +9,27 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import threading
 from dataclasses import dataclass, replace
 
 HESSIANS = ("closed-form", "casadi")
 """The Hessians of the Lagrangian IPOPT can use (``Settings.ipopt_hessian``)."""
+
+SEED_LIMIT = 2**63
+"""Seeds (of Bezier surfaces, of generate's random draws) are integers 0 <= seed <
+SEED_LIMIT: a study stores them as SQLite's signed 64-bit integers."""
+
+
+def check_seed(seed, what: str = "seed") -> int:
+    """``seed`` as an int. Raises ValueError ``"<what> must be a non-negative integer below
+    2**63, got <seed>"`` for anything else (a bool, a float, a negative or too large number)."""
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
+        raise ValueError(f"{what} must be a non-negative integer below 2**63, got {seed!r}")
+    value = int(seed)
+    if not 0 <= value < SEED_LIMIT:
+        raise ValueError(f"{what} must be a non-negative integer below 2**63, got {value}")
+    return value
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, check_seed
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
@@ -71,8 +71,8 @@ def plan(
             raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
     if surfaces < 1:
         raise ValueError(f"--surfaces must be >= 1, got {surfaces}")
-    if first_seed < 0:
-        raise ValueError(f"--first-seed must be >= 0, got {first_seed}")
+    check_seed(first_seed, "--first-seed")
+    check_seed(first_seed + surfaces - 1, "--first-seed + --surfaces - 1 (the last seed)")
     if not patterns or not criteria:
         raise ValueError("at least one pattern and one criterion are needed")
     return [
