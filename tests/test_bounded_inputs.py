@@ -90,3 +90,24 @@ def test_seeds_are_checked_by_the_library():
     with pytest.raises(ValueError, match="the last seed"):
         plan(["1"], ["s"], 2, first_seed=2**63 - 1)
     assert plan(["1"], ["s"], 1, first_seed=2**63 - 1)[0].seed == 2**63 - 1
+
+
+# ------------------------------------------------------------- defect 9: study size is bounded
+def test_huge_study_is_refused_at_once(tmp_path):
+    import time
+
+    from rigidfold.study import plan
+
+    t0 = time.perf_counter()
+    proc = run_cli("study", "--surfaces", "1000000000", "--db", str(tmp_path / "s.db"))
+    one_line_error(
+        proc,
+        f"--surfaces 1000000000 makes 8000000000 runs (1000000000 surfaces x 2 patterns x 4 "
+        f"criteria), more than the limit of {DEFAULTS.max_study_runs}",
+    )
+    assert time.perf_counter() - t0 < 30
+    assert list(tmp_path.iterdir()) == []
+    small = DEFAULTS.with_(max_study_runs=8)
+    assert len(plan(["1", "2"], ["s", "shat"], 2, settings=small)) == 8
+    with pytest.raises(ValueError, match="makes 12 runs"):
+        plan(["1", "2"], ["s", "shat"], 3, settings=small)

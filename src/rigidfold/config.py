@@ -194,6 +194,13 @@ class Settings:
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
         is refused instead of building a problem that cannot be solved.
 
+    Studies (``rigidfold.study``)
+    -----------------------------
+    max_study_runs : int
+        Largest number of runs (surfaces x patterns x criteria) a Bezier study may plan: a
+        typo such as ``--surfaces 1000000000`` is refused at once instead of spending minutes
+        and gigabytes listing runs that could never finish.
+
     Target surfaces from triangle meshes (``rigidfold.surfaces.MeshSurface``)
     -------------------------------------------------------------------------
     surface_grid_nodes : int
@@ -276,6 +283,8 @@ class Settings:
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
     max_pattern_faces: int = 20000
+    # studies
+    max_study_runs: int = 1_000_000
     # target surfaces from triangle meshes
     surface_grid_nodes: int = 65
     surface_footprint_tol: float = 1e-5
