@@ -3,7 +3,9 @@ at once with one line on stderr, exit code 2, no traceback."""
 
 from __future__ import annotations
 
+import errno
 import json
+import os
 import subprocess
 import sys
 
@@ -111,3 +113,85 @@ def test_huge_study_is_refused_at_once(tmp_path):
     assert len(plan(["1", "2"], ["s", "shat"], 2, settings=small)) == 8
     with pytest.raises(ValueError, match="makes 12 runs"):
         plan(["1", "2"], ["s", "shat"], 3, settings=small)
+
+
+# ------------------------------------------------------------------- defect 12: small ones
+def test_expression_starting_with_minus_is_accepted(tmp_path):
+    from rigidfold.cli import _attached_values
+
+    out = str(tmp_path / "o")
+    proc = run_cli(
+        "optimize", "--surface", "bezier", "--expr", "-x*y", "--pattern", "1", "--out", out
+    )
+    one_line_error(proc, "--expr is only used with --surface expr, not bezier")
+    proc = run_cli(
+        "optimize", "--surface", "expr", "--expr", "-log(x)", "--pattern", "1", "--out", out
+    )
+    one_line_error(proc, "not finite")
+    assert _attached_values(["a", "--expr", "-x", "--", "--expr", "-y"]) == [
+        "a",
+        "--expr=-x",
+        "--",
+        "--expr",
+        "-y",
+    ]
+    assert _attached_values(["--expr"]) == ["--expr"]
+
+
+@pytest.mark.parametrize("command", ["optimize", "generate"])
+def test_bad_expression_creates_no_output_directory(tmp_path, command):
+    out = tmp_path / "o"
+    proc = run_cli(
+        command, "--surface", "expr", "--expr", "x +", "--pattern", "1", "--out", str(out)
+    )
+    one_line_error(proc, "invalid expression")
+    assert not out.exists()
+
+
+def test_mixed_2d_and_3d_vertices_are_refused(tmp_path):
+    path = tmp_path / "mixed.fold"
+    data = {
+        "vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1]],
+        "faces_vertices": [[0, 1, 2], [1, 3, 2]],
+    }
+    path.write_text(json.dumps(data))
+    one_line_error(run_cli("analyze", str(path)), "vertices_coords[3] has 2 coordinates")
+
+
+def test_huge_coordinates_are_refused_without_warnings(tmp_path):
+    path = tmp_path / "huge.fold"
+    data = {
+        "vertices_coords": [[0, 0, 0], [1e300, 0, 0], [0, 1e300, 0], [1e300, 1e300, 1]],
+        "faces_vertices": [[0, 1, 2], [1, 3, 2]],
+        "frame_unit": "m",
+    }
+    path.write_text(json.dumps(data))
+    proc = run_cli("analyze", str(path))
+    one_line_error(proc, "vertices_coords[1] = [1e+300, 0, 0] lies farther than 1e+06 m")
+    assert "Warning" not in proc.stderr
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
+def test_full_standard_output_is_one_line(tmp_path):
+    path = tmp_path / "t.fold"
+    path.write_text(json.dumps(TRIANGLE))
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run(
+            [sys.executable, "-m", "rigidfold.cli", "analyze", str(path)],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            check=False,
+            timeout=120,
+        )
+    one_line_error(proc, "cannot write the output: No space left on device")
+
+
+def test_full_disk_leaves_no_temporary_file(tmp_path, monkeypatch):
+    def no_space(fd):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", no_space)
+    with pytest.raises(ValueError, match=r"cannot write '.*x\.json': No space left on device"):
+        write_json(tmp_path / "x.json", {"a": 1})
+    assert list(tmp_path.iterdir()) == []

@@ -80,6 +80,9 @@ class Settings:
         summary.json) or data written as JSON: a deeper document is refused with a one-line
         error instead of exhausting Python's recursion limit (FOLD data nests 4 levels,
         rigidfold's own files about 10).
+    max_coordinate : float
+        Largest |coordinate| in metres accepted in a FOLD file (1000 km): larger values are
+        refused before any geometry is computed on them, where they would overflow.
     triangulation_area_tol : float
         Ear clipping of the polygon faces of FOLD files: a triangle whose doubled signed area
         is below this times the squared size of its polygon (the larger side of its bounding
@@ -276,6 +279,7 @@ class Settings:
     motion_turn_back: float = 0.5
     # reading FOLD files
     max_json_depth: int = 100
+    max_coordinate: float = 1e6
     triangulation_area_tol: float = 1e-12
     # reading SVG drawings
     svg_merge_tol: float = 1e-4

@@ -431,7 +431,8 @@ def read_fold(
     ValueError
         One line naming the file and the problem: unreadable file, invalid JSON, JSON nested
         deeper than ``settings.max_json_depth`` (checked at its default), missing or
-        malformed keys, an unknown ``frame_unit``, non-finite coordinates, indices out of
+        malformed keys, an unknown ``frame_unit``, non-finite coordinates, 2D and 3D vertices
+        mixed, a coordinate beyond ``settings.max_coordinate`` metres, indices out of
         range, cut edges (``"C"``), a boundary edge assigned ``"J"`` or marked fixed, faces
         whose projection onto the xy plane has zero area (a y-up file, a closed or
         flat-folded sheet), a surface that is not an oriented disc.
@@ -497,6 +498,13 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
             f"{', '.join(UNITS)}"
         )
     coords = _coords(data) * UNITS[unit]
+    far = np.abs(coords).max(axis=1, initial=0.0) > settings.max_coordinate
+    if far.any():
+        i = int(np.argmax(far))
+        raise ValueError(
+            f"vertices_coords[{i}] = {_short(data['vertices_coords'][i])} lies farther than "
+            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+        )
     if up == "y":
         coords = coords[:, [0, 2, 1]] * [1.0, -1.0, 1.0]
     polygons = _polygons(data, len(coords))
@@ -577,7 +585,7 @@ def _frame(raw: dict, index: int) -> dict:
 
 
 def _coords(data: dict) -> np.ndarray:
-    """``vertices_coords`` as a (V, 3) float array, z = 0 for 2D points."""
+    """``vertices_coords`` as a (V, 3) float array, z = 0 for 2D points (all 2D or all 3D)."""
     rows = _required_list(data, "vertices_coords")
     coords = np.zeros((len(rows), 3))
     for i, row in enumerate(rows):
@@ -589,6 +597,11 @@ def _coords(data: dict) -> np.ndarray:
             coords[i] = math.inf
         if not np.isfinite(coords[i]).all():
             raise ValueError(f"vertices_coords[{i}] is not finite: {_short(row)}")
+        if len(row) != len(rows[0]):
+            raise ValueError(
+                f"vertices_coords[{i}] has {len(row)} coordinates, vertices_coords[0] has "
+                f"{len(rows[0])}: a file's vertices are all 2D or all 3D, got {_short(row)}"
+            )
     return coords
 
 
