@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold import patterns
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, check_seed
 from rigidfold.io.fold import read_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
@@ -91,6 +91,8 @@ def make_case(
     up : the up axis (``"z"`` or ``"y"``) of a FOLD pattern and of a mesh or FOLD surface.
     ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
     """
+    if seed is not None:
+        check_seed(seed)
     plan = patterns.parse_pattern(
         pattern,
         size=size,

@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 
 from rigidfold import __version__
-from rigidfold.config import DEFAULTS, HESSIANS
+from rigidfold.config import DEFAULTS, HESSIANS, check_seed
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
@@ -45,6 +45,17 @@ def _positive(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
     return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+    try:
+        return check_seed(value)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -197,7 +208,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--criteria", default=",".join(plan.criteria), help="comma-separated (default %(default)s)"
     )
     stu.add_argument("--surfaces", type=int, default=plan.surfaces, help="number of Bezier seeds")
-    stu.add_argument("--first-seed", type=int, default=plan.first_seed)
+    stu.add_argument(
+        "--first-seed",
+        type=_seed,
+        default=plan.first_seed,
+        help="seed of the first Bezier surface, 0 to 2**63 - 1 (default %(default)s)",
+    )
     stu.add_argument(
         "--preset", help="dome, hp or dome,hp: Sections 6.5-6.6 instead of Bezier surfaces"
     )
@@ -271,13 +287,17 @@ def _case_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--seed",
-        type=int,
+        type=_seed,
         default=0,
-        help="seed of the random Bezier surface; generate also draws from it the random hinge "
-        "stiffnesses of the S-hat and S^S criteria and the order of the random criterion "
-        "(default 0)",
+        help="seed (0 to 2**63 - 1) of the random Bezier surface; generate also draws from it "
+        "the random hinge stiffnesses of the S-hat and S^S criteria and the order of the "
+        "random criterion (default 0)",
     )
-    p.add_argument("--expr", help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'")
+    p.add_argument(
+        "--expr",
+        help="z = f(x, y) for --surface expr, e.g. '0.2*sin(x)*y'; the next argument is the "
+        "expression even when it starts with '-' (--expr -x*y)",
+    )
     p.add_argument(
         "--pattern",
         required=True,
@@ -633,7 +653,7 @@ def _names(text: str) -> list[str]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_attached_values(sys.argv[1:] if argv is None else argv))
     if not args.verbose:
         _quiet_exit()
     try:
@@ -648,9 +668,38 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     except BrokenPipeError:
         # the reader went away (``rigidfold analyze X --json | head -1``): stop quietly
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
+        _drop_stdout()
         return EXIT_PIPE
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        if exc.filename is not None:  # a file the library did not report itself
+            print(f"rigidfold: error: {exc.filename}: {reason}", file=sys.stderr)
+            return EXIT_USAGE
+        # standard output cannot be written (``> /dev/full``, a full disk)
+        _drop_stdout()
+        print(f"rigidfold: error: cannot write the output: {reason}", file=sys.stderr)
+        return EXIT_USAGE
+
+
+def _attached_values(argv: Sequence[str]) -> list[str]:
+    """``argv`` with ``--expr VALUE`` written ``--expr=VALUE``, so that an expression that
+    starts with '-' (``--expr -x*y``) is read as the value, not as an option."""
+    out: list[str] = []
+    args = iter(argv)
+    for arg in args:
+        if arg == "--":
+            out += [arg, *args]
+            break
+        value = next(args, None) if arg == "--expr" else None
+        out.append(arg if value is None else f"{arg}={value}")
+    return out
+
+
+def _drop_stdout() -> None:
+    """Send what is still buffered for standard output, and what follows, to the null device
+    (so that Python's final flush does not fail again)."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
 
 
 _QUIET_EXIT: list[bool] = []

@@ -9,11 +9,27 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import threading
 from dataclasses import dataclass, replace
 
 HESSIANS = ("closed-form", "casadi")
 """The Hessians of the Lagrangian IPOPT can use (``Settings.ipopt_hessian``)."""
+
+SEED_LIMIT = 2**63
+"""Seeds (of Bezier surfaces, of generate's random draws) are integers 0 <= seed <
+SEED_LIMIT: a study stores them as SQLite's signed 64-bit integers."""
+
+
+def check_seed(seed, what: str = "seed") -> int:
+    """``seed`` as an int. Raises ValueError ``"<what> must be a non-negative integer below
+    2**63, got <seed>"`` for anything else (a bool, a float, a negative or too large number)."""
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
+        raise ValueError(f"{what} must be a non-negative integer below 2**63, got {seed!r}")
+    value = int(seed)
+    if not 0 <= value < SEED_LIMIT:
+        raise ValueError(f"{what} must be a non-negative integer below 2**63, got {value}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -59,6 +75,14 @@ class Settings:
         A boundary vertex is a corner when the boundary turns there by more than this (radians).
     flat_angle : float
         A free crease with |rho| below this (radians) is flat ("F" in FOLD files).
+    max_json_depth : int
+        Deepest nesting of lists and objects accepted in a JSON file read (FOLD files, a run's
+        summary.json) or data written as JSON: a deeper document is refused with a one-line
+        error instead of exhausting Python's recursion limit (FOLD data nests 4 levels,
+        rigidfold's own files about 10).
+    max_coordinate : float
+        Largest |coordinate| in metres accepted in a FOLD file (1000 km): larger values are
+        refused before any geometry is computed on them, where they would overflow.
     triangulation_area_tol : float
         Ear clipping of the polygon faces of FOLD files: a triangle whose doubled signed area
         is below this times the squared size of its polygon (the larger side of its bounding
@@ -173,6 +197,13 @@ class Settings:
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
         is refused instead of building a problem that cannot be solved.
 
+    Studies (``rigidfold.study``)
+    -----------------------------
+    max_study_runs : int
+        Largest number of runs (surfaces x patterns x criteria) a Bezier study may plan: a
+        typo such as ``--surfaces 1000000000`` is refused at once instead of spending minutes
+        and gigabytes listing runs that could never finish.
+
     Target surfaces from triangle meshes (``rigidfold.surfaces.MeshSurface``)
     -------------------------------------------------------------------------
     surface_grid_nodes : int
@@ -247,6 +278,8 @@ class Settings:
     motion_arc_min_step: float = 1e-6
     motion_turn_back: float = 0.5
     # reading FOLD files
+    max_json_depth: int = 100
+    max_coordinate: float = 1e6
     triangulation_area_tol: float = 1e-12
     # reading SVG drawings
     svg_merge_tol: float = 1e-4
@@ -254,6 +287,8 @@ class Settings:
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
     max_pattern_faces: int = 20000
+    # studies
+    max_study_runs: int = 1_000_000
     # target surfaces from triangle meshes
     surface_grid_nodes: int = 65
     surface_footprint_tol: float = 1e-5

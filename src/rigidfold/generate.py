@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.config import Settings, one_blas_thread
+from rigidfold.config import Settings, check_seed, one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
@@ -258,7 +258,7 @@ def generate(
         target_dof = case.settings.target_dof
     if target_dof < 0:
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(check_seed(seed))
     run = Generation()
     t0 = time.perf_counter()
     problem = case.problem(build_ipopt=solver == "ipopt")

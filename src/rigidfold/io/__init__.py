@@ -1,7 +1,14 @@
 """File formats (FOLD 1.2 crease patterns, SVG drawings and crease patterns drawn in SVG) and
 atomic output files."""
 
-from rigidfold.io.files import atomic_write, jsonable, prepare_output_dir, write_json
+from rigidfold.io.files import (
+    atomic_write,
+    check_json_depth,
+    jsonable,
+    parse_json,
+    prepare_output_dir,
+    write_json,
+)
 from rigidfold.io.fold import (
     UNITS,
     UP_AXES,
@@ -24,10 +31,12 @@ __all__ = [
     "FoldData",
     "SvgDrawing",
     "atomic_write",
+    "check_json_depth",
     "crease_pattern_frame",
     "fold_dict",
     "jsonable",
     "motion_frames",
+    "parse_json",
     "pattern_from_fold",
     "prepare_output_dir",
     "read_fold",

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.config import DEFAULTS
+
 _TEMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
 
 
@@ -83,6 +85,41 @@ def write_json(path: str | os.PathLike, data, *, indent: int | None = 2) -> Path
     return atomic_write(path, json.dumps(clean, indent=indent, allow_nan=False) + "\n")
 
 
+def parse_json(text: str | bytes, *, max_depth: int = DEFAULTS.max_json_depth):
+    """The JSON data of ``text``, nested at most ``max_depth`` levels (``Settings.max_json_depth``).
+
+    Raises json.JSONDecodeError for text that is not JSON, and ValueError ``"nested deeper
+    than N levels"`` for a deeper document (one nested too deep for Python's parser included).
+    """
+    try:
+        value = json.loads(text)
+    except RecursionError:
+        raise ValueError(_too_deep(max_depth)) from None
+    check_json_depth(value, max_depth=max_depth)
+    return value
+
+
+def check_json_depth(value, *, max_depth: int = DEFAULTS.max_json_depth) -> None:
+    """ValueError ``"nested deeper than N levels"`` when lists, tuples and dicts nest in
+    ``value`` deeper than ``max_depth``; measured without recursion, so any depth is safe."""
+    stack = [(value, 1)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, dict):
+            children = list(item.values())
+        elif isinstance(item, list | tuple):
+            children = list(item)
+        else:
+            continue
+        if depth > max_depth:
+            raise ValueError(_too_deep(max_depth))
+        stack.extend((child, depth + 1) for child in children)
+
+
+def _too_deep(max_depth: int) -> str:
+    return f"nested deeper than {max_depth} levels (Settings.max_json_depth)"
+
+
 def jsonable(value, *, where: str = "the value"):
     """``value`` as plain JSON data (what ``json.dumps(..., allow_nan=False)`` accepts).
 
@@ -93,14 +130,24 @@ def jsonable(value, *, where: str = "the value"):
       :class:`rigidfold.status.Outcome` members included).
 
     Raises ValueError ``"<where> holds a <type>, which is not JSON data"`` for anything else
-    (sets, arbitrary objects).
+    (sets, arbitrary objects), and ``"<where> is nested deeper than N levels"`` for lists and
+    dicts nested deeper than ``Settings.max_json_depth``.
     """
+    try:
+        check_json_depth(value)
+    except ValueError as exc:
+        raise ValueError(f"{where} is {exc}") from None
+    return _clean(value, where)
+
+
+def _clean(value, where: str):
+    """:func:`jsonable` of data whose depth is checked."""
     if isinstance(value, np.ndarray | np.generic):
-        return jsonable(value.tolist(), where=where)
+        return _clean(value.tolist(), where)
     if isinstance(value, dict):
-        return {str(k): jsonable(v, where=where) for k, v in value.items()}
+        return {str(k): _clean(v, where) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [jsonable(v, where=where) for v in value]
+        return [_clean(v, where) for v in value]
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if value is None or isinstance(value, str | bool | int):

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
-from rigidfold.io.files import atomic_write, jsonable
+from rigidfold.io.files import atomic_write, check_json_depth, jsonable, parse_json
 from rigidfold.mesh import CreasePattern, geometry, topology
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
 
@@ -429,8 +429,10 @@ def read_fold(
     Raises
     ------
     ValueError
-        One line naming the file and the problem: unreadable file, invalid JSON, missing or
-        malformed keys, an unknown ``frame_unit``, non-finite coordinates, indices out of
+        One line naming the file and the problem: unreadable file, invalid JSON, JSON nested
+        deeper than ``settings.max_json_depth`` (checked at its default), missing or
+        malformed keys, an unknown ``frame_unit``, non-finite coordinates, 2D and 3D vertices
+        mixed, a coordinate beyond ``settings.max_coordinate`` metres, indices out of
         range, cut edges (``"C"``), a boundary edge assigned ``"J"`` or marked fixed, faces
         whose projection onto the xy plane has zero area (a y-up file, a closed or
         flat-folded sheet), a surface that is not an oriented disc.
@@ -458,6 +460,10 @@ def pattern_from_fold(
 def _load(source) -> tuple[str, dict]:
     """(label for messages, parsed FOLD document) of a path or dict."""
     if isinstance(source, dict):
+        try:
+            check_json_depth(source)
+        except ValueError as exc:
+            raise ValueError(f"FOLD data: {exc}") from None
         return "FOLD data", source
     if not isinstance(source, str | os.PathLike):
         raise ValueError(f"read_fold needs a file path or a dict, got {type(source).__name__}")
@@ -469,11 +475,13 @@ def _load(source) -> tuple[str, dict]:
     except UnicodeDecodeError:
         raise ValueError(f"not a FOLD file: {path}: not UTF-8 text") from None
     try:
-        raw = json.loads(text)
+        raw = parse_json(text)
     except json.JSONDecodeError as exc:
         raise ValueError(
             f"not a FOLD file: {path}: invalid JSON at line {exc.lineno} column {exc.colno}"
         ) from None
+    except ValueError as exc:
+        raise ValueError(f"not a FOLD file: {path}: {exc}") from None
     if not isinstance(raw, dict):
         raise ValueError(
             f"not a FOLD file: {path}: the top level is {_kind(raw)}, not a JSON object"
@@ -490,6 +498,13 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
             f"{', '.join(UNITS)}"
         )
     coords = _coords(data) * UNITS[unit]
+    far = np.abs(coords).max(axis=1, initial=0.0) > settings.max_coordinate
+    if far.any():
+        i = int(np.argmax(far))
+        raise ValueError(
+            f"vertices_coords[{i}] = {_short(data['vertices_coords'][i])} lies farther than "
+            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+        )
     if up == "y":
         coords = coords[:, [0, 2, 1]] * [1.0, -1.0, 1.0]
     polygons = _polygons(data, len(coords))
@@ -570,7 +585,7 @@ def _frame(raw: dict, index: int) -> dict:
 
 
 def _coords(data: dict) -> np.ndarray:
-    """``vertices_coords`` as a (V, 3) float array, z = 0 for 2D points."""
+    """``vertices_coords`` as a (V, 3) float array, z = 0 for 2D points (all 2D or all 3D)."""
     rows = _required_list(data, "vertices_coords")
     coords = np.zeros((len(rows), 3))
     for i, row in enumerate(rows):
@@ -582,6 +597,11 @@ def _coords(data: dict) -> np.ndarray:
             coords[i] = math.inf
         if not np.isfinite(coords[i]).all():
             raise ValueError(f"vertices_coords[{i}] is not finite: {_short(row)}")
+        if len(row) != len(rows[0]):
+            raise ValueError(
+                f"vertices_coords[{i}] has {len(row)} coordinates, vertices_coords[0] has "
+                f"{len(rows[0])}: a file's vertices are all 2D or all 3D, got {_short(row)}"
+            )
     return coords
 
 

@@ -10,7 +10,6 @@ run is a one-line ``ValueError``.
 
 from __future__ import annotations
 
-import json
 import os
 import re
 from dataclasses import dataclass
@@ -18,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.io import read_fold
+from rigidfold.io import parse_json, read_fold
 from rigidfold.protocols import TargetSurface
 from rigidfold.surfaces import Bezier, get_surface
 
@@ -276,12 +275,12 @@ def load_run(directory: str | os.PathLike) -> RunData:
 def _json_object(root: Path, name: str) -> dict:
     path = root / name
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = parse_json(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ValueError(
             f"{str(root)!r} is not a rigidfold generate run: it has no {name}"
         ) from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise ValueError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
     if not isinstance(data, dict):
         raise ValueError(f"{str(path)!r} is not a JSON object")

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, check_seed
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
@@ -54,7 +54,12 @@ class StudyConfig:
 
 
 def plan(
-    patterns: Sequence[str], criteria: Sequence[str], surfaces: int, first_seed: int = 0
+    patterns: Sequence[str],
+    criteria: Sequence[str],
+    surfaces: int,
+    first_seed: int = 0,
+    *,
+    settings: Settings = DEFAULTS,
 ) -> list[Key]:
     """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1,
     on crease patterns given by spec (:func:`rigidfold.patterns.parse_pattern` with its
@@ -62,7 +67,8 @@ def plan(
     ``FILE.svg`` fitted into 3 m x 3 m) and criteria.
 
     Seed-major order (every pattern and criterion of a surface before the next surface), so
-    that a study stopped early holds complete surfaces.
+    that a study stopped early holds complete surfaces. At most ``settings.max_study_runs``
+    runs (checked before the list is built).
     """
     for p in patterns:
         parse_pattern(p)
@@ -71,10 +77,17 @@ def plan(
             raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
     if surfaces < 1:
         raise ValueError(f"--surfaces must be >= 1, got {surfaces}")
-    if first_seed < 0:
-        raise ValueError(f"--first-seed must be >= 0, got {first_seed}")
+    check_seed(first_seed, "--first-seed")
+    check_seed(first_seed + surfaces - 1, "--first-seed + --surfaces - 1 (the last seed)")
     if not patterns or not criteria:
         raise ValueError("at least one pattern and one criterion are needed")
+    runs = surfaces * len(patterns) * len(criteria)
+    if runs > settings.max_study_runs:
+        raise ValueError(
+            f"--surfaces {surfaces} makes {runs} runs ({surfaces} surfaces x {len(patterns)} "
+            f"patterns x {len(criteria)} criteria), more than the limit of "
+            f"{settings.max_study_runs} (Settings.max_study_runs)"
+        )
     return [
         Key("bezier", seed, p, c)
         for seed in range(first_seed, first_seed + surfaces)

@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from rigidfold.config import check_seed
+
 
 @dataclass(frozen=True)
 class MirrorPlane:
@@ -126,9 +128,7 @@ class Bezier(Surface):
     name = "bezier"
 
     def __init__(self, seed: int = 0, *, box: tuple[float, float] = (3.0, 3.0)) -> None:
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise ValueError(f"the Bezier seed must be a non-negative integer, got {seed!r}")
-        self.seed: int | None = int(seed)
+        self.seed: int | None = check_seed(seed, "the Bezier seed")
         self.heights = np.random.default_rng(self.seed).uniform(0.0, 3.0, size=(4, 4))
         self.box = _box(box)
 

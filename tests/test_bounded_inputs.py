@@ -1,0 +1,197 @@
+"""Bounded inputs (issue 17): deep JSON, seeds, study size, small CLI defects; each refused
+at once with one line on stderr, exit code 2, no traceback."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from rigidfold.config import DEFAULTS
+from rigidfold.io import jsonable, read_fold, write_json
+
+TRIANGLE = {"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces_vertices": [[0, 1, 2]]}
+
+
+def run_cli(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        check=False,
+        timeout=120,
+    )
+
+
+def one_line_error(proc: subprocess.CompletedProcess, message: str) -> None:
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert message in lines[0], lines[0]
+
+
+# ---------------------------------------------------------------- defect 4: deeply nested JSON
+@pytest.mark.parametrize("where", ["top", "rigidfold-key"])
+def test_deeply_nested_fold_file_is_refused(tmp_path, where):
+    path = tmp_path / "deep.fold"
+    if where == "top":
+        path.write_text("[" * 100_000 + "]" * 100_000)
+    else:
+        text = json.dumps(TRIANGLE)[:-1] + ', "rigidfold:x": ' + "[" * 600 + "]" * 600 + "}"
+        path.write_text(text)
+    proc = run_cli("analyze", str(path))
+    one_line_error(proc, f"nested deeper than {DEFAULTS.max_json_depth} levels")
+    with pytest.raises(ValueError, match=r"deep\.fold: nested deeper"):
+        read_fold(path)
+
+
+def test_deeply_nested_data_is_not_written(tmp_path):
+    deep: list = []
+    for _ in range(100_000):
+        deep = [deep]
+    with pytest.raises(ValueError, match="nested deeper than"):
+        jsonable({"a": deep})
+    with pytest.raises(ValueError, match="nested deeper than"):
+        write_json(tmp_path / "x.json", {"a": deep})
+    with pytest.raises(ValueError, match="FOLD data: nested deeper than"):
+        read_fold({**TRIANGLE, "rigidfold:x": deep})
+    assert list(tmp_path.iterdir()) == []
+    # rigidfold's own data nests far less than the limit
+    assert jsonable({"a": [[[1.0]]]}) == {"a": [[[1.0]]]}
+
+
+# --------------------------------------------------------------- defect 6: seeds out of range
+@pytest.mark.parametrize("seed", ["10000000000000000000000", "-1", str(2**63)])
+def test_seed_out_of_range_is_refused_at_once(tmp_path, seed):
+    out = tmp_path / "o"
+    proc = run_cli(
+        "optimize", "--surface", "bezier", "--pattern", "1", "--seed", seed, "--out", str(out)
+    )
+    one_line_error(
+        proc, f"argument --seed: seed must be a non-negative integer below 2**63, got {seed}"
+    )
+    proc = run_cli("study", "--surfaces", "1", "--first-seed", seed, "--db", str(tmp_path / "s.db"))
+    one_line_error(proc, "argument --first-seed: seed must be a non-negative integer below 2**63")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_seeds_are_checked_by_the_library():
+    from rigidfold.case import make_case
+    from rigidfold.study import plan
+
+    with pytest.raises(ValueError, match=r"seed must be a non-negative integer below 2\*\*63"):
+        make_case("bezier", "1", seed=2**63)
+    with pytest.raises(ValueError, match="--first-seed must be a non-negative integer"):
+        plan(["1"], ["s"], 1, first_seed=10**22)
+    with pytest.raises(ValueError, match="the last seed"):
+        plan(["1"], ["s"], 2, first_seed=2**63 - 1)
+    assert plan(["1"], ["s"], 1, first_seed=2**63 - 1)[0].seed == 2**63 - 1
+
+
+# ------------------------------------------------------------- defect 9: study size is bounded
+def test_huge_study_is_refused_at_once(tmp_path):
+    import time
+
+    from rigidfold.study import plan
+
+    t0 = time.perf_counter()
+    proc = run_cli("study", "--surfaces", "1000000000", "--db", str(tmp_path / "s.db"))
+    one_line_error(
+        proc,
+        f"--surfaces 1000000000 makes 8000000000 runs (1000000000 surfaces x 2 patterns x 4 "
+        f"criteria), more than the limit of {DEFAULTS.max_study_runs}",
+    )
+    assert time.perf_counter() - t0 < 30
+    assert list(tmp_path.iterdir()) == []
+    small = DEFAULTS.with_(max_study_runs=8)
+    assert len(plan(["1", "2"], ["s", "shat"], 2, settings=small)) == 8
+    with pytest.raises(ValueError, match="makes 12 runs"):
+        plan(["1", "2"], ["s", "shat"], 3, settings=small)
+
+
+# ------------------------------------------------------------------- defect 12: small ones
+def test_expression_starting_with_minus_is_accepted(tmp_path):
+    from rigidfold.cli import _attached_values
+
+    out = str(tmp_path / "o")
+    proc = run_cli(
+        "optimize", "--surface", "bezier", "--expr", "-x*y", "--pattern", "1", "--out", out
+    )
+    one_line_error(proc, "--expr is only used with --surface expr, not bezier")
+    proc = run_cli(
+        "optimize", "--surface", "expr", "--expr", "-log(x)", "--pattern", "1", "--out", out
+    )
+    one_line_error(proc, "not finite")
+    assert _attached_values(["a", "--expr", "-x", "--", "--expr", "-y"]) == [
+        "a",
+        "--expr=-x",
+        "--",
+        "--expr",
+        "-y",
+    ]
+    assert _attached_values(["--expr"]) == ["--expr"]
+
+
+@pytest.mark.parametrize("command", ["optimize", "generate"])
+def test_bad_expression_creates_no_output_directory(tmp_path, command):
+    out = tmp_path / "o"
+    proc = run_cli(
+        command, "--surface", "expr", "--expr", "x +", "--pattern", "1", "--out", str(out)
+    )
+    one_line_error(proc, "invalid expression")
+    assert not out.exists()
+
+
+def test_mixed_2d_and_3d_vertices_are_refused(tmp_path):
+    path = tmp_path / "mixed.fold"
+    data = {
+        "vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1]],
+        "faces_vertices": [[0, 1, 2], [1, 3, 2]],
+    }
+    path.write_text(json.dumps(data))
+    one_line_error(run_cli("analyze", str(path)), "vertices_coords[3] has 2 coordinates")
+
+
+def test_huge_coordinates_are_refused_without_warnings(tmp_path):
+    path = tmp_path / "huge.fold"
+    data = {
+        "vertices_coords": [[0, 0, 0], [1e300, 0, 0], [0, 1e300, 0], [1e300, 1e300, 1]],
+        "faces_vertices": [[0, 1, 2], [1, 3, 2]],
+        "frame_unit": "m",
+    }
+    path.write_text(json.dumps(data))
+    proc = run_cli("analyze", str(path))
+    one_line_error(proc, "vertices_coords[1] = [1e+300, 0, 0] lies farther than 1e+06 m")
+    assert "Warning" not in proc.stderr
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
+def test_full_standard_output_is_one_line(tmp_path):
+    path = tmp_path / "t.fold"
+    path.write_text(json.dumps(TRIANGLE))
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run(
+            [sys.executable, "-m", "rigidfold.cli", "analyze", str(path)],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            check=False,
+            timeout=120,
+        )
+    one_line_error(proc, "cannot write the output: No space left on device")
+
+
+def test_full_disk_leaves_no_temporary_file(tmp_path, monkeypatch):
+    def no_space(fd):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", no_space)
+    with pytest.raises(ValueError, match=r"cannot write '.*x\.json': No space left on device"):
+        write_json(tmp_path / "x.json", {"a": 1})
+    assert list(tmp_path.iterdir()) == []
