@@ -60,13 +60,30 @@ def run_study_command(
 
     on_done(failed, finished, total) after each stored run (``failed``: the run ended in an
     error, recorded in the database). A KeyboardInterrupt is recorded and re-raised as
-    :class:`StudyInterrupted`.
+    :class:`StudyInterrupted`. The database is locked while the study runs (a second
+    client is refused, :class:`~rigidfold.study.lock.StudyLock`).
     """
-    from rigidfold import __version__
-
     if workers < 1:
         raise ValueError(f"--workers must be >= 1, got {workers}")
     store = Store(db, config.as_dict())  # refuses another configuration untouched
+    try:
+        return _run(store, keys, config, workers, scheduler, argv, on_done)
+    finally:
+        store.close()  # and release its lock
+
+
+def _run(
+    store: Store,
+    keys: Sequence[Key],
+    config: StudyConfig,
+    workers: int,
+    scheduler: str | None,
+    argv: Sequence[str],
+    on_done: Callable[[bool, int, int], None] | None,
+) -> dict:
+    """:func:`run_study_command` on the open ``store``."""
+    from rigidfold import __version__
+
     started = datetime.now(UTC).isoformat(timespec="seconds")
     t0 = time.perf_counter()
     planned = set(keys)
@@ -95,8 +112,6 @@ def run_study_command(
     except KeyboardInterrupt:
         finished = len(store.done() & planned)
         record("interrupted", finished - before)
-        store.close()
         raise StudyInterrupted(finished) from None
     record("completed", result["ran"])
-    store.close()
     return result
