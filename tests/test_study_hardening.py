@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import os
 import signal
+import socket
 import sqlite3
 import subprocess
 import sys
+import threading
+import time
 
 import pytest
 
@@ -130,3 +133,49 @@ def test_a_second_client_is_refused_and_a_dead_ones_lock_taken_over(tmp_path):
         store.add(Key("bezier", 0, "1", "s"), {"status": "x", "version": "v"}, [])
     store.close()
     assert not (tmp_path / "s.sqlite.lock").exists()
+
+
+def test_a_scheduler_that_is_not_dask_is_refused_within_the_timeout(tmp_path):
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(8)
+    accepted: list[socket.socket] = []
+
+    def accept() -> None:  # accepts and says nothing, as a foreign service would
+        while True:
+            try:
+                accepted.append(server.accept()[0])
+            except OSError:
+                return
+
+    threading.Thread(target=accept, daemon=True).start()
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    t0 = time.perf_counter()
+    try:
+        proc = cli(
+            "study", *STUDY, "--db", str(tmp_path / "c.sqlite"), "--scheduler", address,
+            "--connect-timeout", "3", timeout=120,
+        )  # fmt: skip
+    finally:
+        server.close()
+        for conn in accepted:
+            conn.close()
+    assert time.perf_counter() - t0 < 60
+    assert proc.returncode == 2
+    (line,) = proc.stderr.strip().splitlines()
+    assert f"cannot reach the Dask scheduler at {address!r} within 3 s" in line
+    proc = cli("study", *STUDY, "--db", str(tmp_path / "c.sqlite"), "--connect-timeout", "0")
+    assert proc.returncode == 2 and "--connect-timeout must be > 0" in proc.stderr
+
+
+def test_a_dask_scheduler_is_reached_through_the_handshake():
+    from dask.distributed import LocalCluster
+
+    from rigidfold.study.runner import connect
+
+    with LocalCluster(
+        n_workers=0, processes=False, protocol="tcp://", dashboard_address=None
+    ) as cluster:
+        client = connect(cluster.scheduler_address, 10)
+        assert client.scheduler_info()["address"] == cluster.scheduler_address
+        client.close()
