@@ -159,7 +159,7 @@ def test_plan_and_store_units(tmp_path):
     key = Key("bezier", 5, "1", "shat")
     store.add(key, {"status": "x", "version": "v"}, [])
     assert store.done() == {key}
-    with pytest.raises(sqlite3.IntegrityError):
+    with pytest.raises(ValueError, match="already holds the run"):
         store.add(key, {"status": "x", "version": "v"}, [])  # never counted twice
     assert len(store.runs()) == 1
 

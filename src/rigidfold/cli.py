@@ -221,6 +221,13 @@ def build_parser() -> argparse.ArgumentParser:
     where = stu.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, default=plan.workers, help="local worker processes")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
+    stu.add_argument(
+        "--connect-timeout",
+        type=float,
+        default=plan.connect_timeout,
+        metavar="S",
+        help="seconds that --scheduler has to answer (default %(default)s)",
+    )
     stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
     stu.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     stu.add_argument(
@@ -607,6 +614,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
             config,
             workers=args.workers,
             scheduler=args.scheduler,
+            connect_timeout=args.connect_timeout,
             argv=["rigidfold", *sys.argv[1:]],
             on_done=bar.update,
         )

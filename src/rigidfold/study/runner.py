@@ -183,6 +183,37 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
     return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in run.attempts]
 
 
+CONNECT_TIMEOUT_S = 20.0
+"""Seconds that a Dask scheduler given by address has to answer (``--connect-timeout``)."""
+
+
+def connect(scheduler: str, timeout: float):
+    """A ``dask.distributed.Client`` of the scheduler at ``scheduler``; ValueError naming the
+    address when nothing there completes Dask's handshake within ``timeout`` seconds.
+
+    distributed bounds the TCP connection by its timeout but not the handshake read after it,
+    so a service that accepts and stays silent (an HTTP server) would hang ``Client`` for
+    ever: the handshake is first made here under an asyncio timeout, then the Client made.
+    """
+    import asyncio
+
+    from dask.distributed import Client
+    from distributed.comm import connect as dask_connect
+
+    async def handshake() -> None:
+        comm = await asyncio.wait_for(dask_connect(scheduler, timeout=timeout), timeout)
+        await comm.close()
+
+    try:
+        asyncio.run(handshake())
+        return Client(scheduler, timeout=timeout)
+    except (OSError, ValueError) as exc:  # TimeoutError is an OSError
+        reason = str(exc) or "no Dask handshake (is it a Dask scheduler?)"
+        raise ValueError(
+            f"cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s: {reason}"
+        ) from None
+
+
 def run_study(
     keys: Sequence[Key],
     store: Store,
@@ -190,10 +221,14 @@ def run_study(
     *,
     workers: int = 2,
     scheduler: str | None = None,
+    connect_timeout: float = CONNECT_TIMEOUT_S,
     on_done: Callable[[Key, dict, int, int], None] | None = None,
 ) -> dict:
     """Run every key not yet in ``store``; returns counts, the wall time and the part of it
     spent starting (or connecting to) the Dask cluster (``startup_s``).
+
+    On ``workers`` local processes, or on the cluster of the Dask ``scheduler`` (an address),
+    which must answer within ``connect_timeout`` seconds (:func:`connect`).
 
     on_done(key, run_row, finished, total) is called in the client after each stored run.
     """
@@ -220,10 +255,7 @@ def run_study(
         )
         client = Client(cluster)
     else:
-        try:
-            client = Client(scheduler, timeout="20s")
-        except OSError as exc:
-            raise ValueError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}") from None
+        client = connect(scheduler, connect_timeout)
     startup = time.perf_counter() - t0
     try:
         futures = [

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import TABLES_5_6
-from rigidfold.study.runner import StudyConfig, run_study
+from rigidfold.study.runner import CONNECT_TIMEOUT_S, StudyConfig, run_study
 from rigidfold.study.store import Key, Store
 
 
@@ -25,7 +25,8 @@ class StudyPlan:
     """Defaults of a Bezier study: the runs of the paper's Tables 5-6 on two local workers.
 
     patterns, criteria : names; surfaces : Bezier seeds per (pattern, criterion), from
-    ``first_seed``; workers : local Dask worker processes.
+    ``first_seed``; workers : local Dask worker processes; connect_timeout : seconds that a
+    Dask scheduler given by address has to answer.
     """
 
     patterns: tuple[str, ...] = tuple(sorted({pattern for pattern, _ in TABLES_5_6}))
@@ -33,6 +34,7 @@ class StudyPlan:
     surfaces: int = 100
     first_seed: int = 0
     workers: int = 2
+    connect_timeout: float = CONNECT_TIMEOUT_S
 
 
 STUDY_DEFAULTS = StudyPlan()
@@ -53,6 +55,7 @@ def run_study_command(
     *,
     workers: int = STUDY_DEFAULTS.workers,
     scheduler: str | None = None,
+    connect_timeout: float = STUDY_DEFAULTS.connect_timeout,
     argv: Sequence[str] = (),
     on_done: Callable[[bool, int, int], None] | None = None,
 ) -> dict:
@@ -60,13 +63,33 @@ def run_study_command(
 
     on_done(failed, finished, total) after each stored run (``failed``: the run ended in an
     error, recorded in the database). A KeyboardInterrupt is recorded and re-raised as
-    :class:`StudyInterrupted`.
+    :class:`StudyInterrupted`. The database is locked while the study runs (a second
+    client is refused, :class:`~rigidfold.study.lock.StudyLock`).
     """
-    from rigidfold import __version__
-
     if workers < 1:
         raise ValueError(f"--workers must be >= 1, got {workers}")
+    if not connect_timeout > 0:
+        raise ValueError(f"--connect-timeout must be > 0 seconds, got {connect_timeout}")
     store = Store(db, config.as_dict())  # refuses another configuration untouched
+    try:
+        return _run(store, keys, config, workers, scheduler, connect_timeout, argv, on_done)
+    finally:
+        store.close()  # and release its lock
+
+
+def _run(
+    store: Store,
+    keys: Sequence[Key],
+    config: StudyConfig,
+    workers: int,
+    scheduler: str | None,
+    connect_timeout: float,
+    argv: Sequence[str],
+    on_done: Callable[[bool, int, int], None] | None,
+) -> dict:
+    """:func:`run_study_command` on the open ``store``."""
+    from rigidfold import __version__
+
     started = datetime.now(UTC).isoformat(timespec="seconds")
     t0 = time.perf_counter()
     planned = set(keys)
@@ -91,12 +114,18 @@ def run_study_command(
             on_done(bool(row.get("error")), finished, total)
 
     try:
-        result = run_study(keys, store, config, workers=workers, scheduler=scheduler, on_done=done)
+        result = run_study(
+            keys,
+            store,
+            config,
+            workers=workers,
+            scheduler=scheduler,
+            connect_timeout=connect_timeout,
+            on_done=done,
+        )
     except KeyboardInterrupt:
         finished = len(store.done() & planned)
         record("interrupted", finished - before)
-        store.close()
         raise StudyInterrupted(finished) from None
     record("completed", result["ran"])
-    store.close()
     return result

@@ -15,6 +15,7 @@ A run's ``status`` column holds the generator's stop reason (``Generation.stop_r
 
 from __future__ import annotations
 
+import functools
 import itertools
 import json
 import sqlite3
@@ -23,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rigidfold.generate import Stop
+from rigidfold.study.lock import StudyLock
 
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -190,26 +192,66 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     return diff
 
 
+@functools.cache
+def schema_columns() -> dict[str, dict[str, str]]:
+    """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
+    con = sqlite3.connect(":memory:")
+    con.executescript(SCHEMA)
+    tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")]
+    columns = {t: {r[1]: r[2] for r in con.execute(f"PRAGMA table_info({t})")} for t in tables}
+    con.close()
+    return columns
+
+
 class Store:
     """A study database. ``config`` is checked against (or written to) the ``meta`` table.
 
+    Opening for writing takes the database's :class:`~rigidfold.study.lock.StudyLock` (a
+    second client is refused) and checks an existing file read-only first (:meth:`_check`):
+    a damaged or foreign file, or one of another configuration, is refused untouched.
     ``readonly=True`` opens an existing database for reporting: it never creates one nor
-    writes to it (and takes no ``config``).
+    writes to it (and takes no ``config`` and no lock).
     """
 
     def __init__(
         self, path: str | Path, config: dict | None = None, *, readonly: bool = False
     ) -> None:
         self.path = Path(path)
+        self._lock: StudyLock | None = None
         if readonly:
             if config is not None:
                 raise ValueError("a study database opened read-only takes no configuration")
-            self._open_readonly()
+            if not self.path.is_file():
+                raise ValueError(f"no study database at {str(self.path)!r}")
+            self.db = self._connect_readonly()
+            self._check(self.db)
+            self._attempt_columns = self._columns("attempts")
             return
         if self.path.is_dir():
             raise ValueError(f"database path {str(self.path)!r} is a directory")
-        if config is not None:
-            self._check_config(config)
+        parent = self.path.parent if str(self.path.parent) else Path(".")
+        if not parent.is_dir():
+            raise ValueError(f"cannot create study database {str(self.path)!r}: no such directory")
+        self._lock = StudyLock(self.path)
+        try:
+            if self.path.exists() and self.path.stat().st_size > 0:
+                ro = self._connect_readonly()
+                try:
+                    self._check(ro, config)
+                finally:
+                    ro.close()
+            self._open_writable(config)
+        except BaseException:
+            self._lock.release()
+            raise
+
+    def _connect_readonly(self) -> sqlite3.Connection:
+        try:
+            return sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30)
+        except sqlite3.Error as exc:
+            raise ValueError(f"{str(self.path)!r}: cannot open: {exc}") from None
+
+    def _open_writable(self, config: dict | None) -> None:
         try:
             self.db = sqlite3.connect(self.path, timeout=30)
             self.db.execute("PRAGMA journal_mode=WAL")
@@ -229,48 +271,60 @@ class Store:
         except sqlite3.Error as exc:
             raise ValueError(f"cannot open study database {str(self.path)!r}: {exc}") from None
 
-    def _open_readonly(self) -> None:
-        if not self.path.is_file():
-            raise ValueError(f"no study database at {str(self.path)!r}")
+    def _check(self, con: sqlite3.Connection, config: dict | None = None) -> None:
+        """Refuse, reading ``con`` only, a damaged SQLite file, one without the tables and
+        columns of :data:`SCHEMA` (the columns added later may be absent, and the
+        ``invocations`` table), one with text in a number column or a ``meta`` config that
+        is not a JSON object; and, given ``config``, one with no or another configuration."""
+        name = str(self.path)
         try:
-            self.db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30)
-            self.db.execute("SELECT 1 FROM runs LIMIT 1")
-            self._attempt_columns = self._columns("attempts")
+            verdict = con.execute("PRAGMA quick_check").fetchone()[0]
+            if verdict != "ok":
+                first = [line for line in verdict.splitlines() if not line.startswith("***")]
+                raise ValueError(f"{name!r}: damaged SQLite file: {(first or [verdict])[0]}")
+            for table, columns in schema_columns().items():
+                have = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
+                if not have and table == "invocations":  # older databases lack it
+                    continue
+                if not have:
+                    raise ValueError(
+                        f"{name!r}: not a rigidfold study database: no table {table!r}"
+                    )
+                for column, kind in columns.items():
+                    if column not in have and column not in ADDED_ATTEMPT_COLUMNS:
+                        raise ValueError(
+                            f"{name!r}: not a rigidfold study database: table {table!r} "
+                            f"lacks column {column!r}"
+                        )
+                    if column in have and kind in ("INTEGER", "REAL"):
+                        bad = con.execute(
+                            f"SELECT {column} FROM {table} "
+                            f"WHERE typeof({column}) NOT IN ('integer', 'real', 'null') LIMIT 1"
+                        ).fetchone()
+                        if bad is not None:
+                            raise ValueError(
+                                f"{name!r}: not a rigidfold study database: {table}.{column} "
+                                f"holds {bad[0]!r}, not a number"
+                            )
+            row = con.execute("SELECT value FROM meta WHERE key='config'").fetchone()
         except sqlite3.Error as exc:
+            raise ValueError(f"{name!r}: damaged SQLite file: {exc}") from None
+        try:
+            stored = None if row is None else json.loads(row[0])
+        except (TypeError, json.JSONDecodeError):
+            stored = "?"
+        if row is not None and not isinstance(stored, dict):
             raise ValueError(
-                f"{str(self.path)!r} is not a rigidfold study database: {exc}"
-            ) from None
-
-    def _check_config(self, config: dict) -> None:
-        """Refuse a database of another configuration without writing anything to it."""
-        if not self.path.exists():
-            parent = self.path.parent if str(self.path.parent) else Path(".")
-            if not parent.is_dir():
-                raise ValueError(
-                    f"cannot create study database {str(self.path)!r}: no such directory"
-                )
+                f"{name!r}: not a rigidfold study database: its config is not a JSON object"
+            )
+        if config is None:
             return
-        try:
-            with sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30) as ro:
-                has_meta = ro.execute(
-                    "SELECT 1 FROM sqlite_master WHERE type='table' AND name='meta'"
-                ).fetchone()
-                row = (
-                    ro.execute("SELECT value FROM meta WHERE key='config'").fetchone()
-                    if has_meta
-                    else None
-                )
-            ro.close()
-        except sqlite3.Error as exc:
-            raise ValueError(
-                f"{str(self.path)!r} is not a rigidfold study database: {exc}"
-            ) from None
-        if row is None:
-            raise ValueError(f"{str(self.path)!r} is not a rigidfold study database (no config)")
-        diff = config_differences(json.loads(row[0]), json.loads(json.dumps(config)))
+        if stored is None:
+            raise ValueError(f"{name!r}: not a rigidfold study database (no config)")
+        diff = config_differences(stored, json.loads(json.dumps(config)))
         if diff:
             raise ValueError(
-                f"{str(self.path)!r} holds a study with another configuration "
+                f"{name!r} holds a study with another configuration "
                 f"(differs in: {', '.join(diff)}); use another --db"
             )
 
@@ -288,12 +342,15 @@ class Store:
         return {Key(s, int(seed), p, c, bool(sym)) for s, seed, p, c, sym in rows}
 
     def add(self, key: Key, run: dict, attempts: list[dict]) -> None:
-        """Write one run and its attempts in one transaction."""
+        """Write one run and its attempts in one transaction; refuses (ValueError) a run
+        already in the database, which is left as it was."""
         with self.db:
-            self.db.execute(
-                f"INSERT INTO runs VALUES ({', '.join('?' * (5 + len(RUN_FIELDS)))})",
+            added = self.db.execute(
+                f"INSERT OR IGNORE INTO runs VALUES ({', '.join('?' * (5 + len(RUN_FIELDS)))})",
                 key.row() + tuple(run.get(f) for f in RUN_FIELDS),
-            )
+            ).rowcount
+            if not added:
+                raise ValueError(f"{str(self.path)!r} already holds the run {key.row()}")
             names = ("study", "seed", "pattern", "criterion", "symmetric", *ATTEMPT_FIELDS)
             self.db.executemany(
                 f"INSERT INTO attempts ({', '.join(names)}) VALUES ({', '.join('?' * len(names))})",
@@ -395,4 +452,7 @@ class Store:
             )
 
     def close(self) -> None:
+        """Close the database and release its lock (of a store opened for writing)."""
         self.db.close()
+        if self._lock is not None:
+            self._lock.release()
