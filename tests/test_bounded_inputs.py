@@ -195,3 +195,45 @@ def test_full_disk_leaves_no_temporary_file(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match=r"cannot write '.*x\.json': No space left on device"):
         write_json(tmp_path / "x.json", {"a": 1})
     assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------- defect 3: size of the work
+def test_analysis_too_large_is_refused_before_allocating():
+    import time
+
+    import numpy as np
+
+    from rigidfold.config import Settings
+    from rigidfold.mechanism import analysis_bytes, analyze, check_analysis_size
+    from rigidfold.mesh import CreasePattern
+    from rigidfold.patterns import grid, parse_pattern
+
+    xy, faces = grid(300, 300, 30.0, 30.0, "centre")
+    big = CreasePattern.from_faces(np.column_stack([xy, np.zeros(len(xy))]), faces)
+    for method in ("kinematic", "frame"):
+        t0 = time.perf_counter()
+        with pytest.raises(ValueError, match=r"analysis of 90000 vertices .* GiB, more than"):
+            analyze(big, method=method)
+        assert time.perf_counter() - t0 < 30  # the 548 GiB allocation is never tried
+    # the estimate of pattern 1: C is (E + 9) x 3V = 129 x 147, Q is 147 x 147
+    small = CreasePattern.from_faces(parse_pattern("1").xy, parse_pattern("1").faces)
+    assert analysis_bytes(small.n_edges + 9, 3 * small.n_vertices) == 8 * (147**2 + 2 * 129 * 147)
+    check_analysis_size(small)
+    with pytest.raises(ValueError, match=r"Settings\.max_analysis_bytes"):
+        check_analysis_size(small, Settings(max_analysis_bytes=1000))
+
+
+def test_generate_of_a_pattern_too_large_to_analyse_stops_before_solving(tmp_path):
+    proc = run_cli(
+        "generate",
+        "--surface",
+        "dome",
+        "--pattern",
+        "grid:101x101",
+        "--quiet",
+        "--out",
+        str(tmp_path / "o"),
+    )
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+    assert "needs about 20.8 GiB, more than the limit of 8 GiB" in proc.stderr
+    assert not (tmp_path / "o" / "summary.json").exists()

@@ -196,6 +196,11 @@ class Settings:
         Largest number of triangles a ``grid:`` or ``mesh:`` pattern may have (a mesh's is
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
         is refused instead of building a problem that cannot be solved.
+    max_analysis_bytes : int
+        Largest memory (bytes) the dense mechanism analysis may ask for, estimated from the
+        pattern's size before the dense matrices are built
+        (:func:`rigidfold.mechanism.analysis.analysis_bytes`); a larger shape (any FOLD file
+        given to ``analyze``) is refused in one line instead of running out of memory.
 
     Studies (``rigidfold.study``)
     -----------------------------
@@ -287,6 +292,7 @@ class Settings:
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
     max_pattern_faces: int = 20000
+    max_analysis_bytes: int = 8 * 2**30
     # studies
     max_study_runs: int = 1_000_000
     # target surfaces from triangle meshes

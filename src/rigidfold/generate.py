@@ -40,7 +40,7 @@ import numpy as np
 
 from rigidfold.case import Case
 from rigidfold.config import Settings, check_seed, one_blas_thread
-from rigidfold.mechanism import Mechanism, analyze
+from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
 from rigidfold.selection import (
@@ -259,6 +259,7 @@ def generate(
     if target_dof < 0:
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
     rng = np.random.default_rng(check_seed(seed))
+    check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
     run = Generation()
     t0 = time.perf_counter()
     problem = case.problem(build_ipopt=solver == "ipopt")

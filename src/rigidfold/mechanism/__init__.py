@@ -1,5 +1,11 @@
 """Mechanism analysis of the frame model and prediction of locked crease lines (Section 4)."""
 
-from rigidfold.mechanism.analysis import METHODS, Mechanism, analyze
+from rigidfold.mechanism.analysis import (
+    METHODS,
+    Mechanism,
+    analysis_bytes,
+    analyze,
+    check_analysis_size,
+)
 
-__all__ = ["METHODS", "Mechanism", "analyze"]
+__all__ = ["METHODS", "Mechanism", "analysis_bytes", "analyze", "check_analysis_size"]

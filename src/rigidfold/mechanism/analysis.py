@@ -105,11 +105,20 @@ def analyze(
     """
     if method not in METHODS:
         raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
+    if method == "kinematic":  # C is dense: refuse before building it
+        _check_size(
+            pattern,
+            pattern.n_edges + int(pattern.fixed.sum()) + 9,
+            3 * pattern.n_vertices,
+            settings,
+        )
     frame = FrameModel.from_pattern(pattern, support_face)
     h = frame.n_hinges
     basis: np.ndarray | Callable[[], np.ndarray]
     if method == "frame":
-        H, values, rank = _svd_kernel(frame.compatibility_matrix().toarray(), settings)
+        A = frame.compatibility_matrix()  # sparse until the SVD
+        _check_size(pattern, A.shape[0], A.shape[1], settings)
+        H, values, rank = _svd_kernel(A.toarray(), settings)
         H_phi, basis = H[H.shape[0] - h :], H
     else:
         C = kinematics.constraint_matrix(pattern, frame.support_face)
@@ -126,6 +135,33 @@ def analyze(
         basis = modes
 
     return Mechanism(frame, basis, H_phi, values, rank, _locked(frame, H_phi, settings), settings)
+
+
+def analysis_bytes(rows: int, cols: int) -> int:
+    """Memory (bytes) of the dense kernel of a rows x cols matrix as :func:`analyze` computes
+    it: the matrix and the full factorisation of its transpose (Q or Vt, cols x cols, and R or
+    the singular values), float64."""
+    return 8 * (cols * cols + 2 * rows * cols)
+
+
+def check_analysis_size(pattern: CreasePattern, settings: Settings = DEFAULTS) -> None:
+    """One-line ValueError when the kinematic analysis of ``pattern`` (the method that
+    ``generate`` uses) would need more than ``settings.max_analysis_bytes``; called before
+    any work by :func:`rigidfold.case.make_case` too."""
+    rows = pattern.n_edges + int(pattern.fixed.sum()) + 9
+    _check_size(pattern, rows, 3 * pattern.n_vertices, settings)
+
+
+def _check_size(pattern: CreasePattern, rows: int, cols: int, settings: Settings) -> None:
+    """One-line ValueError when :func:`analysis_bytes` exceeds ``settings.max_analysis_bytes``."""
+    need = analysis_bytes(rows, cols)
+    if need > settings.max_analysis_bytes:
+        raise ValueError(
+            f"the mechanism analysis of {pattern.n_vertices} vertices and {pattern.n_edges} "
+            f"edges needs about {need / 2**30:.3g} GiB, more than the limit of "
+            f"{settings.max_analysis_bytes / 2**30:.3g} GiB (Settings.max_analysis_bytes): "
+            "use a coarser pattern"
+        )
 
 
 def _svd_kernel(A: np.ndarray, settings: Settings) -> tuple[np.ndarray, np.ndarray, int]:
