@@ -289,3 +289,17 @@ def test_a_directory_in_use_by_a_running_generate_is_refused(tmp_path, capsys):
     (out / ".rigidfold-run.lock").write_text(dead.stdout)
     assert main(["generate", *SHORT_RUN, "--out", str(out)]) == 1
     assert not (out / ".rigidfold-run.lock").exists() and (out / "summary.json").is_file()
+
+
+def test_overwrite_never_removes_an_input_file(tmp_path, capsys):
+    """An earlier solution used as the pattern of a new run into the same directory."""
+    out = tmp_path / "run"
+    assert main(["generate", *SHORT_RUN, "--out", str(out)]) == 1
+    solution = out / "solutions" / "step_02_dof_03.fold"
+    before = solution.read_bytes()
+    capsys.readouterr()
+    argv = ["generate", "--surface", "dome", "--pattern", str(solution), "--no-deform", "--quiet"]
+    assert main([*argv, "--out", str(out), "--overwrite"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"--overwrite would remove the input file '{solution}'" in err[0]
+    assert solution.read_bytes() == before and (out / "summary.json").is_file()

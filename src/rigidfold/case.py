@@ -27,7 +27,9 @@ class Case:
     surface : TargetSurface (a Surface); plan : the crease pattern in plan and how it was made
     (its spec, size, diagonals, edge length); pattern : CreasePattern (the plan lifted onto the
     target surface); planes : mirror planes (SymmetryPlane) used for constraint (9);
-    settings : Settings.
+    settings : Settings; inputs : the files the pattern and the surface were read from (a
+    FOLD or SVG pattern, a footprint file, a mesh or FOLD surface), which a run must never
+    remove or replace.
     """
 
     surface: TargetSurface
@@ -35,6 +37,7 @@ class Case:
     pattern: CreasePattern
     planes: tuple[SymmetryPlane, ...]
     settings: Settings
+    inputs: tuple[Path, ...] = ()
 
     def problem(self, *, build_ipopt: bool = True) -> FormFindingProblem:
         """Build problem (6) for this case."""
@@ -118,7 +121,23 @@ def make_case(
             f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
             "(dome or hp)"
         )
-    return Case(surf, plan, shape, planes, settings)
+    return Case(surf, plan, shape, planes, settings, _input_files(pattern, surface))
+
+
+def _input_files(pattern: str, surface: str | Surface) -> tuple[Path, ...]:
+    """The files named by a pattern spec (``FILE.fold``, ``FILE.svg``, ``mesh:FILE``) and a
+    surface spec (``mesh:FILE``, ``fold:FILE``); specs were validated by reading them."""
+    files = []
+    kind, colon, rest = str(pattern).strip().partition(":")
+    if patterns.is_pattern_file(str(pattern)):
+        files.append(Path(str(pattern).strip()))
+    elif colon and kind.strip().lower() == "mesh" and ";" not in rest:
+        files.append(Path(rest.strip()))
+    if not isinstance(surface, Surface):
+        kind, colon, rest = str(surface).partition(":")
+        if colon and kind.strip().lower() in ("mesh", "fold"):
+            files.append(Path(rest.strip()))
+    return tuple(files)
 
 
 def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:

@@ -184,12 +184,13 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def clear_earlier_run(out: str | Path, *, overwrite: bool) -> Path:
+def clear_earlier_run(out: str | Path, *, overwrite: bool, inputs: tuple[Path, ...] = ()) -> Path:
     """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
 
     Only rigidfold's own run files (:data:`RUN_FILES`, :data:`RUN_DIRS`) count and are
     removed; other files in ``out`` stay. A symbolic link among them is removed itself, never
-    followed. Returns ``out`` as a Path. Raises ValueError naming what was found.
+    followed. Removing one of the run's ``inputs`` (e.g. an earlier solution used as the
+    pattern) is refused. Returns ``out`` as a Path. Raises ValueError naming what was found.
     """
     out = Path(out)
     found = [
@@ -202,6 +203,20 @@ def clear_earlier_run(out: str | Path, *, overwrite: bool) -> Path:
             f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
             "give --overwrite to replace it, or another --out"
         )
+    for path in found:
+        for given in inputs:
+            doomed = (
+                given.absolute() == path.absolute()
+                if path.is_symlink()
+                else (
+                    path.resolve() == given.resolve() or path.resolve() in given.resolve().parents
+                )
+            )
+            if doomed:
+                raise ValueError(
+                    f"--overwrite would remove the input file '{given}' with the earlier run's "
+                    f"{path.name}: copy it out of '{out}' first, or use another --out"
+                )
     try:
         for path in found:
             if path.is_dir() and not path.is_symlink():
@@ -293,7 +308,7 @@ class RunWriter:
         self.out = prepare_output_dir(out)
         self.lock = lock_run_dir(self.out)
         try:
-            clear_earlier_run(self.out, overwrite=overwrite)
+            clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
             self.solutions_dir = prepare_output_dir(self.out / "solutions")
         except ValueError:
             self.release()
