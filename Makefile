@@ -40,6 +40,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_cpu_scaling.py
 	$(PY) benchmarks/bench_lookahead.py
 	$(PY) benchmarks/bench_report.py
+	$(PY) benchmarks/mesh_surface.py
+	$(PY) benchmarks/own_design.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

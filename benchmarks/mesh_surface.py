@@ -14,17 +14,7 @@ import time
 import numpy as np
 
 from rigidfold.config import DEFAULTS
-from rigidfold.surfaces import Dome, MeshSurface
-
-
-def dome_mesh(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The dome's formula on n x n vertices over [0, 3]^2: vertices (n*n, 3), triangles."""
-    g = np.linspace(0.0, 3.0, n)
-    x, y = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
-    idx = np.arange(n * n).reshape(n, n)
-    a, b, c, d = (k.ravel() for k in (idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]))
-    triangles = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
-    return np.column_stack([x, y, Dome().height(x, y)]), triangles
+from rigidfold.surfaces import Dome, MeshSurface, sample_mesh
 
 
 def main() -> None:
@@ -40,7 +30,7 @@ def main() -> None:
     print("|---|---:|---:|---:|---:|---:|---:|")
     for footprint in ("square", "disc"):
         for n in args.vertices:
-            vertices, triangles = dome_mesh(n)
+            vertices, triangles = sample_mesh(dome, n)
             inside = np.ones(x.shape, dtype=bool)
             if footprint == "disc":
                 r = np.hypot(vertices[:, 0] - 1.5, vertices[:, 1] - 1.5)

@@ -35,14 +35,9 @@ def folded_grid(n: int = 4, amplitude: float = 0.1, seed: int = 1) -> CreasePatt
 def dome_mesh(n: int) -> tuple[np.ndarray, np.ndarray]:
     """The built-in dome's formula on n x n vertices over [0, 3]^2, as a triangle mesh:
     vertices (n*n, 3), triangles (2 (n-1)^2, 3)."""
-    from rigidfold.surfaces import Dome
+    from rigidfold.surfaces import Dome, sample_mesh
 
-    g = np.linspace(0.0, 3.0, n)
-    x, y = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
-    idx = np.arange(n * n).reshape(n, n)
-    a, b, c, d = (k.ravel() for k in (idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]))
-    triangles = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
-    return np.column_stack([x, y, Dome().height(x, y)]), triangles
+    return sample_mesh(Dome(), n)
 
 
 @pytest.fixture

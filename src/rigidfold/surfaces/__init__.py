@@ -13,7 +13,13 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.surfaces.builtin import Bezier, Dome, HyperbolicParaboloid, MirrorPlane, Surface
 from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
-from rigidfold.surfaces.mesh import MESH_FORMATS, MeshSurface, mesh_surface, read_mesh
+from rigidfold.surfaces.mesh import (
+    MESH_FORMATS,
+    MeshSurface,
+    mesh_surface,
+    read_mesh,
+    sample_mesh,
+)
 
 SURFACES = ("bezier", "dome", "hp", "expr")
 """The named surfaces."""
@@ -83,4 +89,5 @@ __all__ = [
     "parse_expression",
     "placed_mesh",
     "read_mesh",
+    "sample_mesh",
 ]

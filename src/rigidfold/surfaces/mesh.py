@@ -257,6 +257,23 @@ def read_mesh(
     return vertices, triangles
 
 
+def sample_mesh(
+    surface: Surface, n: int, box: tuple[float, float] = (3.0, 3.0)
+) -> tuple[np.ndarray, np.ndarray]:
+    """A triangle mesh of ``surface`` on n x n vertices over [0, W] x [0, H] (e.g. to write a
+    target surface as OBJ for CAD, or to test the mesh fit against its formula).
+
+    Returns vertices (n*n, 3) float64, vertex (i, j) at index i n + j with x = i W / (n - 1),
+    y = j H / (n - 1), and triangles (2 (n-1)^2, 3) int64, counter-clockwise seen from +z.
+    """
+    gx, gy = np.linspace(0.0, box[0], n), np.linspace(0.0, box[1], n)
+    x, y = (a.ravel() for a in np.meshgrid(gx, gy, indexing="ij"))
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = (k.ravel() for k in (idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]))
+    triangles = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return np.column_stack([x, y, surface.height(x, y)]), triangles
+
+
 def mesh_surface(path: str | Path, *, up: str = "z", settings: Settings = DEFAULTS) -> MeshSurface:
     """:class:`MeshSurface` of a mesh file (see :func:`read_mesh`), named by its file name."""
     vertices, triangles = read_mesh(path, up=up, settings=settings)
