@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -30,6 +33,29 @@ def folded_grid(n: int = 4, amplitude: float = 0.1, seed: int = 1) -> CreasePatt
             v = b * n + a
             faces += [(v, v + 1, v + n + 1), (v, v + n + 1, v + n)]
     return CreasePattern.from_faces(np.column_stack([xy, z]), np.array(faces))
+
+
+def run_cli(*args: str, cwd=None, timeout: float = 600) -> subprocess.CompletedProcess:
+    """``python -m rigidfold.cli ARGS`` in a new process; its exit code, stdout and stderr."""
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        check=False,
+        timeout=timeout,
+    )
+
+
+def main_code(argv: list[str]) -> int:
+    """``rigidfold.cli.main``'s exit code in this process, argparse's errors (SystemExit)
+    included."""
+    from rigidfold.cli import main
+
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code or 0)
 
 
 def dome_mesh(n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -11,21 +11,11 @@ import sys
 
 import pytest
 
+from conftest import run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.io import jsonable, read_fold, write_json
 
 TRIANGLE = {"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces_vertices": [[0, 1, 2]]}
-
-
-def run_cli(*args: str, cwd=None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        check=False,
-        timeout=120,
-    )
 
 
 def one_line_error(proc: subprocess.CompletedProcess, message: str) -> None:

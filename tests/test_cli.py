@@ -9,18 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from conftest import run_cli
 from rigidfold.cli import main
 from rigidfold.io import read_fold
-
-
-def run_cli(*args: str, cwd=None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        check=False,
-    )
 
 
 def test_optimize_writes_fold_and_summary(tmp_path, capsys):

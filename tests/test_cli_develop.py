@@ -3,21 +3,14 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from conftest import run_cli
 from rigidfold.cli import main
 from rigidfold.io import read_fold, svg_text, write_fold
 from rigidfold.patterns import miura
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
-    )
 
 
 @pytest.fixture

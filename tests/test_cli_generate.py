@@ -12,16 +12,11 @@ import numpy as np
 import pytest
 
 import rigidfold.generate as generate_module
+from conftest import run_cli
 from rigidfold.cli import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import fold_dict, read_fold, write_fold
 from rigidfold.patterns import miura
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
-    )
 
 
 @pytest.fixture(scope="module")

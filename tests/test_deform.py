@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from conftest import run_cli
 from rigidfold.case import make_case
 from rigidfold.cli import main
 from rigidfold.deform import TubeSection, deform, folding_motion, verify
@@ -19,12 +18,6 @@ from rigidfold.io import read_fold, write_fold
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
 from rigidfold.report import verification_frames
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
-    )
 
 
 def locked_miura(shape):

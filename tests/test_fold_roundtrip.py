@@ -8,13 +8,12 @@ from __future__ import annotations
 
 import copy
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from conftest import run_cli
 from rigidfold.cli import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import UNITS, fold_dict, read_fold, round_trip_dict, write_fold
@@ -25,12 +24,6 @@ from rigidfold.workflows import FLAT_NOTE, UNITLESS_NOTE, analyze_file, develop_
 EXAMPLES = Path(__file__).parent / "data" / "fold_examples"
 READABLE = {"simple": 3, "diagonal-cp": 1, "squaretwist": 1}  # example -> DOF
 REFUSED = ["box", "diagonal-folded"]
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args], capture_output=True, text=True, check=False
-    )
 
 
 def load(path: Path) -> dict:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import dome_mesh
+from conftest import dome_mesh, main_code
 from rigidfold.case import make_case
 from rigidfold.cli import main
 from rigidfold.config import DEFAULTS
@@ -18,14 +18,6 @@ from rigidfold.surfaces import Dome
 DATA = Path(__file__).parent / "data"
 SIMPLE_VERTEX = DATA / "origami_simulator" / "simpleVertex.svg"
 SQUARETWIST = DATA / "fold_examples" / "squaretwist.fold"
-
-
-def run(argv: list[str]) -> int:
-    """main's exit code, argparse's errors (SystemExit) included."""
-    try:
-        return main(argv)
-    except SystemExit as exc:
-        return int(exc.code or 0)
 
 
 @pytest.fixture(scope="module")
@@ -90,7 +82,7 @@ def test_a_mesh_is_placed_at_the_origin_like_the_pattern(dome_obj, tmp_path):
 def test_generate_on_a_pattern_from_another_tool(tmp_path, capsys, pattern, surface):
     out = tmp_path / "run"
     options = ["--no-deform", "--quiet", "--out", str(out)]
-    code = run(["generate", "--surface", surface, "--pattern", pattern, *options])
+    code = main_code(["generate", "--surface", surface, "--pattern", pattern, *options])
     summary = json.loads((out / "summary.json").read_text())
     assert code in (0, 1) and summary["n_solutions"] >= 1
     assert summary["case"]["pattern_file"]["file"] == Path(pattern).name
@@ -146,7 +138,7 @@ def test_bad_own_design_one_line_exit_2(case, tmp_path, dome_obj, capsys):
         if flag not in args:
             args = [flag, value, *args]
     out = tmp_path / "o"
-    code = run(["optimize", *args, "--out", str(out)])
+    code = main_code(["optimize", *args, "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and needle in err[0], err
     assert "Traceback" not in err[0] and not out.exists()

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import main_code
 from rigidfold import patterns
 from rigidfold.case import make_case
 from rigidfold.cli import main
@@ -38,14 +39,6 @@ def square_with_quad(unit: str | None = None, factor: float = 1.0) -> dict:
     if unit is not None:
         data["frame_unit"] = unit
     return data
-
-
-def run(argv: list[str]) -> int:
-    """main's exit code, argparse's errors (SystemExit) included."""
-    try:
-        return main(argv)
-    except SystemExit as exc:
-        return int(exc.code or 0)
 
 
 def pairs(fixed: np.ndarray) -> set:
@@ -189,7 +182,7 @@ def test_upside_down_face_is_refused(tmp_path):
     ],
 )
 def test_bad_pattern_options_one_line_exit_2(tmp_path, capsys, args, message):
-    code = run(["optimize", "--surface", "dome", *args, "--out", str(tmp_path / "o")])
+    code = main_code(["optimize", "--surface", "dome", *args, "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and message in err[0], err
     assert not (tmp_path / "o").exists()

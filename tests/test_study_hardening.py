@@ -14,19 +14,10 @@ import time
 
 import pytest
 
+from conftest import run_cli
 from rigidfold.study import Key, Store, StudyConfig
 
 STUDY = ["--surfaces", "1", "--patterns", "1", "--criteria", "s", "--no-deform", "--quiet"]
-
-
-def cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rigidfold.cli", *args],
-        capture_output=True,
-        text=True,
-        check=False,
-        timeout=timeout,
-    )
 
 
 def valid_database(path) -> None:
@@ -80,7 +71,7 @@ def test_damaged_databases_are_refused_in_one_line_untouched(tmp_path, kind):
     damage(db)
     before = db.read_bytes()
     for args in (["study", *STUDY, "--db", str(db)], ["study-report", str(db)]):
-        proc = cli(*args)
+        proc = run_cli(*args)
         assert proc.returncode == 2, proc.stderr
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and needle in lines[0] and str(db) in lines[0], proc.stderr
@@ -114,7 +105,7 @@ def test_a_second_client_is_refused_and_a_dead_ones_lock_taken_over(tmp_path):
     try:
         assert holder.stdout is not None and holder.stdout.readline() == "ready\n"
         before = db.read_bytes()
-        proc = cli("study", *STUDY, "--db", str(db))
+        proc = run_cli("study", *STUDY, "--db", str(db))
         assert proc.returncode == 2
         (line,) = proc.stderr.strip().splitlines()
         assert f"in use by another rigidfold study (pid {holder.pid} on" in line
@@ -152,7 +143,7 @@ def test_a_scheduler_that_is_not_dask_is_refused_within_the_timeout(tmp_path):
     address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
     t0 = time.perf_counter()
     try:
-        proc = cli(
+        proc = run_cli(
             "study", *STUDY, "--db", str(tmp_path / "c.sqlite"), "--scheduler", address,
             "--connect-timeout", "3", timeout=120,
         )  # fmt: skip
@@ -164,7 +155,7 @@ def test_a_scheduler_that_is_not_dask_is_refused_within_the_timeout(tmp_path):
     assert proc.returncode == 2
     (line,) = proc.stderr.strip().splitlines()
     assert f"cannot reach the Dask scheduler at {address!r} within 3 s" in line
-    proc = cli("study", *STUDY, "--db", str(tmp_path / "c.sqlite"), "--connect-timeout", "0")
+    proc = run_cli("study", *STUDY, "--db", str(tmp_path / "c.sqlite"), "--connect-timeout", "0")
     assert proc.returncode == 2 and "--connect-timeout must be > 0" in proc.stderr
 
 

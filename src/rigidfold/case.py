@@ -49,6 +49,11 @@ class Case:
             build_ipopt=build_ipopt,
         )
 
+    def deviation(self, coords: np.ndarray) -> np.ndarray:
+        """z minus the target's height at each vertex's (x, y), metres.  (V, 3) -> (V,)"""
+        height = self.surface.height(coords[:, 0], coords[:, 1])
+        return coords[:, 2] - np.asarray(height, dtype=float)
+
     def metadata(self) -> dict:
         """JSON-serialisable description of the case: the surface, the pattern spec with its
         plan size, diagonals, edge length and footprint, the symmetry and the design bounds."""
@@ -166,9 +171,7 @@ def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:
 def shape_report(case: Case, result: OptimizeResult, build_time: float) -> dict:
     """summary.json content: solver figures, sizes and shape measures of a solution."""
     shape = result.pattern
-    dz = shape.coords[:, 2] - np.asarray(
-        case.surface.height(shape.coords[:, 0], shape.coords[:, 1])
-    )
+    dz = case.deviation(shape.coords)
     angles = np.degrees(shape.corner_angles)
     free = shape.free_creases
     return {

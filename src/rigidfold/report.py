@@ -335,9 +335,7 @@ class RunWriter:
         check = verify(pattern, run_deform=self.deform, settings=self.case.settings)
         for stage, t in check.times.items():
             self.stage_times[stage] += t
-        dz = pattern.coords[:, 2] - np.asarray(
-            self.case.surface.height(pattern.coords[:, 0], pattern.coords[:, 1]), dtype=float
-        )
+        dz = self.case.deviation(pattern.coords)
         fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
         figures = {"step": solution.step, "dof": dof, "fit": fit, **check.to_dict()}
         self.checks.append(figures)
