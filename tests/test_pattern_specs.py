@@ -248,8 +248,9 @@ def test_make_case_scales_the_surface_and_records_the_pattern():
 
 # ------------------------------------------------------------------------------ end to end
 def test_generate_on_a_6_by_4_grid(tmp_path):
-    """A 6 m x 4 m roof on grid:7x5 down to DOF 1 (the 12 m x 8 m grid:15x9 run of the README
-    takes minutes, most of them tracing the folding motion of its 41 solutions)."""
+    """A 6 m x 4 m roof on grid:7x5 down to DOF 1 (the 12 m x 8 m grid:15x9 run of
+    docs/benchmarks.md takes minutes, most of them tracing the folding motion of its 41
+    solutions)."""
     expr = "0.06*x*(6-x) + 0.05*y*(4-y)"
     argv = ["generate", "--pattern", "grid:7x5", "--size", "6x4", "--surface", "expr"]
     code = main([*argv, "--expr", expr, "--no-deform", "--quiet", "--out", str(tmp_path)])

@@ -165,7 +165,7 @@ def test_a_dask_scheduler_is_reached_through_the_handshake():
     from rigidfold.study.runner import connect
 
     with LocalCluster(
-        n_workers=0, processes=False, protocol="tcp://", dashboard_address=None
+        n_workers=0, processes=False, protocol="tcp://", dashboard_address=":0"
     ) as cluster:
         client = connect(cluster.scheduler_address, 10)
         assert client.scheduler_info()["address"] == cluster.scheduler_address

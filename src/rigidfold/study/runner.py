@@ -250,7 +250,9 @@ def run_study(
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            # no fixed port: None would still serve Dask's HTTP routes on :8787 and warn
+            # when another cluster (another study) holds it
+            dashboard_address=":0",
             silence_logs=logging.ERROR,
         )
         client = Client(cluster)
