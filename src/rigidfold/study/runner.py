@@ -11,12 +11,13 @@ from __future__ import annotations
 import os
 import socket
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS, Settings, check_seed
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
@@ -57,7 +58,7 @@ def plan(
     patterns: Sequence[str],
     criteria: Sequence[str],
     surfaces: int,
-    first_seed: int = 0,
+    first_seed: int = DEFAULT_SEED,
     *,
     settings: Settings = DEFAULTS,
 ) -> list[Key]:
@@ -246,13 +247,17 @@ def run_study(
         return {"total": total, "ran": 0, "skipped": finished, "wall_s": 0.0, "startup_s": 0.0}
     cluster = None
     if scheduler is None:
-        cluster = LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=logging.ERROR,
-        )
+        with warnings.catch_warnings():
+            # no dashboard, yet the scheduler serves HTTP (health checks) on port 8787 and
+            # warns when another Dask cluster holds that port: not the user's concern
+            warnings.filterwarnings("ignore", "Port 8787 is already in use", UserWarning)
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+            )
         client = Client(cluster)
     else:
         client = connect(scheduler, connect_timeout)
