@@ -11,7 +11,7 @@ import pytest
 
 from conftest import run_cli
 from rigidfold.cli import main
-from rigidfold.io import read_fold
+from rigidfold.io import read_fold, write_fold
 
 
 def test_optimize_writes_fold_and_summary(tmp_path, capsys):
@@ -169,3 +169,161 @@ def test_develop_of_a_sheet_folded_flat_prints_nothing_from_casadi(tmp_path):
     )
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     assert proc.stdout.startswith("converged: D = ")
+
+
+# ------------------------------------------------------------------------- --help texts
+def subcommands():
+    """(name, parser) of every subcommand."""
+    import argparse
+
+    from rigidfold.cli import build_parser
+
+    parser = build_parser()
+    (sub,) = (a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return [(parser.prog, parser), *sub.choices.items()]
+
+
+def test_every_option_with_a_default_shows_it_in_its_help():
+    """Every option whose default is a value (not None, not a flag's False) says
+    "default: <value>" in its help, as --help prints it."""
+    import argparse
+
+    checked = 0
+    for name, parser in subcommands():
+        formatter = parser._get_formatter()
+        for action in parser._actions:
+            default = action.default
+            if default is None or default is argparse.SUPPRESS or isinstance(default, bool):
+                continue
+            text = " ".join(formatter._expand_help(action).split())
+            assert f"default: {default}" in text, (name, action.option_strings, text)
+            checked += 1
+    assert checked >= 20
+
+
+def test_every_argument_says_what_it_means():
+    import argparse
+
+    for name, parser in subcommands():
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                continue
+            assert action.help and len(action.help) > 10, (name, action.dest)
+
+
+def test_defaults_come_from_the_library():
+    from rigidfold.cli import build_parser
+    from rigidfold.config import DEFAULT_SEED, DEFAULTS
+    from rigidfold.study import STUDY_DEFAULTS
+
+    parser = build_parser()
+    gen = parser.parse_args(["generate", "--surface", "dome", "--pattern", "1", "--out", "x"])
+    assert (gen.seed, gen.target_dof, gen.dz) == (DEFAULT_SEED, DEFAULTS.target_dof, DEFAULTS.dz)
+    assert gen.hessian == DEFAULTS.ipopt_hessian
+    study = parser.parse_args(["study", "--db", "x.db"])
+    assert (study.surfaces, study.workers, study.first_seed) == (
+        STUDY_DEFAULTS.surfaces,
+        STUDY_DEFAULTS.workers,
+        STUDY_DEFAULTS.first_seed,
+    )
+
+
+# ------------------------------------- what OpenSees, CasADi and IPOPT print: only --verbose
+@pytest.fixture
+def noisy_solvers(monkeypatch):
+    """IPOPT at print level 5 (its banner and every iteration, through CasADi) and OpenSees
+    printing its model (``printModel``) whenever rigidfold wipes it, as each would when
+    something went wrong."""
+    import openseespy.opensees as ops
+
+    import rigidfold.develop.diagram
+    import rigidfold.optimize.ipopt
+
+    real_options, real_wipe = rigidfold.optimize.ipopt.ipopt_options, ops.wipe
+
+    def loud_options(*args, **kwargs):
+        return {**real_options(*args, **kwargs), "ipopt.print_level": 5, "print_time": True}
+
+    def loud_wipe():
+        ops.printModel()
+        real_wipe()
+
+    for module in (rigidfold.optimize.ipopt, rigidfold.develop.diagram):
+        monkeypatch.setattr(module, "ipopt_options", loud_options)
+    monkeypatch.setattr(ops, "wipe", loud_wipe)
+
+
+SOLVER_NOISE = ("Ipopt", "EXIT:", "Number of Iterations", "Node:", "Element:", "Domain")
+"""Text that IPOPT (print level 5) and OpenSees (printModel) print."""
+
+
+def solver_text(text: str) -> list[str]:
+    return [marker for marker in SOLVER_NOISE if marker in text]
+
+
+def test_nothing_from_opensees_or_ipopt_reaches_the_terminal(tmp_path, capfd, noisy_solvers):
+    """generate, optimize, deform, develop, analyze, export and report run in this process
+    with the solvers made to print: standard output holds rigidfold's lines only, standard
+    error nothing."""
+    from rigidfold.patterns import miura
+
+    shape = miura(3, 3)
+    fold = write_fold(tmp_path / "miura.fold", shape)
+    run = tmp_path / "run"
+    commands = {
+        "generate": (["--surface", "dome", "--pattern", "grid:3x3", "--quiet"], run, 6),
+        "optimize": (["--surface", "dome", "--pattern", "grid:3x3"], tmp_path / "opt", 2),
+        "deform": ([str(fold)], tmp_path / "deform", 4),
+        "develop": ([str(fold)], tmp_path / "develop", 2),
+        "export": ([str(fold), "--to", "obj"], tmp_path / "export", 2),
+        "analyze": ([str(fold)], None, 4),
+        "report": ([str(run)], None, 1),
+    }
+    for command, (args, out, n_lines) in commands.items():
+        argv = [command, *args, *([] if out is None else ["--out", str(out)])]
+        assert main(argv) in (0, 1), command
+        captured = capfd.readouterr()
+        assert solver_text(captured.out + captured.err) == [], (command, captured)
+        assert captured.err == "", (command, captured.err)
+        assert len(captured.out.strip().splitlines()) == n_lines, (command, captured.out)
+    # --verbose lets them through
+    assert main(["--verbose", "deform", str(fold), "--out", str(tmp_path / "loud")]) == 0
+    captured = capfd.readouterr()
+    assert "Ipopt" in captured.out and "Node:" in captured.out + captured.err
+    assert main(["--verbose", "optimize", *commands["optimize"][0], "--out", str(run)]) in (0, 1)
+    assert "Number of Iterations" in capfd.readouterr().out
+
+
+def test_a_study_prints_only_its_own_lines(tmp_path):
+    """The study's Dask workers run in processes of their own, which inherit the terminal:
+    nothing of theirs (IPOPT, CasADi, Dask) reaches it."""
+    db = tmp_path / "s.db"
+    args = ["study", "--surfaces", "1", "--patterns", "1", "--criteria", "s", "--no-deform"]
+    proc = run_cli(*args, "--quiet", "--workers", "1", "--db", str(db))
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert proc.stdout.startswith("1 runs done, 0 already in") and proc.stdout.count("\n") == 1
+
+
+def test_native_quiet_drops_what_the_quiet_thread_prints_only(capsys, monkeypatch):
+    import threading
+
+    from rigidfold.quiet import VERBOSE_ENV, native_quiet
+
+    streams = sys.stdout, sys.stderr
+    monkeypatch.delenv(VERBOSE_ENV, raising=False)
+    with native_quiet():
+        print("hidden")
+        with native_quiet():
+            print("hidden too", file=sys.stderr)
+        thread = threading.Thread(target=lambda: print("from a progress bar's thread"))
+        thread.start()
+        thread.join()
+        print("hidden again")
+    print("shown")
+    assert (sys.stdout, sys.stderr) == streams
+    captured = capsys.readouterr()
+    assert captured.out == "from a progress bar's thread\nshown\n" and captured.err == ""
+    monkeypatch.setenv(VERBOSE_ENV, "1")
+    with native_quiet():
+        print("verbose")
+    assert capsys.readouterr().out == "verbose\n"

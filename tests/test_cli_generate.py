@@ -16,6 +16,7 @@ from conftest import run_cli
 from rigidfold.cli import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import fold_dict, read_fold, write_fold
+from rigidfold.mesh.geometry import best_fit
 from rigidfold.patterns import miura
 
 
@@ -89,7 +90,10 @@ def test_generate_writes_solutions_log_and_summary(generated):
     motion = [f for f in raw["file_frames"] if f["frame_classes"] == ["foldedForm"]]
     assert len(motion) == 11
     assert np.abs(np.asarray(motion[0]["vertices_coords"])[:, 2]).max() < 1e-9
-    assert np.allclose(motion[-1]["vertices_coords"], last.pattern.coords, atol=1e-9)
+    # the last motion frame is the design, turned and moved so that its support panel lies
+    # where it lies in the flat frame
+    folded = best_fit(np.array([motion[-1]["vertices_coords"]]), last.pattern.coords)[0]
+    assert np.allclose(folded, last.pattern.coords, atol=1e-9)
 
 
 def test_analyze_json_on_a_generated_solution(generated):
@@ -298,3 +302,40 @@ def test_overwrite_never_removes_an_input_file(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"--overwrite would remove the input file '{solution}'" in err[0]
     assert solution.read_bytes() == before and (out / "summary.json").is_file()
+
+
+DEFORM_RUN = ["--surface", "dome", "--pattern", "grid:3x3", "--quiet", "--no-report"]
+"""SHORT_RUN with Step 9: three solutions, DOF 5 -> 3, in a few seconds."""
+
+
+def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, monkeypatch):
+    """The large-deformation analysis and the folding motion: both verdicts of every solution
+    in summary.json, the final design's in one line before the last; and, when they differ
+    (the motion tracer given too few Newton iterations), the reason."""
+    import rigidfold.report
+
+    assert main(["generate", *DEFORM_RUN, "--out", str(tmp_path / "a")]) == 1
+    lines = capsys.readouterr().out.strip().splitlines()
+    agree = "large deformation reached the plane, folding motion traced: they agree"
+    assert lines[-2] == f"final design: {agree}"
+    summary = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert [s["verdicts"]["line"] for s in summary["per_solution"]] == [agree] * 3
+    assert summary["exports"][-1] == "final/step_02_dof_03.os.fold"
+    assert (tmp_path / "a" / "final" / "step_02_dof_03.os.fold").is_file()
+
+    real = rigidfold.report.verify
+    tight = DEFAULTS.with_(motion_max_iter=1, motion_max_halvings=0)
+    monkeypatch.setattr(
+        rigidfold.report, "verify", lambda pattern, **kw: real(pattern, **{**kw, "settings": tight})
+    )
+    assert main(["generate", *DEFORM_RUN, "--out", str(tmp_path / "b")]) == 1
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[-2].startswith(
+        "final design: large deformation reached the plane, folding motion not traced: they "
+        "differ, because with "
+    )
+    assert "DOF the folding path is not unique" in lines[-2]
+    assert "folding motion not traced for the final design" in lines[-1]
+    final = json.loads((tmp_path / "b" / "summary.json").read_text())["per_solution"][-1]
+    assert final["verdicts"]["agreement"] == "differ"
+    assert final["verdicts"]["line"] == lines[-2].removeprefix("final design: ")

@@ -13,9 +13,10 @@ from rigidfold.case import make_case
 from rigidfold.cli import main
 from rigidfold.deform import TubeSection, deform, folding_motion, verify
 from rigidfold.develop import develop
+from rigidfold.frame.model import default_support_face
 from rigidfold.generate import generate
 from rigidfold.io import read_fold, write_fold
-from rigidfold.mesh.geometry import edge_lengths
+from rigidfold.mesh.geometry import best_fit, edge_lengths
 from rigidfold.patterns import miura
 from rigidfold.report import verification_frames
 
@@ -62,10 +63,19 @@ def test_miura_motion_is_exactly_rigid():
     motion = folding_motion(shape, develop(shape).coords2d)
     assert motion.status == "ok"
     assert np.abs(motion.frames[0][:, 2]).max() < 1e-9
-    assert np.allclose(motion.frames[-1], shape.coords, atol=1e-12)
+    # the last frame is the designed shape, turned and moved as a rigid body
+    assert np.allclose(best_fit(motion.frames[-1:], shape.coords)[0], shape.coords, atol=1e-12)
     assert motion.max_length_error < 1e-8
     for frame in motion.frames:
         assert np.allclose(edge_lengths(frame, shape.edges), shape.edge_lengths, rtol=1e-8)
+    # the support panel (the panel of the support triangle) holds still
+    panel = motion.support_vertices(shape)
+    assert default_support_face(shape) in motion.support_faces
+    assert np.array_equal(
+        motion.support_faces,
+        np.flatnonzero(shape.facets == shape.facets[default_support_face(shape)]),
+    )
+    assert np.abs(motion.frames[:, panel] - motion.frames[0, panel]).max() < 1e-9
 
 
 def test_one_dof_path_trace_of_a_miura_reaches_the_plane():
@@ -111,7 +121,13 @@ def test_generated_one_dof_shape_passes_steps_8_and_9(one_dof_solution):
     assert d.reached_plane and d.mean_dl_mm < 0.25 and d.mean_drho_fix_deg < 0.05
     assert m.status == "ok" and m.max_length_error < 1e-3
     assert np.abs(m.frames[0][:, 2]).max() < 1e-9
-    assert np.allclose(m.frames[-1], one_dof_solution.coords, atol=1e-9)
+    # the designed shape, turned and moved so that its support panel lies on the development
+    last = best_fit(m.frames[-1:], one_dof_solution.coords)[0]
+    assert np.allclose(last, one_dof_solution.coords, atol=1e-9)
+    panel = m.support_vertices(one_dof_solution)
+    assert np.abs(m.frames[1:, panel] - m.frames[-1, panel]).max() < 1e-9
+    # the flat frame is the development: its panel agrees to the development's accuracy
+    assert np.abs(m.frames[0, panel] - m.frames[-1, panel]).max() < 1e-7
     frames = verification_frames(one_dof_solution, check)
     assert frames[0]["frame_classes"] == ["creasePattern"]
     assert [f["frame_classes"] for f in frames[1:]] == [["foldedForm"]] * len(m.frames)
@@ -136,6 +152,120 @@ def test_deform_cli_json_and_files(tmp_path, capsys):
     assert len(history) == 20 and history[-1]["load_factor"] == pytest.approx(1.0)
     flat = read_fold(out / "miura.fold", frame=2).pattern  # first motion frame: flat
     assert np.abs(flat.coords[:, 2]).max() < 1e-9
+
+
+def test_deform_fold_file_holds_the_support_panel_in_every_motion_frame(tmp_path, capsys):
+    """The motion frames of the FOLD file that ``rigidfold deform`` writes: the support panel
+    (recorded in ``rigidfold:motion``) keeps its coordinates in every frame, and each frame
+    carries its own fold angles and assignments."""
+    from rigidfold.config import DEFAULTS
+    from rigidfold.io.fold import edge_assignments
+
+    shape = miura(3, 3)
+    src = write_fold(tmp_path / "miura.fold", shape)
+    assert main(["deform", str(src), "--out", str(tmp_path / "out")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[2] == "large deformation reached the plane, folding motion traced: they agree"
+    raw = json.loads((tmp_path / "out" / "miura.fold").read_text())
+    diagram = next(f for f in raw["file_frames"] if f["frame_classes"] == ["creasePattern"])
+    motion = [f for f in raw["file_frames"] if "folding motion" in f["frame_title"]]
+    assert len(motion) == DEFAULTS.motion_frames
+    support = raw["rigidfold:motion"]["support_faces"]
+    assert (
+        support
+        == np.flatnonzero(shape.facets == shape.facets[default_support_face(shape)]).tolist()
+    )
+    assert len(support) == 2  # a Miura-ori's panels are quads: two triangles, one fixed crease
+    panel = np.unique(np.asarray(diagram["faces_vertices"])[support])
+    coords = np.array([f["vertices_coords"] for f in motion])
+    assert np.abs(coords[:, panel] - coords[0, panel]).max() < 1e-9
+    assert np.abs(coords[0, :, :2] - np.asarray(diagram["vertices_coords"])).max() < 1e-12
+    assert np.abs(coords[0, :, 2]).max() == 0.0  # the flat frame is the development diagram
+    letters = edge_assignments(shape)  # the design's: B boundary, J fixed, M and V creases
+    for frame in motion:
+        assert frame["edges_assignment"] == letters
+        assert len(frame["edges_foldAngle"]) == shape.n_edges
+    # flat: every angle 0, each crease keeps the letter of the way it folds (FOLD's crease
+    # pattern convention); folded: the design's angles
+    assert np.abs(motion[0]["edges_foldAngle"]).max() < 1e-6
+    assert np.allclose(motion[-1]["edges_foldAngle"], np.degrees(shape.fold_angles), atol=1e-6)
+    halfway = np.abs(motion[len(motion) // 2]["edges_foldAngle"])
+    assert 0 < halfway.max() < np.abs(np.degrees(shape.fold_angles)).max()
+
+
+@pytest.fixture(scope="module")
+def free_miura():
+    """A Miura-ori whose quads are cut into free triangles: 9 DOF, developable, rigid-foldable."""
+    shape = miura(3, 3)
+    return shape.with_fixed(np.zeros(shape.n_edges, dtype=bool))
+
+
+TRACER_STOPS = {"motion_max_iter": 1, "motion_max_halvings": 0}
+"""Settings under which the motion tracer gives up at once (one Newton iteration a frame,
+no halving)."""
+
+
+def test_verdicts_agree_on_a_rigid_foldable_miura(miura_checks):
+    check = verify(miura_checks[0])
+    verdicts = check.verdicts
+    assert verdicts.agreement == "agree" and verdicts.reason == ""
+    assert verdicts.line == "large deformation reached the plane, folding motion traced: they agree"
+    assert check.to_dict()["verdicts"]["agreement"] == "agree"
+    assert verify(miura_checks[0], run_deform=False).verdicts is None
+
+
+def test_verdicts_differ_when_the_analysis_stops_short_of_the_plane():
+    from rigidfold.config import DEFAULTS
+
+    check = verify(miura(3, 3), settings=DEFAULTS.with_(deform_load_tol=0.51))  # stops at 0.5
+    verdicts = check.verdicts
+    assert (verdicts.plane, verdicts.motion, verdicts.agreement) == (False, True, "differ")
+    assert verdicts.line.startswith(
+        "large deformation did not reach the plane, folding motion traced: they differ, because "
+        "a rigid-folding path to the plane exists"
+    )
+    assert check.deformation.message in verdicts.reason
+
+
+def test_verdicts_differ_when_the_tracer_stops_on_a_shape_of_several_dof(free_miura):
+    """At 9 DOF the folding path is not unique: the tracer follows one and, with too few
+    Newton iterations, gives up; the OpenSees frame reaches the plane all the same, hardly
+    deforming."""
+    from rigidfold.config import DEFAULTS
+
+    check = verify(free_miura, settings=DEFAULTS.with_(**TRACER_STOPS))
+    assert check.motion.status == "failed" and check.motion.dof == 9
+    assert check.deformation.reached_plane and check.deformation.max_dl_mm < 1e-3
+    verdicts = check.verdicts
+    assert verdicts.agreement == "differ"
+    assert verdicts.line.startswith(
+        "large deformation reached the plane, folding motion not traced: they differ, because "
+        "with 9 DOF the folding path is not unique: the motion tracer follows one"
+    )
+    assert "got there along another (max |dl| = " in verdicts.reason
+    assert verify(free_miura).verdicts.agreement == "agree"  # with the default settings
+
+
+def test_deform_cli_says_why_the_verdicts_differ(free_miura, tmp_path, capsys, monkeypatch):
+    import functools
+
+    import rigidfold.workflows
+    from rigidfold.config import DEFAULTS
+
+    tight = DEFAULTS.with_(**TRACER_STOPS)
+    real = rigidfold.workflows.deform_file
+    monkeypatch.setattr(rigidfold.workflows, "deform_file", functools.partial(real, settings=tight))
+    src = write_fold(tmp_path / "free.fold", free_miura)
+    assert main(["deform", str(src), "--out", str(tmp_path / "out")]) == 0  # reached the plane
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].startswith("folding motion: failed")
+    assert lines[2].startswith(
+        "large deformation reached the plane, folding motion not traced: they differ, because "
+        "with 9 DOF"
+    )
+    assert main(["deform", str(src), "--out", str(tmp_path / "out"), "--json"]) == 0
+    verdicts = json.loads(capsys.readouterr().out)["verdicts"]
+    assert verdicts["agreement"] == "differ" and verdicts["line"] == lines[2]
 
 
 def test_deform_cli_locked_shape_exits_1(tmp_path):

@@ -28,7 +28,7 @@ from rigidfold.exports import (
 )
 from rigidfold.exports.mesh3d import Y_UP
 from rigidfold.exports.sheet import polygon_area
-from rigidfold.io import crease_pattern_frame, write_fold
+from rigidfold.io import crease_pattern_frame, read_fold, write_fold
 from rigidfold.io.fold import edge_assignments
 from rigidfold.mesh.geometry import face_areas
 
@@ -42,6 +42,7 @@ FILES = [
     "design_cutsheet.svg",
     "design_panels.csv",
     "design_creases.csv",
+    "design.os.fold",
 ]
 
 
@@ -270,6 +271,86 @@ def test_schedule_has_one_row_per_panel_and_crease(design, exported):
     )
     row = creases[int(shape.fixed_creases[0])]
     assert row["panel_left"] == row["panel_right"] != "-1"
+
+
+# ------------------------------------------------------------- FOLD for Origami Simulator
+# What Origami Simulator takes, from its source (github.com/amandaghassaei/OrigamiSimulator;
+# the file and function are named at each check; rigidfold.exports.fold_os says the same).
+
+
+def os_fold_angle(coords: np.ndarray, faces: list, v1: int, v2: int) -> float:
+    """Origami Simulator's fold angle (degrees) of the crease from vertex v1 to v2: its two
+    faces ordered as js/pattern.js (getFacesAndVerticesForEdges) orders them (face 1 runs
+    v1 -> v2 in its vertex order), their normals as the normalCalc shader of index.html
+    computes them (cross(b - a, c - a)), the angle as its thetaCalcShader does:
+    atan2(dot(cross(n1, c), n2), dot(n1, n2)) with c the unit vector from v1 to v2."""
+    found = [
+        (f, face.index(v2) - face.index(v1))
+        for f, face in enumerate(faces)
+        if {v1, v2} <= set(face)
+    ]
+    (first, _), (second, step) = found
+    if step in (1, -2):  # the second face runs v1 -> v2: it is face 1
+        first, second = second, first
+
+    def normal(f: int) -> np.ndarray:
+        a, b, c = coords[faces[f]]
+        n = np.cross(b - a, c - a)
+        return n / np.linalg.norm(n)
+
+    n1, n2 = normal(first), normal(second)
+    c = (coords[v2] - coords[v1]) / np.linalg.norm(coords[v2] - coords[v1])
+    return float(np.degrees(np.arctan2(np.cross(n1, c) @ n2, n1 @ n2)))
+
+
+def test_origami_simulator_fold_is_what_its_importer_takes(design, exported):
+    shape, _ = design
+    path = exported / "design.os.fold"
+    doc = json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+    # js/importer.js, openFile: a file without one of these four is refused
+    assert {"vertices_coords", "edges_vertices", "edges_assignment", "faces_vertices"} <= set(doc)
+    # js/pattern.js, processFold: the top-level frame is the model, file_frames are not read
+    assert "file_frames" not in doc and doc["frame_classes"] == ["foldedForm"]
+    # js/model.js, sync: one line list per letter U V M B F C, any other letter fails
+    letters = np.asarray(doc["edges_assignment"])
+    assert set(letters) <= {"M", "V", "F", "B"}
+    expected = np.asarray(edge_assignments(shape))
+    assert np.array_equal(letters == "B", expected == "B")
+    assert np.array_equal(np.isin(letters, ["M", "V"]), np.isin(expected, ["M", "V"]))
+    assert np.array_equal(letters == "F", np.isin(expected, ["J", "F"]))  # fixed: panels
+    # js/model.js, sync: faces are vertex triangles indexed with a Uint16Array
+    faces = doc["faces_vertices"]
+    assert all(len(face) == 3 for face in faces) and len(doc["vertices_coords"]) < 2**16
+    # js/pattern.js, getFacesAndVerticesForEdges: every M, V and F edge needs an angle (null is
+    # skipped); js/importer.js: degrees, M negative, V positive; js/model.js, sync: a crease
+    # whose angle is 0 is a stiff panel crease
+    angles = np.asarray(doc["edges_foldAngle"], dtype=float)
+    assert len(angles) == shape.n_edges and np.isfinite(angles).all()
+    assert (angles[letters == "M"] < 0).all() and (angles[letters == "V"] > 0).all()
+    assert (angles[np.isin(letters, ["F", "B"])] == 0).all()
+    # js/pattern.js, processFold puts a 2D file's (x, y) at (x, 0, y); js/saveFOLD.js writes
+    # y up: the design's height is the file's y, the model turned, not mirrored
+    coords = np.asarray(doc["vertices_coords"], dtype=float)
+    assert coords.shape == (shape.n_vertices, 3)
+    np.testing.assert_array_equal(coords[:, 1], shape.coords[:, 2])
+    # at 100% folding the design is at rest: Origami Simulator's angle of every crease is the
+    # target the file gives it
+    creases = np.flatnonzero(np.isin(letters, ["M", "V"]))
+    assert len(creases) > 0
+    for e in creases:
+        v1, v2 = doc["edges_vertices"][e]
+        assert os_fold_angle(coords, faces, v1, v2) == pytest.approx(angles[e], abs=1e-9)
+
+
+def test_origami_simulator_fold_reads_back_as_the_same_design(design, exported):
+    shape, _ = design
+    data = read_fold(exported / "design.os.fold", up="y")
+    back = data.pattern
+    np.testing.assert_array_equal(back.coords, shape.coords)
+    np.testing.assert_array_equal(back.faces, shape.faces)
+    np.testing.assert_array_equal(back.edges, shape.edges)
+    np.testing.assert_array_equal(back.fixed, shape.fixed)  # edges_rigidfold:fixed
+    np.testing.assert_allclose(back.fold_angles, shape.fold_angles, atol=1e-12)
 
 
 # ------------------------------------------------------------------------------ API

@@ -269,3 +269,9 @@ def test_run_without_solution_and_unfinished_run(copy):
     (copy / "summary.json").write_text(json.dumps({**summary, "stop": "running", "verdict": None}))
     text = report_run(copy).html.read_text()
     assert '"verdict none">Every check passed; the run has not finished' in text
+
+
+def test_the_solutions_table_says_whether_deformation_and_motion_agree(reported):
+    text = reported.html.read_text()
+    assert "<th>deformation vs motion</th>" in text
+    assert text.count("<td>agree</td>") == 4  # every solution of the run

@@ -15,11 +15,12 @@ import sys
 from collections.abc import Sequence
 
 from rigidfold import __version__
-from rigidfold.config import DEFAULTS, HESSIANS, check_seed
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
+from rigidfold.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.selection import CRITERIA
 from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACE_FORMS
@@ -31,6 +32,14 @@ LOOKAHEAD_HELP = (
 )
 EXIT_INTERRUPTED = 130
 EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE
+OUT_HELP = "output directory (created if absent)"
+WORKERS_HELP = "local worker processes, each running one generate at a time (default: %(default)s)"
+FOLD_HELP = (
+    "a FOLD file of the shape (its top-level frame): vertices_coords in 3D (2D: a flat "
+    "sheet), faces_vertices (polygons are triangulated, the added diagonals fixed); edges "
+    "assigned J or marked in edges_rigidfold:fixed are fixed creases, the other interior "
+    "edges free creases"
+)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -59,6 +68,8 @@ def _seed(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The parser of every command. Every option's help says what its value means and, where
+    it has one, its default ("default: ..."), taken from the library."""
     parser = _Parser(
         prog="rigidfold",
         description="Form generation of developable, rigid-foldable origami.",
@@ -67,7 +78,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--verbose",
         action="store_true",
-        help="let through what OpenSees prints when the process ends (hidden by default)",
+        help="show what OpenSees, CasADi and IPOPT print (their warnings and logs, and "
+        "OpenSees's message when the process ends); hidden by default",
     )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
@@ -82,18 +94,25 @@ def build_parser() -> argparse.ArgumentParser:
         "written all the same; the last line says what fell short, and notes the checks that "
         "failed on earlier solutions), 2 on bad input, 130 when interrupted.",
     )
-    _case_options(gen)
+    _case_options(
+        gen,
+        out="output directory: solutions/, log.json, summary.json, final/ (the final design "
+        "exported in every format of rigidfold export) and report.html",
+    )
     gen.add_argument(
         "--criterion",
         default=CRITERIA[0],
         choices=CRITERIA,
-        help="how the next crease to fix is chosen (Section 5; default %(default)s)",
+        help="how the next crease line to fix is chosen, lowest score first (Section 5): shat "
+        "= S-hat and s = S, the shape score S^S over the mechanism score (from normalised or "
+        "plain mechanism modes), ss = S^S alone, random (default: %(default)s)",
     )
     gen.add_argument(
         "--target-dof",
         type=int,
         default=DEFAULTS.target_dof,
-        help="stop at this DOF (default %(default)s)",
+        help="stop at a shape with this many degrees of freedom (DOF: independent rigid "
+        "folding motions; 1 = folds along one path; default: %(default)s)",
     )
     gen.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     gen.add_argument(
@@ -103,9 +122,14 @@ def build_parser() -> argparse.ArgumentParser:
         "ends generation there)",
     )
     gen.add_argument(
-        "--no-deform", action="store_true", help="skip the large-deformation check (Step 9)"
+        "--no-deform",
+        action="store_true",
+        help="skip the large-deformation check (Step 9, OpenSees); the development diagram "
+        "(Step 8) and the folding motion still run",
     )
-    gen.add_argument("--quiet", action="store_true", help="no progress bar")
+    gen.add_argument(
+        "--quiet", action="store_true", help="no progress bar (the result lines are printed)"
+    )
     gen.add_argument(
         "--no-report",
         action="store_true",
@@ -154,11 +178,15 @@ def build_parser() -> argparse.ArgumentParser:
         _cmd_deform,
         out=True,
         help="Step 9: large-deformation check of a FOLD shape (OpenSees) and its folding motion",
-        description="Drive the frame model of a FOLD shape to the plane with OpenSees and trace "
-        "its folding motion. Writes DIR/<name>.fold (the input plus the development diagram and "
-        "the motion frames), DIR/<name>.svg (the development diagram) and DIR/<name>_deform.json "
-        "(figures and the load-step history). Exit code 0 when the plane is reached, 1 when "
-        "not, 2 on bad input.",
+        description="Drive the frame model of a FOLD shape to the plane with OpenSees (tubes "
+        f"{DEFAULTS.tube_diameter * 1e3:g} mm x {DEFAULTS.tube_wall * 1e3:g} mm, E = "
+        f"{DEFAULTS.youngs_modulus / 1e9:g} GPa, {DEFAULTS.deform_steps} load steps) and trace "
+        "its folding motion (a rigid-folding path from the plane, the support panel held "
+        "still); a line says whether the two verdicts agree and, when not, why. Writes "
+        "DIR/<name>.fold (the input plus the development diagram and the motion frames), "
+        "DIR/<name>.svg (the development diagram) and DIR/<name>_deform.json (figures and the "
+        "load-step history). Exit code 0 when the plane is reached, 1 when not, 2 on bad "
+        "input.",
     )
 
     exp = _file_command(
@@ -166,20 +194,23 @@ def build_parser() -> argparse.ArgumentParser:
         "export",
         _cmd_export,
         out=True,
-        help="3D, CAD and cut-sheet files of a FOLD design: OBJ, STL, PLY, GLB, DXF, SVG, CSV",
+        help="3D, CAD and cut-sheet files of a FOLD design: OBJ, STL, PLY, GLB, DXF, SVG, CSV, "
+        "FOLD for Origami Simulator",
         description="Export a FOLD design (a solution of rigidfold generate, or any FOLD shape): "
         "its folded form as OBJ, STL, PLY and GLB (metres, one group or node per panel), its "
-        "development diagram as a cut sheet in DXF and SVG (millimetres at 1:1) and its panel "
-        "and crease schedule as CSV, into DIR/<name>.*. The diagram is the file's "
-        "'creasePattern' frame, or computed (Step 8) when it has none. Exit code 0 when "
-        "written, 1 when the computed diagram did not converge (written all the same), 2 on "
-        "bad input.",
+        "development diagram as a cut sheet in DXF and SVG (millimetres at 1:1), its panel "
+        "and crease schedule as CSV, and its folded form as a FOLD file that Origami "
+        "Simulator opens (fold-os: DIR/<name>.os.fold, y up, creases M, V, F, boundary B), "
+        "into DIR/<name>.*. The diagram is the file's 'creasePattern' frame, or computed "
+        "(Step 8) when it has none. Exit code 0 when written, 1 when the computed diagram did "
+        "not converge (written all the same), 2 on bad input.",
     )
     exp.add_argument(
         "--to",
         default=",".join(EXPORT_FORMATS),
         metavar="FORMATS",
-        help=f"comma-separated, from {','.join(EXPORT_FORMATS)} (default: all)",
+        help=f"comma-separated formats, any of {', '.join(EXPORT_FORMATS)} (default: "
+        "%(default)s, i.e. all)",
     )
     exp.add_argument(
         "--convention",
@@ -187,7 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
         choices=CONVENTIONS,
         help="of the SVG cut sheet: rigidfold's (layers, labels, legend, scale bar) or "
         "origami-simulator (red/blue/black lines, fold angle as stroke opacity, opens in "
-        "Origami Simulator)",
+        "Origami Simulator) (default: %(default)s)",
     )
 
     stu = sub.add_parser(
@@ -201,41 +232,59 @@ def build_parser() -> argparse.ArgumentParser:
     stu.add_argument(
         "--patterns",
         default=",".join(plan.patterns),
-        help="comma-separated pattern specs with their defaults (the paper's names, "
-        "grid:NXxNY, mesh:FILE, FILE.fold, FILE.svg; default %(default)s)",
+        help="comma-separated crease pattern specs, each with its defaults (the paper's names, "
+        "grid:NXxNY, mesh:FILE, FILE.fold, FILE.svg; default: %(default)s)",
     )
     stu.add_argument(
-        "--criteria", default=",".join(plan.criteria), help="comma-separated (default %(default)s)"
+        "--criteria",
+        default=",".join(plan.criteria),
+        help=f"comma-separated selection criteria, any of {', '.join(CRITERIA)} (see generate "
+        "--criterion; default: %(default)s)",
     )
-    stu.add_argument("--surfaces", type=int, default=plan.surfaces, help="number of Bezier seeds")
+    stu.add_argument(
+        "--surfaces",
+        type=int,
+        default=plan.surfaces,
+        help="number of random Bezier target surfaces, seeds --first-seed, --first-seed + 1, "
+        "... (default: %(default)s)",
+    )
     stu.add_argument(
         "--first-seed",
         type=_seed,
         default=plan.first_seed,
-        help="seed of the first Bezier surface, 0 to 2**63 - 1 (default %(default)s)",
+        help="seed of the first Bezier surface, 0 to 2**63 - 1 (default: %(default)s)",
     )
     stu.add_argument(
         "--preset", help="dome, hp or dome,hp: Sections 6.5-6.6 instead of Bezier surfaces"
     )
     stu.add_argument("--db", required=True, metavar="DB", help="SQLite file (created if absent)")
     where = stu.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, default=plan.workers, help="local worker processes")
-    where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
+    where.add_argument("--workers", type=int, default=plan.workers, help=WORKERS_HELP)
+    where.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="address of an existing Dask scheduler (e.g. tcp://host:8786), instead of local "
+        "workers",
+    )
     stu.add_argument(
         "--connect-timeout",
         type=float,
         default=plan.connect_timeout,
         metavar="S",
-        help="seconds that --scheduler has to answer (default %(default)s)",
+        help="seconds that --scheduler has to answer (default: %(default)s)",
     )
-    stu.add_argument("--no-deform", action="store_true", help="skip Steps 8-9 of each solution")
+    stu.add_argument(
+        "--no-deform",
+        action="store_true",
+        help="skip Steps 8-9 (development diagram, large deformation) of each solution",
+    )
     stu.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     stu.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
         choices=HESSIANS,
-        help="IPOPT's Hessian of the Lagrangian: closed-form (default) or casadi (the symbolic "
-        "reference, used by studies made before the closed form)",
+        help="IPOPT's Hessian of the Lagrangian: closed-form or casadi (the symbolic "
+        "reference, used by studies made before the closed form; default: %(default)s)",
     )
     stu.add_argument("--quiet", action="store_true", help="no progress bar")
     stu.set_defaults(func=_cmd_study)
@@ -245,7 +294,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="Tables 5-8 of a study database beside the paper's, with box plots",
     )
     rep.add_argument("db", metavar="DB", nargs="+", help="one or more study databases")
-    rep.add_argument("--out", metavar="DIR", help="write DIR/results.md and PNG box plots")
+    rep.add_argument(
+        "--out",
+        metavar="DIR",
+        help="also write DIR/results.md and PNG box plots (the tables are printed either way)",
+    )
     rep.set_defaults(func=_cmd_study_report)
 
     opt = sub.add_parser(
@@ -255,8 +308,13 @@ def build_parser() -> argparse.ArgumentParser:
         "Exit code 0 when the solution is accepted (F <= F_tol, constraints met), 1 when not "
         "(the files are written all the same), 2 on bad input.",
     )
-    _case_options(opt)
-    opt.add_argument("--fixed", help="comma-separated indices of fixed crease lines")
+    _case_options(opt, out=f"{OUT_HELP}: solution.fold and summary.json")
+    opt.add_argument(
+        "--fixed",
+        help="comma-separated indices (into the pattern's edges, as in its FOLD "
+        "edges_vertices) of the crease lines to fix: each is held flat, joining its two "
+        "triangles into one rigid panel (default: none)",
+    )
     opt.set_defaults(func=_cmd_optimize)
     return parser
 
@@ -267,22 +325,23 @@ def _file_command(
     """A command on one FOLD file: FILE.fold [--out DIR] [--up AXIS] [--json]; returns its
     parser."""
     p = sub.add_parser(name, **text)
-    p.add_argument("file", metavar="FILE.fold")
+    p.add_argument("file", metavar="FILE.fold", help=FOLD_HELP)
     if out:
-        p.add_argument("--out", required=True, metavar="DIR")
+        p.add_argument("--out", required=True, metavar="DIR", help=OUT_HELP)
     p.add_argument(
         "--up",
         default=UP_AXES[0],
         choices=UP_AXES,
         help="the file's up axis: y for files drawn y-up (Blender, Origami Simulator); "
-        "coordinates are read in the file's frame_unit and converted to metres",
+        "coordinates are read in the file's frame_unit and converted to metres (default: "
+        "%(default)s)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=func)
     return p
 
 
-def _case_options(p: argparse.ArgumentParser) -> None:
+def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     p.add_argument(
         "--surface",
         required=True,
@@ -295,10 +354,12 @@ def _case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--seed",
         type=_seed,
-        default=0,
-        help="seed (0 to 2**63 - 1) of the random Bezier surface; generate also draws from it "
-        "the random hinge stiffnesses of the S-hat and S^S criteria and the order of the "
-        "random criterion (default 0)",
+        default=DEFAULT_SEED,
+        help="random seed, 0 to 2**63 - 1: of the Bezier surface; generate also draws from it "
+        "the fictitious hinge stiffnesses K_j (uniform in "
+        f"{DEFAULTS.hinge_stiffness:g} +/- {DEFAULTS.hinge_stiffness_spread:g} Nm, Section "
+        "6.1) that the s and shat criteria rank by, and the order of the random criterion "
+        "(default: %(default)s)",
     )
     p.add_argument(
         "--expr",
@@ -320,8 +381,10 @@ def _case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--size",
         metavar="WxH",
-        help="metres, of a grid: pattern, or the box a FOLD or SVG file drawn without units is "
-        "fitted into, aspect ratio kept (default {:g}x{:g})".format(*DEFAULT_SIZE),
+        help="plan size in metres of a grid: pattern, or the box a FOLD or SVG file drawn "
+        "without units is fitted into, aspect ratio kept (default: {:g}x{:g})".format(
+            *DEFAULT_SIZE
+        ),
     )
     p.add_argument(
         "--scale",
@@ -340,49 +403,63 @@ def _case_options(p: argparse.ArgumentParser) -> None:
         default=UP_AXES[0],
         choices=UP_AXES,
         help="the up axis of a FOLD pattern and of a mesh: or fold: surface: y for files drawn "
-        "y-up (Blender, Origami Simulator)",
+        "y-up (Blender, Origami Simulator) (default: %(default)s)",
     )
     p.add_argument(
         "--diagonals",
         choices=DIAGONALS,
-        help=f"of a grid: pattern's cells (default {DIAGONALS[0]})",
+        help=f"how a grid: pattern's cells are cut into triangles (default: {DIAGONALS[0]})",
     )
     p.add_argument(
         "--edge-length",
         type=_positive,
         metavar="L",
-        help="target edge length in metres of a mesh: pattern (default sqrt(footprint area) / "
-        f"{DEFAULTS.mesh_divisions:g})",
+        help="target edge length in metres of a mesh: pattern (default: sqrt(footprint area) "
+        f"/ {DEFAULTS.mesh_divisions:g})",
     )
-    p.add_argument("--symmetric", action="store_true", help="impose the surface's mirror planes")
+    p.add_argument(
+        "--symmetric",
+        action="store_true",
+        help="make the shape mirror-symmetric about the target surface's mirror planes "
+        "(dome, hp; refused for a surface without any)",
+    )
     p.add_argument(
         "--solver",
         default=SOLVERS[0],
         choices=SOLVERS,
-        help="solver of problem (6) (default %(default)s)",
+        help="solver of problem (6) (default: %(default)s)",
     )
     p.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
         choices=HESSIANS,
-        help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off; default "
-        "%(default)s)",
+        help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off; "
+        "default: %(default)s)",
     )
     p.add_argument(
         "--dz",
         type=float,
         default=DEFAULTS.dz,
-        help="bound on |z - f(x, y)| in metres (default %(default)s)",
+        help="bound on |z - f(x, y)|: how far, in metres, each vertex may lie above or below "
+        "the target surface (default: %(default)s)",
     )
-    for bound in ("min", "max"):
+    for bound, word in (("min", "smallest"), ("max", "largest")):
         default = math.degrees(getattr(DEFAULTS, f"theta_{bound}"))
         p.add_argument(
             f"--theta-{bound}",
             type=float,
-            help=f"bound on every sector angle, degrees (default {default:g})",
+            metavar="DEG",
+            help=f"{word} sector angle (corner angle of a triangle at a vertex) allowed, "
+            f"degrees (default: {default:g})",
         )
-    p.add_argument("--rho-max", type=_positive, help="bound (12) on |fold angle|, degrees")
-    p.add_argument("--out", required=True, metavar="DIR")
+    p.add_argument(
+        "--rho-max",
+        type=_positive,
+        metavar="DEG",
+        help="bound (12) on the fold angle of every free crease, |rho| <= this, degrees "
+        "(default: no bound)",
+    )
+    p.add_argument("--out", required=True, metavar="DIR", help=out)
 
 
 def _case(args: argparse.Namespace):
@@ -465,7 +542,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         progress.close()
         print(
-            f"rigidfold: interrupted; {len(writer.files)} solution(s), log.json and "
+            f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json and "
             f"summary.json are in {writer.out}",
             file=sys.stderr,
         )
@@ -483,6 +560,8 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     if writer.exports:
         names = ", ".join(p.name for p in writer.exports)
         print(f"exported the final design to {writer.out / 'final'}: {names}")
+    if writer.final_verdicts is not None:
+        print(f"final design: {writer.final_verdicts}")
     if not args.no_report:
         print(f"report: {writer.out / 'report.html'}")
     verdict = writer.verdict
@@ -574,6 +653,9 @@ def _cmd_deform(args: argparse.Namespace) -> int:
             f"folding motion: {m.status}, {len(m.frames)} frames, max |dl|/l = "
             f"{m.max_length_error:.2e}" + (f" ({m.message})" if m.message else "")
         )
+    verdicts = checked.verification.verdicts
+    if verdicts is not None:
+        print(verdicts.line)
     print(f"wrote {', '.join(str(p) for p in checked.written)}")
     return 0 if d.reached_plane else 1
 
@@ -662,8 +744,11 @@ def _names(text: str) -> list[str]:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(_attached_values(sys.argv[1:] if argv is None else argv))
-    if not args.verbose:
+    if not (args.verbose or native_output_shown()):
         _quiet_exit()
+    shown = os.environ.get(VERBOSE_ENV)
+    if args.verbose:  # rigidfold.quiet lets the solvers' output through, here and in workers
+        os.environ[VERBOSE_ENV] = "1"
     try:
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits
@@ -687,6 +772,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         _drop_stdout()
         print(f"rigidfold: error: cannot write the output: {reason}", file=sys.stderr)
         return EXIT_USAGE
+    finally:
+        if args.verbose:
+            _restore_env(VERBOSE_ENV, shown)
+
+
+def _restore_env(name: str, value: str | None) -> None:
+    """Set the environment variable ``name`` back to ``value`` (None: unset)."""
+    if value is None:
+        os.environ.pop(name, None)
+    else:
+        os.environ[name] = value
 
 
 def _attached_values(argv: Sequence[str]) -> list[str]:

@@ -20,6 +20,10 @@ SEED_LIMIT = 2**63
 """Seeds (of Bezier surfaces, of generate's random draws) are integers 0 <= seed <
 SEED_LIMIT: a study stores them as SQLite's signed 64-bit integers."""
 
+DEFAULT_SEED = 0
+"""The seed of a Bezier surface and of generate's random draws (hinge stiffnesses, the
+random criterion's order) when none is given."""
+
 
 def check_seed(seed, what: str = "seed") -> int:
     """``seed`` as an int. Raises ValueError ``"<what> must be a non-negative integer below

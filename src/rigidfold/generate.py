@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.config import Settings, check_seed, one_blas_thread
+from rigidfold.config import DEFAULT_SEED, Settings, check_seed, one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
@@ -234,7 +234,7 @@ def generate(
     *,
     criterion: str = CRITERIA[0],
     target_dof: int | None = None,
-    seed: int = 0,
+    seed: int = DEFAULT_SEED,
     solver: str = SOLVERS[0],
     support_face: int | None = None,
     lookahead: bool = False,

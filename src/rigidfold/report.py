@@ -2,10 +2,12 @@
 
 ``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form, a
 ``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
-``foldedForm`` frames) and ``.svg`` beside it, ``DIR/log.json`` (every attempt) and
-``DIR/summary.json`` (the paper's counters, the development and deformation figures (Step 9)
-and stage times). Every file is written atomically (temporary file, then rename), so each one
-on disk is always valid.
+``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.json``
+(every attempt) and ``DIR/summary.json`` (the paper's counters, the development and
+deformation figures (Step 9), each solution's verdicts of the large-deformation analysis and
+the folding motion side by side (:class:`rigidfold.deform.Verdicts`), and stage times).
+Every file is written atomically (temporary file, then rename), so each one on disk is always
+valid.
 """
 
 from __future__ import annotations
@@ -320,6 +322,14 @@ class RunWriter:
         self.verdict: RunVerdict | None = None
         self.final: tuple[CreasePattern, np.ndarray] | None = None
         self.exports: list[Path] = []
+
+    @property
+    def final_verdicts(self) -> str | None:
+        """The final design's verdicts of the large-deformation analysis and the folding motion
+        in one line, and why they differ when they do (:class:`rigidfold.deform.Verdicts`);
+        None without a solution, or when one of the two did not run."""
+        verdicts = self.checks[-1]["verdicts"] if self.checks else None
+        return None if verdicts is None else verdicts["line"]
 
     def release(self) -> None:
         """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""

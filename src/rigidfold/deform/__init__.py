@@ -1,16 +1,19 @@
 """Step 9: large-deformation check (OpenSees), the folding motion, and both with Step 8."""
 
 from rigidfold.deform.analysis import DeformResult, DeformStatus, TubeSection, deform
-from rigidfold.deform.check import Verification, verify
+from rigidfold.deform.check import Agreement, Verdicts, Verification, compare, verify
 from rigidfold.deform.motion import Motion, MotionStatus, folding_motion
 
 __all__ = [
+    "Agreement",
     "DeformResult",
     "DeformStatus",
     "Motion",
     "MotionStatus",
     "TubeSection",
+    "Verdicts",
     "Verification",
+    "compare",
     "deform",
     "folding_motion",
     "verify",

@@ -39,6 +39,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
 from rigidfold.mesh import CreasePattern
+from rigidfold.quiet import native_quiet
 from rigidfold.status import Outcome
 
 
@@ -219,6 +220,7 @@ def _dihedrals(corners: np.ndarray, pattern: CreasePattern, edges: np.ndarray) -
     return np.arctan2(-np.einsum("ij,ij->i", np.cross(na, nb), t), np.einsum("ij,ij->i", na, nb))
 
 
+@native_quiet()
 def deform(
     pattern: CreasePattern,
     *,
@@ -231,7 +233,8 @@ def deform(
     A step that does not converge is retried with half the increment up to
     ``deform_max_halvings`` times; then the analysis stops with status FAILED and the figures
     of the converged steps. The equalDOF pins are enforced with the penalty
-    ``deform_penalty * E A / mean edge length``.
+    ``deform_penalty * E A / mean edge length``. What OpenSees prints is hidden
+    (:func:`rigidfold.quiet.native_quiet`).
     """
     import openseespy.opensees as ops  # heavy: only when an analysis runs
 

@@ -14,9 +14,10 @@ large-deformation analysis:
 For a 1-DOF mechanism the system is square and the path is the mechanism's own; with more
 DOF the minimum-norm corrections follow the steepest descent of m within the mechanism. No
 single crease has to fold monotonically. The flat end is the development diagram (Step 8)
-at z = 0; a rigid motion that goes smoothly (slerp) from the identity (designed shape) to
-the best fit of the last folded frame onto the development puts the whole path in that
-frame.
+at z = 0. The *support panel* (the panel, triangles joined by fixed creases, of the support
+triangle) holds still: every folded frame is turned and moved as a rigid body so that the
+panel's vertices lie where they lie in the development, and the rest of the sheet folds up
+around it.
 ``max_length_error`` is the largest relative edge-length error over all frames.
 """
 
@@ -26,13 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
-from scipy.spatial.transform import Rotation, Slerp
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.mesh import CreasePattern
-from rigidfold.mesh.geometry import edge_lengths
+from rigidfold.mesh.geometry import best_fit, edge_lengths
 from rigidfold.status import Outcome
 
 
@@ -47,17 +47,34 @@ class MotionStatus(Outcome):
 class Motion:
     """Frames of the folding motion, flat first.
 
-    frames : (K, V, 3) float64; frames[0] is flat (z = 0), frames[-1] the designed shape
+    frames : (K, V, 3) float64; traced (status OK): frames[0] is the development diagram at
+        z = 0, frames[-1] the designed shape turned and moved as a rigid body, and the
+        support panel's vertices keep their place in every frame. Not traced: the part that
+        was traced, the designed shape last, in its own place.
     parameter : (K,) fraction of the folding measure m = |rho_free|, 0 (flat) .. 1 (designed)
     max_length_error : largest |l - l0| / l0 over all edges and frames
     status : MotionStatus; message (the detail) says how it was traced or why it failed
+    support_faces : (k,) int, the triangles of the support panel (the panel, joined by fixed
+        creases, of the support triangle), which holds still
+    dof : int or None, the first-order DOF of the rigid-folding constraints at the design,
+        when the tracer computed it (it does when the motion was not traced)
+    turned_back : the shape's one folding path (DOF 1) was traced and turns back before the
+        plane (:attr:`PathTrace.turned_back`)
     """
 
     frames: np.ndarray
     parameter: np.ndarray
     max_length_error: float
     status: MotionStatus
+    support_faces: np.ndarray
     message: str = ""
+    dof: int | None = None
+    turned_back: bool = False
+
+    def support_vertices(self, pattern: CreasePattern) -> np.ndarray:
+        """(n,) int, sorted: the vertices of the support panel of ``pattern`` (the shape the
+        motion folds)."""
+        return np.unique(pattern.faces[self.support_faces])
 
     def to_dict(self) -> dict:
         """JSON-serialisable figures of the motion (not its frames)."""
@@ -66,6 +83,9 @@ class Motion:
             "message": self.message,
             "frames": len(self.frames),
             "max_length_error": self.max_length_error,
+            "support_faces": self.support_faces.tolist(),
+            "dof": self.dof,
+            "turned_back": self.turned_back,
         }
 
 
@@ -167,12 +187,14 @@ def folding_motion(
     """Trace the folding motion of ``pattern`` down to its development ``flat`` (V, 2).
 
     Returns ``settings.motion_frames`` frames from the plane to the designed shape, at equal
-    steps of the folding measure m = |rho_free|. A step that does not converge is retried
-    with half the step up to ``motion_max_halvings`` times; then the 1-DOF path is traced
-    (:func:`trace_one_dof_path`).
+    steps of the folding measure m = |rho_free|, the support panel held still (the panel of
+    ``support_face``, default :func:`rigidfold.frame.model.default_support_face`). A step that
+    does not converge is retried with half the step up to ``motion_max_halvings`` times; then
+    the 1-DOF path is traced (:func:`trace_one_dof_path`).
     """
     if support_face is None:
         support_face = default_support_face(pattern)
+    panel = np.flatnonzero(pattern.facets == pattern.facets[support_face])
     cons = _Constraints(pattern, support_face)
     x = pattern.coords.ravel().copy()
     m0 = cons.measure(x)
@@ -202,6 +224,7 @@ def folding_motion(
             message = f"no rigid-folding shape below {1 - s_done:.4f} of the design's folding"
             break
         path.append(x.copy())
+    dof, turned_back = None, False
     if status is MotionStatus.FAILED:
         trace = trace_one_dof_path(pattern, support_face=support_face, settings=settings)
         if trace is not None and trace.reached_flat:
@@ -209,10 +232,13 @@ def folding_motion(
             message = "traced by pseudo-arclength: " + trace.message
         elif trace is not None:
             message += "; " + trace.message
+        if status is MotionStatus.FAILED:
+            dof = 1 if trace is not None else _rigid_folding_dof(cons, settings)
+            turned_back = trace is not None and trace.turned_back
     V = pattern.n_vertices
     frames = np.array([p.reshape(V, 3) for p in path])
     if status is MotionStatus.OK:
-        frames = _place_flat(frames, flat)
+        frames = _hold_support(frames, flat, np.unique(pattern.faces[panel]))
     else:
         frames = frames[::-1]
     L0 = pattern.edge_lengths
@@ -222,7 +248,21 @@ def folding_motion(
         if status is MotionStatus.OK
         else np.full(len(frames), np.nan)
     )
-    return Motion(frames, parameter, err, status, message)
+    return Motion(frames, parameter, err, status, panel, message, dof, turned_back)
+
+
+def _rigid_folding_dof(constraints: _Constraints, settings: Settings) -> int:
+    """First-order DOF of the rigid-folding constraints (edge lengths, fixed-crease angles,
+    support gauge) at the design: the nullity of their Jacobian (to ``mechanism_rank_tol``)."""
+    _, J = constraints(constraints.X0, 0.0)
+    return _kernel(J[:-1], settings)[1]
+
+
+def _kernel(J: np.ndarray, settings: Settings) -> tuple[np.ndarray, int]:
+    """(the last right singular vector of ``J``, its nullity): the columns of ``J`` minus its
+    rank, counting singular values above ``mechanism_rank_tol`` times the largest."""
+    _, sv, vt = np.linalg.svd(J)
+    return vt[-1], J.shape[1] - int(np.sum(sv > settings.mechanism_rank_tol * sv[0]))
 
 
 @dataclass
@@ -234,6 +274,8 @@ class PathTrace:
     reached_flat : the measure fell to the last motion level (1 / (motion_frames - 1))
     min_measure : the smallest measure on the path
     message : what happened, in words
+    turned_back : the path turns back before the plane (``motion_turn_back``): the shape
+        does not unfold to flat along its mechanism (False when the trace merely stopped)
     """
 
     points: np.ndarray
@@ -241,9 +283,10 @@ class PathTrace:
     reached_flat: bool
     min_measure: float
     message: str
+    turned_back: bool = False
 
     def frames_towards_flat(self, n: int) -> list[np.ndarray]:
-        """n points equally spaced in arclength, the design first (for :func:`_place_flat`)."""
+        """n points equally spaced in arclength, the design first (for :func:`_hold_support`)."""
         idx = np.unique(np.round(np.linspace(0, len(self.points) - 1, n)).astype(int))
         return [self.points[i].copy() for i in idx]
 
@@ -276,12 +319,10 @@ def trace_one_dof_path(
         return r[:-1], J[:-1]
 
     def tangent(J, previous=None):
-        _, sv, vt = np.linalg.svd(J)
-        t = vt[-1]
-        rank = int(np.sum(sv > settings.mechanism_rank_tol * sv[0]))
+        t, nullity = _kernel(J, settings)
         if previous is not None and t @ previous < 0:
             t = -t
-        return t, J.shape[1] - rank
+        return t, nullity
 
     x = pattern.coords.ravel().copy()
     m0 = cons.measure(x)
@@ -295,7 +336,7 @@ def trace_one_dof_path(
         t = -t
     h_max = settings.motion_arc_step * float(np.mean(pattern.edge_lengths))
     h, level = h_max / 4, 1.0 / max(int(settings.motion_frames) - 1, 1)
-    points, measure = [x.copy()], [1.0]
+    points, measure, turned_back = [x.copy()], [1.0], False
     message = f"no step possible after {settings.motion_arc_max_steps} steps"
     for _ in range(settings.motion_arc_max_steps):
         guess = x + h * t
@@ -330,28 +371,22 @@ def trace_one_dof_path(
                 "measure (pseudo-arclength trace): the shape does not unfold to flat along its "
                 "mechanism"
             )
+            turned_back = True
             break
     m = np.asarray(measure)
-    return PathTrace(np.asarray(points), m, bool(m[-1] <= level), float(m.min()), message)
+    return PathTrace(
+        np.asarray(points), m, bool(m[-1] <= level), float(m.min()), message, turned_back
+    )
 
 
-def _place_flat(path: np.ndarray, flat: np.ndarray) -> np.ndarray:
-    """Flat first, ending at the designed shape, in the development's frame.
+def _hold_support(path: np.ndarray, flat: np.ndarray, panel: np.ndarray) -> np.ndarray:
+    """Flat first, ending at the designed shape, the support panel held still.
 
-    path : (n, V, 3) the designed shape and n - 1 frames at equal folding steps, in the
-    designed shape's gauge. The development at z = 0 is appended; a rigid motion that goes
-    smoothly (slerp) from the identity to the best fit of the last folded frame onto the
-    development places every frame.
+    path : (n, V, 3) the designed shape and n - 1 frames at equal folding steps; flat :
+    (V, 2) the development, the flat frame at z = 0; panel : the support panel's vertices.
+    Every frame of ``path`` is turned and moved (a proper rotation and a translation) so
+    that the panel's vertices best fit theirs in the flat frame.
     """
     target = np.column_stack([flat, np.zeros(len(flat))])
-    src = path[-1]
-    path = np.concatenate([path, target[None]])
-    sc, tc = src.mean(axis=0), target.mean(axis=0)
-    rot, _ = Rotation.align_vectors(target - tc, src - sc)
-    slerp = Slerp([0.0, 1.0], Rotation.concatenate([Rotation.identity(), rot]))
-    K = len(path)
-    out = np.empty_like(path)
-    for k, s in enumerate(np.linspace(0.0, 1.0, K - 1)):  # s: 0 designed -> 1 last folded
-        out[k] = slerp([s])[0].apply(path[k] - sc) + sc + s * (tc - sc)
-    out[-1] = target
-    return out[::-1]
+    placed = best_fit(path[::-1], target, panel)
+    return np.concatenate([target[None], placed])

@@ -36,6 +36,7 @@ import shapely
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.ipopt import ipopt_options
+from rigidfold.quiet import native_quiet
 from rigidfold.status import Outcome
 
 _IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -341,9 +342,10 @@ def _solve(pattern: CreasePattern, layout: np.ndarray, start: str, settings: Set
     # a start with two vertices at one point (a crease folded 180 degrees) makes the gradient
     # of |dx| NaN there once; IPOPT steps away from it, so CasADi need not print a warning
     opts = {**ipopt_options(s, tol=s.develop_tol), "show_eval_warnings": False}
-    solver = ca.nlpsol("development", "ipopt", {"x": xi, "f": D, "g": g}, opts)
     x0 = _initial_guess(pattern, a, b, layout).T.ravel()[free]
-    sol = solver(x0=x0, lbx=lbx, lbg=0.0, ubg=np.inf)
+    with native_quiet():
+        solver = ca.nlpsol("development", "ipopt", {"x": xi, "f": D, "g": g}, opts)
+        sol = solver(x0=x0, lbx=lbx, lbg=0.0, ubg=np.inf)
     stats = solver.stats()
 
     ipopt_status = str(stats.get("return_status", "unknown"))

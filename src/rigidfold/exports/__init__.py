@@ -1,9 +1,10 @@
 """3D, CAD and cut-sheet exports of a design: its folded form and development diagram.
 
 :func:`export_design` writes them all into one directory; :mod:`~rigidfold.exports.mesh3d`
-(OBJ, STL, PLY, GLB), :mod:`~rigidfold.exports.cutsheet` (DXF and SVG cut sheets in mm) and
-:mod:`~rigidfold.exports.schedule` (panel and crease CSV tables) write one kind each, from the
-layout of :mod:`~rigidfold.exports.sheet`. trimesh and ezdxf are imported only when a file
+(OBJ, STL, PLY, GLB), :mod:`~rigidfold.exports.cutsheet` (DXF and SVG cut sheets in mm),
+:mod:`~rigidfold.exports.schedule` (panel and crease CSV tables), from the layout of
+:mod:`~rigidfold.exports.sheet`, and :mod:`~rigidfold.exports.fold_os` (the FOLD file that
+Origami Simulator opens) write one kind each. trimesh and ezdxf are imported only when a file
 is written.
 """
 
@@ -23,6 +24,7 @@ from rigidfold.exports.design import (
     parse_formats,
     read_design,
 )
+from rigidfold.exports.fold_os import origami_simulator_fold, write_origami_simulator_fold
 from rigidfold.exports.mesh3d import MESH_FORMATS, mesh_bytes, write_mesh
 from rigidfold.exports.schedule import crease_rows, panel_rows, write_schedule
 from rigidfold.exports.sheet import Sheet, layout_sheet, panel_loops
@@ -40,6 +42,7 @@ __all__ = [
     "export_design",
     "layout_sheet",
     "mesh_bytes",
+    "origami_simulator_fold",
     "panel_loops",
     "panel_rows",
     "parse_formats",
@@ -47,6 +50,7 @@ __all__ = [
     "sheet_svg_text",
     "write_dxf",
     "write_mesh",
+    "write_origami_simulator_fold",
     "write_schedule",
     "write_sheet_svg",
 ]

@@ -15,6 +15,8 @@ dxf      ``NAME_cutsheet.dxf``: cut sheet, mm at 1:1 (:mod:`rigidfold.exports.cu
 svg      ``NAME_cutsheet.svg``: cut sheet, mm at 1:1, in the chosen convention
 csv      ``NAME_panels.csv`` and ``NAME_creases.csv``: the schedule
          (:mod:`rigidfold.exports.schedule`)
+fold-os  ``NAME.os.fold``: folded form as Origami Simulator opens it (y up, assignments
+         M V F B, no frames; :mod:`rigidfold.exports.fold_os`)
 =======  ==================================================================================
 """
 
@@ -30,19 +32,21 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.develop import Development, develop
 from rigidfold.exports.cutsheet import CONVENTIONS, check_convention, write_dxf, write_sheet_svg
+from rigidfold.exports.fold_os import write_origami_simulator_fold
 from rigidfold.exports.mesh3d import MESH_FORMATS, write_mesh
 from rigidfold.exports.schedule import write_schedule
 from rigidfold.exports.sheet import MARGIN_MM, layout_sheet
 from rigidfold.io import FoldData, prepare_output_dir, read_fold
 from rigidfold.mesh import CreasePattern
 
-EXPORT_FORMATS = (*MESH_FORMATS, "dxf", "svg", "csv")
+EXPORT_FORMATS = (*MESH_FORMATS, "dxf", "svg", "csv", "fold-os")
 """The formats of :func:`export_design` (and of ``rigidfold export --to``)."""
 
 _FILES = {
     "dxf": ("{}_cutsheet.dxf",),
     "svg": ("{}_cutsheet.svg",),
     "csv": ("{}_panels.csv", "{}_creases.csv"),
+    "fold-os": ("{}.os.fold",),
 }
 
 
@@ -123,8 +127,10 @@ def export_design(
             written.append(write_dxf(paths[0], sheet))
         elif fmt == "svg":
             written.append(write_sheet_svg(paths[0], sheet, title=title, convention=convention))
-        else:
+        elif fmt == "csv":
             written += write_schedule(paths[0], paths[1], sheet)
+        else:
+            written.append(write_origami_simulator_fold(paths[0], pattern, title=title))
     return written
 
 

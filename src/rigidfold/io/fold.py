@@ -280,7 +280,9 @@ def motion_frames(
     """FOLD frames of a folding motion, inheriting topology from frame ``parent``.
 
     pattern : the folded design (its faces, edges and the crease letters of the motion);
-    frames : (K, V, 3) float, vertex positions from flat to folded; parameter : (K,) fraction
+    frames : (K, V, 3) float, vertex positions from flat to folded, written as given
+    (:func:`rigidfold.deform.folding_motion` holds the support panel still and the figures
+    of the motion, ``rigidfold:motion``, name its triangles); parameter : (K,) fraction
     folded; assignment : E letters every frame carries (default :func:`edge_assignments` of
     the design, so that a crease still flat in a frame keeps its mountain or valley letter).
     Each frame is a "foldedForm" titled with its fraction, with its own ``edges_foldAngle``

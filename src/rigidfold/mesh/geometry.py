@@ -86,6 +86,27 @@ def edge_lengths(coords: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return np.linalg.norm(coords[edges[:, 1]] - coords[edges[:, 0]], axis=1)
 
 
+def best_fit(
+    frames: np.ndarray, target: np.ndarray, points: np.ndarray | None = None
+) -> np.ndarray:
+    """(K, V, 3) ``frames`` each turned and moved (a proper rotation and a translation) so
+    that their ``points`` best fit ``target[points]`` in the least-squares sense (Kabsch).
+
+    frames : (K, V, 3) float64; target : (V, 3) float64; points : (n,) int vertex indices,
+    n >= 3 not on one line (default: every vertex).
+    """
+    chosen = slice(None) if points is None else np.asarray(points)
+    ref = target[chosen]
+    centre = ref.mean(axis=0)
+    mean = frames[:, chosen].mean(axis=1, keepdims=True)
+    h = np.einsum("kvi,vj->kij", frames[:, chosen] - mean, ref - centre)
+    u, _, vt = np.linalg.svd(h)
+    sign = np.sign(np.linalg.det(np.einsum("kij,kjl->kil", u, vt)))
+    u[:, :, 2] *= sign[:, None]
+    rotation = np.einsum("kij,kjl->kil", u, vt)
+    return np.einsum("kvi,kij->kvj", frames - mean, rotation) + centre
+
+
 def fold_angles(
     coords: np.ndarray, faces: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray
 ) -> np.ndarray:

@@ -8,6 +8,7 @@ import numpy as np
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
 from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
+from rigidfold.quiet import native_quiet
 
 _OUTCOME = {
     "Solve_Succeeded": SolverOutcome.SOLVED,
@@ -57,14 +58,16 @@ class IpoptSolver:
         if problem.settings.ipopt_hessian == "closed-form":
             self._hess_lag = closed_form_hess_lag(problem)
             options["hess_lag"] = self._hess_lag
-        self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
+        with native_quiet():
+            self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 
     def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
         The run's message is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``.
         """
-        sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
+        with native_quiet():
+            sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
         stats = self.nlpsol.stats()
         status = str(stats.get("return_status", "unknown"))
         return SolverRun(

@@ -216,6 +216,7 @@ def _solutions(run: RunData) -> str:
         "large deformation",
         "max |dl| (mm)",
         "max |drho_fix| (deg)",
+        "deformation vs motion",
         "max |z - target| (mm)",
         "RMS (mm)",
     ]
@@ -234,10 +235,22 @@ def _solutions(run: RunData) -> str:
                 "not run" if not dfm else dfm.get("status"),
                 None if not dfm else dfm.get("max_dl_mm"),
                 None if not dfm else dfm.get("max_drho_fix_deg"),
+                _agreement(r.get("verdicts")),
                 *(fit[k] if k < len(fit) else (None, None)),
             ]
         )
     return _grid(head, rows)
+
+
+def _agreement(verdicts: dict | None) -> str:
+    """Whether the large-deformation analysis and the folding motion agree on a solution and,
+    when not, why (:class:`rigidfold.deform.Verdicts`); "not compared" when Step 9 did not
+    run (or the run is of a version before the verdicts)."""
+    if not verdicts:
+        return "not compared"
+    if verdicts.get("agreement") == "agree":
+        return "agree"
+    return f"differ: {verdicts.get('reason', '')}"
 
 
 def _attempts(run: RunData) -> list[str]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rigidfold.mesh.geometry import best_fit
 from rigidfold.protocols import TargetSurface
 from rigidfold.reporting.figures import KINDS
 from rigidfold.reporting.run import Design
@@ -28,19 +29,6 @@ MESH_SCALE = [
 ]
 """Colour scale of z - target (ColorBrewer PuOr): purple below the target, orange above,
 white on it. Given as colours: plotly.js knows only a few scales by name."""
-
-
-def best_fit(frames: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """(K, V, 3) ``frames`` each turned and moved (a proper rotation) to best fit ``target``
-    (V, 3) in the least-squares sense (Kabsch)."""
-    centre = target.mean(axis=0)
-    moved = frames - frames.mean(axis=1, keepdims=True)
-    h = np.einsum("kvi,vj->kij", moved, target - centre)
-    u, _, vt = np.linalg.svd(h)
-    sign = np.sign(np.linalg.det(np.einsum("kij,kjl->kil", u, vt)))
-    u[:, :, 2] *= sign[:, None]
-    rotation = np.einsum("kij,kjl->kil", u, vt)
-    return np.einsum("kvi,kij->kvj", moved, rotation) + centre
 
 
 def _lines(coords: np.ndarray, edges: np.ndarray) -> tuple[list, list, list]:

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS, Settings, check_seed
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
@@ -57,7 +57,7 @@ def plan(
     patterns: Sequence[str],
     criteria: Sequence[str],
     surfaces: int,
-    first_seed: int = 0,
+    first_seed: int = DEFAULT_SEED,
     *,
     settings: Settings = DEFAULTS,
 ) -> list[Key]:

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
+from rigidfold.config import DEFAULT_SEED
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import TABLES_5_6
 from rigidfold.study.runner import CONNECT_TIMEOUT_S, StudyConfig, run_study
@@ -32,7 +33,7 @@ class StudyPlan:
     patterns: tuple[str, ...] = tuple(sorted({pattern for pattern, _ in TABLES_5_6}))
     criteria: tuple[str, ...] = CRITERIA
     surfaces: int = 100
-    first_seed: int = 0
+    first_seed: int = DEFAULT_SEED
     workers: int = 2
     connect_timeout: float = CONNECT_TIMEOUT_S
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings
 from rigidfold.surfaces.builtin import Bezier, Dome, HyperbolicParaboloid, MirrorPlane, Surface
 from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
 from rigidfold.surfaces.mesh import (
@@ -43,7 +43,7 @@ def get_surface(
     an OBJ, STL, PLY or OFF mesh (``up`` its up axis, ``"z"`` or ``"y"``), placed with the
     lower-left corner of its plan at (0, 0) (:func:`placed_mesh`)."""
     if name == "bezier":
-        return Bezier(0 if seed is None else seed, box=box)
+        return Bezier(DEFAULT_SEED if seed is None else seed, box=box)
     if name == "dome":
         return Dome(box=box)
     if name == "hp":

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from rigidfold.config import check_seed
+from rigidfold.config import DEFAULT_SEED, check_seed
 
 
 @dataclass(frozen=True)
@@ -127,7 +127,7 @@ class Bezier(Surface):
 
     name = "bezier"
 
-    def __init__(self, seed: int = 0, *, box: tuple[float, float] = (3.0, 3.0)) -> None:
+    def __init__(self, seed: int = DEFAULT_SEED, *, box: tuple[float, float] = (3.0, 3.0)) -> None:
         self.seed: int | None = check_seed(seed, "the Bezier seed")
         self.heights = np.random.default_rng(self.seed).uniform(0.0, 3.0, size=(4, 4))
         self.box = _box(box)
