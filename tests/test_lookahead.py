@@ -19,6 +19,12 @@ from rigidfold.mechanism import analyze
 from rigidfold.selection import lock_forecast, lookahead_order
 
 PARALLEL = {87, 89, 103, 108}  # the demo's four creases with parallel rows at DOF 5 (issue 18)
+VERTICES = {  # its four degree-4 vertices (local one-DOF mechanisms), PARALLEL among them
+    frozenset({8, 12, 28, 29}),
+    frozenset({36, 49, 53, 54}),
+    frozenset({42, 57, 60, 61}),
+    frozenset(PARALLEL),
+}
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +140,9 @@ def test_bad_candidates_are_refused(demo_dof5):
 
 def test_lookahead_order_skips_then_defers_block_by_block(demo_dof5):
     """The lazy order is the same for any block size: the candidates not predicted to lock
-    in their order (each with the skipped ones before it), then the skipped ones."""
+    in their order (each with the skipped ones before it), then the groups of the four
+    degree-4 vertices (a skipped candidate with the nearly flat creases it would lock), then
+    the skipped ones alone."""
     candidates = [(int(e),) for e in demo_dof5.hinges]
     full = lock_forecast(demo_dof5, candidates)
     skip = full.predicts_lock
@@ -145,13 +153,19 @@ def test_lookahead_order_skips_then_defers_block_by_block(demo_dof5):
         else:
             expected.append((k, passed))
             passed = []
+    clean = len(expected)
     expected += [(k, []) for k in np.flatnonzero(skip)]
     for block in (1, 3, 8, 100):
         order = list(lookahead_order(demo_dof5, candidates, block=block))
-        assert [(k, [i for i, _ in p]) for k, _, p in order] == expected
-        for k, locks, p in order:
-            assert locks.tolist() == full.locks(k).tolist()
-            assert all(lk.tolist() == full.locks(i).tolist() for i, lk in p)
+        groups = order[clean : clean + len(VERTICES)]
+        order = order[:clean] + order[clean + len(VERTICES) :]
+        assert [(c.index, [p.index for p in c.passed]) for c in order] == expected
+        for c in order:
+            assert c.locks.tolist() == full.locks(c.index).tolist() and not len(c.carried)
+            assert all(p.locks.tolist() == full.locks(p.index).tolist() for p in c.passed)
+        fixed = [frozenset(candidates[c.index]) | set(c.carried.tolist()) for c in groups]
+        assert set(fixed) == VERTICES and all(c.passed == () for c in groups)
+        assert all(c.carried.tolist() == c.locks.tolist() for c in groups)
     with pytest.raises(ValueError, match="block must be >= 1"):
         next(lookahead_order(demo_dof5, candidates, block=0))
 
@@ -159,10 +173,10 @@ def test_lookahead_order_skips_then_defers_block_by_block(demo_dof5):
 def test_a_fix_to_dof0_is_not_skipped_where_dof0_ends():
     mech = analyze(degree_n_vertex(3))
     candidates = [(int(e),) for e in mech.hinges]
-    assert [p for _, _, p in lookahead_order(mech, candidates)] == [[]] * len(candidates)
+    assert [c.passed for c in lookahead_order(mech, candidates)] == [()] * len(candidates)
     order = list(lookahead_order(mech, candidates, dof0_ends=False))
-    assert [k for k, _, _ in order] == list(range(len(candidates)))
-    assert order[0][2] == [] and len(order[0][1]) == len(candidates) - 1
+    assert [c.index for c in order] == list(range(len(candidates)))
+    assert order[0].passed == () and len(order[0].locks) == len(candidates) - 1
 
 
 @pytest.fixture(scope="module")
