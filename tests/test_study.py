@@ -462,6 +462,7 @@ def test_lookahead_study_has_its_own_database(uninterrupted, tmp_path):
     assert store.config()["lookahead"] is True
     (row,) = criterion_summary(store)
     assert row["n_lock"] == 0 and row["n_reduce"] == 20 and row["skipped_per_run"] >= 3
+    assert row["groups_per_run"] == 0  # no candidate failed: no group was needed
     assert "look-ahead on" in markdown(store)
 
 
@@ -482,6 +483,7 @@ def test_old_databases_resume_with_the_new_attempt_columns(tmp_path):
     (causes,) = lock_causes(store)
     assert causes["causes"]["unknown"] == 4
     assert criterion_summary(store)[0]["skipped_per_run"] is None
+    assert criterion_summary(store)[0]["groups_per_run"] is None
     assert "look-ahead off" in markdown(store)
     store.close()
     digest = hashlib.sha256(db.read_bytes()).hexdigest()

@@ -27,8 +27,9 @@ from rigidfold.surfaces import SURFACE_FORMS
 
 EXIT_USAGE = 2
 LOOKAHEAD_HELP = (
-    "skip the candidate creases whose fix would lock another crease at first order (tried "
-    "only once every other candidate failed)"
+    "skip the candidate creases whose fix would lock another crease at first order, or "
+    "locked one at an earlier shape (tried only once every other candidate failed, first "
+    "together with the nearly flat creases they would lock)"
 )
 EXIT_INTERRUPTED = 130
 EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE

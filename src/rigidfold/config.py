@@ -129,6 +129,13 @@ class Settings:
         solve. At ``lock_tol`` (the default) the forecast is the analysis of the fixed shape
         at the same geometry; a larger value also skips candidates that leave a crease
         nearly still.
+    lookahead_carry_angle : float
+        Look-ahead, once every candidate not forecast to lock has failed: a candidate whose
+        forecast locks only creases that its fix carries to within this angle of flat
+        (radians; first order: their fold angles plus their rotations along the smallest
+        mechanism motion that flattens the candidate) is fixed together with them, as one
+        group (a degree-4 vertex closing flat). Fixed creases are forced flat, so the group
+        asks only what fixing the candidate alone would do, less the lock.
     lock_prediction_tol : float
         After multiplying K_j by 1e14, a hinge whose rotations outside the stiffest mode fall
         below this fraction of its rotations before is predicted locked (Section 4.2).
@@ -258,6 +265,7 @@ class Settings:
     mechanism_rank_tol: float = 1e-9
     lock_tol: float = 1e-7
     lookahead_tol: float = 1e-7
+    lookahead_carry_angle: float = math.radians(2.0)
     lock_prediction_tol: float = 1e-4
     hinge_stiffness: float = 1e-3
     hinge_stiffness_spread: float = 0.5e-6

@@ -20,14 +20,16 @@ The NLP is built once; every solve starts from the last accepted shape.
 
 With ``lookahead=True`` (any criterion), Step 6 forecasts, at the last accepted shape, the
 creases each candidate would lock at first order (:func:`rigidfold.selection.lock_forecast`,
-block by block of the ranking as the candidates are reached); candidates predicted to lock
-are skipped and the others keep the criterion's order. The skipped ones are not dropped: they
-are tried, in the criterion's order, only once every other candidate has failed (so when all
-are predicted to lock, the criterion's full order), and generation never ends where it would
-not without look-ahead (:func:`rigidfold.selection.lookahead_order`). A candidate whose fix
-leaves DOF 0 is not skipped where DOF 0 ends generation. Every lock, with or without
-look-ahead, is logged with the forecast of its candidate and the locked creases' fold angles
-(:class:`Attempt`).
+block by block of the ranking as the candidates are reached); candidates predicted to lock,
+and those whose fix locked a crease at an earlier shape of the run, are skipped and the others
+keep the criterion's order. The skipped ones are not dropped: once every other candidate has
+failed, first those whose forecast locks are nearly flat creases that their fix carries flat
+are fixed together with them (one group, ``Attempt.carried``: the group's creases are fixed,
+not locked), then the skipped ones alone, in the criterion's order; so generation never ends
+where it would not without look-ahead (:func:`rigidfold.selection.lookahead_order`). A
+candidate whose fix leaves DOF 0 is not skipped where DOF 0 ends generation. Every lock, with
+or without look-ahead, is logged with the forecast of its candidate and the locked creases'
+fold angles (:class:`Attempt`).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
 from rigidfold.selection import (
     CRITERIA,
+    Choice,
     crease_groups,
     lock_forecast,
     lookahead_order,
@@ -115,11 +118,15 @@ class Attempt:
         The creases locked at the shape found (every folded free crease at DOF 0).
     skipped, skipped_locks : int, list of dict
         With look-ahead: the candidates passed over just before this one because they were
-        predicted to lock, each as ``{"fixed": [edges], "locks": [edges it would lock]}``.
+        predicted to lock or had locked at an earlier shape, each as ``{"fixed": [edges],
+        "locks": [edges it would lock], "locked_before": [edges its fix locked before]}``.
     predicted_locks : list of int or None
-        With look-ahead: the creases this candidate was predicted to lock (non-empty only
-        where every other candidate had failed); None without look-ahead and for the initial
+        With look-ahead: the creases this fix was predicted to lock (non-empty only where
+        every other candidate had failed); None without look-ahead and for the initial
         solve.
+    carried : list of int
+        With look-ahead: the nearly flat creases fixed together with the candidate, the ones
+        it alone would lock (``fixed_added`` holds the candidate's creases, then these).
     locked_predicted, locked_left : list of bool, list of float or None
         Per crease of ``locked`` (after a fix): whether the forecast at the shape before
         predicted it, and the rotation it was forecast to keep, relative to the largest
@@ -144,6 +151,7 @@ class Attempt:
     skipped: int = 0
     skipped_locks: list[dict] = field(default_factory=list)
     predicted_locks: list[int] | None = None
+    carried: list[int] = field(default_factory=list)
     locked_predicted: list[bool] = field(default_factory=list)
     locked_left: list[float | None] = field(default_factory=list)
     locked_fold_deg: list[float] = field(default_factory=list)
@@ -267,6 +275,7 @@ def generate(
     groups = crease_groups(case.pattern, case.planes, case.settings) if case.planes else None
     settings = case.settings
     zero_ends = settings.zero_dof_ends or target_dof == 0
+    locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
 
     def attempt(
         fixed: np.ndarray, start, added, score
@@ -338,36 +347,49 @@ def generate(
         K = hinge_stiffness(current.mechanism.frame.n_hinges, int(rng.integers(2**32)), settings)
         scores = score_creases(current.mechanism, K=K, settings=settings)
         ranked = rank_candidates(scores, criterion, groups=groups, rng=rng)
-        order: Iterator[tuple[int, np.ndarray | None, list[tuple[int, np.ndarray]]]] = (
+        order: Iterator[Choice] = (
             lookahead_order(
-                current.mechanism, [g for g, _ in ranked], settings=settings, dof0_ends=zero_ends
+                current.mechanism,
+                [g for g, _ in ranked],
+                settings=settings,
+                dof0_ends=zero_ends,
+                locked_before=locked_before,
             )
             if lookahead
-            else ((k, None, []) for k in range(len(ranked)))
+            else (Choice(k) for k in range(len(ranked)))
         )
         t_sel = time.perf_counter() - t1
         while True:  # Step 6, then Step 7 on failure
             t1 = time.perf_counter()
-            k, predicted, passed = next(order, (None, None, []))  # look-ahead: lazy forecast
+            choice = next(order, None)  # look-ahead: lazy forecast
             t_sel += time.perf_counter() - t1
-            if k is None:
+            if choice is None:
                 run.stop = Stop.NO_CANDIDATE
                 return run
-            group, score = ranked[k]
+            group, score = ranked[choice.index]
+            fix = (*group, *choice.carried.tolist())
             trial = current.result.pattern.fixed.copy()
-            trial[list(group)] = True
-            rec, result, mech = attempt(trial, current.result.coords, group, score)
+            trial[list(fix)] = True
+            rec, result, mech = attempt(trial, current.result.coords, fix, score)
             rec.selection_time, t_sel = t_sel, 0.0
-            if predicted is not None:
-                rec.predicted_locks = predicted.tolist()
-                rec.skipped = len(passed)
+            if lookahead:
+                rec.predicted_locks = [] if len(choice.carried) else choice.locks.tolist()
+                rec.carried = choice.carried.tolist()
+                rec.skipped = len(choice.passed)
                 rec.skipped_locks = [
-                    {"fixed": list(ranked[i][0]), "locks": locks.tolist()} for i, locks in passed
+                    {
+                        "fixed": list(ranked[c.index][0]),
+                        "locks": c.locks.tolist(),
+                        "locked_before": c.locked_before.tolist(),
+                    }
+                    for c in choice.passed
                 ]
             if rec.locked:
                 rec.locked_predicted, rec.locked_left = _explain_lock(
                     rec, current.mechanism, settings
                 )
+                if lookahead and not len(choice.carried):
+                    locked_before[group] = rec.locked
             record(rec, result, mech)
             if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
                 break

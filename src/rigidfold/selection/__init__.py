@@ -8,8 +8,11 @@ from rigidfold.selection.criteria import (
     score_creases,
 )
 from rigidfold.selection.lookahead import (
+    Choice,
     LockForecast,
+    carried_angles,
     exact_residuals,
+    flat_groups,
     group_bases,
     lock_forecast,
     lookahead_order,
@@ -19,10 +22,13 @@ from rigidfold.selection.symmetry import crease_groups
 
 __all__ = [
     "CRITERIA",
+    "Choice",
     "LockForecast",
     "Scores",
+    "carried_angles",
     "crease_groups",
     "exact_residuals",
+    "flat_groups",
     "group_bases",
     "lock_forecast",
     "lookahead_order",

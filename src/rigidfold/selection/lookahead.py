@@ -35,13 +35,26 @@ round-off of that subtraction are recomputed from the difference vectors, so a p
 is told from a nearly parallel one to round-off. :func:`lookahead_order` forecasts the
 ranking block by block as generation asks for the next candidate: it usually fixes the first
 it tries, so a selection pays for a few candidates' forecast, not all h.
+
+The order (:func:`lookahead_order`) puts off, besides the candidates forecast to lock, those
+whose fix locked a crease at an earlier shape of the run (``locked_before``): the forecast is
+made at the shape before the solve, and the re-optimised shape can lock a crease that kept
+rotations at first order (the fix flattens a folded candidate: a finite motion); the shapes
+of one run differ by one fix each, and such a fix locks again at the next shape. Once every
+other candidate has failed, a put-off candidate whose forecast locks are all carried to
+nearly flat by its own fix is fixed together with them (:func:`flat_groups`): the typical
+case is a degree-4 vertex, a local one-DOF mechanism whose four rows are parallel; fixing
+one crease flat closes the vertex, and the other three end a few hundredths of a degree from
+flat, free and locked. Fixed with it, they are fixed creases (flat, part of one panel), not
+locked ones: the group removes the vertex's mode (DOF - 1) and locks nothing.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
@@ -228,6 +241,98 @@ def _rows(groups: tuple[tuple[int, ...], ...], hinges: np.ndarray, n_edges: int)
     return members
 
 
+def _no_edges() -> np.ndarray:
+    return np.zeros(0, dtype=np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class Choice:
+    """One fix to try, in the order of :func:`lookahead_order`.
+
+    index : int, the candidate's position in the ranking
+    locks : (m,) int64 edges the candidate alone is forecast to lock
+    locked_before : (b,) int64 edges its fix locked at an earlier shape of the run
+    carried : (c,) int64 creases fixed together with the candidate (:func:`flat_groups`):
+        the nearly flat ones it would lock; empty for the candidate alone
+    passed : the put-off candidates ranked between this one and the one before it
+    """
+
+    index: int
+    locks: np.ndarray = field(default_factory=_no_edges)
+    locked_before: np.ndarray = field(default_factory=_no_edges)
+    carried: np.ndarray = field(default_factory=_no_edges)
+    passed: tuple[Choice, ...] = ()
+
+    @property
+    def put_off(self) -> bool:
+        """Forecast to lock, or locked at an earlier shape: tried once all others failed."""
+        return bool(len(self.locks) or len(self.locked_before))
+
+
+def carried_angles(
+    mechanism: Mechanism,
+    group: Sequence[int],
+    creases: Sequence[int] | np.ndarray,
+    *,
+    settings: Settings = DEFAULTS,
+) -> np.ndarray:
+    """Fold angles of ``creases`` once the fix of ``group`` has flattened it, at first order.
+
+    The smallest motion in the mechanism's modes that takes the group's fold angles to zero,
+    ``a = -pinv(H_phi[G]) rho_G``, turns crease p by ``H_phi[p] a``; for a crease the fix is
+    forecast to lock (its row in the span of the group's rows) that rotation is the same for
+    every such motion. Rows that count as zero (:func:`lock_forecast`) are left out of G.
+
+    group, creases : edge indices of free creases
+    returns : (m,) float64 radians, ``rho[creases] + H_phi[creases] a``
+    """
+    rows = _rows(
+        (tuple(group), *((int(e),) for e in creases)), mechanism.hinges, mechanism.pattern.n_edges
+    )
+    H_phi = mechanism.H_phi
+    rho = mechanism.pattern.fold_angles[mechanism.hinges]
+    norms = mechanism.rotation_norms
+    g = rows[0][rows[0] >= 0]
+    g = g[norms[g] > settings.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)]
+    c = rows[1:, 0]
+    if not len(g):
+        return rho[c]
+    a = np.linalg.lstsq(H_phi[g], -rho[g], rcond=settings.mechanism_rank_tol)[0]
+    return rho[c] + H_phi[c] @ a
+
+
+def flat_groups(
+    mechanism: Mechanism,
+    candidates: Sequence[Sequence[int]],
+    put_off: Sequence[Choice],
+    *,
+    settings: Settings = DEFAULTS,
+) -> list[Choice]:
+    """The put-off candidates to fix together with the creases they would lock.
+
+    A candidate qualifies when its fix is forecast to lock creases, every one of them ends
+    within ``settings.lookahead_carry_angle`` of flat once the candidate is flat
+    (:func:`carried_angles`), and it locked no other crease at an earlier shape. Returned
+    with ``carried`` = those creases: each set of creases once (from the candidate that
+    carries it flattest), the smallest sets first, then the flattest.
+
+    candidates : the ranking (edge groups); put_off : Choices of it (:func:`lookahead_order`)
+    whose fix leaves a mechanism (DOF >= 1: at DOF 0 no motion carries a crease anywhere)
+    """
+    best: dict[frozenset[int], tuple[float, Choice]] = {}
+    for choice in put_off:
+        locks = choice.locks
+        if not len(locks) or not np.isin(choice.locked_before, locks).all():
+            continue
+        group = candidates[choice.index]
+        left = float(np.abs(carried_angles(mechanism, group, locks, settings=settings)).max())
+        key = frozenset(map(int, group)) | frozenset(locks.tolist())
+        if left <= settings.lookahead_carry_angle and left < best.get(key, (np.inf,))[0]:
+            best[key] = (left, dataclasses.replace(choice, carried=locks, passed=()))
+    ranked = sorted(best.items(), key=lambda item: (len(item[0]), item[1][0]))
+    return [choice for _, (_, choice) in ranked]
+
+
 def lookahead_order(
     mechanism: Mechanism,
     candidates: Sequence[Sequence[int]],
@@ -235,37 +340,45 @@ def lookahead_order(
     settings: Settings = DEFAULTS,
     dof0_ends: bool = True,
     block: int = 8,
-) -> Iterator[tuple[int, np.ndarray, list[tuple[int, np.ndarray]]]]:
-    """The order to try ranked candidates with look-ahead: skip those predicted to lock.
+    locked_before: Mapping[tuple[int, ...], Sequence[int]] | None = None,
+) -> Iterator[Choice]:
+    """The order to try ranked candidates with look-ahead: put off those predicted to lock.
 
     candidates : in the criterion's order (best first); dof0_ends : a fix that leaves DOF 0
     ends generation (``Settings.zero_dof_ends``, or a target DOF 0), so such a candidate is
-    not skipped although every crease locks at DOF 0.
-    yields : (k, locks, passed): first every candidate not predicted to lock, in the
-        criterion's order, with ``passed``, the (index, locks) of the skipped candidates ranked
-        between it and the one before; then the skipped ones, in the criterion's order
-        (passed = []). ``locks``: the edges candidate k is predicted to lock. A skipped
-        candidate is thus solved only once every other has failed, so generation with
-        look-ahead never ends where it would not without (when every candidate is predicted
-        to lock, this is the criterion's full order).
+    not put off although every crease locks at DOF 0. locked_before : {candidate (its edges,
+    as ranked): the creases its fix locked at an earlier shape of the run}; such a candidate
+    is put off too.
+    yields : :class:`Choice`: first every candidate not put off, in the criterion's order,
+        with ``passed``, the put-off ones ranked between it and the one before; then the
+        groups of :func:`flat_groups` (a candidate with the nearly flat creases it would
+        lock); then the put-off ones, alone, in the criterion's order. A put-off candidate is
+        thus solved only once every other has failed, so generation with look-ahead never
+        ends where it would not without (when every candidate is put off, the groups and
+        then the criterion's full order).
 
     Lazy: the forecast (:func:`lock_forecast`) is made ``block`` candidates at a time as the
     iteration reaches them.
     """
     if block < 1:
         raise ValueError(f"block must be >= 1, got {block}")
-    skipped: list[tuple[int, np.ndarray]] = []
-    passed: list[tuple[int, np.ndarray]] = []
+    known = locked_before or {}
+    put_off: list[Choice] = []
+    moving: list[Choice] = []  # put off, leaving a mechanism: a group may close one of its modes
+    passed: list[Choice] = []
     for start in range(0, len(candidates), block):
         forecast = lock_forecast(mechanism, candidates[start : start + block], settings=settings)
         ends = dof0_ends & (forecast.dof_after == 0)
-        for i, skip in enumerate((forecast.predicts_lock & ~ends).tolist()):
-            item = (start + i, forecast.locks(i))
-            if skip:
-                passed.append(item)
-                skipped.append(item)
+        for i, group in enumerate(forecast.candidates):
+            before = np.asarray(known.get(tuple(map(int, group)), ()), dtype=np.int64)
+            choice = Choice(start + i, forecast.locks(i), before)
+            if choice.put_off and not ends[i]:
+                passed.append(choice)
+                put_off.append(choice)
+                if forecast.dof_after[i] > 0:
+                    moving.append(choice)
             else:
-                yield (*item, passed)
+                yield dataclasses.replace(choice, passed=tuple(passed))
                 passed = []
-    for item in skipped:
-        yield (*item, [])
+    yield from flat_groups(mechanism, candidates, moving, settings=settings)
+    yield from put_off

@@ -213,22 +213,28 @@ def dof_steps(store: Store) -> list[dict]:
 def criterion_summary(store: Store) -> list[dict]:
     """The figures to compare criteria, and studies with and without look-ahead: per
     (pattern, criterion) of the Bezier study, mean N_reduce, N_lock, N_exceed and F, solves
-    of (6) per run, candidates skipped by the look-ahead per run (None where the database
-    does not store it), and the mean selection and total seconds per run."""
+    of (6) per run, candidates skipped by the look-ahead and fixes of a group of nearly flat
+    creases (``Attempt.carried``) per run (None where the database does not store them), and
+    the mean selection and total seconds per run."""
     runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
     skipped: dict[tuple[str, str], list[int]] = {}
-    for group, _, attempts in store.attempt_runs("bezier", ("skipped",)):
-        values = [s for (s,) in attempts if s is not None]
+    carried: dict[tuple[str, str], list[int]] = {}
+    for group, _, attempts in store.attempt_runs("bezier", ("skipped", "carried")):
+        values = [s for s, _ in attempts if s is not None]
         if values:
             skipped.setdefault(group, []).append(sum(values))
+        fixes = [bool(c) for _, c in attempts if c is not None]
+        if fixes:
+            carried.setdefault(group, []).append(sum(fixes))
     rows = []
     for pattern, crit in sorted({(r["pattern"], r["criterion"]) for r in runs}):
         sel = [r for r in runs if (r["pattern"], r["criterion"]) == (pattern, crit)]
         row: dict = {"pattern": pattern, "criterion": crit, "runs": len(sel)}
         for name in ("n_reduce", "n_lock", "n_exceed", "mean_f", "n_solves"):
             row[name] = _mean_se([r[name] for r in sel])[0]
-        done = skipped.get((pattern, crit))
-        row["skipped_per_run"] = float(np.sum(done)) / len(sel) if done else None
+        for name, counts in (("skipped_per_run", skipped), ("groups_per_run", carried)):
+            done = counts.get((pattern, crit))
+            row[name] = float(np.sum(done)) / len(sel) if done else None
         row["selection_s"] = _mean_se([r["time_selection"] for r in sel])[0]
         row["run_s"] = _mean_se([r["time_total"] for r in sel])[0]
         rows.append(row)
@@ -516,9 +522,10 @@ SECTION_TEXT = {
         "DOF reduced."
     ),
     "Summary per criterion": (
-        "Means per run; skipped: candidates the look-ahead skipped (predicted to lock, not "
-        "solved); selection: ranking (and look-ahead) time, CPU ms per run; run: CPU s per "
-        "run in the workers."
+        "Means per run; skipped: candidates the look-ahead skipped (predicted to lock, or "
+        "locked at an earlier shape; not solved); groups: fixes of a skipped candidate "
+        "together with the nearly flat creases it would lock; selection: ranking (and "
+        "look-ahead) time, CPU ms per run; run: CPU s per run in the workers."
     ),
     "Fold angles of the locked creases": (
         "Locked creases of every lock by |fold angle| at the locked shape (degrees): nearly "
@@ -588,13 +595,14 @@ def _summary_lines(rows: list[dict]) -> list[str]:
         "Summary per criterion",
         [
             *GROUP_HEAD,
-            *("N_reduce", "N_lock", "N_exceed", "mean F", "solves", "skipped"),
+            *("N_reduce", "N_lock", "N_exceed", "mean F", "solves", "skipped", "groups"),
             *("selection ms", "run s"),
         ],
         [
             _group_cells(r)
             + [_fmt(r[k]) for k in ("n_reduce", "n_lock", "n_exceed", "mean_f")]
             + [_fmt(r["n_solves"], digits=1), _fmt(r["skipped_per_run"])]
+            + [_fmt(r["groups_per_run"])]
             + [_fmt(r["selection_s"] * 1e3, digits=1), _fmt(r["run_s"], digits=1)]
             for r in rows
         ],

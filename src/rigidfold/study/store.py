@@ -60,6 +60,7 @@ CREATE TABLE IF NOT EXISTS attempts (
     skipped INTEGER,              -- candidates skipped by the look-ahead just before (NULL: older)
     skipped_locks TEXT, predicted_locks TEXT,  -- JSON, see generate.Attempt
     locked_predicted TEXT, locked_left TEXT, locked_fold_deg TEXT,  -- JSON, per locked crease
+    carried TEXT,                 -- JSON: creases the look-ahead fixed with the candidate
     PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
 );
 """
@@ -71,6 +72,7 @@ ADDED_ATTEMPT_COLUMNS = {
     "locked_predicted": "TEXT",
     "locked_left": "TEXT",
     "locked_fold_deg": "TEXT",
+    "carried": "TEXT",
 }
 """Columns of ``attempts`` added after the first databases (the look-ahead, issue 18): added
 by ALTER TABLE when such a database is opened for writing, read as NULL from one opened
@@ -83,6 +85,7 @@ JSON_ATTEMPT_FIELDS = (
     "locked_predicted",
     "locked_left",
     "locked_fold_deg",
+    "carried",
 )
 """Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
 
