@@ -84,10 +84,9 @@ class Settings:
         Largest |coordinate| in metres accepted in a FOLD file (1000 km): larger values are
         refused before any geometry is computed on them, where they would overflow.
     triangulation_area_tol : float
-        Ear clipping of the polygon faces of FOLD files: a triangle whose doubled signed area
-        is below this times the squared size of its polygon (the larger side of its bounding
-        box, in the polygon's plane) is not an ear, and a vertex within that of an ear's side
-        lies on it.
+        Triangulation of the polygon faces of FOLD and SVG files: a polygon is refused as
+        degenerate when a triangle of it has a doubled signed area below this times the
+        squared size of the polygon (the larger side of its bounding box, in its plane).
     svg_merge_tol : float
         Crease patterns drawn in SVG (:func:`rigidfold.io.read_svg`): points closer than this
         times the diagonal of the drawing's bounding box are one vertex, a line that ends
