@@ -29,6 +29,7 @@ LOOKAHEAD_HELP = (
     "skip the candidate creases whose fix would lock another crease at first order (tried "
     "only once every other candidate failed)"
 )
+EXIT_FAILED = 1  # generate fell short; runs of a study failed
 EXIT_INTERRUPTED = 130
 EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE
 
@@ -489,7 +490,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     assert verdict is not None  # generate_case ends with writer.finish
     final = "none" if verdict.final_design is None else writer.out / verdict.final_design
     print(f"{verdict.outcome.value.replace('_', ' ')}: {verdict.message}; final design: {final}")
-    return 0 if verdict.outcome is RunOutcome.PASSED else 1
+    return 0 if verdict.outcome is RunOutcome.PASSED else EXIT_FAILED
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
@@ -595,7 +596,14 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 def _cmd_study(args: argparse.Namespace) -> int:
     from rigidfold.progress import StudyProgress
-    from rigidfold.study import StudyConfig, StudyInterrupted, plan, preset, run_study_command
+    from rigidfold.study import (
+        StudyConfig,
+        StudyInterrupted,
+        failure_summary,
+        plan,
+        preset,
+        run_study_command,
+    )
 
     if args.preset is not None:
         keys = preset(args.preset)
@@ -632,6 +640,12 @@ def _cmd_study(args: argparse.Namespace) -> int:
         f"{result['ran']} runs done, {result['skipped']} already in {args.db}, "
         f"{result['total']} in the study, {result['wall_s']:.1f} s"
     )
+    if result["failed"]:
+        print(
+            f"rigidfold: {failure_summary(result['failed'], result['ran'], args.db)}",
+            file=sys.stderr,
+        )
+        return EXIT_FAILED
     return 0
 
 
