@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import main_code, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.io import jsonable, read_fold, write_json
 
@@ -299,3 +299,36 @@ def test_large_polygon_face_in_3d_and_from_a_file(tmp_path):
     plan = parse_pattern(str(path))
     assert len(plan.faces) == n - 2 and len(plan.fixed) == 0
     assert np.ptp(plan.xy, axis=0).max() == pytest.approx(3.0)
+
+
+@pytest.mark.parametrize(
+    ("pattern", "message"),
+    [
+        (["grid:3x3", "--size", "1e-10x1e-10"], "pattern 'grid:3x3' is 1e-10 m x 1e-10 m"),
+        (["grid:3x3", "--size", "1e300x1e300"], "pattern 'grid:3x3' is 1e+300 m x 1e+300 m"),
+        (["mesh:0,0;1e-9,0;0,1e-9"], "the footprint '0,0; 1e-09,0; 0,1e-09' is 1e-09 m x"),
+        (["mesh:0,0;1e200,0;0,1e200"], "footprint point 2 (1e+200, 0) lies farther than 1e+06"),
+        (["FILE", "--scale", "1e250"], "cp.fold at --scale 1e+250 is 1e+250 m x 1e+250 m"),
+        (["FILE", "--size", "1e300x1e300"], "cp.fold fitted into --size is 1e+300 m x"),
+        (["TINY"], "tiny.fold (drawn in m) is 1e-10 m x 1e-10 m"),
+    ],
+)
+def test_pattern_plans_too_small_or_too_large_are_refused(tmp_path, capsys, pattern, message):
+    """A plan under 1 mm (a file in the wrong unit: the solvers' absolute tolerances are met
+    trivially or their derivatives turn NaN, with CasADi's warnings on stderr) or over
+    1000 km (overflow: an OverflowError traceback, NumPy's RuntimeWarnings) is refused in
+    one line before anything is written (the fuzz test found the tiny one)."""
+    square = {"vertices_coords": [[0, 0], [1, 0], [1, 1], [0, 1]], "faces_vertices": [[0, 1, 2, 3]]}
+    (tmp_path / "cp.fold").write_text(json.dumps(square))
+    tiny = [[0, 0], [1e-10, 0], [1e-10, 1e-10], [0, 1e-10]]
+    (tmp_path / "tiny.fold").write_text(
+        json.dumps(square | {"frame_unit": "m", "vertices_coords": tiny})
+    )
+    files = {"FILE": str(tmp_path / "cp.fold"), "TINY": str(tmp_path / "tiny.fold")}
+    spec = [files.get(pattern[0], pattern[0]), *pattern[1:]]
+    out = tmp_path / "out"
+    code = main_code(["optimize", "--surface", "dome", "--pattern", *spec, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert message in err and "Settings.max_coordinate" in err, err
+    assert not out.exists()
