@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from conftest import main_code, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.io import jsonable, read_fold, write_json
 
+DATA = Path(__file__).parent / "data"
 TRIANGLE = {"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces_vertices": [[0, 1, 2]]}
 
 
@@ -332,3 +334,32 @@ def test_pattern_plans_too_small_or_too_large_are_refused(tmp_path, capsys, patt
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert message in err and "Settings.max_coordinate" in err, err
     assert not out.exists()
+
+
+def test_a_file_name_that_is_not_utf8_is_developed_whole(tmp_path):
+    """``develop`` of ``sq<0xff>.fold`` (bytes that are not UTF-8) wrote ``sq<0xff>.fold``
+    and then failed on the SVG, whose title held the name ("surrogates not allowed"). Now
+    both files are written under that name, their titles show U+FFFD, and the file names
+    are printed as their bytes even where stdout's encoding is strict."""
+    import shutil
+
+    name = os.fsdecode(b"sq\xff")
+    source = tmp_path / f"{name}.fold"
+    shutil.copy(DATA / "fold_examples" / "squaretwist.fold", source)
+    env = {**os.environ, "PYTHONIOENCODING": "utf-8:strict"}
+    argv = ["develop", str(source), "--out", str(tmp_path / "o")]
+    proc = subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *argv],
+        capture_output=True,
+        env=env,
+        check=False,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr == b""
+    assert os.fsencode(tmp_path / "o" / f"{name}.svg") in proc.stdout
+    assert sorted(os.listdir(os.fsencode(tmp_path / "o"))) == [b"sq\xff.fold", b"sq\xff.svg"]
+    svg = (tmp_path / "o" / f"{name}.svg").read_text(encoding="utf-8")
+    assert "sq\ufffd: development" in svg
+    fold = json.loads((tmp_path / "o" / f"{name}.fold").read_text())
+    assert "sq\ufffd: the folded form" in json.dumps(fold, ensure_ascii=False)

@@ -164,31 +164,32 @@ def delete_key(doc, rng):
     return doc, f"del {[*path, key]}"
 
 
-def bad_number(doc, rng):
-    numbers = [
-        p
-        for p, v in nodes(doc)
-        if isinstance(v, (int, float)) and not isinstance(v, bool) and "vertices_coords" in p
-    ]
-    if not numbers:
-        return doc, "no coordinate"
-    path = rng.choice(numbers)
-    value = rng.choice(NUMBER_JUNK)
+def is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def bad_leaf(doc, rng, wanted: Callable, junk: list):
+    """One number of the document for which ``wanted(path, value)`` holds, set to junk."""
+    leaves = [p for p, v in nodes(doc) if is_number(v) and wanted(p, v)]
+    if not leaves:
+        return doc, "no such number"
+    path, value = rng.choice(leaves), rng.choice(junk)
     return put(doc, path, copy.deepcopy(value)), f"{list(path)} = {value!r}"
+
+
+def bad_number(doc, rng):
+    """A coordinate set to NaN, inf, a huge number, a string, ..."""
+    return bad_leaf(doc, rng, lambda p, v: "vertices_coords" in p, NUMBER_JUNK)
 
 
 def bad_index(doc, rng):
-    indices = [
-        p
-        for p, v in nodes(doc)
-        if isinstance(v, int) and not isinstance(v, bool) and len(p) >= 3
-        and str(p[-3]).endswith("_vertices")
-    ]  # fmt: skip
-    if not indices:
-        return doc, "no index"
-    path = rng.choice(indices)
-    value = rng.choice(INDEX_JUNK)
-    return put(doc, path, copy.deepcopy(value)), f"{list(path)} = {value!r}"
+    """A vertex index of a face or an edge set out of range, fractional, a string, ..."""
+    return bad_leaf(
+        doc,
+        rng,
+        lambda p, v: isinstance(v, int) and len(p) >= 3 and str(p[-3]).endswith("_vertices"),
+        INDEX_JUNK,
+    )
 
 
 def reshape_table(doc, rng):

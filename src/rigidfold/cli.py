@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import io
 import json
 import math
 import os
@@ -678,6 +679,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(_attached_values(sys.argv[1:] if argv is None else argv))
     if not args.verbose:
         _quiet_exit()
+    if isinstance(sys.stdout, io.TextIOWrapper):
+        # a file name whose bytes are not UTF-8 is printed as those bytes, as ls does, not
+        # refused by the encoder after the files were written
+        sys.stdout.reconfigure(errors="surrogateescape")
     try:
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits
