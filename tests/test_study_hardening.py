@@ -188,7 +188,10 @@ def test_a_run_whose_worker_dies_is_recorded_as_failed_and_the_others_go_on(
 
     Two runs on two workers: each run has a worker of its own (Dask counts a death against
     every run its worker held, so a run queued behind seed 1 would be charged too)."""
+    # distributed imported first: leaving the dask.config.set block below would drop its
+    # configuration defaults if it were first imported inside (later clusters then fail)
     import dask
+    import distributed  # noqa: F401
 
     from rigidfold.study import runner
 
