@@ -8,13 +8,16 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
+import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import main_code, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.io import jsonable, read_fold, write_json
 
+DATA = Path(__file__).parent / "data"
 TRIANGLE = {"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces_vertices": [[0, 1, 2]]}
 
 
@@ -191,8 +194,6 @@ def test_full_disk_leaves_no_temporary_file(tmp_path, monkeypatch):
 def test_analysis_too_large_is_refused_before_allocating():
     import time
 
-    import numpy as np
-
     from rigidfold.config import Settings
     from rigidfold.mechanism import analysis_bytes, analyze, check_analysis_size
     from rigidfold.mesh import CreasePattern
@@ -227,3 +228,138 @@ def test_generate_of_a_pattern_too_large_to_analyse_stops_before_solving(tmp_pat
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
     assert "needs about 20.8 GiB, more than the limit of 8 GiB" in proc.stderr
     assert not (tmp_path / "o" / "summary.json").exists()
+
+
+def star_polygon(n: int, seed: int) -> np.ndarray:
+    """(n, 2) vertices of a non-convex star-shaped polygon, counter-clockwise: n random
+    angles, each at a random radius in [0.5, 1]."""
+    rng = np.random.default_rng(seed)
+    angle = np.sort(rng.uniform(0.0, 2.0 * np.pi, n))
+    radius = rng.uniform(0.5, 1.0, n)
+    return np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+
+
+def comb_polygon(teeth: int) -> np.ndarray:
+    """(n, 2) vertices of a comb (non-convex, counter-clockwise) whose base side carries
+    three vertices per tooth in a straight line (collinear corners)."""
+    base = [(x, 0.0) for i in range(teeth) for x in (2 * i, 2 * i + 0.5, 2 * i + 1)]
+    top = [(2.0 * teeth, 0.0), (2.0 * teeth, 10.0)]
+    for i in reversed(range(1, teeth)):
+        top += [(2 * i + 1.5, 10.0), (2 * i + 1.5, 3.0), (2 * i + 0.5, 3.0), (2 * i + 0.5, 10.0)]
+    top += [(1.5, 10.0), (0.0, 10.0)]
+    return np.array(base + top, dtype=float)
+
+
+def shoelace(xy: np.ndarray) -> float:
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+@pytest.mark.parametrize(
+    ("shape", "n"), [("star", 800), ("star", 3000), ("star", 5000), ("comb", 2996)]
+)
+def test_large_polygon_faces_are_triangulated(shape, n):
+    """One polygon face of thousands of vertices is read into n - 2 triangles that tile it.
+
+    Clipping the best ear of all (the triangulation before mapbox_earcut) took 92 s for an
+    800-gon and grows as n^3: hours for these. Each face here is read in well under a second."""
+    xy = star_polygon(n, seed=n) if shape == "star" else comb_polygon(n // 7)
+    assert len(xy) == n
+    fold = {"vertices_coords": xy.tolist(), "faces_vertices": [list(range(n))]}
+    data = read_fold(fold, rigid_panels=True)
+    p = data.pattern
+    assert p.n_faces == n - 2
+    assert data.assignment.count("J") == n - 3 and data.assignment.count("B") == n
+    assert np.all(p.face_normals[:, 2] > 0)
+    tri = p.coords[p.faces][:, :, :2]
+    a, b = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    areas = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / 2
+    assert np.all(areas > 0)
+    assert areas.sum() == pytest.approx(shoelace(xy), rel=1e-12)
+
+
+def test_large_polygon_face_in_3d_and_from_a_file(tmp_path):
+    """A 3000-gon tilted in 3D is triangulated in its own plane; as a crease pattern file it
+    is read, fitted into 3 m x 3 m, its diagonals free creases (without --rigid-panels)."""
+    from rigidfold.patterns import parse_pattern
+
+    n = 3000
+    xy = star_polygon(n, seed=1)
+    c, s = np.cos(0.4), np.sin(0.4)
+    coords = np.column_stack([xy[:, 0], c * xy[:, 1], s * xy[:, 1] + 2.0])
+    data = read_fold({"vertices_coords": coords.tolist(), "faces_vertices": [list(range(n))]})
+    p = data.pattern
+    assert p.n_faces == n - 2 and data.assignment.count("J") == n - 3
+    tri = p.coords[p.faces]
+    area3d = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1) / 2
+    assert area3d.sum() == pytest.approx(shoelace(xy), rel=1e-9)
+
+    path = tmp_path / "panel.fold"
+    path.write_text(
+        json.dumps({"vertices_coords": xy.tolist(), "faces_vertices": [list(range(n))]})
+    )
+    plan = parse_pattern(str(path))
+    assert len(plan.faces) == n - 2 and len(plan.fixed) == 0
+    assert np.ptp(plan.xy, axis=0).max() == pytest.approx(3.0)
+
+
+@pytest.mark.parametrize(
+    ("pattern", "message"),
+    [
+        (["grid:3x3", "--size", "1e-10x1e-10"], "pattern 'grid:3x3' is 1e-10 m x 1e-10 m"),
+        (["grid:3x3", "--size", "1e300x1e300"], "pattern 'grid:3x3' is 1e+300 m x 1e+300 m"),
+        (["mesh:0,0;1e-9,0;0,1e-9"], "the footprint '0,0; 1e-09,0; 0,1e-09' is 1e-09 m x"),
+        (["mesh:0,0;1e200,0;0,1e200"], "footprint point 2 (1e+200, 0) lies farther than 1e+06"),
+        (["FILE", "--scale", "1e250"], "cp.fold at --scale 1e+250 is 1e+250 m x 1e+250 m"),
+        (["FILE", "--size", "1e300x1e300"], "cp.fold fitted into --size is 1e+300 m x"),
+        (["TINY"], "tiny.fold (drawn in m) is 1e-10 m x 1e-10 m"),
+    ],
+)
+def test_pattern_plans_too_small_or_too_large_are_refused(tmp_path, capsys, pattern, message):
+    """A plan under 1 mm (a file in the wrong unit: the solvers' absolute tolerances are met
+    trivially or their derivatives turn NaN, with CasADi's warnings on stderr) or over
+    1000 km (overflow: an OverflowError traceback, NumPy's RuntimeWarnings) is refused in
+    one line before anything is written (the fuzz test found the tiny one)."""
+    square = {"vertices_coords": [[0, 0], [1, 0], [1, 1], [0, 1]], "faces_vertices": [[0, 1, 2, 3]]}
+    (tmp_path / "cp.fold").write_text(json.dumps(square))
+    tiny = [[0, 0], [1e-10, 0], [1e-10, 1e-10], [0, 1e-10]]
+    (tmp_path / "tiny.fold").write_text(
+        json.dumps(square | {"frame_unit": "m", "vertices_coords": tiny})
+    )
+    files = {"FILE": str(tmp_path / "cp.fold"), "TINY": str(tmp_path / "tiny.fold")}
+    spec = [files.get(pattern[0], pattern[0]), *pattern[1:]]
+    out = tmp_path / "out"
+    code = main_code(["optimize", "--surface", "dome", "--pattern", *spec, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert message in err and "Settings.max_coordinate" in err, err
+    assert not out.exists()
+
+
+def test_a_file_name_that_is_not_utf8_is_developed_whole(tmp_path):
+    """``develop`` of ``sq<0xff>.fold`` (bytes that are not UTF-8) wrote ``sq<0xff>.fold``
+    and then failed on the SVG, whose title held the name ("surrogates not allowed"). Now
+    both files are written under that name, their titles show U+FFFD, and the file names
+    are printed as their bytes even where stdout's encoding is strict."""
+    import shutil
+
+    name = os.fsdecode(b"sq\xff")
+    source = tmp_path / f"{name}.fold"
+    shutil.copy(DATA / "fold_examples" / "squaretwist.fold", source)
+    env = {**os.environ, "PYTHONIOENCODING": "utf-8:strict"}
+    argv = ["develop", str(source), "--out", str(tmp_path / "o")]
+    proc = subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *argv],
+        capture_output=True,
+        env=env,
+        check=False,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr == b""
+    assert os.fsencode(tmp_path / "o" / f"{name}.svg") in proc.stdout
+    assert sorted(os.listdir(os.fsencode(tmp_path / "o"))) == [b"sq\xff.fold", b"sq\xff.svg"]
+    svg = (tmp_path / "o" / f"{name}.svg").read_text(encoding="utf-8")
+    assert "sq\ufffd: development" in svg
+    fold = json.loads((tmp_path / "o" / f"{name}.fold").read_text())
+    assert "sq\ufffd: the folded form" in json.dumps(fold, ensure_ascii=False)

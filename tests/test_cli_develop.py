@@ -74,3 +74,13 @@ def test_develop_refuses_to_replace_its_input(miura_file, tmp_path):
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and "would replace the input" in proc.stderr
     assert miura_file.read_bytes() == before
+
+
+def test_deform_refuses_to_replace_its_input(miura_file):
+    """deform writes NAME.fold too: into the input's folder it is refused before any work."""
+    before = miura_file.read_bytes()
+    proc = run_cli("deform", str(miura_file), "--out", str(miura_file.parent))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and "would replace the input" in proc.stderr
+    assert miura_file.read_bytes() == before
+    assert sorted(p.name for p in miura_file.parent.iterdir()) == [miura_file.name]

@@ -245,7 +245,7 @@ def test_miura_quads_are_triangulated_with_joins():
 
 
 def test_miura_diagonals_are_the_shorter_ones():
-    """Ear clipping keeps the fatter triangles: each parallelogram is cut on its short diagonal."""
+    """Delaunay keeps the fatter triangles: each parallelogram is cut on its short diagonal."""
     p = read_fold(miura_dict()).pattern
     quads = np.array(miura_dict()["faces_vertices"])
     d1 = np.linalg.norm(p.coords[quads[:, 0]] - p.coords[quads[:, 2]], axis=1)

@@ -1,5 +1,6 @@
 """`rigidfold study` / `study-report` on damaged or foreign databases, two clients on one
-database, and a scheduler address that is not Dask (issue 17, defects 5, 8 and 10)."""
+database, a scheduler address that is not Dask, and a run whose Dask workers die (issue 17,
+defects 5, 7, 8 and 10)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import time
 
 import pytest
 
-from conftest import run_cli
+from conftest import main_code, run_cli
 from rigidfold.study import Key, Store, StudyConfig
 
 STUDY = ["--surfaces", "1", "--patterns", "1", "--criteria", "s", "--no-deform", "--quiet"]
@@ -165,8 +166,80 @@ def test_a_dask_scheduler_is_reached_through_the_handshake():
     from rigidfold.study.runner import connect
 
     with LocalCluster(
-        n_workers=0, processes=False, protocol="tcp://", dashboard_address=":0"
+        n_workers=0,
+        processes=False,
+        protocol="tcp://",
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # 8787 may be taken
     ) as cluster:
         client = connect(cluster.scheduler_address, 10)
         assert client.scheduler_info()["address"] == cluster.scheduler_address
         client.close()
+
+
+# ------------------------------------------------------------ defect 7: a worker dies on a run
+def test_a_run_whose_worker_dies_is_recorded_as_failed_and_the_others_go_on(
+    tmp_path, monkeypatch, capsys
+):
+    """A real LocalCluster whose worker process ends (os._exit) when it runs seed 1: Dask gives
+    up on that run (KilledWorker; here after the first death, by default after the fourth),
+    the run is stored as failed with the reason, seed 0 is computed, the command is recorded,
+    and the study exits 1 with one summary line; study-report lists the failed run.
+
+    Two runs on two workers: each run has a worker of its own (Dask counts a death against
+    every run its worker held, so a run queued behind seed 1 would be charged too)."""
+    # distributed imported first: leaving the dask.config.set block below would drop its
+    # configuration defaults if it were first imported inside (later clusters then fail)
+    import dask
+    import distributed  # noqa: F401
+
+    from rigidfold.study import runner
+
+    real_run_one = runner.run_one
+
+    def dies_on_seed_1(key, config):  # pickled by value: the workers run this
+        if key.seed == 1:
+            os._exit(3)
+        return real_run_one(key, config)
+
+    monkeypatch.setattr(runner, "run_one", dies_on_seed_1)
+    db = tmp_path / "s.sqlite"
+    args = ["study", "--surfaces", "2", "--patterns", "1", "--criteria", "s", "--no-deform"]
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        code = main_code([*args, "--quiet", "--workers", "2", "--db", str(db)])
+    out, err = capsys.readouterr()
+    assert code == 1, err
+    assert "2 runs done, 0 already in" in out
+    assert "Traceback" not in err
+    assert err.strip().splitlines() == [
+        f"rigidfold: 1 of 2 runs failed and are recorded as errors in {db} (rigidfold "
+        "study-report lists them): 1 x the Dask worker running it died 1 time (KilledWorker: "
+        "killed, out of memory, or a crash in native code)"
+    ]
+    store = Store(db, readonly=True)
+    runs = {r["seed"]: r for r in store.runs()}
+    assert sorted(runs) == [0, 1]
+    assert runs[0]["status"] == "target DOF 1 reached" and runs[0]["n_lock"] is not None
+    assert runs[1]["status"] == (
+        "error: the Dask worker running it died 1 time (KilledWorker: killed, out of memory, "
+        "or a crash in native code)"
+    )
+    assert runs[1]["worker"].startswith("tcp://") and runs[1]["n_lock"] is None
+    [invocation] = store.invocations()
+    assert (invocation["ran"], invocation["outcome"]) == (2, "completed, 1 failed")
+    store.close()
+
+    # resumed: the failed run is not tried again, and nothing fails in this command
+    monkeypatch.setattr(runner, "run_one", real_run_one)
+    assert main_code([*args, "--quiet", "--db", str(db)]) == 0
+    assert "0 runs done, 2 already in" in capsys.readouterr().out
+
+    assert main_code(["study-report", str(db)]) == 0
+    report = capsys.readouterr().out
+    assert "### Runs that failed" in report
+    assert (
+        "| bezier | 1 | 1 | s | False | the Dask worker running it died 1 time (KilledWorker: "
+        "killed, out of memory, or a crash in native code) |" in report
+    )
+    assert "| S | 1 |" in report  # Table 5 counts the one run that finished
+    assert "| completed, 1 failed |" in report

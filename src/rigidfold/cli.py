@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import io
 import json
 import math
 import os
@@ -31,6 +32,7 @@ LOOKAHEAD_HELP = (
     "locked one at an earlier shape (tried only once every other candidate failed, first "
     "together with the nearly flat creases they would lock)"
 )
+EXIT_FAILED = 1  # generate fell short; runs of a study failed
 EXIT_INTERRUPTED = 130
 EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE
 OUT_HELP = "output directory (created if absent)"
@@ -569,7 +571,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     assert verdict is not None  # generate_case ends with writer.finish
     final = "none" if verdict.final_design is None else writer.out / verdict.final_design
     print(f"{verdict.outcome.value.replace('_', ' ')}: {verdict.message}; final design: {final}")
-    return 0 if verdict.outcome is RunOutcome.PASSED else 1
+    return 0 if verdict.outcome is RunOutcome.PASSED else EXIT_FAILED
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
@@ -678,7 +680,14 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 def _cmd_study(args: argparse.Namespace) -> int:
     from rigidfold.progress import StudyProgress
-    from rigidfold.study import StudyConfig, StudyInterrupted, plan, preset, run_study_command
+    from rigidfold.study import (
+        StudyConfig,
+        StudyInterrupted,
+        failure_summary,
+        plan,
+        preset,
+        run_study_command,
+    )
 
     if args.preset is not None:
         keys = preset(args.preset)
@@ -715,6 +724,12 @@ def _cmd_study(args: argparse.Namespace) -> int:
         f"{result['ran']} runs done, {result['skipped']} already in {args.db}, "
         f"{result['total']} in the study, {result['wall_s']:.1f} s"
     )
+    if result["failed"]:
+        print(
+            f"rigidfold: {failure_summary(result['failed'], result['ran'], args.db)}",
+            file=sys.stderr,
+        )
+        return EXIT_FAILED
     return 0
 
 
@@ -750,6 +765,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     shown = os.environ.get(VERBOSE_ENV)
     if args.verbose:  # rigidfold.quiet lets the solvers' output through, here and in workers
         os.environ[VERBOSE_ENV] = "1"
+    if isinstance(sys.stdout, io.TextIOWrapper):
+        # a file name whose bytes are not UTF-8 is printed as those bytes, as ls does, not
+        # refused by the encoder after the files were written
+        sys.stdout.reconfigure(errors="surrogateescape")
     try:
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits

@@ -85,13 +85,13 @@ class Settings:
         error instead of exhausting Python's recursion limit (FOLD data nests 4 levels,
         rigidfold's own files about 10).
     max_coordinate : float
-        Largest |coordinate| in metres accepted in a FOLD file (1000 km): larger values are
-        refused before any geometry is computed on them, where they would overflow.
+        Largest |coordinate| in metres accepted in a FOLD file (1000 km), and largest width or
+        height of a crease pattern's plan: larger values are refused before any geometry is
+        computed on them, where they would overflow.
     triangulation_area_tol : float
-        Ear clipping of the polygon faces of FOLD files: a triangle whose doubled signed area
-        is below this times the squared size of its polygon (the larger side of its bounding
-        box, in the polygon's plane) is not an ear, and a vertex within that of an ear's side
-        lies on it.
+        Triangulation of the polygon faces of FOLD and SVG files: a polygon is refused as
+        degenerate when a triangle of it has a doubled signed area below this times the
+        squared size of the polygon (the larger side of its bounding box, in its plane).
     svg_merge_tol : float
         Crease patterns drawn in SVG (:func:`rigidfold.io.read_svg`): points closer than this
         times the diagonal of the drawing's bounding box are one vertex, a line that ends
@@ -203,6 +203,10 @@ class Settings:
     mesh_angle_cap : float
         A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
         (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    min_pattern_size : float
+        Smallest larger side (metres) of a crease pattern's plan (1 mm): the solvers'
+        tolerances are absolute (``f_tol``, ``dz``), and on a smaller plan (a file read in the
+        wrong unit) problem (6) is met trivially or its derivatives underflow to NaN.
     max_pattern_faces : int
         Largest number of triangles a ``grid:`` or ``mesh:`` pattern may have (a mesh's is
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
@@ -303,6 +307,7 @@ class Settings:
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
+    min_pattern_size: float = 1e-3
     max_pattern_faces: int = 20000
     max_analysis_bytes: int = 8 * 2**30
     # studies

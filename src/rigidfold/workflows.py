@@ -191,6 +191,8 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
     assignments stay as they were (:func:`rigidfold.io.round_trip_dict`)."""
     out_dir = prepare_output_dir(out)
     stem = Path(path).stem
+    # the name in the files' text: bytes of a file name that are not UTF-8 shown as U+FFFD
+    label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     names = [f"{stem}.fold", f"{stem}.svg"] + ([f"{stem}_deform.json"] if deform else [])
     for name in names:  # before any work: a file written must never replace the input
         if (out_dir / name).resolve() == Path(path).resolve():
@@ -204,9 +206,9 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
         out_dir / f"{stem}.fold",
         data.pattern,
         check,
-        title=f"{stem}: the folded form checked, triangulated (metres, z up)",
+        title=f"{label}: the folded form checked, triangulated (metres, z up)",
         metadata={},
-        svg_title=f"{stem}: development",
+        svg_title=f"{label}: development",
         source=data,
     )
     if deform:

@@ -422,7 +422,8 @@ def read_fold(
         The triangulated pattern and what the file says about it. Coordinates are converted
         from the frame's ``frame_unit`` (:data:`UNITS`; none or ``"unit"``: read as metres,
         :attr:`FoldData.unitless`) to metres; 2D coordinates get z = 0; polygon faces are
-        ear-clipped in their best-fit plane, each diagonal an added edge (see
+        triangulated in their best-fit plane (:mod:`rigidfold.mesh.triangulate`: earcut,
+        then constrained Delaunay), each diagonal an added edge (see
         ``rigid_panels``); edges that the file omits are derived from the faces. If the faces
         are consistently oriented but clockwise seen from +z in total, all are reversed. Edges
         assigned ``"J"`` or marked true in ``edges_rigidfold:fixed`` (a list of booleans, one

@@ -1,15 +1,22 @@
-"""Triangulation of polygon faces by ear clipping.
+"""Triangulation of polygon faces: Mapbox's earcut (``mapbox_earcut``), checked, made Delaunay.
 
-Pure functions on arrays and lists. Each polygon is projected onto the plane normal to its
-Newell normal, so faces of a folded sheet (planar or nearly so in 3D) are triangulated in
-their own plane; the added diagonals are returned so that callers can mark them as fixed
-creases.
+Pure functions on arrays. Each polygon is projected onto the plane normal to its Newell
+normal, so faces of a folded sheet (planar or nearly so in 3D) are triangulated in their own
+plane. Earcut (ear clipping on a linked list with z-order hashing: O(n log n) in practice,
+where clipping the best ear of all took O(n^3)) gives the triangles; they are checked to tile
+the polygon (n - 2 triangles of positive area, each side used once and each added diagonal
+twice), since earcut returns what it can of a degenerate or self-intersecting polygon. Earcut
+does not look at the triangles' shapes, so Lawson's flips then turn its diagonals into the
+polygon's constrained Delaunay triangulation (which maximises the smallest angle; a
+parallelogram is cut on its short diagonal). The added diagonals are returned so that
+callers can mark them as fixed creases.
 """
 
 from __future__ import annotations
 
 import math
 
+import mapbox_earcut
 import numpy as np
 
 
@@ -29,7 +36,7 @@ def triangulate_polygons(
     polygons : F lists of int
         Vertex indices of each polygon (at least 3, distinct, in range), in order.
     area_tol : float
-        Relative tolerance of :func:`ear_clip`.
+        Relative tolerance of :func:`triangulate_polygon`.
     name : str
         What messages call the list of polygons, e.g. ``"faces_vertices"``.
 
@@ -53,12 +60,12 @@ def triangulate_polygons(
             triangles.append(polygon)
             continue
         try:
-            local_triangles, local_diagonals = ear_clip(xy, area_tol=area_tol)
+            local_triangles, local_diagonals = triangulate_polygon(xy, area_tol=area_tol)
         except ValueError as exc:
             raise ValueError(f"{name}[{k}]: {exc}") from None
         triangles += [[polygon[i] for i in tri] for tri in local_triangles]
         diagonals += [(polygon[a], polygon[b]) for a, b in local_diagonals]
-    return np.asarray(triangles, dtype=np.int64), diagonals
+    return np.asarray(triangles, dtype=np.int64).reshape(-1, 3), diagonals
 
 
 def orient_up(coords: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -73,12 +80,10 @@ def orient_up(coords: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(triangles[:, ::-1]) if area < 0 else triangles
 
 
-def ear_clip(
+def triangulate_polygon(
     xy: list[list[float]], *, area_tol: float
-) -> tuple[list[tuple[int, ...]], list[tuple[int, int]]]:
-    """Triangulate a simple polygon by ear clipping.
-
-    Of all ears, the one with the largest smallest angle is clipped first.
+) -> tuple[list[list[int]], list[tuple[int, int]]]:
+    """Constrained Delaunay triangulation of a simple polygon (earcut, checked, then flipped).
 
     Parameters
     ----------
@@ -86,49 +91,130 @@ def ear_clip(
         Polygon vertices in order, counter-clockwise, n >= 3.
     area_tol : float
         A triangle with twice its signed area below ``area_tol * size**2`` (size: the larger
-        side of the polygon's bounding box) is not counter-clockwise, and a point within that
-        of a triangle's side lies on it.
+        side of the polygon's bounding box) is degenerate; a diagonal is flipped when the
+        incircle determinant exceeds ``area_tol * size**4`` (no flipping to and fro between
+        the diagonals of four points on a circle).
 
     Returns
     -------
-    triangles : list of n - 2 (i, j, k)
+    triangles : list of n - 2 [i, j, k]
         Local vertex indices, counter-clockwise.
     diagonals : list of n - 3 (i, j)
-        The added interior edges.
+        The added interior edges, i < j.
 
     Raises
     ------
     ValueError
-        When the polygon is degenerate or self-intersecting.
+        When the polygon is degenerate or self-intersecting: earcut's triangles are not
+        n - 2 triangles of twice their area above the tolerance, each side of the polygon
+        used once (in its direction) and each other edge twice (once each way).
     """
+    n = len(xy)
+    found = mapbox_earcut.triangulate_float64(
+        np.asarray(xy, dtype=np.float64).reshape(n, 2), np.array([n], dtype=np.uint32)
+    )
+    tri = found.reshape(-1, 3).tolist()
     size = max(max(p[d] for p in xy) - min(p[d] for p in xy) for d in (0, 1))
-    tol = area_tol * size**2
-    remaining = list(range(len(xy)))
-    triangles: list[tuple[int, ...]] = []
-    diagonals: list[tuple[int, int]] = []
-    while len(remaining) > 3:
-        m = len(remaining)
-        best, best_quality = None, -1.0
-        for k in range(m):
-            a, b, c = remaining[k - 1], remaining[k], remaining[(k + 1) % m]
-            if cross2d(xy[a], xy[b], xy[c]) <= tol:
-                continue
-            others = (i for i in remaining if i not in (a, b, c))
-            if any(in_triangle(xy[i], xy[a], xy[b], xy[c], tol) for i in others):
-                continue
-            quality = min_angle(xy[a], xy[b], xy[c])
-            if quality > best_quality:
-                best, best_quality = k, quality
-        if best is None:
-            raise ValueError("the polygon is degenerate or self-intersecting")
-        a, b, c = remaining[best - 1], remaining[best], remaining[(best + 1) % m]
-        triangles.append((a, b, c))
-        diagonals.append((a, c))
-        remaining.pop(best)
-    if cross2d(*(xy[i] for i in remaining)) <= tol:
+    area_floor = area_tol * size**2
+    doubled = [cross2d(xy[a], xy[b], xy[c]) for a, b, c in tri]
+    if sum(doubled) < 0:  # earcut's own orientation
+        tri, doubled = [t[::-1] for t in tri], [-d for d in doubled]
+    half = {(t[i], t[(i + 1) % 3]): k for k, t in enumerate(tri) for i in range(3)}
+    turns = [(b - a) % n for a, b in half]
+    tiles = (
+        len(tri) == n - 2
+        and min(doubled, default=0.0) > area_floor
+        and len(half) == 3 * len(tri)  # no half-edge twice
+        and turns.count(1) == n  # every side once, in its direction
+        and n - 1 not in turns  # no side the wrong way
+        and all((b, a) in half for (a, b), turn in zip(half, turns, strict=True) if turn != 1)
+    )
+    if not tiles:
         raise ValueError("the polygon is degenerate or self-intersecting")
-    triangles.append(tuple(remaining))
-    return triangles, diagonals
+    tri = delaunay_flips(xy, tri, half, area_floor=area_floor, circle_floor=area_tol * size**4)
+    return tri, [(a, b) for a, b in half if a < b and (b - a) % n not in (1, n - 1)]
+
+
+def delaunay_flips(
+    xy: list[list[float]],
+    tri: list[list[int]],
+    owner: dict[tuple[int, int], int],
+    *,
+    area_floor: float,
+    circle_floor: float,
+) -> list[list[int]]:
+    """Lawson's flips of the diagonals of a polygon's triangulation, towards Delaunay.
+
+    A diagonal shared by (a, b, c) and (b, a, d) is replaced by (c, d) while d lies inside
+    the circle through a, b, c (then the quadrilateral is convex); the polygon's sides stay.
+    At most n log2 n flips are made (Lawson's algorithm needs about n on polygons, and is
+    quadratic at worst): past that the triangulation stays valid, only less well shaped.
+
+    Parameters
+    ----------
+    xy : (n, 2) list of float
+        The polygon, counter-clockwise.
+    tri : list of n - 2 [i, j, k]
+        Counter-clockwise triangles tiling it; changed in place and returned.
+    owner : dict (i, j) -> int
+        The triangle of each of their directed edges; changed in place (its keys stay the
+        directed edges of ``tri``).
+    area_floor, circle_floor : float
+        A flip makes no triangle of twice its area below ``area_floor``, and is made only
+        when the incircle determinant exceeds ``circle_floor``.
+    """
+    n = len(xy)
+    stack = [(a, b) for a, b in owner if a < b and (b - a) % n not in (1, n - 1)]
+    budget = n * max(1, math.ceil(math.log2(n)))
+    while stack and budget:
+        a, b = stack.pop()
+        t1, t2 = owner.get((a, b)), owner.get((b, a))
+        if t1 is None or t2 is None:  # flipped away meanwhile
+            continue
+        c = next(v for v in tri[t1] if v not in (a, b))
+        d = next(v for v in tri[t2] if v not in (a, b))
+        if not (
+            incircle(xy[a], xy[b], xy[c], xy[d]) > circle_floor
+            and cross2d(xy[c], xy[a], xy[d]) > area_floor
+            and cross2d(xy[d], xy[b], xy[c]) > area_floor
+        ):
+            continue
+        tri[t1], tri[t2] = [c, a, d], [d, b, c]
+        del owner[(a, b)], owner[(b, a)]
+        owner.update({(a, d): t1, (d, c): t1, (b, c): t2, (c, d): t2})
+        stack += [
+            (u, v) for u, v in ((a, d), (d, b), (b, c), (c, a)) if (v - u) % n not in (1, n - 1)
+        ]
+        budget -= 1
+    return tri
+
+
+def cross2d(a: list[float], b: list[float], c: list[float]) -> float:
+    """Twice the signed area of the 2D triangle (a, b, c), positive when counter-clockwise.
+
+    a, b, c : (2,) float each (lists: faster than NumPy for single points).
+    """
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def incircle(a: list[float], b: list[float], c: list[float], d: list[float]) -> float:
+    """Positive when d lies inside the circle through the counter-clockwise a, b, c.
+
+    a, b, c, d : (2,) float each; the determinant, of dimension length**4, taken relative to d.
+    """
+    ax, ay, bx, by, cx, cy = (
+        a[0] - d[0],
+        a[1] - d[1],
+        b[0] - d[0],
+        b[1] - d[1],
+        c[0] - d[0],
+        c[1] - d[1],
+    )
+    return (
+        (ax * ax + ay * ay) * (bx * cy - cx * by)
+        + (bx * bx + by * by) * (cx * ay - ax * cy)
+        + (cx * cx + cy * cy) * (ax * by - bx * ay)
+    )
 
 
 def plane_coords(
@@ -137,7 +223,8 @@ def plane_coords(
     """2D coordinates of each polygon's vertices in the plane normal to its Newell normal.
 
     The frame (u, w) of a polygon has u x w = its normal, so the polygon runs
-    counter-clockwise in it; it need not be planar.
+    counter-clockwise in it; it need not be planar. Coordinates are taken relative to the
+    polygon's first vertex.
 
     coords : (V, 3) float; polygons : F lists of vertex indices  ->  F lists of (n, 2) float
     Raises ValueError ``"<name>[k]: the polygon is degenerate (zero area)"``.
@@ -157,31 +244,6 @@ def plane_coords(
     u = np.cross(normal, np.eye(3)[np.argmin(np.abs(normal), axis=1)])
     u /= np.linalg.norm(u, axis=1, keepdims=True)
     w = np.cross(normal, u)
-    p = coords[flat]
+    p = coords[flat] - first
     xy = np.column_stack([np.sum(p * u[owner], axis=1), np.sum(p * w[owner], axis=1)])
     return [part.tolist() for part in np.split(xy, starts[1:])]
-
-
-def cross2d(a: list[float], b: list[float], c: list[float]) -> float:
-    """Twice the signed area of the 2D triangle (a, b, c), positive when counter-clockwise.
-
-    a, b, c : (2,) float each (lists: faster than NumPy for single points).
-    """
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-
-
-def in_triangle(p: list[float], a: list[float], b: list[float], c: list[float], tol: float) -> bool:
-    """True when p lies in the counter-clockwise triangle (a, b, c) or on its sides.
-
-    p, a, b, c : (2,) float each; tol : twice the area by which p may lie outside a side.
-    """
-    return cross2d(a, b, p) >= -tol and cross2d(b, c, p) >= -tol and cross2d(c, a, p) >= -tol
-
-
-def min_angle(a: list[float], b: list[float], c: list[float]) -> float:
-    """Smallest interior angle of the 2D triangle (a, b, c), radians.  a, b, c : (2,) float"""
-    angles = []
-    for p, q, r in ((a, b, c), (b, c, a), (c, a, b)):
-        dot = (q[0] - p[0]) * (r[0] - p[0]) + (q[1] - p[1]) * (r[1] - p[1])
-        angles.append(math.atan2(abs(cross2d(p, q, r)), dot))
-    return min(angles)

@@ -26,7 +26,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.io.fold import read_fold
 from rigidfold.mesh import geometry
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
-from rigidfold.patterns.grids import DEFAULT_SIZE
+from rigidfold.patterns.grids import DEFAULT_SIZE, check_extent
 
 FILE_FORMATS = {".fold": "FOLD", ".svg": "SVG"}
 """File name suffixes read as crease patterns, and their formats."""
@@ -72,7 +72,8 @@ def read_pattern_file(
     rigid_panels : the diagonals added to triangulate polygon faces are fixed creases (the
         faces are rigid flat panels) instead of free ones;
     settings : the tolerances of reading and triangulating (``triangulation_area_tol``,
-        ``degenerate_area``, ``plan_area_tol``).
+        ``degenerate_area``, ``plan_area_tol``) and the plan's bounds (``min_pattern_size``,
+        ``max_coordinate``).
     """
     path = Path(path)
     kind = FILE_FORMATS.get(path.suffix.lower())
@@ -101,7 +102,7 @@ def read_pattern_file(
         )
         faces = orient_up(coords, triangles)
         fixed = np.asarray(diagonals if rigid_panels else [], dtype=np.int64).reshape(-1, 2)
-    xy, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale)
+    xy, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
     _check_unfolded(xy, faces, path, settings)
     source = {
         "file": path.name,
@@ -122,25 +123,30 @@ def _scaled(
     per_unit: float,
     size: tuple[float, float] | None,
     scale: float | None,
+    settings: Settings,
 ) -> tuple[np.ndarray, list[float] | None, float]:
     """(plan in metres, the size fitted into or None, metres per file unit) of a plan read
-    in metres (a drawing without units: one metre per unit)."""
-    width, height = np.ptp(xy, axis=0)
+    in metres (a drawing without units: one metre per unit); the plan's extent is checked
+    (:func:`~rigidfold.patterns.grids.check_extent`) before it is scaled."""
+    width, height = (float(v) for v in np.ptp(xy, axis=0))
     if unit != "unit":
         if size is not None or scale is not None:
             raise ValueError(
                 f"{path} is drawn in {unit} ({width:.6g} m x {height:.6g} m): --size and "
                 "--scale are for drawings without units"
             )
+        check_extent(width, height, f"{path} (drawn in {unit})", settings)
         return xy, None, per_unit
     if size is not None and scale is not None:
         raise ValueError(f"{path}: give --size or --scale, not both")
     if scale is not None:
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"a scale is metres per drawing unit, > 0, got {scale!r}")
+        check_extent(width * scale, height * scale, f"{path} at --scale {scale:g}", settings)
         return xy * scale, None, float(scale)
     box = DEFAULT_SIZE if size is None else size
     factor = float(min(box[0] / width, box[1] / height))
+    check_extent(width * factor, height * factor, f"{path} fitted into --size", settings)
     return xy * factor, list(box), factor
 
 

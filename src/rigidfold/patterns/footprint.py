@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
-from rigidfold.patterns.grids import counter_clockwise
+from rigidfold.patterns.grids import check_extent, counter_clockwise
 
 _PAIR = re.compile(r"^\s*(\S+?)\s*(?:,|\s)\s*(\S+)\s*$")
 
@@ -68,7 +68,8 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
     """The polygon (N, 2) counter-clockwise (a clockwise one reversed, its first point kept
     first), or a one-line ValueError saying what is wrong.
 
-    Refused: fewer than 3 points, non-finite coordinates, a repeated point, zero area and a
+    Refused: fewer than 3 points, non-finite coordinates, a plan too small or too large
+    (:func:`~rigidfold.patterns.grids.check_extent`), a repeated point, zero area and a
     self-intersecting outline (sides that cross or touch anywhere but at shared corners);
     zero area is a convex hull smaller than ``settings.degenerate_area`` times the squared
     larger side of the bounding box.
@@ -81,6 +82,15 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
     if not np.isfinite(xy).all():
         bad = int(np.flatnonzero(~np.isfinite(xy).all(axis=1))[0])
         raise ValueError(f"footprint point {bad + 1} is not finite: {_point(xy[bad])}")
+    far = np.abs(xy).max(axis=1) > settings.max_coordinate  # before any sum could overflow
+    if far.any():
+        bad = int(np.argmax(far))
+        raise ValueError(
+            f"footprint point {bad + 1} {_point(xy[bad])} lies farther than "
+            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+        )
+    width, height = (float(v) for v in np.ptp(xy, axis=0))
+    check_extent(width, height, f"the footprint {_points(xy)}", settings)
     unique, counts = np.unique(xy, axis=0, return_counts=True)
     if (counts > 1).any():
         again = unique[counts > 1][0]

@@ -14,12 +14,27 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import Delaunay
 
+from rigidfold.config import DEFAULTS, Settings
+
 DIAGONALS = ("centre", "parallel", "alternate")
 """How :func:`grid` splits each rectangle: see its docstring."""
 
 DEFAULT_SIZE = (3.0, 3.0)
 """Width and height (metres) of a ``grid:`` pattern without a size, and the box a drawing
 without units is fitted into: the paper's square."""
+
+
+def check_extent(width: float, height: float, what: str, settings: Settings = DEFAULTS) -> None:
+    """A one-line ValueError naming ``what`` unless a plan of ``width`` x ``height`` metres
+    (its bounding box) is from ``settings.min_pattern_size`` to ``settings.max_coordinate``
+    across (its larger side)."""
+    across = max(width, height)
+    if not settings.min_pattern_size <= across <= settings.max_coordinate:
+        raise ValueError(
+            f"{what} is {width:.3g} m x {height:.3g} m: a crease pattern is "
+            f"{settings.min_pattern_size:g} m to {settings.max_coordinate:g} m across "
+            "(Settings.min_pattern_size, Settings.max_coordinate)"
+        )
 
 
 def grid(

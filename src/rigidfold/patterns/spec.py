@@ -19,6 +19,7 @@ from rigidfold.patterns.footprint import default_edge_length, footprint_mesh, re
 from rigidfold.patterns.grids import (
     DEFAULT_SIZE,
     DIAGONALS,
+    check_extent,
     grid,
     grid11,
     pattern1,
@@ -140,6 +141,7 @@ def parse_pattern(
                 f"{settings.max_pattern_faces}"
             )
         width, height = parse_size(size)
+        check_extent(width, height, f"pattern {text!r}", settings)
         diagonals = DIAGONALS[0] if diagonals is None else diagonals
         return Plan(text, *grid(nx, ny, width, height, diagonals), diagonals=diagonals)
     if colon and kind == "mesh":

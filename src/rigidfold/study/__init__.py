@@ -5,6 +5,7 @@ from rigidfold.study.session import (
     STUDY_DEFAULTS,
     StudyInterrupted,
     StudyPlan,
+    failure_summary,
     run_study_command,
 )
 from rigidfold.study.store import Key, Store, run_stop
@@ -17,6 +18,7 @@ __all__ = [
     "StudyConfig",
     "StudyInterrupted",
     "StudyPlan",
+    "failure_summary",
     "plan",
     "preset",
     "run_one",

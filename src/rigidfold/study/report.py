@@ -19,7 +19,7 @@ from rigidfold.io import atomic_write, prepare_output_dir
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import CITATION, TABLE_7_8_ROWS, TABLES_5_6, TABLES_7_8
 from rigidfold.study.runner import PRESETS
-from rigidfold.study.store import Store, run_stop
+from rigidfold.study.store import ERROR_PREFIX, Store, run_stop
 
 ORDER = tuple(sorted(CRITERIA, key=[c for _, c in TABLES_5_6].index))
 """The criteria in the order of the rows of the paper's Tables 5 and 6."""
@@ -324,6 +324,20 @@ def lock_causes(store: Store) -> list[dict]:
     return _per_run_rows(counts, fields)
 
 
+def failed_runs(store: Store) -> list[dict]:
+    """The runs stored with an error (status "error: <message>"), ordered by key: study,
+    seed, pattern, criterion, symmetric (bool) and ``error`` (the message)."""
+    return [
+        {
+            **{k: r[k] for k in ("study", "seed", "pattern", "criterion")},
+            "symmetric": bool(r["symmetric"]),
+            "error": r["status"].removeprefix(ERROR_PREFIX),
+        }
+        for r in store.runs()
+        if run_stop(r["status"]) is None
+    ]
+
+
 def tables_7_8(store: Store) -> list[dict]:
     """Per preset run (dome / hp, with / without symmetry): the rows of Tables 7 and 8."""
     out = []
@@ -447,6 +461,17 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
         found = compute(store)
         if found:
             lines += write(found)
+    lost = failed_runs(store)
+    if lost:
+        lines += _section(
+            "Runs that failed",
+            ["study", "seed", "pattern", "criterion", "symmetric", "why"],
+            [
+                [*(r[k] for k in ("study", "seed", "pattern", "criterion", "symmetric")), why]
+                for r in lost
+                for why in [r["error"].replace("|", "\\|")]  # inside a Markdown table cell
+            ],
+        )
     t78 = tables_7_8(store)
     for name, number in (("dome", "Table 7"), ("hp", "Table 8")):
         runs = [r for r in t78 if r["preset"] == name]
@@ -530,6 +555,11 @@ SECTION_TEXT = {
     "Fold angles of the locked creases": (
         "Locked creases of every lock by |fold angle| at the locked shape (degrees): nearly "
         "flat creases or real folds."
+    ),
+    "Runs that failed": (
+        "Runs stored with an error instead of results (no numbers of theirs in the tables): a "
+        "configuration that cannot run, or a run whose Dask workers died every time it was "
+        "tried. A later `rigidfold study` does not run them again."
     ),
     "Why the locks happen": (
         "Each lock against the first-order forecast at the shape before the fix: every locked "

@@ -3,7 +3,9 @@
 Each run (surface seed, pattern, criterion) is one Dask task executed in a worker process;
 the client process alone writes the database, one transaction per finished run. Runs already
 in the database are skipped, so re-running the same command resumes a killed study. Dask
-reschedules the task of a worker that dies. Dask is imported only here.
+reschedules the task of a worker that dies; a run whose workers die every time (Dask's
+``KilledWorker``: killed, out of memory, a crash in native code) is recorded as failed, like
+a run that could not run, and the study goes on. Dask is imported only here.
 """
 
 from __future__ import annotations
@@ -183,6 +185,27 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
     return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in run.attempts]
 
 
+def lost_run(exc: Exception) -> dict:
+    """The row of a run whose Dask workers all died while running it (``exc``: Dask's
+    ``KilledWorker``), recorded as an error like a run that could not run: the status
+    "error: <message>", and the last worker's address."""
+    from rigidfold import __version__
+
+    deaths = getattr(exc, "allowed_failures", None)
+    times = "repeatedly" if deaths is None else f"{deaths + 1} time{'s' if deaths else ''}"
+    message = (
+        f"the Dask worker running it died {times} (KilledWorker: killed, out of memory, or a "
+        "crash in native code)"
+    )
+    worker = getattr(getattr(exc, "last_worker", None), "address", None)
+    return {
+        "status": ERROR_PREFIX + message,
+        "error": message,
+        "version": __version__,
+        "worker": worker,
+    }
+
+
 CONNECT_TIMEOUT_S = 20.0
 """Seconds that a Dask scheduler given by address has to answer (``--connect-timeout``)."""
 
@@ -224,17 +247,21 @@ def run_study(
     connect_timeout: float = CONNECT_TIMEOUT_S,
     on_done: Callable[[Key, dict, int, int], None] | None = None,
 ) -> dict:
-    """Run every key not yet in ``store``; returns counts, the wall time and the part of it
-    spent starting (or connecting to) the Dask cluster (``startup_s``).
+    """Run every key not yet in ``store``; returns counts, the wall time, the part of it
+    spent starting (or connecting to) the Dask cluster (``startup_s``) and the runs of this
+    call that failed (``failed``: (Key, message) each, in the order they ended).
 
     On ``workers`` local processes, or on the cluster of the Dask ``scheduler`` (an address),
-    which must answer within ``connect_timeout`` seconds (:func:`connect`).
+    which must answer within ``connect_timeout`` seconds (:func:`connect`). A run fails when
+    it cannot run (a ValueError, :func:`run_one`) or when its Dask workers die every time it
+    is tried (:func:`lost_run`); either is stored with its message and the others go on.
 
     on_done(key, run_row, finished, total) is called in the client after each stored run.
     """
     import logging
 
     from dask.distributed import Client, LocalCluster, as_completed
+    from distributed import KilledWorker
 
     if workers < 1:
         raise ValueError(f"--workers must be >= 1, got {workers}")
@@ -242,17 +269,26 @@ def run_study(
     todo = [k for k in keys if k not in done]
     total, finished = len(keys), len(keys) - len(todo)
     t0 = time.perf_counter()
+    failed: list[tuple[Key, str]] = []
     if not todo:
-        return {"total": total, "ran": 0, "skipped": finished, "wall_s": 0.0, "startup_s": 0.0}
+        return {
+            "total": total,
+            "ran": 0,
+            "skipped": finished,
+            "wall_s": 0.0,
+            "startup_s": 0.0,
+            "failed": failed,
+        }
     cluster = None
     if scheduler is None:
         cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
-            # no fixed port: None would still serve Dask's HTTP routes on :8787 and warn
-            # when another cluster (another study) holds it
-            dashboard_address=":0",
+            dashboard_address=None,
+            # the scheduler's HTTP server (health checks) on a free local port: its default,
+            # 8787, warns when another cluster on the machine holds it
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
             silence_logs=logging.ERROR,
         )
         client = Client(cluster)
@@ -260,13 +296,19 @@ def run_study(
         client = connect(scheduler, connect_timeout)
     startup = time.perf_counter() - t0
     try:
+        named = {f"run-{i}-{k.row()}": k for i, k in enumerate(todo)}
         futures = [
-            client.submit(run_one, k, config.as_dict(), pure=False, key=f"run-{i}-{k.row()}")
-            for i, k in enumerate(todo)
+            client.submit(run_one, k, config.as_dict(), pure=False, key=name)
+            for name, k in named.items()
         ]
         for future in as_completed(futures):
-            key, row, attempts = future.result()
+            try:
+                key, row, attempts = future.result()
+            except KilledWorker as exc:
+                key, row, attempts = named[future.key], lost_run(exc), []
             store.add(key, row, attempts)
+            if row.get("error"):
+                failed.append((key, row["error"]))
             finished += 1
             if on_done:
                 on_done(key, row, finished, total)
@@ -281,4 +323,5 @@ def run_study(
         "skipped": total - len(todo),
         "wall_s": time.perf_counter() - t0,
         "startup_s": startup,
+        "failed": failed,
     }

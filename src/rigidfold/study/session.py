@@ -3,12 +3,14 @@
 :func:`run_study_command` is the library side of ``rigidfold study``: it opens (or creates)
 the database, refusing one of another configuration untouched, runs every planned run not
 yet in it on Dask (:func:`rigidfold.study.runner.run_study`), and records the command in the
-``invocations`` table whether it completed or was interrupted.
+``invocations`` table whether it completed or was interrupted. :func:`failure_summary` is the
+line that tells which runs of the command failed.
 """
 
 from __future__ import annotations
 
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -60,7 +62,8 @@ def run_study_command(
     argv: Sequence[str] = (),
     on_done: Callable[[bool, int, int], None] | None = None,
 ) -> dict:
-    """Run the study ``keys`` into the database ``db``; returns :func:`run_study`'s counts.
+    """Run the study ``keys`` into the database ``db``; returns :func:`run_study`'s counts
+    (``failed``: the runs of this command that failed, recorded as errors in the database).
 
     on_done(failed, finished, total) after each stored run (``failed``: the run ended in an
     error, recorded in the database). A KeyboardInterrupt is recorded and re-raised as
@@ -128,5 +131,18 @@ def _run(
         finished = len(store.done() & planned)
         record("interrupted", finished - before)
         raise StudyInterrupted(finished) from None
-    record("completed", result["ran"])
+    failed = len(result["failed"])
+    record(f"completed, {failed} failed" if failed else "completed", result["ran"])
     return result
+
+
+def failure_summary(failed: Sequence[tuple[Key, str]], ran: int, db: str | Path) -> str:
+    """One line: how many of the ``ran`` runs of a command failed, and why (the messages
+    with their counts, most frequent first; the first three)."""
+    reasons = Counter(message for _, message in failed).most_common()
+    shown = "; ".join(f"{n} x {message}" for message, n in reasons[:3])
+    more = f"; and {len(reasons) - 3} other reasons" if len(reasons) > 3 else ""
+    return (
+        f"{len(failed)} of {ran} runs failed and are recorded as errors in {db} "
+        f"(rigidfold study-report lists them): {shown}{more}"
+    )
