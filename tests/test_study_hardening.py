@@ -243,3 +243,39 @@ def test_a_run_whose_worker_dies_is_recorded_as_failed_and_the_others_go_on(
     )
     assert "| S | 1 |" in report  # Table 5 counts the one run that finished
     assert "| completed, 1 failed |" in report
+
+
+def test_a_run_that_raises_unexpectedly_is_recorded_as_failed_and_the_others_go_on(
+    tmp_path, monkeypatch, capsys
+):
+    """A defect in one run (an exception other than bad input) does not end the study in a
+    traceback: the run is stored as failed with the exception's type and message, the other
+    runs are computed, and the command exits 1 with one summary line."""
+    from rigidfold.study import runner
+
+    real_run_one = runner.run_one
+
+    def fails_on_seed_1(key, config):  # pickled by value: the worker runs this
+        if key.seed == 1:
+            raise RuntimeError("singular matrix\nsecond line")
+        return real_run_one(key, config)
+
+    monkeypatch.setattr(runner, "run_one", fails_on_seed_1)
+    db = tmp_path / "s.sqlite"
+    args = ["study", "--surfaces", "2", "--patterns", "1", "--criteria", "s", "--no-deform"]
+    code = main_code([*args, "--quiet", "--workers", "1", "--db", str(db)])
+    out, err = capsys.readouterr()
+    assert code == 1, err
+    assert "2 runs done, 0 already in" in out and "Traceback" not in err
+    message = (
+        "unexpected RuntimeError: singular matrix (a defect: please report it with the run's key)"
+    )
+    assert err.strip().splitlines() == [
+        f"rigidfold: 1 of 2 runs failed and are recorded as errors in {db} (rigidfold "
+        f"study-report lists them): 1 x {message}"
+    ]
+    store = Store(db, readonly=True)
+    runs = {r["seed"]: r for r in store.runs()}
+    assert runs[0]["status"] == "target DOF 1 reached"
+    assert runs[1]["status"] == "error: " + message
+    store.close()

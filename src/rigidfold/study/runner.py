@@ -5,7 +5,8 @@ the client process alone writes the database, one transaction per finished run. 
 in the database are skipped, so re-running the same command resumes a killed study. Dask
 reschedules the task of a worker that dies; a run whose workers die every time (Dask's
 ``KilledWorker``: killed, out of memory, a crash in native code) is recorded as failed, like
-a run that could not run, and the study goes on. Dask is imported only here.
+a run that could not run, and the study goes on; so is a run that ends in an unexpected
+exception (a defect, named with its type and message). Dask is imported only here.
 """
 
 from __future__ import annotations
@@ -206,6 +207,22 @@ def lost_run(exc: Exception) -> dict:
     }
 
 
+def crashed_run(exc: Exception) -> dict:
+    """The row of a run that ended in an unexpected exception ``exc`` (a defect of rigidfold
+    or of a library it calls, not bad input, which :func:`run_one` records itself): recorded
+    as an error with the exception's type and message, so that the study goes on and its
+    summary names the failure instead of ending in a traceback."""
+    from rigidfold import __version__
+
+    text = str(exc).strip().splitlines()
+    message = (
+        f"unexpected {type(exc).__name__}"
+        + (f": {text[0]}" if text else "")
+        + " (a defect: please report it with the run's key)"
+    )
+    return {"status": ERROR_PREFIX + message, "error": message, "version": __version__}
+
+
 CONNECT_TIMEOUT_S = 20.0
 """Seconds that a Dask scheduler given by address has to answer (``--connect-timeout``)."""
 
@@ -306,6 +323,8 @@ def run_study(
                 key, row, attempts = future.result()
             except KilledWorker as exc:
                 key, row, attempts = named[future.key], lost_run(exc), []
+            except Exception as exc:  # a defect in one run: recorded, the others go on
+                key, row, attempts = named[future.key], crashed_run(exc), []
             store.add(key, row, attempts)
             if row.get("error"):
                 failed.append((key, row["error"]))
