@@ -52,6 +52,50 @@ def test_linear_map_satisfies_constraints(surface):
         assert dist.max() < 1e-12
 
 
+def test_linear_map_is_sparse_and_built_block_by_block(monkeypatch):
+    """(7)-(9) are eliminated one small block (a vertex and its mirror images) at a time: T is
+    a sparse matrix with a few entries per coordinate, and no dense matrix of the pattern's
+    size is factorised."""
+    import scipy.linalg
+    import scipy.sparse as sp
+
+    shapes = []
+    qr = scipy.linalg.qr
+
+    def recording_qr(matrix, *args, **kwargs):
+        shapes.append(matrix.shape)
+        return qr(matrix, *args, **kwargs)
+
+    monkeypatch.setattr(scipy.linalg, "qr", recording_qr)
+    for surface in ("dome", "hp"):
+        case = make_case(surface, "grid:21x21", size="3x3", symmetric=True)
+        lmap = build_linear_map(case.pattern, case.planes)
+        assert sp.issparse(lmap.T) and lmap.T.shape == (3 * 441, lmap.n_variables)
+        assert lmap.T.nnz <= 3 * lmap.T.shape[0]
+        assert max(max(shape) for shape in shapes) <= 24  # 4 mirror images x 3 coordinates x 2
+        shapes.clear()
+        rng = np.random.default_rng(0)
+        coords = lmap.expand(lmap.restrict(case.pattern.coords) + rng.standard_normal(318))
+        assert lmap.residual(coords) < 1e-12
+
+
+def test_derivatives_handed_to_ipopt_have_o_of_e_nonzeros():
+    """The constraint Jacobian and the Hessian of the Lagrangian IPOPT gets keep their true
+    sparsity: a bounded number of nonzeros per row, so nnz grows like the number of edges."""
+    per_edge = []
+    for n in (7, 11, 21):
+        case = make_case("dome", f"grid:{n}x{n}", size="3x3")
+        nlpsol = case.problem().solver("ipopt").nlpsol
+        jac = nlpsol.get_function("nlp_jac_g").sparsity_out(1)
+        hess = nlpsol.get_function("nlp_hess_l").sparsity_out(0)  # upper triangle
+        assert max(np.diff(jac.T.colind())) <= 9  # an angle: three vertices
+        assert max(np.diff((hess + hess.T).colind())) <= 100  # two rings of vertices
+        per_edge.append((jac.nnz() / case.pattern.n_edges, hess.nnz() / case.pattern.n_edges))
+    (j7, h7), (j11, h11), (j21, h21) = per_edge
+    assert j21 < 1.1 * j11 and h21 < 1.2 * h11  # the boundary's share shrinks
+    assert j21 < 1.3 * j7 and h21 < 1.5 * h7
+
+
 def test_boundary_vertices_stay_on_their_sides(bezier_problem):
     lmap, shape = bezier_problem.map, bezier_problem.pattern
     rng = np.random.default_rng(1)

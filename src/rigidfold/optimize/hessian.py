@@ -157,18 +157,41 @@ def _pairs(T: sp.csr_matrix, I: np.ndarray, J: np.ndarray):
 
     returns : entry (N,), a (N,), b (N,), weight (N,)
     """
-    TI, TJ = T[I], T[J]
-    cI, cJ = np.diff(TI.indptr), np.diff(TJ.indptr)
+    count = np.diff(T.indptr)
+    cI, cJ = count[I], count[J]
     total = cI * cJ
     entry = np.repeat(np.arange(len(I)), total)
     start = np.repeat(np.cumsum(total) - total, total)
     pos = np.arange(total.sum()) - start
     i_off, j_off = pos // cJ[entry], pos % cJ[entry]
-    ka, kb = TI.indptr[entry] + i_off, TJ.indptr[entry] + j_off
-    a, b = TI.indices[ka], TJ.indices[kb]
-    weight = TI.data[ka] * TJ.data[kb]
+    ka, kb = T.indptr[I][entry] + i_off, T.indptr[J][entry] + j_off
+    a, b = T.indices[ka], T.indices[kb]
+    weight = T.data[ka] * T.data[kb]
     keep = a <= b
     return entry[keep], a[keep], b[keep], weight[keep]
+
+
+def _unique(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """np.unique(keys, return_inverse=True) of int64 keys, by one sort.  -> (unique, slot)"""
+    order = np.argsort(keys)
+    ordered = keys[order]
+    new = np.empty(len(keys), dtype=bool)
+    new[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=new[1:])
+    slot = np.empty(len(keys), dtype=np.int64)
+    slot[order] = np.cumsum(new) - 1
+    return ordered[new], slot
+
+
+def _upper_pairs(sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair (p, q), p <= q, within consecutive groups of ``sizes`` items, in row-major
+    order group by group (``np.triu_indices`` of each group, offset by its start)."""
+    group_start = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    item = np.arange(sizes.sum())
+    run = np.repeat(sizes, sizes) - (item - group_start)  # items from this one to group end
+    p = np.repeat(item, run)
+    q = p + np.arange(run.sum()) - np.repeat(np.cumsum(run) - run, run)
+    return p, q
 
 
 class ClosedFormHessian:
@@ -227,31 +250,26 @@ class ClosedFormHessian:
         self.G = sp.csr_matrix(
             (g_w, (g_slot, g_local)), shape=(len(uniq), self.n_theta * 9)
         )  # G.data of grad d_v (inner rows, xi columns), up to sign
-        G_row, G_col = uniq // n, uniq % n
-        order = np.argsort(G_row, kind="stable")
-        starts = np.searchsorted(G_row[order], np.arange(self.n_inner + 1))
-        pp, qq = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
-        for r in range(self.n_inner):
-            members = order[starts[r] : starts[r + 1]]
-            members = members[np.argsort(G_col[members])]
-            i, j = np.triu_indices(len(members))
-            pp.append(members[i])
-            qq.append(members[j])
-        self.gn_p, self.gn_q = np.concatenate(pp), np.concatenate(qq)
+        G_row, G_col = uniq // n, uniq % n  # sorted by row, then column
+        self.gn_p, self.gn_q = _upper_pairs(np.bincount(G_row, minlength=self.n_inner))
         gn_a, gn_b = G_col[self.gn_p], G_col[self.gn_q]
         # the fixed upper-triangle sparsity: union of everything, column-major
-        keys = np.concatenate([b * n + a for _, a, b, _ in blocks] + [gn_b * n + gn_a])
-        self.keys = np.unique(keys)
-        cols, rows = self.keys // n, self.keys % n
+        keys, slots = _unique(
+            np.concatenate([b * n + a for _, a, b, _ in blocks] + [gn_b * n + gn_a])
+        )
+        cols, rows = keys // n, keys % n
         colptr = np.searchsorted(cols, np.arange(n + 1))
         self.sparsity = ca.Sparsity(n, n, colptr.tolist(), rows.tolist())
-        nnz = len(self.keys)
+        nnz = len(keys)
         self.R = []
-        for (entry, a, b, weight), idx in zip(blocks, (angle_P, edge_P, dz_P), strict=True):
-            slot = np.searchsorted(self.keys, b * n + a)
+        ends = np.cumsum([len(a) for _, a, _, _ in blocks])
+        for (entry, _, _, weight), idx, end in zip(
+            blocks, (angle_P, edge_P, dz_P), ends, strict=True
+        ):
             size = idx.shape[0] * idx.shape[1] ** 2
+            slot = slots[end - len(entry) : end]
             self.R.append(sp.csr_matrix((weight, (slot, entry)), shape=(nnz, size)))
-        self.gn_slot = np.searchsorted(self.keys, gn_b * n + gn_a)
+        self.gn_slot = slots[ends[-1] :]
         # angle Hessians and gradients are computed in (u, v); fold (a, b, c) -> (u, v) in
         eye = sp.identity(self.n_theta, format="csr")
         self.R[0] = (self.R[0] @ sp.kron(eye, np.kron(_B_ANGLE.T, _B_ANGLE.T))).tocsr()

@@ -7,6 +7,7 @@ kept on the problem, so IPOPT is set up once however many solves follow.
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Mapping, Sequence
 from functools import partial
@@ -64,8 +65,8 @@ class FormFindingProblem:
     objective : ca.Function (xi, w) -> (F, F1, F2)
     objective_gradient : ca.Function (xi, w) -> (F, dF (n,))
     constraints : ca.Function (xi, w) -> g (m,)
+        Built on first use (only SLSQP needs it).
     constraint_jacobian : ca.Function (xi, w) -> (g (m,), dg (m, n))
-    angles : ca.Function xi -> theta (3F,)
     build_time : float
         Seconds spent building the model (and IPOPT with ``build_ipopt``).
     """
@@ -91,8 +92,6 @@ class FormFindingProblem:
         self.objective = ca.Function(
             "F", [xi, w], [nlp.f, nlp.f1, nlp.f2], names, ["F", "F1", "F2"]
         )
-        self.constraints = ca.Function("g", [xi, w], [nlp.g], names, ["g"])
-        self.angles = ca.Function("theta", [xi], [nlp.theta], ["xi"], ["theta"])
         self.objective_gradient = ca.Function(
             "dF", [xi, w], [nlp.f, ca.gradient(nlp.f, xi)], names, ["F", "dF"]
         )
@@ -103,6 +102,10 @@ class FormFindingProblem:
         if build_ipopt:
             self.solver("ipopt")
         self.build_time = time.perf_counter() - t0
+
+    @functools.cached_property
+    def constraints(self) -> ca.Function:
+        return ca.Function("g", [self.nlp.x, self.nlp.p], [self.nlp.g], ["xi", "w"], ["g"])
 
     def derivative_functions(self) -> dict[str, ca.Function]:
         """Exact derivatives of each part of (6), for checks and for callers that need them.

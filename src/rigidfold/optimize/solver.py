@@ -68,8 +68,10 @@ class SolverProblem(Protocol):
     nlp: NLP
     objective: ca.Function
     objective_gradient: ca.Function
-    constraints: ca.Function
     constraint_jacobian: ca.Function
+
+    @property
+    def constraints(self) -> ca.Function: ...
 
 
 class Solver(Protocol):

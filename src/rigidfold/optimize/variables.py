@@ -10,18 +10,21 @@ constraints of the paper are assembled into one sparse system ``Gamma P = c`` (E
 A rank-revealing (column-pivoted) QR factorisation of Gamma picks ``r = rank(Gamma)``
 dependent coordinates whose columns are well conditioned; the remaining ``3V - r``
 coordinates are the independent variables ``xi`` (Eq. 11), and ``P = T xi + t`` with a sparse
-``T``. Nothing is specific to a pattern: any disc with straight plan sides and any set of
-vertical mirror planes works.
+``T``. Gamma couples only a vertex with its mirror images, so the QR is done block by block
+(a few coordinates each) and the cost grows linearly with the number of vertices. Nothing
+is specific to a pattern: any disc with straight plan sides and any set of vertical mirror
+planes works.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
@@ -117,42 +120,107 @@ def build_linear_map(
 ) -> LinearMap:
     """Eliminate (7)-(9) from the pattern's coordinates (Eqs. 10-11).
 
+    Each constraint involves the coordinates of one vertex and its mirror images, so Gamma is
+    block diagonal after permuting its rows and columns: one small block per set of
+    coordinates the constraints couple (a corner, a boundary vertex, the orbit of a vertex
+    under the mirror planes). Each block gets its own column-pivoted QR, with the rank
+    threshold relative to the largest column norm of all of Gamma, as one QR of the whole
+    Gamma would (the blocks are orthogonal to each other, so their pivot choices do not
+    interact); no dense matrix larger than a block is formed. A coordinate in no constraint
+    is independent.
+
     Raises ValueError when the constraints contradict each other (e.g. a corner's height
     breaks the symmetry).
     """
     gamma, c = assemble_constraints(pattern, planes, settings)
-    n = gamma.shape[1]
-    if gamma.shape[0] == 0:
+    m, n = gamma.shape
+    if m == 0:
         return LinearMap(sp.identity(n, format="csr"), np.zeros(n), np.arange(n), gamma, c)
+    largest = float(np.sqrt(np.asarray(gamma.multiply(gamma).sum(axis=0))).max())
+    dep_rows, dep_cols, dep_vals = [], [], []
+    t = np.zeros(n)
+    independent = np.ones(n, dtype=bool)
     with one_blas_thread():  # the basis of the free variables sets the optimiser's path
-        q, r, piv = scipy.linalg.qr(gamma.toarray(), mode="economic", pivoting=True)
+        for rows, cols, block in _blocks(gamma):
+            dep, const, ind, coef = _eliminate_block(block, c[rows], largest, settings)
+            independent[cols[dep]] = False
+            t[cols[dep]] = const
+            dr, dc = np.nonzero(coef)
+            dep_rows.append(cols[dep][dr])
+            dep_cols.append(cols[ind][dc])
+            dep_vals.append(coef[dr, dc])
+    ind_all = np.flatnonzero(independent)
+    column_of = np.full(n, -1)
+    column_of[ind_all] = np.arange(len(ind_all))
+    T = sp.coo_matrix(
+        (
+            np.concatenate([np.ones(len(ind_all)), *dep_vals]),
+            (
+                np.concatenate([ind_all, *dep_rows]),
+                column_of[np.concatenate([ind_all, *dep_cols])],
+            ),
+        ),
+        shape=(n, len(ind_all)),
+    )
+    return LinearMap(T.tocsr(), t, ind_all.astype(np.int64), gamma, c)
+
+
+def _blocks(gamma: sp.csr_matrix) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The diagonal blocks of Gamma (m, 3V): the sets of rows and columns coupled by its entries.
+
+    yields : rows (k,) and cols (l,), both ascending, and the dense block (k, l)
+    ``Gamma[rows][:, cols]``, for every block with at least one row.
+    """
+    m, n = gamma.shape
+    link = sp.bmat([[None, gamma], [gamma.T, None]], format="csr")  # rows, then columns
+    n_blocks, label = connected_components(link, directed=False)
+    row_label, col_label = label[:m], label[m:]
+    row_order = np.argsort(row_label, kind="stable")
+    col_order = np.argsort(col_label, kind="stable")
+    row_start = np.searchsorted(row_label[row_order], np.arange(n_blocks + 1))
+    col_start = np.searchsorted(col_label[col_order], np.arange(n_blocks + 1))
+    local_row = np.empty(m, dtype=np.int64)
+    local_row[row_order] = np.arange(m) - row_start[row_label[row_order]]
+    local_col = np.empty(n, dtype=np.int64)
+    local_col[col_order] = np.arange(n) - col_start[col_label[col_order]]
+    coo = gamma.tocoo()
+    entry_block = row_label[coo.row]
+    entries = np.argsort(entry_block, kind="stable")
+    entry_start = np.searchsorted(entry_block[entries], np.arange(n_blocks + 1))
+    for b in np.flatnonzero(np.diff(row_start)):
+        rows = row_order[row_start[b] : row_start[b + 1]]
+        cols = col_order[col_start[b] : col_start[b + 1]]
+        block = np.zeros((len(rows), len(cols)))
+        e = entries[entry_start[b] : entry_start[b + 1]]
+        block[local_row[coo.row[e]], local_col[coo.col[e]]] = coo.data[e]
+        yield rows, cols, block
+
+
+def _eliminate_block(
+    block: np.ndarray, rhs: np.ndarray, largest: float, settings: Settings
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Dependent coordinates of one block of Gamma P = c from a column-pivoted QR.
+
+    block : (k, l) dense block of Gamma; rhs : (k,) its part of c; largest : the largest
+    column norm of Gamma (the rank threshold is relative to it).
+    returns : dep (r,) and ind (l - r,) local columns, const (r,) and coef (r, l - r) with
+    ``P[dep] = coef @ P[ind] + const``.
+    """
+    q, r, piv = scipy.linalg.qr(block, pivoting=True)  # full q: all of rhs is checked
     diag = np.abs(np.diag(r))
-    rank = int(np.sum(diag > settings.linear_rank_tol * diag[0]))
-    qc = q.T @ c
+    rank = int(np.sum(diag > settings.linear_rank_tol * largest))
+    qc = q.T @ rhs
     if np.abs(qc[rank:]).max(initial=0.0) > settings.constraint_tol:
         raise ValueError(
             "the boundary, corner and symmetry constraints (7)-(9) contradict each other for "
             "this shape (is the target surface symmetric about the chosen planes?)"
         )
     dep, ind = piv[:rank], np.sort(piv[rank:])
-    r11 = r[:rank, :rank]
-    # columns of r in pivot order; independent columns re-sorted to match `ind`
-    col_of = np.empty(n, dtype=np.int64)
-    col_of[piv] = np.arange(n)
-    r12 = r[:rank, col_of[ind]]
+    col_of = np.empty(block.shape[1], dtype=np.int64)
+    col_of[piv] = np.arange(block.shape[1])
     solve = scipy.linalg.solve_triangular
-    dep_from_ind = -solve(r11, r12)  # (rank, n_ind)
-    dep_const = solve(r11, qc[:rank])
-    dep_from_ind[np.abs(dep_from_ind) < settings.map_prune_tol] = 0.0
-    dep_const[np.abs(dep_const) < settings.map_prune_tol] = 0.0
-    dr, dc = np.nonzero(dep_from_ind)
-    T = sp.coo_matrix(
-        (
-            np.concatenate([np.ones(len(ind)), dep_from_ind[dr, dc]]),
-            (np.concatenate([ind, dep[dr]]), np.concatenate([np.arange(len(ind)), dc])),
-        ),
-        shape=(n, len(ind)),
-    )
-    t = np.zeros(n)
-    t[dep] = dep_const
-    return LinearMap(T.tocsr(), t, ind.astype(np.int64), gamma, c)
+    coef = -solve(r[:rank, :rank], r[:rank, col_of[ind]])
+    const = solve(r[:rank, :rank], qc[:rank])
+    coef[np.abs(coef) < settings.map_prune_tol] = 0.0
+    const[np.abs(const) < settings.map_prune_tol] = 0.0
+    return dep, const, ind, coef
