@@ -113,7 +113,27 @@ class Settings:
         Two facets of a development diagram overlap when their intersection is larger than
         this fraction of the smaller one's area.
     mechanism_rank_tol : float
-        Singular values below this times the largest one count as zero (rank of S, Eq. 16).
+        Singular values below this times the largest one count as zero (rank of S, Eq. 16);
+        in the kinematic and sparse analyses, the diagonal of the pivoted QR, and the Ritz
+        values, below this times the largest row norm of the constraint matrix (1).
+    sparse_analysis_vertices : int
+        ``analyze`` (and so ``generate``) takes the sparse method
+        (:mod:`rigidfold.mechanism.sparse`) for patterns with at least this many vertices and
+        the dense kinematic one below: the paper's patterns (up to 121 vertices) keep the
+        dense reference, and their results to the last digit.
+    sparse_shift : float
+        delta of the sparse analysis's filter ``(C^T C + delta I)^-1``: directions of
+        singular value s with s^2 << delta pass it like the kernel (all those within reach of
+        ``mechanism_rank_tol``), the others are damped by about delta / s^2 per solve. Far
+        above round-off of C^T C (about 1e-15), far below the squared smallest non-zero
+        singular values of large patterns (about 1e-10).
+    sparse_oversampling : int
+        Columns of the sparse analysis's subspace beyond the expected DOF; the subspace
+        doubles while fewer than half of them are left clear of the kernel.
+    sparse_iterations : int
+        Solves with the filter per subspace: each multiplies the share of the other
+        directions in the computed modes by about delta / s^2 (two give about 1e-14 of the
+        share a dense factorisation leaves, enough for ``lock_tol``).
     lock_tol : float
         A free crease is locked when the norm of its rotations over all modes is below this
         times the largest such norm (and its triangles are not coplanar).
@@ -252,6 +272,10 @@ class Settings:
     overlap_area_tol: float = 1e-9
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
+    sparse_analysis_vertices: int = 400
+    sparse_shift: float = 1e-13
+    sparse_oversampling: int = 12
+    sparse_iterations: int = 2
     lock_tol: float = 1e-7
     lookahead_tol: float = 1e-7
     lock_prediction_tol: float = 1e-4
@@ -324,6 +348,13 @@ class Settings:
         tol = self.surface_footprint_tol
         if not (math.isfinite(tol) and tol >= 0):
             raise ValueError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
+        if not 0 < self.sparse_shift < 1:
+            raise ValueError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
+        least = {"sparse_analysis_vertices": 3, "sparse_oversampling": 2, "sparse_iterations": 1}
+        for name, low in least.items():
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
         if self.ipopt_hessian not in HESSIANS:
             raise ValueError(
                 f"ipopt_hessian must be one of {', '.join(HESSIANS)}, got {self.ipopt_hessian!r}"

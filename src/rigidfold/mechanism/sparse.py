@@ -1,0 +1,114 @@
+"""Kernel of the kinematic constraints without a dense factorisation (large patterns).
+
+The dense analysis factorises the whole constraint matrix C ((E + f + 9) x 3V, see
+:func:`rigidfold.mechanism.kinematics.constraint_matrix`): its cost grows with the cube of
+the pattern's size. The kernel has only d (the DOF, about the number of boundary vertices)
+dimensions, so this module finds it in a space of about that size:
+
+1. The support's nine rows pin nine coordinates: drop them with their columns and the rows
+   left empty (the support triangle's edges). ``A`` (k x n) is what remains.
+2. ``M = A^T A + delta I`` (n x n, a few non-zeros per row) is factorised once by SuperLU
+   (symmetric mode, minimum-degree ordering). ``delta M^-1`` keeps a direction of singular
+   value s of A with the factor ``delta / (s^2 + delta)``: 1 on the kernel and on every
+   direction with s^2 << delta (all those near the rank threshold), about ``delta / s^2``
+   on the others (``Settings.sparse_shift``).
+3. Subspace iteration: ``W <- M^-1 W`` (``Settings.sparse_iterations`` times) from m random
+   columns (a fixed seed: the same basis on every run), m = n - k plus
+   ``Settings.sparse_oversampling``.
+4. Rayleigh-Ritz: with Y a basis of the span of W (its left singular vectors, from a
+   Householder R of W), the singular values of ``A Y`` are the Ritz values, each no smaller
+   than the singular value of A it approximates; the right singular vectors of those at most
+   ``Settings.mechanism_rank_tol`` times the largest row norm of C (the ``|R_00|`` of the
+   dense pivoted QR) span the kernel.
+5. When fewer than half the oversampling columns are left above ``100 sqrt(delta)`` (the
+   directions that the filter cannot tell apart from the kernel), m doubles and 3-4 repeat.
+
+Every rank decision is made on the small dense matrix of step 4, as the dense method makes
+it on the whole matrix; ``tests/test_sparse_mechanism.py`` compares the two. Cost: one
+sparse factorisation, ``sparse_iterations`` solves with m right-hand sides and two Householder
+R factors of n x m matrices, about ``nnz(LU) m + n m^2``; memory about 12 n m floats.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from rigidfold.config import Settings
+
+_SEED = 0
+"""Seed of the random start of the subspace iteration (the same modes on every run)."""
+
+
+def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.ndarray, int]:
+    """Orthonormal basis of the kernel of the constraint matrix C, sparse.
+
+    C : (k, 3V) sparse, rows of unit norm, as built by
+        :func:`~rigidfold.mechanism.kinematics.constraint_matrix` (its last nine rows pin the
+        support triangle's coordinates).
+    returns : (N (3V, d) float64, columns orthonormal to about 1e-4 and zero on the support's
+        coordinates; the Ritz values of step 4 (at most m), decreasing; rank of C = 3V - d).
+    """
+    C = sp.csr_matrix(C)
+    pinned = np.unique(C[-9:].indices)
+    free = np.setdiff1d(np.arange(C.shape[1]), pinned)
+    A = C[:-9][:, free]
+    A = A[np.diff(A.indptr) > 0]
+    k, n = A.shape
+    limit = settings.mechanism_rank_tol * np.sqrt(C.multiply(C).sum(axis=1).max())
+    N = np.zeros((C.shape[1], 0))
+    if n == 0:
+        return N, np.zeros(0), C.shape[1]
+    lu = spla.splu(
+        (A.T @ A + settings.sparse_shift * sp.identity(n)).tocsc(),
+        permc_spec="MMD_AT_PLUS_A",
+        diag_pivot_thresh=0.0,
+        options={"SymmetricMode": True},
+    )
+    p = settings.sparse_oversampling
+    clear = 100 * np.sqrt(settings.sparse_shift)
+    m = min(max(n - k, 0) + p, n)
+    rng = np.random.default_rng(_SEED)
+    while True:
+        W = rng.random((n, m)) - 0.5
+        for _ in range(settings.sparse_iterations):  # rescaled only: the span is what counts
+            W = lu.solve(W / np.linalg.norm(W, axis=0))
+        Y = _span(W)
+        _, s, vt = np.linalg.svd(np.linalg.qr(A @ Y, mode="r"))  # vt: (m', m')
+        values = np.concatenate([s, np.zeros(Y.shape[1] - len(s))])  # k < m': zeros
+        if m == n or np.count_nonzero(values <= clear) <= m - p // 2:
+            break
+        m = min(2 * m, n)
+    small = values <= limit
+    N = np.zeros((C.shape[1], int(small.sum())))
+    N[free] = Y @ vt[small].T
+    return N, values, C.shape[1] - N.shape[1]
+
+
+def _span(W: np.ndarray) -> np.ndarray:
+    """Basis (n, m') of the span of W (n, m) with columns orthonormal to about 1e-4, m' <= m.
+
+    With W = Q R (Householder, R alone) and R = U S V^T, ``W V S^-1 = Q U``: the columns are
+    the left singular vectors of W, here kept down to 1e-12 of the largest singular value,
+    each accurate to eps / (its share): the directions damped more than that by the filter
+    are round-off (the kernel itself has shares near 1). Half the cost of forming Q.
+    """
+    _, s, vt = np.linalg.svd(np.linalg.qr(W, mode="r"))
+    keep = s >= 1e-12 * s[0]
+    return W @ (vt[keep].T / s[keep])
+
+
+def sparse_analysis_bytes(n_vertices: int, n_rows: int, dof: int, settings: Settings) -> int:
+    """Memory (bytes) that :func:`sparse_kernel` and the modes built from it need, estimated
+    before any matrix is built.
+
+    n_vertices : V; n_rows : rows of C (E + f + 9); dof : a guess of d (the generic DOF);
+    about 12 dense n x m arrays of floats (the random start, its solves, Q, the products
+    with C and the frame map) and the sparse factor (about 60 n log2 n non-zeros at 12
+    bytes, the fill of a minimum-degree ordering on a triangulated sheet).
+    """
+    n = 3 * n_vertices
+    m = min(max(n - n_rows, dof, 0) + settings.sparse_oversampling, n)
+    fill = 60 * n * max(np.log2(max(n, 2)), 1.0)
+    return int(8 * 12 * n * m + 12 * fill)
