@@ -42,6 +42,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_report.py
 	$(PY) benchmarks/mesh_surface.py
 	$(PY) benchmarks/own_design.py
+	$(PY) benchmarks/bench_scale.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -215,10 +215,10 @@ def test_analysis_too_large_is_refused_before_allocating():
 
 
 def test_generate_of_a_pattern_too_large_to_analyse_stops_before_solving(tmp_path):
-    # a 200 x 200 grid read from a FOLD file: even its sparse analysis (generate's method at
-    # this size) would need about 10 GiB (a grid: pattern is limited to 20000 triangles,
-    # which the sparse analysis takes in about 1.5 GiB)
-    xy, faces = grid(200, 200, 20.0, 20.0, "centre")
+    # a 230 x 230 grid read from a FOLD file: even its sparse analysis (generate's method at
+    # this size) would need about 11 GiB (a grid: pattern is limited to 20000 triangles,
+    # which the sparse analysis takes in about 1 GiB)
+    xy, faces = grid(230, 230, 23.0, 23.0, "centre")
     fold = tmp_path / "big.fold"
     fold.write_text(
         json.dumps(

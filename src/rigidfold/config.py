@@ -217,10 +217,12 @@ class Settings:
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
         is refused instead of building a problem that cannot be solved.
     max_analysis_bytes : int
-        Largest memory (bytes) the dense mechanism analysis may ask for, estimated from the
-        pattern's size before the dense matrices are built
-        (:func:`rigidfold.mechanism.analysis.analysis_bytes`); a larger shape (any FOLD file
-        given to ``analyze``) is refused in one line instead of running out of memory.
+        Largest memory (bytes) the mechanism analysis may ask for, estimated from the
+        pattern's size for the method it runs before any matrix is built
+        (:func:`rigidfold.mechanism.analysis.analysis_memory`: the dense matrices of the
+        kinematic or frame method, the subspace and sparse factor of the sparse one); a
+        larger shape (any FOLD file given to ``analyze``) is refused in one line instead of
+        running out of memory.
 
     Studies (``rigidfold.study``)
     -----------------------------
@@ -272,7 +274,7 @@ class Settings:
     overlap_area_tol: float = 1e-9
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
-    sparse_analysis_vertices: int = 400
+    sparse_analysis_vertices: int = 200
     sparse_shift: float = 1e-13
     sparse_oversampling: int = 12
     sparse_iterations: int = 2

@@ -26,7 +26,7 @@ dimensions, so this module finds it in a space of about that size:
 Every rank decision is made on the small dense matrix of step 4, as the dense method makes
 it on the whole matrix; ``tests/test_sparse_mechanism.py`` compares the two. Cost: one
 sparse factorisation, ``sparse_iterations`` solves with m right-hand sides and two Householder
-R factors of n x m matrices, about ``nnz(LU) m + n m^2``; memory about 12 n m floats.
+R factors of n x m matrices, about ``nnz(LU) m + n m^2``; memory about 10 n m floats.
 """
 
 from __future__ import annotations
@@ -103,12 +103,13 @@ def sparse_analysis_bytes(n_vertices: int, n_rows: int, dof: int, settings: Sett
     """Memory (bytes) that :func:`sparse_kernel` and the modes built from it need, estimated
     before any matrix is built.
 
-    n_vertices : V; n_rows : rows of C (E + f + 9); dof : a guess of d (the generic DOF);
-    about 12 dense n x m arrays of floats (the random start, its solves, Q, the products
-    with C and the frame map) and the sparse factor (about 60 n log2 n non-zeros at 12
-    bytes, the fill of a minimum-degree ordering on a triangulated sheet).
+    n_vertices : V; n_rows : rows of C (E + f + 9); dof : a guess of d (the generic DOF).
+    About ten dense n x m arrays of floats at their peak (the random start, its solves, the
+    span, the products with A and the frame map; n = 3V) and the sparse factor, about
+    12 n log2 n non-zeros of 12 bytes for a minimum-degree ordering of a triangulated sheet:
+    1.1 to 1.7 times the peak measured on the dome grids from 41 x 41 to 101 x 101
+    (``benchmarks/bench_scale.py`` prints it).
     """
     n = 3 * n_vertices
     m = min(max(n - n_rows, dof, 0) + settings.sparse_oversampling, n)
-    fill = 60 * n * max(np.log2(max(n, 2)), 1.0)
-    return int(8 * 12 * n * m + 12 * fill)
+    return int(8 * 10 * n * m + 12 * 12 * n * np.log2(max(n, 2)))
