@@ -115,7 +115,8 @@ class Settings:
     mechanism_rank_tol : float
         Singular values below this times the largest one count as zero (rank of S, Eq. 16);
         in the kinematic and sparse analyses, the diagonal of the pivoted QR, and the Ritz
-        values, below this times the largest row norm of the constraint matrix (1).
+        values, below this times the largest row norm of the constraint matrix (sqrt 2, the
+        row of an edge's length).
     sparse_analysis_vertices : int
         ``analyze`` (and so ``generate``) takes the sparse method
         (:mod:`rigidfold.mechanism.sparse`) for patterns with at least this many vertices and
@@ -124,16 +125,17 @@ class Settings:
     sparse_shift : float
         delta of the sparse analysis's filter ``(C^T C + delta I)^-1``: directions of
         singular value s with s^2 << delta pass it like the kernel (all those within reach of
-        ``mechanism_rank_tol``), the others are damped by about delta / s^2 per solve. Far
-        above round-off of C^T C (about 1e-15), far below the squared smallest non-zero
-        singular values of large patterns (about 1e-10).
+        ``mechanism_rank_tol``), the others are damped by about delta / s^2 per solve. Ten
+        times the round-off of C^T C (about 1e-15); small enough that two solves damp every
+        direction with s > 1000 sqrt(delta) = 1e-4 below 1e-12 (a solved 31 x 31 grid has
+        some fifteen singular values between 1e-6 and 3e-4 beside its kernel).
     sparse_oversampling : int
         Columns of the sparse analysis's subspace beyond the expected DOF; the subspace
-        doubles while fewer than half of them are left clear of the kernel.
+        doubles while fewer than half of them are damped below 1e-12 of the kernel's share.
     sparse_iterations : int
-        Solves with the filter per subspace: each multiplies the share of the other
-        directions in the computed modes by about delta / s^2 (two give about 1e-14 of the
-        share a dense factorisation leaves, enough for ``lock_tol``).
+        Solves with the filter per subspace: each multiplies the share of a direction of
+        singular value s by about delta / s^2; two leave the modes less than about 1e-12 of
+        every direction with s > 1000 sqrt(delta), far below ``lock_tol``.
     lock_tol : float
         A free crease is locked when the norm of its rotations over all modes is below this
         times the largest such norm (and its triangles are not coplanar).
@@ -275,7 +277,7 @@ class Settings:
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
     sparse_analysis_vertices: int = 200
-    sparse_shift: float = 1e-13
+    sparse_shift: float = 1e-14
     sparse_oversampling: int = 12
     sparse_iterations: int = 2
     lock_tol: float = 1e-7

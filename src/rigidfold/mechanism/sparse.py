@@ -24,7 +24,8 @@ dimensions, so this module finds it in a space of about that size:
    damped below 1e-12 of the kernel's share (and so is every direction outside the
    subspace: the modes keep less than about 1e-12 of them, far below ``lock_tol``).
    Otherwise (many directions of singular value below about ``1000 sqrt(delta)``, e.g. the
-   out-of-plane modes of a flat sheet) m doubles and 3-4 repeat.
+   out-of-plane modes of a flat sheet) as many filtered random columns again join W and 4
+   repeats.
 
 Every rank decision is made on the small dense matrix of step 4, as the dense method makes
 it on the whole matrix; ``tests/test_sparse_mechanism.py`` compares the two. Cost: one
@@ -71,16 +72,21 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
         options={"SymmetricMode": True},
     )
     p = settings.sparse_oversampling
-    m = min(max(n - k, 0) + p, n)
     rng = np.random.default_rng(_SEED)
-    while True:
-        W = rng.random((n, m)) - 0.5
+
+    def filtered(columns: int) -> np.ndarray:  # step 3, columns of unit norm
+        W = rng.random((n, columns)) - 0.5
         for _ in range(settings.sparse_iterations):  # rescaled only: the span is what counts
             W = lu.solve(W / np.linalg.norm(W, axis=0))
+        return W / np.linalg.norm(W, axis=0)
+
+    W = filtered(min(max(n - k, 0) + p, n))
+    while True:
         Y = _span(W)
+        m = W.shape[1]
         if m == n or Y.shape[1] <= m - p // 2:
             break
-        m = min(2 * m, n)
+        W = np.hstack([W, filtered(min(m, n - m))])  # step 5: twice the columns
     _, s, vt = np.linalg.svd(np.linalg.qr(A @ Y, mode="r"))  # vt: (m', m')
     values = np.concatenate([s, np.zeros(Y.shape[1] - len(s))])  # k < m': zeros
     small = values <= limit
