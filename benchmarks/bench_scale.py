@@ -1,7 +1,7 @@
 """Benchmark of issue 19: build, solve and mechanism analysis of square grids up to 61 x 61.
 
 Run with ``make bench`` (or ``python benchmarks/bench_scale.py [--grids 7,11,21,31,41,61]
-[--repeat 3] [--no-solve] [--dense-max 1681]``).
+[--repeat 3] [--no-solve | --solve-max V] [--dense-max 1681]``).
 
 Cases: ``grid:NxN`` with ``--size 3x3`` (a 3 m square, every diagonal towards the centre,
 :func:`rigidfold.patterns.grid`) lifted onto the dome, as in the issue's table. Per grid:
@@ -9,7 +9,8 @@ Cases: ``grid:NxN`` with ``--size 3x3`` (a 3 m square, every diagonal towards th
 * build: ``case.problem(build_ipopt=True)`` (the elimination (7)-(11), CasADi's model and
   IPOPT), median of ``--repeat``;
 * solve: one IPOPT solve of (6) from the lifted shape, no fixed crease, median of
-  ``--repeat`` (``--no-solve`` skips it: the analyses then take the lifted shape);
+  ``--repeat`` (``--no-solve`` skips it, ``--solve-max`` above that many vertices: the
+  analyses then take the lifted shape);
 * analysis: ``rigidfold.mechanism.analyze`` of the solution as ``generate`` runs it
   (method "auto"), the dense reference ("kinematic", up to ``--dense-max`` vertices) and the
   sparse method, each on a fresh copy of the shape (its topology caches rebuilt), median of
@@ -111,7 +112,8 @@ def child(args: argparse.Namespace) -> None:
 
 def run_child(task: str, n: int, args: argparse.Namespace, coords: str) -> dict:
     cmd = [sys.executable, __file__, "--task", task, "--task-grid", str(n)]
-    cmd += ["--repeat", str(args.repeat), "--coords", coords] + (["--no-solve"] * args.no_solve)
+    solve = not args.no_solve and n * n <= args.solve_max
+    cmd += ["--repeat", str(args.repeat), "--coords", coords] + (["--no-solve"] * (not solve))
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if proc.returncode:
         sys.exit(f"grid {n}, task {task} failed:\n{proc.stderr}")
@@ -162,6 +164,9 @@ def main() -> None:
     parser.add_argument("--grids", default="7,11,21,31,41,61", help="vertices per side")
     parser.add_argument("--repeat", type=int, default=3, help="repetitions (median)")
     parser.add_argument("--no-solve", action="store_true", help="analyse the lifted shapes")
+    parser.add_argument(
+        "--solve-max", type=int, default=10**9, help="largest V to solve (lifted above)"
+    )
     parser.add_argument(
         "--dense-max", type=int, default=1681, help="largest V for the dense reference"
     )

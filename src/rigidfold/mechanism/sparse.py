@@ -141,7 +141,7 @@ def sparse_analysis_bytes(n_vertices: int, n_rows: int, dof: int, settings: Sett
     About ten dense n x m arrays of floats at their peak (the random start, its solves, the
     span, the products with A and the frame map; n = 3V) and the sparse factor, about
     12 n log2 n non-zeros of 12 bytes for a minimum-degree ordering of a triangulated sheet:
-    1.1 to 1.7 times the peak measured on the dome grids from 41 x 41 to 101 x 101
+    1.3 to 1.6 times the peak measured on the dome grids from 41 x 41 to 101 x 101
     (``benchmarks/bench_scale.py`` prints it).
     """
     n = 3 * n_vertices
