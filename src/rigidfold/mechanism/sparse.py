@@ -75,10 +75,10 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
     rng = np.random.default_rng(_SEED)
 
     def filtered(columns: int) -> np.ndarray:  # step 3, columns of unit norm
-        W = rng.random((n, columns)) - 0.5
+        W = rng.random((columns, n)).T - 0.5  # column-major, as SuperLU solves
         for _ in range(settings.sparse_iterations):  # rescaled only: the span is what counts
-            W = lu.solve(W / np.linalg.norm(W, axis=0))
-        return W / np.linalg.norm(W, axis=0)
+            W = lu.solve(W / np.sqrt(np.einsum("ij,ij->j", W, W)))
+        return W / np.sqrt(np.einsum("ij,ij->j", W, W))
 
     W = filtered(min(max(n - k, 0) + p, n))
     while True:
