@@ -43,6 +43,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/mesh_surface.py
 	$(PY) benchmarks/own_design.py
 	$(PY) benchmarks/bench_solve_scale.py
+	$(PY) benchmarks/bench_scale.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -28,7 +28,7 @@ def relative_singular_values(solution) -> np.ndarray:
     """Singular values of the constraint matrix of an accepted shape over the largest,
     ascending, padded with zeros to the number of unknowns: (n,) float64."""
     frame = solution.mechanism.frame
-    C = kinematics.constraint_matrix(solution.result.pattern, frame.support_face)
+    C = kinematics.constraint_matrix(solution.result.pattern, frame.support_face).toarray()
     sv = np.linalg.svd(C, compute_uv=False)
     full = np.concatenate([sv, np.zeros(max(0, C.shape[1] - len(sv)))])
     return np.sort(full / sv[0])

@@ -6,6 +6,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -16,6 +17,7 @@ import pytest
 from conftest import main_code, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.io import jsonable, read_fold, write_json
+from rigidfold.patterns import grid
 
 DATA = Path(__file__).parent / "data"
 TRIANGLE = {"vertices_coords": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces_vertices": [[0, 1, 2]]}
@@ -197,7 +199,7 @@ def test_analysis_too_large_is_refused_before_allocating():
     from rigidfold.config import Settings
     from rigidfold.mechanism import analysis_bytes, analyze, check_analysis_size
     from rigidfold.mesh import CreasePattern
-    from rigidfold.patterns import grid, parse_pattern
+    from rigidfold.patterns import parse_pattern
 
     xy, faces = grid(300, 300, 30.0, 30.0, "centre")
     big = CreasePattern.from_faces(np.column_stack([xy, np.zeros(len(xy))]), faces)
@@ -215,18 +217,33 @@ def test_analysis_too_large_is_refused_before_allocating():
 
 
 def test_generate_of_a_pattern_too_large_to_analyse_stops_before_solving(tmp_path):
+    # a 230 x 230 grid read from a FOLD file: even its sparse analysis (generate's method at
+    # this size) would need about 11 GiB (a grid: pattern is limited to 20000 triangles,
+    # which the sparse analysis takes in about 1 GiB)
+    xy, faces = grid(230, 230, 23.0, 23.0, "centre")
+    fold = tmp_path / "big.fold"
+    fold.write_text(
+        json.dumps(
+            {
+                "file_spec": 1.1,
+                "frame_unit": "m",
+                "vertices_coords": np.column_stack([xy, np.zeros(len(xy))]).tolist(),
+                "faces_vertices": faces.tolist(),
+            }
+        )
+    )
     proc = run_cli(
         "generate",
         "--surface",
         "dome",
         "--pattern",
-        "grid:101x101",
+        str(fold),
         "--quiet",
         "--out",
         str(tmp_path / "o"),
     )
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
-    assert "needs about 20.8 GiB, more than the limit of 8 GiB" in proc.stderr
+    assert re.search(r"needs about [\d.]+ GiB, more than the limit of 8 GiB", proc.stderr)
     assert not (tmp_path / "o" / "summary.json").exists()
 
 

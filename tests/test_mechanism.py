@@ -88,7 +88,7 @@ def test_hinge_rotation_is_fold_angle_rate():
     shape = degree_n_vertex(5, seed=2)
     mech = analyze(shape)
     L = mech.frame
-    C = kinematics.constraint_matrix(shape, L.support_face)
+    C = kinematics.constraint_matrix(shape, L.support_face).toarray()
     _, _, vt = np.linalg.svd(C)
     xdot = vt[-1]
     Lmap = kinematics.frame_map(L)

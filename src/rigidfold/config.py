@@ -118,7 +118,29 @@ class Settings:
         Two facets of a development diagram overlap when their intersection is larger than
         this fraction of the smaller one's area.
     mechanism_rank_tol : float
-        Singular values below this times the largest one count as zero (rank of S, Eq. 16).
+        Singular values below this times the largest one count as zero (rank of S, Eq. 16);
+        in the kinematic and sparse analyses, the diagonal of the pivoted QR, and the Ritz
+        values, below this times the largest row norm of the constraint matrix (sqrt 2, the
+        row of an edge's length).
+    sparse_analysis_vertices : int
+        ``analyze`` (and so ``generate``) takes the sparse method
+        (:mod:`rigidfold.mechanism.sparse`) for patterns with at least this many vertices and
+        the dense kinematic one below: the paper's patterns (up to 121 vertices) keep the
+        dense reference, and their results to the last digit.
+    sparse_shift : float
+        delta of the sparse analysis's filter ``(C^T C + delta I)^-1``: directions of
+        singular value s with s^2 << delta pass it like the kernel (all those within reach of
+        ``mechanism_rank_tol``), the others are damped by about delta / s^2 per solve. Ten
+        times the round-off of C^T C (about 1e-15); small enough that two solves damp every
+        direction with s > 1000 sqrt(delta) = 1e-4 below 1e-12 (a solved 31 x 31 grid has
+        some fifteen singular values between 1e-6 and 3e-4 beside its kernel).
+    sparse_oversampling : int
+        Columns of the sparse analysis's subspace beyond the expected DOF; the subspace
+        doubles while fewer than half of them are damped below 1e-12 of the kernel's share.
+    sparse_iterations : int
+        Solves with the filter per subspace: each multiplies the share of a direction of
+        singular value s by about delta / s^2; two leave the modes less than about 1e-12 of
+        every direction with s > 1000 sqrt(delta), far below ``lock_tol``.
     lock_tol : float
         A free crease is locked when the norm of its rotations over all modes is below this
         times the largest such norm (and its triangles are not coplanar).
@@ -213,10 +235,12 @@ class Settings:
         estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
         is refused instead of building a problem that cannot be solved.
     max_analysis_bytes : int
-        Largest memory (bytes) the dense mechanism analysis may ask for, estimated from the
-        pattern's size before the dense matrices are built
-        (:func:`rigidfold.mechanism.analysis.analysis_bytes`); a larger shape (any FOLD file
-        given to ``analyze``) is refused in one line instead of running out of memory.
+        Largest memory (bytes) the mechanism analysis may ask for, estimated from the
+        pattern's size for the method it runs before any matrix is built
+        (:func:`rigidfold.mechanism.analysis.analysis_memory`: the dense matrices of the
+        kinematic or frame method, the subspace and sparse factor of the sparse one); a
+        larger shape (any FOLD file given to ``analyze``) is refused in one line instead of
+        running out of memory.
 
     Studies (``rigidfold.study``)
     -----------------------------
@@ -268,6 +292,10 @@ class Settings:
     overlap_area_tol: float = 1e-9
     # mechanism analysis
     mechanism_rank_tol: float = 1e-9
+    sparse_analysis_vertices: int = 200
+    sparse_shift: float = 1e-14
+    sparse_oversampling: int = 12
+    sparse_iterations: int = 2
     lock_tol: float = 1e-7
     lookahead_tol: float = 1e-7
     lookahead_carry_angle: float = math.radians(2.0)
@@ -342,6 +370,13 @@ class Settings:
         tol = self.surface_footprint_tol
         if not (math.isfinite(tol) and tol >= 0):
             raise ValueError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
+        if not 0 < self.sparse_shift < 1:
+            raise ValueError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
+        least = {"sparse_analysis_vertices": 3, "sparse_oversampling": 2, "sparse_iterations": 1}
+        for name, low in least.items():
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
         if self.ipopt_hessian not in HESSIANS:
             raise ValueError(
                 f"ipopt_hessian must be one of {', '.join(HESSIANS)}, got {self.ipopt_hessian!r}"

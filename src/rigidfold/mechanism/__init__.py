@@ -4,8 +4,18 @@ from rigidfold.mechanism.analysis import (
     METHODS,
     Mechanism,
     analysis_bytes,
+    analysis_memory,
     analyze,
     check_analysis_size,
+    chosen_method,
 )
 
-__all__ = ["METHODS", "Mechanism", "analysis_bytes", "analyze", "check_analysis_size"]
+__all__ = [
+    "METHODS",
+    "Mechanism",
+    "analysis_bytes",
+    "analysis_memory",
+    "analyze",
+    "check_analysis_size",
+    "chosen_method",
+]

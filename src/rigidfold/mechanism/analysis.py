@@ -1,15 +1,20 @@
 """Mechanism analysis (Section 4.1): DOF, mechanism modes H, hinge rotations, locked creases.
 
-Two methods give the same result:
+Three methods give the same result:
 
-* ``"kinematic"`` (default): the kernel of the small vertex-velocity constraint matrix
-  (:mod:`rigidfold.mechanism.kinematics`), mapped onto the frame's displacement space and
-  orthonormalised there. Fast: a dense SVD of about (E + 9) x 3V.
+* ``"kinematic"``: the kernel of the small vertex-velocity constraint matrix
+  (:mod:`rigidfold.mechanism.kinematics`) by a dense pivoted QR, mapped onto the frame's
+  displacement space and orthonormalised there. A dense factorisation of about
+  (E + 9) x 3V: the reference, fast up to a few hundred vertices.
+* ``"sparse"``: the same kernel without a dense factorisation of the whole matrix
+  (:mod:`rigidfold.mechanism.sparse`): for large patterns.
 * ``"frame"``: the paper's way, the right singular vectors of the frame compatibility matrix
-  S (6m x (6n - 6 + h)) for zero singular values. Slow for large patterns; the reference.
+  S (6m x (6n - 6 + h)) for zero singular values. Slow for large patterns; a check.
 
-Both return H with orthonormal columns spanning ker(S) in the frame's v-space, so the pseudo
-stiffness matrix and everything derived from it (Sections 4.2, 5) are the paper's.
+``"auto"`` (the default) takes ``"sparse"`` from ``Settings.sparse_analysis_vertices``
+vertices on and ``"kinematic"`` below. All return H with orthonormal columns spanning ker(S)
+in the frame's v-space, so the pseudo stiffness matrix and everything derived from it
+(Sections 4.2, 5) are the paper's.
 """
 
 from __future__ import annotations
@@ -24,9 +29,10 @@ import scipy.linalg
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.frame import FrameModel
 from rigidfold.mechanism import kinematics
+from rigidfold.mechanism.sparse import sparse_analysis_bytes, sparse_kernel
 from rigidfold.mesh import CreasePattern
 
-METHODS = ("kinematic", "frame")
+METHODS = ("auto", "kinematic", "sparse", "frame")
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,8 +43,8 @@ class Mechanism:
     basis : (6n - 6 + h, d) float64 array, or a callable returning it: an orthonormal basis
         H of ker(S) (Eq. 17), built on first use
     H_phi : (h, d) float64, its hinge-rotation rows (Eq. 18); row j is free crease hinges[j]
-    rank_values : (k,) singular values (or |R_ii| of a pivoted QR) of the matrix whose kernel
-        was taken, decreasing
+    rank_values : (k,) singular values (or |R_ii| of a pivoted QR, or the Ritz values of the
+        sparse method) of the matrix whose kernel was taken, decreasing
     rank : int
     locked : (h,) bool, per hinge (free crease): no rotation in any mode although folded
     settings : Settings
@@ -95,37 +101,35 @@ class Mechanism:
 def analyze(
     pattern: CreasePattern,
     *,
-    method: str = "kinematic",
+    method: str = "auto",
     support_face: int | None = None,
     settings: Settings = DEFAULTS,
 ) -> Mechanism:
     """Mechanism analysis of a polyhedron (Section 4.1).
 
-    pattern : the shape, with its fixed creases; method : "kinematic" or "frame".
+    pattern : the shape, with its fixed creases; method : one of ``METHODS`` (see the
+    module's text). A shape whose analysis would need more than
+    ``settings.max_analysis_bytes`` is refused (ValueError) before anything is built.
     """
-    if method not in METHODS:
-        raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
-    if method == "kinematic":  # C is dense: refuse before building it
-        _check_size(
-            pattern,
-            pattern.n_edges + int(pattern.fixed.sum()) + 9,
-            3 * pattern.n_vertices,
-            settings,
-        )
+    method = chosen_method(pattern, method, settings)
+    check_analysis_size(pattern, settings, method)
     frame = FrameModel.from_pattern(pattern, support_face)
     h = frame.n_hinges
     basis: np.ndarray | Callable[[], np.ndarray]
     if method == "frame":
-        A = frame.compatibility_matrix()  # sparse until the SVD
-        _check_size(pattern, A.shape[0], A.shape[1], settings)
-        H, values, rank = _svd_kernel(A.toarray(), settings)
+        H, values, rank = _svd_kernel(frame.compatibility_matrix().toarray(), settings)
         H_phi, basis = H[H.shape[0] - h :], H
     else:
         C = kinematics.constraint_matrix(pattern, frame.support_face)
-        N, values, rank = _qr_kernel(C, settings)
         L = kinematics.frame_map(frame)
         # H = L N R^-1 with R^T R = N^T L^T L N: orthonormal in the frame's v-space
-        R = np.linalg.cholesky(N.T @ (L.T @ (L @ N))).T if N.shape[1] else np.zeros((0, 0))
+        if method == "kinematic":
+            N, values, rank = _qr_kernel(C.toarray(), settings)
+            gram = N.T @ (L.T @ (L @ N))
+        else:  # L^T L is sparse (3V x 3V): no product of L with the modes
+            N, values, rank = sparse_kernel(C, settings)
+            gram = N.T @ ((L.T @ L) @ N)
+        R = np.linalg.cholesky(gram).T if N.shape[1] else np.zeros((0, 0))
         Rinv = scipy.linalg.solve_triangular(R, np.eye(len(R))) if len(R) else R
         H_phi = L[L.shape[0] - h :] @ N @ Rinv
 
@@ -137,6 +141,16 @@ def analyze(
     return Mechanism(frame, basis, H_phi, values, rank, _locked(frame, H_phi, settings), settings)
 
 
+def chosen_method(pattern: CreasePattern, method: str, settings: Settings = DEFAULTS) -> str:
+    """The method :func:`analyze` runs for ``method`` (one of ``METHODS``): ``"auto"`` is
+    ``"sparse"`` from ``settings.sparse_analysis_vertices`` vertices on, else ``"kinematic"``."""
+    if method not in METHODS:
+        raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
+    if method != "auto":
+        return method
+    return "sparse" if pattern.n_vertices >= settings.sparse_analysis_vertices else "kinematic"
+
+
 def analysis_bytes(rows: int, cols: int) -> int:
     """Memory (bytes) of the dense kernel of a rows x cols matrix as :func:`analyze` computes
     it: the matrix and the full factorisation of its transpose (Q or Vt, cols x cols, and R or
@@ -144,17 +158,28 @@ def analysis_bytes(rows: int, cols: int) -> int:
     return 8 * (cols * cols + 2 * rows * cols)
 
 
-def check_analysis_size(pattern: CreasePattern, settings: Settings = DEFAULTS) -> None:
-    """One-line ValueError when the kinematic analysis of ``pattern`` (the method that
-    ``generate`` uses) would need more than ``settings.max_analysis_bytes``; called before
-    any work by :func:`rigidfold.case.make_case` too."""
+def analysis_memory(pattern: CreasePattern, method: str, settings: Settings = DEFAULTS) -> int:
+    """Memory (bytes) that :func:`analyze` with ``method`` (one of ``METHODS``) would need for
+    ``pattern``, estimated from its sizes alone: :func:`analysis_bytes` of the matrix that a
+    dense method factorises, :func:`~rigidfold.mechanism.sparse.sparse_analysis_bytes` for
+    the sparse one."""
+    method = chosen_method(pattern, method, settings)
     rows = pattern.n_edges + int(pattern.fixed.sum()) + 9
-    _check_size(pattern, rows, 3 * pattern.n_vertices, settings)
+    if method == "sparse":
+        return sparse_analysis_bytes(pattern.n_vertices, rows, pattern.generic_dof, settings)
+    if method == "kinematic":
+        return analysis_bytes(rows, 3 * pattern.n_vertices)
+    nodes = pattern.n_edges + pattern.n_faces  # frame: S is 6m x (6n - 6 + h), m = 3F
+    return analysis_bytes(18 * pattern.n_faces, 6 * nodes - 6 + len(pattern.free_creases))
 
 
-def _check_size(pattern: CreasePattern, rows: int, cols: int, settings: Settings) -> None:
-    """One-line ValueError when :func:`analysis_bytes` exceeds ``settings.max_analysis_bytes``."""
-    need = analysis_bytes(rows, cols)
+def check_analysis_size(
+    pattern: CreasePattern, settings: Settings = DEFAULTS, method: str = "auto"
+) -> None:
+    """One-line ValueError when :func:`analyze` of ``pattern`` with ``method`` (by default
+    the one ``generate`` uses) would need more than ``settings.max_analysis_bytes``
+    (:func:`analysis_memory`); ``generate`` calls it before its first solve."""
+    need = analysis_memory(pattern, method, settings)
     if need > settings.max_analysis_bytes:
         raise ValueError(
             f"the mechanism analysis of {pattern.n_vertices} vertices and {pattern.n_edges} "

@@ -81,28 +81,36 @@ def fold_angle_gradients(pattern: CreasePattern, creases: np.ndarray) -> sp.csr_
     return sp.csr_matrix((grad.ravel(), (rows, cols.ravel())), shape=(n, 3 * V))
 
 
-def constraint_matrix(pattern: CreasePattern, support_face: int) -> np.ndarray:
-    """All kinematic constraints: edge lengths, flat fixed creases, support.  (k, 3V) dense
+def constraint_matrix(pattern: CreasePattern, support_face: int) -> sp.csr_matrix:
+    """All kinematic constraints: edge lengths, flat fixed creases, support.  (k, 3V) sparse
 
     Rows are scaled to unit norm; the kernel is the space of mechanisms with the support fixed.
-    The matrix is small (about (E + 9) x 3V), so it is assembled dense for the kernel step.
+    Rows ``0..E-1`` keep the edge lengths (2 vertices each), the next ``f`` keep the fixed
+    creases flat (4 vertices each) and the last 9 pin the support triangle's coordinates:
+    k = E + f + 9, a few non-zeros per row (``.toarray()`` for the dense analysis).
     """
     E, V = pattern.n_edges, pattern.n_vertices
     fixed = pattern.fixed_creases
-    C = np.zeros((E + len(fixed) + 9, 3 * V))
     e = pattern.edges
     d = pattern.coords[e[:, 1]] - pattern.coords[e[:, 0]]
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    rows = np.arange(E)[:, None]
-    C[rows, 3 * e[:, :1] + np.arange(3)] = -d
-    C[rows, 3 * e[:, 1:] + np.arange(3)] = d
+    c3 = np.arange(3)
+    rows = [np.repeat(np.arange(E), 6)]
+    cols = [np.hstack([3 * e[:, :1] + c3, 3 * e[:, 1:] + c3]).ravel()]
+    vals = [np.hstack([-d, d]).ravel()]
     if len(fixed):
-        _, grad, cols = fold_angles_and_gradients(pattern.coords, pattern.crease_stencils(fixed))
+        _, grad, gcols = fold_angles_and_gradients(pattern.coords, pattern.crease_stencils(fixed))
         grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
-        C[E + np.arange(len(fixed))[:, None], cols] = grad  # 4 distinct vertices per row
-    support = (3 * pattern.faces[support_face][:, None] + np.arange(3)).ravel()
-    C[E + len(fixed) + np.arange(9), support] = 1.0
-    return C
+        rows.append(E + np.repeat(np.arange(len(fixed)), 12))  # 4 distinct vertices per row
+        cols.append(gcols.ravel())
+        vals.append(grad.ravel())
+    rows.append(E + len(fixed) + np.arange(9))
+    cols.append((3 * pattern.faces[support_face][:, None] + c3).ravel())
+    vals.append(np.ones(9))
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(E + len(fixed) + 9, 3 * V),
+    )
 
 
 def angular_velocity_blocks(pattern: CreasePattern) -> np.ndarray:
