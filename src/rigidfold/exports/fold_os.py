@@ -39,18 +39,13 @@ import numpy as np
 from rigidfold.io import write_document
 from rigidfold.io.fold import FOLD_SPEC, PREFIX
 from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.geometry import to_y_up
 
 MAX_VERTICES = 2**16
 """Origami Simulator indexes the vertices of its faces with 16-bit integers."""
 
 ASSIGNMENTS = ("M", "V", "F", "B")
 """The assignments of the file: mountain, valley, flat (panel), boundary."""
-
-
-def to_y_up(coords: np.ndarray) -> np.ndarray:
-    """(V, 3) z-up coordinates (x, y, z) turned y up: (x, z, -y), a rotation about x.
-    ``rigidfold.io.read_fold(..., up="y")`` turns them back exactly."""
-    return np.column_stack([coords[:, 0], coords[:, 2], -coords[:, 1]])
 
 
 def origami_simulator_fold(pattern: CreasePattern, *, title: str = "") -> dict:

@@ -509,7 +509,7 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
             f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
         )
     if up == "y":
-        coords = coords[:, [0, 2, 1]] * [1.0, -1.0, 1.0]
+        coords = geometry.from_y_up(coords)
     polygons = _polygons(data, len(coords))
     file_edges, file_assignment = _file_edges(data, len(coords))
     file_assignment = _mark_fixed(data, file_edges, file_assignment)

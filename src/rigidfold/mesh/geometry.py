@@ -86,6 +86,18 @@ def edge_lengths(coords: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return np.linalg.norm(coords[edges[:, 1]] - coords[edges[:, 0]], axis=1)
 
 
+def from_y_up(coords: np.ndarray) -> np.ndarray:
+    """(V, 3) coordinates of a file drawn y up (Blender, Origami Simulator) turned z up:
+    (x, y, z) -> (x, -z, y), a rotation about x; :func:`to_y_up` is its inverse."""
+    return coords[:, [0, 2, 1]] * [1.0, -1.0, 1.0]
+
+
+def to_y_up(coords: np.ndarray) -> np.ndarray:
+    """(V, 3) z-up coordinates turned y up: (x, y, z) -> (x, z, -y), the inverse of
+    :func:`from_y_up`."""
+    return coords[:, [0, 2, 1]] * [1.0, 1.0, -1.0]
+
+
 def best_fit(
     frames: np.ndarray, target: np.ndarray, points: np.ndarray | None = None
 ) -> np.ndarray:

@@ -190,8 +190,6 @@ def lost_run(exc: Exception) -> dict:
     """The row of a run whose Dask workers all died while running it (``exc``: Dask's
     ``KilledWorker``), recorded as an error like a run that could not run: the status
     "error: <message>", and the last worker's address."""
-    from rigidfold import __version__
-
     deaths = getattr(exc, "allowed_failures", None)
     times = "repeatedly" if deaths is None else f"{deaths + 1} time{'s' if deaths else ''}"
     message = (
@@ -199,12 +197,7 @@ def lost_run(exc: Exception) -> dict:
         "crash in native code)"
     )
     worker = getattr(getattr(exc, "last_worker", None), "address", None)
-    return {
-        "status": ERROR_PREFIX + message,
-        "error": message,
-        "version": __version__,
-        "worker": worker,
-    }
+    return _failed_row(message, worker)
 
 
 def crashed_run(exc: Exception) -> dict:
@@ -212,15 +205,25 @@ def crashed_run(exc: Exception) -> dict:
     or of a library it calls, not bad input, which :func:`run_one` records itself): recorded
     as an error with the exception's type and message, so that the study goes on and its
     summary names the failure instead of ending in a traceback."""
-    from rigidfold import __version__
-
     text = str(exc).strip().splitlines()
     message = (
         f"unexpected {type(exc).__name__}"
         + (f": {text[0]}" if text else "")
         + " (a defect: please report it with the run's key)"
     )
-    return {"status": ERROR_PREFIX + message, "error": message, "version": __version__}
+    return _failed_row(message)
+
+
+def _failed_row(message: str, worker: str | None = None) -> dict:
+    """The row of a run that failed in the client's view: status "error: <message>"."""
+    from rigidfold import __version__
+
+    return {
+        "status": ERROR_PREFIX + message,
+        "error": message,
+        "version": __version__,
+        "worker": worker,
+    }
 
 
 CONNECT_TIMEOUT_S = 20.0
