@@ -520,3 +520,28 @@ def test_report_figures_never_follow_a_link(uninterrupted, tmp_path):
     assert outside.read_bytes() == b"keep"
     png = out / "n_lock_pattern_1.png"
     assert not png.is_symlink() and png.read_bytes().startswith(b"\x89PNG")
+
+
+def test_generate_progress_shows_the_last_step_and_an_eta(capsys):
+    from types import SimpleNamespace
+
+    from rigidfold.progress import GenerateProgress
+
+    bar = GenerateProgress(enabled=True, target=1, log_every=3600.0)
+    bar.plain = True
+    run = SimpleNamespace(initial_dof=11, n_reduce=0, final_dof=11, n_lock=0, n_exceed=0)
+    step = SimpleNamespace(solve_time=0.25, analysis_time=0.125)
+    bar.update(run, step)  # the first line prints
+    run.n_reduce, run.final_dof, run.n_lock = 4, 7, 1
+    bar.update(run, step)  # within log_every: silent
+    done, total, text = bar.describe(run, 120.0)
+    assert (done, total) == (4, 10)
+    assert "ETA 3.0 min" in text  # 6 DOF to go at 0.5 min each
+    run.n_reduce, run.final_dof = 10, 1
+    bar.update(run, step)  # the last line always prints
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 2
+    assert lines[0].startswith("generate 0/10  DOF 11  lock 0  exceed 0")
+    assert "ETA ?" in lines[0]
+    assert lines[1].startswith("generate 10/10  DOF 1  lock 1")
+    assert "last step: solve 0.25 s, analysis 0.12 s" in lines[1]

@@ -72,6 +72,19 @@ class Settings:
         IPOPT's Hessian of the Lagrangian: "closed-form" (element Hessians assembled with
         NumPy, ``rigidfold.optimize.hessian``) or "casadi" (CasADi's symbolic Hessian, the
         reference it is tested against). Both are exact; they differ by round-off.
+    projection_vertices : int
+        From this many vertices on, the IPOPT solver of (6) first tries the projection onto
+        F = 0 (:mod:`rigidfold.optimize.projection`) from the start; when that does not
+        converge, IPOPT runs and stops at the first feasible iterate with F <= ``ipopt_stop_f``,
+        which the projection then finishes. Smaller patterns (the paper's, up to 121
+        vertices) run IPOPT alone, as before.
+    projection_tol, projection_max_iter, projection_damping : float, int, float
+        The projection converges at F <= ``projection_tol``, stops after
+        ``projection_max_iter`` factorisations, and starts with the damping
+        ``projection_damping`` times |r| times the largest diagonal entry of J J^T.
+    ipopt_stop_f : float
+        F at which IPOPT hands over to the projection on patterns of ``projection_vertices``
+        or more (far below ``f_tol``, so that the projection starts near a zero of F).
     slsqp_ftol, slsqp_max_iter : float, int
         SciPy SLSQP's stopping tolerance and iteration limit.
     degenerate_area : float
@@ -278,6 +291,11 @@ class Settings:
     ipopt_max_iter: int = 500
     ipopt_mu_strategy: str = "adaptive"
     ipopt_hessian: str = "closed-form"
+    projection_vertices: int = 200
+    projection_tol: float = 1e-14
+    projection_max_iter: int = 30
+    projection_damping: float = 1e-3
+    ipopt_stop_f: float = 1e-9
     slsqp_ftol: float = 1e-12
     slsqp_max_iter: int = 1000
     # geometry tolerances
@@ -370,9 +388,19 @@ class Settings:
         tol = self.surface_footprint_tol
         if not (math.isfinite(tol) and tol >= 0):
             raise ValueError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
+        for name in ("projection_tol", "projection_damping", "ipopt_stop_f"):
+            value = getattr(self, name)
+            if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value!r}")
         if not 0 < self.sparse_shift < 1:
             raise ValueError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
-        least = {"sparse_analysis_vertices": 3, "sparse_oversampling": 2, "sparse_iterations": 1}
+        least = {
+            "sparse_analysis_vertices": 3,
+            "sparse_oversampling": 2,
+            "sparse_iterations": 1,
+            "projection_vertices": 3,
+            "projection_max_iter": 1,
+        }
         for name, low in least.items():
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:

@@ -1,6 +1,7 @@
 """Progress on stderr for long commands: a rich bar on a terminal, plain lines otherwise.
 
-:class:`GenerateProgress` follows a generation run (DOF removed so far, locks, exceeds);
+:class:`GenerateProgress` follows a generation run (DOF removed so far, locks, exceeds, the
+cost of the last step, ETA);
 :class:`StudyProgress` follows a study (runs done, failures, rate, ETA). Both are silent when
 disabled, and import rich only when they first draw.
 """
@@ -38,29 +39,61 @@ def _rich_bar(label: str, *columns: str, eta: bool = False) -> Progress:
 
 
 class GenerateProgress:
-    """A bar over the DOF to remove; call :meth:`update` after every attempt and solution.
+    """Progress of a generation run over the DOF to remove; call :meth:`update` after every
+    attempt and solution.
+
+    It shows the DOF, the locks and exceeds so far, the cost of the last attempt (solve and
+    mechanism analysis, seconds) and an ETA from the mean time per DOF removed. On a terminal
+    it is a rich bar; otherwise (a batch job, a log file) a plain line with the same figures,
+    at most every ``log_every`` seconds and at the end.
 
     run : rigidfold.generate.Generation (``initial_dof``, ``n_reduce``, ``final_dof``,
-    ``n_lock``, ``n_exceed`` are read).
+    ``n_lock``, ``n_exceed`` are read); attempt : rigidfold.generate.Attempt or None
+    (``solve_time``, ``analysis_time``).
     """
 
-    def __init__(self, *, enabled: bool, target: int) -> None:
+    def __init__(self, *, enabled: bool, target: int, log_every: float = 30.0) -> None:
         self.enabled, self.target = enabled, target
         self.bar: Progress | None = None
         self.task: TaskID | None = None
+        self.plain = not sys.stderr.isatty()
+        self.log_every, self.t0 = log_every, time.monotonic()
+        self.last = -math.inf
+        self.step = ""
+
+    def describe(self, run, elapsed: float) -> tuple[int, int, str]:
+        """(DOF removed, DOF to remove, the figures) of a run after ``elapsed`` seconds."""
+        total = max(run.initial_dof - self.target, 0)
+        done = min(run.n_reduce, total)
+        eta = "?"
+        if done:
+            eta = f"{(total - done) * elapsed / done / 60:.1f} min"
+        text = (
+            f"DOF {run.final_dof}  lock {run.n_lock}  exceed {run.n_exceed}"
+            f"{self.step}  elapsed {elapsed / 60:.1f} min  ETA {eta}"
+        )
+        return done, total, text
 
     def update(self, run, attempt=None) -> None:
         if not self.enabled or run.initial_dof is None:
             return
+        if attempt is not None:
+            self.step = (
+                f"  last step: solve {attempt.solve_time:.2f} s, "
+                f"analysis {attempt.analysis_time:.2f} s"
+            )
+        now = time.monotonic()
+        done, total, text = self.describe(run, now - self.t0)
+        if self.plain:
+            if now - self.last >= self.log_every or done >= total:
+                self.last = now
+                print(f"generate {done}/{total}  {text}", file=sys.stderr, flush=True)
+            return
         if self.bar is None:
             self.bar = _rich_bar("generate")
-            self.task = self.bar.add_task("", total=max(run.initial_dof - self.target, 0))
+            self.task = self.bar.add_task("", total=total)
         assert self.task is not None  # added with the bar
-        self.bar.update(
-            self.task,
-            completed=run.n_reduce,
-            description=f"DOF {run.final_dof}  lock {run.n_lock}  exceed {run.n_exceed}",
-        )
+        self.bar.update(self.task, completed=done, description=text)
 
     def close(self) -> None:
         if self.bar is not None:

@@ -1,4 +1,13 @@
-"""IPOPT (through CasADi) on problem (6), with exact gradient, Jacobian and Hessian."""
+"""IPOPT (through CasADi) on problem (6), with exact gradient, Jacobian and Hessian.
+
+On large patterns (``Settings.projection_vertices``) the solver does three things: the
+projection onto F = 0 from the start (``rigidfold.optimize.projection``), which is all that is
+needed after one more crease is fixed; otherwise IPOPT, stopped at its first feasible
+iterate with F <= ``Settings.ipopt_stop_f`` by an iteration callback; then the projection
+from there. IPOPT's last iterations on (6) creep along the family of zeros of F: on a
+41 x 41 grid it reaches F = 1.5e-11 at iteration 98 of 180, and steps from a start that is
+already a solution can take 158 iterations that leave F where it was (``docs/scale.md``).
+"""
 
 from __future__ import annotations
 
@@ -7,6 +16,7 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
+from rigidfold.optimize.projection import Projection
 from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
 from rigidfold.quiet import native_quiet
 
@@ -17,6 +27,7 @@ _OUTCOME = {
     "Maximum_Iterations_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_WallTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
+    "User_Requested_Stop": SolverOutcome.SOLVED,  # only _EarlyStop asks, at F <= ipopt_stop_f
 }
 
 
@@ -58,6 +69,8 @@ class IpoptSolver:
 
     def __init__(self, problem: SolverProblem) -> None:
         nlp = problem.nlp
+        large = problem.pattern.n_vertices >= problem.settings.projection_vertices
+        self.projection = Projection(problem) if large else None
         self._lbg, self._ubg = nlp.lbg, nlp.ubg
         options = ipopt_options(problem.settings) | {
             # the problem's derivatives, so that CasADi does not differentiate (6) again
@@ -72,14 +85,35 @@ class IpoptSolver:
         if problem.settings.ipopt_hessian == "closed-form":
             self._hess_lag = closed_form_hess_lag(problem)
             options["hess_lag"] = self._hess_lag
+        self._stop = None
+        if large:
+            self._stop = _EarlyStop(problem, problem.settings.ipopt_stop_f)
+            options["iteration_callback"] = self._stop
         with native_quiet():
             self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 
     def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
-        The run's message is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``.
+        The run's message is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``, and on
+        large patterns what the projection did before or after it.
         """
+        if self.projection is None:
+            return self._ipopt(xi0, w)
+        first = self.projection(xi0, w)
+        if first.converged:
+            return SolverRun(
+                first.xi, first.iterations, SolverOutcome.SOLVED, f"projection: {first.reason}"
+            )
+        run = self._ipopt(xi0, w)
+        polish = self.projection(run.xi, w)
+        iterations = first.iterations + run.iterations + polish.iterations
+        message = f"projection: {first.reason}; {run.message}; projection: {polish.reason}"
+        if polish.converged:
+            return SolverRun(polish.xi, iterations, SolverOutcome.SOLVED, message)
+        return SolverRun(polish.xi, iterations, run.outcome, message)
+
+    def _ipopt(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
         with native_quiet():
             sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
         stats = self.nlpsol.stats()
@@ -90,3 +124,50 @@ class IpoptSolver:
             outcome=_OUTCOME.get(status, SolverOutcome.FAILED),
             message=f"IPOPT: {status}",
         )
+
+
+class _EarlyStop(ca.Callback):
+    """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f``.
+
+    CasADi calls it with nlpsol's outputs (x, f, g, lam_x, lam_g, lam_p) after each iteration;
+    a return value of 1 ends the run as ``User_Requested_Stop`` at that iterate.
+    """
+
+    def __init__(self, problem: SolverProblem, stop_f: float) -> None:
+        ca.Callback.__init__(self)
+        self.stop_f = stop_f
+        self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
+        self.tol = 0.1 * problem.settings.constraint_tol
+        self.sizes = {
+            "x": problem.map.n_variables,
+            "lam_x": problem.map.n_variables,
+            "g": len(self.lbg),
+            "lam_g": len(self.lbg),
+            "f": 1,
+            "lam_p": 0,
+        }
+        self.construct("early_stop", {})
+
+    def get_n_in(self) -> int:
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self) -> int:
+        return 1
+
+    def get_name_in(self, i: int) -> str:
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i: int) -> str:
+        return "stop"
+
+    def get_sparsity_in(self, i: int) -> ca.Sparsity:
+        size = self.sizes[ca.nlpsol_out(i)]
+        return ca.Sparsity.dense(size, 1) if size else ca.Sparsity(0, 1)
+
+    def eval(self, arg):
+        f = float(arg[1])
+        if not f <= self.stop_f:
+            return [0]
+        g = np.asarray(arg[2], dtype=float).ravel()
+        violation = max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0))
+        return [1 if violation <= self.tol else 0]

@@ -73,6 +73,10 @@ class SolverProblem(Protocol):
     @property
     def constraints(self) -> ca.Function: ...
 
+    def violation(self, coords: np.ndarray, fixed: np.ndarray) -> float:
+        """Largest violation of any constraint of (6) at a shape (V, 3), fixed (E,) bool."""
+        ...
+
 
 class Solver(Protocol):
     """A solver of problem (6), built for one ``SolverProblem`` (a ``FormFindingProblem``)."""

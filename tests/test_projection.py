@@ -1,0 +1,172 @@
+"""The projection onto F = 0 and the large-pattern path of the IPOPT solver (issue 19).
+
+Unit tests over reference patterns (the residuals are F, their Jacobian its derivative),
+invariants (every projected iterate is feasible; the fold-angle gradient equals the mechanism
+analysis's), and the solver's path: paper-size patterns run IPOPT alone, large ones project.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidfold.case import make_case
+from rigidfold.config import DEFAULTS
+from rigidfold.generate import generate
+from rigidfold.mechanism.kinematics import fold_angles_and_gradients
+from rigidfold.optimize import Status
+from rigidfold.optimize.hessian import angle_derivatives
+from rigidfold.optimize.projection import Projection
+from rigidfold.optimize.residuals import Residuals, angle_gradients, fold_angle_gradients
+
+CASES = [
+    ("bezier", "1", {"seed": 3}),
+    ("bezier", "2", {"seed": 5}),
+    ("hp", "11", {"symmetric": True}),
+    ("dome", "grid:7x7", {"size": "3x3"}),
+    ("dome", "mesh:0,0;3,0;3,2;1.5,2.6;0,2", {"edge_length": 0.5}),
+]
+
+
+def _perturbed(problem, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return problem.start_point() + 0.02 * rng.standard_normal(problem.n_variables)
+
+
+@pytest.mark.parametrize(("surface", "pattern", "kw"), CASES)
+def test_residuals_square_to_the_objective_and_differentiate_to_its_jacobian(surface, pattern, kw):
+    problem = make_case(surface, pattern, **kw).problem(build_ipopt=False)
+    rng = np.random.default_rng(1)
+    xi = _perturbed(problem, 2)
+    w = (rng.random(problem.pattern.n_edges) < 0.3).astype(float)
+    res = Residuals(problem.pattern, problem.map)
+    r, J = res(xi, w)
+    F, F1, _ = (float(v) for v in problem.objective(xi, w))
+    assert r @ r == pytest.approx(F, rel=1e-12)
+    assert r[: res.n_inner] @ r[: res.n_inner] == pytest.approx(F1, rel=1e-12)
+    assert J.shape == (len(r), problem.n_variables)
+    d = rng.standard_normal(problem.n_variables)
+    h = 1e-6
+    fd = (res(xi + h * d, w, False)[0] - res(xi - h * d, w, False)[0]) / (2 * h)
+    assert np.abs(J @ d - fd).max() <= 1e-6 * max(1.0, np.abs(fd).max())
+
+
+def test_element_gradients_equal_the_hessian_module_and_the_mechanism_analysis():
+    rng = np.random.default_rng(4)
+    corners = rng.standard_normal((50, 3, 3))
+    theta, grad = angle_gradients(corners)
+    u, v = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    theta_ref, g6, _ = angle_derivatives(u, v)
+    np.testing.assert_allclose(theta, theta_ref, rtol=1e-12)
+    np.testing.assert_allclose(grad[:, 3:], g6, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(grad[:, :3], -g6[:, :3] - g6[:, 3:], rtol=1e-10, atol=1e-12)
+    coords = rng.standard_normal((40, 3))
+    stencils = np.array([rng.choice(40, 4, replace=False) for _ in range(30)])
+    rho, g = fold_angle_gradients(coords[stencils])
+    rho_ref, g_ref, _ = fold_angles_and_gradients(coords, stencils)
+    np.testing.assert_allclose(rho, rho_ref, atol=1e-13)
+    np.testing.assert_allclose(g, g_ref, rtol=1e-9, atol=1e-10)
+
+
+@pytest.fixture(scope="module")
+def solved_grid():
+    """A 21 x 21 grid on the dome (441 vertices, the large-pattern path) and its solution."""
+    case = make_case("dome", "grid:21x21", size="3x3")
+    problem = case.problem()
+    return case, problem, problem.solve()
+
+
+def test_large_pattern_ipopt_hands_over_to_the_projection(solved_grid):
+    case, _, result = solved_grid
+    assert case.pattern.n_vertices >= DEFAULTS.projection_vertices
+    assert result.status is Status.CONVERGED
+    assert result.F <= DEFAULTS.projection_tol
+    assert result.max_violation == 0.0
+    # the lifted dome breaks the sector-angle bounds: IPOPT first, stopped early, then polished
+    assert "the start violates a constraint" in result.message
+    assert "User_Requested_Stop" in result.message
+    assert "projection: converged, F = " in result.message
+
+
+def test_paper_size_patterns_run_ipopt_alone():
+    result = make_case("dome", "grid:11x11", size="3x3").problem().solve()
+    assert result.status is Status.CONVERGED
+    assert result.message.startswith("IPOPT: Solve_Succeeded")
+    assert "projection" not in result.message
+
+
+def test_a_larger_threshold_keeps_ipopt_alone_on_a_large_pattern():
+    settings = DEFAULTS.with_(projection_vertices=10**6)
+    case = make_case("dome", "grid:15x15", size="3x3", settings=settings)
+    result = case.problem().solve()
+    assert result.status is Status.CONVERGED
+    assert "projection" not in result.message
+
+
+def test_fixing_one_more_crease_is_a_short_projection(solved_grid):
+    _, problem, result = solved_grid
+    rho = np.abs(result.pattern.fold_angles)
+    folded = np.flatnonzero(~result.pattern.is_boundary_edge & (rho > 1e-3))
+    crease = folded[np.argmin(rho[folded])]  # as the criteria tend to: a crease folded little
+    fixed = result.pattern.fixed.copy()
+    fixed[crease] = True
+    again = problem.solve(fixed=fixed, start=result.coords)
+    assert again.status is Status.CONVERGED
+    assert again.message.startswith("projection: converged, F = ")
+    assert abs(again.pattern.fold_angles[crease]) < 1e-7
+    assert again.max_violation == 0.0
+    assert again.iterations < DEFAULTS.projection_max_iter
+
+
+def test_every_projected_iterate_stays_feasible(solved_grid):
+    """With the dz bound pulled in to the solution's own largest |dz|, the projection may not
+    step outside it: it ends at a feasible point, converged or not."""
+    case, _, result = solved_grid
+    coords = result.coords
+    dz = np.abs(coords[:, 2] - case.surface.height(coords[:, 0], coords[:, 1])).max()
+    tight = make_case(
+        "dome", "grid:21x21", size="3x3", settings=DEFAULTS.with_(dz=float(dz) + 1e-9)
+    ).problem(build_ipopt=False)
+    projection = Projection(tight)
+    w = np.zeros(case.pattern.n_edges)
+    interior = np.flatnonzero(~result.pattern.is_boundary_edge)
+    w[interior[np.argsort(-np.abs(result.pattern.fold_angles[interior]))[:3]]] = 1.0
+    out = projection(tight.start_point(coords), w)
+    assert tight.violation(tight.map.expand(out.xi), w > 0) <= 0.1 * DEFAULTS.constraint_tol
+    assert out.iterations >= 1
+
+
+def test_an_infeasible_start_is_not_projected():
+    problem = make_case("dome", "grid:21x21", size="3x3").problem(build_ipopt=False)
+    out = Projection(problem)(problem.start_point(), np.zeros(problem.pattern.n_edges))
+    assert not out.converged
+    assert out.iterations == 0
+    assert "violates" in out.reason
+
+
+def test_generate_on_a_large_grid_projects_after_the_first_solve():
+    case = make_case("dome", "grid:15x15", size="3x3")
+    assert case.pattern.n_vertices >= DEFAULTS.projection_vertices
+    messages = []
+    run = generate(case, criterion="s", target_dof=case.settings.target_dof)
+    for sol in run.solutions:
+        messages.append(sol.result.message)
+    assert run.final_dof is not None and run.solutions
+    assert all(s.result.max_violation == 0.0 for s in run.solutions)
+    projected = [m.startswith("projection: converged") for m in messages[1:]]
+    assert sum(projected) >= len(projected) // 2
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("projection_vertices", 2),
+        ("projection_max_iter", 0),
+        ("projection_tol", 0.0),
+        ("projection_damping", -1.0),
+        ("ipopt_stop_f", float("nan")),
+    ],
+)
+def test_projection_settings_are_validated(name, value):
+    with pytest.raises(ValueError, match=name):
+        DEFAULTS.with_(**{name: value})
