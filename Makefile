@@ -44,6 +44,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/own_design.py
 	$(PY) benchmarks/bench_solve_scale.py
 	$(PY) benchmarks/bench_scale.py
+	$(PY) benchmarks/bench_generate_scale.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
