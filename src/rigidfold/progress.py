@@ -59,38 +59,43 @@ class GenerateProgress:
         self.plain = not sys.stderr.isatty()
         self.log_every, self.t0 = log_every, time.monotonic()
         self.last = -math.inf
-        self.step = ""
+        self.costs: tuple[float, float] | None = None  # solve, analysis of the last attempt
+
+    def counts(self, run) -> tuple[int, int, str]:
+        """(DOF removed, DOF to remove, "DOF d  lock l  exceed e") of a run."""
+        total = max(run.initial_dof - self.target, 0)
+        dof = run.initial_dof if run.final_dof is None else run.final_dof  # before a solution
+        return (
+            min(run.n_reduce, total),
+            total,
+            (f"DOF {dof}  lock {run.n_lock}  exceed {run.n_exceed}"),
+        )
 
     def describe(self, run, elapsed: float) -> tuple[int, int, str]:
         """(DOF removed, DOF to remove, the figures) of a run after ``elapsed`` seconds."""
-        total = max(run.initial_dof - self.target, 0)
-        done = min(run.n_reduce, total)
-        eta = "?"
-        if done:
-            eta = f"{(total - done) * elapsed / done / 60:.1f} min"
-        text = (
-            f"DOF {run.final_dof}  lock {run.n_lock}  exceed {run.n_exceed}"
-            f"{self.step}  elapsed {elapsed / 60:.1f} min  ETA {eta}"
-        )
-        return done, total, text
+        done, total, text = self.counts(run)
+        if self.costs is not None:
+            text += f"  last step: solve {self.costs[0]:.2f} s, analysis {self.costs[1]:.2f} s"
+        eta = f"{(total - done) * elapsed / done / 60:.1f} min" if done else "?"
+        return done, total, f"{text}  elapsed {elapsed / 60:.1f} min  ETA {eta}"
 
     def update(self, run, attempt=None) -> None:
         if not self.enabled or run.initial_dof is None:
             return
         if attempt is not None:
-            self.step = (
-                f"  last step: solve {attempt.solve_time:.2f} s, "
-                f"analysis {attempt.analysis_time:.2f} s"
-            )
-        now = time.monotonic()
-        done, total, text = self.describe(run, now - self.t0)
+            self.costs = (attempt.solve_time, attempt.analysis_time)
         if self.plain:
+            now = time.monotonic()
+            done, total, text = self.describe(run, now - self.t0)
             if now - self.last >= self.log_every or done >= total:
                 self.last = now
                 print(f"generate {done}/{total}  {text}", file=sys.stderr, flush=True)
             return
+        done, total, text = self.counts(run)  # elapsed and ETA in rich's columns: it fits
+        if self.costs is not None:
+            text += f"  step {self.costs[0]:.2f}+{self.costs[1]:.2f} s"
         if self.bar is None:
-            self.bar = _rich_bar("generate")
+            self.bar = _rich_bar("generate", eta=True)
             self.task = self.bar.add_task("", total=total)
         assert self.task is not None  # added with the bar
         self.bar.update(self.task, completed=done, description=text)

@@ -19,15 +19,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from rigidfold.mesh import CreasePattern
+from rigidfold.optimize.hessian import B_ANGLE, row_cross, row_dot
 from rigidfold.optimize.variables import LinearMap
-
-_B_ANGLE = np.zeros((6, 9))  # (u, v) = (b - a, c - a) from the corners (a, b, c)
-_B_ANGLE[0:3, 0:3] = _B_ANGLE[3:6, 0:3] = -np.eye(3)
-_B_ANGLE[0:3, 3:6] = _B_ANGLE[3:6, 6:9] = np.eye(3)
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("ki,ki->k", a, b)
 
 
 def angle_gradients(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -37,7 +30,7 @@ def angle_gradients(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     c - a.  ->  theta (K,), grad (K, 9) in (a, b, c).
     """
     u, v = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-    uu, vv, c = _dot(u, u), _dot(v, v), _dot(u, v)
+    uu, vv, c = row_dot(u, u), row_dot(v, v), row_dot(u, v)
     s = np.sqrt(np.maximum(uu * vv - c * c, 0.0))  # |u x v|
     r2 = uu * vv
     # grad theta = (c grad s - s grad c) / r2, grad s = (u |v|^2 - c v, v |u|^2 - c u) / s
@@ -47,7 +40,7 @@ def angle_gradients(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     gv = (c[:, None] * (v * uu[:, None] - c[:, None] * u) / s[:, None] - s[:, None] * u) / r2[
         :, None
     ]
-    return np.arctan2(s, c), np.concatenate([gu, gv], axis=1) @ _B_ANGLE
+    return np.arctan2(s, c), np.concatenate([gu, gv], axis=1) @ B_ANGLE
 
 
 def fold_angle_gradients(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -63,16 +56,16 @@ def fold_angle_gradients(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     pu, pv, pa, pb = (corners[:, k] for k in range(4))
     e = pv - pu
-    ee = _dot(e, e)
-    na = np.cross(e, pa - pu)  # left triangle (u, v, a)
-    nb = np.cross(pu - pv, pb - pv)  # right triangle (v, u, b)
+    ee = row_dot(e, e)
+    na = row_cross(e, pa - pu)  # left triangle (u, v, a)
+    nb = row_cross(pu - pv, pb - pv)  # right triangle (v, u, b)
     t = e / np.sqrt(ee)[:, None]
-    rho = np.arctan2(-_dot(np.cross(na, nb), t), _dot(na, nb))
+    rho = np.arctan2(-row_dot(row_cross(na, nb), t), row_dot(na, nb))
     length = np.sqrt(ee)
-    ga = (length / _dot(na, na))[:, None] * na
-    gb = (length / _dot(nb, nb))[:, None] * nb
-    sa = (_dot(pa - pu, e) / ee)[:, None]  # where a projects onto the crease, 0 at u, 1 at v
-    sb = (_dot(pb - pu, e) / ee)[:, None]
+    ga = (length / row_dot(na, na))[:, None] * na
+    gb = (length / row_dot(nb, nb))[:, None] * nb
+    sa = (row_dot(pa - pu, e) / ee)[:, None]  # where a projects onto the crease, 0 at u, 1 at v
+    sb = (row_dot(pb - pu, e) / ee)[:, None]
     gu = -(1 - sa) * ga - (1 - sb) * gb
     gv = -sa * ga - sb * gb
     return rho, np.concatenate([gu, gv, ga, gb], axis=1)
@@ -100,6 +93,9 @@ class Residuals:
         self.n_inner = len(inner)
         self._angle_corners = corners[at_inner]  # (A, 3): angles that count in F1
         self._angle_row = row_of[corners[at_inner, 0]]
+        # their rows and columns in the Jacobian in P = (x_1..x_V, y_1..y_V, z_1..z_V)
+        self._angle_J_rows = np.repeat(self._angle_row, 9)
+        self._angle_J_cols = (self._angle_corners[:, :, None] + V * np.arange(3)).ravel()
         self.interior = pattern.interior_edges
         self._stencils = pattern.crease_stencils(self.interior)  # (Ei, 4)
 
@@ -118,13 +114,11 @@ class Residuals:
         r = np.concatenate([defect, root * np.sin(rho)])
         if not jacobian:
             return r, None
-        # columns in P = (x_1..x_V, y_1..y_V, z_1..z_V)
-        cols_a = (self._angle_corners[:, :, None] + V * np.arange(3)).reshape(-1, 9)
-        cols_r = (self._stencils[on][:, :, None] + V * np.arange(3)).reshape(-1, 12)
+        cols_r = (self._stencils[on][:, :, None] + V * np.arange(3)).ravel()
         rows = np.concatenate(
-            [np.repeat(self._angle_row, 9), self.n_inner + np.repeat(np.arange(len(on)), 12)]
+            [self._angle_J_rows, self.n_inner + np.repeat(np.arange(len(on)), 12)]
         )
-        cols = np.concatenate([cols_a.ravel(), cols_r.ravel()])
+        cols = np.concatenate([self._angle_J_cols, cols_r])
         vals = np.concatenate([-g_theta.ravel(), ((root * np.cos(rho))[:, None] * g_rho).ravel()])
         J_P = sp.csr_matrix((vals, (rows, cols)), shape=(len(r), 3 * V))
         return r, (J_P @ self.T).tocsr()
