@@ -8,8 +8,8 @@ The case is the issue's: ``grid:NxN`` spanning 3 m with diagonals towards the ce
 dome, criterion S, no Step 9 (``generate`` itself, as ``rigidfold generate --pattern
 grid:41x41 --size 3x3 --surface dome --criterion s --no-deform`` runs it). Printed: the wall
 time to the lowest DOF, the number of solves, N_lock and N_exceed, how the solves ended
-(the projection alone, or IPOPT and then the projection), and the medians and totals of the
-solve and analysis times per attempt.
+(the projection alone, or IPOPT and then the projection), the medians and totals of the
+solve and analysis times per attempt, and the five slowest solves with the solver's words.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def main() -> None:
     args = parser.parse_args()
     settings = DEFAULTS.with_(projection_vertices=10**9) if args.ipopt_alone else DEFAULTS
     case = make_case("dome", f"grid:{args.grid}x{args.grid}", size="3x3", settings=settings)
-    messages: list[str] = []  # the solver's words of every solve, in order
+    messages: list[tuple[float, str]] = []  # (seconds, the solver's words) of every solve
     build = case.problem
 
     def recording_problem(*a, **kw):
@@ -41,7 +41,7 @@ def main() -> None:
 
         def recording_solve(*sa, **skw):
             result = solve(*sa, **skw)
-            messages.append("ipopt" if "IPOPT" in result.message else "projection")
+            messages.append((result.wall_time, result.message))
             return result
 
         problem.solve = recording_solve
@@ -64,15 +64,16 @@ def main() -> None:
         f"{wall:.1f} s ({wall / 60:.1f} min), {len(run.attempts)} solves, "
         f"N_lock {run.n_lock}, N_exceed {run.n_exceed}"
     )
-    print(
-        f"solves by the projection alone: {messages.count('projection')}, "
-        f"with IPOPT: {messages.count('ipopt')}"
-    )
+    with_ipopt = sum("IPOPT" in message for _, message in messages)
+    print(f"solves by the projection alone: {len(messages) - with_ipopt}, with IPOPT: {with_ipopt}")
     print(
         f"per attempt: solve median {statistics.median(solve):.2f} s (total {sum(solve):.1f} s, "
         f"largest {max(solve):.1f} s), analysis median {statistics.median(analysis):.2f} s "
         f"(total {sum(analysis):.1f} s); build {run.build_time:.1f} s"
     )
+    print("slowest solves:")
+    for seconds, message in sorted(messages, reverse=True)[:5]:
+        print(f"  {seconds:7.2f} s  {message}")
 
 
 if __name__ == "__main__":

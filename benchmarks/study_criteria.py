@@ -5,7 +5,8 @@
 For each pattern and criterion, runs ``generate`` (target DOF 1, no deformation check) on
 Bezier seeds 0..N-1 and prints the means of N_reduce, N_lock, N_exceed and F (the mean
 over each run's accepted solutions, then over runs), next to the paper's Tables 5 and 6
-(100 surfaces each). The full 100-surface study with its database is a separate tool.
+(100 surfaces each); each count is followed by the standard error of its mean. The full
+100-surface study with its database is a separate tool.
 """
 
 from __future__ import annotations
@@ -36,6 +37,14 @@ def support_face(case, corner: str) -> int | None:
     point = np.array([float(v) for v in corner.split(",")])
     bary = case.pattern.coords[case.pattern.faces].mean(axis=1)[:, :2]
     return int(np.argmin(np.linalg.norm(bary - point, axis=1)))
+
+
+COUNTS = ("N_reduce", "N_lock", "N_exceed")
+
+
+def standard_error(values: list[float]) -> float:
+    """Standard error of the mean of ``values`` (0 for fewer than two)."""
+    return statistics.stdev(values) / len(values) ** 0.5 if len(values) > 1 else 0.0
 
 
 def one_run(args: tuple[str, str, int, str, str]) -> dict:
@@ -71,7 +80,7 @@ def main() -> None:
     )
     args = parser.parse_args()
     header = (
-        f"{'pattern':<8}{'criterion':<10}{'N_reduce':>9}{'N_lock':>8}{'N_exceed':>9}"
+        f"{'pattern':<8}{'criterion':<10}{'N_reduce':>14}{'N_lock':>14}{'N_exceed':>14}"
         f"{'mean F':>10}{'DOF 1':>7}{'wall s':>8}   paper: N_reduce N_lock N_exceed F"
     )
     print(header)
@@ -82,16 +91,17 @@ def main() -> None:
                     (pattern, criterion, s, args.solver, args.support) for s in range(args.seeds)
                 ]
                 runs = list(pool.map(one_run, jobs))
-                means = {k: statistics.mean(r[k] for r in runs) for k in ("N_reduce", "N_lock")}
-                means["N_exceed"] = statistics.mean(r["N_exceed"] for r in runs)
+                means = {k: statistics.mean(r[k] for r in runs) for k in COUNTS}
+                errors = {k: standard_error([r[k] for r in runs]) for k in COUNTS}
                 wall = statistics.median(r["wall_s"] for r in runs)
                 fs = [r["mean_F_accepted"] for r in runs if r["mean_F_accepted"] is not None]
                 reached = sum(r["final_dof"] == 1 for r in runs)
                 p = PAPER.get((pattern, criterion))
                 paper = f"{p[0]:.2f} {p[1]:.2f} {p[2]:.2f} {p[3]:.2e}" if p else ""
                 print(
-                    f"{pattern:<8}{criterion:<10}{means['N_reduce']:>9.2f}{means['N_lock']:>8.2f}"
-                    f"{means['N_exceed']:>9.2f}{statistics.mean(fs):>10.2e}"
+                    f"{pattern:<8}{criterion:<10}"
+                    + "".join(f"{means[k]:>7.2f} ±{errors[k]:<5.2f}" for k in COUNTS)
+                    + f"{statistics.mean(fs):>10.2e}"
                     f"{reached:>4}/{len(runs):<3}{wall:>7.1f}"
                     f"   {paper}",
                     flush=True,

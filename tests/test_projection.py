@@ -136,10 +136,50 @@ def test_every_projected_iterate_stays_feasible(solved_grid):
     assert out.iterations >= 1
 
 
+def test_a_step_blocked_by_a_bound_slides_along_it(solved_grid):
+    """With the dz bound pulled in to the solution's own largest |dz|, fixing the three creases
+    folded least needs a step that would push a vertex past the bound: the projection holds
+    that constraint (its row joins J) and still converges, instead of refusing every step."""
+    case, _, result = solved_grid
+    coords = result.coords
+    dz = np.abs(coords[:, 2] - case.surface.height(coords[:, 0], coords[:, 1])).max()
+    tight = make_case(
+        "dome", "grid:21x21", size="3x3", settings=DEFAULTS.with_(dz=float(dz) + 1e-9)
+    ).problem(build_ipopt=False)
+    rho = np.abs(result.pattern.fold_angles)
+    folded = np.flatnonzero(~result.pattern.is_boundary_edge & (rho > 1e-3))
+    w = np.zeros(case.pattern.n_edges)
+    w[folded[np.argsort(rho[folded])[:3]]] = 1.0
+    out = Projection(tight)(tight.start_point(coords), w)
+    assert out.converged and out.feasible
+    assert out.held >= 1
+    assert "constraint held" in out.reason
+    assert tight.violation(tight.map.expand(out.xi), w > 0) <= 0.1 * DEFAULTS.constraint_tol
+    F, _, _ = (float(v) for v in tight.objective(out.xi, w))
+    assert F <= DEFAULTS.projection_tol
+
+
+def test_a_projection_stopped_near_a_zero_is_taken_without_ipopt(solved_grid):
+    """A feasible projection that stops at F <= ipopt_stop_f is the answer: IPOPT would stop
+    at once. Here projection_tol is out of reach, so every step stops at its iteration limit."""
+    _, _, result = solved_grid
+    settings = DEFAULTS.with_(projection_tol=1e-300, projection_max_iter=8, ipopt_stop_f=1e-6)
+    problem = make_case("dome", "grid:21x21", size="3x3", settings=settings).problem()
+    rho = np.abs(result.pattern.fold_angles)
+    folded = np.flatnonzero(~result.pattern.is_boundary_edge & (rho > 1e-3))
+    fixed = result.pattern.fixed.copy()
+    fixed[folded[np.argmin(rho[folded])]] = True
+    again = problem.solve(fixed=fixed, start=result.coords)
+    assert again.message.startswith("projection: stopped at F = ")
+    assert "IPOPT" not in again.message
+    assert again.status is Status.CONVERGED
+    assert again.F <= 1e-6 and again.max_violation == 0.0
+
+
 def test_an_infeasible_start_is_not_projected():
     problem = make_case("dome", "grid:21x21", size="3x3").problem(build_ipopt=False)
     out = Projection(problem)(problem.start_point(), np.zeros(problem.pattern.n_edges))
-    assert not out.converged
+    assert not out.converged and not out.feasible
     assert out.iterations == 0
     assert "violates" in out.reason
 
@@ -164,6 +204,7 @@ def test_generate_on_a_large_grid_projects_after_the_first_solve():
         ("projection_max_iter", 0),
         ("projection_tol", 0.0),
         ("projection_damping", -1.0),
+        ("projection_margin", 0.0),
         ("ipopt_stop_f", float("nan")),
     ],
 )

@@ -82,9 +82,13 @@ class Settings:
         The projection converges at F <= ``projection_tol``, stops after
         ``projection_max_iter`` factorisations, and starts with the damping
         ``projection_damping`` times |r| times the largest diagonal entry of J J^T.
+    projection_margin : float
+        How far inside its bound the projection holds a constraint of (6) that blocked one of
+        its steps (radians for sector angles, metres for dz, the cosine for (12)).
     ipopt_stop_f : float
         F at which IPOPT hands over to the projection on patterns of ``projection_vertices``
-        or more (far below ``f_tol``, so that the projection starts near a zero of F).
+        or more (far below ``f_tol``, so that the projection starts near a zero of F); a
+        projection that stops at a feasible point this close to F = 0 is taken without IPOPT.
     slsqp_ftol, slsqp_max_iter : float, int
         SciPy SLSQP's stopping tolerance and iteration limit.
     degenerate_area : float
@@ -293,8 +297,9 @@ class Settings:
     ipopt_hessian: str = "closed-form"
     projection_vertices: int = 200
     projection_tol: float = 1e-14
-    projection_max_iter: int = 30
+    projection_max_iter: int = 60
     projection_damping: float = 1e-3
+    projection_margin: float = 1e-5
     ipopt_stop_f: float = 1e-9
     slsqp_ftol: float = 1e-12
     slsqp_max_iter: int = 1000
@@ -388,7 +393,7 @@ class Settings:
         tol = self.surface_footprint_tol
         if not (math.isfinite(tol) and tol >= 0):
             raise ValueError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
-        for name in ("projection_tol", "projection_damping", "ipopt_stop_f"):
+        for name in ("projection_tol", "projection_damping", "projection_margin", "ipopt_stop_f"):
             value = getattr(self, name)
             if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")

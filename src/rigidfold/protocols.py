@@ -53,6 +53,10 @@ class TargetSurface(Protocol):
         """z at plan points; x, y are arrays of one shape (or CasADi symbols with xp=casadi)."""
         ...
 
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(f_x, f_y) at plan points.  arrays of the broadcast shape of x, y"""
+        ...
+
     def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(f_xx, f_xy, f_yy) at plan points.  arrays of the broadcast shape of x, y"""
         ...

@@ -145,7 +145,7 @@ def normal_cosine_derivatives(pa: np.ndarray, pb: np.ndarray):
     return c, grad, hess
 
 
-def _expand(T: sp.csr_matrix, rows: np.ndarray):
+def expand_rows(T: sp.csr_matrix, rows: np.ndarray):
     """Nonzeros of T[rows]: (entry, column, value) for each listed P-row."""
     sub = T[rows]
     entry = np.repeat(np.arange(len(rows)), np.diff(sub.indptr))
@@ -171,7 +171,7 @@ def _pairs(T: sp.csr_matrix, I: np.ndarray, J: np.ndarray):
     return entry[keep], a[keep], b[keep], weight[keep]
 
 
-def _unique(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """np.unique(keys, return_inverse=True) of int64 keys, by one sort.  -> (unique, slot)"""
     order = np.argsort(keys)
     ordered = keys[order]
@@ -242,7 +242,7 @@ class ClosedFormHessian:
         # Gauss-Newton part of F1: rows of grad d_v in xi, from the angle gradients
         at_inner = np.flatnonzero(self.angle_row >= 0)
         gI = angle_P[at_inner].ravel()
-        g_entry, g_col, g_w = _expand(self.T, gI)
+        g_entry, g_col, g_w = expand_rows(self.T, gI)
         g_local = at_inner[g_entry // 9] * 9 + g_entry % 9  # index into (3F, 9) gradients
         g_row = self.angle_row[g_local // 9]
         key = g_row * n + g_col
@@ -254,7 +254,7 @@ class ClosedFormHessian:
         self.gn_p, self.gn_q = _upper_pairs(np.bincount(G_row, minlength=self.n_inner))
         gn_a, gn_b = G_col[self.gn_p], G_col[self.gn_q]
         # the fixed upper-triangle sparsity: union of everything, column-major
-        keys, slots = _unique(
+        keys, slots = unique_inverse(
             np.concatenate([b * n + a for _, a, b, _ in blocks] + [gn_b * n + gn_a])
         )
         cols, rows = keys // n, keys % n

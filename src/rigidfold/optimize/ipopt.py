@@ -1,12 +1,15 @@
 """IPOPT (through CasADi) on problem (6), with exact gradient, Jacobian and Hessian.
 
-On large patterns (``Settings.projection_vertices``) the solver does three things: the
-projection onto F = 0 from the start (``rigidfold.optimize.projection``), which is all that is
-needed after one more crease is fixed; otherwise IPOPT, stopped at its first feasible
-iterate with F <= ``Settings.ipopt_stop_f`` by an iteration callback; then the projection
-from there. IPOPT's last iterations on (6) creep along the family of zeros of F: on a
-41 x 41 grid it reaches F = 1.5e-11 at iteration 98 of 180, and steps from a start that is
-already a solution can take 158 iterations that leave F where it was (``docs/scale.md``).
+On large patterns (``Settings.projection_vertices``) IPOPT gets the gradient of F and the
+constraint Jacobian in closed form (``rigidfold.optimize.jacobian``), and the solver does
+three things: the projection onto F = 0 from the start (``rigidfold.optimize.projection``),
+which is all that is needed after one more crease is fixed (a projection that stops,
+feasible, at F <= ``Settings.ipopt_stop_f`` is taken too: IPOPT would stop there at once);
+otherwise IPOPT, stopped at its first feasible iterate with F <= ``ipopt_stop_f`` by an
+iteration callback; then the projection from there. IPOPT's last iterations on (6) creep
+along the family of zeros of F: on a 41 x 41 grid it reaches F = 1.5e-11 at iteration 98 of
+180, and steps from a start that is already a solution can take 158 iterations that leave F
+where it was (``docs/scale.md``).
 """
 
 from __future__ import annotations
@@ -16,7 +19,9 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
+from rigidfold.optimize.jacobian import ClosedFormJacobian, closed_form_first_derivatives
 from rigidfold.optimize.projection import Projection
+from rigidfold.optimize.residuals import Residuals
 from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
 from rigidfold.quiet import native_quiet
 
@@ -70,12 +75,22 @@ class IpoptSolver:
     def __init__(self, problem: SolverProblem) -> None:
         nlp = problem.nlp
         large = problem.pattern.n_vertices >= problem.settings.projection_vertices
-        self.projection = Projection(problem) if large else None
+        self.projection = None
+        if large:
+            residuals, jacobian = (
+                Residuals(problem.pattern, problem.map),
+                ClosedFormJacobian(problem),
+            )
+            self.projection = Projection(problem, residuals, jacobian)
         self._lbg, self._ubg = nlp.lbg, nlp.ubg
+        self._stop_f = problem.settings.ipopt_stop_f
+        if large:  # closed-form first derivatives: CasADi's cost most of a large build
+            self._first = closed_form_first_derivatives(problem, residuals, jacobian)
+        else:  # the problem's, so that CasADi does not differentiate (6) again
+            self._first = (problem.objective_gradient, problem.constraint_jacobian)
         options = ipopt_options(problem.settings) | {
-            # the problem's derivatives, so that CasADi does not differentiate (6) again
-            "grad_f": problem.objective_gradient,
-            "jac_g": problem.constraint_jacobian,
+            "grad_f": self._first[0],
+            "jac_g": self._first[1],
             # no multipliers of the parameters w: their symbolic gradient of the
             # Lagrangian would cost more to build than everything else
             "calc_lam_p": False,
@@ -101,7 +116,8 @@ class IpoptSolver:
         if self.projection is None:
             return self._ipopt(xi0, w)
         first = self.projection(xi0, w)
-        if first.converged:
+        if first.converged or (first.feasible and first.F <= self._stop_f):
+            # IPOPT would stop at once and hand the same point back
             return SolverRun(
                 first.xi, first.iterations, SolverOutcome.SOLVED, f"projection: {first.reason}"
             )

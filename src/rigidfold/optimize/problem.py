@@ -65,8 +65,9 @@ class FormFindingProblem:
     objective : ca.Function (xi, w) -> (F, F1, F2)
     objective_gradient : ca.Function (xi, w) -> (F, dF (n,))
     constraints : ca.Function (xi, w) -> g (m,)
-        Built on first use (only SLSQP needs it).
     constraint_jacobian : ca.Function (xi, w) -> (g (m,), dg (m, n))
+        CasADi's symbolic derivatives, each built on first use (IPOPT on paper-size
+        patterns, SLSQP; large patterns give IPOPT ``rigidfold.optimize.jacobian``'s).
     build_time : float
         Seconds spent building the model (and IPOPT with ``build_ipopt``).
     """
@@ -92,16 +93,24 @@ class FormFindingProblem:
         self.objective = ca.Function(
             "F", [xi, w], [nlp.f, nlp.f1, nlp.f2], names, ["F", "F1", "F2"]
         )
-        self.objective_gradient = ca.Function(
-            "dF", [xi, w], [nlp.f, ca.gradient(nlp.f, xi)], names, ["F", "dF"]
-        )
-        self.constraint_jacobian = ca.Function(
-            "dg", [xi, w], [nlp.g, ca.jacobian(nlp.g, xi)], names, ["g", "dg"]
-        )
         self._solvers: dict[str, Solver] = {}
         if build_ipopt:
             self.solver("ipopt")
         self.build_time = time.perf_counter() - t0
+
+    @functools.cached_property
+    def objective_gradient(self) -> ca.Function:
+        nlp = self.nlp
+        return ca.Function(
+            "dF", [nlp.x, nlp.p], [nlp.f, ca.gradient(nlp.f, nlp.x)], ["xi", "w"], ["F", "dF"]
+        )
+
+    @functools.cached_property
+    def constraint_jacobian(self) -> ca.Function:
+        nlp = self.nlp
+        return ca.Function(
+            "dg", [nlp.x, nlp.p], [nlp.g, ca.jacobian(nlp.g, nlp.x)], ["xi", "w"], ["g", "dg"]
+        )
 
     @functools.cached_property
     def constraints(self) -> ca.Function:

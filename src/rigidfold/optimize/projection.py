@@ -6,17 +6,24 @@ one, the nearest is found by Gauss-Newton steps of least norm on the residuals o
 
 ::
 
-    dxi = -J^T (J J^T + mu I)^-1 r,     mu = lambda |r| max diag(J J^T)
+    dxi = -A^T (A A^T + mu I)^-1 (r, h),     A = (J; C_W),     mu = lambda |r| max diag(A A^T)
 
 ``J J^T`` has a row per interior vertex and fixed crease and a few dozen non-zeros per row,
 so one step costs a sparse factorisation of that size (SuperLU); near a zero of F the steps
 converge quadratically. The damping is proportional to |r| (Fan and Yuan's choice, which keeps
 the fast local convergence where the zeros of F form a family, as they do here), and lambda
-follows the ratio of the actual to the predicted decrease of F; a step that leaves
-the feasible set of (6) (the dz, sector angle and fold angle bounds) is refused like one that
-does not decrease F, so every iterate is feasible. The projection ends converged at
-F <= ``Settings.projection_tol``; otherwise it stops after ``Settings.projection_max_iter``
-factorisations and says so.
+follows the ratio of the actual to the predicted decrease of F.
+
+Every iterate meets the constraints of (6) (the dz, sector angle and fold angle bounds): the
+projection starts only from a feasible shape and refuses a step that leaves the feasible set,
+like one that does not decrease F. A constraint that a step would break joins the working
+set W and is held: its row of the constraint Jacobian C (``rigidfold.optimize.jacobian``)
+joins J, with the residual h that keeps it ``Settings.projection_margin`` inside its bound,
+so the next steps slide along the bound instead of being refused; a held constraint whose
+multiplier (its entry of (A A^T + mu I)^-1 (r, h)) pulls it away from its bound is released.
+This is what lets a step of ``generate`` move a shape whose sector angles or heights sit at
+their bounds. The projection ends converged at F <= ``Settings.projection_tol``; otherwise it
+stops after ``Settings.projection_max_iter`` factorisations and says so.
 
 IPOPT's interior-point path finds zeros of F far from the start (the lifted target surface
 is far from developable); the projection finds the near ones: after one more crease is
@@ -32,6 +39,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from rigidfold.optimize.jacobian import ClosedFormJacobian
 from rigidfold.optimize.residuals import Residuals
 from rigidfold.optimize.solver import SolverProblem
 
@@ -42,25 +50,40 @@ _GAIN = 1e-4  # least ratio of actual to predicted decrease for a step to be tak
 class Projected:
     """The end of one projection.
 
-    xi : (n,) float64, the last feasible iterate; F : its objective; iterations : the
-    factorisations it took; converged : F <= ``Settings.projection_tol``; reason : why it
-    stopped, in words.
+    xi : (n,) float64, the last iterate (feasible unless the start was not); F : its
+    objective; iterations : the factorisations it took; converged : F <=
+    ``Settings.projection_tol``; feasible : whether xi meets the constraints of (6) (False only
+    for an infeasible start, which is not projected); held : how many constraints were held
+    at the end; reason : why it stopped, in words.
     """
 
     xi: np.ndarray
     F: float
     iterations: int
     converged: bool
+    feasible: bool
+    held: int
     reason: str
 
 
 class Projection:
-    """The projection of a FormFindingProblem (a ``SolverProblem``), built once and kept."""
+    """The projection of a FormFindingProblem (a ``SolverProblem``), built once and kept.
 
-    def __init__(self, problem: SolverProblem) -> None:
+    ``residuals`` and ``constraints`` (a ``ClosedFormJacobian``) are the problem's, built here
+    unless given (the IPOPT solver shares its own).
+    """
+
+    def __init__(
+        self,
+        problem: SolverProblem,
+        residuals: Residuals | None = None,
+        constraints: ClosedFormJacobian | None = None,
+    ) -> None:
         self.problem = problem
         self.settings = problem.settings
-        self.residuals = Residuals(problem.pattern, problem.map)
+        self.residuals = residuals or Residuals(problem.pattern, problem.map)
+        self.constraints = constraints or ClosedFormJacobian(problem)
+        self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
 
     def feasible(self, xi: np.ndarray, w: np.ndarray) -> bool:
         """Whether a point meets every constraint of (6), well inside ``constraint_tol``."""
@@ -72,36 +95,83 @@ class Projection:
         s = self.settings
         xi = np.asarray(xi0, dtype=float).copy()
         w = np.asarray(w, dtype=float)
-        r, J = self.residuals(xi, w)
-        F = float(r @ r)
         if not self.feasible(xi, w):
-            return Projected(xi, F, 0, False, "the start violates a constraint of (6)")
-        scale = -1.0  # the largest diagonal entry of J J^T at the start
+            r, _ = self.residuals(xi, w, jacobian=False)
+            reason = "the start violates a constraint of (6)"
+            return Projected(xi, float(r @ r), 0, False, False, 0, reason)
+        held = np.zeros(0, dtype=np.int64)  # the working set W
+        r, J, A, ra, g = self._system(xi, w, held)
+        F = float(r @ r)
+        scale = -1.0  # the largest diagonal entry of A A^T at the start
         lam, nu = s.projection_damping, 2.0
+        slack = 0.1 * s.constraint_tol
+        k = 0
         for k in range(s.projection_max_iter):
             if F <= s.projection_tol:
-                return Projected(xi, F, k, True, f"converged, F = {F:.3g} in {k} steps")
-            assert J is not None
-            JJ = (J @ J.T).tocsc()
+                return self._end(xi, F, k, held, "converged")
+            AA = (A @ A.T).tocsc()
             if scale < 0:
-                scale = float(JJ.diagonal().max())
-            step = -(J.T @ _solve(JJ, lam * scale * np.sqrt(F), r))
+                scale = float(AA.diagonal().max())
+            y = _solve(AA, lam * scale * np.sqrt(F), ra)
+            loose = self._loose(held, g, y[len(r) :])
+            if loose.any():  # held against the wrong side: let go
+                held = held[~loose]
+                r, J, A, ra, g = self._system(xi, w, held)
+                continue
+            step = -(A.T @ y)
             predicted = F - float(np.sum((r + J @ step) ** 2))
             trial = xi + step
+            g_trial, _ = self.constraints.values(trial, w)
+            broken = np.flatnonzero((g_trial < self.lbg - slack) | (g_trial > self.ubg + slack))
+            blocked = np.setdiff1d(broken, held)
+            if blocked.size:  # hold them and take the step again
+                held = np.union1d(held, blocked)
+                r, J, A, ra, g = self._system(xi, w, held)
+                continue
             r_trial, _ = self.residuals(trial, w, jacobian=False)
             F_trial = float(r_trial @ r_trial)
             gain = (F - F_trial) / predicted if predicted > 0 else -1.0
-            if gain > _GAIN and self.feasible(trial, w):
+            if gain > _GAIN and not broken.size and self.feasible(trial, w):
                 xi, F = trial, F_trial
-                r, J = self.residuals(xi, w)
+                r, J, A, ra, g = self._system(xi, w, held)
                 lam *= 0.25 if gain > 0.75 else 1.0 if gain > 0.25 else 4.0
                 nu = 2.0
             else:
                 lam *= nu
                 nu *= 2
-        if F <= s.projection_tol:
-            return Projected(xi, F, k + 1, True, f"converged, F = {F:.3g} in {k + 1} steps")
-        return Projected(xi, F, k + 1, False, f"stopped at F = {F:.3g} after {k + 1} steps")
+        return self._end(xi, F, k + 1, held, "converged" if F <= s.projection_tol else "stopped")
+
+    def _system(self, xi: np.ndarray, w: np.ndarray, held: np.ndarray):
+        """r, J, A = (J; C_W), (r, h) and g at xi, for the held constraints ``held``."""
+        r, J = self.residuals(xi, w)
+        assert J is not None
+        g, nonzeros = self.constraints.values(xi, w)
+        if not held.size:
+            return r, J, J, r, g
+        margin = self.settings.projection_margin
+        lo, hi = self.lbg[held] + margin, self.ubg[held] - margin
+        h = g[held] - np.clip(g[held], lo, np.maximum(lo, hi))
+        C = self.constraints.matrix(nonzeros)[held]
+        return r, J, sp.vstack([J, C]).tocsr(), np.concatenate([r, h]), g
+
+    def _loose(self, held: np.ndarray, g: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Which held constraints (bool, like ``held``) their multipliers y pull inwards.
+
+        A step is ``-A^T y``, so a row held at its upper bound pushes its constraint down
+        when its multiplier is positive, and one at its lower bound up when it is negative.
+        """
+        upper = np.abs(g[held] - self.ubg[held]) < np.abs(g[held] - self.lbg[held])
+        return np.where(upper, y < 0, y > 0)
+
+    def _end(self, xi: np.ndarray, F: float, k: int, held: np.ndarray, how: str) -> Projected:
+        words = (
+            f"{how}, F = {F:.3g} in {k} steps"
+            if how == "converged"
+            else (f"stopped at F = {F:.3g} after {k} steps")
+        )
+        if held.size:
+            words += f", {held.size} constraint{'s' if held.size > 1 else ''} held"
+        return Projected(xi, F, k, how == "converged", True, int(held.size), words)
 
 
 def _solve(JJ: sp.csc_matrix, mu: float, r: np.ndarray) -> np.ndarray:

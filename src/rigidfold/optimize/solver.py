@@ -67,8 +67,12 @@ class SolverProblem(Protocol):
     map: LinearMap
     nlp: NLP
     objective: ca.Function
-    objective_gradient: ca.Function
-    constraint_jacobian: ca.Function
+
+    @property
+    def objective_gradient(self) -> ca.Function: ...
+
+    @property
+    def constraint_jacobian(self) -> ca.Function: ...
 
     @property
     def constraints(self) -> ca.Function: ...
