@@ -27,6 +27,7 @@ from rigidfold.mechanism import (
     check_analysis_size,
     chosen_method,
 )
+from rigidfold.mechanism import sparse as sparse_module
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns import grid, miura
@@ -183,3 +184,30 @@ def test_memory_estimate_follows_the_method():
 def test_sparse_settings_are_checked(field, value):
     with pytest.raises(ValueError, match=field):
         DEFAULTS.with_(**{field: value})
+
+
+@pytest.mark.parametrize("name", ["hp-11-fixed", "dome-sym-dof13.fold"])
+def test_a_narrow_span_grows_by_what_it_needs(name, monkeypatch):
+    """With an oversampling of 6, the first subspace of these shapes has one or two columns
+    fewer than it needs to spare half the oversampling, but not a full span: it grows by what
+    leaves room for its span and the oversampling (not twice), and agrees with the dense."""
+    spans: list[tuple[int, int]] = []
+    real = sparse_module._span
+
+    def recording(W: np.ndarray) -> np.ndarray:
+        Y = real(W)
+        spans.append((W.shape[1], Y.shape[1]))
+        return Y
+
+    monkeypatch.setattr(sparse_module, "_span", recording)
+    settings = DEFAULTS.with_(sparse_oversampling=6)
+    shape = SHAPES[name]()
+    sparse = analyze(shape, method="sparse", settings=settings)
+    dense = analyze(shape, method="kinematic", settings=settings)
+    (m, span), (grown, _) = spans
+    assert m - 3 < span < m
+    assert grown == span + 6
+    assert sparse.dof == dense.dof and sparse.rank == dense.rank
+    assert np.array_equal(sparse.locked, dense.locked)
+    outside = sparse.H - dense.H @ (dense.H.T @ sparse.H)
+    assert np.linalg.norm(outside, 2) < 1e-8

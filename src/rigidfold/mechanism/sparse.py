@@ -23,9 +23,11 @@ dimensions, so this module finds it in a space of about that size:
 5. The subspace must have had room: at least half the oversampling columns are directions
    damped below 1e-12 of the kernel's share (and so is every direction outside the
    subspace: the modes keep less than about 1e-12 of them, far below ``lock_tol``).
-   Otherwise (many directions of singular value below about ``1000 sqrt(delta)``, e.g. the
-   out-of-plane modes of a flat sheet) as many filtered random columns again join W and 4
-   repeats.
+   Otherwise filtered random columns join W and 4 repeats: when the span of W is narrower
+   than W (a few near-mechanisms, singular values just above the rank threshold, kept by
+   the filter), as many as leave room for the span and ``sparse_oversampling`` more; when it
+   is full (many directions of singular value below about ``1000 sqrt(delta)``, e.g. the
+   out-of-plane modes of a flat sheet), as many again as W has.
 
 Every rank decision is made on the small dense matrix of step 4, as the dense method makes
 it on the whole matrix; ``tests/test_sparse_mechanism.py`` compares the two. Cost: one
@@ -86,7 +88,10 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
         m = W.shape[1]
         if m == n or Y.shape[1] <= m - p // 2:
             break
-        W = np.hstack([W, filtered(min(m, n - m))])  # step 5: twice the columns
+        # step 5: room for the directions the filter keeps, and p more; twice the columns
+        # when the span is full (no sign of how many there are)
+        grow = Y.shape[1] + p - m if Y.shape[1] < m else m
+        W = np.hstack([W, filtered(min(grow, n - m))])
     _, s, vt = np.linalg.svd(np.linalg.qr(A @ Y, mode="r"))  # vt: (m', m')
     values = np.concatenate([s, np.zeros(Y.shape[1] - len(s))])  # k < m': zeros
     small = values <= limit
