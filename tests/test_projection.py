@@ -118,15 +118,22 @@ def test_fixing_one_more_crease_is_a_short_projection(solved_grid):
     assert again.iterations < DEFAULTS.projection_max_iter
 
 
-def test_every_projected_iterate_stays_feasible(solved_grid):
-    """With the dz bound pulled in to the solution's own largest |dz|, the projection may not
-    step outside it: it ends at a feasible point, converged or not."""
+@pytest.fixture(scope="module")
+def tight_grid(solved_grid):
+    """The 21 x 21 problem with the dz bound pulled in to its solution's own largest |dz|."""
     case, _, result = solved_grid
     coords = result.coords
     dz = np.abs(coords[:, 2] - case.surface.height(coords[:, 0], coords[:, 1])).max()
-    tight = make_case(
+    return make_case(
         "dome", "grid:21x21", size="3x3", settings=DEFAULTS.with_(dz=float(dz) + 1e-9)
     ).problem(build_ipopt=False)
+
+
+def test_every_projected_iterate_stays_feasible(solved_grid, tight_grid):
+    """With the dz bound pulled in to the solution's own largest |dz|, the projection may not
+    step outside it: it ends at a feasible point, converged or not."""
+    case, _, result = solved_grid
+    coords, tight = result.coords, tight_grid
     projection = Projection(tight)
     w = np.zeros(case.pattern.n_edges)
     interior = np.flatnonzero(~result.pattern.is_boundary_edge)
@@ -136,16 +143,12 @@ def test_every_projected_iterate_stays_feasible(solved_grid):
     assert out.iterations >= 1
 
 
-def test_a_step_blocked_by_a_bound_slides_along_it(solved_grid):
+def test_a_step_blocked_by_a_bound_slides_along_it(solved_grid, tight_grid):
     """With the dz bound pulled in to the solution's own largest |dz|, fixing the three creases
     folded least needs a step that would push a vertex past the bound: the projection holds
     that constraint (its row joins J) and still converges, instead of refusing every step."""
     case, _, result = solved_grid
-    coords = result.coords
-    dz = np.abs(coords[:, 2] - case.surface.height(coords[:, 0], coords[:, 1])).max()
-    tight = make_case(
-        "dome", "grid:21x21", size="3x3", settings=DEFAULTS.with_(dz=float(dz) + 1e-9)
-    ).problem(build_ipopt=False)
+    coords, tight = result.coords, tight_grid
     rho = np.abs(result.pattern.fold_angles)
     folded = np.flatnonzero(~result.pattern.is_boundary_edge & (rho > 1e-3))
     w = np.zeros(case.pattern.n_edges)
