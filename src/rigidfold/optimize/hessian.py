@@ -38,6 +38,24 @@ B_ANGLE[0:3, 3:6] = B_ANGLE[3:6, 6:9] = np.eye(3)
 _EYE = np.eye(3)
 
 
+def angle_corners(faces: np.ndarray) -> np.ndarray:
+    """Corners (a, b, c) of every sector angle, (3F, 3): row k*F + f is the angle at
+    ``faces[f, k]``, between the edges to ``faces[f, k + 1]`` and ``faces[f, k + 2]``."""
+    F = len(faces)
+    k, f = np.repeat(np.arange(3), F), np.tile(np.arange(F), 3)
+    return np.stack([faces[f, k], faces[f, (k + 1) % 3], faces[f, (k + 2) % 3]], 1)
+
+
+def coordinate_rows(vertices: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Rows of P = (x_1..x_V, y_1..y_V, z_1..z_V) of the vertices' coordinates.
+
+    vertices : (K, m) int  ->  (K, 3m), vertex by vertex, x, y, z of each.
+    """
+    return (vertices[:, :, None] + n_vertices * np.arange(3)).reshape(
+        len(vertices), 3 * vertices.shape[1]
+    )
+
+
 def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[:, :, None] * b[:, None, :]
 
@@ -208,12 +226,7 @@ class ClosedFormHessian:
         faces = pat.faces
         F = len(faces)
         self.rho = problem.settings.rho_bar
-        # angles: entry k*F + f is the angle at faces[f, k]
-        k_of = np.repeat(np.arange(3), F)
-        f_of = np.tile(np.arange(F), 3)
-        self.angle_vertices = np.stack(
-            [faces[f_of, k_of], faces[f_of, (k_of + 1) % 3], faces[f_of, (k_of + 2) % 3]], 1
-        )  # (3F, 3): a, b, c
+        self.angle_vertices = angle_corners(faces)  # (3F, 3): a, b, c
         inner = pat.interior_vertices
         row_of = np.full(V, -1)
         row_of[inner] = np.arange(len(inner))
@@ -226,12 +239,8 @@ class ClosedFormHessian:
         self.dz_vertices = problem.nlp.dz_vertices
         self.n_dz = len(self.dz_vertices)
         self.n_theta = 3 * F
-
-        def coords_index(vertices: np.ndarray) -> np.ndarray:  # (K, m) -> (K, 3m) P rows
-            return (vertices[:, :, None] + V * np.arange(3)).reshape(len(vertices), -1)
-
-        angle_P = coords_index(self.angle_vertices)  # (3F, 9) P rows of (a, b, c)
-        edge_P = coords_index(self.edge_corners)  # (Ei, 18)
+        angle_P = coordinate_rows(self.angle_vertices, V)  # (3F, 9) P rows of (a, b, c)
+        edge_P = coordinate_rows(self.edge_corners, V)  # (Ei, 18)
         dz_P = np.stack([self.dz_vertices, V + self.dz_vertices], 1)  # (n_dz, 2)
         blocks = []
         for idx in (angle_P, edge_P, dz_P):

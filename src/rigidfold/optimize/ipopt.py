@@ -74,17 +74,16 @@ class IpoptSolver:
 
     def __init__(self, problem: SolverProblem) -> None:
         nlp = problem.nlp
-        large = problem.pattern.n_vertices >= problem.settings.projection_vertices
-        self.projection = None
-        if large:
-            residuals, jacobian = (
-                Residuals(problem.pattern, problem.map),
-                ClosedFormJacobian(problem),
-            )
-            self.projection = Projection(problem, residuals, jacobian)
         self._lbg, self._ubg = nlp.lbg, nlp.ubg
         self._stop_f = problem.settings.ipopt_stop_f
-        if large:  # closed-form first derivatives: CasADi's cost most of a large build
+        self.projection: Projection | None = None
+        self._stop: _EarlyStop | None = None
+        if problem.pattern.n_vertices >= problem.settings.projection_vertices:
+            residuals = Residuals(problem.pattern, problem.map)
+            jacobian = ClosedFormJacobian(problem)
+            self.projection = Projection(problem, residuals, jacobian)
+            self._stop = _EarlyStop(problem, self._stop_f)
+            # closed-form first derivatives: CasADi's cost most of a large build
             self._first = closed_form_first_derivatives(problem, residuals, jacobian)
         else:  # the problem's, so that CasADi does not differentiate (6) again
             self._first = (problem.objective_gradient, problem.constraint_jacobian)
@@ -96,14 +95,12 @@ class IpoptSolver:
             "calc_lam_p": False,
             "no_nlp_grad": True,
         }
+        if self._stop is not None:
+            options["iteration_callback"] = self._stop
         self._hess_lag = None
         if problem.settings.ipopt_hessian == "closed-form":
             self._hess_lag = closed_form_hess_lag(problem)
             options["hess_lag"] = self._hess_lag
-        self._stop = None
-        if large:
-            self._stop = _EarlyStop(problem, problem.settings.ipopt_stop_f)
-            options["iteration_callback"] = self._stop
         with native_quiet():
             self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 

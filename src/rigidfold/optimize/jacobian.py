@@ -27,7 +27,12 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
-from rigidfold.optimize.hessian import expand_rows, unique_inverse
+from rigidfold.optimize.hessian import (
+    angle_corners,
+    coordinate_rows,
+    expand_rows,
+    unique_inverse,
+)
 from rigidfold.optimize.residuals import Residuals, angle_gradients, fold_angle_gradients
 from rigidfold.optimize.solver import SolverProblem
 
@@ -44,18 +49,12 @@ class ClosedFormJacobian:
         V, n = pat.n_vertices, lin.n_variables
         self.V, self.T, self.t = V, lin.T.tocsr(), lin.t
         self.surface = problem.surface
-        faces = pat.faces
-        F = len(faces)
-        k_of, f_of = np.repeat(np.arange(3), F), np.tile(np.arange(F), 3)
-        # row k*F + f of theta is the angle at faces[f, k]: corners (a, b, c)
-        self.angle_vertices = np.stack(
-            [faces[f_of, k_of], faces[f_of, (k_of + 1) % 3], faces[f_of, (k_of + 2) % 3]], 1
-        )
+        self.angle_vertices = angle_corners(pat.faces)  # (3F, 3): a, b, c
         self.dz_vertices = problem.nlp.dz_vertices
         self.rho_bar = problem.settings.rho_bar
         self.interior = pat.interior_edges
         self.stencils = pat.crease_stencils(self.interior)  # (Ei, 4): u, v, a, b
-        n_dz, n_theta = len(self.dz_vertices), 3 * F
+        n_dz, n_theta = len(self.dz_vertices), len(self.angle_vertices)
         blocks = [self.dz_vertices[:, None], self.angle_vertices]
         if self.rho_bar is not None:
             blocks.append(self.stencils)
@@ -67,14 +66,15 @@ class ClosedFormJacobian:
         for vertices in blocks:
             K, L = vertices.shape
             rows.append(np.repeat(np.arange(start, start + K), 3 * L))
-            P_rows.append((vertices[:, :, None] + V * np.arange(3)).ravel())
+            P_rows.append(coordinate_rows(vertices, V).ravel())
             start += K
         row, P_row = np.concatenate(rows), np.concatenate(P_rows)
         entry, col, weight = expand_rows(self.T, P_row)
         keys, slot = unique_inverse(col * self.m + row[entry])  # column-major
         cols, g_rows = keys // self.m, keys % self.m
-        colptr = np.searchsorted(cols, np.arange(n + 1))
-        self.sparsity = ca.Sparsity(self.m, n, colptr.tolist(), g_rows.tolist())
+        self._colptr = np.searchsorted(cols, np.arange(n + 1))
+        self._g_rows = g_rows
+        self.sparsity = ca.Sparsity(self.m, n, self._colptr.tolist(), g_rows.tolist())
         self.R = sp.csr_matrix((weight, (slot, entry)), shape=(len(keys), len(row)))
 
     def values(self, xi: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -95,8 +95,8 @@ class ClosedFormJacobian:
 
     def matrix(self, nonzeros: np.ndarray) -> sp.csr_matrix:
         """The Jacobian (m, n) as a SciPy matrix, from the nonzeros of ``values``."""
-        indptr, indices = self.sparsity.get_ccs()
-        return sp.csc_matrix((nonzeros, indices, indptr), shape=self.sparsity.shape).tocsr()
+        shape = (self.m, len(self._colptr) - 1)
+        return sp.csc_matrix((nonzeros, self._g_rows, self._colptr), shape=shape).tocsr()
 
 
 class ClosedFormGradient:

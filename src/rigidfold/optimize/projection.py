@@ -66,6 +66,17 @@ class Projected:
     reason: str
 
 
+@dataclass(frozen=True, eq=False)
+class _Point:
+    """What a step needs at one iterate: r (m,), J (m, n), g (c,) and the nonzeros of the
+    constraint Jacobian (``ClosedFormJacobian.values``)."""
+
+    r: np.ndarray
+    J: sp.csr_matrix
+    g: np.ndarray
+    nonzeros: np.ndarray
+
+
 class Projection:
     """The projection of a FormFindingProblem (a ``SolverProblem``), built once and kept.
 
@@ -100,7 +111,9 @@ class Projection:
             reason = "the start violates a constraint of (6)"
             return Projected(xi, float(r @ r), 0, False, False, 0, reason)
         held = np.zeros(0, dtype=np.int64)  # the working set W
-        r, J, A, ra, g = self._system(xi, w, held)
+        point = self._evaluate(xi, w)
+        r, J, g = point.r, point.J, point.g
+        A, ra = self._augment(point, held)
         F = float(r @ r)
         scale = -1.0  # the largest diagonal entry of A A^T at the start
         lam, nu = s.projection_damping, 2.0
@@ -116,24 +129,26 @@ class Projection:
             loose = self._loose(held, g, y[len(r) :])
             if loose.any():  # held against the wrong side: let go
                 held = held[~loose]
-                r, J, A, ra, g = self._system(xi, w, held)
+                A, ra = self._augment(point, held)
                 continue
             step = -(A.T @ y)
             predicted = F - float(np.sum((r + J @ step) ** 2))
             trial = xi + step
-            g_trial, _ = self.constraints.values(trial, w)
+            g_trial, nonzeros_trial = self.constraints.values(trial, w)
             broken = np.flatnonzero((g_trial < self.lbg - slack) | (g_trial > self.ubg + slack))
             blocked = np.setdiff1d(broken, held)
             if blocked.size:  # hold them and take the step again
                 held = np.union1d(held, blocked)
-                r, J, A, ra, g = self._system(xi, w, held)
+                A, ra = self._augment(point, held)
                 continue
             r_trial, _ = self.residuals(trial, w, jacobian=False)
             F_trial = float(r_trial @ r_trial)
             gain = (F - F_trial) / predicted if predicted > 0 else -1.0
             if gain > _GAIN and not broken.size and self.feasible(trial, w):
                 xi, F = trial, F_trial
-                r, J, A, ra, g = self._system(xi, w, held)
+                point = self._evaluate(xi, w, (g_trial, nonzeros_trial))
+                r, J, g = point.r, point.J, point.g
+                A, ra = self._augment(point, held)
                 lam *= 0.25 if gain > 0.75 else 1.0 if gain > 0.25 else 4.0
                 nu = 2.0
             else:
@@ -141,18 +156,29 @@ class Projection:
                 nu *= 2
         return self._end(xi, F, k + 1, held, "converged" if F <= s.projection_tol else "stopped")
 
-    def _system(self, xi: np.ndarray, w: np.ndarray, held: np.ndarray):
-        """r, J, A = (J; C_W), (r, h) and g at xi, for the held constraints ``held``."""
+    def _evaluate(
+        self,
+        xi: np.ndarray,
+        w: np.ndarray,
+        constraints: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> _Point:
+        """Residuals, constraints and their Jacobians at xi; ``constraints`` are the
+        (g, nonzeros) of ``ClosedFormJacobian.values`` there, when already known."""
         r, J = self.residuals(xi, w)
         assert J is not None
-        g, nonzeros = self.constraints.values(xi, w)
+        g, nonzeros = self.constraints.values(xi, w) if constraints is None else constraints
+        return _Point(r, J, g, nonzeros)
+
+    def _augment(self, point: _Point, held: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
+        """A = (J; C_W) and (r, h) at a point, for the held constraints ``held``."""
         if not held.size:
-            return r, J, J, r, g
+            return point.J, point.r
         margin = self.settings.projection_margin
+        g = point.g[held]
         lo, hi = self.lbg[held] + margin, self.ubg[held] - margin
-        h = g[held] - np.clip(g[held], lo, np.maximum(lo, hi))
-        C = self.constraints.matrix(nonzeros)[held]
-        return r, J, sp.vstack([J, C]).tocsr(), np.concatenate([r, h]), g
+        h = g - np.clip(g, lo, np.maximum(lo, hi))
+        C = self.constraints.matrix(point.nonzeros)[held]
+        return sp.vstack([point.J, C]).tocsr(), np.concatenate([point.r, h])
 
     def _loose(self, held: np.ndarray, g: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Which held constraints (bool, like ``held``) their multipliers y pull inwards.

@@ -19,7 +19,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from rigidfold.mesh import CreasePattern
-from rigidfold.optimize.hessian import B_ANGLE, row_cross, row_dot
+from rigidfold.optimize.hessian import (
+    B_ANGLE,
+    angle_corners,
+    coordinate_rows,
+    row_cross,
+    row_dot,
+)
 from rigidfold.optimize.variables import LinearMap
 
 
@@ -81,11 +87,8 @@ class Residuals:
     def __init__(self, pattern: CreasePattern, lmap: LinearMap) -> None:
         self.pattern, self.map = pattern, lmap
         self.T = lmap.T.tocsr()
-        V, faces = pattern.n_vertices, pattern.faces
-        F = len(faces)
-        k = np.repeat(np.arange(3), F)
-        f = np.tile(np.arange(F), 3)
-        corners = np.stack([faces[f, k], faces[f, (k + 1) % 3], faces[f, (k + 2) % 3]], 1)
+        V = pattern.n_vertices
+        corners = angle_corners(pattern.faces)
         inner = pattern.interior_vertices
         row_of = np.full(V, -1)
         row_of[inner] = np.arange(len(inner))
@@ -95,7 +98,7 @@ class Residuals:
         self._angle_row = row_of[corners[at_inner, 0]]
         # their rows and columns in the Jacobian in P = (x_1..x_V, y_1..y_V, z_1..z_V)
         self._angle_J_rows = np.repeat(self._angle_row, 9)
-        self._angle_J_cols = (self._angle_corners[:, :, None] + V * np.arange(3)).ravel()
+        self._angle_J_cols = coordinate_rows(self._angle_corners, V).ravel()
         self.interior = pattern.interior_edges
         self._stencils = pattern.crease_stencils(self.interior)  # (Ei, 4)
 
@@ -114,7 +117,7 @@ class Residuals:
         r = np.concatenate([defect, root * np.sin(rho)])
         if not jacobian:
             return r, None
-        cols_r = (self._stencils[on][:, :, None] + V * np.arange(3)).ravel()
+        cols_r = coordinate_rows(self._stencils[on], V).ravel()
         rows = np.concatenate(
             [self._angle_J_rows, self.n_inner + np.repeat(np.arange(len(on)), 12)]
         )
