@@ -14,7 +14,9 @@ Cases: ``grid:NxN`` with ``--size 3x3`` (a 3 m square, every diagonal towards th
 * analysis: ``rigidfold.mechanism.analyze`` of the solution as ``generate`` runs it
   (method "auto"), the dense reference ("kinematic", up to ``--dense-max`` vertices) and the
   sparse method, each on a fresh copy of the shape (its topology caches rebuilt), median of
-  ``--repeat``; the criterion S of the sparse analysis (``score_creases``); the DOF;
+  ``--repeat``; the criterion S of the sparse analysis (``score_creases``); the DOF; where
+  both ran, how far the sparse modes lie outside the span of the dense ones;
+  ``--sparse-iterations`` sets ``Settings.sparse_iterations`` for the analyses;
 * memory: the peak resident set of a process that only reads the shape and runs the auto
   analysis (and of the build-and-solve process), from ``getrusage``, so that one method's
   peak does not hide another's.
@@ -40,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.case import make_case
-from rigidfold.config import one_blas_thread
+from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mechanism import analyze
 from rigidfold.selection import score_creases
 
@@ -81,18 +83,24 @@ def task_solve(n: int, repeat: int, solve: bool, coords_file: str) -> dict:
     return row
 
 
-def task_analyse(n: int, repeat: int, methods: list[str], coords_file: str) -> dict:
+def task_analyse(
+    n: int, repeat: int, methods: list[str], coords_file: str, settings: Settings
+) -> dict:
     """Analyse the shape in ``coords_file`` with each method; criterion S on the last one."""
     shape = grid_case(n).pattern.with_coords(np.load(coords_file))
     row: dict = {"base_mb": peak_mb()}
-    mech = None
+    mech, mechs = None, {}
     for method in methods:
 
         def run(method=method):
-            return analyze(shape.with_coords(shape.coords), method=method)
+            return analyze(shape.with_coords(shape.coords), method=method, settings=settings)
 
         row[method], mech = timed(run, repeat)
         row[f"dof_{method}"] = mech.dof
+        mechs[method] = mech
+    if {"sparse", "kinematic"} <= set(mechs) and mechs["sparse"].dof == mechs["kinematic"].dof:
+        H, ref = mechs["sparse"].H, mechs["kinematic"].H  # sparse modes outside the dense span
+        row["outside"] = float(np.linalg.norm(H - ref @ (ref.T @ H), 2)) if H.size else 0.0
     if mech is not None and "sparse" in methods:
         with one_blas_thread():
             row["criteria"], _ = timed(lambda: score_creases(mech).of("s"), repeat)
@@ -106,7 +114,8 @@ def child(args: argparse.Namespace) -> None:
         if args.task == "solve":
             row = task_solve(n, repeat, not args.no_solve, args.coords)
         else:
-            row = task_analyse(n, repeat, args.task.split(","), args.coords)
+            settings = DEFAULTS.with_(sparse_iterations=args.sparse_iterations)
+            row = task_analyse(n, repeat, args.task.split(","), args.coords, settings)
     print(json.dumps(row))
 
 
@@ -114,6 +123,7 @@ def run_child(task: str, n: int, args: argparse.Namespace, coords: str) -> dict:
     cmd = [sys.executable, __file__, "--task", task, "--task-grid", str(n)]
     solve = not args.no_solve and n * n <= args.solve_max
     cmd += ["--repeat", str(args.repeat), "--coords", coords] + (["--no-solve"] * (not solve))
+    cmd += ["--sparse-iterations", str(args.sparse_iterations)]
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if proc.returncode:
         sys.exit(f"grid {n}, task {task} failed:\n{proc.stderr}")
@@ -132,6 +142,8 @@ def measure(n: int, args: argparse.Namespace) -> dict:
         row.update(sparse=both["sparse"], criteria=both["criteria"], dof_sparse=both["dof_sparse"])
         if "kinematic" in both:
             row.update(dense=both["kinematic"], dof_dense=both["dof_kinematic"])
+        if "outside" in both:
+            row["outside"] = both["outside"]
     return row
 
 
@@ -170,6 +182,12 @@ def main() -> None:
     parser.add_argument(
         "--dense-max", type=int, default=1681, help="largest V for the dense reference"
     )
+    parser.add_argument(
+        "--sparse-iterations",
+        type=int,
+        default=DEFAULTS.sparse_iterations,
+        help="filterings of the sparse analysis's subspace (Settings.sparse_iterations)",
+    )
     parser.add_argument("--task", help=argparse.SUPPRESS)
     parser.add_argument("--task-grid", type=int, help=argparse.SUPPRESS)
     parser.add_argument("--coords", help=argparse.SUPPRESS)
@@ -199,6 +217,11 @@ def main() -> None:
         print(f"log-log slope vs V, {label}: " + ", ".join(parts))
     pairs = [(n, r["sparse"] / r["dense"]) for n, r in rows.items() if "dense" in r]
     print("sparse / dense analysis time: " + ", ".join(f"{n}x{n} {x:.3f}" for n, x in pairs))
+    errors = [(n, r["outside"]) for n, r in rows.items() if "outside" in r]
+    print(
+        "sparse modes outside the dense span (2-norm): "
+        + ", ".join(f"{n}x{n} {x:.1e}" for n, x in errors)
+    )
 
 
 if __name__ == "__main__":
