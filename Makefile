@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test browser bench lint format clean
+.PHONY: demo test browser bench lint format clean same-path
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -18,8 +18,14 @@ demo: $(STAMP)
 	$(VENV)/bin/rigidfold generate --surface bezier --seed 1 --pattern 1 --criterion shat --out out/demo --overwrite
 	@echo "open the report: out/demo/report.html"
 
+# the suite on every core (pytest-xdist); the tests run with the pinned numerics
+# (rigidfold.numerics: pytest restarts itself with them)
 test: $(STAMP) browser
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(shell nproc 2>/dev/null || echo 2)
+
+# the demo case under several OpenBLAS kernels: the same counters and F to every digit
+same-path: $(STAMP)
+	$(PY) .ci/same_path.py
 
 # headless Chromium for the browser test of the report; where it cannot be installed (no
 # apt-get, not root) that test skips and says why
@@ -45,6 +51,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_solve_scale.py
 	$(PY) benchmarks/bench_scale.py
 	$(PY) benchmarks/bench_generate_scale.py
+	$(PY) benchmarks/bench_numerics.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -9,6 +9,20 @@ import numpy as np
 import pytest
 
 from rigidfold.mesh import CreasePattern
+from rigidfold.numerics import restart_pinned
+
+
+def pytest_configure(config):
+    """Run the tests, their xdist workers and the commands they start with the pinned
+    numerics (rigidfold.numerics): tests that assert one generation path's counts or digits
+    then hold on every x86-64 CPU. A pytest started without them restarts itself once, with
+    pytest's capture of the terminal suspended so that the new process writes to it."""
+    capture = config.pluginmanager.getplugin("capturemanager")
+    if capture is not None:
+        capture.suspend_global_capture(in_=True)
+    restart_pinned()
+    if capture is not None:
+        capture.resume_global_capture()
 
 
 def degree_n_vertex(n: int, lift: float = 0.15, seed: int = 0) -> CreasePattern:

@@ -298,8 +298,11 @@ def demo_runs():
 
 
 def test_demo_with_lookahead_meets_no_lock(demo_runs):
+    """8 locks without the look-ahead: a count of one path, the same on every x86-64 CPU
+    under the pinned numerics (tests/test_numerics.py); 0 with it, which the look-ahead
+    guarantees on this pattern."""
     without, with_ = demo_runs[False], demo_runs[True]
-    assert without.n_lock == 4 and with_.n_lock == 0
+    assert without.n_lock == 8 and with_.n_lock == 0
     assert with_.final_dof == 1 and with_.n_reduce == 20
     assert with_.n_skipped >= 3 and with_.to_dict()["n_skipped"] == with_.n_skipped
     assert len(with_.attempts) < len(without.attempts)
@@ -309,14 +312,16 @@ def test_demo_with_lookahead_meets_no_lock(demo_runs):
     for a in skipping:
         assert len(a.skipped_locks) == a.skipped
         for s in a.skipped_locks:
-            assert set(s["fixed"]) <= PARALLEL and set(s["locks"]) == PARALLEL - set(s["fixed"])
+            (vertex,) = [v for v in VERTICES if set(s["fixed"]) <= v]
+            assert set(s["locks"]) == vertex - set(s["fixed"])
     assert all(a.predicted_locks == [] for a in with_.attempts[1:])
 
 
 def test_every_lock_logs_its_fold_angles_and_whether_it_was_predicted(demo_runs):
     locks = [a for a in demo_runs[False].attempts if a.outcome == "lock"]
-    for a in locks:
-        assert set(a.locked) | set(a.fixed_added) == PARALLEL
+    assert len(locks) == demo_runs[False].n_lock
+    for a in locks:  # a lock is always the four creases of one degree-4 vertex
+        assert set(a.locked) | set(a.fixed_added) in VERTICES
         assert a.locked_predicted == [True] * 3
         assert len(a.locked_fold_deg) == 3 and max(map(abs, a.locked_fold_deg)) < 1.0
         assert max(a.locked_left) <= DEFAULTS.lookahead_tol

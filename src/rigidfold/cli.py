@@ -277,6 +277,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="seconds that --scheduler has to answer (default: %(default)s)",
     )
     stu.add_argument(
+        "--allow-mixed-numerics",
+        action="store_true",
+        help="add runs to a database whose runs were computed with other numerics (another "
+        "machine's BLAS, SIMD or libm, or other library versions), and accept Dask workers "
+        "that compute with other numerics than this process",
+    )
+    stu.add_argument(
         "--no-deform",
         action="store_true",
         help="skip Steps 8-9 (development diagram, large deformation) of each solution",
@@ -709,6 +716,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
             connect_timeout=args.connect_timeout,
             argv=["rigidfold", *sys.argv[1:]],
             on_done=bar.update,
+            allow_mixed_numerics=args.allow_mixed_numerics,
         )
     except StudyInterrupted as stop:
         bar.close()

@@ -44,6 +44,7 @@ from rigidfold.case import Case
 from rigidfold.config import DEFAULT_SEED, Settings, check_seed, one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.stiffness import hinge_stiffness
+from rigidfold.numerics import numeric_environment
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
 from rigidfold.selection import (
     CRITERIA,
@@ -187,6 +188,7 @@ class Generation:
     stop: Stop = Stop.RUNNING
     stop_detail: str = ""
     build_time: float = 0.0
+    numerics: dict | None = None  # rigidfold.numerics.NumericEnvironment.to_dict()
 
     @property
     def stop_reason(self) -> str:
@@ -227,6 +229,7 @@ class Generation:
             "n_skipped": self.n_skipped,
             "mean_F_accepted": float(np.mean(accepted_F)) if accepted_F else None,
             "mean_F_all_solves": float(np.mean(all_F)) if all_F else None,
+            "numerics": self.numerics,
             "time_s": {
                 "build": self.build_time,
                 "solve": sum(a.solve_time for a in self.attempts),
@@ -268,7 +271,7 @@ def generate(
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
     rng = np.random.default_rng(check_seed(seed))
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
-    run = Generation()
+    run = Generation(numerics=numeric_environment().to_dict())
     t0 = time.perf_counter()
     problem = case.problem(build_ipopt=solver == "ipopt")
     run.build_time = time.perf_counter() - t0

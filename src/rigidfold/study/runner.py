@@ -134,7 +134,13 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
             assert c.deformation is not None  # verify runs the analysis by default
             checks.append({"D": c.development.D, **c.deformation.to_dict(), "times": c.times})
 
-    row: dict = {"version": __version__, "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    from rigidfold.numerics import numeric_environment
+
+    row: dict = {
+        "version": __version__,
+        "worker": f"{socket.gethostname()}:{os.getpid()}",
+        "numerics": numeric_environment().key,
+    }
     try:
         case = make_case(
             key.study,
@@ -257,6 +263,26 @@ def connect(scheduler: str, timeout: float):
         ) from None
 
 
+def worker_numerics() -> str:
+    """The key of a Dask worker's numeric environment (run on every worker)."""
+    from rigidfold.numerics import numeric_environment
+
+    return numeric_environment().key
+
+
+def check_worker_numerics(keys: dict[str, str], expected: str) -> None:
+    """ValueError naming the first worker of ``keys`` (address -> numerics key) whose key is
+    not ``expected``."""
+    for address, key in sorted(keys.items()):
+        if key != expected:
+            raise ValueError(
+                f"Dask worker {address} computes with numerics {key!r}, this process with "
+                f"{expected!r}: start the workers with `python -m rigidfold.pinned "
+                "dask worker ...` on machines with the same library versions, or pass "
+                "--allow-mixed-numerics"
+            )
+
+
 def run_study(
     keys: Sequence[Key],
     store: Store,
@@ -266,6 +292,7 @@ def run_study(
     scheduler: str | None = None,
     connect_timeout: float = CONNECT_TIMEOUT_S,
     on_done: Callable[[Key, dict, int, int], None] | None = None,
+    numerics_key: str | None = None,
 ) -> dict:
     """Run every key not yet in ``store``; returns counts, the wall time, the part of it
     spent starting (or connecting to) the Dask cluster (``startup_s``) and the runs of this
@@ -277,6 +304,9 @@ def run_study(
     is tried (:func:`lost_run`); either is stored with its message and the others go on.
 
     on_done(key, run_row, finished, total) is called in the client after each stored run.
+    ``numerics_key``: the numeric environment every worker must compute with
+    (:attr:`rigidfold.numerics.NumericEnvironment.key`); a worker with another is refused
+    (ValueError naming it) before any run starts. Local workers inherit this process's.
     """
     import logging
 
@@ -316,6 +346,8 @@ def run_study(
         client = connect(scheduler, connect_timeout)
     startup = time.perf_counter() - t0
     try:
+        if numerics_key is not None:
+            check_worker_numerics(client.run(worker_numerics), numerics_key)
         named = {f"run-{i}-{k.row()}": k for i, k in enumerate(todo)}
         futures = [
             client.submit(run_one, k, config.as_dict(), pure=False, key=name)

@@ -61,6 +61,7 @@ def run_study_command(
     connect_timeout: float = STUDY_DEFAULTS.connect_timeout,
     argv: Sequence[str] = (),
     on_done: Callable[[bool, int, int], None] | None = None,
+    allow_mixed_numerics: bool = False,
 ) -> dict:
     """Run the study ``keys`` into the database ``db``; returns :func:`run_study`'s counts
     (``failed``: the runs of this command that failed, recorded as errors in the database).
@@ -68,15 +69,34 @@ def run_study_command(
     on_done(failed, finished, total) after each stored run (``failed``: the run ended in an
     error, recorded in the database). A KeyboardInterrupt is recorded and re-raised as
     :class:`StudyInterrupted`. The database is locked while the study runs (a second
-    client is refused, :class:`~rigidfold.study.lock.StudyLock`).
+    client is refused, :class:`~rigidfold.study.lock.StudyLock`). A database whose runs
+    were computed with other numerics (:mod:`rigidfold.numerics`), and Dask workers that
+    compute with other numerics than this process, are refused unless
+    ``allow_mixed_numerics``.
     """
     if workers < 1:
         raise ValueError(f"--workers must be >= 1, got {workers}")
     if not connect_timeout > 0:
         raise ValueError(f"--connect-timeout must be > 0 seconds, got {connect_timeout}")
-    store = Store(db, config.as_dict())  # refuses another configuration untouched
+    from rigidfold.numerics import numeric_environment
+
+    numerics = numeric_environment().to_dict()
+    # refuses another configuration, or runs of other numerics, untouched
+    store = Store(
+        db, config.as_dict(), numerics=numerics, allow_mixed_numerics=allow_mixed_numerics
+    )
     try:
-        return _run(store, keys, config, workers, scheduler, connect_timeout, argv, on_done)
+        return _run(
+            store,
+            keys,
+            config,
+            workers,
+            scheduler,
+            connect_timeout,
+            argv,
+            on_done,
+            numerics["key"] if not allow_mixed_numerics else None,
+        )
     finally:
         store.close()  # and release its lock
 
@@ -90,8 +110,10 @@ def _run(
     connect_timeout: float,
     argv: Sequence[str],
     on_done: Callable[[bool, int, int], None] | None,
+    numerics_key: str | None,
 ) -> dict:
-    """:func:`run_study_command` on the open ``store``."""
+    """:func:`run_study_command` on the open ``store`` (``numerics_key``: the numerics every
+    worker must have; None: any)."""
     from rigidfold import __version__
 
     started = datetime.now(UTC).isoformat(timespec="seconds")
@@ -126,6 +148,7 @@ def _run(
             scheduler=scheduler,
             connect_timeout=connect_timeout,
             on_done=done,
+            numerics_key=numerics_key,
         )
     except KeyboardInterrupt:
         finished = len(store.done() & planned)

@@ -77,6 +77,11 @@ ADDED_ATTEMPT_COLUMNS = {
 """Columns of ``attempts`` added after the first databases (the look-ahead, issue 18): added
 by ALTER TABLE when such a database is opened for writing, read as NULL from one opened
 read-only."""
+ADDED_RUN_COLUMNS = {"numerics": "TEXT"}
+"""Columns of ``runs`` added later, as :data:`ADDED_ATTEMPT_COLUMNS`: ``numerics`` is the
+key of the numeric environment of the worker that computed the run
+(:attr:`rigidfold.numerics.NumericEnvironment.key`); NULL for runs of older versions."""
+ADDED_COLUMNS = {"attempts": ADDED_ATTEMPT_COLUMNS, "runs": ADDED_RUN_COLUMNS}
 JSON_ATTEMPT_FIELDS = (
     "fixed_added",
     "locked",
@@ -112,6 +117,7 @@ RUN_FIELDS = (
     "time_total",
     "version",
     "worker",
+    *ADDED_RUN_COLUMNS,
 )
 ATTEMPT_FIELDS = (
     "idx",
@@ -214,15 +220,28 @@ class Store:
     a damaged or foreign file, or one of another configuration, is refused untouched.
     ``readonly=True`` opens an existing database for reporting: it never creates one nor
     writes to it (and takes no ``config`` and no lock).
+
+    ``numerics`` (:meth:`rigidfold.numerics.NumericEnvironment.to_dict` of the process that
+    will add runs) is stored with the first runs; a database whose runs were computed with
+    another numeric environment (another ``key``), or before rigidfold recorded it, is
+    refused untouched unless ``allow_mixed_numerics``.
     """
 
     def __init__(
-        self, path: str | Path, config: dict | None = None, *, readonly: bool = False
+        self,
+        path: str | Path,
+        config: dict | None = None,
+        *,
+        readonly: bool = False,
+        numerics: dict | None = None,
+        allow_mixed_numerics: bool = False,
     ) -> None:
         self.path = Path(path)
         self._lock: StudyLock | None = None
+        self._numerics = numerics
+        self._allow_mixed = allow_mixed_numerics
         if readonly:
-            if config is not None:
+            if config is not None or numerics is not None:
                 raise ValueError("a study database opened read-only takes no configuration")
             if not self.path.is_file():
                 raise ValueError(f"no study database at {str(self.path)!r}")
@@ -260,15 +279,23 @@ class Store:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")
             self.db.executescript(SCHEMA)
-            have = self._columns("attempts")
-            for name, kind in ADDED_ATTEMPT_COLUMNS.items():
-                if name not in have:  # a database of an earlier version: same rows, new columns
-                    self.db.execute(f"ALTER TABLE attempts ADD COLUMN {name} {kind}")
+            for table, added in ADDED_COLUMNS.items():
+                have = self._columns(table)
+                for name, kind in added.items():
+                    if name not in have:  # a database of an earlier version: new columns
+                        self.db.execute(f"ALTER TABLE {table} ADD COLUMN {name} {kind}")
             self._attempt_columns = self._columns("attempts")
             if config is not None:
                 self.db.execute(
                     "INSERT OR IGNORE INTO meta VALUES ('config', ?)",
                     (json.dumps(config, sort_keys=True),),
+                )
+            if self._numerics is not None:  # the numerics of the first runs are kept
+                n_runs = self.db.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+                verb = "IGNORE" if n_runs else "REPLACE"
+                self.db.execute(
+                    f"INSERT OR {verb} INTO meta VALUES ('numerics', ?)",
+                    (json.dumps(self._numerics, sort_keys=True),),
                 )
             self.db.commit()
         except sqlite3.Error as exc:
@@ -294,7 +321,7 @@ class Store:
                         f"{name!r}: not a rigidfold study database: no table {table!r}"
                     )
                 for column, kind in columns.items():
-                    if column not in have and column not in ADDED_ATTEMPT_COLUMNS:
+                    if column not in have and column not in ADDED_COLUMNS.get(table, {}):
                         raise ValueError(
                             f"{name!r}: not a rigidfold study database: table {table!r} "
                             f"lacks column {column!r}"
@@ -330,6 +357,42 @@ class Store:
                 f"{name!r} holds a study with another configuration "
                 f"(differs in: {', '.join(diff)}); use another --db"
             )
+        if self._numerics is not None and not self._allow_mixed:
+            self._check_numerics(con, self._numerics)
+
+    def _check_numerics(self, con: sqlite3.Connection, current: dict) -> None:
+        """Refuse a database whose runs were computed with other numerics than ``current``."""
+        name = str(self.path)
+        try:
+            row = con.execute("SELECT value FROM meta WHERE key='numerics'").fetchone()
+            n_runs = con.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+        except sqlite3.Error as exc:
+            raise ValueError(f"{name!r}: damaged SQLite file: {exc}") from None
+        try:
+            stored = None if row is None else json.loads(row[0])
+        except (TypeError, json.JSONDecodeError):
+            stored = None
+        stored_key = stored.get("key") if isinstance(stored, dict) else None
+        if stored_key == current.get("key") or n_runs == 0:
+            return
+        was = (
+            f"numerics {stored_key!r}"
+            if stored_key
+            else "numerics that were not recorded (an earlier rigidfold)"
+        )
+        raise ValueError(
+            f"{name!r} holds runs computed with {was}, this machine computes with "
+            f"{current.get('key')!r}: mixing them makes the study depend on the machines; "
+            "use another --db, or pass --allow-mixed-numerics"
+        )
+
+    def numerics(self) -> dict | None:
+        """The numeric environment stored with the first runs (None: not recorded)."""
+        row = self.db.execute("SELECT value FROM meta WHERE key='numerics'").fetchone()
+        try:
+            return None if row is None else json.loads(row[0])
+        except (TypeError, json.JSONDecodeError):
+            return None
 
     def _columns(self, table: str) -> set[str]:
         """Names of the columns of ``table`` in this file."""
@@ -348,8 +411,10 @@ class Store:
         """Write one run and its attempts in one transaction; refuses (ValueError) a run
         already in the database, which is left as it was."""
         with self.db:
+            names = ("study", "seed", "pattern", "criterion", "symmetric", *RUN_FIELDS)
             added = self.db.execute(
-                f"INSERT OR IGNORE INTO runs VALUES ({', '.join('?' * (5 + len(RUN_FIELDS)))})",
+                f"INSERT OR IGNORE INTO runs ({', '.join(names)}) "
+                f"VALUES ({', '.join('?' * len(names))})",
                 key.row() + tuple(run.get(f) for f in RUN_FIELDS),
             ).rowcount
             if not added:

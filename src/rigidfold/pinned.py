@@ -1,0 +1,37 @@
+"""``python -m rigidfold.pinned``: this machine's numeric environment, or a command run with
+the pinned numerics of :mod:`rigidfold.numerics`.
+
+::
+
+    python -m rigidfold.pinned                  # the environment as JSON
+    python -m rigidfold.pinned dask worker tcp://host:8786   # a study worker, pinned
+    python -m rigidfold.pinned python script.py # a script whose designs match the CLI's
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+
+from rigidfold.numerics import RESTARTED_ENV, numeric_environment, pinned_environ, restart_pinned
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if args:
+        program = shutil.which(args[0])
+        if program is None:
+            print(f"rigidfold.pinned: no command {args[0]!r}", file=sys.stderr)
+            return 127
+        env = pinned_environ(os.environ)
+        env[RESTARTED_ENV] = "1"
+        os.execve(program, args, env)
+    restart_pinned()
+    print(json.dumps(numeric_environment().to_dict(), indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
