@@ -23,6 +23,7 @@ from rigidfold.numerics import (
     numeric_environment,
     pinned_environ,
 )
+from rigidfold.study.report import markdown
 from rigidfold.study.runner import check_worker_numerics
 from rigidfold.study.store import Key, Store
 
@@ -182,6 +183,8 @@ def test_a_study_database_refuses_runs_of_other_numerics(tmp_path):
     assert mixed.numerics() == NUMERICS_A  # the first runs' environment is kept
     assert {r["numerics"] for r in mixed.runs()} == {"aaaa", "bbbb"}
     mixed.close()
+    report = markdown(Store(db, readonly=True))
+    assert "Numerics: pinned, `aaaa numpy=1`; the runs come from 2 numeric environments" in report
 
 
 def test_a_database_without_recorded_numerics(tmp_path):

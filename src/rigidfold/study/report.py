@@ -417,7 +417,21 @@ def _configuration_lines(store: Store) -> list[str]:
         f"look-ahead {'on' if lookahead else 'off'}; {len(store.runs())} runs, "
         f"{store.count_attempts()} solves of (6); rigidfold {', '.join(versions) or '-'}.",
         "",
+        *_numerics_lines(store),
     ]
+
+
+def _numerics_lines(store: Store) -> list[str]:
+    """Which numeric environments computed the runs (rigidfold.numerics); none before they
+    were recorded."""
+    numerics = store.numerics()
+    keys = {r.get("numerics") for r in store.runs()} - {None}
+    if numerics is None and not keys:
+        return []
+    status = (numerics or {}).get("status", "?")
+    key = (numerics or {}).get("key", "?")
+    mixed = f"; the runs come from {len(keys)} numeric environments" if len(keys) > 1 else ""
+    return [f"Numerics: {status}, `{key}`{mixed}.", ""]
 
 
 def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
