@@ -105,6 +105,63 @@ def test_output_path_that_is_a_file(tmp_path):
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
+OPTIMIZE_RUN = ["optimize", "--surface", "dome", "--pattern", "grid:3x3"]
+
+
+def _one_line_error(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+def test_optimize_refuses_to_replace_its_input(tmp_path, capsys):
+    """A pattern or a surface read from a file that optimize would write, directly or through
+    a symbolic link, is refused before anything is written (issue 30)."""
+    assert main([*OPTIMIZE_RUN, "--out", str(tmp_path / "a")]) == 0
+    solution = tmp_path / "a" / "solution.fold"
+    cases = []
+    for name, option in (("solution.fold", "--pattern"), ("summary.json", "--surface")):
+        folder = tmp_path / f"in_{name}"
+        folder.mkdir()
+        given = folder / name
+        given.write_bytes(solution.read_bytes())
+        spec = str(given) if option == "--pattern" else f"fold:{given}"
+        cases.append((folder, given, {"--pattern": "grid:3x3", option: spec}, []))
+    link_dir = tmp_path / "linked"
+    link_dir.mkdir()
+    (link_dir / "solution.fold").write_bytes(solution.read_bytes())
+    link = tmp_path / "link.fold"
+    link.symlink_to(link_dir / "solution.fold")
+    cases.append((link_dir, link, {"--pattern": str(link)}, ["--overwrite"]))
+    for folder, given, specs, extra in cases:
+        before = {p.name: p.read_bytes() for p in folder.iterdir()}
+        capsys.readouterr()
+        options = {"--surface": "dome", **specs}
+        argv = ["optimize", *[t for kv in options.items() for t in kv], "--out", str(folder)]
+        assert main([*argv, *extra]) == 2
+        error = _one_line_error(capsys)
+        assert f"would replace the input file '{given}'" in error
+        assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+
+
+def test_optimize_refuses_an_earlier_run_unless_overwrite(tmp_path, capsys):
+    """Like generate: the files of an earlier run in --out are refused, --overwrite replaces
+    them and keeps the other files (issue 30, item 24)."""
+    out = tmp_path / "run"
+    assert main([*OPTIMIZE_RUN, "--out", str(out)]) == 0
+    (out / "notes.txt").write_text("mine")
+    (out / "summary.json").write_text("{}")
+    capsys.readouterr()
+    assert main([*OPTIMIZE_RUN, "--out", str(out)]) == 2
+    error = _one_line_error(capsys)
+    assert "holds an earlier run (solution.fold, summary.json): give --overwrite" in error
+    assert (out / "summary.json").read_text() == "{}"
+    assert main([*OPTIMIZE_RUN, "--out", str(out), "--overwrite"]) == 0
+    assert json.loads((out / "summary.json").read_text())["status"] == "converged"
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "solution.fold", "summary.json"]
+    assert (out / "notes.txt").read_text() == "mine"
+
+
 def test_help_lists_optimize():
     proc = run_cli("--help")
     assert proc.returncode == 0 and "optimize" in proc.stdout
@@ -290,7 +347,8 @@ def test_nothing_from_opensees_or_ipopt_reaches_the_terminal(tmp_path, capfd, no
     assert main(["--verbose", "deform", str(fold), "--out", str(tmp_path / "loud")]) == 0
     captured = capfd.readouterr()
     assert "Ipopt" in captured.out and "Node:" in captured.out + captured.err
-    assert main(["--verbose", "optimize", *commands["optimize"][0], "--out", str(run)]) in (0, 1)
+    loud = ["--verbose", "optimize", *commands["optimize"][0]]
+    assert main([*loud, "--out", str(tmp_path / "loud_opt")]) in (0, 1)
     assert "Number of Iterations" in capfd.readouterr().out
 
 

@@ -304,6 +304,28 @@ def test_overwrite_never_removes_an_input_file(tmp_path, capsys):
     assert solution.read_bytes() == before and (out / "summary.json").is_file()
 
 
+def test_generate_refuses_to_replace_its_input(tmp_path, capsys):
+    """A surface read from a file generate would write (here DIR/summary.json) is refused,
+    naming the input, before anything is written (issue 30)."""
+    assert (
+        main(["optimize", "--surface", "dome", "--pattern", "grid:3x3", "--out", str(tmp_path)])
+        == 0
+    )
+    out = tmp_path / "run"
+    out.mkdir()
+    surface = out / "summary.json"
+    before = (tmp_path / "solution.fold").read_bytes()
+    surface.write_bytes(before)
+    capsys.readouterr()
+    argv = ["generate", "--surface", f"fold:{surface}", "--pattern", "grid:3x3", "--quiet"]
+    for extra in ([], ["--overwrite"]):
+        assert main([*argv, "--out", str(out), *extra]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"would replace the input file '{surface}'" in err[0]
+        assert sorted(p.name for p in out.iterdir()) == ["summary.json"]
+        assert surface.read_bytes() == before
+
+
 DEFORM_RUN = ["--surface", "dome", "--pattern", "grid:3x3", "--quiet", "--no-report"]
 """SHORT_RUN with Step 9: three solutions, DOF 5 -> 3, in a few seconds."""
 

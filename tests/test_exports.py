@@ -451,3 +451,24 @@ def test_export_command_bad_input(solution_file, tmp_path, args, message):
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr
     assert "Traceback" not in proc.stderr and proc.stdout == ""
+
+
+def test_export_command_refuses_to_replace_its_input(solution_file, tmp_path, capsys):
+    """An input named like one of the exports in --out, or a link to one, is refused before
+    anything is written (issue 30)."""
+    folder = tmp_path / "x"
+    folder.mkdir()
+    given = folder / "design.obj"
+    given.write_bytes(solution_file.read_bytes())
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (folder / "design_cutsheet.dxf").write_bytes(solution_file.read_bytes())
+    link = elsewhere / "design.fold"
+    link.symlink_to(folder / "design_cutsheet.dxf")
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    for path, to in ((given, "obj,stl"), (link, "dxf"), (link, ",".join(EXPORT_FORMATS))):
+        capsys.readouterr()
+        assert main(["export", str(path), "--out", str(folder), "--to", to]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"would replace the input file '{path}'" in err[0]
+        assert {p.name: p.read_bytes() for p in folder.iterdir()} == before

@@ -10,7 +10,13 @@ import stat
 import numpy as np
 import pytest
 
-from rigidfold.io import atomic_write, jsonable, prepare_output_dir, write_json
+from rigidfold.io import (
+    atomic_write,
+    jsonable,
+    prepare_output_dir,
+    refuse_replacing_inputs,
+    write_json,
+)
 from rigidfold.status import Outcome
 
 
@@ -124,3 +130,27 @@ def test_write_json(tmp_path):
     with pytest.raises(ValueError, match=r"the JSON data of '.+s\.json' holds a set"):
         write_json(path, {"x": {1}})
     assert json.loads(path.read_text()) == {"F": None, "n": 2}
+
+
+def test_refuse_replacing_inputs(tmp_path):
+    """An output that is an input, by its own name, through a symbolic link to it or from it,
+    or as a hard link, is refused; naming the input. An output that is not there yet is
+    compared by its resolved path."""
+    given = tmp_path / "in.fold"
+    given.write_text("{}")
+    (tmp_path / "sub").mkdir()
+    link = tmp_path / "sub" / "link.fold"
+    link.symlink_to(given)
+    hard = tmp_path / "hard.fold"
+    os.link(given, hard)
+    for inp, out in (
+        (given, given),
+        (given, tmp_path / "sub" / ".." / "in.fold"),
+        (link, given),
+        (given, link),
+        (hard, given),
+    ):
+        with pytest.raises(ValueError, match=f"would replace the input file '{inp}'"):
+            refuse_replacing_inputs([tmp_path / "other.fold", inp], [tmp_path / "x.svg", out])
+    refuse_replacing_inputs([given], [tmp_path / "new" / "in.fold", tmp_path / "in.svg"])
+    refuse_replacing_inputs([], [given])

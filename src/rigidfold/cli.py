@@ -316,9 +316,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="solve problem (6): a developable polyhedron near a target surface",
         description="Solve problem (6) once and write DIR/solution.fold and DIR/summary.json. "
         "Exit code 0 when the solution is accepted (F <= F_tol, constraints met), 1 when not "
-        "(the files are written all the same), 2 on bad input.",
+        "(the files are written all the same), 2 on bad input. A DIR that holds an earlier "
+        "run's files is refused unless --overwrite.",
     )
     _case_options(opt, out=f"{OUT_HELP}: solution.fold and summary.json")
+    opt.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the solution.fold and summary.json of an earlier run in DIR (refused "
+        "otherwise); other files in DIR are kept",
+    )
     opt.add_argument(
         "--fixed",
         help="comma-separated indices (into the pattern's edges, as in its FOLD "
@@ -507,7 +514,9 @@ def _case(args: argparse.Namespace):
 def _cmd_optimize(args: argparse.Namespace) -> int:
     from rigidfold.workflows import optimize_case
 
-    out = optimize_case(_case(args), args.out, fixed=args.fixed, solver=args.solver)
+    out = optimize_case(
+        _case(args), args.out, fixed=args.fixed, solver=args.solver, overwrite=args.overwrite
+    )
     result = out.result
     print(
         f"{result.status.value}: F = {result.F:.3e} (F1 = {result.F1:.2e}, F2 = {result.F2:.2e}), "

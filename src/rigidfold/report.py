@@ -29,6 +29,7 @@ from rigidfold.io import (
     crease_pattern_frame,
     motion_frames,
     prepare_output_dir,
+    refuse_replacing_inputs,
     round_trip_dict,
     write_document,
     write_fold,
@@ -186,18 +187,23 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def clear_earlier_run(out: str | Path, *, overwrite: bool, inputs: tuple[Path, ...] = ()) -> Path:
+def clear_earlier_run(
+    out: str | Path,
+    *,
+    overwrite: bool,
+    inputs: tuple[Path, ...] = (),
+    names: tuple[str, ...] = (*RUN_FILES, *RUN_DIRS),
+) -> Path:
     """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
 
-    Only rigidfold's own run files (:data:`RUN_FILES`, :data:`RUN_DIRS`) count and are
-    removed; other files in ``out`` stay. A symbolic link among them is removed itself, never
-    followed. Removing one of the run's ``inputs`` (e.g. an earlier solution used as the
-    pattern) is refused. Returns ``out`` as a Path. Raises ValueError naming what was found.
+    Only the run's own files and directories, ``names`` (a generation run's by default:
+    :data:`RUN_FILES`, :data:`RUN_DIRS`), count and are removed; other files in ``out``
+    stay. A symbolic link among them is removed itself, never followed. Removing one of the
+    run's ``inputs`` (e.g. an earlier solution used as the pattern) is refused. Returns
+    ``out`` as a Path. Raises ValueError naming what was found.
     """
     out = Path(out)
-    found = [
-        out / n for n in (*RUN_FILES, *RUN_DIRS) if (out / n).is_symlink() or (out / n).exists()
-    ]
+    found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
     if not found:
         return out
     if not overwrite:
@@ -307,6 +313,7 @@ class RunWriter:
         deform: bool = True,
         overwrite: bool = False,
     ) -> None:
+        refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
         self.out = prepare_output_dir(out)
         self.lock = lock_run_dir(self.out)
         try:

@@ -36,6 +36,7 @@ from rigidfold.exports import (
     Design,
     check_convention,
     export_design,
+    export_paths,
     parse_formats,
     read_design,
 )
@@ -45,12 +46,13 @@ from rigidfold.io import (
     atomic_write,
     prepare_output_dir,
     read_fold,
+    refuse_replacing_inputs,
     write_fold,
     write_json,
 )
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
-from rigidfold.report import RunWriter, write_checked_shape
+from rigidfold.report import RunWriter, clear_earlier_run, write_checked_shape
 from rigidfold.reporting import RunData, load_run, page, render_figures, view_figure
 
 # ------------------------------------------------------------------------------ analyze
@@ -189,17 +191,13 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
     rigidfold's frames (in metres, ``frame_unit: "m"``, z up) and ``rigidfold:`` keys added:
     nothing of the input is dropped or rewritten, so its unit, orientation, polygons and
     assignments stay as they were (:func:`rigidfold.io.round_trip_dict`)."""
-    out_dir = prepare_output_dir(out)
     stem = Path(path).stem
     # the name in the files' text: bytes of a file name that are not UTF-8 shown as U+FFFD
     label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     names = [f"{stem}.fold", f"{stem}.svg"] + ([f"{stem}_deform.json"] if deform else [])
-    for name in names:  # before any work: a file written must never replace the input
-        if (out_dir / name).resolve() == Path(path).resolve():
-            raise ValueError(
-                f"the output {str(out_dir / name)!r} would replace the input file; "
-                "choose another output directory"
-            )
+    # before any work: a file written must never replace the input
+    refuse_replacing_inputs([path], [Path(out) / name for name in names])
+    out_dir = prepare_output_dir(out)
     data = read_fold(path, up=up, settings=settings)
     check = verify(data.pattern, run_deform=deform, run_motion=deform, settings=settings)
     written = write_checked_shape(
@@ -217,6 +215,10 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
 
 
 # ------------------------------------------------------------------------------ optimize
+OPTIMIZE_FILES = ("solution.fold", "summary.json")
+"""The files ``optimize_case`` writes into its directory."""
+
+
 @dataclass(frozen=True, eq=False)
 class OptimizeOutput:
     """One solve of problem (6): the result, ``summary.json``'s content, the files written."""
@@ -231,11 +233,22 @@ class OptimizeOutput:
 
 
 def optimize_case(
-    case: Case, out: str | os.PathLike, *, fixed: str | None = None, solver: str = "ipopt"
+    case: Case,
+    out: str | os.PathLike,
+    *,
+    fixed: str | None = None,
+    solver: str = "ipopt",
+    overwrite: bool = False,
 ) -> OptimizeOutput:
     """Solve (6) once with the creases ``fixed`` ("I,J,...") fixed; write
-    ``OUT/solution.fold`` and ``OUT/summary.json`` whatever the outcome."""
+    ``OUT/solution.fold`` and ``OUT/summary.json`` whatever the outcome.
+
+    Before any work, ValueError when one of the files would replace one of ``case.inputs``,
+    and when OUT holds them from an earlier run, unless ``overwrite`` (then they are removed
+    first, like ``generate --overwrite``: :func:`rigidfold.report.clear_earlier_run`)."""
+    refuse_replacing_inputs(case.inputs, [Path(out) / name for name in OPTIMIZE_FILES])
     out_dir = prepare_output_dir(out)
+    clear_earlier_run(out_dir, overwrite=overwrite, inputs=case.inputs, names=OPTIMIZE_FILES)
     mask = parse_fixed(fixed, case.pattern)
     problem = case.problem(build_ipopt=solver == "ipopt")
     result = problem.solve(fixed=mask, solver=solver)
@@ -353,9 +366,10 @@ def export_file(
     sheet in ``convention`` (:func:`rigidfold.exports.export_design`)."""
     chosen = parse_formats(formats)
     check_convention(convention)
+    stem = Path(path).stem
+    refuse_replacing_inputs([path], export_paths(out, chosen, name=stem))
     out_dir = prepare_output_dir(out)
     design = read_design(path, up=up, settings=settings)
-    stem = Path(path).stem
     written = export_design(
         design.pattern,
         design.coords2d,

@@ -21,6 +21,7 @@ from rigidfold.exports.design import (
     EXPORT_FORMATS,
     Design,
     export_design,
+    export_paths,
     parse_formats,
     read_design,
 )
@@ -40,6 +41,7 @@ __all__ = [
     "crease_rows",
     "dxf_text",
     "export_design",
+    "export_paths",
     "layout_sheet",
     "mesh_bytes",
     "origami_simulator_fold",

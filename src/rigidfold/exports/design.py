@@ -68,6 +68,22 @@ def parse_formats(formats: str | Sequence[str]) -> tuple[str, ...]:
     return tuple(f for f in EXPORT_FORMATS if f in wanted)
 
 
+def export_paths(
+    out_dir: str | os.PathLike, formats: str | Sequence[str] = EXPORT_FORMATS, *, name: str
+) -> list[Path]:
+    """The files :func:`export_design` writes into ``out_dir`` for ``formats`` (see
+    :func:`parse_formats`) and the stem ``name``, in :data:`EXPORT_FORMATS` order."""
+    out = Path(out_dir)
+    return [
+        out / template.format(name) for fmt in parse_formats(formats) for template in _files(fmt)
+    ]
+
+
+def _files(fmt: str) -> tuple[str, ...]:
+    """The file names of one format, ``{}`` standing for the design's name."""
+    return (f"{{}}.{fmt}",) if fmt in MESH_FORMATS else _FILES[fmt]
+
+
 def export_design(
     pattern: CreasePattern,
     coords2d: np.ndarray,
@@ -119,11 +135,10 @@ def export_design(
     out = prepare_output_dir(out_dir)
     written: list[Path] = []
     for fmt in chosen:
+        paths = [out / template.format(name) for template in _files(fmt)]
         if fmt in MESH_FORMATS:
-            written.append(write_mesh(out / f"{name}.{fmt}", pattern, title=title))
-            continue
-        paths = [out / template.format(name) for template in _FILES[fmt]]
-        if fmt == "dxf":
+            written.append(write_mesh(paths[0], pattern, title=title))
+        elif fmt == "dxf":
             written.append(write_dxf(paths[0], sheet))
         elif fmt == "svg":
             written.append(write_sheet_svg(paths[0], sheet, title=title, convention=convention))

@@ -7,6 +7,7 @@ from rigidfold.io.files import (
     jsonable,
     parse_json,
     prepare_output_dir,
+    refuse_replacing_inputs,
     write_json,
 )
 from rigidfold.io.fold import (
@@ -41,6 +42,7 @@ __all__ = [
     "prepare_output_dir",
     "read_fold",
     "read_svg",
+    "refuse_replacing_inputs",
     "round_trip_dict",
     "svg_text",
     "write_document",

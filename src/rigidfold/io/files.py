@@ -13,6 +13,7 @@ import json
 import math
 import os
 import secrets
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +39,40 @@ def prepare_output_dir(path: str | os.PathLike) -> Path:
     except OSError as exc:
         raise ValueError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
     return out
+
+
+def refuse_replacing_inputs(
+    inputs: Iterable[str | os.PathLike], outputs: Iterable[str | os.PathLike]
+) -> None:
+    """Refuse, before anything is written, a command whose output would replace its input.
+
+    ``outputs`` are the files a command would write, ``inputs`` the files it reads. Two paths
+    are the same file when :func:`os.path.samefile` says so (symbolic and hard links
+    included), or, when one of them does not exist, when their resolved paths are equal.
+
+    Raises ValueError ``"the output 'OUT' would replace the input file 'IN'; choose another
+    output directory"`` for the first output that is an input.
+    """
+    given = [Path(p) for p in inputs]
+    for output in outputs:
+        for path in given:
+            if _same_file(Path(output), path):
+                raise ValueError(
+                    f"the output '{output}' would replace the input file '{path}'; choose "
+                    "another output directory"
+                )
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (see :func:`refuse_replacing_inputs`)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (or cannot be looked at)
+        pass
+    try:
+        return a.resolve() == b.resolve()
+    except (OSError, RuntimeError):  # a loop of symbolic links names no file
+        return False
 
 
 def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
