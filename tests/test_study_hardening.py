@@ -157,7 +157,7 @@ def test_a_scheduler_that_is_not_dask_is_refused_within_the_timeout(tmp_path):
     (line,) = proc.stderr.strip().splitlines()
     assert f"cannot reach the Dask scheduler at {address!r} within 3 s" in line
     proc = run_cli("study", *STUDY, "--db", str(tmp_path / "c.sqlite"), "--connect-timeout", "0")
-    assert proc.returncode == 2 and "--connect-timeout must be > 0" in proc.stderr
+    assert proc.returncode == 2 and "--connect-timeout must be a finite number" in proc.stderr
 
 
 def test_a_dask_scheduler_is_reached_through_the_handshake():
@@ -279,3 +279,129 @@ def test_a_run_that_raises_unexpectedly_is_recorded_as_failed_and_the_others_go_
     assert runs[0]["status"] == "target DOF 1 reached"
     assert runs[1]["status"] == "error: " + message
     store.close()
+
+
+def _study_args(db) -> list[str]:
+    return [
+        "study", "--surfaces", "1", "--patterns", "1", "--criteria", "s", "--no-deform",
+        "--quiet", "--db", str(db),
+    ]  # fmt: skip
+
+
+def test_workers_are_bounded_by_the_machine_before_the_database_is_made(
+    tmp_path, monkeypatch, capsys
+):
+    """Issue 30, item 6: more local workers than CPUs (or than the open-file limit allows)
+    are refused in one line naming the limit, by the library and the CLI, and no file made."""
+    from rigidfold.study import runner, session
+
+    db = tmp_path / "w.sqlite"
+    monkeypatch.setattr(runner, "usable_cpus", lambda: 3)
+    monkeypatch.setattr(runner, "open_file_limit", lambda: None)
+    assert runner.max_workers() == (3, "the 3 CPUs this process may use")
+    with pytest.raises(ValueError, match=r"^--workers 4 is more .* at most 3 local workers"):
+        session.run_study_command([Key("bezier", 0, "1", "s")], db, StudyConfig(), workers=4)
+    code = main_code([*_study_args(db), "--workers", "10000"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert "--workers 10000 is more than this machine runs: at most 3" in err
+    # the open-file limit: (1024 - 256) // 16 = 48 workers
+    monkeypatch.setattr(runner, "usable_cpus", lambda: 1000)
+    monkeypatch.setattr(runner, "open_file_limit", lambda: 1024)
+    limit, reason = runner.max_workers()
+    assert limit == 48 and "open-file limit of 1024" in reason
+    with pytest.raises(ValueError, match="at most 48 local workers"):
+        runner.check_workers(49)
+    runner.check_workers(48)
+    # the default is allowed on a one-CPU machine
+    monkeypatch.setattr(runner, "usable_cpus", lambda: 1)
+    runner.check_workers(session.STUDY_DEFAULTS.workers)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_real_limits_are_positive_and_used_by_run_study(tmp_path):
+    from rigidfold.study import runner
+
+    limit, _ = runner.max_workers()
+    assert limit >= 2
+    store = Store(tmp_path / "r.sqlite", StudyConfig().as_dict())
+    try:
+        with pytest.raises(ValueError, match=f"at most {limit} local workers"):
+            runner.run_study([Key("bezier", 0, "1", "s")], store, StudyConfig(), workers=limit + 1)
+        with pytest.raises(ValueError, match="--connect-timeout must be a finite"):
+            runner.run_study(
+                [Key("bezier", 0, "1", "s")], store, StudyConfig(), connect_timeout=float("inf")
+            )
+    finally:
+        store.close()
+
+
+@pytest.mark.parametrize("value", ["inf", "nan", "-1", "0", "1e400"])
+def test_connect_timeout_must_be_finite_and_positive(tmp_path, capsys, value):
+    """Issue 30, item 13: ``--connect-timeout inf`` is one line (exit 2), no database made."""
+    db = tmp_path / "t.sqlite"
+    code = main_code([*_study_args(db), f"--connect-timeout={value}"])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err
+    assert err.startswith("rigidfold: error: --connect-timeout must be a finite number")
+    assert err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", ["run#2.sqlite", "a?mode=rwc.sqlite", "p%41 q.sqlite", "x#"])
+def test_a_database_named_with_uri_characters_resumes_without_stray_files(tmp_path, name):
+    """Issue 30, item 7: the read-only connection (the check of an existing database, and
+    reports) opens that very file, not the name cut at ``#`` or ``?`` nor ``%XX`` decoded."""
+    db = tmp_path / name
+    key = Key("bezier", 0, "1", "s")
+    config = StudyConfig().as_dict()
+    store = Store(db, config)
+    store.add(key, {"status": "target DOF 1 reached", "n_lock": 2, "version": "t"}, [])
+    store.close()
+    store = Store(db, config)  # resumed: the existing file is checked read-only first
+    assert store.done() == {key}
+    store.close()
+    report = Store(db, readonly=True)
+    assert [r["n_lock"] for r in report.runs()] == [2]
+    report.close()
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == sorted(n for n in (name, f"{name}-wal", f"{name}-shm") if n in left)
+    assert name in left
+
+
+def test_report_figures_of_patterns_with_directories_are_written(tmp_path, capsys):
+    """Issue 30, item 8: a pattern given as ``sub/t.fold`` (or ``grid:3x3``) names a figure
+    in DIR (a slug, unique), linked from results.md."""
+    from rigidfold.study.report import figure_name
+    from rigidfold.study.store import RUN_FIELDS
+
+    db = tmp_path / "s.sqlite"
+    store = Store(db, StudyConfig().as_dict())
+    numbers = {
+        f: 1 for f in RUN_FIELDS if f.startswith(("n_", "mean_f", "time_", "initial", "final"))
+    }
+    for i, pattern in enumerate(["sub/t.fold", "sub:t.fold", "grid:3x3", "../up.fold"]):
+        for seed in range(2):
+            store.add(
+                Key("bezier", seed, pattern, "s"),
+                numbers | {"status": "target DOF 1 reached", "n_lock": seed + i, "version": "t"},
+                [],
+            )
+    store.close()
+    out = tmp_path / "rep"
+    code = main_code(["study-report", str(db), "--out", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [
+        "n_lock_pattern_.._up.fold.png",
+        "n_lock_pattern_grid_3x3.png",
+        "n_lock_pattern_sub_t.fold.png",
+        "n_lock_pattern_sub_t.fold_2.png",
+        "results.md",
+    ]
+    text = (out / "results.md").read_text()
+    for png in names[:-1]:
+        assert f"]({png})" in text
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert figure_name("?#", set()) == "figure.png"

@@ -9,6 +9,7 @@ from __future__ import annotations
 import io
 import itertools
 import math
+import re
 from collections import Counter
 from pathlib import Path
 
@@ -719,8 +720,26 @@ def _cost_lines(store: Store) -> list[str]:
     return [*lines, ""]
 
 
-def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
-    """One PNG per pattern: N_lock per criterion. Returns pattern -> file name."""
+def figure_name(text: str, used: set[str]) -> str:
+    """A file name for a figure of ``text`` (a pattern spec, a database name): its letters,
+    digits, ``.``, ``-`` and ``_``, any other run of characters (``/``, ``:``, ``#``, spaces)
+    one ``_``, then ``.png``; made unique among ``used`` (``_2``, ``_3``, ...) and added to it.
+    """
+    slug = re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._")[:120] or "figure"
+    name, n = f"{slug}.png", 1
+    while name.lower() in used:  # lower: distinct on case-insensitive file systems too
+        n += 1
+        name = f"{slug}_{n}.png"
+    used.add(name.lower())
+    return name
+
+
+def box_plots(
+    store: Store, out: Path, prefix: str = "", used: set[str] | None = None
+) -> dict[str, str]:
+    """One PNG per pattern: N_lock per criterion. Returns pattern -> file name, a slug of
+    ``prefix`` and the pattern's spec (:func:`figure_name`: a spec with a directory,
+    ``sub/t.fold``, names a file in ``out``), unique among ``used``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -728,6 +747,7 @@ def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
 
     runs = [r for r in store.runs("bezier") if r["n_lock"] is not None]
     files = {}
+    used = set() if used is None else used
     for pattern in sorted({r["pattern"] for r in runs}):
         crits = [
             c for c in ORDER if any(r["criterion"] == c and r["pattern"] == pattern for r in runs)
@@ -742,7 +762,7 @@ def box_plots(store: Store, out: Path, prefix: str = "") -> dict[str, str]:
         ax.set_ylabel("N_lock per run")
         ax.set_title(f"Pattern {pattern}: N_lock per run, {len(data[0])} surfaces", fontsize=10)
         fig.tight_layout()
-        name = f"{prefix}n_lock_pattern_{pattern}.png"
+        name = figure_name(f"{prefix}n_lock_pattern_{pattern}", used)
         png = io.BytesIO()
         fig.savefig(png, format="png")
         plt.close(fig)
@@ -757,8 +777,10 @@ def write_report(stores: Store | list[Store], out: str | Path) -> Path:
 
     stores = [stores] if isinstance(stores, Store) else list(stores)
     out = prepare_output_dir(out)
+    used: set[str] = set()
     figures = [
-        box_plots(s, out, prefix=f"{s.path.stem}_" if len(stores) > 1 else "") for s in stores
+        box_plots(s, out, prefix=f"{s.path.stem}_" if len(stores) > 1 else "", used=used)
+        for s in stores
     ]
     path = out / "results.md"
     return atomic_write(path, "# rigidfold study report\n\n" + markdown(stores, figures) + "\n")

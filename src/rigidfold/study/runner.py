@@ -11,6 +11,7 @@ exception (a defect, named with its type and message). Dask is imported only her
 
 from __future__ import annotations
 
+import math
 import os
 import socket
 import time
@@ -235,6 +236,77 @@ def _failed_row(message: str, worker: str | None = None) -> dict:
 CONNECT_TIMEOUT_S = 20.0
 """Seconds that a Dask scheduler given by address has to answer (``--connect-timeout``)."""
 
+MIN_WORKER_LIMIT = 2
+"""Local workers always allowed, even on a machine with fewer CPUs (the default, 2)."""
+
+FILES_PER_WORKER = 16
+"""Open files that the client process holds per local Dask worker (measured: about 9: the
+worker's and its nanny's connections and pipes), with a margin."""
+
+FILES_RESERVED = 256
+"""Open files kept for the client itself (the database, its lock, Python, Dask's scheduler)."""
+
+
+def usable_cpus() -> int:
+    """The CPUs this process may run on (its CPU affinity; ``os.cpu_count()`` where the
+    platform has none)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def open_file_limit() -> int | None:
+    """This process's soft limit of open files (RLIMIT_NOFILE); None: unlimited or unknown."""
+    try:
+        import resource
+    except ImportError:
+        return None
+    soft, _ = resource.getrlimit(resource.RLIMIT_NOFILE)
+    return None if soft == resource.RLIM_INFINITY or soft < 0 else soft
+
+
+def max_workers() -> tuple[int, str]:
+    """The most local Dask workers this machine runs, and what bounds it: the CPUs this
+    process may use (:func:`usable_cpus`, at least :data:`MIN_WORKER_LIMIT`), and the open
+    files the client needs for them (:data:`FILES_PER_WORKER` each, beyond
+    :data:`FILES_RESERVED`, within :func:`open_file_limit`)."""
+    cpus = usable_cpus()
+    limit = max(cpus, MIN_WORKER_LIMIT)
+    reason = f"the {cpus} CPU{'s' if cpus != 1 else ''} this process may use"
+    files = open_file_limit()
+    if files is not None:
+        by_files = max((files - FILES_RESERVED) // FILES_PER_WORKER, 1)
+        if by_files < limit:
+            limit = by_files
+            reason = f"the open-file limit of {files} (ulimit -n), {FILES_PER_WORKER} per worker"
+    return limit, reason
+
+
+def check_workers(workers: int) -> None:
+    """ValueError unless ``workers`` local Dask workers are at least 1 and at most
+    :func:`max_workers`, naming the limit."""
+    if isinstance(workers, bool) or not isinstance(workers, int):
+        raise ValueError(f"--workers must be a whole number, got {workers!r}")
+    if workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {workers}")
+    limit, reason = max_workers()
+    if workers > limit:
+        raise ValueError(
+            f"--workers {workers} is more than this machine runs: at most {limit} local "
+            f"workers ({reason}); use --scheduler for a larger cluster"
+        )
+
+
+def check_connect_timeout(timeout: float) -> None:
+    """ValueError unless ``timeout`` (``--connect-timeout``) is a finite number > 0."""
+    if isinstance(timeout, bool) or not isinstance(timeout, int | float):
+        raise ValueError(f"--connect-timeout must be a number of seconds, got {timeout!r}")
+    if not (math.isfinite(timeout) and timeout > 0):
+        raise ValueError(
+            f"--connect-timeout must be a finite number of seconds > 0, got {timeout:g}"
+        )
+
 
 def connect(scheduler: str, timeout: float):
     """A ``dask.distributed.Client`` of the scheduler at ``scheduler``; ValueError naming the
@@ -298,8 +370,9 @@ def run_study(
     spent starting (or connecting to) the Dask cluster (``startup_s``) and the runs of this
     call that failed (``failed``: (Key, message) each, in the order they ended).
 
-    On ``workers`` local processes, or on the cluster of the Dask ``scheduler`` (an address),
-    which must answer within ``connect_timeout`` seconds (:func:`connect`). A run fails when
+    On ``workers`` local processes (at most :func:`max_workers`), or on the cluster of the
+    Dask ``scheduler`` (an address), which must answer within ``connect_timeout`` seconds, a
+    finite number (:func:`connect`). A run fails when
     it cannot run (a ValueError, :func:`run_one`) or when its Dask workers die every time it
     is tried (:func:`lost_run`); either is stored with its message and the others go on.
 
@@ -313,8 +386,9 @@ def run_study(
     from dask.distributed import Client, LocalCluster, as_completed
     from distributed import KilledWorker
 
-    if workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {workers}")
+    if scheduler is None:
+        check_workers(workers)
+    check_connect_timeout(connect_timeout)
     done = store.done()
     todo = [k for k in keys if k not in done]
     total, finished = len(keys), len(keys) - len(todo)

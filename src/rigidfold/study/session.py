@@ -19,7 +19,13 @@ from pathlib import Path
 from rigidfold.config import DEFAULT_SEED
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import TABLES_5_6
-from rigidfold.study.runner import CONNECT_TIMEOUT_S, StudyConfig, run_study
+from rigidfold.study.runner import (
+    CONNECT_TIMEOUT_S,
+    StudyConfig,
+    check_connect_timeout,
+    check_workers,
+    run_study,
+)
 from rigidfold.study.store import Key, Store
 
 
@@ -74,10 +80,11 @@ def run_study_command(
     compute with other numerics than this process, are refused unless
     ``allow_mixed_numerics``.
     """
-    if workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {workers}")
-    if not connect_timeout > 0:
-        raise ValueError(f"--connect-timeout must be > 0 seconds, got {connect_timeout}")
+    # checked before the database is created: local workers within what the machine runs
+    # (CPUs, open files), a finite timeout
+    if scheduler is None:
+        check_workers(workers)
+    check_connect_timeout(connect_timeout)
     from rigidfold.numerics import numeric_environment
 
     numerics = numeric_environment().to_dict()

@@ -18,6 +18,7 @@ from __future__ import annotations
 import functools
 import itertools
 import json
+import os
 import sqlite3
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -201,6 +202,16 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     return diff
 
 
+def sqlite_uri(path: str | Path, mode: str) -> str:
+    """The SQLite URI of the file ``path`` opened with ``mode`` (``ro``, ``rw``, ``rwc``): its
+    absolute path percent-encoded, so that a name with ``#``, ``?`` or ``%`` (``run#2.sqlite``)
+    names that file, not a shorter one with the rest read as the query or fragment."""
+    from urllib.parse import quote
+
+    absolute = os.path.abspath(os.fsencode(path))
+    return f"file:{quote(absolute, safe='/')}?mode={mode}"
+
+
 @functools.cache
 def schema_columns() -> dict[str, dict[str, str]]:
     """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
@@ -269,7 +280,7 @@ class Store:
 
     def _connect_readonly(self) -> sqlite3.Connection:
         try:
-            return sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, timeout=30)
+            return sqlite3.connect(sqlite_uri(self.path, "ro"), uri=True, timeout=30)
         except sqlite3.Error as exc:
             raise ValueError(f"{str(self.path)!r}: cannot open: {exc}") from None
 
