@@ -70,19 +70,10 @@ def child_environ(mode: str) -> dict[str, str]:
     return native
 
 
-def median_time(fn, repeat: int) -> tuple[float, object]:
-    """Median seconds of ``repeat`` calls of ``fn`` and its last result."""
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), out
-
-
 def child(args: argparse.Namespace) -> None:
     """Measure in this process (started with the numerics of ``args.child``)."""
     # imported here: the parent must not load NumPy, and rigidfold must come first
+    from bench_scale import timed as median_time  # this folder is on sys.path (a script)
     from rigidfold.case import make_case
     from rigidfold.config import one_blas_thread
     from rigidfold.generate import generate
