@@ -83,3 +83,11 @@ def dome_mesh(n: int) -> tuple[np.ndarray, np.ndarray]:
 @pytest.fixture
 def grid() -> CreasePattern:
     return folded_grid()
+
+
+def paper_generate(case, **kwargs):
+    """``rigidfold.generate.generate`` with the paper's Step 5 (no deployability check): the
+    tests of the paper's method and counters use it."""
+    from rigidfold.generate import generate
+
+    return generate(case, deploy_check=False, **kwargs)

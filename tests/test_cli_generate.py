@@ -56,6 +56,7 @@ def test_generate_writes_solutions_log_and_summary(generated):
         "solve",
         "analysis",
         "selection",
+        "path",
         "develop",
         "deform",
         "motion",
@@ -63,9 +64,13 @@ def test_generate_writes_solutions_log_and_summary(generated):
     dev = summary["development"]
     assert dev["max_D"] < 1e-8 and dev["flipped"] == 0 and dev["overlaps"] == 0
     assert len(summary["per_solution"]) == 4
-    # --no-deform: no Step 9, but the development and the folding motion of every solution
+    # --no-deform: no Step 9; the development of every solution, the folding motion of the
+    # final design (--check final, the default), its path traced for the deployability check
     assert summary["deformation"]["checked"] == 0 and summary["time_s"]["deform"] == 0.0
-    assert summary["motion"]["traced"] == 4 and summary["motion"]["max_length_error"] < 1e-3
+    assert summary["motion"]["traced"] == 1 and summary["motion"]["max_length_error"] < 1e-8
+    assert [s["motion"] is None for s in summary["per_solution"]] == [True] * 3 + [False]
+    assert summary["N_path"] == 0 and summary["final_deploys"] is True
+    assert summary["per_solution"][-1]["deployability"]["deploys"] is True
     assert summary["verdict"] == {
         "outcome": "passed",
         "message": "the target DOF was reached and every check of the final design passed",
@@ -333,10 +338,10 @@ DEFORM_RUN = ["--surface", "dome", "--pattern", "grid:3x3", "--quiet", "--no-rep
 def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, monkeypatch):
     """The large-deformation analysis and the folding motion: both verdicts of every solution
     in summary.json, the final design's in one line before the last; and, when they differ
-    (the motion tracer given too few Newton iterations), the reason."""
+    (the motion tracer given a budget of one step), the reason."""
     import rigidfold.report
 
-    assert main(["generate", *DEFORM_RUN, "--out", str(tmp_path / "a")]) == 1
+    assert main(["generate", *DEFORM_RUN, "--check", "all", "--out", str(tmp_path / "a")]) == 1
     lines = capsys.readouterr().out.strip().splitlines()
     agree = "large deformation reached the plane, folding motion traced: they agree"
     assert lines[-2] == f"final design: {agree}"
@@ -346,9 +351,11 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     assert (tmp_path / "a" / "final" / "step_02_dof_03.os.fold").is_file()
 
     real = rigidfold.report.verify
-    tight = DEFAULTS.with_(motion_max_iter=1, motion_max_halvings=0)
+    tight = DEFAULTS.with_(path_max_steps=1)  # the tracer gives up after one step
     monkeypatch.setattr(
-        rigidfold.report, "verify", lambda pattern, **kw: real(pattern, **{**kw, "settings": tight})
+        rigidfold.report,
+        "verify",
+        lambda pattern, **kw: real(pattern, **{**kw, "path": None, "settings": tight}),
     )
     assert main(["generate", *DEFORM_RUN, "--out", str(tmp_path / "b")]) == 1
     lines = capsys.readouterr().out.strip().splitlines()

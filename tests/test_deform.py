@@ -78,20 +78,6 @@ def test_miura_motion_is_exactly_rigid():
     assert np.abs(motion.frames[:, panel] - motion.frames[0, panel]).max() < 1e-9
 
 
-def test_one_dof_path_trace_of_a_miura_reaches_the_plane():
-    from rigidfold.deform.motion import trace_one_dof_path
-
-    shape = miura(3, 3, height=0.5)
-    trace = trace_one_dof_path(shape)
-    assert trace.reached_flat and trace.measure[-1] <= 0.1
-    assert np.all(np.diff(trace.measure) < 0)  # a Miura-ori unfolds monotonically
-    for x in trace.frames_towards_flat(10):
-        frame = x.reshape(-1, 3)
-        assert np.allclose(edge_lengths(frame, shape.edges), shape.edge_lengths, rtol=1e-10)
-    assert trace_one_dof_path(locked_miura(shape)) is None  # 0 DOF: no path
-    assert trace_one_dof_path(make_case("bezier", "1", seed=0).pattern) is None  # 21 DOF
-
-
 def test_symmetric_dome_one_dof_shape_turns_back_before_the_plane():
     """The DOF-1 shape of the symmetric dome (Sec. 6.5, criterion S): its one folding path
     reaches 0.288 of the design's folding measure and then folds up again, so the motion
@@ -169,7 +155,7 @@ def test_deform_fold_file_holds_the_support_panel_in_every_motion_frame(tmp_path
     raw = json.loads((tmp_path / "out" / "miura.fold").read_text())
     diagram = next(f for f in raw["file_frames"] if f["frame_classes"] == ["creasePattern"])
     motion = [f for f in raw["file_frames"] if "folding motion" in f["frame_title"]]
-    assert len(motion) == DEFAULTS.motion_frames
+    assert 3 <= len(motion) <= DEFAULTS.motion_frames
     support = raw["rigidfold:motion"]["support_faces"]
     assert (
         support
@@ -200,9 +186,8 @@ def free_miura():
     return shape.with_fixed(np.zeros(shape.n_edges, dtype=bool))
 
 
-TRACER_STOPS = {"motion_max_iter": 1, "motion_max_halvings": 0}
-"""Settings under which the motion tracer gives up at once (one Newton iteration a frame,
-no halving)."""
+TRACER_STOPS = {"path_max_steps": 1}
+"""Settings under which the motion tracer gives up at once (one continuation step)."""
 
 
 def test_verdicts_agree_on_a_rigid_foldable_miura(miura_checks):
@@ -228,8 +213,8 @@ def test_verdicts_differ_when_the_analysis_stops_short_of_the_plane():
 
 
 def test_verdicts_differ_when_the_tracer_stops_on_a_shape_of_several_dof(free_miura):
-    """At 9 DOF the folding path is not unique: the tracer follows one and, with too few
-    Newton iterations, gives up; the OpenSees frame reaches the plane all the same, hardly
+    """At 9 DOF the folding path is not unique: the tracer follows one and, with a budget of
+    one step, gives up; the OpenSees frame reaches the plane all the same, hardly
     deforming."""
     from rigidfold.config import DEFAULTS
 
@@ -305,70 +290,3 @@ def test_load_factor_tol_and_penalty_settings_take_effect(miura_checks):
     assert half.status is DeformStatus.FAILED and "from the plane" in half.message
     loose = deform(shape, settings=DEFAULTS.with_(deform_penalty=1.0))  # pins barely hold
     assert loose.history != free.history
-
-
-def count_calls(monkeypatch, module, name: str, result=None) -> dict:
-    """Replace ``module.name`` by a wrapper that counts its calls (returning ``result``
-    instead of calling it, when given)."""
-    real, calls = getattr(module, name), {"n": 0}
-
-    def wrapper(*args, **kwargs):
-        calls["n"] += 1
-        return real(*args, **kwargs) if result is None else result(*args)
-
-    monkeypatch.setattr(module, name, wrapper)
-    return calls
-
-
-def test_motion_halvings_have_their_own_setting(monkeypatch):
-    from rigidfold.config import DEFAULTS
-    from rigidfold.deform import motion as motion_module
-
-    shape = miura(3, 3)
-    calls = count_calls(monkeypatch, motion_module, "_newton", lambda c, x, t, s: (x, False))
-    monkeypatch.setattr(motion_module, "trace_one_dof_path", lambda *a, **k: None)
-    settings = DEFAULTS.with_(motion_max_halvings=2, deform_max_halvings=6)
-    m = folding_motion(shape, np.zeros((shape.n_vertices, 2)), settings=settings)
-    assert m.status == "failed" and calls["n"] == 3  # the first step and two halvings
-
-
-def test_motion_level_tol_takes_effect(monkeypatch):
-    from rigidfold.config import DEFAULTS
-    from rigidfold.deform import motion as motion_module
-
-    shape = miura(3, 3)
-    calls = count_calls(monkeypatch, motion_module, "_newton")
-    flat = develop(shape).coords2d
-    m = folding_motion(shape, flat, settings=DEFAULTS.with_(motion_level_tol=1.0))
-    assert m.status == "ok" and calls["n"] == 0  # every level counts as reached
-    assert folding_motion(shape, flat).status == "ok" and calls["n"] > 0
-
-
-def test_motion_stall_settings_take_effect(monkeypatch):
-    from rigidfold.config import DEFAULTS
-    from rigidfold.deform import motion as motion_module
-
-    shape = miura(3, 3)
-    cons = motion_module._Constraints(shape, 0)
-    calls = count_calls(monkeypatch, motion_module._Constraints, "__call__")
-    x = shape.coords.ravel().copy()
-    # a negative folding measure cannot be reached: Newton stalls
-    stall = DEFAULTS.with_(motion_stall_iter=1, motion_stall_ratio=0.0)
-    _, ok = motion_module._newton(cons, x, -1.0, stall)
-    assert not ok and calls["n"] == 3  # iterations 0 and 1, then the final residual
-    calls["n"] = 0
-    motion_module._newton(cons, x, -1.0, DEFAULTS)
-    assert calls["n"] > 3
-
-
-def test_path_trace_settings_take_effect(monkeypatch):
-    from rigidfold.config import DEFAULTS
-    from rigidfold.deform.motion import trace_one_dof_path
-
-    shape = miura(3, 3, height=0.5)
-    turned = trace_one_dof_path(shape, settings=DEFAULTS.with_(motion_turn_back=-1.0))
-    assert not turned.reached_flat and "turns back" in turned.message
-    assert len(turned.points) == 2  # the first step already counts as turning back
-    stuck = DEFAULTS.with_(motion_max_iter=1, motion_arc_min_step=1.0)
-    trace = trace_one_dof_path(shape, settings=stuck)
-    assert "could not be continued" in trace.message and len(trace.points) == 1

@@ -121,18 +121,36 @@ def test_input_frames_and_custom_keys_are_kept(tmp_path):
 
 
 def test_deform_appends_the_motion_under_the_diagram(tmp_path):
-    assert main(["deform", str(EXAMPLES / "squaretwist.fold"), "--out", str(tmp_path)]) == 0
-    output = load(tmp_path / "squaretwist.fold")
+    """A FOLD file of another tool (a Miura-ori, written as theirs) keeps every key; the
+    development diagram and the folding motion are appended under it."""
+    from rigidfold.patterns import miura
+
+    src = write_fold(tmp_path / "theirs.fold", miura(3, 3))
+    assert main(["deform", str(src), "--out", str(tmp_path / "out")]) == 0
+    output = load(tmp_path / "out" / "theirs.fold")
     frames = output["file_frames"]
     assert frames[0]["frame_classes"] == ["creasePattern"]
     motion = frames[1:-1]
-    assert len(motion) == DEFAULTS.motion_frames
+    assert 3 <= len(motion) <= DEFAULTS.motion_frames
     assert all(f["frame_parent"] == 1 and f["frame_inherit"] for f in motion)
     assert all(f["frame_title"].startswith("rigidfold: folding motion") for f in motion)
-    first = read_fold(tmp_path / "squaretwist.fold", frame=2)  # the motion's flat frame
+    first = read_fold(tmp_path / "out" / "theirs.fold", frame=2)  # the motion's flat frame
     assert first.unit == "m" and np.abs(first.pattern.coords[:, 2]).max() < 1e-9
-    for key, value in load(EXAMPLES / "squaretwist.fold").items():
-        assert output[key] == value, key
+    for key, value in load(src).items():
+        if key != "file_frames":
+            assert output[key] == value, key
+
+
+def test_a_square_twist_is_not_rigidly_deployable(tmp_path):
+    """The square twist of the FOLD examples (its quads rigid): its folding path does not reach
+    the flat state (the square twist needs its panels to bend), so ``deform`` says the motion
+    was not traced and keeps the traced part out of the file. The OpenSees frame, whose
+    members may bend, gets to the plane (exit 0)."""
+    assert main(["deform", str(EXAMPLES / "squaretwist.fold"), "--out", str(tmp_path)]) == 0
+    output = load(tmp_path / "squaretwist.fold")
+    assert not any("folding motion" in f.get("frame_title", "") for f in output["file_frames"])
+    assert output["rigidfold:motion"]["status"] == "failed"
+    assert output["rigidfold:motion"]["path"]["deploys"] is False
 
 
 def test_round_trip_dict_does_not_modify_the_input():

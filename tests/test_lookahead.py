@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from conftest import degree_n_vertex, folded_grid
+from conftest import paper_generate as generate
 from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
-from rigidfold.generate import generate
 from rigidfold.mechanism import analyze
 from rigidfold.mesh import CreasePattern
 from rigidfold.selection import carried_angles, flat_groups, lock_forecast, lookahead_order

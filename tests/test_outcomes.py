@@ -10,6 +10,7 @@ import pytest
 from rigidfold.deform import DeformStatus, MotionStatus, verify
 from rigidfold.develop import DevelopStatus
 from rigidfold.generate import STOP_REASONS, Attempt, AttemptOutcome, Generation, Stop
+from rigidfold.mechanism.path import PathStatus
 from rigidfold.optimize import Status
 from rigidfold.patterns import miura
 from rigidfold.status import Outcome
@@ -17,7 +18,16 @@ from rigidfold.status import Outcome
 # the values that JSON files and study databases of every version hold
 VALUES = {
     Status: ["converged", "tolerance_not_met", "infeasible", "iteration_limit", "failed"],
-    AttemptOutcome: ["accepted", "exceed", "lock", "zero_dof", "initial_failed"],
+    AttemptOutcome: ["accepted", "exceed", "lock", "zero_dof", "path", "initial_failed"],
+    PathStatus: [
+        "flat",
+        "turned_back",
+        "stops_short",
+        "collision",
+        "stalled",
+        "max_steps",
+        "rigid",
+    ],
     Stop: ["running", "target_reached", "zero_dof", "no_candidate", "initial_failed"],
     DevelopStatus: ["converged", "flipped", "overlap", "failed"],
     DeformStatus: ["reached_plane", "failed"],

@@ -28,9 +28,9 @@ def generate(out, *extra: str) -> None:
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
-    """A small finished run with Steps 8-9: DOF 9 -> 6, four solutions."""
+    """A small finished run with Steps 8-9 on every solution: DOF 9 -> 6, four solutions."""
     out = tmp_path_factory.mktemp("run")
-    generate(out, "--target-dof", "6")
+    generate(out, "--target-dof", "6", "--check", "all")
     return out
 
 

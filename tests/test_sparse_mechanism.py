@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from conftest import degree_n_vertex, folded_grid
+from conftest import paper_generate as generate
 from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS, Settings
-from rigidfold.generate import generate
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism import (
     analysis_bytes,

@@ -272,11 +272,15 @@ def test_settings_added_later_at_their_default_are_compatible():
     from rigidfold.study.store import config_differences
 
     current = StudyConfig().as_dict()
-    older = _without_setting(current, "motion_arc_step")  # written before it existed
+    older = _without_setting(current, "path_step")  # written before it existed
     assert config_differences(older, current) == []
-    changed = StudyConfig(settings=DEFAULTS.with_(motion_arc_step=0.5)).as_dict()
-    assert config_differences(older, changed) == ["settings.motion_arc_step"]
-    assert config_differences(current, older) == ["settings.motion_arc_step"]  # one removed
+    changed = StudyConfig(settings=DEFAULTS.with_(path_step=0.5)).as_dict()
+    assert config_differences(older, changed) == ["settings.path_step"]
+    assert config_differences(current, older) == ["settings.path_step"]  # one removed
+    # the settings of the tracer before issue 29, removed since: a database that has them
+    # resumes
+    retired = {**current, "settings": {**current["settings"], "motion_arc_step": 0.2}}
+    assert config_differences(retired, current) == []
     assert config_differences(current, StudyConfig(deform=True).as_dict()) == ["deform"]
     tighter = StudyConfig(settings=DEFAULTS.with_(f_tol=1e-9)).as_dict()
     assert config_differences(current, tighter) == ["settings.f_tol"]
@@ -529,8 +533,8 @@ def test_generate_progress_shows_the_last_step_and_an_eta(capsys):
 
     bar = GenerateProgress(enabled=True, target=1, log_every=3600.0)
     bar.plain = True
-    run = SimpleNamespace(initial_dof=11, n_reduce=0, final_dof=11, n_lock=0, n_exceed=0)
-    step = SimpleNamespace(solve_time=0.25, analysis_time=0.125)
+    run = SimpleNamespace(initial_dof=11, n_reduce=0, final_dof=11, n_lock=0, n_exceed=0, n_path=0)
+    step = SimpleNamespace(solve_time=0.25, analysis_time=0.125, path_time=0.5)
     bar.update(run, step)  # the first line prints
     run.n_reduce, run.final_dof, run.n_lock = 4, 7, 1
     bar.update(run, step)  # within log_every: silent
@@ -541,7 +545,7 @@ def test_generate_progress_shows_the_last_step_and_an_eta(capsys):
     bar.update(run, step)  # the last line always prints
     lines = capsys.readouterr().err.splitlines()
     assert len(lines) == 2
-    assert lines[0].startswith("generate 0/10  DOF 11  lock 0  exceed 0")
+    assert lines[0].startswith("generate 0/10  DOF 11  lock 0  exceed 0  path 0")
     assert "ETA ?" in lines[0]
     assert lines[1].startswith("generate 10/10  DOF 1  lock 1")
-    assert "last step: solve 0.25 s, analysis 0.12 s" in lines[1]
+    assert "last step: solve 0.25 s, analysis 0.12 s, path 0.50 s" in lines[1]

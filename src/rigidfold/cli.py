@@ -16,7 +16,7 @@ import sys
 from collections.abc import Sequence
 
 from rigidfold import __version__
-from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
+from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
@@ -129,6 +129,22 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="skip the large-deformation check (Step 9, OpenSees); the development diagram "
         "(Step 8) and the folding motion still run",
+    )
+    gen.add_argument(
+        "--no-deploy-check",
+        action="store_true",
+        help="the paper's Step 5: accept a solution without tracing its folding path to the "
+        "flat state (by default a solution of at most DOF max(target, "
+        f"{DEFAULTS.deploy_check_max_dof}) whose path does not reach the flat state is "
+        "replaced like a lock and counted in N_path)",
+    )
+    gen.add_argument(
+        "--check",
+        choices=CHECKS,
+        default=CHECKS[0],
+        help="which solutions get the folding motion and the large-deformation check: the "
+        "final design only, or all (default: %(default)s; the development diagram is drawn "
+        "for every solution)",
     )
     gen.add_argument(
         "--quiet", action="store_true", help="no progress bar (the result lines are printed)"
@@ -289,6 +305,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="skip Steps 8-9 (development diagram, large deformation) of each solution",
     )
     stu.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
+    stu.add_argument(
+        "--deploy-check",
+        action="store_true",
+        help="accept only solutions whose folding path reaches the flat state, as generate "
+        "does by default (N_path); without it the study runs the paper's Step 5 and traces "
+        "only each final design's path (whether it deploys)",
+    )
     stu.add_argument(
         "--hessian",
         default=DEFAULTS.ipopt_hessian,
@@ -542,9 +565,16 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         "lookahead": args.lookahead,
         "symmetric": args.symmetric,
         "deform": not args.no_deform,
+        "deploy_check": not args.no_deploy_check,
+        "check": args.check,
     }
     writer = RunWriter(
-        args.out, _case(args), options, deform=not args.no_deform, overwrite=args.overwrite
+        args.out,
+        _case(args),
+        options,
+        deform=not args.no_deform,
+        overwrite=args.overwrite,
+        check=args.check,
     )
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
     try:
@@ -555,6 +585,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
             seed=args.seed,
             solver=args.solver,
             lookahead=args.lookahead,
+            deploy_check=not args.no_deploy_check,
             progress=progress.update,
             report=not args.no_report,
         )
@@ -571,7 +602,8 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     print(
         f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['final_dof']}, "
         f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
-        f"N_exceed={summary['N_exceed']}, {summary['n_solves']} solves"
+        f"N_exceed={summary['N_exceed']} N_path={summary['N_path']}, "
+        f"{summary['n_solves']} solves"
     )
     print(
         f"wrote {_count(len(writer.files), 'solution')}, log.json and summary.json to {writer.out}"
@@ -713,6 +745,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
         deform=not args.no_deform,
         settings=DEFAULTS.with_(ipopt_hessian=args.hessian),
         lookahead=args.lookahead,
+        deploy_check=args.deploy_check,
     )
     bar = StudyProgress(enabled=not args.quiet)
     try:

@@ -17,6 +17,10 @@ from dataclasses import dataclass, replace
 HESSIANS = ("closed-form", "casadi")
 """The Hessians of the Lagrangian IPOPT can use (``Settings.ipopt_hessian``)."""
 
+CHECKS = ("final", "all")
+"""Which solutions of a generation run get the folding motion and Step 9 (``generate
+--check``): the final design only (the default), or every solution."""
+
 SEED_LIMIT = 2**63
 """Seeds (of Bezier surfaces, of generate's random draws) are integers 0 <= seed <
 SEED_LIMIT: a study stores them as SQLite's signed 64-bit integers."""
@@ -198,42 +202,55 @@ class Settings:
         The plane is reached when every frame node ends within this distance (m) of z = 0.
     motion_frames : int
         Frames of the folding motion from flat to the designed shape.
-    motion_tol, motion_max_iter : float, int
-        Newton correction of each motion frame onto the rigid-folding constraints: residual
-        norm (metres and radians) and iteration limit.
     motion_length_tol : float
-        Where no exact rigid-folding shape exists (an imperfect design near the flat state),
-        the least-squares shape is accepted while every edge length is within this relative
-        error.
-    motion_arc_step, motion_arc_max_steps : float, int
-        When the folding measure cannot be driven to 0 on a 1-DOF shape, its one folding path
-        is traced by pseudo-arclength continuation, with steps of at most this times the mean
-        edge length, for at most this many steps, to find out whether it reaches the plane or
-        turns back.
+        A shape whose development diagram misses its edge lengths by more than this
+        (relative) is not developable for the folding motion's verdict (``deform.compare``).
     deform_penalty : float
         Penalty factor of the pins of the frame model (OpenSees ``Penalty`` handler), times
         E A / (mean edge length).
     deform_load_tol : float
         The analysis has reached the plane when the load factor is within this of 1.
-    motion_max_halvings : int
-        A step of the folding motion that does not converge is retried with half the step
-        this many times.
-    motion_level_tol : float
-        A motion frame is reached when the folding measure done is within this fraction of the
-        design's measure of the frame's level.
-    motion_stall_iter, motion_stall_ratio : int, float
-        The Newton correction of a motion frame stops converging (and takes the least-squares
-        shape) when, after this many iterations, the residual norm exceeds this ratio times
-        the previous iteration's.
-    motion_probe : float
-        Step (times the mean edge length) of the probe that orients the 1-DOF path towards a
-        smaller folding measure.
-    motion_arc_min_step : float
-        The pseudo-arclength trace gives up when its step falls below this fraction of the
-        largest step.
-    motion_turn_back : float
-        The 1-DOF path turns back (does not reach the plane) when its folding measure rises
-        this many motion levels (1 / (motion_frames - 1) of the design's) above its minimum.
+
+    Rigid-folding path (``rigidfold.mechanism.path``, Step 5 beyond the paper)
+    -------------------------------------------------------------------------
+    path_flat_tol : float
+        The path reaches the flat state when every free crease's fold angle is within this
+        of 0, radians (0.5 degrees).
+    path_fold_limit : float
+        The path ends where a crease folds to this, radians (179 degrees): its panels meet.
+    path_tol : float
+        Corrector tolerance: norm of the constraint residual (edge lengths in mean edge
+        lengths, fold angles in radians) at every traced point.
+    path_step, path_max_step, path_min_step : float
+        First, largest and smallest continuation step: the root-mean-square displacement of
+        the vertices, in mean edge lengths.
+    path_max_fold_step : float
+        Largest change of any fold angle in one continuation step, radians (5 degrees): the
+        traced points resolve the motion.
+    path_max_steps : int
+        Accepted steps of one direction of the trace before it gives up.
+    path_corrector_iter, path_contraction : int, float
+        Chord iterations of the corrector, and the largest ratio of successive corrections
+        it accepts (a step that converges more slowly is halved).
+    path_max_turn : float
+        Largest angle, radians, between the tangent and the chord of one step (DOF 1).
+    path_regularization, path_damping : float
+        Diagonal added to the constraint block of the KKT systems (self-stressed rows), and
+        to the fold-angle metric of the Gauss-Newton direction (DOF > 1).
+    path_stall_steps, path_stall_ratio : int, float
+        With DOF > 1 the path stops short when this many steps in a row each lower the
+        folding measure by less than this fraction.
+    polish_tol : float
+        Before the deployability check, an accepted solution is projected onto F = 0 to this
+        F (:meth:`rigidfold.optimize.FormFindingProblem.polish`): developable to round-off.
+    deploy_check : bool
+        Generation (Step 5) accepts only solutions whose folding path reaches the flat state
+        (:func:`rigidfold.mechanism.path.trace_path`); others count in N_path and are
+        replaced like a lock (Step 7). False is the paper's method.
+    deploy_check_max_dof : int
+        The deployability check runs on accepted solutions of at most this DOF or the target
+        DOF, whichever is larger (0: on every solution). A run that does not reach the target
+        names the lowest-DOF solution that deploys as its final design.
 
     Crease patterns (``rigidfold.patterns``)
     ----------------------------------------
@@ -336,20 +353,28 @@ class Settings:
     deform_max_iter: int = 30
     plane_tol: float = 1e-6
     motion_frames: int = 11
-    motion_tol: float = 1e-13
-    motion_max_iter: int = 50
     motion_length_tol: float = 1e-3
-    motion_arc_step: float = 0.2
-    motion_arc_max_steps: int = 400
     deform_penalty: float = 1e6
     deform_load_tol: float = 1e-12
-    motion_max_halvings: int = 6
-    motion_level_tol: float = 1e-12
-    motion_stall_iter: int = 5
-    motion_stall_ratio: float = 0.9
-    motion_probe: float = 1e-6
-    motion_arc_min_step: float = 1e-6
-    motion_turn_back: float = 0.5
+    # rigid-folding path (Step 5, beyond the paper)
+    path_flat_tol: float = math.radians(0.5)
+    path_fold_limit: float = math.radians(179.0)
+    path_tol: float = 1e-10
+    path_step: float = 0.05
+    path_max_step: float = 0.5
+    path_min_step: float = 1e-7
+    path_max_fold_step: float = math.radians(5.0)
+    path_max_steps: int = 500
+    path_corrector_iter: int = 8
+    path_contraction: float = 0.5
+    path_max_turn: float = math.radians(30.0)
+    path_regularization: float = 1e-12
+    path_damping: float = 1e-9
+    path_stall_steps: int = 5
+    path_stall_ratio: float = 1e-4
+    polish_tol: float = 1e-26
+    deploy_check: bool = True
+    deploy_check_max_dof: int = 1
     # reading FOLD files
     max_json_depth: int = 100
     max_coordinate: float = 1e6

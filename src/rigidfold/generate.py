@@ -43,6 +43,7 @@ import numpy as np
 from rigidfold.case import Case
 from rigidfold.config import DEFAULT_SEED, Settings, check_seed, one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
+from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.numerics import numeric_environment
 from rigidfold.optimize import SOLVERS, OptimizeResult, Status
@@ -65,6 +66,10 @@ class AttemptOutcome(Outcome):
     EXCEED = "exceed", "the solve missed F <= F_tol or did not converge (Step 4, N_exceed)"
     LOCK = "lock", "the mechanism has a locked crease (Step 5, N_lock)"
     ZERO_DOF = "zero_dof", "the mechanism has DOF 0: generation ends (Step 5 -> Step 8)"
+    PATH = (
+        "path",
+        "the shape's rigid-folding path does not reach the flat state (Step 5, N_path)",
+    )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
 
 
@@ -135,6 +140,13 @@ class Attempt:
         before). Made with and without look-ahead.
     locked_fold_deg : list of float
         Per crease of ``locked``: its fold angle at the shape found, degrees.
+    path : dict or None
+        The deployability check (:meth:`rigidfold.mechanism.path.FoldingPath.to_dict`): how
+        the shape's folding path ended, and for a path that does not reach the flat state,
+        where it came closest (its measure m and the free creases' fold angles there); None
+        where it did not run.
+    path_time : float
+        Seconds of the check.
     """
 
     index: int
@@ -156,6 +168,8 @@ class Attempt:
     locked_predicted: list[bool] = field(default_factory=list)
     locked_left: list[float | None] = field(default_factory=list)
     locked_fold_deg: list[float] = field(default_factory=list)
+    path: dict | None = None
+    path_time: float = 0.0
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""
@@ -164,11 +178,13 @@ class Attempt:
 
 @dataclass
 class Solution:
-    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease."""
+    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease; with the deployability
+    check, also its folding path to the flat state (``path``, None where it did not run)."""
 
     step: int
     result: OptimizeResult
     mechanism: Mechanism
+    path: FoldingPath | None = None
 
 
 @dataclass
@@ -185,6 +201,9 @@ class Generation:
     attempts: list[Attempt] = field(default_factory=list)
     n_lock: int = 0
     n_exceed: int = 0
+    n_path: int = 0
+    deploy_check: bool = False
+    final_step: int | None = None
     stop: Stop = Stop.RUNNING
     stop_detail: str = ""
     build_time: float = 0.0
@@ -194,6 +213,15 @@ class Generation:
     def stop_reason(self) -> str:
         """How the run ended, in words: e.g. "target DOF 1 reached" (see :data:`STOP_REASONS`)."""
         return self.stop.reason(self.stop_detail)
+
+    @property
+    def final(self) -> Solution | None:
+        """The final design: the last solution, or, with the deployability check on a run
+        that fell short of its target, the lowest-DOF solution that deploys (``final_step``);
+        None without one."""
+        if not self.solutions:
+            return None
+        return self.solutions[-1 if self.final_step is None else self.final_step]
 
     @property
     def final_dof(self) -> int | None:
@@ -224,6 +252,12 @@ class Generation:
             "N_reduce": self.n_reduce,
             "N_lock": self.n_lock,
             "N_exceed": self.n_exceed,
+            "N_path": self.n_path,
+            "deploy_check": self.deploy_check,
+            "final_step": None if self.final is None else self.final.step,
+            "final_deploys": (
+                None if self.final is None or self.final.path is None else self.final.path.deploys
+            ),
             "n_solutions": len(self.solutions),
             "n_solves": len(self.attempts),
             "n_skipped": self.n_skipped,
@@ -235,6 +269,7 @@ class Generation:
                 "solve": sum(a.solve_time for a in self.attempts),
                 "analysis": sum(a.analysis_time for a in self.attempts),
                 "selection": sum(a.selection_time for a in self.attempts),
+                "path": sum(a.path_time for a in self.attempts),
             },
         }
 
@@ -249,6 +284,7 @@ def generate(
     solver: str = SOLVERS[0],
     support_face: int | None = None,
     lookahead: bool = False,
+    deploy_check: bool | None = None,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
 ) -> Generation:
@@ -260,7 +296,12 @@ def generate(
     ``support_face`` is the triangle whose frame node carries the s = 6 supports (default:
     the one nearest the centroid); it sets the metric of the mechanism modes and so the
     S^F-hat scores. ``lookahead``: skip the candidates predicted to lock (see the module's
-    text); the forecast's cost is part of the selection time.
+    text); the forecast's cost is part of the selection time. ``deploy_check`` (default
+    ``Settings.deploy_check``): polish every accepted solution to F = 0
+    (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
+    rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
+    on solutions of at most ``Settings.deploy_check_max_dof`` DOF, 0: all); one that does not
+    counts in N_path and is replaced like a lock (Step 7). False is the paper's method.
     A KeyboardInterrupt propagates after the callbacks of everything finished so far.
     """
     if criterion not in CRITERIA:
@@ -271,19 +312,22 @@ def generate(
         raise ValueError(f"target DOF must be >= 0, got {target_dof}")
     rng = np.random.default_rng(check_seed(seed))
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
-    run = Generation(numerics=numeric_environment().to_dict())
+    settings = case.settings
+    deploy = settings.deploy_check if deploy_check is None else bool(deploy_check)
+    run = Generation(numerics=numeric_environment().to_dict(), deploy_check=deploy)
     t0 = time.perf_counter()
     problem = case.problem(build_ipopt=solver == "ipopt")
     run.build_time = time.perf_counter() - t0
     groups = crease_groups(case.pattern, case.planes, case.settings) if case.planes else None
-    settings = case.settings
     zero_ends = settings.zero_dof_ends or target_dof == 0
     locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
 
     def attempt(
         fixed: np.ndarray, start, added, score
-    ) -> tuple[Attempt, OptimizeResult, Mechanism | None]:
+    ) -> tuple[Attempt, OptimizeResult, Mechanism | None, FoldingPath | None]:
         result = problem.solve(fixed=fixed, start=start, solver=solver)
+        if deploy:
+            result = problem.polish(result)
         t1 = time.perf_counter()
         mech = (
             analyze(result.pattern, support_face=support_face, settings=settings)
@@ -301,6 +345,16 @@ def generate(
             outcome = AttemptOutcome.LOCK
         else:
             outcome = AttemptOutcome.ACCEPTED
+        path, t_path = None, 0.0
+        if outcome is AttemptOutcome.ACCEPTED and deploy and _checked(mech, target_dof, settings):
+            assert mech is not None
+            t2 = time.perf_counter()
+            path = trace_path(
+                result.pattern, dof=mech.dof, support_face=support_face, settings=settings
+            )
+            t_path = time.perf_counter() - t2
+            if not path.deploys:
+                outcome = AttemptOutcome.PATH
         locked = [] if mech is None else mech.locked_creases.tolist()
         rec = Attempt(
             index=len(run.attempts),
@@ -315,34 +369,38 @@ def generate(
             solve_time=result.wall_time,
             analysis_time=t_an,
             locked_fold_deg=np.degrees(result.pattern.fold_angles[locked]).tolist(),
+            path=None if path is None else path.to_dict(),
+            path_time=t_path,
         )
         run.attempts.append(rec)
-        return rec, result, mech
+        return rec, result, mech, path
 
-    def record(rec: Attempt, result, mech) -> None:
+    def record(rec: Attempt, result, mech, path) -> None:
         if rec.outcome is AttemptOutcome.EXCEED:
             run.n_exceed += 1
         elif rec.outcome is AttemptOutcome.LOCK:
             run.n_lock += 1
+        elif rec.outcome is AttemptOutcome.PATH:
+            run.n_path += 1
         if on_attempt:
             on_attempt(run, rec)
         if rec.outcome is AttemptOutcome.ACCEPTED:
-            sol = Solution(len(run.solutions), result, mech)
+            sol = Solution(len(run.solutions), result, mech, path)
             run.solutions.append(sol)
             if on_solution:
                 on_solution(run, sol)
 
     # Steps 2-5 for the triangulated target surface
     fixed = case.pattern.fixed.copy()
-    rec, result, mech = attempt(fixed, None, (), None)
+    rec, result, mech, path = attempt(fixed, None, (), None)
     if rec.outcome is not AttemptOutcome.ACCEPTED:
         run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
         rec.outcome = AttemptOutcome.INITIAL_FAILED
-        record(rec, result, mech)
+        record(rec, result, mech, path)
         return run
     assert mech is not None  # an accepted attempt was analysed
     run.initial_dof = mech.dof
-    record(rec, result, mech)
+    record(rec, result, mech, path)
 
     while run.solutions[-1].mechanism.dof > target_dof:  # run.final_dof, never None here
         current = run.solutions[-1]
@@ -368,12 +426,12 @@ def generate(
             t_sel += time.perf_counter() - t1
             if choice is None:
                 run.stop = Stop.NO_CANDIDATE
-                return run
+                return _deployable_final(run, deploy, support_face, settings)
             group, score = ranked[choice.index]
             fix = (*group, *choice.carried.tolist())
             trial = current.result.pattern.fixed.copy()
             trial[list(fix)] = True
-            rec, result, mech = attempt(trial, current.result.coords, fix, score)
+            rec, result, mech, path = attempt(trial, current.result.coords, fix, score)
             rec.selection_time, t_sel = t_sel, 0.0
             if lookahead:
                 rec.predicted_locks = [] if len(choice.carried) else choice.locks.tolist()
@@ -393,14 +451,43 @@ def generate(
                 )
                 if lookahead and not len(choice.carried):
                     locked_before[group] = rec.locked
-            record(rec, result, mech)
+            record(rec, result, mech, path)
             if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
                 break
         if rec.outcome is AttemptOutcome.ZERO_DOF:
             run.stop = Stop.ZERO_DOF
-            return run
+            return _deployable_final(run, deploy, support_face, settings)
     run.stop, run.stop_detail = Stop.TARGET_REACHED, str(target_dof)
     return run
+
+
+def _deployable_final(
+    run: Generation, deploy: bool, support_face: int | None, settings: Settings
+) -> Generation:
+    """With the deployability check, a run that ends short of its target names as its final
+    design the lowest-DOF solution whose folding path reaches the flat state (tracing the
+    paths not yet traced, from the last solution back); none: the last solution."""
+    if not deploy:
+        return run
+    for solution in reversed(run.solutions):
+        if solution.path is None:
+            solution.path = trace_path(
+                solution.result.pattern,
+                dof=solution.mechanism.dof,
+                support_face=support_face,
+                settings=settings,
+            )
+        if solution.path.deploys:
+            run.final_step = solution.step
+            return run
+    return run
+
+
+def _checked(mech: Mechanism | None, target_dof: int, settings: Settings) -> bool:
+    """Whether the deployability check runs on an accepted solution with this mechanism: at
+    most ``Settings.deploy_check_max_dof`` or ``target_dof`` DOF (0: every solution)."""
+    limit = settings.deploy_check_max_dof
+    return mech is not None and (limit <= 0 or mech.dof <= max(limit, target_dof))
 
 
 def _explain_lock(

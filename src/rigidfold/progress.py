@@ -48,8 +48,9 @@ class GenerateProgress:
     at most every ``log_every`` seconds and at the end.
 
     run : rigidfold.generate.Generation (``initial_dof``, ``n_reduce``, ``final_dof``,
-    ``n_lock``, ``n_exceed`` are read); attempt : rigidfold.generate.Attempt or None
-    (``solve_time``, ``analysis_time``).
+    ``n_lock``, ``n_exceed``, ``n_path`` are read); attempt : rigidfold.generate.Attempt or
+    None (``solve_time``, ``analysis_time``, ``path_time``: the folding path traced for the
+    deployability check).
     """
 
     def __init__(self, *, enabled: bool, target: int, log_every: float = 30.0) -> None:
@@ -59,7 +60,8 @@ class GenerateProgress:
         self.plain = not sys.stderr.isatty()
         self.log_every, self.t0 = log_every, time.monotonic()
         self.last = -math.inf
-        self.costs: tuple[float, float] | None = None  # solve, analysis of the last attempt
+        # solve, analysis and path tracing of the last attempt
+        self.costs: tuple[float, float, float] | None = None
 
     def counts(self, run) -> tuple[int, int, str]:
         """(DOF removed, DOF to remove, "DOF d  lock l  exceed e") of a run."""
@@ -68,14 +70,17 @@ class GenerateProgress:
         return (
             min(run.n_reduce, total),
             total,
-            (f"DOF {dof}  lock {run.n_lock}  exceed {run.n_exceed}"),
+            (f"DOF {dof}  lock {run.n_lock}  exceed {run.n_exceed}  path {run.n_path}"),
         )
 
     def describe(self, run, elapsed: float) -> tuple[int, int, str]:
         """(DOF removed, DOF to remove, the figures) of a run after ``elapsed`` seconds."""
         done, total, text = self.counts(run)
         if self.costs is not None:
-            text += f"  last step: solve {self.costs[0]:.2f} s, analysis {self.costs[1]:.2f} s"
+            text += (
+                f"  last step: solve {self.costs[0]:.2f} s, analysis {self.costs[1]:.2f} s, "
+                f"path {self.costs[2]:.2f} s"
+            )
         eta = f"{(total - done) * elapsed / done / 60:.1f} min" if done else "?"
         return done, total, f"{text}  elapsed {elapsed / 60:.1f} min  ETA {eta}"
 
@@ -83,7 +88,7 @@ class GenerateProgress:
         if not self.enabled or run.initial_dof is None:
             return
         if attempt is not None:
-            self.costs = (attempt.solve_time, attempt.analysis_time)
+            self.costs = (attempt.solve_time, attempt.analysis_time, attempt.path_time)
         if self.plain:
             now = time.monotonic()
             done, total, text = self.describe(run, now - self.t0)
@@ -93,7 +98,7 @@ class GenerateProgress:
             return
         done, total, text = self.counts(run)  # elapsed and ETA in rich's columns: it fits
         if self.costs is not None:
-            text += f"  step {self.costs[0]:.2f}+{self.costs[1]:.2f} s"
+            text += f"  step {self.costs[0]:.2f}+{self.costs[1]:.2f}+{self.costs[2]:.2f} s"
         if self.bar is None:
             self.bar = _rich_bar("generate", eta=True)
             self.task = self.bar.add_task("", total=total)

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.case import Case
+from rigidfold.config import CHECKS
 from rigidfold.deform import DeformStatus, MotionStatus, Verification, verify
 from rigidfold.develop import DevelopStatus
 from rigidfold.exports import export_design
@@ -106,34 +107,44 @@ def _failed_checks(check: dict) -> list[str]:
 
 def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: int) -> RunVerdict:
     """The verdict on ``run``: passed when it reached ``target`` (Stop.TARGET_REACHED, or
-    DOF 0 for a target of 0) and every check that ran on the final design (the last
-    solution) passed: development diagram converged, folding motion traced, large
-    deformation reached the plane. A check that failed on an earlier solution is a warning.
+    DOF 0 for a target of 0) and every check that ran on the final design
+    (:attr:`rigidfold.generate.Generation.final`) passed: development diagram converged,
+    folding motion traced, large deformation reached the plane. A check that failed on
+    another solution is a warning. With the deployability check, a run that fell short
+    says so when no deployable design was found at a lower DOF (N_path > 0).
 
     checks : the figures of each solution's check (``Verification.to_dict()`` with its
     ``step``), in the order of ``files`` (their FOLD paths, relative to the run's DIR).
     """
     short = []
     reached = run.stop is Stop.TARGET_REACHED or (run.stop is Stop.ZERO_DOF and target == 0)
-    if not run.solutions:
+    final = run.final
+    k = -1 if final is None else final.step
+    if final is None:
         short.append(f"no solution: {run.stop_reason}")
     elif not reached:
         short.append(
-            f"target DOF {target} not reached: final DOF {run.solutions[-1].mechanism.dof} "
-            f"({run.stop_reason})"
+            f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"
         )
+        if run.deploy_check and run.n_path:
+            short.append(
+                f"no deployable design below DOF {final.mechanism.dof}: the folding paths of "
+                f"{run.n_path} solution{'s' if run.n_path > 1 else ''} did not reach the flat "
+                "state (N_path)"
+            )
     if checks:
-        short += [f"{_CHECKS[s]} for the final design" for s in _failed_checks(checks[-1])]
+        short += [f"{_CHECKS[s]} for the final design" for s in _failed_checks(checks[k])]
     earlier: dict[str, list[str]] = {stage: [] for stage in _CHECKS}
-    for check, path in zip(checks[:-1], files[:-1], strict=True):
-        for stage in _failed_checks(check):
-            earlier[stage].append(path.name)
+    for i, (check, path) in enumerate(zip(checks, files, strict=True)):
+        if i != (k % len(checks)):
+            for stage in _failed_checks(check):
+                earlier[stage].append(path.name)
     warnings = tuple(f"{_CHECKS[s]} for {', '.join(n)}" for s, n in earlier.items() if n)
     return RunVerdict(
         RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
         tuple(short),
         warnings,
-        files[-1] if files else None,
+        files[k] if files else None,
     )
 
 
@@ -298,10 +309,12 @@ def write_checked_shape(
 class RunWriter:
     """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date.
 
-    ``deform``: run the large-deformation check (Step 9) on every solution; the development
-    diagram (Step 8) and the folding motion always run. ``overwrite``: replace the files of an
-    earlier run in ``out`` (:func:`clear_earlier_run`), which are refused otherwise.
-    ``options["target_dof"]`` is the target the verdict (:meth:`finish`) judges by.
+    The development diagram (Step 8) runs on every solution as it comes; the folding motion
+    and, with ``deform``, the large-deformation check (Step 9) run on the solutions ``check``
+    names (:data:`CHECKS`): the final design only, once the run has ended (its FOLD file is
+    then written again with them), or every solution as it comes. ``overwrite``: replace the
+    files of an earlier run in ``out`` (:func:`clear_earlier_run`), which are refused
+    otherwise. ``options["target_dof"]`` is the target the verdict (:meth:`finish`) judges by.
     """
 
     def __init__(
@@ -312,7 +325,10 @@ class RunWriter:
         *,
         deform: bool = True,
         overwrite: bool = False,
+        check: str = CHECKS[0],
     ) -> None:
+        if check not in CHECKS:
+            raise ValueError(f"unknown check {check!r} (choose from {', '.join(CHECKS)})")
         refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
         self.out = prepare_output_dir(out)
         self.lock = lock_run_dir(self.out)
@@ -322,7 +338,9 @@ class RunWriter:
         except ValueError:
             self.release()
             raise
-        self.case, self.options, self.deform = case, options, deform
+        self.case, self.options, self.deform, self.check = case, options, deform, check
+        self.solutions: list[Solution] = []
+        self.developments: dict[int, np.ndarray] = {}  # step -> the development, (V, 2)
         self.files: list[Path] = []
         self.checks: list[dict] = []
         self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
@@ -347,16 +365,33 @@ class RunWriter:
         self.write_summary(run)
 
     def on_solution(self, run: Generation, solution: Solution) -> None:
+        full = self.check == "all"
+        self.solutions.append(solution)
+        self.checks.append({})
+        self.files.append(self._write_solution(solution, deform=full and self.deform, motion=full))
+        self.write_summary(run)
+
+    def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
+        """Check one solution (Step 8; the motion and Step 9 as asked) and write its FOLD and
+        SVG files; its figures replace ``checks[solution.step]``. Returns the FOLD path."""
         dof = solution.mechanism.dof
         pattern = solution.result.pattern
-        check = verify(pattern, run_deform=self.deform, settings=self.case.settings)
+        check = verify(
+            pattern,
+            run_deform=deform,
+            run_motion=motion,
+            dof=dof,
+            path=solution.path,
+            settings=self.case.settings,
+        )
         for stage, t in check.times.items():
             self.stage_times[stage] += t
         dz = self.case.deviation(pattern.coords)
         fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
         figures = {"step": solution.step, "dof": dof, "fit": fit, **check.to_dict()}
-        self.checks.append(figures)
-        self.final = (pattern, check.development.coords2d)
+        figures["deployability"] = None if solution.path is None else solution.path.to_dict()
+        self.checks[solution.step] = figures
+        self.developments[solution.step] = check.development.coords2d
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
             path,
@@ -373,13 +408,22 @@ class RunWriter:
                 "lookahead": self.options.get("lookahead", False),
             },
         )
-        self.files.append(path)
-        self.write_summary(run)
+        return path
 
     def finish(self, run: Generation) -> RunVerdict:
         """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
-        and the final design exported to ``DIR/final/`` in every format of
-        :func:`rigidfold.exports.export_design`, named after its solution file."""
+        and the final design (:attr:`rigidfold.generate.Generation.final`) exported to
+        ``DIR/final/`` in every format of :func:`rigidfold.exports.export_design`, named
+        after its solution file. With ``check="final"`` the final design's folding motion and
+        Step 9 run first and its files are written again with them."""
+        final = run.final
+        if final is not None:
+            if self.check == "final":
+                self.solutions[final.step] = final  # its path may have been traced since
+                self._write_solution(final, deform=self.deform, motion=True)
+            pattern = final.result.pattern
+            coords2d = self.developments[final.step]
+            self.final = (pattern, coords2d)
         self.verdict = run_verdict(
             run,
             self.checks,
@@ -388,7 +432,7 @@ class RunWriter:
         )
         if self.final is not None:
             pattern, coords2d = self.final
-            stem = self.files[-1].stem
+            stem = self.files[-1 if final is None else final.step].stem
             self.exports = export_design(
                 pattern, coords2d, self.out / "final", name=stem, title=f"rigidfold: {stem}"
             )

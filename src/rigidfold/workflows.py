@@ -272,12 +272,13 @@ def generate_case(
     seed: int,
     solver: str,
     lookahead: bool = False,
+    deploy_check: bool | None = None,
     progress: Callable[[Generation, Attempt | None], None] | None = None,
     report: bool = True,
 ) -> Generation:
     """Steps 2-9 on ``writer.case``, every attempt and solution written by ``writer`` as it
     comes (so an interrupt loses nothing); ``progress(run, attempt)`` after each of them.
-    ``lookahead``: skip the candidates predicted to lock (``generate``'s option).
+    ``lookahead``, ``deploy_check``: ``generate``'s options.
     ``summary.json`` is written once more at the end, with the run's verdict
     (``writer.verdict``, :func:`rigidfold.report.run_verdict`); then, with ``report``,
     ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is released at the
@@ -301,6 +302,7 @@ def generate_case(
             seed=seed,
             solver=solver,
             lookahead=lookahead,
+            deploy_check=deploy_check,
             on_attempt=on_attempt,
             on_solution=on_solution,
         )

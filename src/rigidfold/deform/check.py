@@ -22,6 +22,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.analysis import DeformResult, deform
 from rigidfold.deform.motion import Motion, MotionStatus, folding_motion
 from rigidfold.develop import Development, DevelopStatus, develop
+from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
 
@@ -177,9 +178,14 @@ def verify(
     run_deform: bool = True,
     run_motion: bool = True,
     support_face: int | None = None,
+    dof: int | None = None,
+    path: FoldingPath | None = None,
     settings: Settings = DEFAULTS,
 ) -> Verification:
-    """Development (Step 8), large-deformation check (Step 9) and motion of one shape."""
+    """Development (Step 8), large-deformation check (Step 9) and motion of one shape.
+
+    ``dof``, ``path``: the shape's DOF and traced folding path where they are known
+    (:func:`rigidfold.deform.folding_motion` traces the path otherwise)."""
     times = {}
     t0 = time.perf_counter()
     development = develop(pattern, settings=settings)
@@ -193,7 +199,12 @@ def verify(
     if run_motion and development.status is DevelopStatus.CONVERGED:
         t0 = time.perf_counter()
         motion = folding_motion(
-            pattern, development.coords2d, support_face=support_face, settings=settings
+            pattern,
+            development.coords2d,
+            support_face=support_face,
+            dof=dof,
+            path=path,
+            settings=settings,
         )
         times["motion"] = time.perf_counter() - t0
     return Verification(development, deformation, motion, times, settings)

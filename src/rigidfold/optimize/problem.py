@@ -7,6 +7,7 @@ kept on the problem, so IPOPT is set up once however many solves follow.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -20,6 +21,7 @@ from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.ipopt import IpoptSolver
 from rigidfold.optimize.nlp import NLP, build_nlp
+from rigidfold.optimize.projection import Projection
 from rigidfold.optimize.result import OptimizeResult, Status
 from rigidfold.optimize.slsqp import SlsqpSolver
 from rigidfold.optimize.solver import Solver, SolverOutcome, SolverProblem
@@ -94,6 +96,7 @@ class FormFindingProblem:
             "F", [xi, w], [nlp.f, nlp.f1, nlp.f2], names, ["F", "F1", "F2"]
         )
         self._solvers: dict[str, Solver] = {}
+        self._projection: Projection | None = None
         if build_ipopt:
             self.solver("ipopt")
         self.build_time = time.perf_counter() - t0
@@ -227,6 +230,44 @@ class FormFindingProblem:
             wall_time=wall,
             solver=solver,
             n_variables=self.n_variables,
+        )
+
+    # ------------------------------------------------------------------ polish
+    def polish(self, result: OptimizeResult) -> OptimizeResult:
+        """An accepted ``result`` projected onto F = 0 to ``Settings.polish_tol``
+        (:class:`rigidfold.optimize.projection.Projection`, every constraint of (6) kept).
+
+        F_tol (1e-7) leaves angle defects of up to about 3e-4 rad, and a shape that is not
+        developable to round-off cannot reach the flat state along a rigid-folding path: the
+        path passes the flat state at a distance of about the square root of the defects. The
+        projection moves the vertices by about that defect times the edge length. Returns
+        ``result`` itself when it was not accepted or the projection does not lower F.
+        """
+        if result.status is not Status.CONVERGED:
+            return result
+        if self._projection is None:
+            self._projection = Projection(self)
+        w = result.pattern.fixed.astype(float)
+        t0 = time.perf_counter()
+        with one_blas_thread():
+            run = self._projection(self.start_point(result.coords), w, tol=self.settings.polish_tol)
+        if not run.feasible or not run.F < result.F:
+            return result
+        coords = self.map.expand(run.xi)
+        F, F1, F2 = (float(v) for v in self.objective(run.xi, w))
+        viol = self.violation(coords, result.pattern.fixed)
+        status, _ = classify(SolverOutcome.SOLVED, F, viol, self.settings)
+        if status is not Status.CONVERGED:
+            return result
+        return dataclasses.replace(
+            result,
+            pattern=result.pattern.with_coords(coords),
+            F=F,
+            F1=F1,
+            F2=F2,
+            max_violation=viol,
+            message=f"{result.message}; polished ({run.reason})",
+            wall_time=result.wall_time + time.perf_counter() - t0,
         )
 
 

@@ -101,9 +101,11 @@ class Projection:
         coords = self.problem.map.expand(xi)
         return self.problem.violation(coords, w > 0) <= 0.1 * self.settings.constraint_tol
 
-    def __call__(self, xi0: np.ndarray, w: np.ndarray) -> Projected:
-        """Project from ``xi0`` (n,) with fixed-crease weights ``w`` (E,)."""
+    def __call__(self, xi0: np.ndarray, w: np.ndarray, *, tol: float | None = None) -> Projected:
+        """Project from ``xi0`` (n,) with fixed-crease weights ``w`` (E,) to F <= ``tol``
+        (default ``Settings.projection_tol``)."""
         s = self.settings
+        tol = s.projection_tol if tol is None else tol
         xi = np.asarray(xi0, dtype=float).copy()
         w = np.asarray(w, dtype=float)
         if not self.feasible(xi, w):
@@ -120,8 +122,8 @@ class Projection:
         slack = 0.1 * s.constraint_tol
         k = 0
         for k in range(s.projection_max_iter):
-            if F <= s.projection_tol:
-                return self._end(xi, F, k, held, "converged")
+            if F <= tol:
+                return self._end(xi, F, k, held, "converged", tol)
             AA = (A @ A.T).tocsc()
             if scale < 0:
                 scale = float(AA.diagonal().max())
@@ -154,7 +156,7 @@ class Projection:
             else:
                 lam *= nu
                 nu *= 2
-        return self._end(xi, F, k + 1, held, "converged" if F <= s.projection_tol else "stopped")
+        return self._end(xi, F, k + 1, held, "converged" if F <= tol else "stopped", tol)
 
     def _evaluate(
         self,
@@ -189,7 +191,9 @@ class Projection:
         upper = np.abs(g[held] - self.ubg[held]) < np.abs(g[held] - self.lbg[held])
         return np.where(upper, y < 0, y > 0)
 
-    def _end(self, xi: np.ndarray, F: float, k: int, held: np.ndarray, how: str) -> Projected:
+    def _end(
+        self, xi: np.ndarray, F: float, k: int, held: np.ndarray, how: str, tol: float
+    ) -> Projected:
         words = (
             f"{how}, F = {F:.3g} in {k} steps"
             if how == "converged"
@@ -197,7 +201,7 @@ class Projection:
         )
         if held.size:
             words += f", {held.size} constraint{'s' if held.size > 1 else ''} held"
-        return Projected(xi, F, k, how == "converged", True, int(held.size), words)
+        return Projected(xi, F, k, F <= tol, True, int(held.size), words)
 
 
 def _solve(JJ: sp.csc_matrix, mu: float, r: np.ndarray) -> np.ndarray:

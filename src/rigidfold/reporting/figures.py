@@ -31,6 +31,7 @@ OUTCOME_STYLE = {
     "lock": ("x", "#d62728", "lock (N_lock)"),
     "exceed": ("v", "#ff7f0e", "F > F_tol or not converged (N_exceed)"),
     "zero_dof": ("s", "#9467bd", "DOF 0"),
+    "path": ("P", "#8c564b", "folding path does not reach flat (N_path)"),
     "initial_failed": ("D", "#7f7f7f", "initial solve failed"),
 }
 """Attempt outcome -> (marker, colour, legend label)."""
@@ -154,7 +155,7 @@ def _attempts(plt, run: RunData):
     bottom.grid(alpha=0.3)
     top.set_title(
         f"DOF and F per attempt: N_lock = {run.summary.get('N_lock')}, "
-        f"N_exceed = {run.summary.get('N_exceed')}"
+        f"N_exceed = {run.summary.get('N_exceed')}, N_path = {run.summary.get('N_path', 0)}"
     )
     bottom.legend(fontsize=7, loc="best")
     return (

@@ -110,6 +110,13 @@ def _answer(run: RunData) -> list[str]:
         ("final DOF", "–" if s.get("final_dof") is None else str(s["final_dof"])),
         ("target DOF", "–" if target is None else str(target)),
         ("N_lock", str(s.get("N_lock"))),
+        *((("N_path", str(s["N_path"])),) if s.get("deploy_check") else ()),
+        (
+            "deploys",
+            "–"
+            if s.get("final_deploys") is None
+            else ("yes: its folding path reaches the flat state" if s["final_deploys"] else "no"),
+        ),
         ("final design", "none" if final is None else final.name),
     ]
     out = [
@@ -180,8 +187,8 @@ def _figure(figure: Figure) -> str:
 def _tables(run: RunData) -> list[str]:
     s = run.summary
     run_keys = (
-        "stop_reason initial_dof final_dof N_reduce N_lock N_exceed n_solutions n_solves "
-        "n_skipped mean_F_accepted mean_F_all_solves"
+        "stop_reason initial_dof final_dof N_reduce N_lock N_exceed N_path deploy_check "
+        "final_deploys n_solutions n_solves n_skipped mean_F_accepted mean_F_all_solves"
     ).split()
     blocks = [("Run", _pairs({k: s.get(k) for k in run_keys if k in s}))]
     for key, head in (

@@ -214,7 +214,8 @@ def dof_steps(store: Store) -> list[dict]:
 def criterion_summary(store: Store) -> list[dict]:
     """The figures to compare criteria, and studies with and without look-ahead: per
     (pattern, criterion) of the Bezier study, mean N_reduce, N_lock, N_exceed and F, solves
-    of (6) per run, candidates skipped by the look-ahead and fixes of a group of nearly flat
+    of (6) per run, mean N_path and the share of final designs whose folding path reaches the
+    flat state, candidates skipped by the look-ahead and fixes of a group of nearly flat
     creases (``Attempt.carried``) per run (None where the database does not store them), and
     the mean selection and total seconds per run."""
     runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
@@ -236,6 +237,10 @@ def criterion_summary(store: Store) -> list[dict]:
         for name, counts in (("skipped_per_run", skipped), ("groups_per_run", carried)):
             done = counts.get((pattern, crit))
             row[name] = float(np.sum(done)) / len(sel) if done else None
+        paths = [r["n_path"] for r in sel if r.get("n_path") is not None]
+        row["n_path"] = _mean_se(paths)[0] if paths else None
+        deploys = [r["final_deploys"] for r in sel if r.get("final_deploys") is not None]
+        row["deploys_share"] = float(np.mean(deploys)) if deploys else None
         row["selection_s"] = _mean_se([r["time_selection"] for r in sel])[0]
         row["run_s"] = _mean_se([r["time_total"] for r in sel])[0]
         rows.append(row)
@@ -640,12 +645,16 @@ def _summary_lines(rows: list[dict]) -> list[str]:
         "Summary per criterion",
         [
             *GROUP_HEAD,
-            *("N_reduce", "N_lock", "N_exceed", "mean F", "solves", "skipped", "groups"),
-            *("selection ms", "run s"),
+            *("N_reduce", "N_lock", "N_exceed", "N_path", "deploys", "mean F", "solves"),
+            *("skipped", "groups", "selection ms", "run s"),
         ],
         [
             _group_cells(r)
-            + [_fmt(r[k]) for k in ("n_reduce", "n_lock", "n_exceed", "mean_f")]
+            + [_fmt(r[k]) for k in ("n_reduce", "n_lock", "n_exceed", "n_path")]
+            + [
+                "-" if r["deploys_share"] is None else f"{100 * r['deploys_share']:.0f} %",
+                _fmt(r["mean_f"]),
+            ]
             + [_fmt(r["n_solves"], digits=1), _fmt(r["skipped_per_run"])]
             + [_fmt(r["groups_per_run"])]
             + [_fmt(r["selection_s"] * 1e3, digits=1), _fmt(r["run_s"], digits=1)]

@@ -74,14 +74,26 @@ ADDED_ATTEMPT_COLUMNS = {
     "locked_left": "TEXT",
     "locked_fold_deg": "TEXT",
     "carried": "TEXT",
+    "path": "TEXT",
+    "path_time": "REAL",
 }
-"""Columns of ``attempts`` added after the first databases (the look-ahead, issue 18): added
+"""Columns of ``attempts`` added after the first databases (the look-ahead, issue 18; the
+deployability check, issue 29: ``path`` is JSON, ``generate.Attempt.path``): added
 by ALTER TABLE when such a database is opened for writing, read as NULL from one opened
 read-only."""
-ADDED_RUN_COLUMNS = {"numerics": "TEXT"}
+ADDED_RUN_COLUMNS = {
+    "numerics": "TEXT",
+    "n_path": "INTEGER",
+    "final_deploys": "INTEGER",
+    "time_path": "REAL",
+}
 """Columns of ``runs`` added later, as :data:`ADDED_ATTEMPT_COLUMNS`: ``numerics`` is the
 key of the numeric environment of the worker that computed the run
-(:attr:`rigidfold.numerics.NumericEnvironment.key`); NULL for runs of older versions."""
+(:attr:`rigidfold.numerics.NumericEnvironment.key`); ``n_path`` the solutions replaced
+because their folding path does not reach the flat state (N_path, 0 without the
+deployability check), ``final_deploys`` whether the final design's folding path reaches the
+flat state (1 or 0), ``time_path`` the seconds of tracing; NULL for runs of older
+versions."""
 ADDED_COLUMNS = {"attempts": ADDED_ATTEMPT_COLUMNS, "runs": ADDED_RUN_COLUMNS}
 JSON_ATTEMPT_FIELDS = (
     "fixed_added",
@@ -92,6 +104,7 @@ JSON_ATTEMPT_FIELDS = (
     "locked_left",
     "locked_fold_deg",
     "carried",
+    "path",
 )
 """Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
 
@@ -169,8 +182,25 @@ class Key:
 
 # settings added with a default that differs from what rigidfold did before they existed
 LEGACY_SETTINGS = {"ipopt_hessian": "casadi"}
+# settings that a later rigidfold removed, with what they set: a database that stored them
+# resumes, since no study ran what they tuned
+RETIRED_SETTINGS = frozenset(
+    {  # the folding-motion tracer before issue 29 (studies trace no motion)
+        "motion_tol",
+        "motion_max_iter",
+        "motion_arc_step",
+        "motion_arc_max_steps",
+        "motion_max_halvings",
+        "motion_level_tol",
+        "motion_stall_iter",
+        "motion_stall_ratio",
+        "motion_probe",
+        "motion_arc_min_step",
+        "motion_turn_back",
+    }
+)
 # configuration entries added later, at the value that reproduces the studies made before
-LEGACY_CONFIG = {"lookahead": False}
+LEGACY_CONFIG = {"lookahead": False, "deploy_check": False}
 
 
 def config_differences(stored: dict, current: dict) -> list[str]:
@@ -180,7 +210,8 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     equal when ``current`` has it at the value that reproduces the older code: its default,
     or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes; so
     does an entry of the configuration itself at its value in ``LEGACY_CONFIG`` (e.g.
-    ``lookahead`` false). So a study can be resumed by a newer version as long as nothing it
+    ``lookahead`` false); a setting a later rigidfold removed (``RETIRED_SETTINGS``) is not
+    compared. So a study can be resumed by a newer version as long as nothing it
     measures has changed.
     """
     from dataclasses import asdict
@@ -195,7 +226,8 @@ def config_differences(stored: dict, current: dict) -> list[str]:
             diff += [
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
-                if a.get(k, LEGACY_SETTINGS.get(k, defaults.get(k))) != b.get(k) or k not in b
+                if k not in RETIRED_SETTINGS
+                and (a.get(k, LEGACY_SETTINGS.get(k, defaults.get(k))) != b.get(k) or k not in b)
             ]
         elif a != b:
             diff.append(key)

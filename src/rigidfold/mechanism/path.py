@@ -1,0 +1,682 @@
+"""The rigid-folding path of a shape: numerical continuation of its constraint manifold.
+
+A triangulated shape folds rigidly while every edge keeps its length, every fixed crease its
+fold angle, and one support triangle stays where it is (the gauge). These constraints
+``c(x) = 0`` on the vertex coordinates x (3V,) leave a manifold of dimension DOF through the
+design; the shape *deploys* when a path on it joins the design to the flat state (every fold
+angle within ``path_flat_tol`` of 0). :func:`trace_path` follows such a path by
+predictor-corrector continuation on the sparse constraint Jacobian J (Allgower & Georg,
+*Introduction to Numerical Continuation Methods*, ch. 2-5):
+
+* **DOF 1** (J has 3V - 1 independent rows): the path is the manifold itself. The tangent t
+  solves the augmented system ``[J; t_prev^T] t = e``, so it keeps its orientation; the
+  corrector is the chord (pseudo-arclength) iteration ``[J_k; t_k^T] dy = -[c(y); 0]`` with
+  the factors of the last point. The first direction is the one that lowers the folding
+  measure ``m = |rho_free|``. The trace goes on past the points where m stops falling (limit
+  points of m, where dm/ds changes sign) and so follows the whole closed branch if need be:
+  it ends at the flat state, back at the design (a closed loop that misses the flat state:
+  the path *turns back*), where a crease folds to ``path_fold_limit`` (its panels meet), or
+  when the step or the budget runs out; in the last three cases the other direction from the
+  design is traced too. A sign change of ``det [J; t^T]`` is a bifurcation point, which the
+  trace passes on its branch and records.
+* **DOF > 1** (or self-stressed constraints): the path is the one closest to the straight
+  line in fold angles: each step moves along the Gauss-Newton direction d that takes the
+  free fold angles rho towards 0 within the mechanism, ``min |rho + J_rho d|^2 + mu |d|^2``
+  subject to ``J d = 0`` (one sparse KKT system), and the corrector is the minimum-norm chord
+  iteration on the same factors. The path *stops short* where no such direction lowers m.
+
+Each step costs one sparse LU factorisation (SuperLU through SciPy). The step length (in
+mean edge lengths) grows after an easy correction, halves after a failed one, and near the
+flat state is cut to the linear prediction of the closest approach, so the flat end is met
+rather than passed. Lengths are kept to ``path_tol`` at every point.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.frame.model import default_support_face
+from rigidfold.mechanism.analysis import analyze
+from rigidfold.mesh import CreasePattern
+from rigidfold.optimize.residuals import fold_angle_gradients
+from rigidfold.status import Outcome
+
+
+class PathStatus(Outcome):
+    """How the trace of a folding path ended."""
+
+    FLAT = "flat", "the folding path reaches the flat state: the shape deploys"
+    TURNED_BACK = (
+        "turned_back",
+        "the folding path turns back and returns to the design without reaching the flat state",
+    )
+    STOPS_SHORT = (
+        "stops_short",
+        "the folding path stops short of the flat state: no rigid folding goes closer to flat",
+    )
+    COLLISION = "collision", "a crease folds to 180 degrees (its panels meet) before the flat state"
+    STALLED = "stalled", "the folding path could not be continued"
+    MAX_STEPS = "max_steps", "the step budget ran out before the flat state"
+    RIGID = "rigid", "the shape has no mechanism (DOF 0): no folding path leaves it"
+
+
+@dataclass(frozen=True, eq=False)
+class FoldingPath:
+    """A traced rigid-folding path, the design first.
+
+    points : (K, V, 3) float64, shapes along the path (points[0] is the design); for a path
+        that deploys, points[-1] is the flat end (every free fold angle within
+        ``path_flat_tol``)
+    arclength : (K,) float64, distance along the path from the design, metres
+    measure : (K,) float64, folding measure m = |rho_free| of each point over the design's
+    max_fold : (K,) float64, largest |fold angle| of a free crease at each point, radians
+    status : PathStatus; message : what happened, in words
+    dof : int, the DOF the trace worked with (1: the manifold's one path)
+    closest : index of the point nearest the flat state (smallest max_fold)
+    fold_at_closest : (n_free,) float64, the free creases' fold angles there, radians
+    limit_points, bifurcations : indices of points where dm/ds changed sign, where
+        det [J; t^T] changed sign (DOF 1)
+    steps : accepted continuation steps; factorizations : sparse LU factorisations
+    max_length_error : largest |l - l0| / l0 over all points and edges
+    """
+
+    points: np.ndarray
+    arclength: np.ndarray
+    measure: np.ndarray
+    max_fold: np.ndarray
+    status: PathStatus
+    message: str
+    dof: int
+    closest: int
+    fold_at_closest: np.ndarray
+    limit_points: tuple[int, ...]
+    bifurcations: tuple[int, ...]
+    steps: int
+    factorizations: int
+    max_length_error: float
+
+    @property
+    def deploys(self) -> bool:
+        """The path joins the design to the flat state."""
+        return self.status is PathStatus.FLAT
+
+    @cached_property
+    def fraction(self) -> np.ndarray:
+        """(K,) float64: 1 at the design, 0 at the path's far end, linear in arclength."""
+        total = self.arclength[-1]
+        return 1.0 - self.arclength / total if total > 0 else np.ones(len(self.arclength))
+
+    def frames(
+        self,
+        pattern: CreasePattern,
+        n: int,
+        *,
+        support_face: int | None = None,
+        settings: Settings = DEFAULTS,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(frames (n, V, 3), fraction (n,)): the path at ``n`` equal steps of arclength from
+        its far end (fraction 0) to the design (fraction 1), for the shape ``pattern`` it was
+        traced on (with the same ``support_face``). A frame between two traced points is
+        their linear interpolation corrected onto the constraints (minimum-norm chord
+        steps), so every frame keeps the lengths to ``path_tol``; where that correction fails
+        the nearest traced point stands in, at its own fraction."""
+        n = max(int(n), 2)
+        if len(self.points) == 1:
+            return self.points[[0] * n], np.linspace(0.0, 1.0, n)
+        if support_face is None:
+            support_face = default_support_face(pattern)
+        cons = RigidFoldingConstraints(pattern, support_face)
+        total = float(self.arclength[-1])
+        fraction = np.linspace(0.0, 1.0, n)
+        frames = []
+        for k, f in enumerate(fraction):
+            s = (1.0 - f) * total
+            i = int(np.clip(np.searchsorted(self.arclength, s), 1, len(self.arclength) - 1))
+            s0, s1 = self.arclength[i - 1], self.arclength[i]
+            w = 0.0 if s1 <= s0 else (s - s0) / (s1 - s0)
+            if w <= 1e-12 or w >= 1 - 1e-12:
+                j = i - 1 if w <= 1e-12 else i
+                frames.append(self.points[j])
+                continue
+            guess = ((1 - w) * self.points[i - 1] + w * self.points[i]).ravel() / cons.scale
+            y, ok, _, _ = _correct(cons, guess, "projection", None, settings)
+            if ok:
+                frames.append(y.reshape(-1, 3) * cons.scale)
+            else:
+                j = i - 1 if w < 0.5 else i
+                frames.append(self.points[j])
+                fraction[k] = self.fraction[j]
+        return np.asarray(frames), fraction
+
+    def to_dict(self) -> dict:
+        """JSON-ready figures of the trace (not its points)."""
+        return {
+            "status": self.status.value,
+            "message": self.message,
+            "deploys": self.deploys,
+            "dof": self.dof,
+            "points": len(self.points),
+            "length_m": float(self.arclength[-1]),
+            "steps": self.steps,
+            "factorizations": self.factorizations,
+            "min_measure": float(self.measure.min()),
+            "closest_max_fold_deg": float(np.degrees(self.max_fold[self.closest])),
+            "closest_measure": float(self.measure[self.closest]),
+            "fold_at_closest_deg": np.degrees(self.fold_at_closest).round(4).tolist(),
+            "limit_points": len(self.limit_points),
+            "bifurcations": len(self.bifurcations),
+            "max_length_error": self.max_length_error,
+        }
+
+
+class RigidFoldingConstraints:
+    """c(x) and its sparse Jacobian for one shape, in units of the mean edge length.
+
+    Rows: the edge lengths (E), the fixed creases' fold angles (n_fix), and a gauge of six
+    linear rows that hold the support triangle ``(a, b, c)`` still: a's three coordinates, b's
+    two across the edge ab, c's one across the triangle's plane. x is the vertex coordinates
+    over the mean edge length, (3V,). The sparsity pattern is built once; an evaluation fills
+    in its values.
+    """
+
+    def __init__(self, pattern: CreasePattern, support_face: int) -> None:
+        self.pattern = pattern
+        self.scale = float(np.mean(pattern.edge_lengths))
+        self.x0 = pattern.coords.ravel() / self.scale
+        self.L0 = pattern.edge_lengths / self.scale
+        fixed, free = pattern.fixed_creases, pattern.free_creases
+        self.n_fixed, self.free = len(fixed), free
+        self.rho_fixed0 = pattern.fold_angles[fixed]
+        self.fixed_stencils = pattern.crease_stencils(fixed)
+        self.free_stencils = pattern.crease_stencils(free)
+        a, b, c = (int(v) for v in pattern.faces[support_face])
+        p = pattern.coords
+        e1 = (p[b] - p[a]) / np.linalg.norm(p[b] - p[a])
+        normal = np.cross(p[b] - p[a], p[c] - p[a])
+        normal /= np.linalg.norm(normal)
+        e2 = np.cross(normal, e1)
+        c3 = np.arange(3)
+        self.gauge_rows = np.concatenate([c3, [3, 3, 3, 4, 4, 4, 5, 5, 5]])
+        self.gauge_cols = np.concatenate([3 * a + c3, 3 * b + c3, 3 * b + c3, 3 * c + c3])
+        self.gauge_vals = np.concatenate([np.ones(3), e2, normal, normal])
+        E, nf = len(pattern.edges), self.n_fixed
+        self.n_rows = E + nf + 6
+        e = pattern.edges
+        rows = [
+            np.repeat(np.arange(E), 6),
+            E + np.repeat(np.arange(nf), 12),
+            E + nf + self.gauge_rows,
+        ]
+        cols = [
+            np.hstack([3 * e[:, :1] + c3, 3 * e[:, 1:] + c3]).ravel(),
+            (3 * self.fixed_stencils[:, :, None] + c3).reshape(-1),
+            self.gauge_cols,
+        ]
+        self._J = _Pattern(np.concatenate(rows), np.concatenate(cols), (self.n_rows, self.n))
+        self._Jr = _Pattern(
+            np.repeat(np.arange(len(free)), 12),
+            (3 * self.free_stencils[:, :, None] + c3).reshape(-1),
+            (len(free), self.n),
+        )
+        self.gauge0 = self._gauge(self.x0)
+
+    @property
+    def n(self) -> int:
+        """Unknowns: 3V."""
+        return len(self.x0)
+
+    def _gauge(self, x: np.ndarray) -> np.ndarray:
+        return np.bincount(self.gauge_rows, self.gauge_vals * x[self.gauge_cols], minlength=6)
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        """c(x) (m,): length errors, fixed-crease angle changes, gauge."""
+        X = x.reshape(-1, 3)
+        e = self.pattern.edges
+        length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
+        rho_fixed = fold_angle_gradients(X[self.fixed_stencils])[0]
+        return np.concatenate(
+            [length - self.L0, rho_fixed - self.rho_fixed0, self._gauge(x) - self.gauge0]
+        )
+
+    def free_angles(self, x: np.ndarray) -> np.ndarray:
+        """The free creases' fold angles (n_free,) at x, radians."""
+        return fold_angle_gradients(x.reshape(-1, 3)[self.free_stencils])[0]
+
+    def jacobian(self, x: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
+        """(J (m, n), J_rho (n_free, n)) at x, both sparse CSC: the constraints' Jacobian and
+        the free fold angles' gradients, in the scaled coordinates x."""
+        X = x.reshape(-1, 3)
+        e = self.pattern.edges
+        d = X[e[:, 1]] - X[e[:, 0]]
+        u = d / np.linalg.norm(d, axis=1)[:, None]
+        grad_fixed = fold_angle_gradients(X[self.fixed_stencils])[1]
+        grad_free = fold_angle_gradients(X[self.free_stencils])[1]
+        J = self._J.fill(
+            np.concatenate([np.hstack([-u, u]).ravel(), grad_fixed.ravel(), self.gauge_vals])
+        )
+        return J, self._Jr.fill(grad_free.ravel())
+
+    def length_error(self, x: np.ndarray) -> float:
+        """Largest |l - l0| / l0 at x."""
+        X = x.reshape(-1, 3)
+        e = self.pattern.edges
+        length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
+        return float(np.max(np.abs(length - self.L0) / self.L0))
+
+
+class _Pattern:
+    """A sparse matrix's pattern (COO rows and columns, no duplicates), filled in CSC."""
+
+    def __init__(self, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> None:
+        order = sp.csc_matrix((np.arange(1, len(rows) + 1, dtype=float), (rows, cols)), shape=shape)
+        self.order = order.data.astype(np.int64) - 1
+        self.indices, self.indptr, self.shape = order.indices, order.indptr, shape
+
+    def fill(self, values: np.ndarray) -> sp.csc_matrix:
+        """The matrix with ``values`` given in the COO order of the pattern."""
+        return sp.csc_matrix((values[self.order], self.indices, self.indptr), shape=self.shape)
+
+
+class _Factors:
+    """Sparse LU of a square matrix, with the sign of its determinant."""
+
+    def __init__(self, A: sp.spmatrix) -> None:
+        self.lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self.lu.solve(b)
+
+    @cached_property
+    def det_sign(self) -> int:
+        diag = self.lu.U.diagonal()
+        sign = int(np.prod(np.sign(diag)))
+        return sign * _parity(self.lu.perm_r) * _parity(self.lu.perm_c)
+
+
+def _parity(perm: np.ndarray) -> int:
+    """+1 for an even permutation, -1 for an odd one."""
+    seen = np.zeros(len(perm), bool)
+    sign = 1
+    for start in range(len(perm)):
+        if seen[start]:
+            continue
+        length, k = 0, start
+        while not seen[k]:
+            seen[k] = True
+            k = perm[k]
+            length += 1
+        if length % 2 == 0:
+            sign = -sign
+    return sign
+
+
+class _System:
+    """The factored linear system of one point of the trace (see the module's text).
+
+    mode "augmented": ``A = [J; t^T]`` (DOF 1); "projection": ``K = [[I, J^T], [J, -delta]]``
+    (DOF 1, self-stressed rows); "descent": ``K = [[J_rho^T J_rho + mu I, J^T], [J, -delta]]``
+    (DOF > 1). :meth:`direction` is the next tangent (or Gauss-Newton direction),
+    :meth:`correction` one corrector step.
+    """
+
+    def __init__(
+        self,
+        J: sp.csc_matrix,
+        J_rho: sp.csr_matrix,
+        mode: str,
+        t: np.ndarray | None,
+        settings: Settings,
+    ) -> None:
+        m, n = J.shape
+        self.mode, self.n, self.m, self.J_rho = mode, n, m, J_rho
+        if mode == "augmented":
+            assert t is not None
+            self.factors = _Factors(sp.vstack([J, sp.csr_matrix(t[None])]))
+            return
+        if mode == "projection":
+            M = sp.identity(n, format="csc")
+        else:
+            M = (J_rho.T @ J_rho) + settings.path_damping * sp.identity(n)
+        delta = settings.path_regularization
+        self.factors = _Factors(sp.bmat([[M, J.T], [J, -delta * sp.identity(m)]], format="csc"))
+
+    def direction(self, t: np.ndarray | None, rho: np.ndarray) -> np.ndarray:
+        """The unit tangent continuing ``t`` (DOF 1), or the Gauss-Newton step that takes the
+        free fold angles ``rho`` towards 0 within the mechanism (not normalised)."""
+        if self.mode == "augmented":
+            rhs = np.zeros(self.n)
+            rhs[-1] = 1.0
+            d = self.factors.solve(rhs)
+        else:
+            top = t if self.mode == "projection" else -(self.J_rho.T @ rho)
+            d = self.factors.solve(np.concatenate([top, np.zeros(self.m)]))[: self.n]
+        return d if self.mode == "descent" else d / np.linalg.norm(d)
+
+    def correction(self, c: np.ndarray) -> np.ndarray:
+        """One corrector step for the residual ``c``: in the plane normal to the tangent
+        (augmented), or of least norm in the system's metric."""
+        if self.mode == "augmented":
+            return self.factors.solve(np.concatenate([-c, [0.0]]))
+        return self.factors.solve(np.concatenate([np.zeros(self.n), -c]))[: self.n]
+
+
+def _correct(
+    cons: RigidFoldingConstraints,
+    y: np.ndarray,
+    mode: str,
+    t: np.ndarray | None,
+    settings: Settings,
+) -> tuple[np.ndarray, bool, int, _System | None]:
+    """Corrector from the prediction y onto c = 0: chord steps on the factors of the latest
+    iterate, refactored where they contract by less than ``path_contraction``; converged when
+    every |c_i| <= ``path_tol`` (after at least one factorisation, which the next direction
+    needs).
+
+    returns (y, converged, factorizations, the last system).
+    """
+    system, previous, factorizations = None, np.inf, 0
+    for _ in range(settings.path_corrector_iter + 1):
+        c = cons.residual(y)
+        norm = float(np.abs(c).max())
+        if not np.isfinite(norm):
+            return y, False, factorizations, system
+        if system is None or norm > settings.path_contraction * previous:
+            try:
+                system = _System(*cons.jacobian(y), mode, t, settings)
+            except RuntimeError:  # an exactly singular factor
+                return y, False, factorizations, system
+            factorizations += 1
+        if norm <= settings.path_tol:
+            return y, True, factorizations, system
+        previous = norm
+        y = y + system.correction(c)
+    return y, False, factorizations, system
+
+
+@dataclass
+class _Trace:
+    """The points of one direction of the trace, as it grows."""
+
+    points: list
+    arclength: list
+    measure: list
+    max_fold: list
+    folds: list
+    limit_points: list
+    bifurcations: list
+    steps: int = 0
+    factorizations: int = 0
+
+
+def _trace_direction(
+    cons: RigidFoldingConstraints,
+    x0: np.ndarray,
+    t0: np.ndarray | None,
+    mode: str,
+    m0: float,
+    settings: Settings,
+) -> tuple[_Trace, PathStatus, str]:
+    """Continue from the design x0 (mode "augmented"/"projection": along t0; "descent": the
+    Gauss-Newton direction) until the path ends (see the module's text)."""
+    J, J_rho = cons.jacobian(x0)
+    rho = cons.free_angles(x0)
+    tr = _Trace([x0.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
+    flat_tol, limit = settings.path_flat_tol, settings.path_fold_limit
+    system = _System(J, J_rho, mode, t0, settings)
+    tr.factorizations += 1
+    t = t0 if mode == "descent" else system.direction(t0, rho)
+    det_sign = system.factors.det_sign if mode == "augmented" else 0
+    # step lengths are root-mean-square vertex displacements, in mean edge lengths
+    rms = math.sqrt(cons.pattern.n_vertices)
+    first, largest, least = (
+        rms * v for v in (settings.path_step, settings.path_max_step, settings.path_min_step)
+    )
+    x, h, travelled, slope_sign, slow = x0.copy(), first, 0.0, 0, 0
+    best = 1.0  # descent: the smallest measure so far
+    while True:
+        if tr.steps >= settings.path_max_steps:
+            return tr, PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps"
+        if mode == "descent":
+            d = system.direction(None, rho)
+            size = float(np.linalg.norm(d))
+            if not size > least:
+                return (
+                    tr,
+                    PathStatus.STOPS_SHORT,
+                    (
+                        "no rigid folding lowers the folding measure below "
+                        f"{tr.measure[-1]:.3g} of the design's"
+                    ),
+                )
+            unit, step = d / size, min(h, size)
+        else:
+            assert t is not None
+            unit, step = t, h
+        # no crease turns by more than path_max_fold_step in one step; and the step is cut at
+        # the linear prediction of the closest approach to the flat state
+        rate = system.J_rho @ unit
+        fastest = float(np.abs(rate).max(initial=0.0))
+        if fastest * step > settings.path_max_fold_step:
+            step = settings.path_max_fold_step / fastest
+        rr = float(rate @ rate)
+        if rr > 0:
+            s_star = -float(rho @ rate) / rr
+            if 0 < s_star < step and np.abs(rho + s_star * rate).max() < 2 * flat_tol:
+                step = max(s_star, least)
+        y, ok, nf, new = _correct(cons, x + step * unit, mode, t, settings)
+        tr.factorizations += nf
+        if ok and mode != "descent":  # the tangent must not turn too far in one step
+            chord = y - x
+            ok = float(chord @ unit) > np.cos(settings.path_max_turn) * np.linalg.norm(chord)
+        if not ok:
+            h = step / 2
+            if h < least:
+                return (
+                    tr,
+                    PathStatus.STALLED,
+                    (
+                        f"the step fell below {settings.path_min_step:g} mean edge lengths at "
+                        f"m = {tr.measure[-1]:.3g} of the design's"
+                    ),
+                )
+            continue
+        assert new is not None
+        rho_y = cons.free_angles(y)
+        fold_max = float(np.abs(rho_y).max(initial=0.0))
+        if fold_max >= limit:
+            return (
+                tr,
+                PathStatus.COLLISION,
+                (
+                    f"crease {int(cons.free[np.argmax(np.abs(rho_y))])} folds to "
+                    f"{np.degrees(fold_max):.1f} degrees at m = "
+                    f"{np.linalg.norm(rho_y) / m0:.3g} of the design's"
+                ),
+            )
+        travelled += float(np.linalg.norm(y - x))
+        x, rho, system = y, rho_y, new
+        if mode != "descent":
+            t = system.direction(t, rho)
+        tr.steps += 1
+        m = float(np.linalg.norm(rho)) / m0
+        slope = int(np.sign(m - tr.measure[-1]))
+        if slope_sign and slope and slope != slope_sign:
+            tr.limit_points.append(len(tr.points) - 1)
+        slope_sign = slope or slope_sign
+        if mode == "augmented":
+            sign = system.factors.det_sign
+            if sign != det_sign:
+                tr.bifurcations.append(len(tr.points))
+                det_sign = sign
+        if mode == "descent":
+            slow = slow + 1 if m > best * (1 - settings.path_stall_ratio) else 0
+            best = min(best, m)
+        tr.points.append(x.copy())
+        tr.arclength.append(travelled)
+        tr.measure.append(m)
+        tr.max_fold.append(fold_max)
+        tr.folds.append(rho)
+        if fold_max <= flat_tol:
+            return (
+                tr,
+                PathStatus.FLAT,
+                (
+                    f"every fold angle below {np.degrees(flat_tol):.2g} degrees after {tr.steps} "
+                    f"steps ({travelled * cons.scale:.3g} m of path)"
+                ),
+            )
+        if slow >= settings.path_stall_steps:
+            return (
+                tr,
+                PathStatus.STOPS_SHORT,
+                (f"no rigid folding lowers the folding measure below {m:.3g} of the design's"),
+            )
+        if mode != "descent" and travelled > 4 * largest:
+            if np.linalg.norm(x - x0) < max(step, first):
+                k = int(np.argmin(tr.max_fold))
+                return (
+                    tr,
+                    PathStatus.TURNED_BACK,
+                    (
+                        f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest "
+                        f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees) and returns "
+                        "to the design"
+                    ),
+                )
+        h = min(2 * step, largest) if nf == 1 else step
+
+
+def trace_path(
+    pattern: CreasePattern,
+    *,
+    dof: int | None = None,
+    support_face: int | None = None,
+    settings: Settings = DEFAULTS,
+) -> FoldingPath:
+    """Trace the rigid-folding path of ``pattern`` from the design towards the flat state.
+
+    dof : the shape's DOF where known; default that of :func:`rigidfold.mechanism.analyze`
+        (with ``support_face``). ``support_face``: the gauge triangle (default
+        :func:`rigidfold.frame.model.default_support_face`). See the module's text.
+    """
+    if support_face is None:
+        support_face = default_support_face(pattern)
+    cons = RigidFoldingConstraints(pattern, support_face)
+    if dof is None:
+        dof = analyze(pattern, support_face=support_face, settings=settings).dof
+    x0 = cons.x0.copy()
+    J, J_rho = cons.jacobian(x0)
+    rho = cons.free_angles(x0)
+    m0 = float(np.linalg.norm(rho))
+    if dof <= 0:
+        return _result(
+            cons,
+            [_single(cons, x0, rho)],
+            PathStatus.RIGID,
+            PathStatus.RIGID.message,
+            max(dof, 0),
+            m0,
+        )
+    if m0 == 0 or np.abs(rho).max() <= settings.path_flat_tol:
+        return _result(
+            cons,
+            [_single(cons, x0, rho)],
+            PathStatus.FLAT,
+            "the shape is flat already",
+            dof,
+            m0 or 1.0,
+        )
+    if dof == 1:
+        mode = "augmented" if cons.n_rows == cons.n - 1 else "projection"
+        t = _first_tangent(J, J_rho, rho, settings)
+        traces = []
+        for sign in (1.0, -1.0):
+            try:
+                tr, status, message = _trace_direction(cons, x0, sign * t, mode, m0, settings)
+            except RuntimeError:  # the augmented matrix is singular at the design
+                mode = "projection"
+                tr, status, message = _trace_direction(cons, x0, sign * t, mode, m0, settings)
+            traces.append((tr, status, message))
+            if status in (PathStatus.FLAT, PathStatus.TURNED_BACK):
+                break
+        best = next((r for r in traces if r[1] is PathStatus.FLAT), traces[0])
+        tr, status, message = best
+        if len(traces) == 2 and best is traces[1]:
+            message += " (in the direction that first folds further)"
+        k = int(np.argmin(tr.measure))
+        if status not in (PathStatus.FLAT, PathStatus.TURNED_BACK) and k < len(tr.measure) - 1:
+            status, message = (
+                PathStatus.TURNED_BACK,
+                (
+                    f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest fold "
+                    f"angle there {np.degrees(tr.max_fold[k]):.3g} degrees); then {message}"
+                ),
+            )
+        factorizations = sum(t[0].factorizations for t in traces)
+        return _result(cons, [tr], status, message, 1, m0, factorizations)
+    tr, status, message = _trace_direction(cons, x0, None, "descent", m0, settings)
+    return _result(cons, [tr], status, message, dof, m0)
+
+
+def _first_tangent(
+    J: sp.csc_matrix, J_rho: sp.csr_matrix, rho: np.ndarray, settings: Settings
+) -> np.ndarray:
+    """The unit tangent of a 1-DOF manifold at the design, oriented to lower m first: the
+    projection of -grad(m^2 / 2) onto the null space of J."""
+    n, m = J.shape[1], J.shape[0]
+    K = sp.bmat(
+        [[sp.identity(n), J.T], [J, -settings.path_regularization * sp.identity(m)]],
+        format="csc",
+    )
+    g = -(J_rho.T @ rho)
+    t = spla.splu(K, permc_spec="COLAMD").solve(np.concatenate([g, np.zeros(m)]))[:n]
+    norm = float(np.linalg.norm(t))
+    if not norm > 0:
+        raise ValueError("the shape's folding path has no tangent at the design")
+    return t / norm
+
+
+def _single(cons: RigidFoldingConstraints, x: np.ndarray, rho: np.ndarray) -> _Trace:
+    return _Trace([x.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
+
+
+def _result(
+    cons: RigidFoldingConstraints,
+    traces: list[_Trace],
+    status: PathStatus,
+    message: str,
+    dof: int,
+    m0: float,
+    factorizations: int | None = None,
+) -> FoldingPath:
+    tr = traces[0]
+    V = cons.pattern.n_vertices
+    points = np.asarray(tr.points).reshape(-1, V, 3) * cons.scale
+    max_fold = np.asarray(tr.max_fold)
+    closest = int(np.argmin(max_fold))
+    error = max(cons.length_error(p) for p in np.asarray(tr.points))
+    return FoldingPath(
+        points=points,
+        arclength=np.asarray(tr.arclength) * cons.scale,
+        measure=np.asarray(tr.measure),
+        max_fold=max_fold,
+        status=status,
+        message=message,
+        dof=dof,
+        closest=closest,
+        fold_at_closest=np.asarray(tr.folds[closest]),
+        limit_points=tuple(tr.limit_points),
+        bifurcations=tuple(tr.bifurcations),
+        steps=sum(t.steps for t in traces),
+        factorizations=(
+            sum(t.factorizations for t in traces) if factorizations is None else factorizations
+        ),
+        max_length_error=error,
+    )

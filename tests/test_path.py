@@ -1,0 +1,217 @@
+"""The rigid-folding path (``rigidfold.mechanism.path``) and the deployability check of
+generation (Step 5 beyond the paper: N_path)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from conftest import paper_generate
+from rigidfold.case import make_case
+from rigidfold.cli import main
+from rigidfold.config import DEFAULTS
+from rigidfold.frame.model import default_support_face
+from rigidfold.generate import AttemptOutcome, generate
+from rigidfold.io.fold import pattern_from_fold
+from rigidfold.mechanism.path import (
+    PathStatus,
+    RigidFoldingConstraints,
+    _System,
+    trace_path,
+)
+from rigidfold.mesh.geometry import edge_lengths
+from rigidfold.patterns import miura
+
+DATA = Path(__file__).parent / "data"
+
+
+def locked(shape):
+    """The shape with one more free crease fixed: a Miura-ori so made has no mechanism."""
+    fixed = shape.fixed.copy()
+    fixed[shape.free_creases[len(shape.free_creases) // 2]] = True
+    return shape.with_fixed(fixed)
+
+
+def free(shape):
+    """The shape with every crease free (a Miura-ori's quads cut into free triangles)."""
+    return shape.with_fixed(np.zeros(shape.n_edges, dtype=bool))
+
+
+def assert_rigid(path, shape, tol=1e-8):
+    """Every traced point keeps every edge length and fixed-crease fold angle."""
+    from rigidfold.mesh import CreasePattern
+
+    assert path.max_length_error < tol
+    for point in path.points:
+        assert np.allclose(edge_lengths(point, shape.edges), shape.edge_lengths, rtol=tol)
+        moved = CreasePattern(point, shape.faces, shape.edges, shape.fixed, shape.settings)
+        fixed = shape.fixed_creases
+        assert np.allclose(moved.fold_angles[fixed], shape.fold_angles[fixed], atol=1e-7)
+
+
+@pytest.mark.parametrize("height", [0.3, 0.5, 0.8])
+def test_a_miura_ori_unfolds_to_flat_along_its_one_path(height):
+    shape = miura(3, 3, height=height)
+    path = trace_path(shape)
+    assert path.status is PathStatus.FLAT and path.deploys and path.dof == 1
+    assert path.max_fold[-1] <= DEFAULTS.path_flat_tol
+    assert np.all(np.diff(path.measure) < 0)  # a Miura-ori unfolds monotonically
+    assert path.limit_points == () and path.bifurcations == ()
+    assert np.allclose(path.points[0], shape.coords, rtol=0, atol=1e-12)
+    assert_rigid(path, shape)
+
+
+def test_the_tangent_and_the_descent_direction_lie_in_the_null_space():
+    """Invariants of the linear algebra: J t = 0 for the tangent of a 1-DOF shape and for the
+    Gauss-Newton direction of a many-DOF one; the direction lowers the fold angles."""
+    for shape, mode in ((miura(3, 3), "projection"), (free(miura(3, 3)), "descent")):
+        cons = RigidFoldingConstraints(shape, default_support_face(shape))
+        J, J_rho = cons.jacobian(cons.x0)
+        rho = cons.free_angles(cons.x0)
+        t0 = np.random.default_rng(1).standard_normal(cons.n)
+        system = _System(J, J_rho, mode, t0, DEFAULTS)
+        d = system.direction(t0, rho)
+        assert np.abs(J @ d).max() < 1e-9 * max(np.abs(d).max(), 1e-300)
+        if mode == "descent":
+            assert float(rho @ (J_rho @ d)) < 0
+
+
+def test_the_jacobian_is_the_derivative_of_the_constraints():
+    shape = miura(3, 3, height=0.6)
+    cons = RigidFoldingConstraints(shape, default_support_face(shape))
+    rng = np.random.default_rng(0)
+    x = cons.x0 + 1e-3 * rng.standard_normal(cons.n)
+    J, J_rho = cons.jacobian(x)
+    v = rng.standard_normal(cons.n)
+    h = 1e-6
+    fd = (cons.residual(x + h * v) - cons.residual(x - h * v)) / (2 * h)
+    assert np.allclose(J @ v, fd, atol=1e-7)
+    fd_rho = (cons.free_angles(x + h * v) - cons.free_angles(x - h * v)) / (2 * h)
+    assert np.allclose(J_rho @ v, fd_rho, atol=1e-7)
+    assert sp.issparse(J) and J.shape == (cons.n_rows, cons.n)
+
+
+def test_a_shape_without_mechanism_has_no_path():
+    path = trace_path(locked(miura(3, 3)))
+    assert path.status is PathStatus.RIGID and not path.deploys and len(path.points) == 1
+
+
+def test_a_shape_of_many_dof_goes_to_flat_closest_to_the_straight_line():
+    shape = free(miura(3, 3))
+    path = trace_path(shape)
+    assert path.dof == 9 and path.deploys
+    assert np.all(np.diff(path.measure) < 0)
+    assert_rigid(path, shape)
+
+
+def test_a_path_that_turns_back_is_found_and_explained():
+    """The DOF-1 shape of the symmetric dome (criterion S, Section 6.5): its one path comes
+    down to 0.288 of the design's folding measure and folds up again."""
+    shape = pattern_from_fold(DATA / "dome_sym_dof1.fold")
+    path = trace_path(shape)
+    assert path.status is PathStatus.TURNED_BACK and not path.deploys
+    assert "turns back at m = 0.288" in path.message
+    assert path.measure[path.closest] == pytest.approx(0.288, abs=5e-4)
+    assert len(path.limit_points) >= 1
+    record = path.to_dict()
+    assert record["closest_measure"] == pytest.approx(0.288, abs=5e-4)
+    assert len(record["fold_at_closest_deg"]) == len(shape.free_creases)
+    json.dumps(record)
+    assert_rigid(path, shape)
+
+
+def test_path_settings_take_effect():
+    shape = miura(3, 3, height=0.5)
+    budget = trace_path(shape, settings=DEFAULTS.with_(path_max_steps=1))
+    assert budget.status is PathStatus.MAX_STEPS and budget.steps <= 2 * 1
+    collide = trace_path(shape, settings=DEFAULTS.with_(path_fold_limit=math.radians(1.0)))
+    assert collide.status in (PathStatus.COLLISION, PathStatus.TURNED_BACK)
+    loose = trace_path(shape, settings=DEFAULTS.with_(path_flat_tol=math.radians(170.0)))
+    assert loose.deploys and loose.steps == 0 and "flat already" in loose.message
+    fine = trace_path(shape, settings=DEFAULTS.with_(path_max_fold_step=math.radians(1.0)))
+    coarse = trace_path(shape)
+    assert fine.deploys and fine.steps > coarse.steps
+
+
+def test_motion_frames_are_equal_steps_of_the_path_and_keep_lengths():
+    from rigidfold.deform import folding_motion
+    from rigidfold.develop import develop
+
+    shape = miura(4, 3)
+    motion = folding_motion(shape, develop(shape).coords2d)
+    assert motion.status == "ok" and len(motion.frames) == DEFAULTS.motion_frames
+    assert np.allclose(motion.parameter, np.linspace(0, 1, DEFAULTS.motion_frames))
+    assert motion.max_length_error < 1e-8
+    assert motion.path["deploys"] is True
+
+
+# --------------------------------------------------------------- generation (N_path)
+@pytest.fixture(scope="module")
+def seed_103():
+    """Pattern 1 on Bezier seed 103 (S-hat, look-ahead): the paper's Step 5 ends on a DOF-1
+    shape whose path does not reach the flat state; the deployability check replaces it."""
+    case = make_case("bezier", "1", seed=103)
+    paper = paper_generate(case, criterion="shat", seed=103, lookahead=True)
+    checked = generate(case, criterion="shat", seed=103, lookahead=True)
+    return case, paper, checked
+
+
+def test_a_design_whose_path_turns_back_is_rejected(seed_103):
+    _, paper, checked = seed_103
+    final = paper.solutions[-1]
+    assert paper.final_dof == 1 and paper.n_path == 0 and not paper.deploy_check
+    assert not trace_path(final.result.pattern, dof=1).deploys  # as the paper delivers it
+    assert checked.deploy_check and checked.n_path >= 1
+    rejected = [a for a in checked.attempts if a.outcome is AttemptOutcome.PATH]
+    assert len(rejected) == checked.n_path
+    for attempt in rejected:
+        assert attempt.path is not None and attempt.path["deploys"] is False
+        assert attempt.path["status"] != "flat" and attempt.dof is not None
+        assert len(attempt.path["fold_at_closest_deg"]) > 0
+
+
+def test_a_deployable_design_is_accepted_and_delivered(seed_103):
+    _, _, checked = seed_103
+    final = checked.final
+    assert checked.final_dof == 1 and final is not None and final.path is not None
+    assert final.path.deploys and final.path.max_fold[-1] <= DEFAULTS.path_flat_tol
+    assert_rigid(final.path, final.result.pattern)
+    assert final.result.F <= DEFAULTS.polish_tol * 10  # polished to F = 0
+    record = checked.to_dict()
+    assert record["N_path"] == checked.n_path and record["final_deploys"] is True
+    assert record["time_s"]["path"] > 0
+
+
+def test_polish_keeps_the_constraints_and_moves_the_shape_little():
+    case = make_case("bezier", "1", seed=1)
+    problem = case.problem()
+    result = problem.solve()
+    polished = problem.polish(result)
+    assert polished.F <= DEFAULTS.polish_tol < result.F
+    assert polished.max_violation <= DEFAULTS.constraint_tol
+    assert np.abs(polished.coords - result.coords).max() < 1e-3
+    assert np.abs(polished.pattern.angle_defects).max() < 1e-12
+
+
+def test_the_counters_are_stored_and_reported(tmp_path, capsys):
+    out = tmp_path / "run"
+    args = ["generate", "--surface", "bezier", "--seed", "103", "--pattern", "1"]
+    assert main([*args, "--lookahead", "--no-deform", "--quiet", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert f"N_path={summary['N_path']}" in printed and summary["N_path"] >= 1
+    assert summary["final_deploys"] is True and summary["options"]["deploy_check"] is True
+    log = json.loads((out / "log.json").read_text())["attempts"]
+    assert sum(a["outcome"] == "path" for a in log) == summary["N_path"]
+    # the report's slider shows the traced path of the final design, flat to folded
+    final = json.loads((out / summary["verdict"]["final_design"]).read_text())
+    motion = [f for f in final["file_frames"] if "folding motion" in f.get("frame_title", "")]
+    assert len(motion) == DEFAULTS.motion_frames
+    assert final["rigidfold:motion"]["path"]["deploys"] is True
+    html = (out / "report.html").read_text()
+    assert "N_path" in html
