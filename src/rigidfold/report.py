@@ -222,19 +222,25 @@ def clear_earlier_run(
 
     Only the run's own files and directories, ``names`` (a generation run's by default:
     :data:`RUN_FILES`, :data:`RUN_DIRS`), count and are removed; other files in ``out``
-    stay. A symbolic link among them is removed itself, never followed. Removing one of the
+    stay. With ``overwrite`` the temporary files of those names that a killed run left
+    (``.report.html.<random>.tmp``: :func:`rigidfold.io.files.temp_files`) are removed too.
+    A symbolic link among them is removed itself, never followed. Removing one of the
     run's ``inputs`` (e.g. an earlier solution used as the pattern) is refused. Returns
     ``out`` as a Path. Raises ValueError naming what was found.
     """
+    from rigidfold.io.files import temp_files
+
     out = Path(out)
     found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
-    if not found:
-        return out
-    if not overwrite:
+    if found and not overwrite:
         raise ValueError(
             f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
             "give --overwrite to replace it, or another --out"
         )
+    if overwrite:
+        found += temp_files(out, names)
+    if not found:
+        return out
     for path in found:
         for given in inputs:
             doomed = (
@@ -254,7 +260,7 @@ def clear_earlier_run(
             if path.is_dir() and not path.is_symlink():
                 shutil.rmtree(path)
             else:
-                path.unlink()
+                path.unlink(missing_ok=True)
     except OSError as exc:
         raise ValueError(
             f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"

@@ -12,8 +12,9 @@ import time
 
 import pytest
 
+from conftest import main_code
 from rigidfold import report
-from rigidfold.report import LOCK_NAME, lock_run_dir
+from rigidfold.report import LOCK_NAME, clear_earlier_run, lock_run_dir
 
 
 def _dead_pid() -> int:
@@ -92,3 +93,47 @@ def test_a_lock_that_is_a_link_is_refused_not_followed(tmp_path):
     with pytest.raises(ValueError, match="is a symbolic link, not a rigidfold lock"):
         lock_run_dir(out)
     assert target.read_text() == "keep"
+
+
+# --------------------------------------------- item 18: temporary files of a killed run
+LEFT = [".report.html.0123456789ab.tmp", ".summary.json.a1b2c3d4e5f6.tmp", ".log.json.ff.tmp"]
+"""What a run killed while it wrote its files leaves (:func:`rigidfold.io.atomic_write`)."""
+KEPT = [
+    ".report.html.notes",  # not a temporary name
+    "report.html.0123456789ab.tmp",  # no leading dot
+    ".report.html.0123456789ab.tmpx",
+    ".report.html.xyz.tmp",  # not hexadecimal
+    ".notes.txt.0123456789ab.tmp",  # of a file that is not the run's
+    ".r.0123456789ab.tmp",  # a short prefix of a run's name: not a cut name
+]
+
+
+def test_overwrite_removes_the_temporary_files_a_killed_run_left(tmp_path):
+    """Issue 30, item 18: a SIGKILL while report.html (2 MB) was written left
+    ``.report.html.<hex>.tmp``, which ``--overwrite`` kept for ever."""
+    outside = tmp_path / "outside.txt"
+    outside.write_text("keep")
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "summary.json").write_text("{}")
+    for name in [*LEFT, *KEPT]:
+        (out / name).write_bytes(b"x" * 1000)
+    (out / ".log.json.abcdefabcdef.tmp").symlink_to(outside)  # removed, not followed
+    (out / ".report.html.abcdef012345.tmp").mkdir()  # a directory is nobody's temporary file
+    with pytest.raises(ValueError, match=r"holds an earlier run \(summary\.json\)"):
+        clear_earlier_run(out, overwrite=False)
+    assert len(list(out.iterdir())) == 1 + len(LEFT) + len(KEPT) + 2
+    clear_earlier_run(out, overwrite=True)
+    assert sorted(p.name for p in out.iterdir()) == sorted([*KEPT, ".report.html.abcdef012345.tmp"])
+    assert outside.read_text() == "keep"
+
+
+def test_generate_overwrite_removes_them(tmp_path, capsys):
+    out = tmp_path / "run"
+    args = ["generate", "--surface", "dome", "--pattern", "grid:3x3", "--no-deform", "--quiet"]
+    assert main_code([*args, "--target-dof", "6", "--out", str(out)]) == 0
+    for name in LEFT:
+        (out / name).write_bytes(b"x" * 1000)
+    assert main_code([*args, "--target-dof", "6", "--out", str(out), "--overwrite"]) == 0
+    assert not [p.name for p in out.iterdir() if p.name.endswith(".tmp")]
+    assert (out / "report.html").is_file()
