@@ -212,6 +212,11 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
     return f"file:{quote(absolute, safe='/')}?mode={mode}"
 
 
+READONLY_COPY_TRIES = 3
+"""Times a database opened read-only is copied into memory before it is read in place
+instead (:meth:`Store._connect_readonly`): a copy is kept only if nothing wrote meanwhile."""
+
+
 @functools.cache
 def schema_columns() -> dict[str, dict[str, str]]:
     """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
@@ -230,7 +235,9 @@ class Store:
     second client is refused) and checks an existing file read-only first (:meth:`_check`):
     a damaged or foreign file, or one of another configuration, is refused untouched.
     ``readonly=True`` opens an existing database for reporting: it never creates one nor
-    writes to it (and takes no ``config`` and no lock).
+    writes to it, nor makes its ``-wal`` and ``-shm`` files where no study is writing it
+    (:meth:`_connect_readonly`: it reads from a read-only file system too), and takes no
+    ``config`` and no lock.
 
     ``numerics`` (:meth:`rigidfold.numerics.NumericEnvironment.to_dict` of the process that
     will add runs) is stored with the first runs; a database whose runs were computed with
@@ -279,10 +286,74 @@ class Store:
             raise
 
     def _connect_readonly(self) -> sqlite3.Connection:
+        """A read-only connection to the database that makes no file beside it.
+
+        When no write-ahead log holds data (no ``-wal`` file, or an empty one) and there is
+        no rollback journal, the file holds the whole database: it is copied into memory
+        through an ``immutable`` connection (no lock taken, no ``-wal`` or ``-shm`` made,
+        also on a read-only file system), and the copy is kept if the file did not change
+        while it was copied (else tried again). Otherwise (a study writing it now, or one
+        killed with runs in its ``-wal``) it is opened ``mode=ro``, which reads the
+        ``-wal`` through the ``-shm`` beside it (making that one when it is missing).
+        Raises ValueError: :meth:`_open_error`.
+        """
+        for _ in range(READONLY_COPY_TRIES):
+            before = self._state()
+            wal, journal = before[1:]
+            if (wal is not None and wal[1] > 0) or journal is not None:
+                break
+            try:
+                source = sqlite3.connect(
+                    sqlite_uri(self.path, "ro") + "&immutable=1", uri=True, timeout=30
+                )
+                try:
+                    copy = sqlite3.connect(":memory:")
+                    source.backup(copy)
+                finally:
+                    source.close()
+            except sqlite3.Error as exc:
+                raise self._open_error(exc) from None
+            if self._state() == before:
+                return copy
+            copy.close()  # written meanwhile: copy again, or read it in place
         try:
-            return sqlite3.connect(sqlite_uri(self.path, "ro"), uri=True, timeout=30)
+            con = sqlite3.connect(sqlite_uri(self.path, "ro"), uri=True, timeout=30)
+            con.execute("PRAGMA schema_version")  # opens the file (and its -wal) now
         except sqlite3.Error as exc:
-            raise ValueError(f"{str(self.path)!r}: cannot open: {exc}") from None
+            raise self._open_error(exc) from None
+        return con
+
+    def _state(self) -> tuple:
+        """(inode, size, mtime) of the database, its ``-wal`` and its ``-journal`` (None for
+        a missing one): what changes when the database is written."""
+        state = []
+        for suffix in ("", "-wal", "-journal"):
+            try:
+                st = os.stat(f"{self.path}{suffix}")
+            except FileNotFoundError:
+                state.append(None)
+                continue
+            except OSError as exc:
+                raise ValueError(f"{str(self.path)!r}: cannot open: {exc.strerror}") from None
+            state.append((st.st_ino, st.st_size, st.st_mtime_ns))
+        return tuple(state)
+
+    def _open_error(self, exc: sqlite3.Error) -> ValueError:
+        """The one-line error of a database that could not be opened read-only: one it may
+        not read, one whose ``-wal`` holds runs but whose directory is read-only (SQLite
+        cannot make the ``-shm`` it needs), else a damaged file."""
+        name = str(self.path)
+        if getattr(exc, "sqlite_errorname", "") != "SQLITE_CANTOPEN":
+            return ValueError(f"{name!r}: damaged SQLite file: {exc}")
+        if not os.access(self.path, os.R_OK):
+            return ValueError(f"{name!r}: cannot open: no permission to read it")
+        if not os.access(self.path.parent if str(self.path.parent) else ".", os.W_OK):
+            return ValueError(
+                f"{name!r}: cannot read its write-ahead log ({self.path.name}-wal) in a "
+                f"read-only directory: SQLite needs to create {self.path.name}-shm beside it; "
+                "copy the database with its -wal file to a writable directory"
+            )
+        return ValueError(f"{name!r}: cannot open: {exc}")
 
     def _open_writable(self, config: dict | None) -> None:
         try:
