@@ -326,7 +326,7 @@ class Store:
     def _state(self) -> tuple:
         """(inode, size, mtime) of the database, its ``-wal`` and its ``-journal`` (None for
         a missing one): what changes when the database is written."""
-        state = []
+        state: list[tuple[int, int, int] | None] = []
         for suffix in ("", "-wal", "-journal"):
             try:
                 st = os.stat(f"{self.path}{suffix}")
