@@ -14,7 +14,7 @@ import sys
 import pytest
 
 from conftest import main_code, run_cli
-from rigidfold.study import Key, Store, StudyConfig
+from rigidfold.study import Key, Store, StoreWriteError, StudyConfig
 from rigidfold.study.store import RUN_FIELDS
 
 STUDY = ["study", "--patterns", "1", "--criteria", "s", "--no-deform", "--quiet"]
@@ -28,6 +28,69 @@ def fake_run(key, config):
     row |= {"status": "target DOF 1 reached", "version": "t", "numerics": numeric_environment().key}
     attempt = {"fixed_added": list(range(100)), "status": "converged", "locked": list(range(100))}
     return key, row, [attempt | {"idx": i, "outcome": "accepted", "dof": 40 - i} for i in range(40)]
+
+
+def test_a_full_disk_stops_the_study_in_one_line_and_keeps_the_runs(tmp_path, monkeypatch, capsys):
+    """Issue 30, item 11: the second run's write fails as on a full disk (SQLite's own
+    SQLITE_FULL: the database may not grow by a page); before, a sqlite3.OperationalError
+    traceback. Now: exit 2, one line naming the database, the first run kept; the same
+    command then resumes and completes."""
+    from rigidfold.study import runner
+
+    monkeypatch.setattr(runner, "run_one", fake_run)  # pickled by value: the worker runs it
+    real_add = Store.add
+    calls = []
+
+    def add_on_a_full_disk(self, key, run, attempts):
+        calls.append(key)
+        if len(calls) == 2:  # the disk fills up: not one page more
+            pages = self.db.execute("PRAGMA page_count").fetchone()[0]
+            self.db.execute(f"PRAGMA max_page_count = {pages}")
+        return real_add(self, key, run, attempts)
+
+    monkeypatch.setattr(Store, "add", add_on_a_full_disk)
+    db = tmp_path / "s.sqlite"
+    args = [*STUDY, "--surfaces", "3", "--workers", "1", "--db", str(db)]
+    code = main_code(args)
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err, err
+    assert err.splitlines() == [
+        f"rigidfold: error: cannot write to the study database {str(db)!r}: database or disk "
+        "is full; the 1 runs stored before are kept: free disk space, then run the same "
+        "command to resume"
+    ]
+    store = Store(db, readonly=True)
+    assert [r["seed"] for r in store.runs()] == [calls[0].seed]  # whole, with its attempts
+    assert store.count_attempts() == 40
+    store.close()
+    assert not (tmp_path / "s.sqlite.lock").exists()  # released
+
+    monkeypatch.setattr(Store, "add", real_add)  # space freed: the same command resumes
+    assert main_code(args) == 0
+    assert "2 runs done, 1 already in" in capsys.readouterr().out
+    store = Store(db, readonly=True)
+    assert len(store.runs()) == 3 and store.count_attempts() == 120
+    outcomes = [r["outcome"] for r in store.invocations()]
+    assert sorted(outcomes) == ["completed", "stopped: the database could not be written"]
+    store.close()
+
+
+def test_a_failed_write_is_rolled_back_whole(tmp_path):
+    store = Store(tmp_path / "s.sqlite", StudyConfig().as_dict())
+    _, run, attempts = fake_run(Key("bezier", 0, "1", "s"), {})
+    store.add(Key("bezier", 0, "1", "s"), run, attempts)
+    pages = store.db.execute("PRAGMA page_count").fetchone()[0]
+    store.db.execute(f"PRAGMA max_page_count = {pages}")
+    with pytest.raises(StoreWriteError, match="database or disk is full; the 1 runs stored"):
+        store.add(Key("bezier", 1, "1", "s"), run, attempts)
+    with pytest.raises(StoreWriteError, match="free disk space"):
+        store.add_invocation(
+            argv=["x" * 100_000],  # more than the free space of its pages
+            **dict.fromkeys(("started", "scheduler", "outcome", "version"), "x"),
+            **dict.fromkeys(("workers", "ran", "skipped", "total", "wall_s"), 1),
+        )
+    assert len(store.runs()) == 1 and store.count_attempts() == 40
+    store.close()
 
 
 # ---------------------------------------------------- item 18: reports leave the files alone

@@ -153,6 +153,11 @@ def run_stop(status: str) -> Stop | None:
     return Stop.from_reason(status)[0]
 
 
+class StoreWriteError(ValueError):
+    """A study database could not be written (a full disk, a read-only file): the run or
+    command being written is not stored, every run stored before is (one transaction each)."""
+
+
 @dataclass(frozen=True)
 class Key:
     """Identifies one run: (study, seed, pattern, criterion, symmetric)."""
@@ -491,7 +496,15 @@ class Store:
 
     def add(self, key: Key, run: dict, attempts: list[dict]) -> None:
         """Write one run and its attempts in one transaction; refuses (ValueError) a run
-        already in the database, which is left as it was."""
+        already in the database, which is left as it was. A write that fails (a full disk)
+        rolls the transaction back and raises :class:`StoreWriteError`
+        (:meth:`_write_error`): the runs stored before are kept."""
+        try:
+            self._add(key, run, attempts)
+        except sqlite3.Error as exc:
+            raise self._write_error(exc) from None
+
+    def _add(self, key: Key, run: dict, attempts: list[dict]) -> None:
         with self.db:
             names = ("study", "seed", "pattern", "criterion", "symmetric", *RUN_FIELDS)
             added = self.db.execute(
@@ -521,12 +534,30 @@ class Store:
             "started", "argv", "workers", "scheduler", "ran", "skipped", "total", "wall_s",
             "outcome", "version",
         )  # fmt: skip
-        with self.db:
-            self.db.execute(
-                f"INSERT INTO invocations ({', '.join(names)}) VALUES "
-                f"({', '.join('?' * len(names))})",
-                tuple(json.dumps(row[n]) if n == "argv" else row[n] for n in names),
-            )
+        try:
+            with self.db:
+                self.db.execute(
+                    f"INSERT INTO invocations ({', '.join(names)}) VALUES "
+                    f"({', '.join('?' * len(names))})",
+                    tuple(json.dumps(row[n]) if n == "argv" else row[n] for n in names),
+                )
+        except sqlite3.Error as exc:
+            raise self._write_error(exc) from None
+
+    def _write_error(self, exc: sqlite3.Error) -> StoreWriteError:
+        """The one-line error of a write that failed (its transaction rolled back): what
+        SQLite said, how many runs the database keeps, and what to do."""
+        try:
+            kept = f"the {self.db.execute('SELECT COUNT(*) FROM runs').fetchone()[0]} runs"
+        except sqlite3.Error:
+            kept = "the runs"
+        full = getattr(exc, "sqlite_errorname", "") == "SQLITE_FULL"
+        return StoreWriteError(
+            f"cannot write to the study database {str(self.path)!r}: "
+            f"{' '.join(str(exc).split())}; {kept} stored before are kept: "
+            + ("free disk space" if full else "make it writable")
+            + ", then run the same command to resume"
+        )
 
     def invocations(self) -> list[dict]:
         """Every recorded command, oldest first (none in a database from before the table)."""
