@@ -180,12 +180,15 @@ def _has_shape(value, shape) -> bool:
     """Whether ``value`` is of the kind of ``shape`` (its items are checked apart)."""
     if shape is bool:
         return isinstance(value, bool)
-    if shape is int:
-        return isinstance(value, int) and not isinstance(value, bool)
+    if shape is int:  # within int64: numpy and matplotlib take it
+        return isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2**63
     if shape is float:
-        return (
-            isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-        )
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            return False
+        try:
+            return math.isfinite(value)
+        except OverflowError:  # an integer beyond the floats
+            return False
     if shape is str:
         return isinstance(value, str)
     if isinstance(shape, Record):
@@ -198,7 +201,12 @@ def _has_shape(value, shape) -> bool:
 def _expected(shape) -> str:
     if isinstance(shape, Nullable):
         return f"{_expected(shape.shape)} or null"
-    words = {bool: "true or false", int: "a whole number", float: "a finite number", str: "text"}
+    words = {
+        bool: "true or false",
+        int: "a whole number (64 bits)",
+        float: "a finite number",
+        str: "text",
+    }
     if isinstance(shape, type):
         return words[shape]
     if isinstance(shape, Record):
