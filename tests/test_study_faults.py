@@ -56,7 +56,7 @@ def test_a_full_disk_stops_the_study_in_one_line_and_keeps_the_runs(tmp_path, mo
     assert code == 2 and "Traceback" not in err, err
     assert err.splitlines() == [
         f"rigidfold: error: cannot write to the study database {str(db)!r}: database or disk "
-        "is full; the 1 runs stored before are kept: free disk space, then run the same "
+        "is full; the 1 run stored before is kept: free disk space, then run the same "
         "command to resume"
     ]
     store = Store(db, readonly=True)
@@ -81,7 +81,9 @@ def test_a_failed_write_is_rolled_back_whole(tmp_path):
     store.add(Key("bezier", 0, "1", "s"), run, attempts)
     pages = store.db.execute("PRAGMA page_count").fetchone()[0]
     store.db.execute(f"PRAGMA max_page_count = {pages}")
-    with pytest.raises(StoreWriteError, match="database or disk is full; the 1 runs stored"):
+    with pytest.raises(
+        StoreWriteError, match="database or disk is full; the 1 run stored before is kept"
+    ):
         store.add(Key("bezier", 1, "1", "s"), run, attempts)
     with pytest.raises(StoreWriteError, match="free disk space"):
         store.add_invocation(
@@ -91,6 +93,23 @@ def test_a_failed_write_is_rolled_back_whole(tmp_path):
         )
     assert len(store.runs()) == 1 and store.count_attempts() == 40
     store.close()
+
+
+def test_a_full_disk_before_the_study_names_the_lock_file(tmp_path, monkeypatch):
+    """On a disk already full the lock file is made but its pid cannot be written: before,
+    "cannot write the output: No space left on device" (as if stdout had failed)."""
+    import errno
+
+    from rigidfold.study import lock
+
+    def full(fd, length):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(lock.os, "ftruncate", full)
+    db = tmp_path / "s.sqlite"
+    with pytest.raises(ValueError, match=r"cannot write its lock file .*: No space left on dev"):
+        Store(db, StudyConfig().as_dict())
+    assert list(tmp_path.iterdir()) == []
 
 
 # ---------------------------------------------------- item 18: reports leave the files alone

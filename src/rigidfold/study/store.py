@@ -548,13 +548,14 @@ class Store:
         """The one-line error of a write that failed (its transaction rolled back): what
         SQLite said, how many runs the database keeps, and what to do."""
         try:
-            kept = f"the {self.db.execute('SELECT COUNT(*) FROM runs').fetchone()[0]} runs"
+            n = int(self.db.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
+            kept = f"the {n} run stored before is" if n == 1 else f"the {n} runs stored before are"
         except sqlite3.Error:
-            kept = "the runs"
+            kept = "the runs stored before are"
         full = getattr(exc, "sqlite_errorname", "") == "SQLITE_FULL"
         return StoreWriteError(
             f"cannot write to the study database {str(self.path)!r}: "
-            f"{' '.join(str(exc).split())}; {kept} stored before are kept: "
+            f"{' '.join(str(exc).split())}; {kept} kept: "
             + ("free disk space" if full else "make it writable")
             + ", then run the same command to resume"
         )
