@@ -153,45 +153,69 @@ LOCK_NAME = ".rigidfold-run.lock"
 
 
 def lock_run_dir(out: Path) -> Path:
-    """Claim ``out`` for one run: create :data:`LOCK_NAME` in it (exclusive creation, no link
-    followed) holding this process's id. A lock left by a process that no longer runs is
-    taken over. Returns the lock's path; ValueError when another live run holds it."""
+    """Claim ``out`` for one run: :data:`LOCK_NAME` in it holding this process's id. Returns
+    the lock's path; ValueError when another live run holds it.
+
+    The lock file is opened (created when absent; a symbolic link is refused, never
+    followed) and decided on under an exclusive ``flock`` of it, which every claimant takes
+    before it reads the pid: a live pid refuses; a lock that is empty, unreadable, or left
+    by a process that no longer runs is taken over in place (this pid written over it). So
+    of two processes taking over one stale lock, one gets it and the other finds it held,
+    and a lock being created is never taken for a stale one. A lock released (removed) while
+    it was waited for is made again.
+    """
+    import fcntl
+
     path = out / LOCK_NAME
-    for _ in range(2):
+    for _ in range(100):
         try:
-            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
-        except FileExistsError:
-            pid = _lock_owner(path)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+        except OSError as exc:
+            if path.is_symlink():
+                raise ValueError(
+                    f"cannot lock output directory '{out}': its {LOCK_NAME} is a symbolic "
+                    "link, not a rigidfold lock; remove it"
+                ) from None
+            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)  # held only while deciding; closing drops it
+            try:
+                same = os.stat(path, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if not same:  # released (and maybe made again) while we waited: start over
+                continue
+            pid = _lock_owner(fd)
             if pid is not None and _alive(pid):
                 raise ValueError(
                     f"output directory '{out}' is in use by another rigidfold run (pid {pid}); "
                     "wait for it to end, or use another --out"
-                ) from None
-            path.unlink(missing_ok=True)  # stale: its run is gone
-            continue
+                )
+            os.ftruncate(fd, 0)  # new, or stale: its run is gone
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            return path
         except OSError as exc:
             raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
-        with os.fdopen(fd, "w") as file:
-            file.write(f"{os.getpid()}\n")
-        return path
+        finally:
+            os.close(fd)
     raise ValueError(f"cannot lock output directory '{out}': its lock keeps coming back")
 
 
-def _lock_owner(path: Path) -> int | None:
-    """The pid written in a lock file, None when it cannot be read (a link, garbage)."""
+def _lock_owner(fd: int) -> int | None:
+    """The pid written in the open lock file ``fd``, None when there is none: empty, not a
+    number, or not a possible pid (0 or less names a process group in ``kill``)."""
     try:
-        if path.is_symlink():
-            return None
-        return int(path.read_text().strip())
-    except (OSError, ValueError):
+        pid = int(os.pread(fd, 64, 0).decode("ascii").strip())
+    except (OSError, ValueError):  # UnicodeDecodeError is a ValueError
         return None
+    return pid if pid > 0 else None
 
 
 def _alive(pid: int) -> bool:
     """Whether a process with this id runs (on this machine)."""
     try:
         os.kill(pid, 0)
-    except ProcessLookupError:
+    except (ProcessLookupError, OverflowError):  # OverflowError: no pid is that large
         return False
     except PermissionError:
         return True
@@ -209,19 +233,25 @@ def clear_earlier_run(
 
     Only the run's own files and directories, ``names`` (a generation run's by default:
     :data:`RUN_FILES`, :data:`RUN_DIRS`), count and are removed; other files in ``out``
-    stay. A symbolic link among them is removed itself, never followed. Removing one of the
+    stay. With ``overwrite`` the temporary files of those names that a killed run left
+    (``.report.html.<random>.tmp``: :func:`rigidfold.io.files.temp_files`) are removed too.
+    A symbolic link among them is removed itself, never followed. Removing one of the
     run's ``inputs`` (e.g. an earlier solution used as the pattern) is refused. Returns
     ``out`` as a Path. Raises ValueError naming what was found.
     """
+    from rigidfold.io.files import temp_files
+
     out = Path(out)
     found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
-    if not found:
-        return out
-    if not overwrite:
+    if found and not overwrite:
         raise ValueError(
             f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
             "give --overwrite to replace it, or another --out"
         )
+    if overwrite:
+        found += temp_files(out, names)
+    if not found:
+        return out
     for path in found:
         for given in inputs:
             doomed = (
@@ -241,7 +271,7 @@ def clear_earlier_run(
             if path.is_dir() and not path.is_symlink():
                 shutil.rmtree(path)
             else:
-                path.unlink()
+                path.unlink(missing_ok=True)
     except OSError as exc:
         raise ValueError(
             f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"

@@ -12,6 +12,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import secrets
 from collections.abc import Iterable
 from pathlib import Path
@@ -203,6 +204,38 @@ def _create_temp(directory: Path, stem: str) -> tuple[int, Path]:
         except FileExistsError:
             continue
     raise FileExistsError(f"no free temporary file name in {directory}")
+
+
+def temp_files(directory: Path, names: Iterable[str]) -> list[Path]:
+    """The temporary files that :func:`atomic_write` left in ``directory`` for the files
+    ``names`` (``.<name>.<random>.tmp``, the name maybe cut: a process killed between
+    creating one and renaming it onto its target leaves it), sorted. A symbolic link of
+    such a name counts too (to be removed, never followed), a directory does not; ``[]``
+    when ``directory`` cannot be listed."""
+    names = [n for n in names if n]
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return []
+    found = []
+    for entry in entries:
+        match = _TEMP_NAME.fullmatch(entry.name)
+        if (
+            match
+            and any(_cut_from(match["stem"], n) for n in names)
+            and not entry.is_dir(follow_symlinks=False)
+        ):
+            found.append(Path(directory) / entry.name)
+    return sorted(found)
+
+
+_TEMP_NAME = re.compile(r"\.(?P<stem>.+)\.[0-9a-f]+\.tmp", re.DOTALL)
+"""A name made by :func:`_create_temp`."""
+
+
+def _cut_from(stem: str, name: str) -> bool:
+    """Whether a temporary file's ``stem`` is ``name``, or ``name`` cut (a long prefix)."""
+    return stem == name or (len(stem) >= 64 and name.startswith(stem))
 
 
 def _reason(exc: OSError) -> str:

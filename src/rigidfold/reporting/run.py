@@ -10,6 +10,8 @@ run is a one-line ``ValueError``.
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import re
 from dataclasses import dataclass
@@ -26,6 +28,201 @@ _PERCENT = re.compile(r"([0-9.]+)% folded")
 
 SUMMARY_KEYS = ("stop", "stop_reason", "final_dof", "N_lock", "solutions", "per_solution", "case")
 """Keys every ``summary.json`` of ``rigidfold generate`` has (those the report reads)."""
+
+
+@dataclass(frozen=True)
+class Nullable:
+    """A shape (see :data:`SUMMARY_SHAPE`) that may also be JSON ``null``."""
+
+    shape: object
+
+
+@dataclass(frozen=True)
+class Record:
+    """A JSON object whose keys, when present (``required``: always), have these shapes;
+    other keys may hold anything."""
+
+    keys: dict
+    required: tuple[str, ...] = ()
+
+
+_NUMBERS = Nullable(float)
+SUMMARY_SHAPE = Record(
+    {
+        "stop": str,
+        "stop_reason": str,
+        "final_dof": Nullable(int),
+        "initial_dof": Nullable(int),
+        "N_reduce": Nullable(int),
+        "N_lock": Nullable(int),
+        "N_exceed": Nullable(int),
+        "solutions": [str],
+        "per_solution": [
+            Record(
+                {
+                    "step": Nullable(int),
+                    "dof": Nullable(int),
+                    "development": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "D": _NUMBERS,
+                                "flipped": Nullable(int),
+                                "overlaps": Nullable(int),
+                            }
+                        )
+                    ),
+                    "motion": Nullable(
+                        Record({"status": Nullable(str), "max_length_error": _NUMBERS})
+                    ),
+                    "deformation": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "reached_plane": Nullable(bool),
+                                "max_dl_mm": _NUMBERS,
+                                "max_drho_fix_deg": _NUMBERS,
+                            }
+                        )
+                    ),
+                    "verdicts": Nullable(
+                        Record({"agreement": Nullable(str), "reason": Nullable(str)})
+                    ),
+                }
+            )
+        ],
+        "case": Record(
+            {
+                "surface": Nullable(
+                    Record(
+                        {
+                            "name": Nullable(str),
+                            "plan_box_m": Nullable((float, float)),
+                            "control_heights": Nullable([[float]]),
+                            "expression": Nullable(str),
+                        }
+                    )
+                ),
+                "F_tol": _NUMBERS,
+                "dz_m": _NUMBERS,
+            }
+        ),
+        "options": Nullable(Record({"target_dof": Nullable(int)})),
+        "verdict": Nullable(Record({"outcome": str, "message": str}, ("outcome", "message"))),
+    },
+    SUMMARY_KEYS,
+)
+"""What the report reads of ``summary.json`` and the shape it must have (:func:`check_shape`):
+``int`` a whole number, ``float`` a finite number, ``str`` text, ``bool`` true or false, a
+list ``[S]`` a list of S, a tuple a list of that many items of those shapes, a
+:class:`Record` an object, :class:`Nullable` also null."""
+
+LOG_SHAPE = Record(
+    {
+        "attempts": [
+            Record(
+                {
+                    "index": int,
+                    "outcome": str,
+                    "dof": Nullable(int),
+                    "F": _NUMBERS,
+                    "iterations": Nullable(int),
+                },
+                ("outcome", "dof"),
+            )
+        ]
+    },
+    ("attempts",),
+)
+"""What the report reads of ``log.json`` (see :data:`SUMMARY_SHAPE`)."""
+
+HISTORY_SHAPE = [
+    Record(
+        {k: float for k in ("load_factor", "mean_dl_mm", "max_dl_mm", "max_drho_fix_deg")},
+        ("load_factor", "mean_dl_mm", "max_dl_mm", "max_drho_fix_deg"),
+    )
+]
+"""The large-deformation history of a solution file (``deformation.history``)."""
+
+
+def check_shape(value, shape, file: str | os.PathLike, where: str = "") -> None:
+    """ValueError naming ``file`` and the key (``per_solution[0].development.D``) of the
+    first part of ``value`` (JSON data) that does not have ``shape`` (:data:`SUMMARY_SHAPE`
+    says how shapes are written), and what it holds instead."""
+    stack = [(value, shape, where)]
+    while stack:
+        value, given, where = stack.pop()
+        shape = given.shape if isinstance(given, Nullable) else given
+        if value is None and shape is not given:
+            continue
+        if not _has_shape(value, shape):
+            key = f"{where!r}" if where else "the document"
+            raise ValueError(f"'{file}': {key} is {_received(value)}, expected {_expected(given)}")
+        if isinstance(shape, Record):
+            missing = [k for k in shape.required if k not in value]
+            if missing:
+                key = f"{where!r}" if where else "the document"
+                raise ValueError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
+            stack += [
+                (value[k], s, f"{where}.{k}" if where else k)
+                for k, s in reversed(shape.keys.items())
+                if k in value
+            ]
+        elif isinstance(shape, list):
+            stack += [(v, shape[0], f"{where}[{i}]") for i, v in reversed(list(enumerate(value)))]
+        elif isinstance(shape, tuple):
+            stack += [
+                (v, s, f"{where}[{i}]") for i, (v, s) in enumerate(zip(value, shape, strict=True))
+            ]
+
+
+def _has_shape(value, shape) -> bool:
+    """Whether ``value`` is of the kind of ``shape`` (its items are checked apart)."""
+    if shape is bool:
+        return isinstance(value, bool)
+    if shape is int:  # within int64: numpy and matplotlib take it
+        return isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2**63
+    if shape is float:
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            return False
+        try:
+            return math.isfinite(value)
+        except OverflowError:  # an integer beyond the floats
+            return False
+    if shape is str:
+        return isinstance(value, str)
+    if isinstance(shape, Record):
+        return isinstance(value, dict)
+    if isinstance(shape, tuple):
+        return isinstance(value, list) and len(value) == len(shape)
+    return isinstance(value, list)
+
+
+def _expected(shape) -> str:
+    if isinstance(shape, Nullable):
+        return f"{_expected(shape.shape)} or null"
+    words = {
+        bool: "true or false",
+        int: "a whole number (64 bits)",
+        float: "a finite number",
+        str: "text",
+    }
+    if isinstance(shape, type):
+        return words[shape]
+    if isinstance(shape, Record):
+        return "an object"
+    if isinstance(shape, tuple):
+        return f"a list of {len(shape)} items"
+    return "a list"
+
+
+def _received(value) -> str:
+    """``value`` as JSON text, cut to 40 characters."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= 40 else text[:39] + "…"
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,6 +263,7 @@ def read_design(path: Path, name: str) -> Design:
     """The :class:`Design` in the FOLD file ``path`` (``name``: its path in the run)."""
     data = read_fold(path)
     pattern, meta = data.pattern, data.metadata
+    check_shape(data.raw, DESIGN_SHAPE, path)
     n_v = pattern.n_vertices
     coords2d, motion, fraction = None, [], []
     for k, frame in enumerate(data.raw.get("file_frames") or []):
@@ -93,6 +291,16 @@ def read_design(path: Path, name: str) -> Design:
         fraction=np.asarray(fraction, dtype=float),
         history=list(deformation.get("history") or []),
     )
+
+
+DESIGN_SHAPE = Record(
+    {
+        "rigidfold:step": int,
+        "rigidfold:dof": int,
+        "rigidfold:deformation": Nullable(Record({"history": Nullable(HISTORY_SHAPE)})),
+    }
+)
+"""What the report reads of rigidfold's keys in a solution file (see :data:`SUMMARY_SHAPE`)."""
 
 
 def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndarray:
@@ -243,8 +451,10 @@ def load_run(directory: str | os.PathLike) -> RunData:
     """Read the generate run in ``directory`` (see the module's text).
 
     Raises ValueError (one line) when ``directory`` is not a generate run: no directory, no
-    or malformed ``summary.json`` / ``log.json``, or a listed solution file that is missing
-    or not a FOLD file.
+    or malformed ``summary.json`` / ``log.json`` (what the report reads of them not of the
+    shape it must have, :data:`SUMMARY_SHAPE` and :data:`LOG_SHAPE`: the error names the
+    file and the key), or a listed solution file that is not in the directory, is missing or
+    is not a FOLD file of a generate run.
     """
     root = Path(directory)
     if not root.is_dir():
@@ -256,14 +466,27 @@ def load_run(directory: str | os.PathLike) -> RunData:
             f"{str(root / 'summary.json')!r} is not the summary of rigidfold generate "
             f"(no {', '.join(missing)})"
         )
-    attempts = _json_object(root, "log.json").get("attempts")
-    if not isinstance(attempts, list):
+    check_shape(summary, SUMMARY_SHAPE, root / "summary.json")
+    log = _json_object(root, "log.json")
+    if not isinstance(log.get("attempts"), list):
         raise ValueError(f"{str(root / 'log.json')!r} has no list of attempts")
+    check_shape(log, LOG_SHAPE, root / "log.json")
+    attempts = log["attempts"]
+    for k, attempt in enumerate(attempts):
+        if attempt["outcome"] == "accepted" and attempt["dof"] is None:
+            raise ValueError(
+                f"'{root / 'log.json'}': 'attempts[{k}].dof' is null, expected a whole number "
+                "(an accepted shape has a DOF)"
+            )
     names = summary["solutions"]
-    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-        raise ValueError(f"{str(root / 'summary.json')!r}: 'solutions' is not a list of files")
     designs = []
-    for name in names:
+    for k, name in enumerate(names):
+        parts = Path(name).parts
+        if not parts or Path(name).is_absolute() or ".." in parts:
+            raise ValueError(
+                f"'{root / 'summary.json'}': 'solutions[{k}]' is {_received(name)}, expected "
+                "a file in the run's directory"
+            )
         path = root / name
         if not path.is_file():
             raise ValueError(f"solution file {str(path)!r} listed in summary.json is missing")

@@ -9,6 +9,8 @@ is turned and moved as a rigid body to best fit the folded form, so the sheet fo
 
 from __future__ import annotations
 
+import html
+
 import numpy as np
 
 from rigidfold.mesh.geometry import best_fit
@@ -155,7 +157,8 @@ def _layout(points: np.ndarray, design: Design, frames: list[dict]) -> dict:
             "aspectratio": dict(zip("xyz", (float(r) for r in ratio), strict=True)),
             "camera": {"eye": {"x": 1.25, "y": -1.25, "z": 0.8}},
         },
-        "title": {"text": f"{design.name}: DOF {design.dof}", "x": 0.5},
+        # plotly.js reads a title as HTML (<a href> makes a link): the file name as text
+        "title": {"text": f"{html.escape(design.name, quote=False)}: DOF {design.dof}", "x": 0.5},
     }
     if frames:
         animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}}

@@ -8,13 +8,14 @@ from rigidfold.study.session import (
     failure_summary,
     run_study_command,
 )
-from rigidfold.study.store import Key, Store, run_stop
+from rigidfold.study.store import Key, Store, StoreWriteError, run_stop
 
 __all__ = [
     "PRESETS",
     "STUDY_DEFAULTS",
     "Key",
     "Store",
+    "StoreWriteError",
     "StudyConfig",
     "StudyInterrupted",
     "StudyPlan",

@@ -44,8 +44,15 @@ class StudyLock:
             if self._same_file(fd):  # else its holder removed it while we opened it: retry
                 break
             os.close(fd)
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()} {socket.gethostname()}\n".encode())
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()} {socket.gethostname()}\n".encode())
+        except OSError as exc:  # a full disk
+            self.path.unlink(missing_ok=True)
+            os.close(fd)
+            raise ValueError(
+                f"{str(db)!r}: cannot write its lock file {str(self.path)!r}: {exc.strerror}"
+            ) from None
         self._fd: int | None = fd
 
     def _same_file(self, fd: int) -> bool:

@@ -28,6 +28,41 @@ PAPER_PATTERN = {"1p": "1"}
 """Layout variants compared with the paper's table of the pattern they vary."""
 LABEL = {"s": "S", "shat": "S-hat", "ss": "S^S", "random": "random"}
 
+_MARKDOWN_SPECIAL = re.compile(r"([\\`*_\[\]|~@])")
+"""Characters that make Markdown (GitHub's included) of text: escaped with a backslash."""
+
+
+def _one_line(text: str) -> str:
+    """``text`` with every character that is not printable (newlines, ESC, ...) written as
+    its Python escape (``\\n``, ``\\x1b``)."""
+    return "".join(
+        c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text
+    )
+
+
+def md_text(value) -> str:
+    """``str(value)`` as literal text in Markdown, a table cell included: one line
+    (:func:`_one_line`); HTML's ``&``, ``<`` and ``>`` as entities (no tag, no script); the
+    characters of :data:`_MARKDOWN_SPECIAL` escaped (no emphasis, link, image or code, no
+    cell break); and no link made of a URL (``://`` and ``www.`` broken by an escape). A
+    pattern named ``q<img src=x onerror=...>.fold`` or ``a|b.fold`` reads as its name."""
+    text = _one_line(str(value))
+    text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    text = _MARKDOWN_SPECIAL.sub(r"\\\1", text)
+    return re.sub(r"(?i)(?<=www)\.", r"\\.", text.replace("://", r":\/\/"))
+
+
+def md_code(value, *, cell: bool = False) -> str:
+    """``str(value)`` as a Markdown code span, on one line: fenced by more backticks than
+    it holds in a row, and in a table ``cell`` its ``|`` escaped (GitHub reads ``\\|``
+    there as ``|``, also in code)."""
+    text = _one_line(str(value))
+    if cell:
+        text = text.replace("|", "\\|")
+    fence = "`" * (max((len(run) for run in re.findall("`+", text)), default=0) + 1)
+    pad = " " if text.startswith("`") or text.endswith("`") else ""
+    return f"{fence}{pad}{text}{pad}{fence}"
+
 
 def _mean_se(values: list[float]) -> tuple[float, float]:
     x = np.asarray([v for v in values if v is not None and math.isfinite(v)], dtype=float)
@@ -398,7 +433,7 @@ def markdown(stores: Store | list[Store], figures: list[dict] | dict | None = No
     lines = [f"Paper values: {CITATION}.", ""]
     for store, figs in zip(stores, figures, strict=True):
         if len(stores) > 1:
-            lines += [f"## {store.path.name}", ""]
+            lines += [f"## {md_text(store.path.name)}", ""]
         lines += _configuration_lines(store)
         lines += _store_lines(store, figs)
     return "\n".join(lines)
@@ -418,10 +453,11 @@ def _configuration_lines(store: Store) -> list[str]:
         solver = f"ipopt ({hessian} Hessian)"
     lookahead = config.get("lookahead", LEGACY_CONFIG["lookahead"])
     return [
-        f"Configuration: solver {solver}, target DOF {config.get('target_dof')}, "
+        f"Configuration: solver {md_text(solver)}, target DOF {md_text(config.get('target_dof'))}, "
         f"Steps 8-9 {'on' if config.get('deform') else 'off'}, "
         f"look-ahead {'on' if lookahead else 'off'}; {len(store.runs())} runs, "
-        f"{store.count_attempts()} solves of (6); rigidfold {', '.join(versions) or '-'}.",
+        f"{store.count_attempts()} solves of (6); rigidfold "
+        f"{', '.join(md_text(v) for v in versions) or '-'}.",
         "",
         *_numerics_lines(store),
     ]
@@ -437,7 +473,7 @@ def _numerics_lines(store: Store) -> list[str]:
     status = (numerics or {}).get("status", "?")
     key = (numerics or {}).get("key", "?")
     mixed = f"; the runs come from {len(keys)} numeric environments" if len(keys) > 1 else ""
-    return [f"Numerics: {status}, `{key}`{mixed}.", ""]
+    return [f"Numerics: {md_text(status)}, {md_code(key)}{mixed}.", ""]
 
 
 def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
@@ -448,7 +484,7 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
         lo, hi = rows[0]["seeds"]
         number = {"1": "Table 5", "2": "Table 6"}.get(PAPER_PATTERN.get(pattern, pattern), "")
         lines += [
-            f"### Crease pattern {pattern}" + (f" (paper's {number})" if number else ""),
+            f"### Crease pattern {md_text(pattern)}" + (f" (paper's {number})" if number else ""),
             "",
             f"Bezier seeds {lo}-{hi}; mean ± standard error over runs; paper: 100 surfaces.",
             "",
@@ -465,7 +501,8 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
                 f"| {_fmt(p[0])} | {_fmt(p[1])} | {_fmt(p[2])} | {_fmt(p[3])} |"
             )
         if pattern in figures:
-            lines += ["", f"![N_lock per criterion, pattern {pattern}]({figures[pattern]})"]
+            alt = f"N_lock per criterion, pattern {md_text(pattern)}"
+            lines += ["", f"![{alt}]({figures[pattern]})"]  # a file name: figure_name
         lines.append("")
     pairs = paired_comparisons(store)
     if pairs:
@@ -487,9 +524,11 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
             "Runs that failed",
             ["study", "seed", "pattern", "criterion", "symmetric", "why"],
             [
-                [*(r[k] for k in ("study", "seed", "pattern", "criterion", "symmetric")), why]
+                [
+                    *(r[k] for k in ("study", "seed", "pattern", "criterion", "symmetric")),
+                    r["error"],
+                ]
                 for r in lost
-                for why in [r["error"].replace("|", "\\|")]  # inside a Markdown table cell
             ],
         )
     t78 = tables_7_8(store)
@@ -535,7 +574,7 @@ def _ordering_lines(t56: list[dict], pairs: list[dict]) -> list[str]:
             c for c in PAPER_ORDER if any(r["criterion"] == c for r in rows)
         ]
         lines.append(
-            f"- Pattern {pattern}: {ours}; "
+            f"- Pattern {md_text(pattern)}: {ours}; "
             + ("the paper's order." if same else f"the paper's order is {paper}.")
         )
     lines += [
@@ -548,7 +587,7 @@ def _ordering_lines(t56: list[dict], pairs: list[dict]) -> list[str]:
     ]
     for c in pairs:
         lines.append(
-            f"| {c['pattern']} | {LABEL[c['a']]} - {LABEL[c['b']]} | {c['n']} "
+            f"| {md_text(c['pattern'])} | {LABEL[c['a']]} - {LABEL[c['b']]} | {c['n']} "
             f"| {_fmt(c['mean_diff'], c['se'])} | {c['less']} / {c['equal']} / {c['more']} "
             f"| {c['p_value']:.2g} |"
         )
@@ -594,7 +633,8 @@ SECTION_TEXT = {
 
 def _section(title: str, head: list[str], rows: list[list]) -> list[str]:
     """A Markdown section of the report: its title, its paragraph (:data:`SECTION_TEXT`) and a
-    table (``head``: the column titles, ``rows``: one list of cells each)."""
+    table (``head``: the column titles, ``rows``: one list of cells each, written as text:
+    :func:`md_text`)."""
     return [
         f"### {title}",
         "",
@@ -602,7 +642,7 @@ def _section(title: str, head: list[str], rows: list[list]) -> list[str]:
         "",
         "| " + " | ".join(head) + " |",
         "|" + "---|" * len(head),
-        *("| " + " | ".join(str(cell) for cell in row) + " |" for row in rows),
+        *("| " + " | ".join(md_text(cell) for cell in row) + " |" for row in rows),
         "",
     ]
 
@@ -612,7 +652,7 @@ GROUP_HEAD = ("pattern", "criterion", "runs")
 
 def _group_cells(r: dict) -> list:
     """The first cells of a per-(pattern, criterion) row: :data:`GROUP_HEAD`."""
-    return [r["pattern"], LABEL[r["criterion"]], r["runs"]]
+    return [r["pattern"], LABEL.get(r["criterion"], r["criterion"]), r["runs"]]
 
 
 def _stage_lines(stages: list[dict]) -> list[str]:
@@ -703,7 +743,8 @@ def _cost_lines(store: Store) -> list[str]:
     ]
     for c in costs(store):
         lines.append(
-            f"| {c['study']} | {c['pattern']} | {LABEL.get(c['criterion'], c['criterion'])} "
+            f"| {md_text(c['study'])} | {md_text(c['pattern'])} "
+            f"| {md_text(LABEL.get(c['criterion'], c['criterion']))} "
             f"| {c['runs']} | {c['solves_per_run']:.1f} "
             f"| {_fmt(c['iterations_per_solve'], digits=1)} "
             f"| {_fmt(c['solve_s'], digits=3)} | {_fmt(c['median_run_s'], digits=1)} "
@@ -722,9 +763,9 @@ def _cost_lines(store: Store) -> list[str]:
         for r in inv:
             where = r["workers"] if r["workers"] is not None else f"scheduler {r['scheduler']}"
             lines.append(
-                f"| {r['started']} | `{' '.join(r['argv'])}` | {where} "
-                f"| {r['ran']} / {r['skipped']} / {r['total']} | {r['wall_s']:.0f} "
-                f"| {r['outcome']} | {r['version']} |"
+                f"| {md_text(r['started'])} | {md_code(' '.join(map(str, r['argv'])), cell=True)} "
+                f"| {md_text(where)} | {r['ran']} / {r['skipped']} / {r['total']} "
+                f"| {r['wall_s']:.0f} | {md_text(r['outcome'])} | {md_text(r['version'])} |"
             )
     return [*lines, ""]
 
@@ -769,7 +810,8 @@ def box_plots(
         ax.boxplot(data, tick_labels=[LABEL[c] for c in crits])
         ax.set_yscale("symlog", linthresh=1.0)
         ax.set_ylabel("N_lock per run")
-        ax.set_title(f"Pattern {pattern}: N_lock per run, {len(data[0])} surfaces", fontsize=10)
+        shown = _one_line(pattern).replace("$", r"\$")  # text, not matplotlib's mathtext
+        ax.set_title(f"Pattern {shown}: N_lock per run, {len(data[0])} surfaces", fontsize=10)
         fig.tight_layout()
         name = figure_name(f"{prefix}n_lock_pattern_{pattern}", used)
         png = io.BytesIO()

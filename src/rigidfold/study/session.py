@@ -9,6 +9,7 @@ line that tells which runs of the command failed.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -26,7 +27,7 @@ from rigidfold.study.runner import (
     check_workers,
     run_study,
 )
-from rigidfold.study.store import Key, Store
+from rigidfold.study.store import Key, Store, StoreWriteError
 
 
 @dataclass(frozen=True)
@@ -74,11 +75,13 @@ def run_study_command(
 
     on_done(failed, finished, total) after each stored run (``failed``: the run ended in an
     error, recorded in the database). A KeyboardInterrupt is recorded and re-raised as
-    :class:`StudyInterrupted`. The database is locked while the study runs (a second
-    client is refused, :class:`~rigidfold.study.lock.StudyLock`). A database whose runs
-    were computed with other numerics (:mod:`rigidfold.numerics`), and Dask workers that
-    compute with other numerics than this process, are refused unless
-    ``allow_mixed_numerics``.
+    :class:`StudyInterrupted`. A database that cannot be written (a full disk) stops the
+    study with :class:`~rigidfold.study.store.StoreWriteError` (a ValueError, one line),
+    recorded when it can be: every run stored before is kept, and the same command resumes.
+    The database is locked while the study runs (a second client is refused,
+    :class:`~rigidfold.study.lock.StudyLock`). A database whose runs were computed with
+    other numerics (:mod:`rigidfold.numerics`), and Dask workers that compute with other
+    numerics than this process, are refused unless ``allow_mixed_numerics``.
     """
     # checked before the database is created: local workers within what the machine runs
     # (CPUs, open files), a finite timeout
@@ -159,8 +162,15 @@ def _run(
         )
     except KeyboardInterrupt:
         finished = len(store.done() & planned)
-        record("interrupted", finished - before)
+        with contextlib.suppress(StoreWriteError):  # the runs are stored; the record is a note
+            record("interrupted", finished - before)
         raise StudyInterrupted(finished) from None
+    except StoreWriteError:  # a full disk: the study stops, the runs stored are kept
+        with contextlib.suppress(StoreWriteError):
+            record(
+                "stopped: the database could not be written", len(store.done() & planned) - before
+            )
+        raise
     failed = len(result["failed"])
     record(f"completed, {failed} failed" if failed else "completed", result["ran"])
     return result

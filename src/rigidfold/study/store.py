@@ -166,6 +166,11 @@ def run_stop(status: str) -> Stop | None:
     return Stop.from_reason(status)[0]
 
 
+class StoreWriteError(ValueError):
+    """A study database could not be written (a full disk, a read-only file): the run or
+    command being written is not stored, every run stored before is (one transaction each)."""
+
+
 @dataclass(frozen=True)
 class Key:
     """Identifies one run: (study, seed, pattern, criterion, symmetric)."""
@@ -244,6 +249,11 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
     return f"file:{quote(absolute, safe='/')}?mode={mode}"
 
 
+READONLY_COPY_TRIES = 3
+"""Times a database opened read-only is copied into memory before it is read in place
+instead (:meth:`Store._connect_readonly`): a copy is kept only if nothing wrote meanwhile."""
+
+
 @functools.cache
 def schema_columns() -> dict[str, dict[str, str]]:
     """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
@@ -262,7 +272,9 @@ class Store:
     second client is refused) and checks an existing file read-only first (:meth:`_check`):
     a damaged or foreign file, or one of another configuration, is refused untouched.
     ``readonly=True`` opens an existing database for reporting: it never creates one nor
-    writes to it (and takes no ``config`` and no lock).
+    writes to it, nor makes its ``-wal`` and ``-shm`` files where no study is writing it
+    (:meth:`_connect_readonly`: it reads from a read-only file system too), and takes no
+    ``config`` and no lock.
 
     ``numerics`` (:meth:`rigidfold.numerics.NumericEnvironment.to_dict` of the process that
     will add runs) is stored with the first runs; a database whose runs were computed with
@@ -311,10 +323,74 @@ class Store:
             raise
 
     def _connect_readonly(self) -> sqlite3.Connection:
+        """A read-only connection to the database that makes no file beside it.
+
+        When no write-ahead log holds data (no ``-wal`` file, or an empty one) and there is
+        no rollback journal, the file holds the whole database: it is copied into memory
+        through an ``immutable`` connection (no lock taken, no ``-wal`` or ``-shm`` made,
+        also on a read-only file system), and the copy is kept if the file did not change
+        while it was copied (else tried again). Otherwise (a study writing it now, or one
+        killed with runs in its ``-wal``) it is opened ``mode=ro``, which reads the
+        ``-wal`` through the ``-shm`` beside it (making that one when it is missing).
+        Raises ValueError: :meth:`_open_error`.
+        """
+        for _ in range(READONLY_COPY_TRIES):
+            before = self._state()
+            wal, journal = before[1:]
+            if (wal is not None and wal[1] > 0) or journal is not None:
+                break
+            try:
+                source = sqlite3.connect(
+                    sqlite_uri(self.path, "ro") + "&immutable=1", uri=True, timeout=30
+                )
+                try:
+                    copy = sqlite3.connect(":memory:")
+                    source.backup(copy)
+                finally:
+                    source.close()
+            except sqlite3.Error as exc:
+                raise self._open_error(exc) from None
+            if self._state() == before:
+                return copy
+            copy.close()  # written meanwhile: copy again, or read it in place
         try:
-            return sqlite3.connect(sqlite_uri(self.path, "ro"), uri=True, timeout=30)
+            con = sqlite3.connect(sqlite_uri(self.path, "ro"), uri=True, timeout=30)
+            con.execute("PRAGMA schema_version")  # opens the file (and its -wal) now
         except sqlite3.Error as exc:
-            raise ValueError(f"{str(self.path)!r}: cannot open: {exc}") from None
+            raise self._open_error(exc) from None
+        return con
+
+    def _state(self) -> tuple:
+        """(inode, size, mtime) of the database, its ``-wal`` and its ``-journal`` (None for
+        a missing one): what changes when the database is written."""
+        state: list[tuple[int, int, int] | None] = []
+        for suffix in ("", "-wal", "-journal"):
+            try:
+                st = os.stat(f"{self.path}{suffix}")
+            except FileNotFoundError:
+                state.append(None)
+                continue
+            except OSError as exc:
+                raise ValueError(f"{str(self.path)!r}: cannot open: {exc.strerror}") from None
+            state.append((st.st_ino, st.st_size, st.st_mtime_ns))
+        return tuple(state)
+
+    def _open_error(self, exc: sqlite3.Error) -> ValueError:
+        """The one-line error of a database that could not be opened read-only: one it may
+        not read, one whose ``-wal`` holds runs but whose directory is read-only (SQLite
+        cannot make the ``-shm`` it needs), else a damaged file."""
+        name = str(self.path)
+        if getattr(exc, "sqlite_errorname", "") != "SQLITE_CANTOPEN":
+            return ValueError(f"{name!r}: damaged SQLite file: {exc}")
+        if not os.access(self.path, os.R_OK):
+            return ValueError(f"{name!r}: cannot open: no permission to read it")
+        if not os.access(self.path.parent if str(self.path.parent) else ".", os.W_OK):
+            return ValueError(
+                f"{name!r}: cannot read its write-ahead log ({self.path.name}-wal) in a "
+                f"read-only directory: SQLite needs to create {self.path.name}-shm beside it; "
+                "copy the database with its -wal file to a writable directory"
+            )
+        return ValueError(f"{name!r}: cannot open: {exc}")
 
     def _open_writable(self, config: dict | None) -> None:
         try:
@@ -452,7 +528,15 @@ class Store:
 
     def add(self, key: Key, run: dict, attempts: list[dict]) -> None:
         """Write one run and its attempts in one transaction; refuses (ValueError) a run
-        already in the database, which is left as it was."""
+        already in the database, which is left as it was. A write that fails (a full disk)
+        rolls the transaction back and raises :class:`StoreWriteError`
+        (:meth:`_write_error`): the runs stored before are kept."""
+        try:
+            self._add(key, run, attempts)
+        except sqlite3.Error as exc:
+            raise self._write_error(exc) from None
+
+    def _add(self, key: Key, run: dict, attempts: list[dict]) -> None:
         with self.db:
             names = ("study", "seed", "pattern", "criterion", "symmetric", *RUN_FIELDS)
             added = self.db.execute(
@@ -482,12 +566,31 @@ class Store:
             "started", "argv", "workers", "scheduler", "ran", "skipped", "total", "wall_s",
             "outcome", "version",
         )  # fmt: skip
-        with self.db:
-            self.db.execute(
-                f"INSERT INTO invocations ({', '.join(names)}) VALUES "
-                f"({', '.join('?' * len(names))})",
-                tuple(json.dumps(row[n]) if n == "argv" else row[n] for n in names),
-            )
+        try:
+            with self.db:
+                self.db.execute(
+                    f"INSERT INTO invocations ({', '.join(names)}) VALUES "
+                    f"({', '.join('?' * len(names))})",
+                    tuple(json.dumps(row[n]) if n == "argv" else row[n] for n in names),
+                )
+        except sqlite3.Error as exc:
+            raise self._write_error(exc) from None
+
+    def _write_error(self, exc: sqlite3.Error) -> StoreWriteError:
+        """The one-line error of a write that failed (its transaction rolled back): what
+        SQLite said, how many runs the database keeps, and what to do."""
+        try:
+            n = int(self.db.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
+            kept = f"the {n} run stored before is" if n == 1 else f"the {n} runs stored before are"
+        except sqlite3.Error:
+            kept = "the runs stored before are"
+        full = getattr(exc, "sqlite_errorname", "") == "SQLITE_FULL"
+        return StoreWriteError(
+            f"cannot write to the study database {str(self.path)!r}: "
+            f"{' '.join(str(exc).split())}; {kept} kept: "
+            + ("free disk space" if full else "make it writable")
+            + ", then run the same command to resume"
+        )
 
     def invocations(self) -> list[dict]:
         """Every recorded command, oldest first (none in a database from before the table)."""
