@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
+from rigidfold.cli import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import UNITS, SvgDrawing, read_svg
 from rigidfold.mesh import CreasePattern
@@ -396,3 +397,113 @@ def test_origami_simulator_curved_file():
         match=r"wavy_pleats\.svg: <path> \(drawn element 2\) has a curved piece \(CubicBezier\)",
     ):
         read_svg(DATA / "wavy_pleats.svg")
+
+
+# --------------------------------------------------------------------------- headers, nesting
+HEADERS = {
+    "empty viewBox": (
+        'width="100mm" height="100mm" viewBox="0 0 0 0"',
+        r'<svg> has viewBox="0 0 0 0": a viewBox is four finite numbers',
+    ),
+    "empty viewBox without units": ('viewBox="0 0 0 0"', r'<svg> has viewBox="0 0 0 0"'),
+    "tiny viewBox": (
+        'width="100mm" height="100mm" viewBox="0 0 1e-300 1e-300"',
+        r"\(drawn in mm\) is 1e\+301 m x 1e\+301 m: a crease pattern is 0\.001 m to",
+    ),
+    "huge viewBox": (
+        'width="100mm" height="100mm" viewBox="0 0 1e308 1e308"',
+        r'the viewBox="0 0 1e308 1e308" scales the drawing to its width="100mm" and '
+        r'height="100mm" by 0 x 0, which cannot be computed with',
+    ),
+    "width nan": (
+        'width="nanmm" height="100mm" viewBox="0 0 100 100"',
+        r'<svg> has width="nanmm": a width is a positive finite length',
+    ),
+    "width overflows": (
+        'width="1e400mm" height="100mm" viewBox="0 0 100 100"',
+        r'<svg> has width="1e400mm": a width is a positive finite length',
+    ),
+    "height zero": ('width="100mm" height="0" viewBox="0 0 100 100"', r'<svg> has height="0"'),
+    "viewBox of three numbers": ('viewBox="0 0 100"', r'<svg> has viewBox="0 0 100"'),
+}
+
+
+@pytest.mark.parametrize("case", HEADERS)
+def test_bad_headers_one_line_exit_2(tmp_path, capsys, case):
+    """A width, height or viewBox that svgelements divides by zero on (a ZeroDivisionError
+    traceback before) is a one-line error naming what was received."""
+    size, message = HEADERS[case]
+    path = write(tmp_path, SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>', size)
+    code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and re.fullmatch(f"rigidfold: error: {re.escape(str(path))}.*\n", err), err
+    assert re.search(message, err), err
+
+
+BAD_TRANSFORMS = {
+    "matrix(nan,0,0,1,0,0)": r'<g id="t"> has transform="matrix\(nan,0,0,1,0,0\)": a transform',
+    "matrix(1,2)": r'<g id="t"> has transform="matrix\(1,2\)"',
+    "scale(1e400)": r'<g id="t"> has transform="scale\(1e400\)"',
+    "rotate(inf)": r'<g id="t"> has transform="rotate\(inf\)"',
+    "turn(90)": r'<g id="t"> has transform="turn\(90\)"',
+    "scale(1e200) scale(1e200)": r"<rect> \(drawn element 1\) is drawn with a transform that "
+    r"is not finite, matrix\(nan, nan, nan, nan, 0, 0\)",
+    "translate(1e308) translate(1e308)": r"<rect> \(drawn element 1\) is drawn with a "
+    r"transform that is not finite, matrix\(nan, nan, nan, nan, nan, nan\)",
+}
+
+
+@pytest.mark.parametrize("transform", BAD_TRANSFORMS)
+def test_bad_transforms(tmp_path, transform):
+    path = write(tmp_path, f'<g id="t" transform="{transform}">{SQUARE}</g>')
+    with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {BAD_TRANSFORMS[transform]}"):
+        read_svg(path)
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        (
+            SQUARE + '<line x1="0" y1="0" x2="1e400" y2="100" stroke="red"/>',
+            r"<line> \(drawn element 2\) has a line from \(0, 0\) to \(nan, nan\): coordinates "
+            "must be finite",
+        ),
+        (
+            SQUARE + '<path d="M0,0 L1e308,1e308" stroke="red"/>',
+            r"its lines span inf drawing units .* more than 1e\+150",
+        ),
+        (
+            f'<g id="a"><use xmlns:xlink="http://www.w3.org/1999/xlink" xlink:href="#a"/>{SQUARE}'
+            "</g>",
+            r"svgelements cannot read the drawing \(RecursionError: .*\): do its <use> elements "
+            "refer to each other in a loop\\?",
+        ),
+    ],
+)
+def test_coordinates_svgelements_cannot_compute_with(tmp_path, body, message):
+    path = write(tmp_path, body)
+    with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {message}"):
+        read_svg(path)
+
+
+@pytest.mark.parametrize("transform", ["rotate(45 50 50)", "translate(10px, 5px)", "none", ""])
+def test_good_transforms(tmp_path, transform):
+    path = write(tmp_path, f'<g transform="{transform}">{SQUARE}</g>')
+    assert counts(read_svg(path)) == (4, 4, 1)
+
+
+def test_nesting_depth_is_bounded(tmp_path, capsys):
+    """5,000 nested groups (a RecursionError traceback from svgelements before) are refused in
+    one line; Settings.max_svg_depth is the limit."""
+    deep = 5000
+    path = write(tmp_path, "<g>" * deep + SQUARE + "</g>" * deep)
+    code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err == (
+        f"rigidfold: error: {path}: its elements nest more than 100 levels deep (at <g>; "
+        "Settings.max_svg_depth)\n"
+    )
+    nested = write(tmp_path, "<g>" * 98 + SQUARE + "</g>" * 98)  # <svg>, 98 <g>, <rect>
+    assert counts(read_svg(nested)) == (4, 4, 1)
+    with pytest.raises(ValueError, match="nest more than 99 levels deep"):
+        read_svg(nested, settings=DEFAULTS.with_(max_svg_depth=99))

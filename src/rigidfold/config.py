@@ -117,6 +117,10 @@ class Settings:
         of drawing programs (about 1e-3 px) lies far below the default; Origami Simulator
         merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals, and a carelessly
         drawn pattern may need 1e-3, which would also merge real features of some designs.
+    max_svg_depth : int
+        Deepest nesting of elements accepted in an SVG drawing: a deeper file is refused with
+        a one-line error before svgelements, which reads it recursively, exhausts Python's
+        recursion limit (near 1,000 levels). Drawing programs nest groups a few levels deep.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -356,6 +360,7 @@ class Settings:
     triangulation_area_tol: float = 1e-12
     # reading SVG drawings
     svg_merge_tol: float = 1e-4
+    max_svg_depth: int = 100
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
@@ -405,6 +410,7 @@ class Settings:
             "sparse_iterations": 1,
             "projection_vertices": 3,
             "projection_max_iter": 1,
+            "max_svg_depth": 1,
         }
         for name, low in least.items():
             value = getattr(self, name)

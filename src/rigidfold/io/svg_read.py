@@ -6,7 +6,12 @@ flat facet lines, magenta undriven creases, green cuts, and a crease's stroke op
 fraction of 180 degrees it folds. :func:`read_svg` reads such a drawing into its planar
 faces, in the drawing's own coordinates (user units, y flipped to point up).
 
-What is read (svgelements parses the file: transforms, ``viewBox``, ``<use>``, styles):
+What is read (svgelements parses the file: transforms, ``viewBox``, ``<use>``, styles), once
+the XML has been walked without recursion: elements nested deeper than
+``Settings.max_svg_depth``, an ``<svg>`` ``width`` or ``height`` that is not a positive
+finite length, a ``viewBox`` that is not four finite numbers with a positive size, and a
+``transform`` that is not transform functions of finite numbers are refused before
+svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or IndexError):
 
 * every ``<line>``, ``<polyline>``, ``<polygon>``, ``<rect>`` and ``<path>`` with a stroke;
   unstroked shapes, text and images are not drawn lines and are skipped. A curved piece
@@ -31,6 +36,7 @@ is ``"unit"``, scale 1.
 from __future__ import annotations
 
 import colorsys
+import contextlib
 import math
 import os
 import re
@@ -57,6 +63,9 @@ magenta (300) is that colour; any other stroke is refused."""
 
 HUE_TOLERANCE = 30.0
 """Largest hue difference (degrees) of a stroke from its colour in :data:`COLOURS`."""
+
+_LARGEST = 1e150
+"""Largest extent of a drawing in its own units: squares of its lengths stay finite."""
 
 _HUES = {"M": 0.0, "F": 60.0, "C": 120.0, "V": 240.0, "U": 300.0}
 _SHAPES = (se.SimpleLine, se.Polyline, se.Polygon, se.Rect, se.Path, se.Circle, se.Ellipse)
@@ -111,10 +120,12 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
     Raises
     ------
     ValueError
-        One line naming the file: unreadable, not an SVG, no lines, a curve, an unknown or
-        a cut (green) colour, no boundary, a boundary that is not one closed outline (open,
-        branching, several pieces, holes), creases outside the boundary, a crease ending
-        inside a face, a face that is not a simple polygon.
+        One line naming the file: unreadable, not an SVG, elements nested deeper than
+        ``settings.max_svg_depth``, a ``width``, ``height``, ``viewBox`` or ``transform``
+        that is not finite numbers (or scales the drawing to nothing), no lines, a curve, an
+        unknown or a cut (green) colour, no boundary, a boundary that is not one closed
+        outline (open, branching, several pieces, holes), creases outside the boundary, a
+        crease ending inside a face, a face that is not a simple polygon.
     """
     path = Path(path)
     try:
@@ -122,9 +133,17 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
     except OSError as exc:
         raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
     try:
+        _check_xml(data, settings)
+    except ElementTree.ParseError as exc:
+        raise ValueError(f"not an SVG file: {path}: {exc}") from None
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+    try:
         svg = se.SVG.parse(BytesIO(data))
     except (ElementTree.ParseError, ValueError) as exc:
         raise ValueError(f"not an SVG file: {path}: {exc}") from None
+    except _SVGELEMENTS_ERRORS as exc:
+        raise ValueError(f"{path}: {_cannot_read(exc)}") from None
     if not isinstance(svg, se.SVG):
         raise ValueError(f"not an SVG file: {path}: the root element is not <svg>")
     try:
@@ -151,10 +170,144 @@ def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     )
 
 
+# ------------------------------------------------------------------------- the XML
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_LENGTH = re.compile(rf"\s*({_NUMBER})\s*([A-Za-z%]*)\s*")
+_SEPARATORS = re.compile(r"[\s,]+")
+_TRANSFORM_NUMBERS = {
+    "matrix": (6,),
+    "translate": (1, 2),
+    "translatex": (1,),
+    "translatey": (1,),
+    "scale": (1, 2),
+    "scalex": (1,),
+    "scaley": (1,),
+    "rotate": (1, 3),
+    "skew": (1, 2),
+    "skewx": (1,),
+    "skewy": (1,),
+}
+"""How many numbers each transform function of svgelements takes."""
+
+
+def _check_xml(data: bytes, settings: Settings) -> None:
+    """Walk the XML once before svgelements reads it, without recursion: ValueError for
+    elements nested deeper than ``settings.max_svg_depth`` and for the attributes svgelements
+    would fail on with a ZeroDivisionError or IndexError (:func:`_check_attributes`);
+    ``ElementTree.ParseError`` for text that is not XML."""
+    parser: ElementTree.XMLPullParser = ElementTree.XMLPullParser(events=("start", "end"))
+    depth = 0
+    step = 1 << 16
+    for start in range(0, len(data) + 1, step):
+        if start < len(data):
+            parser.feed(data[start : start + step])
+        else:
+            parser.close()
+        for event in parser.read_events():
+            kind, element = event[0], event[-1]
+            if not isinstance(element, ElementTree.Element):
+                continue  # only "start" and "end" events are asked for
+            if kind == "end":
+                depth -= 1
+                element.clear()
+                continue
+            depth += 1
+            if depth > settings.max_svg_depth:
+                raise ValueError(
+                    f"its elements nest more than {settings.max_svg_depth} levels deep (at "
+                    f"<{_local(element.tag)}>; Settings.max_svg_depth)"
+                )
+            _check_attributes(element)
+
+
+def _check_attributes(element: ElementTree.Element) -> None:
+    """ValueError naming the element and the value for a ``width`` or ``height`` of an
+    ``<svg>`` that is not a positive finite length, a ``viewBox`` that is not four finite
+    numbers with a positive width and height, and a ``transform`` that is not a list of
+    transform functions of finite numbers."""
+    tag = _local(element.tag)
+    key = element.get("id")
+    name = f'<{tag} id="{key}">' if key else f"<{tag}>"
+    if tag == "svg":
+        for size in ("width", "height"):
+            text = element.get(size)
+            length = None if text is None else _LENGTH.fullmatch(text)
+            if text is not None and not (length and 0 < float(length[1]) < math.inf):
+                raise ValueError(
+                    f'{name} has {size}="{text}": a {size} is a positive finite length, such '
+                    "as 210mm or 800"
+                )
+    text = element.get("viewBox")
+    if text is not None and text.strip():
+        try:
+            box = [float(v) for v in _SEPARATORS.split(text.strip())]
+        except ValueError:
+            box = []
+        if not (len(box) == 4 and all(map(math.isfinite, box)) and min(box[2:]) > 0):
+            raise ValueError(
+                f'{name} has viewBox="{text}": a viewBox is four finite numbers "min-x min-y '
+                'width height", the width and height positive'
+            )
+    text = element.get("transform")
+    if text is not None and not _transform_ok(text):
+        raise ValueError(
+            f'{name} has transform="{text}": a transform is a list of matrix(a,b,c,d,e,f), '
+            "translate, scale, rotate, skewX or skewY of finite numbers"
+        )
+
+
+def _transform_ok(text: str) -> bool:
+    """Whether svgelements reads the transform attribute ``text`` as written: only transform
+    functions, each with as many finite numbers as it takes (``"none"`` is none)."""
+    text = text.lower()
+    if text.strip() in ("", "none"):
+        return True
+    if _SEPARATORS.sub("", se.REGEX_TRANSFORM_TEMPLATE.sub("", text)):
+        return False  # something besides the functions: unknown words, a missing bracket
+    for function, arguments in se.REGEX_TRANSFORM_TEMPLATE.findall(text):
+        numbers = [float(v) for v, _ in se.REGEX_TRANSFORM_PARAMETER.findall(arguments)]
+        if _SEPARATORS.sub("", se.REGEX_TRANSFORM_PARAMETER.sub("", arguments)):
+            return False  # something besides numbers: nan, inf, words
+        if len(numbers) not in _TRANSFORM_NUMBERS[function]:
+            return False
+        if not all(map(math.isfinite, numbers)):
+            return False
+    return True
+
+
+def _local(tag: str) -> str:
+    """An XML tag without its namespace: ``{http://www.w3.org/2000/svg}g`` -> ``g``."""
+    return tag.rpartition("}")[2]
+
+
+_SVGELEMENTS_ERRORS = (ArithmeticError, IndexError, RecursionError)
+"""What svgelements raises on drawings it cannot compute with: arithmetic on degenerate or
+enormous numbers, a transform or style it misreads, references in a loop."""
+
+
+def _cannot_read(exc: BaseException) -> str:
+    """The message of :data:`_SVGELEMENTS_ERRORS`."""
+    hint = (
+        "do its <use> elements refer to each other in a loop?"
+        if isinstance(exc, RecursionError)
+        else "check the numbers of its width, height, viewBox and transform attributes and styles"
+    )
+    return f"svgelements cannot read the drawing ({type(exc).__name__}: {exc}): {hint}"
+
+
+@contextlib.contextmanager
+def _svgelements():
+    """Turn :data:`_SVGELEMENTS_ERRORS` into a one-line ValueError."""
+    try:
+        yield
+    except _SVGELEMENTS_ERRORS as exc:
+        raise ValueError(_cannot_read(exc)) from None
+
+
 # ------------------------------------------------------------------------- the drawing
 def _units(svg: se.SVG) -> tuple[str, float, se.Matrix]:
     """(unit, metres per user unit, matrix from svgelements' pixels to user units)."""
-    to_user = ~se.Matrix(svg.viewbox_transform) if svg.viewbox_transform else se.Matrix()
+    to_user = _to_user(svg)
     width = str(svg.values.get("width", ""))
     match = re.fullmatch(r"\s*(\+?[\d.]+(?:[eE][-+]?\d+)?)\s*(mm|cm|in|pt)\s*", width)
     if match is None or not svg.width > 0:
@@ -168,10 +321,32 @@ def _units(svg: se.SVG) -> tuple[str, float, se.Matrix]:
     return unit, px_x * float(match.group(1)) * UNITS[unit] / svg.width, to_user
 
 
+def _to_user(svg: se.SVG) -> se.Matrix:
+    """The inverse of the root's viewBox transform (a scale and a translation), computed
+    without the determinant (whose square of the scale underflows or overflows first);
+    ValueError when the scale is not a finite nonzero number or its inverse overflows."""
+    with _svgelements():
+        transform = svg.viewbox_transform
+    if not transform:
+        return se.Matrix()
+    m = se.Matrix(transform)
+    with np.errstate(all="ignore"):
+        a, d = np.float64(1.0) / m.a, np.float64(1.0) / m.d
+        inverse = [a, 0.0, 0.0, d, -m.e * a, -m.f * d]
+    if m.b or m.c or not np.isfinite([m.a, m.d, m.e, m.f, *inverse]).all() or 0 in (a, d):
+        raise ValueError(
+            f'the viewBox="{svg.values.get("viewBox")}" scales the drawing to its width="'
+            f'{svg.values.get("width")}" and height="{svg.values.get("height")}" by '
+            f"{m.a:.3g} x {m.d:.3g}, which cannot be computed with"
+        )
+    return se.Matrix(*map(float, inverse))
+
+
 def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list[float]]:
     """Every straight piece drawn: ends (n, 2, 2) in user units y up, letters, fold angles."""
     ends, letters, angles = [], [], []
-    shapes = [e for e in svg.elements() if isinstance(e, _SHAPES)]
+    with _svgelements():
+        shapes = [e for e in svg.elements() if isinstance(e, _SHAPES)]
     for k, shape in enumerate(shapes, start=1):
         tag = shape.values.get("tag", type(shape).__name__.lower())
         name = f'<{tag} id="{shape.id}">' if shape.id else f"<{tag}> (drawn element {k})"
@@ -180,7 +355,15 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
         letter = _letter(shape.stroke, shape.values.get("stroke"), name)
         opacity = _opacity(shape, name)
         angle = {"M": -180.0 * opacity, "V": 180.0 * opacity, "U": math.nan}.get(letter, 0.0)
-        for piece in se.Path(shape).segments():
+        m = shape.transform
+        if not np.isfinite([m.a, m.b, m.c, m.d, m.e, m.f]).all():
+            raise ValueError(
+                f"{name} is drawn with a transform that is not finite, matrix({m.a:g}, {m.b:g}, "
+                f"{m.c:g}, {m.d:g}, {m.e:g}, {m.f:g}) (its transforms and the viewBox multiplied)"
+            )
+        with _svgelements():
+            pieces = list(se.Path(shape).segments())
+        for piece in pieces:
             if isinstance(piece, se.Move):
                 continue
             if not isinstance(piece, se.Line | se.Close):
@@ -192,6 +375,11 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
                 to_user.point_in_matrix_space(piece.start),
                 to_user.point_in_matrix_space(piece.end),
             )
+            if not np.isfinite([a.x, a.y, b.x, b.y]).all():
+                raise ValueError(
+                    f"{name} has a line from ({a.x:g}, {a.y:g}) to ({b.x:g}, {b.y:g}): "
+                    "coordinates must be finite numbers (transforms and the viewBox applied)"
+                )
             ends.append([[a.x, 0.0 - a.y], [b.x, 0.0 - b.y]])
             letters.append(letter)
             angles.append(angle)
@@ -202,7 +390,15 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
         )
     if "B" not in letters:
         raise ValueError("no boundary: no black lines (Origami Simulator draws it black)")
-    return np.array(ends, dtype=float), letters, angles
+    drawn = np.array(ends, dtype=float)
+    with np.errstate(over="ignore"):
+        across = float(np.linalg.norm(np.ptp(drawn.reshape(-1, 2), axis=0)))
+    if not across <= _LARGEST:
+        raise ValueError(
+            f"its lines span {across:.3g} drawing units (their transforms and viewBox "
+            f"applied): more than {_LARGEST:g}, too large to compute with"
+        )
+    return drawn, letters, angles
 
 
 def _opacity(shape: se.Shape, name: str) -> float:
