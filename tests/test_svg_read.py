@@ -277,7 +277,7 @@ ERRORS = {
     "dangling crease": (
         SQUARE + '<line x1="0" y1="50" x2="60" y2="50" stroke="red"/>',
         r"a crease ends inside a face at \(60, 50\): creases must end on another line \(an end "
-        r"within 0\.0141 drawing units of a line is joined to it\)",
+        r"within 1\.41 drawing units of a line is joined to it; Settings\.svg_snap_tol\)",
     ),
     "crease crossing out of the boundary": (
         SQUARE + '<line x1="50" y1="50" x2="150" y2="50" stroke="blue"/>',
@@ -352,14 +352,125 @@ def test_missing_file(tmp_path):
 
 
 def test_merge_tolerance_is_a_setting(tmp_path):
-    """A crease end 0.5 units short of a line (3.5e-3 of the diagonal) dangles by default and
-    is joined to the line with a larger svg_merge_tol."""
+    """A crease end 0.5 units short of a line (3.5e-3 of the diagonal) dangles without
+    mending and is joined to the line with a larger svg_merge_tol."""
     body = SQUARE + '<line x1="0" y1="50" x2="99.5" y2="50" stroke="red"/>'
     path = write(tmp_path, body)
+    unmended = DEFAULTS.with_(svg_snap_tol=0)
     with pytest.raises(ValueError, match=r"a crease ends inside a face at \(99\.5, 50\)"):
-        read_svg(path)
-    drawing = read_svg(path, settings=DEFAULTS.with_(svg_merge_tol=5e-3))
+        read_svg(path, settings=unmended)
+    drawing = read_svg(path, settings=unmended.with_(svg_merge_tol=5e-3))
     assert counts(drawing) == (6, 7, 2)
+
+
+# --------------------------------------------------------------------------- slips mended
+SLIPS = {
+    # slip: (drawn besides the square, (V, E, faces), {letter: count}); a square cut in two by
+    # a mountain is (6, 7, 2), {"B": 6, "M": 1}
+    "crease short of the boundary": (
+        '<line x1="0" y1="50" x2="99" y2="50" stroke="red"/>',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+    ),
+    "crease past the boundary": (
+        '<line x1="0" y1="50" x2="101" y2="50" stroke="red"/>',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+    ),
+    "crease past the boundary at both ends": (
+        '<line x1="-1.2" y1="50" x2="101" y2="50" stroke="red"/>',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+    ),
+    "crease short of the boundary, not pointing at it": (
+        '<line x1="0" y1="50" x2="60" y2="50" stroke="red"/>'
+        + '<line x1="60" y1="50" x2="99" y2="49" stroke="red"/>',
+        (7, 8, 2),
+        {"B": 6, "M": 2},
+    ),
+    "two creases overlapping in two colours": (
+        '<line x1="0" y1="50" x2="51" y2="50" stroke="red"/>'
+        + '<line x1="50" y1="50" x2="100" y2="50" stroke="blue"/>'
+        + '<line x1="50" y1="0" x2="50" y2="100" stroke="blue"/>',
+        (9, 12, 4),
+        {"B": 8, "M": 1, "V": 3},
+    ),
+}
+
+
+@pytest.mark.parametrize("slip", SLIPS)
+def test_slips_within_the_snap_tolerance_are_mended(tmp_path, slip):
+    """Slips of under 1 % of the diagonal (1.41 units here) are mended by default
+    (Settings.svg_snap_tol) and refused with svg_snap_tol=0."""
+    body, sizes, letters = SLIPS[slip]
+    path = write(tmp_path, SQUARE + body)
+    drawing = read_svg(path)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    assert any(x == 100 and -51 < y < -48 for x, y in points(drawing.xy))  # on the boundary
+    with pytest.raises(ValueError, match=r"lies outside the boundary|ends inside a face|both"):
+        read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_slips_beyond_the_snap_tolerance_are_refused(tmp_path):
+    path = write(tmp_path, SQUARE + '<line x1="0" y1="50" x2="97" y2="50" stroke="red"/>')
+    with pytest.raises(ValueError, match=r"a crease ends inside a face at \(97, 50\): .* within "):
+        read_svg(path)
+    assert counts(read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0.03))) == (6, 7, 2)
+    with pytest.raises(ValueError, match="svg_snap_tol must be a fraction from 0 to below 1"):
+        DEFAULTS.with_(svg_snap_tol=-0.1)
+
+
+@pytest.mark.parametrize(
+    ("name", "sizes", "letters", "triangles", "refusal"),
+    [
+        (
+            "huffmanWaterbomb.svg",
+            (448, 1165, 718),
+            {"B": 88, "M": 758, "V": 319},
+            806,
+            r"the crease from \(135\.014, 1074\.92\) to \(135\.014, 1075\.5\) lies outside "
+            r"the boundary",
+        ),
+        (
+            "hypar.svg",
+            (98, 285, 188),
+            {"B": 4, "M": 96, "V": 89, "U": 96},
+            190,
+            r"a crease ends inside a face at \(629\.168, 524\.834\)",
+        ),
+    ],
+)
+def test_origami_simulator_files_with_slips(name, sizes, letters, triangles, refusal):
+    """Origami Simulator's examples with slips of under 1e-3 of their diagonals (creases
+    0.58 units past the boundary; a crease ending 0.83 units short of a line) read once the
+    slips are mended; without mending they are refused as before."""
+    from rigidfold.patterns.files import read_pattern_file
+
+    drawing = read_svg(DATA / name)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    assert len(read_pattern_file(DATA / name).faces) == triangles
+    with pytest.raises(ValueError, match=refusal):
+        read_svg(DATA / name, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_cli_svg_tolerance(tmp_path, capsys):
+    """--svg-tolerance sets Settings.svg_snap_tol; its default is the setting's."""
+    path = write(tmp_path, SQUARE + '<line x1="0" y1="50" x2="98" y2="50" stroke="red"/>')
+    args = ["optimize", "--surface", "dome", "--pattern", str(path), "--out"]
+    assert main([*args, str(tmp_path / "a")]) == 2
+    assert "a crease ends inside a face at (98, 50)" in capsys.readouterr().err
+    assert main([*args, str(tmp_path / "b"), "--svg-tolerance", "0.02"]) == 0
+    assert (tmp_path / "b" / "solution.fold").is_file()
+    with pytest.raises(SystemExit) as stop:
+        main([*args, str(tmp_path / "c"), "--svg-tolerance", "1.5"])
+    assert stop.value.code == 2
+    assert "--svg-tolerance: must be a number from 0 to below 1, got '1.5'" in (
+        capsys.readouterr().err
+    )
 
 
 # --------------------------------------------------------------------------- Origami Simulator

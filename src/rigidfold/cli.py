@@ -59,6 +59,29 @@ def _positive(text: str) -> float:
     return value
 
 
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value < 1:
+        raise argparse.ArgumentTypeError(f"must be a number from 0 to below 1, got {text!r}")
+    return value
+
+
+def _svg_tolerance(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--svg-tolerance",
+        type=_fraction,
+        default=DEFAULTS.svg_snap_tol,
+        metavar="FRACTION",
+        help="slips of the pen in an SVG pattern mended, as a fraction of the drawing's "
+        "diagonal: a crease overshooting the line it ends on, or ending short of one, by up "
+        "to this much is cut or extended to it; 0 mends nothing (default: %(default)g, "
+        "Settings.svg_snap_tol)",
+    )
+
+
 def _seed(text: str) -> int:
     try:
         value = int(text)
@@ -296,6 +319,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="IPOPT's Hessian of the Lagrangian: closed-form or casadi (the symbolic "
         "reference, used by studies made before the closed form; default: %(default)s)",
     )
+    _svg_tolerance(stu)
     stu.add_argument("--quiet", action="store_true", help="no progress bar")
     stu.set_defaults(func=_cmd_study)
 
@@ -395,6 +419,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
         "the lower-left corner of its bounding box at (0, 0); the built-in surfaces scale to "
         "that box, --expr is in metres as given",
     )
+    _svg_tolerance(p)
     p.add_argument(
         "--size",
         metavar="WxH",
@@ -494,6 +519,7 @@ def _case(args: argparse.Namespace):
         rho_bar_deg=args.rho_max,
         zero_dof_ends=not getattr(args, "retry_zero_dof", False),
         ipopt_hessian=args.hessian,
+        svg_snap_tol=args.svg_tolerance,
     )
     return make_case(
         args.surface,
@@ -705,15 +731,18 @@ def _cmd_study(args: argparse.Namespace) -> int:
         run_study_command,
     )
 
+    settings = DEFAULTS.with_(ipopt_hessian=args.hessian, svg_snap_tol=args.svg_tolerance)
     if args.preset is not None:
         keys = preset(args.preset)
     else:
-        keys = plan(_names(args.patterns), _names(args.criteria), args.surfaces, args.first_seed)
-    config = StudyConfig(
-        deform=not args.no_deform,
-        settings=DEFAULTS.with_(ipopt_hessian=args.hessian),
-        lookahead=args.lookahead,
-    )
+        keys = plan(
+            _names(args.patterns),
+            _names(args.criteria),
+            args.surfaces,
+            args.first_seed,
+            settings=settings,
+        )
+    config = StudyConfig(deform=not args.no_deform, settings=settings, lookahead=args.lookahead)
     bar = StudyProgress(enabled=not args.quiet)
     try:
         result = run_study_command(

@@ -117,6 +117,13 @@ class Settings:
         of drawing programs (about 1e-3 px) lies far below the default; Origami Simulator
         merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals, and a carelessly
         drawn pattern may need 1e-3, which would also merge real features of some designs.
+    svg_snap_tol : float
+        Crease patterns drawn in SVG: slips of the pen up to this times the diagonal of the
+        drawing's bounding box are mended, where a crease would otherwise end on nothing
+        (refused): an overshoot that far past the line a crease crosses is cut off, and a
+        crease that ends that far short of a line is extended to it. Origami Simulator's own
+        examples have slips of 4e-4 of their diagonals (its 3 px merge tolerance hides them);
+        0 mends nothing. The command line's ``--svg-tolerance``.
     max_svg_depth : int
         Deepest nesting of elements accepted in an SVG drawing: a deeper file is refused with
         a one-line error before svgelements, which reads it recursively, exhausts Python's
@@ -360,6 +367,7 @@ class Settings:
     triangulation_area_tol: float = 1e-12
     # reading SVG drawings
     svg_merge_tol: float = 1e-4
+    svg_snap_tol: float = 1e-2
     max_svg_depth: int = 100
     # crease patterns
     mesh_divisions: float = 6.0
@@ -402,6 +410,10 @@ class Settings:
             value = getattr(self, name)
             if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")
+        for name in ("svg_merge_tol", "svg_snap_tol"):
+            value = getattr(self, name)
+            if not (isinstance(value, float | int) and 0 <= value < 1):
+                raise ValueError(f"{name} must be a fraction from 0 to below 1, got {value!r}")
         if not 0 < self.sparse_shift < 1:
             raise ValueError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
         least = {

@@ -23,6 +23,11 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
   pieces shorter than that are dropped. A piece drawn twice is kept once: if one drawing
   is black it stays boundary, other differing colours are refused. Where just two pieces
   of the same colour and opacity meet in a straight line, they become one line;
+* slips of the pen up to ``Settings.svg_snap_tol`` times the diagonal are mended where a
+  crease would otherwise end on nothing: an overshoot past the line a crease crosses (the
+  boundary among them) is cut off, a piece drawn in two crease colours (one crease running
+  on along another) is dropped, and a crease that ends short of a line is extended to it
+  (:func:`_mend`);
 * the black lines must form one closed outline, every crease must lie inside it and end
   on another line, and every face must be a simple polygon (no holes, no crease loop
   hanging at one point). Each problem is a one-line ``ValueError`` naming the file.
@@ -63,6 +68,10 @@ magenta (300) is that colour; any other stroke is refused."""
 
 HUE_TOLERANCE = 30.0
 """Largest hue difference (degrees) of a stroke from its colour in :data:`COLOURS`."""
+
+_MENDS = 3
+"""How many times the slips of a drawing are mended (:func:`_mend`) and the drawing noded
+again, at most: cutting off an overshoot can leave another loose end."""
 
 _LARGEST = 1e150
 """Largest extent of a drawing in its own units: squares of its lengths stay finite."""
@@ -155,10 +164,24 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
 def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     unit, scale, to_user = _units(svg)
     ends, letters, angles = _lines(svg, to_user)
-    tol = settings.svg_merge_tol * float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
-    xy, edges, letters, angles = _node(ends, letters, angles, tol)
-    xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
-    _check_creases(xy, edges, letters, _check_boundary(xy, edges, letters), tol)
+    across = float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
+    tol, snap = settings.svg_merge_tol * across, settings.svg_snap_tol * across
+    pieces: tuple[np.ndarray, list[str], list[float]] | None = (ends, letters, angles)
+    for _ in range(_MENDS):
+        if pieces is None:
+            break
+        xy, edges, letters, angles = _node(*pieces, tol, snap)
+        xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
+        pieces = _mend(xy, edges, letters, angles, snap)
+    boundary = _check_boundary(xy, edges, letters)
+    inside = _inside(xy, edges, boundary, letters, snap)
+    if not inside.all():
+        xy, edges = _compact(xy, edges[inside])
+        letters = [a for a, k in zip(letters, inside, strict=True) if k]
+        angles = [a for a, k in zip(angles, inside, strict=True) if k]
+        xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
+        boundary = _check_boundary(xy, edges, letters)
+    _check_creases(xy, edges, letters, boundary, max(tol, snap))
     return SvgDrawing(
         xy=xy,
         polygons=_faces(xy, edges),
@@ -436,11 +459,13 @@ def _letter(colour: se.Color, written: str | None, name: str) -> str:
 
 # ------------------------------------------------------------------------- the geometry
 def _node(
-    ends: np.ndarray, letters: list[str], angles: list[float], tol: float
+    ends: np.ndarray, letters: list[str], angles: list[float], tol: float, snap: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, list[str], list[float]]:
     """The drawn pieces split where they meet, close points merged, repeats dropped.
 
-    ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance.
+    ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance; snap : a piece
+    no longer than this drawn in two crease colours (where a crease overshoots its end along
+    another) is dropped, for :func:`_mend` to join the lines again, instead of refused.
     Returns xy (V, 2), edges (E, 2) int64 (in drawing order), their letters and angles.
     """
     a, b = ends[:, 0], ends[:, 1]
@@ -462,6 +487,7 @@ def _node(
     piece = np.flatnonzero(seg[:-1] == seg[1:])
     kept: dict[tuple[int, int], int] = {}
     edges: list[tuple[int, int]] = []
+    dropped: set[int] = set()
     out_letters, out_angles = [], []
     for k in piece:
         u, v, source = int(vertex[k]), int(vertex[k + 1]), drawn[seg[k]]
@@ -477,12 +503,20 @@ def _node(
         e = kept[key]
         if letter == "B":
             out_letters[e], out_angles[e] = "B", 0.0
+            dropped.discard(e)
         elif out_letters[e] not in ("B", letter):
-            raise ValueError(
-                f"the line from {_at(points[first[u]])} to {_at(points[first[v]])} is drawn "
-                f"both {COLOURS[out_letters[e]]} and {COLOURS[letter]}"
-            )
-    return (*_compact(points[first], np.array(edges, dtype=np.int64)), out_letters, out_angles)
+            if np.linalg.norm(points[first[u]] - points[first[v]]) > snap:
+                raise ValueError(
+                    f"the line from {_at(points[first[u]])} to {_at(points[first[v]])} is "
+                    f"drawn both {COLOURS[out_letters[e]]} and {COLOURS[letter]}"
+                )
+            dropped.add(e)
+    keep = [e for e in range(len(edges)) if e not in dropped]
+    return (
+        *_compact(points[first], np.array(edges, dtype=np.int64).reshape(-1, 2)[keep]),
+        [out_letters[e] for e in keep],
+        [out_angles[e] for e in keep],
+    )
 
 
 def _splits(
@@ -560,6 +594,58 @@ def _join_straight(
     return xy, edges, [letters[e] for e in keep], [angles[e] for e in keep]
 
 
+def _mend(
+    xy: np.ndarray, edges: np.ndarray, letters: list[str], angles: list[float], snap: float
+) -> tuple[np.ndarray, list[str], list[float]] | None:
+    """The drawing with its slips within ``snap`` mended, as pieces to node again (ends
+    (n, 2, 2), letters, angles), or None when it has none. A loose crease end (one that
+    touches no other line) is mended: the piece no longer than ``snap`` that ends there (an
+    overshoot past the line it crosses) is dropped; a longer crease is extended from there to
+    the first line that it points at within ``snap``, or else to the nearest point within
+    ``snap`` of a line that does not touch it. Boundary (black) lines are left as drawn.
+    xy (V, 2), edges (E, 2) -> see above."""
+    crease = np.array(letters) != "B"
+    degree = np.bincount(edges.ravel(), minlength=len(xy))
+    loose = (degree[edges] == 1) & crease[:, None]  # (E, 2): a crease's loose ends
+    if not loose.any():
+        return None
+    length = np.linalg.norm(xy[edges[:, 1]] - xy[edges[:, 0]], axis=1)
+    keep = ~(loose.any(axis=1) & (length <= snap))
+    edges, letters = edges[keep], [a for a, k in zip(letters, keep, strict=True) if k]
+    angles = [a for a, k in zip(angles, keep, strict=True) if k]
+    degree = np.bincount(edges.ravel(), minlength=len(xy))
+    e, side = np.nonzero((degree[edges] == 1) & (np.array(letters) != "B")[:, None])
+    w, p = edges[e, side], edges[e, 1 - side]  # the loose end, the crease's other end
+    lines = shapely.linestrings(xy[edges])
+    near, other = shapely.STRtree(lines).query(
+        shapely.points(xy[w]), predicate="dwithin", distance=snap
+    )
+    touching = (edges[other] == w[near, None]) | (edges[other] == p[near, None])
+    near, other = near[~touching.any(axis=1)], other[~touching.any(axis=1)]
+    pieces = [xy[edges]]
+    for k in np.unique(near):
+        f = other[near == k]
+        a, r = xy[edges[f, 0]], xy[edges[f, 1]] - xy[edges[f, 0]]
+        start = xy[w[k]]
+        d = start - xy[p[k]]
+        d = d / np.linalg.norm(d)
+        denom = _cross(np.broadcast_to(d, r.shape), r)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = _cross(a - start, r) / denom  # along the crease's direction from its end
+            t = _cross(a - start, np.broadcast_to(d, r.shape)) / denom  # along the line
+        ahead = (denom != 0) & (s >= 0) & (s <= snap) & (t >= 0) & (t <= 1)
+        if ahead.any():
+            target = start + s[ahead].min() * d
+        else:
+            t = np.clip(np.sum((start - a) * r, axis=1) / np.sum(r * r, axis=1), 0, 1)
+            foot = a + t[:, None] * r
+            target = foot[np.argmin(np.linalg.norm(foot - start, axis=1))]
+        pieces.append(np.array([[start, target]]))
+        letters.append(letters[e[k]])
+        angles.append(angles[e[k]])
+    return np.concatenate(pieces), letters, angles
+
+
 def _compact(xy: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Only the vertices that edges use, numbered in order of first use.
     xy (V, 2), edges (E, 2) -> xy (V', 2), edges (E, 2)."""
@@ -601,6 +687,22 @@ def _check_boundary(xy: np.ndarray, edges: np.ndarray, letters: list[str]) -> li
     raise ValueError(f"the boundary (black) is {len(loops)} separate outlines, not one sheet")
 
 
+def _inside(
+    xy: np.ndarray, edges: np.ndarray, boundary: list[int], letters: list[str], snap: float
+) -> np.ndarray:
+    """(E,) bool: False for the creases outside the ``boundary`` (its vertex indices) whose
+    ends both lie within ``snap`` of it (overshoots of creases that end on the boundary),
+    True for every other edge."""
+    outline = shapely.Polygon(xy[boundary])
+    mid = xy[edges].mean(axis=1)
+    outside = ~shapely.contains_xy(outline, mid[:, 0], mid[:, 1]) & (np.array(letters) != "B")
+    if not outside.any():
+        return ~outside
+    gap = shapely.distance(outline.exterior, shapely.points(xy[edges[outside]]))  # (k, 2)
+    outside[outside] = (gap <= snap).all(axis=1)
+    return ~outside
+
+
 def _check_creases(
     xy: np.ndarray, edges: np.ndarray, letters: list[str], boundary: list[int], tol: float
 ) -> None:
@@ -616,7 +718,8 @@ def _check_creases(
     if (degree == 1).any():
         raise ValueError(
             f"a crease ends inside a face at {_at(xy[degree == 1][0])}: creases must end on "
-            f"another line (an end within {tol:.3g} drawing units of a line is joined to it)"
+            f"another line (an end within {tol:.3g} drawing units of a line is joined to it; "
+            "Settings.svg_snap_tol)"
         )
     n, component = connected_components(_graph(edges, len(xy)), directed=False)
     if n > 1:
