@@ -13,6 +13,7 @@ import json
 import math
 import os
 import sys
+import unicodedata
 from collections.abc import Sequence
 
 from rigidfold import __version__
@@ -49,7 +50,28 @@ class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (no usage dump) and exit code 2."""
 
     def error(self, message: str):
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {one_line(message)}\n")
+
+
+_ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def one_line(text: str) -> str:
+    """``text`` with its control characters escaped as Python writes them in strings (a
+    newline as ``\\n``, ESC as ``\\x1b``, U+2028 as ``\\u2028``), so that a message that
+    carries a file name or a value read from a file prints as one line and cannot move the
+    cursor, clear the screen or retitle the terminal. Backslashes are kept as they are."""
+    out = []
+    for ch in text:
+        if unicodedata.category(ch) in ("Cc", "Zl", "Zp"):
+            ch = _ESCAPES.get(ch) or ascii(ch)[1:-1]
+        out.append(ch)
+    return "".join(out)
+
+
+def _error(message: str) -> None:
+    """Print ``rigidfold: error: <message>`` on stderr, on one line (:func:`one_line`)."""
+    print(f"rigidfold: error: {one_line(message)}", file=sys.stderr)
 
 
 def _positive(text: str) -> float:
@@ -587,8 +609,10 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         progress.close()
         print(
-            f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json and "
-            f"summary.json are in {writer.out}",
+            one_line(
+                f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json "
+                f"and summary.json are in {writer.out}"
+            ),
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
@@ -759,8 +783,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
     except StudyInterrupted as stop:
         bar.close()
         print(
-            f"rigidfold: interrupted; {stop.finished} finished runs are in {args.db}; run the "
-            "same command to resume",
+            one_line(
+                f"rigidfold: interrupted; {stop.finished} finished runs are in {args.db}; run "
+                "the same command to resume"
+            ),
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
@@ -772,7 +798,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
     )
     if result["failed"]:
         print(
-            f"rigidfold: {failure_summary(result['failed'], result['ran'], args.db)}",
+            one_line(f"rigidfold: {failure_summary(result['failed'], result['ran'], args.db)}"),
             file=sys.stderr,
         )
         return EXIT_FAILED
@@ -820,7 +846,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits
         return code
     except ValueError as exc:
-        print(f"rigidfold: error: {exc}", file=sys.stderr)
+        _error(str(exc))
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("rigidfold: interrupted", file=sys.stderr)
@@ -832,11 +858,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         reason = exc.strerror or str(exc)
         if exc.filename is not None:  # a file the library did not report itself
-            print(f"rigidfold: error: {exc.filename}: {reason}", file=sys.stderr)
+            _error(f"{exc.filename}: {reason}")
             return EXIT_USAGE
         # standard output cannot be written (``> /dev/full``, a full disk)
         _drop_stdout()
-        print(f"rigidfold: error: cannot write the output: {reason}", file=sys.stderr)
+        _error(f"cannot write the output: {reason}")
         return EXIT_USAGE
     finally:
         if args.verbose:
