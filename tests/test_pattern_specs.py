@@ -168,6 +168,8 @@ BAD = [
     ("11", {"diagonals": "parallel"}, "pattern '11' takes no diagonals"),
     ("mesh:0,0;1,0;1,1", {"size": "2x2"}, "takes no size"),
     ("mesh:0,0;2,0;2,2;0,2", {"edge_length": -1.0}, "got -1"),
+    ("mesh:0,0;2,0;2,2;0,2", {"edge_length": 1e308}, "at most 1e+06 m, the largest plan"),
+    ("mesh:0,0;2,0;2,2;0,2", {"edge_length": math.inf}, "got inf"),
     ("mesh:0,0;2,0;2,2;0,2", {"edge_length": 1e-4}, "more than 20000"),
     ("mesh:0,0;1,1;1,0;0,1", {}, "not a simple polygon: its sides intersect at [0.5 0.5]"),
     ("mesh:0,0;2,0;2,2;1,0;0,2", {}, "not a simple polygon"),
@@ -196,6 +198,7 @@ def test_bad_specs_one_line(spec, options, message):
         (["--pattern", "1", "--edge-length", "0.3"], "pattern '1' takes no edge length"),
         (["--pattern", "grid:7x7", "--diagonals", "random"], "invalid choice: 'random'"),
         (["--pattern", "mesh:0,0;1,0;1,1", "--edge-length", "0"], "must be a positive number"),
+        (["--pattern", "mesh:0,0;1,0;1,1", "--edge-length", "1e308"], "got 1e+308 m"),
     ],
 )
 def test_cli_bad_specs_exit_2(tmp_path, capsys, args, message):

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
+from rigidfold.cli import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import UNITS, SvgDrawing, read_svg
 from rigidfold.mesh import CreasePattern
@@ -276,7 +277,7 @@ ERRORS = {
     "dangling crease": (
         SQUARE + '<line x1="0" y1="50" x2="60" y2="50" stroke="red"/>',
         r"a crease ends inside a face at \(60, 50\): creases must end on another line \(an end "
-        r"within 0\.0141 drawing units of a line is joined to it\)",
+        r"within 1\.41 drawing units of a line is joined to it; Settings\.svg_snap_tol\)",
     ),
     "crease crossing out of the boundary": (
         SQUARE + '<line x1="50" y1="50" x2="150" y2="50" stroke="blue"/>',
@@ -351,14 +352,125 @@ def test_missing_file(tmp_path):
 
 
 def test_merge_tolerance_is_a_setting(tmp_path):
-    """A crease end 0.5 units short of a line (3.5e-3 of the diagonal) dangles by default and
-    is joined to the line with a larger svg_merge_tol."""
+    """A crease end 0.5 units short of a line (3.5e-3 of the diagonal) dangles without
+    mending and is joined to the line with a larger svg_merge_tol."""
     body = SQUARE + '<line x1="0" y1="50" x2="99.5" y2="50" stroke="red"/>'
     path = write(tmp_path, body)
+    unmended = DEFAULTS.with_(svg_snap_tol=0)
     with pytest.raises(ValueError, match=r"a crease ends inside a face at \(99\.5, 50\)"):
-        read_svg(path)
-    drawing = read_svg(path, settings=DEFAULTS.with_(svg_merge_tol=5e-3))
+        read_svg(path, settings=unmended)
+    drawing = read_svg(path, settings=unmended.with_(svg_merge_tol=5e-3))
     assert counts(drawing) == (6, 7, 2)
+
+
+# --------------------------------------------------------------------------- slips mended
+SLIPS = {
+    # slip: (drawn besides the square, (V, E, faces), {letter: count}); a square cut in two by
+    # a mountain is (6, 7, 2), {"B": 6, "M": 1}
+    "crease short of the boundary": (
+        '<line x1="0" y1="50" x2="99" y2="50" stroke="red"/>',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+    ),
+    "crease past the boundary": (
+        '<line x1="0" y1="50" x2="101" y2="50" stroke="red"/>',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+    ),
+    "crease past the boundary at both ends": (
+        '<line x1="-1.2" y1="50" x2="101" y2="50" stroke="red"/>',
+        (6, 7, 2),
+        {"B": 6, "M": 1},
+    ),
+    "crease short of the boundary, not pointing at it": (
+        '<line x1="0" y1="50" x2="60" y2="50" stroke="red"/>'
+        + '<line x1="60" y1="50" x2="99" y2="49" stroke="red"/>',
+        (7, 8, 2),
+        {"B": 6, "M": 2},
+    ),
+    "two creases overlapping in two colours": (
+        '<line x1="0" y1="50" x2="51" y2="50" stroke="red"/>'
+        + '<line x1="50" y1="50" x2="100" y2="50" stroke="blue"/>'
+        + '<line x1="50" y1="0" x2="50" y2="100" stroke="blue"/>',
+        (9, 12, 4),
+        {"B": 8, "M": 1, "V": 3},
+    ),
+}
+
+
+@pytest.mark.parametrize("slip", SLIPS)
+def test_slips_within_the_snap_tolerance_are_mended(tmp_path, slip):
+    """Slips of under 1 % of the diagonal (1.41 units here) are mended by default
+    (Settings.svg_snap_tol) and refused with svg_snap_tol=0."""
+    body, sizes, letters = SLIPS[slip]
+    path = write(tmp_path, SQUARE + body)
+    drawing = read_svg(path)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    assert any(x == 100 and -51 < y < -48 for x, y in points(drawing.xy))  # on the boundary
+    with pytest.raises(ValueError, match=r"lies outside the boundary|ends inside a face|both"):
+        read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_slips_beyond_the_snap_tolerance_are_refused(tmp_path):
+    path = write(tmp_path, SQUARE + '<line x1="0" y1="50" x2="97" y2="50" stroke="red"/>')
+    with pytest.raises(ValueError, match=r"a crease ends inside a face at \(97, 50\): .* within "):
+        read_svg(path)
+    assert counts(read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0.03))) == (6, 7, 2)
+    with pytest.raises(ValueError, match="svg_snap_tol must be a fraction from 0 to below 1"):
+        DEFAULTS.with_(svg_snap_tol=-0.1)
+
+
+@pytest.mark.parametrize(
+    ("name", "sizes", "letters", "triangles", "refusal"),
+    [
+        (
+            "huffmanWaterbomb.svg",
+            (448, 1165, 718),
+            {"B": 88, "M": 758, "V": 319},
+            806,
+            r"the crease from \(135\.014, 1074\.92\) to \(135\.014, 1075\.5\) lies outside "
+            r"the boundary",
+        ),
+        (
+            "hypar.svg",
+            (98, 285, 188),
+            {"B": 4, "M": 96, "V": 89, "U": 96},
+            190,
+            r"a crease ends inside a face at \(629\.168, 524\.834\)",
+        ),
+    ],
+)
+def test_origami_simulator_files_with_slips(name, sizes, letters, triangles, refusal):
+    """Origami Simulator's examples with slips of under 1e-3 of their diagonals (creases
+    0.58 units past the boundary; a crease ending 0.83 units short of a line) read once the
+    slips are mended; without mending they are refused as before."""
+    from rigidfold.patterns.files import read_pattern_file
+
+    drawing = read_svg(DATA / name)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    assert len(read_pattern_file(DATA / name).faces) == triangles
+    with pytest.raises(ValueError, match=refusal):
+        read_svg(DATA / name, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_cli_svg_tolerance(tmp_path, capsys):
+    """--svg-tolerance sets Settings.svg_snap_tol; its default is the setting's."""
+    path = write(tmp_path, SQUARE + '<line x1="0" y1="50" x2="98" y2="50" stroke="red"/>')
+    args = ["optimize", "--surface", "dome", "--pattern", str(path), "--out"]
+    assert main([*args, str(tmp_path / "a")]) == 2
+    assert "a crease ends inside a face at (98, 50)" in capsys.readouterr().err
+    assert main([*args, str(tmp_path / "b"), "--svg-tolerance", "0.02"]) == 0
+    assert (tmp_path / "b" / "solution.fold").is_file()
+    with pytest.raises(SystemExit) as stop:
+        main([*args, str(tmp_path / "c"), "--svg-tolerance", "1.5"])
+    assert stop.value.code == 2
+    assert "--svg-tolerance: must be a number from 0 to below 1, got '1.5'" in (
+        capsys.readouterr().err
+    )
 
 
 # --------------------------------------------------------------------------- Origami Simulator
@@ -396,3 +508,113 @@ def test_origami_simulator_curved_file():
         match=r"wavy_pleats\.svg: <path> \(drawn element 2\) has a curved piece \(CubicBezier\)",
     ):
         read_svg(DATA / "wavy_pleats.svg")
+
+
+# --------------------------------------------------------------------------- headers, nesting
+HEADERS = {
+    "empty viewBox": (
+        'width="100mm" height="100mm" viewBox="0 0 0 0"',
+        r'<svg> has viewBox="0 0 0 0": a viewBox is four finite numbers',
+    ),
+    "empty viewBox without units": ('viewBox="0 0 0 0"', r'<svg> has viewBox="0 0 0 0"'),
+    "tiny viewBox": (
+        'width="100mm" height="100mm" viewBox="0 0 1e-300 1e-300"',
+        r"\(drawn in mm\) is 1e\+301 m x 1e\+301 m: a crease pattern is 0\.001 m to",
+    ),
+    "huge viewBox": (
+        'width="100mm" height="100mm" viewBox="0 0 1e308 1e308"',
+        r'the viewBox="0 0 1e308 1e308" scales the drawing to its width="100mm" and '
+        r'height="100mm" by 0 x 0, which cannot be computed with',
+    ),
+    "width nan": (
+        'width="nanmm" height="100mm" viewBox="0 0 100 100"',
+        r'<svg> has width="nanmm": a width is a positive finite length',
+    ),
+    "width overflows": (
+        'width="1e400mm" height="100mm" viewBox="0 0 100 100"',
+        r'<svg> has width="1e400mm": a width is a positive finite length',
+    ),
+    "height zero": ('width="100mm" height="0" viewBox="0 0 100 100"', r'<svg> has height="0"'),
+    "viewBox of three numbers": ('viewBox="0 0 100"', r'<svg> has viewBox="0 0 100"'),
+}
+
+
+@pytest.mark.parametrize("case", HEADERS)
+def test_bad_headers_one_line_exit_2(tmp_path, capsys, case):
+    """A width, height or viewBox that svgelements divides by zero on (a ZeroDivisionError
+    traceback before) is a one-line error naming what was received."""
+    size, message = HEADERS[case]
+    path = write(tmp_path, SQUARE + '<line x1="0" y1="0" x2="100" y2="100" stroke="red"/>', size)
+    code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and re.fullmatch(f"rigidfold: error: {re.escape(str(path))}.*\n", err), err
+    assert re.search(message, err), err
+
+
+BAD_TRANSFORMS = {
+    "matrix(nan,0,0,1,0,0)": r'<g id="t"> has transform="matrix\(nan,0,0,1,0,0\)": a transform',
+    "matrix(1,2)": r'<g id="t"> has transform="matrix\(1,2\)"',
+    "scale(1e400)": r'<g id="t"> has transform="scale\(1e400\)"',
+    "rotate(inf)": r'<g id="t"> has transform="rotate\(inf\)"',
+    "turn(90)": r'<g id="t"> has transform="turn\(90\)"',
+    "scale(1e200) scale(1e200)": r"<rect> \(drawn element 1\) is drawn with a transform that "
+    r"is not finite, matrix\(nan, nan, nan, nan, 0, 0\)",
+    "translate(1e308) translate(1e308)": r"<rect> \(drawn element 1\) is drawn with a "
+    r"transform that is not finite, matrix\(nan, nan, nan, nan, nan, nan\)",
+}
+
+
+@pytest.mark.parametrize("transform", BAD_TRANSFORMS)
+def test_bad_transforms(tmp_path, transform):
+    path = write(tmp_path, f'<g id="t" transform="{transform}">{SQUARE}</g>')
+    with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {BAD_TRANSFORMS[transform]}"):
+        read_svg(path)
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        (
+            SQUARE + '<line x1="0" y1="0" x2="1e400" y2="100" stroke="red"/>',
+            r"<line> \(drawn element 2\) has a line from \(0, 0\) to \(nan, nan\): coordinates "
+            "must be finite",
+        ),
+        (
+            SQUARE + '<path d="M0,0 L1e308,1e308" stroke="red"/>',
+            r"its lines span inf drawing units .* more than 1e\+150",
+        ),
+        (
+            f'<g id="a"><use xmlns:xlink="http://www.w3.org/1999/xlink" xlink:href="#a"/>{SQUARE}'
+            "</g>",
+            r"svgelements cannot read the drawing \(RecursionError: .*\): do its <use> elements "
+            "refer to each other in a loop\\?",
+        ),
+    ],
+)
+def test_coordinates_svgelements_cannot_compute_with(tmp_path, body, message):
+    path = write(tmp_path, body)
+    with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {message}"):
+        read_svg(path)
+
+
+@pytest.mark.parametrize("transform", ["rotate(45 50 50)", "translate(10px, 5px)", "none", ""])
+def test_good_transforms(tmp_path, transform):
+    path = write(tmp_path, f'<g transform="{transform}">{SQUARE}</g>')
+    assert counts(read_svg(path)) == (4, 4, 1)
+
+
+def test_nesting_depth_is_bounded(tmp_path, capsys):
+    """5,000 nested groups (a RecursionError traceback from svgelements before) are refused in
+    one line; Settings.max_svg_depth is the limit."""
+    deep = 5000
+    path = write(tmp_path, "<g>" * deep + SQUARE + "</g>" * deep)
+    code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err == (
+        f"rigidfold: error: {path}: its elements nest more than 100 levels deep (at <g>; "
+        "Settings.max_svg_depth)\n"
+    )
+    nested = write(tmp_path, "<g>" * 98 + SQUARE + "</g>" * 98)  # <svg>, 98 <g>, <rect>
+    assert counts(read_svg(nested)) == (4, 4, 1)
+    with pytest.raises(ValueError, match="nest more than 99 levels deep"):
+        read_svg(nested, settings=DEFAULTS.with_(max_svg_depth=99))

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import sys
+import unicodedata
 from collections.abc import Sequence
 
 from rigidfold import __version__
@@ -49,7 +50,28 @@ class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (no usage dump) and exit code 2."""
 
     def error(self, message: str):
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {one_line(message)}\n")
+
+
+_ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def one_line(text: str) -> str:
+    """``text`` with its control characters escaped as Python writes them in strings (a
+    newline as ``\\n``, ESC as ``\\x1b``, U+2028 as ``\\u2028``), so that a message that
+    carries a file name or a value read from a file prints as one line and cannot move the
+    cursor, clear the screen or retitle the terminal. Backslashes are kept as they are."""
+    out = []
+    for ch in text:
+        if unicodedata.category(ch) in ("Cc", "Zl", "Zp"):
+            ch = _ESCAPES.get(ch) or ascii(ch)[1:-1]
+        out.append(ch)
+    return "".join(out)
+
+
+def _error(message: str) -> None:
+    """Print ``rigidfold: error: <message>`` on stderr, on one line (:func:`one_line`)."""
+    print(f"rigidfold: error: {one_line(message)}", file=sys.stderr)
 
 
 def _positive(text: str) -> float:
@@ -57,6 +79,29 @@ def _positive(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
     return value
+
+
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value < 1:
+        raise argparse.ArgumentTypeError(f"must be a number from 0 to below 1, got {text!r}")
+    return value
+
+
+def _svg_tolerance(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--svg-tolerance",
+        type=_fraction,
+        default=DEFAULTS.svg_snap_tol,
+        metavar="FRACTION",
+        help="slips of the pen in an SVG pattern mended, as a fraction of the drawing's "
+        "diagonal: a crease overshooting the line it ends on, or ending short of one, by up "
+        "to this much is cut or extended to it; 0 mends nothing (default: %(default)g, "
+        "Settings.svg_snap_tol)",
+    )
 
 
 def _seed(text: str) -> int:
@@ -319,6 +364,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="IPOPT's Hessian of the Lagrangian: closed-form or casadi (the symbolic "
         "reference, used by studies made before the closed form; default: %(default)s)",
     )
+    _svg_tolerance(stu)
     stu.add_argument("--quiet", action="store_true", help="no progress bar")
     stu.set_defaults(func=_cmd_study)
 
@@ -418,6 +464,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
         "the lower-left corner of its bounding box at (0, 0); the built-in surfaces scale to "
         "that box, --expr is in metres as given",
     )
+    _svg_tolerance(p)
     p.add_argument(
         "--size",
         metavar="WxH",
@@ -517,6 +564,7 @@ def _case(args: argparse.Namespace):
         rho_bar_deg=args.rho_max,
         zero_dof_ends=not getattr(args, "retry_zero_dof", False),
         ipopt_hessian=args.hessian,
+        svg_snap_tol=args.svg_tolerance,
     )
     return make_case(
         args.surface,
@@ -592,8 +640,10 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         progress.close()
         print(
-            f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json and "
-            f"summary.json are in {writer.out}",
+            one_line(
+                f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json "
+                f"and summary.json are in {writer.out}"
+            ),
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
@@ -737,13 +787,20 @@ def _cmd_study(args: argparse.Namespace) -> int:
         run_study_command,
     )
 
+    settings = DEFAULTS.with_(ipopt_hessian=args.hessian, svg_snap_tol=args.svg_tolerance)
     if args.preset is not None:
         keys = preset(args.preset)
     else:
-        keys = plan(_names(args.patterns), _names(args.criteria), args.surfaces, args.first_seed)
+        keys = plan(
+            _names(args.patterns),
+            _names(args.criteria),
+            args.surfaces,
+            args.first_seed,
+            settings=settings,
+        )
     config = StudyConfig(
         deform=not args.no_deform,
-        settings=DEFAULTS.with_(ipopt_hessian=args.hessian),
+        settings=settings,
         lookahead=args.lookahead,
         deploy_check=args.deploy_check,
     )
@@ -763,8 +820,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
     except StudyInterrupted as stop:
         bar.close()
         print(
-            f"rigidfold: interrupted; {stop.finished} finished runs are in {args.db}; run the "
-            "same command to resume",
+            one_line(
+                f"rigidfold: interrupted; {stop.finished} finished runs are in {args.db}; run "
+                "the same command to resume"
+            ),
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
@@ -776,7 +835,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
     )
     if result["failed"]:
         print(
-            f"rigidfold: {failure_summary(result['failed'], result['ran'], args.db)}",
+            one_line(f"rigidfold: {failure_summary(result['failed'], result['ran'], args.db)}"),
             file=sys.stderr,
         )
         return EXIT_FAILED
@@ -824,7 +883,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits
         return code
     except ValueError as exc:
-        print(f"rigidfold: error: {exc}", file=sys.stderr)
+        _error(str(exc))
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("rigidfold: interrupted", file=sys.stderr)
@@ -836,11 +895,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         reason = exc.strerror or str(exc)
         if exc.filename is not None:  # a file the library did not report itself
-            print(f"rigidfold: error: {exc.filename}: {reason}", file=sys.stderr)
+            _error(f"{exc.filename}: {reason}")
             return EXIT_USAGE
         # standard output cannot be written (``> /dev/full``, a full disk)
         _drop_stdout()
-        print(f"rigidfold: error: cannot write the output: {reason}", file=sys.stderr)
+        _error(f"cannot write the output: {reason}")
         return EXIT_USAGE
     finally:
         if args.verbose:

@@ -121,6 +121,17 @@ class Settings:
         of drawing programs (about 1e-3 px) lies far below the default; Origami Simulator
         merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals, and a carelessly
         drawn pattern may need 1e-3, which would also merge real features of some designs.
+    svg_snap_tol : float
+        Crease patterns drawn in SVG: slips of the pen up to this times the diagonal of the
+        drawing's bounding box are mended, where a crease would otherwise end on nothing
+        (refused): an overshoot that far past the line a crease crosses is cut off, and a
+        crease that ends that far short of a line is extended to it. Origami Simulator's own
+        examples have slips of 4e-4 of their diagonals (its 3 px merge tolerance hides them);
+        0 mends nothing. The command line's ``--svg-tolerance``.
+    max_svg_depth : int
+        Deepest nesting of elements accepted in an SVG drawing: a deeper file is refused with
+        a one-line error before svgelements, which reads it recursively, exhausts Python's
+        recursion limit (near 1,000 levels). Drawing programs nest groups a few levels deep.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -381,6 +392,8 @@ class Settings:
     triangulation_area_tol: float = 1e-12
     # reading SVG drawings
     svg_merge_tol: float = 1e-4
+    svg_snap_tol: float = 1e-2
+    max_svg_depth: int = 100
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
@@ -422,6 +435,10 @@ class Settings:
             value = getattr(self, name)
             if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")
+        for name in ("svg_merge_tol", "svg_snap_tol"):
+            value = getattr(self, name)
+            if not (isinstance(value, float | int) and 0 <= value < 1):
+                raise ValueError(f"{name} must be a fraction from 0 to below 1, got {value!r}")
         if not 0 < self.sparse_shift < 1:
             raise ValueError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
         least = {
@@ -430,6 +447,7 @@ class Settings:
             "sparse_iterations": 1,
             "projection_vertices": 3,
             "projection_max_iter": 1,
+            "max_svg_depth": 1,
         }
         for name, low in least.items():
             value = getattr(self, name)

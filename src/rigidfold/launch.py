@@ -6,14 +6,23 @@ Kept apart from :mod:`rigidfold.cli` so that the restart with the pinned numeric
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
+
+EXIT_INTERRUPTED = 130  # as rigidfold.cli, which is not imported yet
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from rigidfold.numerics import restart_pinned
+    """Run the command line; Ctrl-C at any time, while the libraries load too, exits 130
+    with one line ``rigidfold: interrupted``, not a traceback."""
+    try:
+        from rigidfold.numerics import restart_pinned
 
-    if argv is None:  # the process's own command line: it can be started again
-        restart_pinned()
-    from rigidfold.cli import main as cli_main
+        if argv is None:  # the process's own command line: it can be started again
+            restart_pinned()
+        from rigidfold.cli import main as cli_main
 
-    return cli_main(argv)
+        return cli_main(argv)
+    except KeyboardInterrupt:
+        print("rigidfold: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED

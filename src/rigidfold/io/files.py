@@ -198,12 +198,28 @@ def _create_temp(directory: Path, stem: str) -> tuple[int, Path]:
     new name is tried) with the permissions the umask allows, like any new file.
     """
     for _ in range(100):
-        tmp = directory / f".{stem[:200]}.{secrets.token_hex(6)}.tmp"
+        tmp = directory / f".{_cut(stem, _TEMP_STEM_BYTES)}.{secrets.token_hex(6)}.tmp"
         try:
             return os.open(tmp, _TEMP_FLAGS, 0o666), tmp
         except FileExistsError:
             continue
     raise FileExistsError(f"no free temporary file name in {directory}")
+
+
+_TEMP_STEM_BYTES = 200
+"""Most bytes of a file's name kept in its temporary name: with the dot, the random part and
+``.tmp`` (18 bytes) it stays within the 255 bytes of a name on Linux and macOS."""
+
+
+def _cut(name: str, limit: int) -> str:
+    """The longest start of ``name`` that is at most ``limit`` bytes in the file system's
+    encoding, cut between characters (a CJK character is 3 bytes in UTF-8)."""
+    size = 0
+    for k, ch in enumerate(name):
+        size += len(os.fsencode(ch))
+        if size > limit:
+            return name[:k]
+    return name
 
 
 def temp_files(directory: Path, names: Iterable[str]) -> list[Path]:
@@ -234,8 +250,9 @@ _TEMP_NAME = re.compile(r"\.(?P<stem>.+)\.[0-9a-f]+\.tmp", re.DOTALL)
 
 
 def _cut_from(stem: str, name: str) -> bool:
-    """Whether a temporary file's ``stem`` is ``name``, or ``name`` cut (a long prefix)."""
-    return stem == name or (len(stem) >= 64 and name.startswith(stem))
+    """Whether a temporary file's ``stem`` is ``name``, or ``name`` cut to
+    ``_TEMP_STEM_BYTES`` (:func:`_cut`)."""
+    return stem == name or stem == _cut(name, _TEMP_STEM_BYTES)
 
 
 def _reason(exc: OSError) -> str:

@@ -6,7 +6,12 @@ flat facet lines, magenta undriven creases, green cuts, and a crease's stroke op
 fraction of 180 degrees it folds. :func:`read_svg` reads such a drawing into its planar
 faces, in the drawing's own coordinates (user units, y flipped to point up).
 
-What is read (svgelements parses the file: transforms, ``viewBox``, ``<use>``, styles):
+What is read (svgelements parses the file: transforms, ``viewBox``, ``<use>``, styles), once
+the XML has been walked without recursion: elements nested deeper than
+``Settings.max_svg_depth``, an ``<svg>`` ``width`` or ``height`` that is not a positive
+finite length, a ``viewBox`` that is not four finite numbers with a positive size, and a
+``transform`` that is not transform functions of finite numbers are refused before
+svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or IndexError):
 
 * every ``<line>``, ``<polyline>``, ``<polygon>``, ``<rect>`` and ``<path>`` with a stroke;
   unstroked shapes, text and images are not drawn lines and are skipped. A curved piece
@@ -18,6 +23,11 @@ What is read (svgelements parses the file: transforms, ``viewBox``, ``<use>``, s
   pieces shorter than that are dropped. A piece drawn twice is kept once: if one drawing
   is black it stays boundary, other differing colours are refused. Where just two pieces
   of the same colour and opacity meet in a straight line, they become one line;
+* slips of the pen up to ``Settings.svg_snap_tol`` times the diagonal are mended where a
+  crease would otherwise end on nothing: an overshoot past the line a crease crosses (the
+  boundary among them) is cut off, a piece drawn in two crease colours (one crease running
+  on along another) is dropped, and a crease that ends short of a line is extended to it
+  (:func:`_mend`);
 * the black lines must form one closed outline, every crease must lie inside it and end
   on another line, and every face must be a simple polygon (no holes, no crease loop
   hanging at one point). Each problem is a one-line ``ValueError`` naming the file.
@@ -31,6 +41,7 @@ is ``"unit"``, scale 1.
 from __future__ import annotations
 
 import colorsys
+import contextlib
 import math
 import os
 import re
@@ -57,6 +68,13 @@ magenta (300) is that colour; any other stroke is refused."""
 
 HUE_TOLERANCE = 30.0
 """Largest hue difference (degrees) of a stroke from its colour in :data:`COLOURS`."""
+
+_MENDS = 3
+"""How many times the slips of a drawing are mended (:func:`_mend`) and the drawing noded
+again, at most: cutting off an overshoot can leave another loose end."""
+
+_LARGEST = 1e150
+"""Largest extent of a drawing in its own units: squares of its lengths stay finite."""
 
 _HUES = {"M": 0.0, "F": 60.0, "C": 120.0, "V": 240.0, "U": 300.0}
 _SHAPES = (se.SimpleLine, se.Polyline, se.Polygon, se.Rect, se.Path, se.Circle, se.Ellipse)
@@ -111,10 +129,12 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
     Raises
     ------
     ValueError
-        One line naming the file: unreadable, not an SVG, no lines, a curve, an unknown or
-        a cut (green) colour, no boundary, a boundary that is not one closed outline (open,
-        branching, several pieces, holes), creases outside the boundary, a crease ending
-        inside a face, a face that is not a simple polygon.
+        One line naming the file: unreadable, not an SVG, elements nested deeper than
+        ``settings.max_svg_depth``, a ``width``, ``height``, ``viewBox`` or ``transform``
+        that is not finite numbers (or scales the drawing to nothing), no lines, a curve, an
+        unknown or a cut (green) colour, no boundary, a boundary that is not one closed
+        outline (open, branching, several pieces, holes), creases outside the boundary, a
+        crease ending inside a face, a face that is not a simple polygon.
     """
     path = Path(path)
     try:
@@ -122,9 +142,17 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
     except OSError as exc:
         raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
     try:
+        _check_xml(data, settings)
+    except ElementTree.ParseError as exc:
+        raise ValueError(f"not an SVG file: {path}: {exc}") from None
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+    try:
         svg = se.SVG.parse(BytesIO(data))
     except (ElementTree.ParseError, ValueError) as exc:
         raise ValueError(f"not an SVG file: {path}: {exc}") from None
+    except _SVGELEMENTS_ERRORS as exc:
+        raise ValueError(f"{path}: {_cannot_read(exc)}") from None
     if not isinstance(svg, se.SVG):
         raise ValueError(f"not an SVG file: {path}: the root element is not <svg>")
     try:
@@ -136,10 +164,24 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
 def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     unit, scale, to_user = _units(svg)
     ends, letters, angles = _lines(svg, to_user)
-    tol = settings.svg_merge_tol * float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
-    xy, edges, letters, angles = _node(ends, letters, angles, tol)
-    xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
-    _check_creases(xy, edges, letters, _check_boundary(xy, edges, letters), tol)
+    across = float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
+    tol, snap = settings.svg_merge_tol * across, settings.svg_snap_tol * across
+    pieces: tuple[np.ndarray, list[str], list[float]] | None = (ends, letters, angles)
+    for _ in range(_MENDS):
+        if pieces is None:
+            break
+        xy, edges, letters, angles = _node(*pieces, tol, snap)
+        xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
+        pieces = _mend(xy, edges, letters, angles, snap)
+    boundary = _check_boundary(xy, edges, letters)
+    inside = _inside(xy, edges, boundary, letters, snap)
+    if not inside.all():
+        xy, edges = _compact(xy, edges[inside])
+        letters = [a for a, k in zip(letters, inside, strict=True) if k]
+        angles = [a for a, k in zip(angles, inside, strict=True) if k]
+        xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
+        boundary = _check_boundary(xy, edges, letters)
+    _check_creases(xy, edges, letters, boundary, max(tol, snap))
     return SvgDrawing(
         xy=xy,
         polygons=_faces(xy, edges),
@@ -151,10 +193,144 @@ def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     )
 
 
+# ------------------------------------------------------------------------- the XML
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_LENGTH = re.compile(rf"\s*({_NUMBER})\s*([A-Za-z%]*)\s*")
+_SEPARATORS = re.compile(r"[\s,]+")
+_TRANSFORM_NUMBERS = {
+    "matrix": (6,),
+    "translate": (1, 2),
+    "translatex": (1,),
+    "translatey": (1,),
+    "scale": (1, 2),
+    "scalex": (1,),
+    "scaley": (1,),
+    "rotate": (1, 3),
+    "skew": (1, 2),
+    "skewx": (1,),
+    "skewy": (1,),
+}
+"""How many numbers each transform function of svgelements takes."""
+
+
+def _check_xml(data: bytes, settings: Settings) -> None:
+    """Walk the XML once before svgelements reads it, without recursion: ValueError for
+    elements nested deeper than ``settings.max_svg_depth`` and for the attributes svgelements
+    would fail on with a ZeroDivisionError or IndexError (:func:`_check_attributes`);
+    ``ElementTree.ParseError`` for text that is not XML."""
+    parser: ElementTree.XMLPullParser = ElementTree.XMLPullParser(events=("start", "end"))
+    depth = 0
+    step = 1 << 16
+    for start in range(0, len(data) + 1, step):
+        if start < len(data):
+            parser.feed(data[start : start + step])
+        else:
+            parser.close()
+        for event in parser.read_events():
+            kind, element = event[0], event[-1]
+            if not isinstance(element, ElementTree.Element):
+                continue  # only "start" and "end" events are asked for
+            if kind == "end":
+                depth -= 1
+                element.clear()
+                continue
+            depth += 1
+            if depth > settings.max_svg_depth:
+                raise ValueError(
+                    f"its elements nest more than {settings.max_svg_depth} levels deep (at "
+                    f"<{_local(element.tag)}>; Settings.max_svg_depth)"
+                )
+            _check_attributes(element)
+
+
+def _check_attributes(element: ElementTree.Element) -> None:
+    """ValueError naming the element and the value for a ``width`` or ``height`` of an
+    ``<svg>`` that is not a positive finite length, a ``viewBox`` that is not four finite
+    numbers with a positive width and height, and a ``transform`` that is not a list of
+    transform functions of finite numbers."""
+    tag = _local(element.tag)
+    key = element.get("id")
+    name = f'<{tag} id="{key}">' if key else f"<{tag}>"
+    if tag == "svg":
+        for size in ("width", "height"):
+            text = element.get(size)
+            length = None if text is None else _LENGTH.fullmatch(text)
+            if text is not None and not (length and 0 < float(length[1]) < math.inf):
+                raise ValueError(
+                    f'{name} has {size}="{text}": a {size} is a positive finite length, such '
+                    "as 210mm or 800"
+                )
+    text = element.get("viewBox")
+    if text is not None and text.strip():
+        try:
+            box = [float(v) for v in _SEPARATORS.split(text.strip())]
+        except ValueError:
+            box = []
+        if not (len(box) == 4 and all(map(math.isfinite, box)) and min(box[2:]) > 0):
+            raise ValueError(
+                f'{name} has viewBox="{text}": a viewBox is four finite numbers "min-x min-y '
+                'width height", the width and height positive'
+            )
+    text = element.get("transform")
+    if text is not None and not _transform_ok(text):
+        raise ValueError(
+            f'{name} has transform="{text}": a transform is a list of matrix(a,b,c,d,e,f), '
+            "translate, scale, rotate, skewX or skewY of finite numbers"
+        )
+
+
+def _transform_ok(text: str) -> bool:
+    """Whether svgelements reads the transform attribute ``text`` as written: only transform
+    functions, each with as many finite numbers as it takes (``"none"`` is none)."""
+    text = text.lower()
+    if text.strip() in ("", "none"):
+        return True
+    if _SEPARATORS.sub("", se.REGEX_TRANSFORM_TEMPLATE.sub("", text)):
+        return False  # something besides the functions: unknown words, a missing bracket
+    for function, arguments in se.REGEX_TRANSFORM_TEMPLATE.findall(text):
+        numbers = [float(v) for v, _ in se.REGEX_TRANSFORM_PARAMETER.findall(arguments)]
+        if _SEPARATORS.sub("", se.REGEX_TRANSFORM_PARAMETER.sub("", arguments)):
+            return False  # something besides numbers: nan, inf, words
+        if len(numbers) not in _TRANSFORM_NUMBERS[function]:
+            return False
+        if not all(map(math.isfinite, numbers)):
+            return False
+    return True
+
+
+def _local(tag: str) -> str:
+    """An XML tag without its namespace: ``{http://www.w3.org/2000/svg}g`` -> ``g``."""
+    return tag.rpartition("}")[2]
+
+
+_SVGELEMENTS_ERRORS = (ArithmeticError, IndexError, RecursionError)
+"""What svgelements raises on drawings it cannot compute with: arithmetic on degenerate or
+enormous numbers, a transform or style it misreads, references in a loop."""
+
+
+def _cannot_read(exc: BaseException) -> str:
+    """The message of :data:`_SVGELEMENTS_ERRORS`."""
+    hint = (
+        "do its <use> elements refer to each other in a loop?"
+        if isinstance(exc, RecursionError)
+        else "check the numbers of its width, height, viewBox and transform attributes and styles"
+    )
+    return f"svgelements cannot read the drawing ({type(exc).__name__}: {exc}): {hint}"
+
+
+@contextlib.contextmanager
+def _svgelements():
+    """Turn :data:`_SVGELEMENTS_ERRORS` into a one-line ValueError."""
+    try:
+        yield
+    except _SVGELEMENTS_ERRORS as exc:
+        raise ValueError(_cannot_read(exc)) from None
+
+
 # ------------------------------------------------------------------------- the drawing
 def _units(svg: se.SVG) -> tuple[str, float, se.Matrix]:
     """(unit, metres per user unit, matrix from svgelements' pixels to user units)."""
-    to_user = ~se.Matrix(svg.viewbox_transform) if svg.viewbox_transform else se.Matrix()
+    to_user = _to_user(svg)
     width = str(svg.values.get("width", ""))
     match = re.fullmatch(r"\s*(\+?[\d.]+(?:[eE][-+]?\d+)?)\s*(mm|cm|in|pt)\s*", width)
     if match is None or not svg.width > 0:
@@ -168,10 +344,32 @@ def _units(svg: se.SVG) -> tuple[str, float, se.Matrix]:
     return unit, px_x * float(match.group(1)) * UNITS[unit] / svg.width, to_user
 
 
+def _to_user(svg: se.SVG) -> se.Matrix:
+    """The inverse of the root's viewBox transform (a scale and a translation), computed
+    without the determinant (whose square of the scale underflows or overflows first);
+    ValueError when the scale is not a finite nonzero number or its inverse overflows."""
+    with _svgelements():
+        transform = svg.viewbox_transform
+    if not transform:
+        return se.Matrix()
+    m = se.Matrix(transform)
+    with np.errstate(all="ignore"):
+        a, d = np.float64(1.0) / m.a, np.float64(1.0) / m.d
+        inverse = [a, 0.0, 0.0, d, -m.e * a, -m.f * d]
+    if m.b or m.c or not np.isfinite([m.a, m.d, m.e, m.f, *inverse]).all() or 0 in (a, d):
+        raise ValueError(
+            f'the viewBox="{svg.values.get("viewBox")}" scales the drawing to its width="'
+            f'{svg.values.get("width")}" and height="{svg.values.get("height")}" by '
+            f"{m.a:.3g} x {m.d:.3g}, which cannot be computed with"
+        )
+    return se.Matrix(*map(float, inverse))
+
+
 def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list[float]]:
     """Every straight piece drawn: ends (n, 2, 2) in user units y up, letters, fold angles."""
     ends, letters, angles = [], [], []
-    shapes = [e for e in svg.elements() if isinstance(e, _SHAPES)]
+    with _svgelements():
+        shapes = [e for e in svg.elements() if isinstance(e, _SHAPES)]
     for k, shape in enumerate(shapes, start=1):
         tag = shape.values.get("tag", type(shape).__name__.lower())
         name = f'<{tag} id="{shape.id}">' if shape.id else f"<{tag}> (drawn element {k})"
@@ -180,7 +378,15 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
         letter = _letter(shape.stroke, shape.values.get("stroke"), name)
         opacity = _opacity(shape, name)
         angle = {"M": -180.0 * opacity, "V": 180.0 * opacity, "U": math.nan}.get(letter, 0.0)
-        for piece in se.Path(shape).segments():
+        m = shape.transform
+        if not np.isfinite([m.a, m.b, m.c, m.d, m.e, m.f]).all():
+            raise ValueError(
+                f"{name} is drawn with a transform that is not finite, matrix({m.a:g}, {m.b:g}, "
+                f"{m.c:g}, {m.d:g}, {m.e:g}, {m.f:g}) (its transforms and the viewBox multiplied)"
+            )
+        with _svgelements():
+            pieces = list(se.Path(shape).segments())
+        for piece in pieces:
             if isinstance(piece, se.Move):
                 continue
             if not isinstance(piece, se.Line | se.Close):
@@ -192,6 +398,11 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
                 to_user.point_in_matrix_space(piece.start),
                 to_user.point_in_matrix_space(piece.end),
             )
+            if not np.isfinite([a.x, a.y, b.x, b.y]).all():
+                raise ValueError(
+                    f"{name} has a line from ({a.x:g}, {a.y:g}) to ({b.x:g}, {b.y:g}): "
+                    "coordinates must be finite numbers (transforms and the viewBox applied)"
+                )
             ends.append([[a.x, 0.0 - a.y], [b.x, 0.0 - b.y]])
             letters.append(letter)
             angles.append(angle)
@@ -202,7 +413,15 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
         )
     if "B" not in letters:
         raise ValueError("no boundary: no black lines (Origami Simulator draws it black)")
-    return np.array(ends, dtype=float), letters, angles
+    drawn = np.array(ends, dtype=float)
+    with np.errstate(over="ignore"):
+        across = float(np.linalg.norm(np.ptp(drawn.reshape(-1, 2), axis=0)))
+    if not across <= _LARGEST:
+        raise ValueError(
+            f"its lines span {across:.3g} drawing units (their transforms and viewBox "
+            f"applied): more than {_LARGEST:g}, too large to compute with"
+        )
+    return drawn, letters, angles
 
 
 def _opacity(shape: se.Shape, name: str) -> float:
@@ -240,11 +459,13 @@ def _letter(colour: se.Color, written: str | None, name: str) -> str:
 
 # ------------------------------------------------------------------------- the geometry
 def _node(
-    ends: np.ndarray, letters: list[str], angles: list[float], tol: float
+    ends: np.ndarray, letters: list[str], angles: list[float], tol: float, snap: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, list[str], list[float]]:
     """The drawn pieces split where they meet, close points merged, repeats dropped.
 
-    ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance.
+    ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance; snap : a piece
+    no longer than this drawn in two crease colours (where a crease overshoots its end along
+    another) is dropped, for :func:`_mend` to join the lines again, instead of refused.
     Returns xy (V, 2), edges (E, 2) int64 (in drawing order), their letters and angles.
     """
     a, b = ends[:, 0], ends[:, 1]
@@ -266,6 +487,7 @@ def _node(
     piece = np.flatnonzero(seg[:-1] == seg[1:])
     kept: dict[tuple[int, int], int] = {}
     edges: list[tuple[int, int]] = []
+    dropped: set[int] = set()
     out_letters, out_angles = [], []
     for k in piece:
         u, v, source = int(vertex[k]), int(vertex[k + 1]), drawn[seg[k]]
@@ -281,12 +503,20 @@ def _node(
         e = kept[key]
         if letter == "B":
             out_letters[e], out_angles[e] = "B", 0.0
+            dropped.discard(e)
         elif out_letters[e] not in ("B", letter):
-            raise ValueError(
-                f"the line from {_at(points[first[u]])} to {_at(points[first[v]])} is drawn "
-                f"both {COLOURS[out_letters[e]]} and {COLOURS[letter]}"
-            )
-    return (*_compact(points[first], np.array(edges, dtype=np.int64)), out_letters, out_angles)
+            if np.linalg.norm(points[first[u]] - points[first[v]]) > snap:
+                raise ValueError(
+                    f"the line from {_at(points[first[u]])} to {_at(points[first[v]])} is "
+                    f"drawn both {COLOURS[out_letters[e]]} and {COLOURS[letter]}"
+                )
+            dropped.add(e)
+    keep = [e for e in range(len(edges)) if e not in dropped]
+    return (
+        *_compact(points[first], np.array(edges, dtype=np.int64).reshape(-1, 2)[keep]),
+        [out_letters[e] for e in keep],
+        [out_angles[e] for e in keep],
+    )
 
 
 def _splits(
@@ -364,6 +594,58 @@ def _join_straight(
     return xy, edges, [letters[e] for e in keep], [angles[e] for e in keep]
 
 
+def _mend(
+    xy: np.ndarray, edges: np.ndarray, letters: list[str], angles: list[float], snap: float
+) -> tuple[np.ndarray, list[str], list[float]] | None:
+    """The drawing with its slips within ``snap`` mended, as pieces to node again (ends
+    (n, 2, 2), letters, angles), or None when it has none. A loose crease end (one that
+    touches no other line) is mended: the piece no longer than ``snap`` that ends there (an
+    overshoot past the line it crosses) is dropped; a longer crease is extended from there to
+    the first line that it points at within ``snap``, or else to the nearest point within
+    ``snap`` of a line that does not touch it. Boundary (black) lines are left as drawn.
+    xy (V, 2), edges (E, 2) -> see above."""
+    crease = np.array(letters) != "B"
+    degree = np.bincount(edges.ravel(), minlength=len(xy))
+    loose = (degree[edges] == 1) & crease[:, None]  # (E, 2): a crease's loose ends
+    if not loose.any():
+        return None
+    length = np.linalg.norm(xy[edges[:, 1]] - xy[edges[:, 0]], axis=1)
+    keep = ~(loose.any(axis=1) & (length <= snap))
+    edges, letters = edges[keep], [a for a, k in zip(letters, keep, strict=True) if k]
+    angles = [a for a, k in zip(angles, keep, strict=True) if k]
+    degree = np.bincount(edges.ravel(), minlength=len(xy))
+    e, side = np.nonzero((degree[edges] == 1) & (np.array(letters) != "B")[:, None])
+    w, p = edges[e, side], edges[e, 1 - side]  # the loose end, the crease's other end
+    lines = shapely.linestrings(xy[edges])
+    near, other = shapely.STRtree(lines).query(
+        shapely.points(xy[w]), predicate="dwithin", distance=snap
+    )
+    touching = (edges[other] == w[near, None]) | (edges[other] == p[near, None])
+    near, other = near[~touching.any(axis=1)], other[~touching.any(axis=1)]
+    pieces = [xy[edges]]
+    for k in np.unique(near):
+        f = other[near == k]
+        a, r = xy[edges[f, 0]], xy[edges[f, 1]] - xy[edges[f, 0]]
+        start = xy[w[k]]
+        d = start - xy[p[k]]
+        d = d / np.linalg.norm(d)
+        denom = _cross(np.broadcast_to(d, r.shape), r)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = _cross(a - start, r) / denom  # along the crease's direction from its end
+            t = _cross(a - start, np.broadcast_to(d, r.shape)) / denom  # along the line
+        ahead = (denom != 0) & (s >= 0) & (s <= snap) & (t >= 0) & (t <= 1)
+        if ahead.any():
+            target = start + s[ahead].min() * d
+        else:
+            t = np.clip(np.sum((start - a) * r, axis=1) / np.sum(r * r, axis=1), 0, 1)
+            foot = a + t[:, None] * r
+            target = foot[np.argmin(np.linalg.norm(foot - start, axis=1))]
+        pieces.append(np.array([[start, target]]))
+        letters.append(letters[e[k]])
+        angles.append(angles[e[k]])
+    return np.concatenate(pieces), letters, angles
+
+
 def _compact(xy: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Only the vertices that edges use, numbered in order of first use.
     xy (V, 2), edges (E, 2) -> xy (V', 2), edges (E, 2)."""
@@ -405,6 +687,22 @@ def _check_boundary(xy: np.ndarray, edges: np.ndarray, letters: list[str]) -> li
     raise ValueError(f"the boundary (black) is {len(loops)} separate outlines, not one sheet")
 
 
+def _inside(
+    xy: np.ndarray, edges: np.ndarray, boundary: list[int], letters: list[str], snap: float
+) -> np.ndarray:
+    """(E,) bool: False for the creases outside the ``boundary`` (its vertex indices) whose
+    ends both lie within ``snap`` of it (overshoots of creases that end on the boundary),
+    True for every other edge."""
+    outline = shapely.Polygon(xy[boundary])
+    mid = xy[edges].mean(axis=1)
+    outside = ~shapely.contains_xy(outline, mid[:, 0], mid[:, 1]) & (np.array(letters) != "B")
+    if not outside.any():
+        return ~outside
+    gap = shapely.distance(outline.exterior, shapely.points(xy[edges[outside]]))  # (k, 2)
+    outside[outside] = (gap <= snap).all(axis=1)
+    return ~outside
+
+
 def _check_creases(
     xy: np.ndarray, edges: np.ndarray, letters: list[str], boundary: list[int], tol: float
 ) -> None:
@@ -420,7 +718,8 @@ def _check_creases(
     if (degree == 1).any():
         raise ValueError(
             f"a crease ends inside a face at {_at(xy[degree == 1][0])}: creases must end on "
-            f"another line (an end within {tol:.3g} drawing units of a line is joined to it)"
+            f"another line (an end within {tol:.3g} drawing units of a line is joined to it; "
+            "Settings.svg_snap_tol)"
         )
     n, component = connected_components(_graph(edges, len(xy)), directed=False)
     if n > 1:

@@ -87,12 +87,15 @@ def read_pattern_file(
         faces = data.pattern.faces
         fixed = data.pattern.edges[data.pattern.fixed]
         unit, per_unit = data.unit, data.scale
+        plan, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
     else:
         from rigidfold.io.svg_read import read_svg
 
         drawing = read_svg(path, settings=settings)
         unit, per_unit = drawing.unit, drawing.scale
         xy = drawing.xy * per_unit
+        # the extent is checked before the faces are triangulated (where it could overflow)
+        plan, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
         coords = np.column_stack([xy, np.zeros(len(xy))])
         triangles, diagonals = triangulate_polygons(
             coords,
@@ -102,7 +105,7 @@ def read_pattern_file(
         )
         faces = orient_up(coords, triangles)
         fixed = np.asarray(diagonals if rigid_panels else [], dtype=np.int64).reshape(-1, 2)
-    xy, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
+    xy = plan
     _check_unfolded(xy, faces, path, settings)
     source = {
         "file": path.name,

@@ -126,12 +126,18 @@ def footprint_mesh(
     ``settings.mesh_angle_cap``) (except at the footprint's own corners sharper than that)
     and no triangle is larger than the equilateral triangle of side ``edge_length``. The
     footprint's corners come first, in order, then the points on its sides, then the inner
-    points. Returns the plan vertices (V, 2) and counter-clockwise triangles (F, 3).
+    points. Returns the plan vertices (V, 2) and counter-clockwise triangles (F, 3). An edge
+    length that is not a positive number up to ``settings.max_coordinate`` is a ValueError.
     """
     import triangle
 
     if not (math.isfinite(edge_length) and edge_length > 0):
         raise ValueError(f"the edge length must be a positive number of metres, got {edge_length}")
+    if edge_length > settings.max_coordinate:  # its square would overflow
+        raise ValueError(
+            f"the edge length must be at most {settings.max_coordinate:g} m, the largest plan "
+            f"(Settings.max_coordinate), got {edge_length:g} m"
+        )
     area = abs(_signed_area(xy))
     triangle_area = math.sqrt(3) / 4 * edge_length**2
     if area / triangle_area > settings.max_pattern_faces:

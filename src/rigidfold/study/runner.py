@@ -80,7 +80,7 @@ def plan(
     runs (checked before the list is built).
     """
     for p in patterns:
-        parse_pattern(p)
+        parse_pattern(p, settings=settings)
     for c in criteria:
         if c not in CRITERIA:
             raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")

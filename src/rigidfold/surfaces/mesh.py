@@ -237,6 +237,8 @@ def read_mesh(
         )
     if not path.is_file():
         raise ValueError(f"cannot read mesh {path}: no such file")
+    if kind == "stl":
+        _check_stl(path)
     import trimesh
 
     try:
@@ -255,6 +257,36 @@ def read_mesh(
     if problem:
         raise ValueError(f"mesh {path}: {problem}")
     return vertices, triangles
+
+
+def _check_stl(path: Path) -> None:
+    """ValueError naming ``path`` for an STL file that is neither a binary STL of the size its
+    header gives (84 bytes, then 50 per triangle counted at byte 80) nor ASCII STL text
+    (``solid`` ...): a damaged or cut binary file, which trimesh would try to read as text
+    of an unknown encoding."""
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as file:
+            head = file.read(84)
+            if len(head) == 84 and 84 + 50 * int.from_bytes(head[80:], "little") == size:
+                return
+            if head.lstrip()[:5].lower() == b"solid":
+                file.seek(0)
+                file.read().decode("utf-8")
+                return
+    except OSError as exc:
+        raise ValueError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        pass
+    if len(head) < 84:
+        found = f"it has {size} bytes, fewer than the 84 of a binary STL header"
+    else:
+        count = int.from_bytes(head[80:], "little")
+        found = f"its header counts {count} triangles, {84 + 50 * count} bytes, but it has {size}"
+    raise ValueError(
+        f"mesh {path}: a damaged binary STL ({found}) and no ASCII STL (UTF-8 text starting "
+        "with 'solid')"
+    )
 
 
 def sample_mesh(
