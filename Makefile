@@ -52,6 +52,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_scale.py
 	$(PY) benchmarks/bench_generate_scale.py
 	$(PY) benchmarks/bench_numerics.py
+	$(PY) benchmarks/bench_path.py
+	$(PY) benchmarks/deploy_share.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

@@ -23,10 +23,12 @@ FINAL = "solutions/step_03_dof_06.fold"
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory) -> Path:
-    """A small finished run with Steps 8-9 (DOF 9 -> 6, four solutions), without its report."""
+    """A small finished run with Steps 8-9 on every solution (DOF 9 -> 6, four solutions),
+    without its report."""
     out = tmp_path_factory.mktemp("run") / "run"
     args = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "grid:4x4"]
-    assert main_code([*args, "--target-dof", "6", "--quiet", "--out", str(out)]) == 0
+    argv = [*args, "--target-dof", "6", "--check", "all", "--quiet", "--out", str(out)]
+    assert main_code(argv) == 0
     shutil.rmtree(out / "figures")
     shutil.rmtree(out / "final")
     (out / "report.html").unlink()

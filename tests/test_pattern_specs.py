@@ -259,14 +259,13 @@ def test_generate_on_a_6_by_4_grid(tmp_path):
     code = main([*argv, "--expr", expr, "--no-deform", "--quiet", "--out", str(tmp_path)])
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["final_dof"] == 1 and summary["stop"] == "target_reached"
-    # the method guarantees DOF 1 with no lock, not that the final design's branch of the
-    # folding motion reaches flat (issue 29): on this path it turns back, and the run says so
-    verdict = summary["verdict"]
-    assert (code, verdict["outcome"]) in ((0, "passed"), (1, "fell_short")), verdict
-    assert verdict.get("shortfalls", []) in ([], ["folding motion not traced for the final design"])
+    # with the deployability check, a design of the target DOF deploys by construction
+    assert summary["final_deploys"] is True
+    assert code == 0 and summary["verdict"]["outcome"] == "passed", summary["verdict"]
     assert summary["case"]["plan_size_m"] == [6.0, 4.0]
     files = sorted((tmp_path / "solutions").glob("*.fold"))
-    assert len(files) == summary["n_solutions"] == summary["initial_dof"]
+    # a fix may leave the DOF as it was (a crease whose every mode is already still)
+    assert len(files) == summary["n_solutions"] >= summary["initial_dof"]
     for path in files:
         analysis = analyze_file(path)
         meta = analysis.data.metadata

@@ -56,6 +56,10 @@ SUMMARY_SHAPE = Record(
         "N_reduce": Nullable(int),
         "N_lock": Nullable(int),
         "N_exceed": Nullable(int),
+        "N_path": Nullable(int),
+        "deploy_check": Nullable(bool),
+        "final_step": Nullable(int),
+        "final_deploys": Nullable(bool),
         "solutions": [str],
         "per_solution": [
             Record(
@@ -74,6 +78,9 @@ SUMMARY_SHAPE = Record(
                     ),
                     "motion": Nullable(
                         Record({"status": Nullable(str), "max_length_error": _NUMBERS})
+                    ),
+                    "deployability": Nullable(
+                        Record({"status": Nullable(str), "deploys": Nullable(bool)})
                     ),
                     "deformation": Nullable(
                         Record(
@@ -127,6 +134,7 @@ LOG_SHAPE = Record(
                     "dof": Nullable(int),
                     "F": _NUMBERS,
                     "iterations": Nullable(int),
+                    "path": Nullable(Record({"status": Nullable(str), "deploys": Nullable(bool)})),
                 },
                 ("outcome", "dof"),
             )
@@ -377,8 +385,15 @@ class RunData:
 
     @property
     def final(self) -> Design | None:
-        """The final design (the last solution), None when the run has no solution."""
-        return self.designs[-1] if self.designs else None
+        """The final design (the last solution, or the one ``final_step`` of summary.json
+        names: the lowest-DOF solution that deploys of a run that fell short), None when the
+        run has no solution."""
+        if not self.designs:
+            return None
+        step = self.summary.get("final_step")
+        if isinstance(step, int) and 0 <= step < len(self.designs):
+            return self.designs[step]
+        return self.designs[-1]
 
     @property
     def target_dof(self) -> int | None:

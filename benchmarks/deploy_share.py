@@ -1,0 +1,97 @@
+"""The share of generate runs that reach DOF 1 with a deployable design, before and after
+the deployability check (issue 29).
+
+Run with ``python benchmarks/deploy_share.py [--jobs 2] [--out FILE.jsonl]``.
+
+Each case runs twice with S-hat and the look-ahead: with the paper's Step 5
+(``deploy_check=False``; the final design's folding path is traced afterwards, as delivered)
+and with the deployability check (rigidfold's default). A run *deploys* when it reaches its
+target DOF 1 and the final design's folding path reaches the flat state (every fold angle
+below ``Settings.path_flat_tol``, every length kept). Cases: the crease patterns of Origami
+Simulator drawn by users (waterbomb, Resch's triangle tessellation, Miura-ori; tests/data)
+on the dome, the HP and a Bezier surface; the paper's patterns 1 and 2 on ten Bezier surfaces
+each; the paper's pattern 11 and a 9 x 9 grid on the dome and the HP: 33 cases. Prints one
+line per run, then the shares and the median times.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+DATA = Path(__file__).resolve().parents[1] / "tests" / "data" / "origami_simulator"
+DRAWN = ("waterbomb.svg", "reschTriTessellation.svg", "miura-ori.svg")
+
+
+def cases() -> list[tuple[str, str, int]]:
+    out = [(s, str(DATA / f), 7) for f in DRAWN for s in ("dome", "hp", "bezier")]
+    out += [("bezier", p, seed) for p in ("1", "2") for seed in range(101, 111)]
+    out += [(s, p, 0) for p in ("11", "grid:9x9") for s in ("dome", "hp")]
+    return out
+
+
+def run(case: tuple[str, str, int], deploy: bool) -> dict:
+    from rigidfold.case import make_case
+    from rigidfold.generate import Stop, generate
+    from rigidfold.mechanism.path import trace_path
+
+    surface, pattern, seed = case
+    t0 = time.perf_counter()
+    built = make_case(surface, pattern, seed=seed)
+    gen = generate(built, criterion="shat", seed=seed, lookahead=True, deploy_check=deploy)
+    final = gen.final
+    if final is not None and final.path is None:
+        final.path = trace_path(final.result.pattern, dof=final.mechanism.dof)
+    deploys = final is not None and final.path is not None and final.path.deploys
+    return {
+        "surface": surface,
+        "pattern": Path(pattern).name,
+        "seed": seed,
+        "deploy_check": deploy,
+        "stop": gen.stop_reason,
+        "final_dof": None if final is None else final.mechanism.dof,
+        "reached": gen.stop is Stop.TARGET_REACHED,
+        "deploys": bool(deploys),
+        "dof1_deploys": bool(gen.stop is Stop.TARGET_REACHED and deploys),
+        "path_status": None if final is None or final.path is None else final.path.status.value,
+        "N_lock": gen.n_lock,
+        "N_path": gen.n_path,
+        "solves": len(gen.attempts),
+        "time_s": time.perf_counter() - t0,
+        "path_s": sum(a.path_time for a in gen.attempts),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=None)
+    args = parser.parse_args()
+    work = [(c, d) for c in cases() for d in (False, True)]
+    rows = []
+    with ProcessPoolExecutor(args.jobs) as pool:
+        for row in pool.map(run, *zip(*work, strict=True)):
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+            if args.out:
+                with args.out.open("a") as f:
+                    f.write(json.dumps(row) + "\n")
+    for deploy in (False, True):
+        sel = [r for r in rows if r["deploy_check"] is deploy]
+        share = sum(r["dof1_deploys"] for r in sel) / len(sel)
+        name = "deployability check" if deploy else "paper's Step 5     "
+        print(
+            f"{name}: {sum(r['dof1_deploys'] for r in sel)}/{len(sel)} runs reach DOF 1 with a "
+            f"deployable design ({100 * share:.0f} %), DOF 1 reached "
+            f"{sum(r['reached'] for r in sel)}, median run "
+            f"{statistics.median(r['time_s'] for r in sel):.1f} s, "
+            f"N_path {sum(r['N_path'] for r in sel)}"
+        )
+
+
+if __name__ == "__main__":
+    main()
