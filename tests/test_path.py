@@ -18,12 +18,8 @@ from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate import AttemptOutcome, generate
 from rigidfold.io.fold import pattern_from_fold
-from rigidfold.mechanism.path import (
-    PathStatus,
-    RigidFoldingConstraints,
-    _System,
-    trace_path,
-)
+from rigidfold.mechanism.path import PathStatus, trace_path
+from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
 
@@ -74,7 +70,7 @@ def test_the_tangent_and_the_descent_direction_lie_in_the_null_space():
         J, J_rho = cons.jacobian(cons.x0)
         rho = cons.free_angles(cons.x0)
         t0 = np.random.default_rng(1).standard_normal(cons.n)
-        system = _System(J, J_rho, mode, t0, DEFAULTS)
+        system = System(J, J_rho, mode, t0, DEFAULTS)
         d = system.direction(t0, rho)
         assert np.abs(J @ d).max() < 1e-9 * max(np.abs(d).max(), 1e-300)
         if mode == "descent":

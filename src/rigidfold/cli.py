@@ -167,7 +167,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--retry-zero-dof",
         action="store_true",
         help="treat a 0-DOF solution as a lock and try the next crease (the paper's Step 5 "
-        "ends generation there)",
+        "ends generation there; with the deployability check, the default, a 0-DOF solution "
+        "is always retried, since it cannot deploy)",
     )
     gen.add_argument(
         "--no-deform",

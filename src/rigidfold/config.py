@@ -243,6 +243,9 @@ class Settings:
     path_corrector_iter, path_contraction : int, float
         Chord iterations of the corrector, and the largest ratio of successive corrections
         it accepts (a step that converges more slowly is halved).
+    path_turn_back : float
+        A 1-DOF path turns back (the shape does not deploy along it) when its folding
+        measure, having fallen, rises this much (a fraction of the design's) above its lowest.
     path_max_turn : float
         Largest angle, radians, between the tangent and the chord of one step (DOF 1).
     path_regularization, path_damping : float
@@ -250,7 +253,10 @@ class Settings:
         to the fold-angle metric of the Gauss-Newton direction (DOF > 1).
     path_stall_steps, path_stall_ratio : int, float
         With DOF > 1 the path stops short when this many steps in a row each lower the
-        folding measure by less than this fraction.
+        folding measure by less than this fraction (of its lowest so far).
+    path_wander_steps : int
+        With DOF 1 the path stops short when this many steps in a row bring the folding
+        measure no lower (by ``path_stall_ratio``) than its lowest so far.
     polish_tol : float
         Before the deployability check, an accepted solution is projected onto F = 0 to this
         F (:meth:`rigidfold.optimize.FormFindingProblem.polish`): developable to round-off.
@@ -375,14 +381,16 @@ class Settings:
     path_max_step: float = 0.5
     path_min_step: float = 1e-7
     path_max_fold_step: float = math.radians(5.0)
-    path_max_steps: int = 500
+    path_max_steps: int = 200
     path_corrector_iter: int = 8
     path_contraction: float = 0.5
+    path_turn_back: float = 0.05
     path_max_turn: float = math.radians(30.0)
     path_regularization: float = 1e-12
     path_damping: float = 1e-9
     path_stall_steps: int = 5
     path_stall_ratio: float = 1e-4
+    path_wander_steps: int = 40
     polish_tol: float = 1e-26
     deploy_check: bool = True
     deploy_check_max_dof: int = 1

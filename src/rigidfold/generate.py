@@ -301,7 +301,8 @@ def generate(
     (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
     rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
     on solutions of at most ``Settings.deploy_check_max_dof`` DOF, 0: all); one that does not
-    counts in N_path and is replaced like a lock (Step 7). False is the paper's method.
+    counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape (which cannot
+    deploy) is retried like a lock where the target is >= 1. False is the paper's method.
     A KeyboardInterrupt propagates after the callbacks of everything finished so far.
     """
     if criterion not in CRITERIA:
@@ -319,7 +320,9 @@ def generate(
     problem = case.problem(build_ipopt=solver == "ipopt")
     run.build_time = time.perf_counter() - t0
     groups = crease_groups(case.pattern, case.planes, case.settings) if case.planes else None
-    zero_ends = settings.zero_dof_ends or target_dof == 0
+    # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
+    # over-reduction, retried like a lock (as with zero_dof_ends=False)
+    zero_ends = (settings.zero_dof_ends and not deploy) or target_dof == 0
     locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
 
     def attempt(

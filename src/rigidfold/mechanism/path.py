@@ -11,13 +11,15 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
 * **DOF 1** (J has 3V - 1 independent rows): the path is the manifold itself. The tangent t
   solves the augmented system ``[J; t_prev^T] t = e``, so it keeps its orientation; the
   corrector is the chord (pseudo-arclength) iteration ``[J_k; t_k^T] dy = -[c(y); 0]`` with
-  the factors of the last point. The first direction is the one that lowers the folding
-  measure ``m = |rho_free|``. The trace goes on past the points where m stops falling (limit
-  points of m, where dm/ds changes sign) and so follows the whole closed branch if need be:
-  it ends at the flat state, back at the design (a closed loop that misses the flat state:
-  the path *turns back*), where a crease folds to ``path_fold_limit`` (its panels meet), or
-  when the step or the budget runs out; in the last three cases the other direction from the
-  design is traced too. A sign change of ``det [J; t^T]`` is a bifurcation point, which the
+  the factors of the latest iterate (self-stressed constraints, as a Miura-ori's rigid quads
+  give, take the projection form of :mod:`rigidfold.mechanism.rigid_folding`). The trace
+  starts in the direction that lowers the folding measure ``m = |rho_free|`` and passes the
+  points where m stops falling only on its way down: it ends at the flat state; where m,
+  having fallen, rises ``path_turn_back`` above its lowest (the path *turns back*: the
+  shape does not deploy along it); where a crease folds to ``path_fold_limit`` (its panels
+  meet); where m comes no lower for ``path_wander_steps`` steps (the path *stops short*); when
+  the budget runs out; or when the step does, and then the other direction from the design is
+  traced too. A sign change of ``det [J; t^T]`` is a bifurcation point, which the
   trace passes on its branch and records.
 * **DOF > 1** (or self-stressed constraints): the path is the one closest to the straight
   line in fold angles: each step moves along the Gauss-Newton direction d that takes the
@@ -44,8 +46,8 @@ import scipy.sparse.linalg as spla
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
 from rigidfold.mechanism.analysis import analyze
+from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System, correct
 from rigidfold.mesh import CreasePattern
-from rigidfold.optimize.residuals import fold_angle_gradients
 from rigidfold.status import Outcome
 
 
@@ -146,7 +148,7 @@ class FoldingPath:
                 frames.append(self.points[j])
                 continue
             guess = ((1 - w) * self.points[i - 1] + w * self.points[i]).ravel() / cons.scale
-            y, ok, _, _ = _correct(cons, guess, "projection", None, settings)
+            y, ok, _, _ = correct(cons, guess, "projection", None, settings)
             if ok:
                 frames.append(y.reshape(-1, 3) * cons.scale)
             else:
@@ -174,230 +176,6 @@ class FoldingPath:
             "bifurcations": len(self.bifurcations),
             "max_length_error": self.max_length_error,
         }
-
-
-class RigidFoldingConstraints:
-    """c(x) and its sparse Jacobian for one shape, in units of the mean edge length.
-
-    Rows: the edge lengths (E), the fixed creases' fold angles (n_fix), and a gauge of six
-    linear rows that hold the support triangle ``(a, b, c)`` still: a's three coordinates, b's
-    two across the edge ab, c's one across the triangle's plane. x is the vertex coordinates
-    over the mean edge length, (3V,). The sparsity pattern is built once; an evaluation fills
-    in its values.
-    """
-
-    def __init__(self, pattern: CreasePattern, support_face: int) -> None:
-        self.pattern = pattern
-        self.scale = float(np.mean(pattern.edge_lengths))
-        self.x0 = pattern.coords.ravel() / self.scale
-        self.L0 = pattern.edge_lengths / self.scale
-        fixed, free = pattern.fixed_creases, pattern.free_creases
-        self.n_fixed, self.free = len(fixed), free
-        self.rho_fixed0 = pattern.fold_angles[fixed]
-        self.fixed_stencils = pattern.crease_stencils(fixed)
-        self.free_stencils = pattern.crease_stencils(free)
-        a, b, c = (int(v) for v in pattern.faces[support_face])
-        p = pattern.coords
-        e1 = (p[b] - p[a]) / np.linalg.norm(p[b] - p[a])
-        normal = np.cross(p[b] - p[a], p[c] - p[a])
-        normal /= np.linalg.norm(normal)
-        e2 = np.cross(normal, e1)
-        c3 = np.arange(3)
-        self.gauge_rows = np.concatenate([c3, [3, 3, 3, 4, 4, 4, 5, 5, 5]])
-        self.gauge_cols = np.concatenate([3 * a + c3, 3 * b + c3, 3 * b + c3, 3 * c + c3])
-        self.gauge_vals = np.concatenate([np.ones(3), e2, normal, normal])
-        E, nf = len(pattern.edges), self.n_fixed
-        self.n_rows = E + nf + 6
-        e = pattern.edges
-        rows = [
-            np.repeat(np.arange(E), 6),
-            E + np.repeat(np.arange(nf), 12),
-            E + nf + self.gauge_rows,
-        ]
-        cols = [
-            np.hstack([3 * e[:, :1] + c3, 3 * e[:, 1:] + c3]).ravel(),
-            (3 * self.fixed_stencils[:, :, None] + c3).reshape(-1),
-            self.gauge_cols,
-        ]
-        self._J = _Pattern(np.concatenate(rows), np.concatenate(cols), (self.n_rows, self.n))
-        self._Jr = _Pattern(
-            np.repeat(np.arange(len(free)), 12),
-            (3 * self.free_stencils[:, :, None] + c3).reshape(-1),
-            (len(free), self.n),
-        )
-        self.gauge0 = self._gauge(self.x0)
-
-    @property
-    def n(self) -> int:
-        """Unknowns: 3V."""
-        return len(self.x0)
-
-    def _gauge(self, x: np.ndarray) -> np.ndarray:
-        return np.bincount(self.gauge_rows, self.gauge_vals * x[self.gauge_cols], minlength=6)
-
-    def residual(self, x: np.ndarray) -> np.ndarray:
-        """c(x) (m,): length errors, fixed-crease angle changes, gauge."""
-        X = x.reshape(-1, 3)
-        e = self.pattern.edges
-        length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
-        rho_fixed = fold_angle_gradients(X[self.fixed_stencils])[0]
-        return np.concatenate(
-            [length - self.L0, rho_fixed - self.rho_fixed0, self._gauge(x) - self.gauge0]
-        )
-
-    def free_angles(self, x: np.ndarray) -> np.ndarray:
-        """The free creases' fold angles (n_free,) at x, radians."""
-        return fold_angle_gradients(x.reshape(-1, 3)[self.free_stencils])[0]
-
-    def jacobian(self, x: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
-        """(J (m, n), J_rho (n_free, n)) at x, both sparse CSC: the constraints' Jacobian and
-        the free fold angles' gradients, in the scaled coordinates x."""
-        X = x.reshape(-1, 3)
-        e = self.pattern.edges
-        d = X[e[:, 1]] - X[e[:, 0]]
-        u = d / np.linalg.norm(d, axis=1)[:, None]
-        grad_fixed = fold_angle_gradients(X[self.fixed_stencils])[1]
-        grad_free = fold_angle_gradients(X[self.free_stencils])[1]
-        J = self._J.fill(
-            np.concatenate([np.hstack([-u, u]).ravel(), grad_fixed.ravel(), self.gauge_vals])
-        )
-        return J, self._Jr.fill(grad_free.ravel())
-
-    def length_error(self, x: np.ndarray) -> float:
-        """Largest |l - l0| / l0 at x."""
-        X = x.reshape(-1, 3)
-        e = self.pattern.edges
-        length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
-        return float(np.max(np.abs(length - self.L0) / self.L0))
-
-
-class _Pattern:
-    """A sparse matrix's pattern (COO rows and columns, no duplicates), filled in CSC."""
-
-    def __init__(self, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> None:
-        order = sp.csc_matrix((np.arange(1, len(rows) + 1, dtype=float), (rows, cols)), shape=shape)
-        self.order = order.data.astype(np.int64) - 1
-        self.indices, self.indptr, self.shape = order.indices, order.indptr, shape
-
-    def fill(self, values: np.ndarray) -> sp.csc_matrix:
-        """The matrix with ``values`` given in the COO order of the pattern."""
-        return sp.csc_matrix((values[self.order], self.indices, self.indptr), shape=self.shape)
-
-
-class _Factors:
-    """Sparse LU of a square matrix, with the sign of its determinant."""
-
-    def __init__(self, A: sp.spmatrix) -> None:
-        self.lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        return self.lu.solve(b)
-
-    @cached_property
-    def det_sign(self) -> int:
-        diag = self.lu.U.diagonal()
-        sign = int(np.prod(np.sign(diag)))
-        return sign * _parity(self.lu.perm_r) * _parity(self.lu.perm_c)
-
-
-def _parity(perm: np.ndarray) -> int:
-    """+1 for an even permutation, -1 for an odd one."""
-    seen = np.zeros(len(perm), bool)
-    sign = 1
-    for start in range(len(perm)):
-        if seen[start]:
-            continue
-        length, k = 0, start
-        while not seen[k]:
-            seen[k] = True
-            k = perm[k]
-            length += 1
-        if length % 2 == 0:
-            sign = -sign
-    return sign
-
-
-class _System:
-    """The factored linear system of one point of the trace (see the module's text).
-
-    mode "augmented": ``A = [J; t^T]`` (DOF 1); "projection": ``K = [[I, J^T], [J, -delta]]``
-    (DOF 1, self-stressed rows); "descent": ``K = [[J_rho^T J_rho + mu I, J^T], [J, -delta]]``
-    (DOF > 1). :meth:`direction` is the next tangent (or Gauss-Newton direction),
-    :meth:`correction` one corrector step.
-    """
-
-    def __init__(
-        self,
-        J: sp.csc_matrix,
-        J_rho: sp.csr_matrix,
-        mode: str,
-        t: np.ndarray | None,
-        settings: Settings,
-    ) -> None:
-        m, n = J.shape
-        self.mode, self.n, self.m, self.J_rho = mode, n, m, J_rho
-        if mode == "augmented":
-            assert t is not None
-            self.factors = _Factors(sp.vstack([J, sp.csr_matrix(t[None])]))
-            return
-        if mode == "projection":
-            M = sp.identity(n, format="csc")
-        else:
-            M = (J_rho.T @ J_rho) + settings.path_damping * sp.identity(n)
-        delta = settings.path_regularization
-        self.factors = _Factors(sp.bmat([[M, J.T], [J, -delta * sp.identity(m)]], format="csc"))
-
-    def direction(self, t: np.ndarray | None, rho: np.ndarray) -> np.ndarray:
-        """The unit tangent continuing ``t`` (DOF 1), or the Gauss-Newton step that takes the
-        free fold angles ``rho`` towards 0 within the mechanism (not normalised)."""
-        if self.mode == "augmented":
-            rhs = np.zeros(self.n)
-            rhs[-1] = 1.0
-            d = self.factors.solve(rhs)
-        else:
-            top = t if self.mode == "projection" else -(self.J_rho.T @ rho)
-            d = self.factors.solve(np.concatenate([top, np.zeros(self.m)]))[: self.n]
-        return d if self.mode == "descent" else d / np.linalg.norm(d)
-
-    def correction(self, c: np.ndarray) -> np.ndarray:
-        """One corrector step for the residual ``c``: in the plane normal to the tangent
-        (augmented), or of least norm in the system's metric."""
-        if self.mode == "augmented":
-            return self.factors.solve(np.concatenate([-c, [0.0]]))
-        return self.factors.solve(np.concatenate([np.zeros(self.n), -c]))[: self.n]
-
-
-def _correct(
-    cons: RigidFoldingConstraints,
-    y: np.ndarray,
-    mode: str,
-    t: np.ndarray | None,
-    settings: Settings,
-) -> tuple[np.ndarray, bool, int, _System | None]:
-    """Corrector from the prediction y onto c = 0: chord steps on the factors of the latest
-    iterate, refactored where they contract by less than ``path_contraction``; converged when
-    every |c_i| <= ``path_tol`` (after at least one factorisation, which the next direction
-    needs).
-
-    returns (y, converged, factorizations, the last system).
-    """
-    system, previous, factorizations = None, np.inf, 0
-    for _ in range(settings.path_corrector_iter + 1):
-        c = cons.residual(y)
-        norm = float(np.abs(c).max())
-        if not np.isfinite(norm):
-            return y, False, factorizations, system
-        if system is None or norm > settings.path_contraction * previous:
-            try:
-                system = _System(*cons.jacobian(y), mode, t, settings)
-            except RuntimeError:  # an exactly singular factor
-                return y, False, factorizations, system
-            factorizations += 1
-        if norm <= settings.path_tol:
-            return y, True, factorizations, system
-        previous = norm
-        y = y + system.correction(c)
-    return y, False, factorizations, system
 
 
 @dataclass
@@ -429,7 +207,7 @@ def _trace_direction(
     rho = cons.free_angles(x0)
     tr = _Trace([x0.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
     flat_tol, limit = settings.path_flat_tol, settings.path_fold_limit
-    system = _System(J, J_rho, mode, t0, settings)
+    system = System(J, J_rho, mode, t0, settings)
     tr.factorizations += 1
     t = t0 if mode == "descent" else system.direction(t0, rho)
     det_sign = system.factors.det_sign if mode == "augmented" else 0
@@ -439,7 +217,8 @@ def _trace_direction(
         rms * v for v in (settings.path_step, settings.path_max_step, settings.path_min_step)
     )
     x, h, travelled, slope_sign, slow = x0.copy(), first, 0.0, 0, 0
-    best = 1.0  # descent: the smallest measure so far
+    best = 1.0  # the smallest measure so far
+    lowest = np.inf  # DOF 1: the smallest measure since m first fell
     while True:
         if tr.steps >= settings.path_max_steps:
             return tr, PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps"
@@ -470,7 +249,7 @@ def _trace_direction(
             s_star = -float(rho @ rate) / rr
             if 0 < s_star < step and np.abs(rho + s_star * rate).max() < 2 * flat_tol:
                 step = max(s_star, least)
-        y, ok, nf, new = _correct(cons, x + step * unit, mode, t, settings)
+        y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings)
         tr.factorizations += nf
         if ok and mode != "descent":  # the tangent must not turn too far in one step
             chord = y - x
@@ -515,9 +294,8 @@ def _trace_direction(
             if sign != det_sign:
                 tr.bifurcations.append(len(tr.points))
                 det_sign = sign
-        if mode == "descent":
-            slow = slow + 1 if m > best * (1 - settings.path_stall_ratio) else 0
-            best = min(best, m)
+        slow = slow + 1 if m > best * (1 - settings.path_stall_ratio) else 0
+        best = min(best, m)
         tr.points.append(x.copy())
         tr.arclength.append(travelled)
         tr.measure.append(m)
@@ -532,22 +310,26 @@ def _trace_direction(
                     f"steps ({travelled * cons.scale:.3g} m of path)"
                 ),
             )
-        if slow >= settings.path_stall_steps:
+        if slow >= (settings.path_stall_steps if mode == "descent" else settings.path_wander_steps):
             return (
                 tr,
                 PathStatus.STOPS_SHORT,
-                (f"no rigid folding lowers the folding measure below {m:.3g} of the design's"),
+                (
+                    f"no rigid folding lowers the folding measure below {best:.3g} of the "
+                    f"design's (none in the last {slow} steps)"
+                ),
             )
-        if mode != "descent" and travelled > 4 * largest:
-            if np.linalg.norm(x - x0) < max(step, first):
-                k = int(np.argmin(tr.max_fold))
+        if mode != "descent":
+            if slope < 0:  # m falls: from here on a rise of path_turn_back is a turn back
+                lowest = min(lowest, m)
+            elif m > lowest + settings.path_turn_back:
+                k = int(np.argmin(tr.measure))
                 return (
                     tr,
                     PathStatus.TURNED_BACK,
                     (
                         f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest "
-                        f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees) and returns "
-                        "to the design"
+                        f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees)"
                     ),
                 )
         h = min(2 * step, largest) if nf == 1 else step
@@ -604,7 +386,7 @@ def trace_path(
                 mode = "projection"
                 tr, status, message = _trace_direction(cons, x0, sign * t, mode, m0, settings)
             traces.append((tr, status, message))
-            if status in (PathStatus.FLAT, PathStatus.TURNED_BACK):
+            if status is not PathStatus.STALLED:
                 break
         best = next((r for r in traces if r[1] is PathStatus.FLAT), traces[0])
         tr, status, message = best

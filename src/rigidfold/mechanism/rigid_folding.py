@@ -1,0 +1,262 @@
+"""The rigid-folding constraints of a shape and the linear algebra of their continuation.
+
+A triangulated shape folds rigidly while ``c(x) = 0``: every edge keeps its length, every
+fixed crease its fold angle, and a support triangle stays where it is (six linear rows, the
+gauge). :class:`RigidFoldingConstraints` evaluates c and its sparse Jacobian J on a sparsity
+pattern built once, in coordinates scaled by the mean edge length; :class:`System` factors
+(SuperLU) the one linear system a continuation step needs, in one of three forms:
+
+* ``"augmented"``: ``A = [J; t^T]`` for a 1-DOF shape (J has 3V - 1 independent rows): its
+  solve with ``e_n`` is the next tangent, with ``[-c; 0]`` a pseudo-arclength correction, and
+  the sign of det A tells a bifurcation (Allgower & Georg, ch. 2 and 8);
+* ``"projection"``: ``K = [[I, J^T], [J, -delta I]]`` for a 1-DOF shape whose constraints
+  are self-stressed (redundant rows, as a Miura-ori's rigid quads): the tangent is the
+  projection of the last one onto the null space of J, the correction of least norm;
+* ``"descent"``: ``K = [[J_rho^T J_rho + mu I, J^T], [J, -delta I]]`` for more DOF: the
+  Gauss-Newton direction that takes the free fold angles rho towards 0 within the
+  mechanism, ``min |rho + J_rho d|^2 + mu |d|^2`` subject to ``J d = 0``, and corrections of
+  least norm in that metric.
+
+:func:`correct` is the corrector: chord steps on the factors of the latest iterate,
+refactored where they stop contracting.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from rigidfold.config import Settings
+from rigidfold.mesh import CreasePattern
+from rigidfold.optimize.residuals import fold_angle_gradients
+
+
+class RigidFoldingConstraints:
+    """c(x) and its sparse Jacobian for one shape, in units of the mean edge length.
+
+    Rows: the edge lengths (E), the fixed creases' fold angles (n_fix), and a gauge of six
+    linear rows that hold the support triangle ``(a, b, c)`` still: a's three coordinates, b's
+    two across the edge ab, c's one across the triangle's plane. x is the vertex coordinates
+    over the mean edge length, (3V,). The sparsity pattern is built once; an evaluation fills
+    in its values.
+    """
+
+    def __init__(self, pattern: CreasePattern, support_face: int) -> None:
+        self.pattern = pattern
+        self.scale = float(np.mean(pattern.edge_lengths))
+        self.x0 = pattern.coords.ravel() / self.scale
+        self.L0 = pattern.edge_lengths / self.scale
+        fixed, free = pattern.fixed_creases, pattern.free_creases
+        self.n_fixed, self.free = len(fixed), free
+        self.rho_fixed0 = pattern.fold_angles[fixed]
+        self.fixed_stencils = pattern.crease_stencils(fixed)
+        self.free_stencils = pattern.crease_stencils(free)
+        a, b, c = (int(v) for v in pattern.faces[support_face])
+        p = pattern.coords
+        e1 = (p[b] - p[a]) / np.linalg.norm(p[b] - p[a])
+        normal = np.cross(p[b] - p[a], p[c] - p[a])
+        normal /= np.linalg.norm(normal)
+        e2 = np.cross(normal, e1)
+        c3 = np.arange(3)
+        self.gauge_rows = np.concatenate([c3, [3, 3, 3, 4, 4, 4, 5, 5, 5]])
+        self.gauge_cols = np.concatenate([3 * a + c3, 3 * b + c3, 3 * b + c3, 3 * c + c3])
+        self.gauge_vals = np.concatenate([np.ones(3), e2, normal, normal])
+        E, nf = len(pattern.edges), self.n_fixed
+        self.n_rows = E + nf + 6
+        e = pattern.edges
+        rows = [
+            np.repeat(np.arange(E), 6),
+            E + np.repeat(np.arange(nf), 12),
+            E + nf + self.gauge_rows,
+        ]
+        cols = [
+            np.hstack([3 * e[:, :1] + c3, 3 * e[:, 1:] + c3]).ravel(),
+            (3 * self.fixed_stencils[:, :, None] + c3).reshape(-1),
+            self.gauge_cols,
+        ]
+        self._J = _Pattern(np.concatenate(rows), np.concatenate(cols), (self.n_rows, self.n))
+        self._Jr = _Pattern(
+            np.repeat(np.arange(len(free)), 12),
+            (3 * self.free_stencils[:, :, None] + c3).reshape(-1),
+            (len(free), self.n),
+        )
+        self.gauge0 = self._gauge(self.x0)
+
+    @property
+    def n(self) -> int:
+        """Unknowns: 3V."""
+        return len(self.x0)
+
+    def _gauge(self, x: np.ndarray) -> np.ndarray:
+        return np.bincount(self.gauge_rows, self.gauge_vals * x[self.gauge_cols], minlength=6)
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        """c(x) (m,): length errors, fixed-crease angle changes, gauge (not finite where a
+        triangle has collapsed)."""
+        X = x.reshape(-1, 3)
+        e = self.pattern.edges
+        length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rho_fixed = fold_angle_gradients(X[self.fixed_stencils])[0]
+        return np.concatenate(
+            [length - self.L0, rho_fixed - self.rho_fixed0, self._gauge(x) - self.gauge0]
+        )
+
+    def free_angles(self, x: np.ndarray) -> np.ndarray:
+        """The free creases' fold angles (n_free,) at x, radians."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return fold_angle_gradients(x.reshape(-1, 3)[self.free_stencils])[0]
+
+    def jacobian(self, x: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
+        """(J (m, n), J_rho (n_free, n)) at x, both sparse CSC: the constraints' Jacobian and
+        the free fold angles' gradients, in the scaled coordinates x."""
+        X = x.reshape(-1, 3)
+        e = self.pattern.edges
+        d = X[e[:, 1]] - X[e[:, 0]]
+        u = d / np.linalg.norm(d, axis=1)[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            grad_fixed = fold_angle_gradients(X[self.fixed_stencils])[1]
+            grad_free = fold_angle_gradients(X[self.free_stencils])[1]
+        J = self._J.fill(
+            np.concatenate([np.hstack([-u, u]).ravel(), grad_fixed.ravel(), self.gauge_vals])
+        )
+        return J, self._Jr.fill(grad_free.ravel())
+
+    def length_error(self, x: np.ndarray) -> float:
+        """Largest |l - l0| / l0 at x."""
+        X = x.reshape(-1, 3)
+        e = self.pattern.edges
+        length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
+        return float(np.max(np.abs(length - self.L0) / self.L0))
+
+
+class _Pattern:
+    """A sparse matrix's pattern (COO rows and columns, no duplicates), filled in CSC."""
+
+    def __init__(self, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> None:
+        order = sp.csc_matrix((np.arange(1, len(rows) + 1, dtype=float), (rows, cols)), shape=shape)
+        self.order = order.data.astype(np.int64) - 1
+        self.indices, self.indptr, self.shape = order.indices, order.indptr, shape
+
+    def fill(self, values: np.ndarray) -> sp.csc_matrix:
+        """The matrix with ``values`` given in the COO order of the pattern."""
+        return sp.csc_matrix((values[self.order], self.indices, self.indptr), shape=self.shape)
+
+
+class Factors:
+    """Sparse LU of a square matrix, with the sign of its determinant."""
+
+    def __init__(self, A: sp.spmatrix) -> None:
+        self.lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self.lu.solve(b)
+
+    @cached_property
+    def det_sign(self) -> int:
+        diag = self.lu.U.diagonal()
+        sign = int(np.prod(np.sign(diag)))
+        return sign * _parity(self.lu.perm_r) * _parity(self.lu.perm_c)
+
+
+def _parity(perm: np.ndarray) -> int:
+    """+1 for an even permutation, -1 for an odd one."""
+    seen = np.zeros(len(perm), bool)
+    sign = 1
+    for start in range(len(perm)):
+        if seen[start]:
+            continue
+        length, k = 0, start
+        while not seen[k]:
+            seen[k] = True
+            k = perm[k]
+            length += 1
+        if length % 2 == 0:
+            sign = -sign
+    return sign
+
+
+class System:
+    """The factored linear system of one point of the trace (see the module's text).
+
+    mode "augmented": ``A = [J; t^T]`` (DOF 1); "projection": ``K = [[I, J^T], [J, -delta]]``
+    (DOF 1, self-stressed rows); "descent": ``K = [[J_rho^T J_rho + mu I, J^T], [J, -delta]]``
+    (DOF > 1). :meth:`direction` is the next tangent (or Gauss-Newton direction),
+    :meth:`correction` one corrector step.
+    """
+
+    def __init__(
+        self,
+        J: sp.csc_matrix,
+        J_rho: sp.csr_matrix,
+        mode: str,
+        t: np.ndarray | None,
+        settings: Settings,
+    ) -> None:
+        m, n = J.shape
+        self.mode, self.n, self.m, self.J_rho = mode, n, m, J_rho
+        if mode == "augmented":
+            assert t is not None
+            self.factors = Factors(sp.vstack([J, sp.csr_matrix(t[None])]))
+            return
+        if mode == "projection":
+            M = sp.identity(n, format="csc")
+        else:
+            M = (J_rho.T @ J_rho) + settings.path_damping * sp.identity(n)
+        delta = settings.path_regularization
+        self.factors = Factors(sp.bmat([[M, J.T], [J, -delta * sp.identity(m)]], format="csc"))
+
+    def direction(self, t: np.ndarray | None, rho: np.ndarray) -> np.ndarray:
+        """The unit tangent continuing ``t`` (DOF 1), or the Gauss-Newton step that takes the
+        free fold angles ``rho`` towards 0 within the mechanism (not normalised)."""
+        if self.mode == "augmented":
+            rhs = np.zeros(self.n)
+            rhs[-1] = 1.0
+            d = self.factors.solve(rhs)
+        else:
+            top = t if self.mode == "projection" else -(self.J_rho.T @ rho)
+            d = self.factors.solve(np.concatenate([top, np.zeros(self.m)]))[: self.n]
+        return d if self.mode == "descent" else d / np.linalg.norm(d)
+
+    def correction(self, c: np.ndarray) -> np.ndarray:
+        """One corrector step for the residual ``c``: in the plane normal to the tangent
+        (augmented), or of least norm in the system's metric."""
+        if self.mode == "augmented":
+            return self.factors.solve(np.concatenate([-c, [0.0]]))
+        return self.factors.solve(np.concatenate([np.zeros(self.n), -c]))[: self.n]
+
+
+def correct(
+    cons: RigidFoldingConstraints,
+    y: np.ndarray,
+    mode: str,
+    t: np.ndarray | None,
+    settings: Settings,
+) -> tuple[np.ndarray, bool, int, System | None]:
+    """Corrector from the prediction y onto c = 0: chord steps on the factors of the latest
+    iterate, refactored where they contract by less than ``path_contraction``; converged when
+    every |c_i| <= ``path_tol`` (after at least one factorisation, which the next direction
+    needs).
+
+    returns (y, converged, factorizations, the last system).
+    """
+    system, previous, factorizations = None, np.inf, 0
+    for _ in range(settings.path_corrector_iter + 1):
+        c = cons.residual(y)
+        norm = float(np.abs(c).max())
+        if not np.isfinite(norm):
+            return y, False, factorizations, system
+        if system is None or norm > settings.path_contraction * previous:
+            try:
+                system = System(*cons.jacobian(y), mode, t, settings)
+            except RuntimeError:  # an exactly singular factor
+                return y, False, factorizations, system
+            factorizations += 1
+        if norm <= settings.path_tol:
+            return y, True, factorizations, system
+        previous = norm
+        y = y + system.correction(c)
+    return y, False, factorizations, system
