@@ -27,10 +27,19 @@ DATA = Path(__file__).resolve().parents[1] / "tests" / "data" / "origami_simulat
 DRAWN = ("waterbomb.svg", "reschTriTessellation.svg", "miura-ori.svg")
 
 
-def cases() -> list[tuple[str, str, int]]:
-    out = [(s, str(DATA / f), 7) for f in DRAWN for s in ("dome", "hp", "bezier")]
-    out += [("bezier", p, seed) for p in ("1", "2") for seed in range(101, 111)]
-    out += [(s, p, 0) for p in ("11", "grid:9x9") for s in ("dome", "hp")]
+CASES = ("all", "drawn", "paper", "grids")
+
+
+def cases(which: str = "all") -> list[tuple[str, str, int]]:
+    """The cases of ``which``: the drawn patterns, the paper's 1 and 2 on Bezier surfaces,
+    pattern 11 and the 9 x 9 grid on the dome and the HP, or all."""
+    out = []
+    if which in ("all", "drawn"):
+        out += [(s, str(DATA / f), 7) for f in DRAWN for s in ("dome", "hp", "bezier")]
+    if which in ("all", "paper"):
+        out += [("bezier", p, seed) for p in ("1", "2") for seed in range(101, 111)]
+    if which in ("all", "grids"):
+        out += [(s, p, 0) for p in ("11", "grid:9x9") for s in ("dome", "hp")]
     return out
 
 
@@ -70,8 +79,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--cases", choices=CASES, default="all")
     args = parser.parse_args()
-    work = [(c, d) for c in cases() for d in (False, True)]
+    work = [(c, d) for c in cases(args.cases) for d in (False, True)]
     rows = []
     with ProcessPoolExecutor(args.jobs) as pool:
         for row in pool.map(run, *zip(*work, strict=True)):

@@ -28,7 +28,14 @@ VALUES = {
         "max_steps",
         "rigid",
     ],
-    Stop: ["running", "target_reached", "zero_dof", "no_candidate", "initial_failed"],
+    Stop: [
+        "running",
+        "target_reached",
+        "zero_dof",
+        "no_candidate",
+        "no_deployable",
+        "initial_failed",
+    ],
     DevelopStatus: ["converged", "flipped", "overlap", "failed"],
     DeformStatus: ["reached_plane", "failed"],
     MotionStatus: ["ok", "failed"],
@@ -51,6 +58,7 @@ def test_stop_reasons_are_the_texts_of_every_version():
         (Stop.TARGET_REACHED, "1"): "target DOF 1 reached",
         (Stop.ZERO_DOF, ""): "DOF 0 reached",
         (Stop.NO_CANDIDATE, ""): "no candidate crease succeeds",
+        (Stop.NO_DEPLOYABLE, "30"): "no deployable solution in 30 candidates",
         (Stop.INITIAL_FAILED, "lock"): "no developable polyhedron from the initial shape (lock)",
         (Stop.RUNNING, ""): "running",
     }

@@ -264,6 +264,11 @@ class Settings:
         Generation (Step 5) accepts only solutions whose folding path reaches the flat state
         (:func:`rigidfold.mechanism.path.trace_path`); others count in N_path and are
         replaced like a lock (Step 7). False is the paper's method.
+    deploy_max_candidates : int
+        Step 7 gives up on a shape once this many of its candidates gave solutions whose
+        folding paths do not reach the flat state (``Stop.NO_DEPLOYABLE``; 0: it tries them
+        all): every candidate costs a solve and a trace, and a shape whose first candidates
+        all fail rarely has a deployable one further down the ranking.
     deploy_check_max_dof : int
         The deployability check runs on accepted solutions of at most this DOF or the target
         DOF, whichever is larger (0: on every solution). A run that does not reach the target
@@ -394,6 +399,7 @@ class Settings:
     polish_tol: float = 1e-26
     deploy_check: bool = True
     deploy_check_max_dof: int = 1
+    deploy_max_candidates: int = 30
     # reading FOLD files
     max_json_depth: int = 100
     max_coordinate: float = 1e6

@@ -80,6 +80,10 @@ class Stop(Outcome):
     TARGET_REACHED = "target_reached", "the target DOF is reached"
     ZERO_DOF = "zero_dof", "a solution has DOF 0 (Step 5 -> Step 8)"
     NO_CANDIDATE = "no_candidate", "no candidate crease succeeds (Step 7)"
+    NO_DEPLOYABLE = (
+        "no_deployable",
+        "the folding paths of the last candidates do not reach the flat state (Step 7, N_path)",
+    )
     INITIAL_FAILED = "initial_failed", "no developable polyhedron from the initial shape"
 
     def reason(self, detail: str = "") -> str:
@@ -105,6 +109,7 @@ STOP_REASONS = {
     Stop.TARGET_REACHED: "target DOF {} reached",
     Stop.ZERO_DOF: "DOF 0 reached",
     Stop.NO_CANDIDATE: "no candidate crease succeeds",
+    Stop.NO_DEPLOYABLE: "no deployable solution in {} candidates",
     Stop.INITIAL_FAILED: "no developable polyhedron from the initial shape ({})",
 }
 """The words of each :class:`Stop`, ``{}`` standing for the detail (the target DOF, or the
@@ -423,6 +428,7 @@ def generate(
             else (Choice(k) for k in range(len(ranked)))
         )
         t_sel = time.perf_counter() - t1
+        undeployable = 0  # candidates of this shape whose paths do not reach the flat state
         while True:  # Step 6, then Step 7 on failure
             t1 = time.perf_counter()
             choice = next(order, None)  # look-ahead: lazy forecast
@@ -457,6 +463,10 @@ def generate(
             record(rec, result, mech, path)
             if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
                 break
+            undeployable += rec.outcome is AttemptOutcome.PATH
+            if undeployable >= settings.deploy_max_candidates > 0:  # bounded cost
+                run.stop, run.stop_detail = Stop.NO_DEPLOYABLE, str(undeployable)
+                return _deployable_final(run, deploy, support_face, settings)
         if rec.outcome is AttemptOutcome.ZERO_DOF:
             run.stop = Stop.ZERO_DOF
             return _deployable_final(run, deploy, support_face, settings)

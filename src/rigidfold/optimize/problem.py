@@ -241,7 +241,8 @@ class FormFindingProblem:
         developable to round-off cannot reach the flat state along a rigid-folding path: the
         path passes the flat state at a distance of about the square root of the defects. The
         projection moves the vertices by about that defect times the edge length. Returns
-        ``result`` itself when it was not accepted or the projection does not lower F.
+        ``result`` itself when it was not accepted, or the projection does not lower F or
+        meets a singular factor.
         """
         if result.status is not Status.CONVERGED:
             return result
@@ -249,8 +250,13 @@ class FormFindingProblem:
             self._projection = Projection(self)
         w = result.pattern.fixed.astype(float)
         t0 = time.perf_counter()
-        with one_blas_thread():
-            run = self._projection(self.start_point(result.coords), w, tol=self.settings.polish_tol)
+        try:
+            with one_blas_thread():
+                run = self._projection(
+                    self.start_point(result.coords), w, tol=self.settings.polish_tol
+                )
+        except RuntimeError:  # a singular factor (redundant rows at F ~ 0): keep the result
+            return result
         if not run.feasible or not run.F < result.F:
             return result
         coords = self.map.expand(run.xi)
