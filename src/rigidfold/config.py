@@ -132,6 +132,15 @@ class Settings:
         Deepest nesting of elements accepted in an SVG drawing: a deeper file is refused with
         a one-line error before svgelements, which reads it recursively, exhausts Python's
         recursion limit (near 1,000 levels). Drawing programs nest groups a few levels deep.
+    max_svg_pairs : int
+        Largest number of pairs of line pieces of an SVG drawing that meet, cross or come
+        within the merge distance (``svg_merge_tol``) of each other, each of which is looked
+        at for a crossing or a T-junction: a drawing with more is refused in one line as
+        soon as they are counted, before they are examined, instead of spending minutes and
+        gigabytes (the pairs cost about 1 s and 100 MB a million; their crossings, when they
+        cross, about ten times that). Pieces of one colour drawn over each other along one
+        line are made one first and count once. A 110 x 110 grid of lines has 12,100
+        crossings, a drawing of ``max_pattern_faces`` triangles some 10^5 pairs.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -394,6 +403,7 @@ class Settings:
     svg_merge_tol: float = 1e-4
     svg_snap_tol: float = 1e-2
     max_svg_depth: int = 100
+    max_svg_pairs: int = 500_000
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
@@ -448,6 +458,7 @@ class Settings:
             "projection_vertices": 3,
             "projection_max_iter": 1,
             "max_svg_depth": 1,
+            "max_svg_pairs": 1,
         }
         for name, low in least.items():
             value = getattr(self, name)
