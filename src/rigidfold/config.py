@@ -311,6 +311,13 @@ class Settings:
         bicubic spline is fitted to the samples: 65 nodes are 47 mm apart on a 3 m box. From
         4 to 513 (a finer grid costs seconds and gigabytes to fit). A grid finer than the
         mesh's triangles makes the spline follow their facets; a coarser one smooths them.
+    max_mesh_triangles : int
+        Largest number of triangles of a target mesh (``--surface mesh:FILE``): a larger one
+        is refused in one line (a binary STL file from its header, before it is loaded)
+        instead of spending minutes and gigabytes. The surface is sampled on at most 513 x 513
+        grid nodes, about 263,000: a mesh of twice as many triangles is finer than any fit
+        can use (decimate it). A polygon face of an OBJ file counts as the triangles of its
+        fan.
     surface_footprint_tol : float
         A plan point within this fraction of the longer side of the mesh's plan box of its
         footprint (its triangles seen from above) counts as inside it: pattern vertices
@@ -415,6 +422,7 @@ class Settings:
     # target surfaces from triangle meshes
     surface_grid_nodes: int = 65
     surface_footprint_tol: float = 1e-5
+    max_mesh_triangles: int = 500_000
     # the plan of a crease pattern
     plan_area_tol: float = 1e-6
 
@@ -459,6 +467,7 @@ class Settings:
             "projection_max_iter": 1,
             "max_svg_depth": 1,
             "max_svg_pairs": 1,
+            "max_mesh_triangles": 1,
         }
         for name, low in least.items():
             value = getattr(self, name)
