@@ -285,9 +285,12 @@ class Settings:
         tolerances are absolute (``f_tol``, ``dz``), and on a smaller plan (a file read in the
         wrong unit) problem (6) is met trivially or its derivatives underflow to NaN.
     max_pattern_faces : int
-        Largest number of triangles a ``grid:`` or ``mesh:`` pattern may have (a mesh's is
-        estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
-        is refused instead of building a problem that cannot be solved.
+        Largest number of triangles a crease pattern (``--pattern``) may have: a typo such as
+        ``grid:1500x900`` is refused instead of building a problem that cannot be solved. A
+        ``mesh:`` pattern's is estimated from its footprint area and edge length and from
+        the points on its outline before Triangle runs, and counted after; an SVG drawing's
+        is counted before its faces are triangulated, a FOLD file's once read: each is
+        refused before any problem is built.
     max_analysis_bytes : int
         Largest memory (bytes) the mechanism analysis may ask for, estimated from the
         pattern's size for the method it runs before any matrix is built
