@@ -8,6 +8,7 @@ run on a MeshSurface too: ``tests/test_surfaces.py``, surface "mesh".
 from __future__ import annotations
 
 import pickle
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -297,3 +298,109 @@ def test_form_finding_on_the_dome_mesh(fine_dome):
     assert result.F <= DEFAULTS.f_tol  # measured 2e-17
     c = result.pattern.coords
     assert np.abs(c[:, 2] - DOME.height(c[:, 0], c[:, 1])).max() <= DEFAULTS.dz + 1e-3
+
+
+# ----------------------------------------------- issue 30, item 4: the size of a target mesh
+def fan(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A cone of n long thin triangles around its apex over the unit disc (a fan)."""
+    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    rim = np.column_stack([np.cos(angle), np.sin(angle), np.zeros(n)])
+    vertices = np.vstack([[0.0, 0.0, 1.0], rim])
+    k = np.arange(n)
+    return vertices, np.column_stack([np.zeros(n, dtype=np.int64), k + 1, (k + 1) % n + 1])
+
+
+def test_a_fan_is_fitted_in_linear_memory():
+    """A fan's triangles have bounding boxes over most of the plan: every point was paired
+    with most triangles (20,000 of them: 67 s and 5.5 GB, then a MemoryError). The pairs are
+    now found along each triangle's columns of buckets, in batches of bounded size."""
+    import tracemalloc
+
+    from rigidfold.surfaces.mesh import _candidates
+
+    vertices, triangles = fan(4000)
+    plan = vertices[triangles][:, :, :2]
+    g = np.linspace(-1, 1, 65)
+    points = np.stack(np.meshgrid(g, g, indexing="ij"), axis=-1).reshape(-1, 2)
+    batches = list(_candidates(points, plan, 1e-5, batch=10_000))
+    pairs = sum(len(p) for p, _ in batches)
+    # about the triangles' widths in bucket columns (4,000 x some 40), not the points in
+    # their boxes (about a third of 4,225 points x 4,000 triangles before)
+    assert pairs < len(points) * len(triangles) / 50
+    assert max(len(p) for p, _ in batches) <= 10_000 + 4225  # a batch, or one column's points
+    for p, t in batches:
+        assert len(np.unique(p * len(triangles) + t)) == len(p)  # each pair once
+    tracemalloc.start()
+    surface = MeshSurface(vertices, triangles, source="fan")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 200e6, peak
+    assert surface.fit_error < 0.05  # the cone's tip and rim smoothed by the spline
+    assert float(surface.height(0.5, 0.0)) == pytest.approx(0.5, abs=0.02)
+
+
+def test_candidates_are_a_superset_of_the_hits():
+    """Every point inside (or within the tolerance of) a triangle is a candidate of it."""
+    from rigidfold.surfaces.mesh import _candidates
+
+    rng = np.random.default_rng(3)
+    plan = rng.uniform(0, 1, (300, 3, 2))
+    plan[:100] *= [1.0, 0.02]  # thin ones
+    points = rng.uniform(-0.1, 1.1, (2000, 2))
+    tol = 0.01
+    found = set()
+    for p, t in _candidates(points, plan, tol, batch=777):
+        found.update(zip(p.tolist(), t.tolist(), strict=True))
+    import shapely
+
+    polygons = shapely.polygons(plan)
+    near = shapely.STRtree(polygons).query(shapely.points(points), "dwithin", distance=tol)
+    assert set(zip(*near.tolist(), strict=True)) <= found
+
+
+def test_too_many_triangles_are_refused_in_one_line(tmp_path):
+    """Settings.max_mesh_triangles bounds a target mesh: MeshSurface and read_mesh refuse one
+    line; a binary STL file by its header, before trimesh loads it (a 2-million-face STL took
+    8.9 GB before)."""
+    small = DEFAULTS.with_(max_mesh_triangles=100)
+    vertices, triangles = fan(200)
+    message = (
+        "200 triangles, more than 100 (Settings.max_mesh_triangles): decimate the mesh; the "
+        "surface is sampled on at most 513 x 513 grid nodes"
+    )
+    with pytest.raises(ValueError, match=f"^mesh fan: {re.escape(message)}$"):
+        MeshSurface(vertices, triangles, source="fan", settings=small)
+    path = write_mesh(tmp_path / "fan.obj", vertices, triangles)
+    with pytest.raises(ValueError, match=f"^{re.escape(f'mesh {path}: {message}')}$"):
+        read_mesh(path, settings=small)
+    stl = tmp_path / "huge.stl"  # 2,000,000 triangles by its header, sparse on disk
+    with stl.open("wb") as file:
+        file.write(b"\0" * 80 + (2_000_000).to_bytes(4, "little"))
+        file.truncate(84 + 50 * 2_000_000)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import resource, sys; resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30)); "
+            "from rigidfold.cli import main; sys.exit(main(sys.argv[1:]))",
+            "optimize",
+            "--surface",
+            f"mesh:{stl}",
+            "--pattern",
+            "1",
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr == (
+        f"rigidfold: error: mesh {stl}: 2000000 triangles, more than 500000 "
+        "(Settings.max_mesh_triangles): decimate the mesh; the surface is sampled on at most "
+        "513 x 513 grid nodes\n"
+    )
+    with pytest.raises(ValueError, match="max_mesh_triangles must be an integer >= 1"):
+        DEFAULTS.with_(max_mesh_triangles=0)

@@ -276,3 +276,77 @@ def test_generate_on_a_6_by_4_grid(tmp_path):
     xy = analysis.data.pattern.coords[:, :2]
     assert np.allclose(xy.min(axis=0), [0, 0], atol=1e-6)
     assert np.allclose(np.ptp(xy, axis=0), [6, 4], atol=1e-6)
+
+
+# ------------------------------------- issue 30, item 5: the real triangle count of a pattern
+def circle(n: int, radius: float = 3.0) -> str:
+    """A mesh: footprint of n corners on a circle."""
+    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return ";".join(f"{radius * math.cos(a):.9f},{radius * math.sin(a):.9f}" for a in angle)
+
+
+def test_mesh_footprint_with_many_corners_is_refused_before_triangle(tmp_path, capsys):
+    """A polygon of 30,000 corners made 178,266 triangles (the limit was checked on an
+    estimate from the area): its outline points are counted before Triangle runs."""
+    path = tmp_path / "outline.txt"
+    path.write_text(circle(30_000).replace(";", "\n"))
+    code = main(
+        ["optimize", "--surface", "dome", "--pattern", f"mesh:{path}", "--out", str(tmp_path / "o")]
+    )
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert "has 30000 points on its outline: at least 29998 triangles, more than 20000 " in err
+    assert "(Settings.max_pattern_faces)" in err and not (tmp_path / "o").exists()
+
+
+def test_mesh_pattern_is_checked_on_its_real_triangle_count():
+    """Triangle's refinement adds points: the count after it is checked, not only the
+    estimate from the area (here 7) and the outline's points (40)."""
+    spec = f"mesh:{circle(40)}"
+    plan = patterns.parse_pattern(spec, edge_length=3.0)
+    assert len(plan.faces) == 120
+    settings = DEFAULTS.with_(max_pattern_faces=100)
+    with pytest.raises(ValueError) as info:
+        patterns.parse_pattern(spec, edge_length=3.0, settings=settings)
+    assert str(info.value) == (
+        f"pattern {spec!r} has 120 triangles, more than 100 (Settings.max_pattern_faces)"
+    )
+
+
+def test_svg_and_fold_files_are_checked_on_their_triangles(tmp_path, capsys):
+    """An SVG of 110 x 110 grid lines (23,762 triangles) reached CasADi and failed there with a
+    RuntimeError; a FOLD file of too many faces was never checked."""
+    lines = "".join(
+        f'<line x1="{x:.4f}" y1="0" x2="{x:.4f}" y2="100" stroke="red"/>'
+        f'<line x1="0" y1="{x:.4f}" x2="100" y2="{x:.4f}" stroke="blue"/>'
+        for x in 100 * np.arange(1, 111) / 111
+    )
+    svg = tmp_path / "grid.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">'
+        f'<rect x="0" y="0" width="100" height="100" fill="none" stroke="#000"/>{lines}</svg>'
+    )
+    code = main(
+        ["optimize", "--surface", "dome", "--pattern", str(svg), "--out", str(tmp_path / "o")]
+    )
+    assert code == 2 and capsys.readouterr().err == (
+        f"rigidfold: error: {svg}: its 12321 faces make 24642 triangles, more than 20000 "
+        "(Settings.max_pattern_faces)\n"
+    )
+    xy, faces = patterns.grid(9, 9, 3.0, 3.0)
+    fold = tmp_path / "grid.fold"
+    fold.write_text(
+        json.dumps(
+            {
+                "vertices_coords": np.column_stack([xy, np.zeros(len(xy))]).tolist(),
+                "faces_vertices": faces.tolist(),
+            }
+        )
+    )
+    assert len(patterns.parse_pattern(str(fold)).faces) == 128
+    small = DEFAULTS.with_(max_pattern_faces=100)
+    with pytest.raises(ValueError, match=r"has 128 triangles, more than 100 \(Settings"):
+        patterns.parse_pattern(str(fold), settings=small)
+    with pytest.raises(ValueError, match=r"make 24642 triangles, more than 100 \(Settings"):
+        patterns.parse_pattern(str(svg), settings=small)
+    assert not (tmp_path / "o").exists()

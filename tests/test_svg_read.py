@@ -618,3 +618,60 @@ def test_nesting_depth_is_bounded(tmp_path, capsys):
     assert counts(read_svg(nested)) == (4, 4, 1)
     with pytest.raises(ValueError, match="nest more than 99 levels deep"):
         read_svg(nested, settings=DEFAULTS.with_(max_svg_depth=99))
+
+
+# ------------------------------------------------- issue 30, item 3: pieces drawn over each other
+def back_and_forth(times: int) -> str:
+    """A red crease across the square drawn back and forth ``times`` times in one path."""
+    return SQUARE + f'<path d="M0,50 {"L100,50 L0,50 " * times}" stroke="red" fill="none"/>'
+
+
+def test_a_line_drawn_over_itself_many_times_is_one_line(tmp_path):
+    """4,000 pieces along one line (28 KB) took 12 to 25 s and 1.4 GB (every pair of them was
+    examined); 8,000 ran out of memory. They are one line first: no more pairs than once."""
+    once = read_svg(write(tmp_path, back_and_forth(1)))
+    path = write(tmp_path, back_and_forth(2000))
+    assert path.stat().st_size > 28_000
+    few = DEFAULTS.with_(max_svg_pairs=20)  # the square and the crease meet in a few pairs
+    drawing = read_svg(path, settings=few)
+    check_planar(drawing)
+    assert counts(drawing) == counts(once) == (6, 7, 2)
+    assert points(drawing.xy) == points(once.xy)
+    assert Counter(drawing.assignment) == {"B": 6, "M": 1}
+
+
+def test_pieces_that_cannot_be_merged_are_bounded_by_max_svg_pairs(tmp_path):
+    """Pieces drawn over each other that are not one crease (each of its own opacity) are
+    refused in one line once their pairs pass Settings.max_svg_pairs, before they are
+    examined."""
+    lines = "".join(
+        f'<line x1="0" y1="50" x2="100" y2="50" stroke="red" stroke-opacity="{0.5 + k / 400}"/>'
+        for k in range(100)
+    )
+    path = write(tmp_path, SQUARE + lines)
+    assert counts(read_svg(path)) == (6, 7, 2)  # 4,950 pairs and more: below the default
+    message = (
+        f"{path}: more than 1000 pairs of its 104 line pieces meet, cross or come within the "
+        "merge distance of each other (Settings.max_svg_pairs): too many lines cross or are "
+        "drawn over each other"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+        read_svg(path, settings=DEFAULTS.with_(max_svg_pairs=1000))
+    with pytest.raises(ValueError, match="max_svg_pairs must be an integer >= 1, got 0"):
+        DEFAULTS.with_(max_svg_pairs=0)
+
+
+def test_too_many_pairs_one_line_exit_2(tmp_path, capsys):
+    """At the default limit, from the command line: 1,001 pieces over each other, exit 2."""
+    lines = "".join(
+        f'<line x1="0" y1="50" x2="100" y2="50" stroke="red" stroke-opacity="{0.5 + k / 4004}"/>'
+        for k in range(1001)
+    )
+    path = write(tmp_path, SQUARE + lines)
+    code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err == (
+        f"rigidfold: error: {path}: more than {DEFAULTS.max_svg_pairs} pairs of its 1005 line "
+        "pieces meet, cross or come within the merge distance of each other "
+        "(Settings.max_svg_pairs): too many lines cross or are drawn over each other\n"
+    )

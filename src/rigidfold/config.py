@@ -132,6 +132,15 @@ class Settings:
         Deepest nesting of elements accepted in an SVG drawing: a deeper file is refused with
         a one-line error before svgelements, which reads it recursively, exhausts Python's
         recursion limit (near 1,000 levels). Drawing programs nest groups a few levels deep.
+    max_svg_pairs : int
+        Largest number of pairs of line pieces of an SVG drawing that meet, cross or come
+        within the merge distance (``svg_merge_tol``) of each other, each of which is looked
+        at for a crossing or a T-junction: a drawing with more is refused in one line as
+        soon as they are counted, before they are examined, instead of spending minutes and
+        gigabytes (the pairs cost about 1 s and 100 MB a million; their crossings, when they
+        cross, about ten times that). Pieces of one colour drawn over each other along one
+        line are made one first and count once. A 110 x 110 grid of lines has 12,100
+        crossings, a drawing of ``max_pattern_faces`` triangles some 10^5 pairs.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -287,9 +296,12 @@ class Settings:
         tolerances are absolute (``f_tol``, ``dz``), and on a smaller plan (a file read in the
         wrong unit) problem (6) is met trivially or its derivatives underflow to NaN.
     max_pattern_faces : int
-        Largest number of triangles a ``grid:`` or ``mesh:`` pattern may have (a mesh's is
-        estimated from its footprint area and edge length): a typo such as ``grid:1500x900``
-        is refused instead of building a problem that cannot be solved.
+        Largest number of triangles a crease pattern (``--pattern``) may have: a typo such as
+        ``grid:1500x900`` is refused instead of building a problem that cannot be solved. A
+        ``mesh:`` pattern's is estimated from its footprint area and edge length and from
+        the points on its outline before Triangle runs, and counted after; an SVG drawing's
+        is counted before its faces are triangulated, a FOLD file's once read: each is
+        refused before any problem is built.
     max_analysis_bytes : int
         Largest memory (bytes) the mechanism analysis may ask for, estimated from the
         pattern's size for the method it runs before any matrix is built
@@ -313,6 +325,13 @@ class Settings:
         bicubic spline is fitted to the samples: 65 nodes are 47 mm apart on a 3 m box. From
         4 to 513 (a finer grid costs seconds and gigabytes to fit). A grid finer than the
         mesh's triangles makes the spline follow their facets; a coarser one smooths them.
+    max_mesh_triangles : int
+        Largest number of triangles of a target mesh (``--surface mesh:FILE``): a larger one
+        is refused in one line (a binary STL file from its header, before it is loaded)
+        instead of spending minutes and gigabytes. The surface is sampled on at most 513 x 513
+        grid nodes, about 263,000: a mesh of twice as many triangles is finer than any fit
+        can use (decimate it). A polygon face of an OBJ file counts as the triangles of its
+        fan.
     surface_footprint_tol : float
         A plan point within this fraction of the longer side of the mesh's plan box of its
         footprint (its triangles seen from above) counts as inside it: pattern vertices
@@ -408,6 +427,7 @@ class Settings:
     svg_merge_tol: float = 1e-4
     svg_snap_tol: float = 1e-2
     max_svg_depth: int = 100
+    max_svg_pairs: int = 500_000
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
@@ -419,6 +439,7 @@ class Settings:
     # target surfaces from triangle meshes
     surface_grid_nodes: int = 65
     surface_footprint_tol: float = 1e-5
+    max_mesh_triangles: int = 500_000
     # the plan of a crease pattern
     plan_area_tol: float = 1e-6
 
@@ -462,6 +483,8 @@ class Settings:
             "projection_vertices": 3,
             "projection_max_iter": 1,
             "max_svg_depth": 1,
+            "max_svg_pairs": 1,
+            "max_mesh_triangles": 1,
         }
         for name, low in least.items():
             value = getattr(self, name)

@@ -22,7 +22,10 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
   ``Settings.svg_merge_tol`` times the drawing's bounding-box diagonal are merged, and
   pieces shorter than that are dropped. A piece drawn twice is kept once: if one drawing
   is black it stays boundary, other differing colours are refused. Where just two pieces
-  of the same colour and opacity meet in a straight line, they become one line;
+  of the same colour and opacity meet in a straight line, they become one line. Pieces of
+  one colour and opacity drawn over each other along one line are made one before they are
+  split (a line drawn back and forth many times costs no more than once), and a drawing
+  with more than ``Settings.max_svg_pairs`` pairs of pieces that meet or cross is refused;
 * slips of the pen up to ``Settings.svg_snap_tol`` times the diagonal are mended where a
   crease would otherwise end on nothing: an overshoot past the line a crease crosses (the
   boundary among them) is cut off, a piece drawn in two crease colours (one crease running
@@ -124,7 +127,7 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
         The SVG file.
     settings : Settings
         ``svg_merge_tol``: points closer than this times the bounding-box diagonal of all
-        lines are one vertex.
+        lines are one vertex; ``svg_snap_tol``, ``max_svg_depth``, ``max_svg_pairs``.
 
     Raises
     ------
@@ -132,7 +135,8 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
         One line naming the file: unreadable, not an SVG, elements nested deeper than
         ``settings.max_svg_depth``, a ``width``, ``height``, ``viewBox`` or ``transform``
         that is not finite numbers (or scales the drawing to nothing), no lines, a curve, an
-        unknown or a cut (green) colour, no boundary, a boundary that is not one closed
+        unknown or a cut (green) colour, more than ``settings.max_svg_pairs`` pairs of
+        pieces that meet or cross, no boundary, a boundary that is not one closed
         outline (open, branching, several pieces, holes), creases outside the boundary, a
         crease ending inside a face, a face that is not a simple polygon.
     """
@@ -170,7 +174,7 @@ def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     for _ in range(_MENDS):
         if pieces is None:
             break
-        xy, edges, letters, angles = _node(*pieces, tol, snap)
+        xy, edges, letters, angles = _node(*pieces, tol, snap, settings.max_svg_pairs)
         xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
         pieces = _mend(xy, edges, letters, angles, snap)
     boundary = _check_boundary(xy, edges, letters)
@@ -459,30 +463,41 @@ def _letter(colour: se.Color, written: str | None, name: str) -> str:
 
 # ------------------------------------------------------------------------- the geometry
 def _node(
-    ends: np.ndarray, letters: list[str], angles: list[float], tol: float, snap: float = 0.0
+    ends: np.ndarray,
+    letters: list[str],
+    angles: list[float],
+    tol: float,
+    snap: float = 0.0,
+    max_pairs: int = DEFAULTS.max_svg_pairs,
 ) -> tuple[np.ndarray, np.ndarray, list[str], list[float]]:
     """The drawn pieces split where they meet, close points merged, repeats dropped.
 
     ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance; snap : a piece
     no longer than this drawn in two crease colours (where a crease overshoots its end along
-    another) is dropped, for :func:`_mend` to join the lines again, instead of refused.
+    another) is dropped, for :func:`_mend` to join the lines again, instead of refused;
+    max_pairs : ``Settings.max_svg_pairs`` (:func:`_splits`). Pieces of one colour and
+    angle drawn over each other along one line are first made one (:func:`_merge_overlaps`),
+    so that a line drawn back and forth many times costs no more than once.
     Returns xy (V, 2), edges (E, 2) int64 (in drawing order), their letters and angles.
     """
+    ends, letters, angles = _merge_overlaps(ends, letters, angles, tol)
     a, b = ends[:, 0], ends[:, 1]
     length = np.linalg.norm(b - a, axis=1)
     drawn = np.flatnonzero(length > tol)
     if not len(drawn):
         raise ValueError("the lines drawn have no length")
     a, b, length = a[drawn], b[drawn], length[drawn]
-    seg, t, points = _splits(a, b, length, tol)
+    seg, t, points = _splits(a, b, length, tol, max_pairs)
     n = len(drawn)
     seg = np.concatenate([np.arange(n), np.arange(n), seg])
     t = np.concatenate([np.zeros(n), np.ones(n), t])
     points = np.concatenate([a, b, points])
     order = np.lexsort((t, seg))
     seg, points = seg[order], points[order]
-    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
-    vertex = connected_components(_graph(pairs, len(points)), directed=False)[1]
+    distinct, same = np.unique(points, axis=0, return_inverse=True)  # ends drawn again
+    pairs = cKDTree(distinct).query_pairs(tol, output_type="ndarray")
+    vertex = connected_components(_graph(pairs, len(distinct)), directed=False)[1]
+    vertex = vertex[same.reshape(-1)]
     first = np.unique(vertex, return_index=True)[1]  # first point of each merged vertex
     piece = np.flatnonzero(seg[:-1] == seg[1:])
     kept: dict[tuple[int, int], int] = {}
@@ -519,8 +534,83 @@ def _node(
     )
 
 
+def _merge_overlaps(
+    ends: np.ndarray, letters: list[str], angles: list[float], tol: float
+) -> tuple[np.ndarray, list[str], list[float]]:
+    """Pieces of one letter and angle that lie along one line (both ends within ``tol`` of
+    the longest one's line) and overlap by more than ``tol`` made one piece, from the
+    farthest end of them to the other, in the place of the first one drawn; the other
+    pieces as drawn. What :func:`_node` makes of the drawing is the same (the ends inside a
+    merged piece would be vertices on a straight line of one letter, which
+    :func:`_join_straight` removes), without the pairs of :func:`_splits` that grow with the
+    square of the number of pieces drawn over each other.
+
+    Candidates are grouped by letter, angle, direction (bins of ``tol`` over the extent of
+    the drawing) and distance of their line from the origin (bins of ``tol``), so the work
+    is near-linear in the number of pieces; pieces that fall into neighbouring bins are
+    left to :func:`_splits`. ends (n, 2, 2) -> ends (m, 2, 2), letters, angles, m <= n.
+    """
+    n = len(ends)
+    if n < 2 or not tol > 0:
+        return ends, letters, angles
+    a, b = ends[:, 0], ends[:, 1]
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    flip = (d[:, 0] < 0) | ((d[:, 0] == 0) & (d[:, 1] < 0))
+    d[flip] *= -1
+    across = float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = d / length[:, None]
+        direction = np.floor(np.arctan2(u[:, 1], u[:, 0]) * across / tol)
+        offset = np.floor(_cross(u, a) / tol)
+    groups: dict[tuple, list[int]] = {}
+    for k in np.flatnonzero(length > tol).tolist():
+        angle = angles[k]
+        key = (letters[k], "nan" if math.isnan(angle) else angle, direction[k], offset[k])
+        groups.setdefault(key, []).append(k)
+    merged: dict[int, np.ndarray] = {}  # first piece of a run -> its ends
+    gone = np.zeros(n, dtype=bool)
+    for members in groups.values():
+        if len(members) < 2:
+            continue
+        ref = members[int(np.argmax(length[members]))]
+        start, axis = a[ref], u[ref]
+        on = np.array(members)
+        off = np.abs(_cross(axis, np.stack([a[on], b[on]], axis=1) - start))  # (m, 2)
+        on = on[(off <= tol).all(axis=1)]
+        s = np.stack([(a[on] - start) @ axis, (b[on] - start) @ axis], axis=1)  # (m, 2)
+        low, high = s.min(axis=1), s.max(axis=1)
+        order = np.argsort(low, kind="stable").tolist()
+        run, top = [order[0]], order[0]  # a run of overlapping pieces, the one reaching farthest
+        for m in [*order[1:], None]:
+            if m is not None and low[m] < high[top] - tol:
+                run.append(m)
+                top = m if high[m] > high[top] else top
+                continue
+            if len(run) > 1:
+                bottom = run[0]  # sorted by low
+                lo = ends[on[bottom], int(s[bottom, 1] < s[bottom, 0])]
+                hi = ends[on[top], int(s[top, 1] > s[top, 0])]
+                gone[on[run]] = True
+                merged[int(on[run].min())] = np.array([lo, hi])
+            if m is not None:
+                run, top = [m], m
+    if not merged:
+        return ends, letters, angles
+    ends = ends.copy()
+    for k, piece in merged.items():
+        gone[k] = False
+        ends[k] = piece
+    keep = np.flatnonzero(~gone)
+    return ends[keep], [letters[k] for k in keep], [angles[k] for k in keep]
+
+
 def _splits(
-    a: np.ndarray, b: np.ndarray, length: np.ndarray, tol: float
+    a: np.ndarray,
+    b: np.ndarray,
+    length: np.ndarray,
+    tol: float,
+    max_pairs: int = DEFAULTS.max_svg_pairs,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where pieces must be split: where an end of another piece lies within ``tol`` of
     their interior (a T-junction: split at the foot of the perpendicular from that end) and
@@ -528,34 +618,53 @@ def _splits(
 
     a, b : (n, 2) float, the pieces' ends; length : (n,) float, all > tol.
     Returns the piece index (k,), the parameter along it (k,) and the point (k, 2).
+    ValueError when more than ``max_pairs`` pairs of pieces come within ``tol`` of each
+    other (``Settings.max_svg_pairs``), counted in batches before the pairs are examined.
     """
     lines = shapely.linestrings(np.stack([a, b], axis=1))
-    i, j = shapely.STRtree(lines).query(lines, predicate="dwithin", distance=tol)
-    i, j = i[i < j], j[i < j]
+    tree = shapely.STRtree(lines)
+    found, pairs, batch = [], 0, 256  # pieces per query: the pairs of a query stay small
+    for first in range(0, len(lines), batch):
+        i, j = tree.query(lines[first : first + batch], predicate="dwithin", distance=tol)
+        i += first
+        i, j = i[i < j], j[i < j]
+        pairs += len(i)
+        if pairs > max_pairs:
+            raise ValueError(
+                f"more than {max_pairs} pairs of its {len(lines)} line pieces meet, cross or "
+                "come within the merge distance of each other (Settings.max_svg_pairs): too "
+                "many lines cross or are drawn over each other"
+            )
+        found.append((i, j))
+    i = np.concatenate([p[0] for p in found])
+    j = np.concatenate([p[1] for p in found])
     seg, t, points = [], [], []
 
     def interior(s: np.ndarray, on: np.ndarray) -> np.ndarray:
         return (s * length[on] > tol) & ((1 - s) * length[on] > tol)
 
-    for on, other in ((i, j), (j, i)):
-        d = b[on] - a[on]
-        for end in (a[other], b[other]):
-            s = np.sum((end - a[on]) * d, axis=1) / length[on] ** 2
-            foot = a[on] + s[:, None] * d
-            hit = interior(s, on) & (np.linalg.norm(foot - end, axis=1) <= tol)
-            seg.append(on[hit])
-            t.append(s[hit])
-            points.append(foot[hit])
-    di, dj, r = b[i] - a[i], b[j] - a[j], a[j] - a[i]
-    denom = _cross(di, dj)
-    parallel = denom == 0
-    si = np.divide(_cross(r, dj), denom, out=np.full(len(i), np.nan), where=~parallel)
-    sj = np.divide(_cross(r, di), denom, out=np.full(len(i), np.nan), where=~parallel)
-    hit = interior(si, i) & interior(sj, j)
-    crossing = a[i][hit] + si[hit, None] * di[hit]
-    seg += [i[hit], j[hit]]
-    t += [si[hit], sj[hit]]
-    points += [crossing, crossing]
+    chunk = 1 << 16  # pairs examined at once: the temporary arrays stay small
+    for k in range(0, max(len(i), 1), chunk):  # once at least: the arrays returned
+        ik, jk = i[k : k + chunk], j[k : k + chunk]
+        for on, other in ((ik, jk), (jk, ik)):
+            d = b[on] - a[on]
+            for end in (a[other], b[other]):
+                s = np.sum((end - a[on]) * d, axis=1) / length[on] ** 2
+                foot = a[on] + s[:, None] * d
+                hit = interior(s, on) & (np.linalg.norm(foot - end, axis=1) <= tol)
+                seg.append(on[hit])
+                t.append(s[hit])
+                points.append(foot[hit])
+        di, dj, r = b[ik] - a[ik], b[jk] - a[jk], a[jk] - a[ik]
+        denom = _cross(di, dj)
+        parallel = denom == 0
+        si = np.divide(_cross(r, dj), denom, out=np.full(len(ik), np.nan), where=~parallel)
+        sj = np.divide(_cross(r, di), denom, out=np.full(len(ik), np.nan), where=~parallel)
+        hit = interior(si, ik) & interior(sj, jk)
+        crossing = a[ik][hit] + si[hit, None] * di[hit]
+        seg += [ik[hit], jk[hit]]
+        t += [si[hit], sj[hit]]
+        points += [crossing, crossing]
     return np.concatenate(seg), np.concatenate(t), np.concatenate(points).reshape(-1, 2)
 
 

@@ -73,7 +73,8 @@ def read_pattern_file(
         faces are rigid flat panels) instead of free ones;
     settings : the tolerances of reading and triangulating (``triangulation_area_tol``,
         ``degenerate_area``, ``plan_area_tol``) and the plan's bounds (``min_pattern_size``,
-        ``max_coordinate``).
+        ``max_coordinate``; an SVG drawing's triangles, counted before its faces are
+        triangulated, ``max_pattern_faces``).
     """
     path = Path(path)
     kind = FILE_FORMATS.get(path.suffix.lower())
@@ -96,6 +97,12 @@ def read_pattern_file(
         xy = drawing.xy * per_unit
         # the extent is checked before the faces are triangulated (where it could overflow)
         plan, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
+        count = sum(len(polygon) - 2 for polygon in drawing.polygons)  # n - 2 per polygon
+        if count > settings.max_pattern_faces:
+            raise ValueError(
+                f"{path}: its {len(drawing.polygons)} faces make {count} triangles, more than "
+                f"{settings.max_pattern_faces} (Settings.max_pattern_faces)"
+            )
         coords = np.column_stack([xy, np.zeros(len(xy))])
         triangles, diagonals = triangulate_polygons(
             coords,

@@ -143,10 +143,18 @@ def footprint_mesh(
     if area / triangle_area > settings.max_pattern_faces:
         raise ValueError(
             f"edge length {edge_length:g} m makes about {area / triangle_area:.0f} triangles on "
-            f"a footprint of {area:g} m^2, more than {settings.max_pattern_faces}"
+            f"a footprint of {area:g} m^2, more than {settings.max_pattern_faces} "
+            "(Settings.max_pattern_faces)"
         )
     ends = np.roll(xy, -1, axis=0)
     pieces = np.maximum(1, np.rint(np.hypot(*(ends - xy).T) / edge_length).astype(int))
+    if int(pieces.sum()) - 2 > settings.max_pattern_faces:  # n points on the outline: >= n - 2
+        raise ValueError(
+            f"the footprint of {len(xy)} corners, its sides divided at edge length "
+            f"{edge_length:g} m, has {int(pieces.sum())} points on its outline: at least "
+            f"{int(pieces.sum()) - 2} triangles, more than {settings.max_pattern_faces} "
+            "(Settings.max_pattern_faces)"
+        )
     points, outline = [xy], []
     for k, n in enumerate(pieces):  # corner k, then the inner points of its side
         first = sum(len(q) for q in points)

@@ -135,11 +135,7 @@ def parse_pattern(
                 f"a grid pattern is grid:NXxNY (vertex counts, e.g. grid:15x9), got {text!r}"
             )
         nx, ny = int(counts[1]), int(counts[2])
-        if 2 * (nx - 1) * (ny - 1) > settings.max_pattern_faces:
-            raise ValueError(
-                f"pattern {text!r} has {2 * (nx - 1) * (ny - 1)} triangles, more than "
-                f"{settings.max_pattern_faces}"
-            )
+        check_faces(2 * (nx - 1) * (ny - 1), f"pattern {text!r}", settings)
         width, height = parse_size(size)
         check_extent(width, height, f"pattern {text!r}", settings)
         diagonals = DIAGONALS[0] if diagonals is None else diagonals
@@ -150,6 +146,7 @@ def parse_pattern(
         outline = outline - outline.min(axis=0)
         length = default_edge_length(outline, settings) if edge_length is None else edge_length
         xy, faces = footprint_mesh(outline, length, settings)
+        check_faces(len(faces), f"pattern {text!r}", settings)
         return Plan(text, xy, faces, edge_length=float(length), footprint=outline)
     if is_pattern_file(text):
         _refuse_options(text, given, keep=("size", "scale", "rigid panels"))
@@ -161,8 +158,20 @@ def parse_pattern(
             rigid_panels=rigid_panels,
             settings=settings,
         )
+        check_faces(len(read.faces), f"pattern {text!r}", settings)
         return Plan(text, read.xy, read.faces, fixed=read.fixed, source=read.source)
     raise ValueError(f"unknown pattern {spec!r} (choose from {FORMS})")
+
+
+def check_faces(count: int, what: str, settings: Settings = DEFAULTS) -> None:
+    """ValueError ``"<what> has <count> triangles, more than <limit>
+    (Settings.max_pattern_faces)"`` when a pattern's real triangle count passes the limit:
+    checked after triangulation, before any problem is built on it."""
+    if count > settings.max_pattern_faces:
+        raise ValueError(
+            f"{what} has {count} triangles, more than {settings.max_pattern_faces} "
+            "(Settings.max_pattern_faces)"
+        )
 
 
 def parse_size(size: str | tuple[float, float] | None) -> tuple[float, float]:

@@ -18,6 +18,11 @@ twice continuously differentiable with exact derivatives in problem (6).
 * **Resolution.** ``Settings.surface_grid_nodes`` nodes along the longer side of the plan box,
   the same spacing along the other. A grid finer than the mesh's triangles makes the spline
   follow their facets; a coarser one smooths them. ``fit_error`` is measured either way.
+* **Size.** A mesh of more than ``Settings.max_mesh_triangles`` triangles is refused (a
+  binary STL file before it is loaded). The heights are found through buckets of the plan
+  points and the columns of them each triangle crosses (:func:`_candidates`), in batches:
+  the memory is linear in the mesh and the points, also for the long thin triangles of a
+  fan (a polygon face of an OBJ file), whose bounding boxes cover most of the plan.
 
 ``trimesh`` reads the files; it is imported when a file is read, not with ``rigidfold``.
 """
@@ -167,21 +172,24 @@ class MeshSurface(Surface):
 
     def _top(self, points: np.ndarray) -> np.ndarray:
         """Height of the highest triangle within the footprint tolerance above or below each
-        plan point, NaN where there is none.  points (P, 2) -> (P,)"""
+        plan point, NaN where there is none.  points (P, 2) -> (P,)
+
+        The candidate pairs of points and triangles come in batches of bounded size
+        (:func:`_candidates`), so that the memory stays linear in the mesh and the points."""
         c, tol = self._corners, self._tol
-        point, tri = _pairs(points, c[:, :, :2].min(axis=1) - tol, c[:, :, :2].max(axis=1) + tol)
-        a, e1, e2 = c[tri, 0], c[tri, 1] - c[tri, 0], c[tri, 2] - c[tri, 0]
-        d = points[point] - a[:, :2]
-        u = (d[:, 0] * e2[:, 1] - d[:, 1] * e2[:, 0]) / self._det[tri]
-        v = (e1[:, 0] * d[:, 1] - e1[:, 1] * d[:, 0]) / self._det[tri]
-        hit = (u >= 0) & (v >= 0) & (u + v <= 1)
-        near = np.flatnonzero(~hit)
-        if tol > 0 and near.size:
-            p, corners = points[point[near]], c[tri[near], :, :2]
-            gaps = [_segment_distance(p, corners[:, k], corners[:, k - 1]) for k in range(3)]
-            hit[near] = np.min(gaps, axis=0) <= tol
         top = np.full(len(points), np.nan)
-        np.fmax.at(top, point[hit], (a[:, 2] + u * e1[:, 2] + v * e2[:, 2])[hit])
+        for point, tri in _candidates(points, c[:, :, :2], tol):
+            a, e1, e2 = c[tri, 0], c[tri, 1] - c[tri, 0], c[tri, 2] - c[tri, 0]
+            d = points[point] - a[:, :2]
+            u = (d[:, 0] * e2[:, 1] - d[:, 1] * e2[:, 0]) / self._det[tri]
+            v = (e1[:, 0] * d[:, 1] - e1[:, 1] * d[:, 0]) / self._det[tri]
+            hit = (u >= 0) & (v >= 0) & (u + v <= 1)
+            near = np.flatnonzero(~hit)
+            if tol > 0 and near.size:
+                p, corners = points[point[near]], c[tri[near], :, :2]
+                gaps = [_segment_distance(p, corners[:, k], corners[:, k - 1]) for k in range(3)]
+                hit[near] = np.min(gaps, axis=0) <= tol
+            np.fmax.at(top, point[hit], (a[:, 2] + u * e1[:, 2] + v * e2[:, 2])[hit])
         return top
 
 
@@ -197,6 +205,8 @@ def _mesh_problem(
         return f"triangles must be an (M, 3) array of vertex indices, got shape {t.shape}"
     if len(t) == 0:
         return "no triangles"
+    if len(t) > settings.max_mesh_triangles:
+        return _too_many(len(t), settings)
     outside = t[(t < 0) | (t >= len(v))]
     if outside.size:
         return f"a triangle refers to vertex {outside[0]}, but there are {len(v)} vertices"
@@ -214,6 +224,15 @@ def _mesh_problem(
             f"or closed one{hint}"
         )
     return ""
+
+
+def _too_many(count: int, settings: Settings) -> str:
+    """The message about a mesh of ``count`` triangles, more than the limit."""
+    return (
+        f"{count} triangles, more than {settings.max_mesh_triangles} "
+        "(Settings.max_mesh_triangles): decimate the mesh; the surface is sampled on at most "
+        "513 x 513 grid nodes"
+    )
 
 
 def read_mesh(
@@ -238,7 +257,9 @@ def read_mesh(
     if not path.is_file():
         raise ValueError(f"cannot read mesh {path}: no such file")
     if kind == "stl":
-        _check_stl(path)
+        count = _check_stl(path)
+        if count is not None and count > settings.max_mesh_triangles:
+            raise ValueError(f"mesh {path}: {_too_many(count, settings)}")
     import trimesh
 
     try:
@@ -259,21 +280,22 @@ def read_mesh(
     return vertices, triangles
 
 
-def _check_stl(path: Path) -> None:
-    """ValueError naming ``path`` for an STL file that is neither a binary STL of the size its
-    header gives (84 bytes, then 50 per triangle counted at byte 80) nor ASCII STL text
-    (``solid`` ...): a damaged or cut binary file, which trimesh would try to read as text
-    of an unknown encoding."""
+def _check_stl(path: Path) -> int | None:
+    """The triangle count of a binary STL file (None for ASCII STL), read from its header
+    before the file is loaded. ValueError naming ``path`` for an STL file that is neither a
+    binary STL of the size its header gives (84 bytes, then 50 per triangle counted at byte
+    80) nor ASCII STL text (``solid`` ...): a damaged or cut binary file, which trimesh would
+    try to read as text of an unknown encoding."""
     try:
         size = path.stat().st_size
         with path.open("rb") as file:
             head = file.read(84)
             if len(head) == 84 and 84 + 50 * int.from_bytes(head[80:], "little") == size:
-                return
+                return int.from_bytes(head[80:], "little")
             if head.lstrip()[:5].lower() == b"solid":
                 file.seek(0)
                 file.read().decode("utf-8")
-                return
+                return None
     except OSError as exc:
         raise ValueError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
@@ -312,29 +334,86 @@ def mesh_surface(path: str | Path, *, up: str = "z", settings: Settings = DEFAUL
     return MeshSurface(vertices, triangles, source=Path(path).name, settings=settings)
 
 
-def _pairs(points: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(point index, box index) of every plan point inside every box, found through buckets of
-    a regular grid.  points (P, 2), lo and hi (M, 2) corners of the boxes -> (K,), (K,)"""
-    pmin, pmax = points.min(axis=0, initial=np.inf), points.max(axis=0, initial=-np.inf)
-    boxes = np.flatnonzero((hi >= pmin).all(axis=1) & (lo <= pmax).all(axis=1))
-    if boxes.size == 0:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    lo, hi, extent = lo[boxes], hi[boxes], pmax - pmin
-    # buckets about one box wide, and not many more buckets than points
-    cell = max(float(np.median((hi - lo).max(axis=1))), float(np.sqrt(extent.prod() / len(points))))
+_BATCH = 1 << 18
+"""Candidate pairs (and strips of triangles) :func:`_candidates` yields at most at once
+(unless one strip alone has more): some 30 MB of temporary arrays in ``MeshSurface._top``."""
+
+
+def _candidates(points: np.ndarray, plan: np.ndarray, tol: float, batch: int = _BATCH):
+    """Batches (point index (K,), triangle index (K,)) of every plan point that may lie within
+    ``tol`` of a triangle: a superset, each pair once.  points (P, 2), plan (M, 3, 2)
+
+    The points are sorted into square buckets about one point apart; each triangle is cut
+    into the columns of buckets it spans, and in each column only the buckets between its
+    lowest and highest point there (widened by ``tol``) are candidates, one contiguous run
+    of the sorted points. A long thin triangle (a fan's) thus meets the points along it,
+    not all the points of its bounding box: the work is about the sum of the triangles'
+    widths in bucket columns plus the pairs, in batches of about ``batch`` of each.
+    """
+    if not len(points) or not len(plan):
+        return
+    pmin, pmax = points.min(axis=0), points.max(axis=0)
+    lo, hi = plan.min(axis=1) - tol, plan.max(axis=1) + tol
+    tris = np.flatnonzero((hi >= pmin).all(axis=1) & (lo <= pmax).all(axis=1))
+    if not tris.size:
+        return
+    extent = pmax - pmin
+    cell = max(float(np.sqrt(extent.prod() / len(points))), float(extent.max()) / len(points))
+    cell = cell if cell > 0 else 1.0  # all points at one place
     shape = (extent // cell).astype(np.int64) + 1
-    key = ((points - pmin) // cell).astype(np.int64)
+    key = np.minimum(((points - pmin) // cell).astype(np.int64), shape - 1)
     bucket = key[:, 0] * shape[1] + key[:, 1]
     order = np.argsort(bucket, kind="stable")
     start = np.searchsorted(bucket[order], np.arange(shape.prod() + 1))
-    b0 = np.clip((lo - pmin) // cell, 0, shape - 1).astype(np.int64)
-    span = np.clip((hi - pmin) // cell, 0, shape - 1).astype(np.int64) - b0 + 1
-    box, k = _ragged(span[:, 0] * span[:, 1])
-    b = (b0[box, 0] + k // span[box, 1]) * shape[1] + b0[box, 1] + k % span[box, 1]
-    owner, j = _ragged(start[b + 1] - start[b])
-    point, box = order[start[b[owner]] + j], box[owner]
-    inside = ((points[point] >= lo[box]) & (points[point] <= hi[box])).all(axis=1)
-    return point[inside], boxes[box[inside]]
+    columns = np.clip(
+        (np.stack([lo[tris, 0], hi[tris, 0]], axis=1) - pmin[0]) // cell, 0, shape[0] - 1
+    )
+    columns = columns.astype(np.int64)
+    width = columns[:, 1] - columns[:, 0] + 1
+    ends = np.searchsorted(np.cumsum(width), np.arange(batch, int(width.sum()), batch))
+    for chunk in np.split(np.arange(len(tris)), ends + 1):
+        if not chunk.size:
+            continue
+        owner, k = _ragged(width[chunk])
+        tri, column = tris[chunk][owner], columns[chunk, 0][owner] + k
+        ylo, yhi = _strip_span(
+            plan[tri], pmin[0] + column * cell - tol, pmin[0] + (column + 1) * cell + tol
+        )
+        rows = np.clip((np.stack([ylo - tol, yhi + tol], axis=1) - pmin[1]) // cell, -1, shape[1])
+        rows = rows.astype(np.int64)
+        first = column * shape[1] + np.clip(rows[:, 0], 0, shape[1] - 1)
+        last = column * shape[1] + np.clip(rows[:, 1], 0, shape[1] - 1)
+        outside = (rows[:, 1] < 0) | (rows[:, 0] >= shape[1])
+        s0, count = start[first], np.where(outside, 0, start[last + 1] - start[first])
+        cuts = np.searchsorted(np.cumsum(count), np.arange(batch, int(count.sum()), batch))
+        for piece in np.split(np.arange(len(tri)), cuts + 1):
+            owner, j = _ragged(count[piece])
+            if owner.size:
+                yield order[s0[piece][owner] + j], tri[piece][owner]
+
+
+def _strip_span(
+    corners: np.ndarray, xa: np.ndarray, xb: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest and highest y of triangles within the vertical strips xa <= x <= xb (each
+    meeting its triangle): over the pieces of its three sides inside the strip.
+    corners (K, 3, 2), xa, xb (K,) -> (K,), (K,)"""
+    low, high = np.full(len(xa), np.inf), np.full(len(xa), -np.inf)
+    for k in range(3):
+        p, q = corners[:, k], corners[:, k - 1]
+        x0, x1 = np.minimum(p[:, 0], q[:, 0]), np.maximum(p[:, 0], q[:, 0])
+        a, b = np.maximum(xa, x0), np.minimum(xb, x1)
+        on = a <= b
+        dx = q[:, 0] - p[:, 0]
+        slope = np.divide(q[:, 1] - p[:, 1], dx, out=np.zeros_like(dx), where=dx != 0)
+        ya, yb = p[:, 1] + (a - p[:, 0]) * slope, p[:, 1] + (b - p[:, 0]) * slope
+        flat = dx == 0  # a vertical side: both its ends
+        ya, yb = np.where(flat, p[:, 1], ya), np.where(flat, q[:, 1], yb)
+        low = np.where(on, np.minimum(low, np.minimum(ya, yb)), low)
+        high = np.where(on, np.maximum(high, np.maximum(ya, yb)), high)
+    missed = low > high  # round-off: the whole triangle
+    low[missed], high[missed] = corners[missed, :, 1].min(axis=1), corners[missed, :, 1].max(axis=1)
+    return low, high
 
 
 def _ragged(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
