@@ -18,11 +18,10 @@ the same shapes, and prints the ratio. Shapes:
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 from pathlib import Path
 
-from legacy_motion import legacy_folding_motion  # this folder is on sys.path (a script)
+from bench_scale import timed  # this folder is on sys.path (a script)
+from legacy_motion import legacy_folding_motion
 from rigidfold.case import make_case
 from rigidfold.deform import folding_motion
 from rigidfold.develop import develop
@@ -32,15 +31,6 @@ from rigidfold.patterns import miura
 RESCH = (
     Path(__file__).resolve().parents[1] / "tests/data/origami_simulator/reschTriTessellation.svg"
 )
-
-
-def timed(fn, repeat: int):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), out
 
 
 def shapes():

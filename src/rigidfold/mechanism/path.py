@@ -41,7 +41,6 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
@@ -412,17 +411,10 @@ def _first_tangent(
 ) -> np.ndarray:
     """The unit tangent of a 1-DOF manifold at the design, oriented to lower m first: the
     projection of -grad(m^2 / 2) onto the null space of J."""
-    n, m = J.shape[1], J.shape[0]
-    K = sp.bmat(
-        [[sp.identity(n), J.T], [J, -settings.path_regularization * sp.identity(m)]],
-        format="csc",
-    )
-    g = -(J_rho.T @ rho)
-    t = spla.splu(K, permc_spec="COLAMD").solve(np.concatenate([g, np.zeros(m)]))[:n]
-    norm = float(np.linalg.norm(t))
-    if not norm > 0:
+    t = System(J, J_rho, "projection", None, settings).direction(-(J_rho.T @ rho), rho)
+    if not np.isfinite(t).all():
         raise ValueError("the shape's folding path has no tangent at the design")
-    return t / norm
+    return t
 
 
 def _single(cons: RigidFoldingConstraints, x: np.ndarray, rho: np.ndarray) -> _Trace:
