@@ -436,7 +436,8 @@ class RunData:
             Check(
                 "folding motion",
                 None if not motions else not bad,
-                f"{len(motions) - len(bad)}/{n} traced, max |dl|/l = {err:.2g}" + _steps(bad)
+                f"{len(motions) - len(bad)}/{len(motions)} traced{_checked(len(motions), n)}, "
+                f"max |dl|/l = {err:.2g}" + _steps(bad)
                 if motions
                 else "no motion was traced",
             )
@@ -447,7 +448,8 @@ class RunData:
             Check(
                 "large deformation",
                 None if not deformed else not bad,
-                f"{len(deformed) - len(bad)}/{n} reached the plane, max |dl| = "
+                f"{len(deformed) - len(bad)}/{len(deformed)} reached the plane"
+                f"{_checked(len(deformed), n)}, max |dl| = "
                 f"{max(d.get('max_dl_mm') or 0.0 for _, d in deformed):.3g} mm, max |drho_fix| "
                 f"= {max(d.get('max_drho_fix_deg') or 0.0 for _, d in deformed):.3g} deg"
                 + _steps(bad)
@@ -456,6 +458,15 @@ class RunData:
             )
         )
         return checks
+
+
+def _checked(checked: int, solutions: int) -> str:
+    """ " (the final design only; --check all for every solution)" where a stage ran on fewer
+    than all ``solutions``, "" otherwise."""
+    if checked >= solutions:
+        return ""
+    which = "the final design only" if checked == 1 else f"{checked} of {solutions} solutions"
+    return f" ({which}; --check all for every solution)"
 
 
 def _steps(bad: list) -> str:
