@@ -24,7 +24,7 @@ import statistics
 import tempfile
 from pathlib import Path
 
-from rigidfold.study import Store, StudyConfig, plan, run_study
+from rigidfold.study import STUDY_OPTIONS, Store, StudyConfig, plan, run_study
 
 
 def measure(keys, config, workers: int) -> dict:
@@ -43,7 +43,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     keys = plan(["1"], ["shat", "s"], args.surfaces)
-    config = StudyConfig(deform=False)
+    config = StudyConfig(STUDY_OPTIONS.replace(deform=False))
     base = None
     print(f"{len(keys)} runs per study, medians of {args.repeat} repeats", flush=True)
     for n in args.workers:

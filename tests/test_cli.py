@@ -271,11 +271,18 @@ def test_every_argument_says_what_it_means():
 def test_defaults_come_from_the_library():
     from rigidfold.cli import build_parser
     from rigidfold.config import DEFAULT_SEED, DEFAULTS
+    from rigidfold.generate import GenerateOptions
     from rigidfold.study import STUDY_DEFAULTS
 
     parser = build_parser()
     gen = parser.parse_args(["generate", "--surface", "dome", "--pattern", "1", "--out", "x"])
-    assert (gen.seed, gen.target_dof, gen.dz) == (DEFAULT_SEED, DEFAULTS.target_dof, DEFAULTS.dz)
+    options = GenerateOptions()
+    assert (gen.seed, gen.target_dof, gen.dz) == (DEFAULT_SEED, options.target_dof, DEFAULTS.dz)
+    assert (gen.criterion, gen.solver, gen.check) == (
+        options.criterion,
+        options.solver,
+        options.check,
+    )
     assert gen.hessian == DEFAULTS.ipopt_hessian
     study = parser.parse_args(["study", "--db", "x.db"])
     assert (study.surfaces, study.workers, study.first_seed) == (

@@ -18,7 +18,7 @@ from rigidfold.generate import generate
 from rigidfold.io import read_fold, write_fold
 from rigidfold.mesh.geometry import best_fit, edge_lengths
 from rigidfold.patterns import miura
-from rigidfold.report import verification_frames
+from rigidfold.run import verification_frames
 
 
 def locked_miura(shape):

@@ -23,7 +23,7 @@ from rigidfold.numerics import (
     numeric_environment,
     pinned_environ,
 )
-from rigidfold.study.report import markdown
+from rigidfold.study.markdown import markdown
 from rigidfold.study.runner import check_worker_numerics
 from rigidfold.study.store import Key, Store
 

@@ -13,6 +13,7 @@ import pytest
 from conftest import paper_generate as generate
 from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate import GenerateOptions
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.optimize import Status
 from rigidfold.optimize.hessian import angle_derivatives
@@ -191,7 +192,7 @@ def test_generate_on_a_large_grid_projects_after_the_first_solve():
     case = make_case("dome", "grid:15x15", size="3x3")
     assert case.pattern.n_vertices >= DEFAULTS.projection_vertices
     messages = []
-    run = generate(case, criterion="s", target_dof=case.settings.target_dof)
+    run = generate(case, criterion="s", target_dof=GenerateOptions().target_dof)
     for sol in run.solutions:
         messages.append(sol.result.message)
     assert run.final_dof is not None and run.solutions

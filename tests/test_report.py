@@ -13,8 +13,9 @@ import pytest
 
 from rigidfold.case import make_case
 from rigidfold.cli import main
-from rigidfold.reporting import load_run, page, render_figures, target_surface, view_figure
+from rigidfold.reporting import page, render_figures, view_figure
 from rigidfold.reporting.view3d import best_fit
+from rigidfold.run import load_run, target_surface
 from rigidfold.workflows import report_run
 
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -11,9 +11,10 @@ from html.parser import HTMLParser
 import numpy as np
 import pytest
 
-from rigidfold.reporting import Design, view_figure
+from rigidfold.reporting import view_figure
+from rigidfold.run import SolutionFile
 from rigidfold.study import Key, Store, StudyConfig
-from rigidfold.study.report import md_code, md_text, write_report
+from rigidfold.study.markdown import md_code, md_text, write_report
 from rigidfold.study.store import RUN_FIELDS
 
 NAMES = [
@@ -122,7 +123,7 @@ def test_markdown_escapes():
 
 def test_the_3d_views_title_shows_the_file_name_as_text():
     name = 'solutions/<a href="https:/evil.example">x</a>.fold'
-    design = Design(
+    design = SolutionFile(
         name=name,
         step=0,
         dof=1,

@@ -13,8 +13,8 @@ import time
 import pytest
 
 from conftest import main_code
-from rigidfold import report
-from rigidfold.report import LOCK_NAME, clear_earlier_run, lock_run_dir
+from rigidfold.run import LOCK_NAME, clear_earlier_run, lock_run_dir
+from rigidfold.run import lock as run_lock
 
 
 def _dead_pid() -> int:
@@ -51,13 +51,13 @@ def test_a_stale_lock_is_taken_over_by_one_claimant_only(tmp_path, monkeypatch):
     it dead; before, each removed the lock it found and made its own, so that every one of
     them "took over". Threads of one process contend like processes: each opens the lock
     itself (its own open file description, its own flock)."""
-    real_alive = report._alive
+    real_alive = run_lock._alive
 
     def slow_alive(pid: int) -> bool:
         time.sleep(0.02)
         return real_alive(pid)
 
-    monkeypatch.setattr(report, "_alive", slow_alive)
+    monkeypatch.setattr(run_lock, "_alive", slow_alive)
     dead = _dead_pid()
     for trial in range(8):
         out = tmp_path / f"t{trial}"

@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 from rigidfold.generate import Stop
-from rigidfold.study import Key, Store, StudyConfig, plan, preset
-from rigidfold.study.report import (
+from rigidfold.study import STUDY_OPTIONS, Key, Store, StudyConfig, plan, preset
+from rigidfold.study.markdown import markdown, write_report
+from rigidfold.study.tables import (
     FOLD_BINS,
     costs,
     criterion_summary,
@@ -25,10 +26,8 @@ from rigidfold.study.report import (
     lock_causes,
     locked_fold_angles,
     locks_by_stage,
-    markdown,
     paired_comparisons,
     tables_5_6,
-    write_report,
 )
 
 STUDY = ["--surfaces", "3", "--patterns", "1", "--criteria", "shat,s", "--no-deform"]
@@ -281,7 +280,8 @@ def test_settings_added_later_at_their_default_are_compatible():
     # resumes
     retired = {**current, "settings": {**current["settings"], "motion_arc_step": 0.2}}
     assert config_differences(retired, current) == []
-    assert config_differences(current, StudyConfig(deform=True).as_dict()) == ["deform"]
+    deform = StudyConfig(STUDY_OPTIONS.replace(deform=True)).as_dict()
+    assert config_differences(current, deform) == ["deform"]
     tighter = StudyConfig(settings=DEFAULTS.with_(f_tol=1e-9)).as_dict()
     assert config_differences(current, tighter) == ["settings.f_tol"]
 
@@ -492,7 +492,7 @@ def test_old_databases_resume_with_the_new_attempt_columns(tmp_path):
     store.close()
     digest = hashlib.sha256(db.read_bytes()).hexdigest()
     with pytest.raises(ValueError, match="differs in: lookahead"):
-        Store(db, StudyConfig(lookahead=True).as_dict())
+        Store(db, StudyConfig(STUDY_OPTIONS.replace(lookahead=True)).as_dict())
     assert hashlib.sha256(db.read_bytes()).hexdigest() == digest
     store = Store(db, StudyConfig().as_dict())
     attempt = {

@@ -16,7 +16,7 @@ import time
 import pytest
 
 from conftest import main_code, run_cli
-from rigidfold.study import Key, Store, StudyConfig
+from rigidfold.study import STUDY_OPTIONS, Key, Store, StudyConfig
 
 STUDY = ["--surfaces", "1", "--patterns", "1", "--criteria", "s", "--no-deform", "--quiet"]
 
@@ -85,7 +85,7 @@ def test_damaged_databases_are_refused_in_one_line_untouched(tmp_path, kind):
 
 def test_a_second_client_is_refused_and_a_dead_ones_lock_taken_over(tmp_path):
     db = tmp_path / "s.sqlite"
-    config = StudyConfig(deform=False).as_dict()
+    config = StudyConfig(STUDY_OPTIONS.replace(deform=False)).as_dict()
     first = Store(db, config)
     with pytest.raises(ValueError, match=f"in use by another rigidfold study \\(pid {os.getpid()}"):
         Store(db, config)
@@ -96,8 +96,8 @@ def test_a_second_client_is_refused_and_a_dead_ones_lock_taken_over(tmp_path):
         [
             sys.executable,
             "-c",
-            "import sys, time\nfrom rigidfold.study import Store, StudyConfig\n"
-            f"Store({str(db)!r}, StudyConfig(deform=False).as_dict())\n"
+            "import sys, time\nfrom rigidfold.study import STUDY_OPTIONS, Store, StudyConfig\n"
+            f"Store({str(db)!r}, StudyConfig(STUDY_OPTIONS.replace(deform=False)).as_dict())\n"
             "print('ready', flush=True)\ntime.sleep(300)",
         ],
         stdout=subprocess.PIPE,
@@ -372,7 +372,7 @@ def test_a_database_named_with_uri_characters_resumes_without_stray_files(tmp_pa
 def test_report_figures_of_patterns_with_directories_are_written(tmp_path, capsys):
     """Issue 30, item 8: a pattern given as ``sub/t.fold`` (or ``grid:3x3``) names a figure
     in DIR (a slug, unique), linked from results.md."""
-    from rigidfold.study.report import figure_name
+    from rigidfold.study.markdown import figure_name
     from rigidfold.study.store import RUN_FIELDS
 
     db = tmp_path / "s.sqlite"

@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from rigidfold import __version__
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
+from rigidfold.generate import GenerateOptions
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
@@ -26,6 +27,9 @@ from rigidfold.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.selection import CRITERIA
 from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACE_FORMS
+
+GENERATE_DEFAULTS = GenerateOptions()
+"""The defaults of ``generate``'s options (criterion, target DOF, solver, check)."""
 
 EXIT_USAGE = 2
 LOOKAHEAD_HELP = (
@@ -149,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     gen.add_argument(
         "--criterion",
-        default=CRITERIA[0],
+        default=GENERATE_DEFAULTS.criterion,
         choices=CRITERIA,
         help="how the next crease line to fix is chosen, lowest score first (Section 5): shat "
         "= S-hat and s = S, the shape score S^S over the mechanism score (from normalised or "
@@ -158,7 +162,7 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument(
         "--target-dof",
         type=int,
-        default=DEFAULTS.target_dof,
+        default=GENERATE_DEFAULTS.target_dof,
         help="stop at a shape with this many degrees of freedom (DOF: independent rigid "
         "folding motions; 1 = folds along one path; default: %(default)s)",
     )
@@ -187,7 +191,7 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument(
         "--check",
         choices=CHECKS,
-        default=CHECKS[0],
+        default=GENERATE_DEFAULTS.check,
         help="which solutions get the folding motion and the large-deformation check: the "
         "final design only, or all (default: %(default)s; the development diagram is drawn "
         "for every solution)",
@@ -348,7 +352,9 @@ def build_parser() -> argparse.ArgumentParser:
     stu.add_argument(
         "--no-deform",
         action="store_true",
-        help="skip Steps 8-9 (development diagram, large deformation) of each solution",
+        help="skip the large-deformation check (Step 9, OpenSees) of each solution, as in "
+        "generate; a study writes no development diagram, so Step 8 (its D in Table 7) runs "
+        "only with Step 9",
     )
     stu.add_argument("--lookahead", action="store_true", help=LOOKAHEAD_HELP)
     stu.add_argument(
@@ -513,7 +519,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     )
     p.add_argument(
         "--solver",
-        default=SOLVERS[0],
+        default=GENERATE_DEFAULTS.solver,
         choices=SOLVERS,
         help="solver of problem (6) (default: %(default)s)",
     )
@@ -601,43 +607,25 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
 def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.progress import GenerateProgress
-    from rigidfold.report import RunOutcome, RunWriter
+    from rigidfold.run import RunOutcome, RunWriter
     from rigidfold.workflows import generate_case
 
     if args.target_dof < 0:
         raise ValueError(f"--target-dof must be >= 0, got {args.target_dof}")
-    options = {
-        "criterion": args.criterion,
-        "target_dof": args.target_dof,
-        "seed": args.seed,
-        "solver": args.solver,
-        "lookahead": args.lookahead,
-        "symmetric": args.symmetric,
-        "deform": not args.no_deform,
-        "deploy_check": not args.no_deploy_check,
-        "check": args.check,
-    }
-    writer = RunWriter(
-        args.out,
-        _case(args),
-        options,
+    options = GenerateOptions(
+        criterion=args.criterion,
+        target_dof=args.target_dof,
+        seed=args.seed,
+        solver=args.solver,
+        lookahead=args.lookahead,
+        deploy_check=not args.no_deploy_check,
         deform=not args.no_deform,
-        overwrite=args.overwrite,
         check=args.check,
     )
+    writer = RunWriter(args.out, _case(args), options, overwrite=args.overwrite)
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
     try:
-        run = generate_case(
-            writer,
-            criterion=args.criterion,
-            target_dof=args.target_dof,
-            seed=args.seed,
-            solver=args.solver,
-            lookahead=args.lookahead,
-            deploy_check=not args.no_deploy_check,
-            progress=progress.update,
-            report=not args.no_report,
-        )
+        run = generate_case(writer, progress=progress.update, report=not args.no_report)
     except KeyboardInterrupt:
         progress.close()
         print(
@@ -780,6 +768,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
 def _cmd_study(args: argparse.Namespace) -> int:
     from rigidfold.progress import StudyProgress
     from rigidfold.study import (
+        STUDY_OPTIONS,
         StudyConfig,
         StudyInterrupted,
         failure_summary,
@@ -800,10 +789,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
             settings=settings,
         )
     config = StudyConfig(
-        deform=not args.no_deform,
-        settings=settings,
-        lookahead=args.lookahead,
-        deploy_check=args.deploy_check,
+        STUDY_OPTIONS.replace(
+            deform=not args.no_deform, lookahead=args.lookahead, deploy_check=args.deploy_check
+        ),
+        settings,
     )
     bar = StudyProgress(enabled=not args.quiet)
     try:
@@ -845,7 +834,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 def _cmd_study_report(args: argparse.Namespace) -> int:
     from rigidfold.study import Store
-    from rigidfold.study.report import markdown, write_report
+    from rigidfold.study.markdown import markdown, write_report
 
     stores = [Store(db, readonly=True) for db in args.db]
     if args.out:

@@ -58,8 +58,6 @@ class Settings:
 
     Generation (Steps 5-7)
     ----------------------
-    target_dof : int
-        Generation stops when an accepted shape has this DOF (paper: 1).
     zero_dof_ends : bool
         Step 5 of the paper: a solution of (6) whose mechanism has DOF 0 ends generation (it
         goes to Step 8; not counted in N_reduce, N_lock or N_exceed). ``False``: while the
@@ -269,10 +267,6 @@ class Settings:
     polish_tol : float
         Before the deployability check, an accepted solution is projected onto F = 0 to this
         F (:meth:`rigidfold.optimize.FormFindingProblem.polish`): developable to round-off.
-    deploy_check : bool
-        Generation (Step 5) accepts only solutions whose folding path reaches the flat state
-        (:func:`rigidfold.mechanism.path.trace_path`); others count in N_path and are
-        replaced like a lock (Step 7). False is the paper's method.
     deploy_max_candidates : int
         Step 7 gives up on a shape once this many of its candidates gave solutions whose
         folding paths do not reach the flat state (``Stop.NO_DEPLOYABLE``; 0: it tries them
@@ -345,7 +339,6 @@ class Settings:
     rho_bar: float | None = None
     f_tol: float = 1e-7
     # generation procedure (Steps 5-7)
-    target_dof: int = 1
     zero_dof_ends: bool = True
     # solver tolerances
     constraint_tol: float = 1e-8
@@ -416,7 +409,6 @@ class Settings:
     path_stall_ratio: float = 1e-4
     path_wander_steps: int = 40
     polish_tol: float = 1e-26
-    deploy_check: bool = True
     deploy_check_max_dof: int = 1
     deploy_max_candidates: int = 30
     # reading FOLD files
@@ -456,8 +448,6 @@ class Settings:
             raise ValueError(
                 f"rho_bar must lie in (0, 180) degrees, got {math.degrees(self.rho_bar):g}"
             )
-        if not (isinstance(self.target_dof, int) and self.target_dof >= 0):
-            raise ValueError(f"target DOF must be an integer >= 0, got {self.target_dof!r}")
         if not self.f_tol > 0:
             raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
         nodes = self.surface_grid_nodes

@@ -36,12 +36,12 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.config import DEFAULT_SEED, Settings, check_seed, one_blas_thread
+from rigidfold.config import CHECKS, DEFAULT_SEED, Settings, check_seed, one_blas_thread
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.stiffness import hinge_stiffness
@@ -279,93 +279,152 @@ class Generation:
         }
 
 
-@one_blas_thread()  # the same path on every machine (see one_blas_thread)
-def generate(
-    case: Case,
-    *,
-    criterion: str = CRITERIA[0],
-    target_dof: int | None = None,
-    seed: int = DEFAULT_SEED,
-    solver: str = SOLVERS[0],
-    support_face: int | None = None,
-    lookahead: bool = False,
-    deploy_check: bool | None = None,
-    on_attempt: Callable[[Generation, Attempt], None] | None = None,
-    on_solution: Callable[[Generation, Solution], None] | None = None,
-) -> Generation:
-    """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
+@dataclass(frozen=True)
+class GenerateOptions:
+    """How one generation run goes, in one place: Steps 2-7 (:func:`generate`) and the
+    checks that follow them (Steps 8-9, run by :class:`rigidfold.run.RunWriter`).
 
-    criterion : one of ``CRITERIA`` (default: the first, S-hat); target_dof : default
-    ``case.settings.target_dof``; solver : one of ``SOLVERS`` (default: the first, IPOPT).
-    With mirror planes in the case, creases are fixed in mirror groups (2 or 4 at once).
-    ``support_face`` is the triangle whose frame node carries the s = 6 supports (default:
-    the one nearest the centroid); it sets the metric of the mechanism modes and so the
-    S^F-hat scores. ``lookahead``: skip the candidates predicted to lock (see the module's
-    text); the forecast's cost is part of the selection time. ``deploy_check`` (default
-    ``Settings.deploy_check``): polish every accepted solution to F = 0
-    (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
-    rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
-    on solutions of at most ``Settings.deploy_check_max_dof`` DOF, 0: all); one that does not
-    counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape (which cannot
-    deploy) is retried like a lock where the target is >= 1. False is the paper's method.
-    A KeyboardInterrupt propagates after the callbacks of everything finished so far.
+    criterion : one of ``CRITERIA`` (default: the first, S-hat).
+    target_dof : int >= 0, the DOF at which generation ends (default 1: stabilised by one
+        support or actuator).
+    seed : the stream of the random criterion and of the hinge stiffnesses of S^F-hat.
+    solver : one of ``SOLVERS`` (default: the first, IPOPT).
+    lookahead : skip the candidates predicted to lock (see the module's text); the
+        forecast's cost is part of the selection time.
+    deploy_check : polish every accepted solution to F = 0
+        (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
+        rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
+        on solutions of at most ``Settings.deploy_check_max_dof`` DOF, 0: all); one that does
+        not counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape (which
+        cannot deploy) is retried like a lock where the target is >= 1. False is the paper's
+        method.
+    support_face : the triangle whose frame node carries the s = 6 supports (default: the
+        one nearest the centroid); it sets the metric of the mechanism modes and so the
+        S^F-hat scores.
+    deform : run Step 9 (the large-deformation check) on the checked solutions.
+    check : one of ``CHECKS``: the folding motion and Step 9 on the final design only
+        ("final") or on every solution ("all").
     """
-    if criterion not in CRITERIA:
-        raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
-    if target_dof is None:
-        target_dof = case.settings.target_dof
-    if target_dof < 0:
-        raise ValueError(f"target DOF must be >= 0, got {target_dof}")
-    rng = np.random.default_rng(check_seed(seed))
-    check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
-    settings = case.settings
-    deploy = settings.deploy_check if deploy_check is None else bool(deploy_check)
-    run = Generation(numerics=numeric_environment().to_dict(), deploy_check=deploy)
-    t0 = time.perf_counter()
-    problem = case.problem(build_ipopt=solver == "ipopt")
-    run.build_time = time.perf_counter() - t0
-    groups = crease_groups(case.pattern, case.planes, case.settings) if case.planes else None
-    # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
-    # over-reduction, retried like a lock (as with zero_dof_ends=False)
-    zero_ends = (settings.zero_dof_ends and not deploy) or target_dof == 0
-    locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
 
-    def attempt(
-        fixed: np.ndarray, start, added, score
-    ) -> tuple[Attempt, OptimizeResult, Mechanism | None, FoldingPath | None]:
-        result = problem.solve(fixed=fixed, start=start, solver=solver)
-        if deploy:
-            result = problem.polish(result)
+    criterion: str = CRITERIA[0]
+    target_dof: int = 1
+    seed: int = DEFAULT_SEED
+    solver: str = SOLVERS[0]
+    lookahead: bool = False
+    deploy_check: bool = True
+    support_face: int | None = None
+    deform: bool = True
+    check: str = CHECKS[0]
+
+    def __post_init__(self) -> None:
+        if self.criterion not in CRITERIA:
+            raise ValueError(
+                f"unknown criterion {self.criterion!r} (choose from {', '.join(CRITERIA)})"
+            )
+        if self.solver not in SOLVERS:
+            raise ValueError(f"unknown solver {self.solver!r} (choose from {', '.join(SOLVERS)})")
+        if self.check not in CHECKS:
+            raise ValueError(f"unknown check {self.check!r} (choose from {', '.join(CHECKS)})")
+        target = self.target_dof
+        if isinstance(target, bool) or not isinstance(target, int | np.integer) or target < 0:
+            raise ValueError(f"target DOF must be an integer >= 0, got {target!r}")
+        face = self.support_face
+        if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
+            raise ValueError(f"support face must be a face index, got {face!r}")
+        check_seed(self.seed)
+
+    def replace(self, **changes) -> GenerateOptions:
+        """These options with ``changes`` (field names), validated; unknown names are a
+        ValueError naming them."""
+        unknown = sorted(set(changes) - {f.name for f in fields(self)})
+        if unknown:
+            raise ValueError(f"unknown generate option {', '.join(map(repr, unknown))}")
+        return replace(self, **changes) if changes else self
+
+    def to_dict(self) -> dict:
+        """The options as JSON values (summary.json's ``options``)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> GenerateOptions:
+        """The options of :meth:`to_dict`; keys of other versions (``symmetric``, kept in
+        the case) are ignored, missing ones take their defaults."""
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in data.items() if k in names})
+
+
+@dataclass
+class _Trial:
+    """What one solve produced: the result, its mechanism (None: not analysed) and its
+    folding path (None: not traced)."""
+
+    result: OptimizeResult
+    mechanism: Mechanism | None
+    path: FoldingPath | None
+
+
+class _Steps:
+    """The steps of one generation run on its state: the problem (built once), the options,
+    the run being recorded and the callbacks that see it."""
+
+    def __init__(
+        self,
+        case: Case,
+        options: GenerateOptions,
+        on_attempt: Callable[[Generation, Attempt], None] | None,
+        on_solution: Callable[[Generation, Solution], None] | None,
+    ) -> None:
+        self.case, self.options, self.settings = case, options, case.settings
+        self.on_attempt, self.on_solution = on_attempt, on_solution
+        self.rng = np.random.default_rng(options.seed)
+        self.run = Generation(
+            numerics=numeric_environment().to_dict(), deploy_check=options.deploy_check
+        )
+        t0 = time.perf_counter()
+        self.problem = case.problem(build_ipopt=options.solver == "ipopt")
+        self.run.build_time = time.perf_counter() - t0
+        self.groups = (
+            crease_groups(case.pattern, case.planes, self.settings) if case.planes else None
+        )
+        # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
+        # over-reduction, retried like a lock (as with zero_dof_ends=False)
+        self.zero_ends = (
+            self.settings.zero_dof_ends and not options.deploy_check
+        ) or options.target_dof == 0
+        self.locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
+
+    def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
+        """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
+        (with the deployability check), analyse the mechanism, classify, trace the path."""
+        opts, settings = self.options, self.settings
+        result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver)
+        if opts.deploy_check:
+            result = self.problem.polish(result)
         t1 = time.perf_counter()
         mech = (
-            analyze(result.pattern, support_face=support_face, settings=settings)
+            analyze(result.pattern, support_face=opts.support_face, settings=settings)
             if result.converged
             else None
         )
         t_an = time.perf_counter() - t1
-        if mech is None:
-            outcome = AttemptOutcome.EXCEED
-        elif mech.dof == 0:
-            # the paper's final cycle (Step 5 -> Step 8); optionally, with a target >= 1, an
-            # over-reduction counted as a lock: every folded free crease has stopped moving
-            outcome = AttemptOutcome.ZERO_DOF if zero_ends else AttemptOutcome.LOCK
-        elif mech.has_lock:
-            outcome = AttemptOutcome.LOCK
-        else:
-            outcome = AttemptOutcome.ACCEPTED
+        outcome = _classify(mech, self.zero_ends)
         path, t_path = None, 0.0
-        if outcome is AttemptOutcome.ACCEPTED and deploy and _checked(mech, target_dof, settings):
+        if (
+            outcome is AttemptOutcome.ACCEPTED
+            and opts.deploy_check
+            and _checked(mech, opts, settings)
+        ):
             assert mech is not None
             t2 = time.perf_counter()
             path = trace_path(
-                result.pattern, dof=mech.dof, support_face=support_face, settings=settings
+                result.pattern, dof=mech.dof, support_face=opts.support_face, settings=settings
             )
             t_path = time.perf_counter() - t2
             if not path.deploys:
                 outcome = AttemptOutcome.PATH
         locked = [] if mech is None else mech.locked_creases.tolist()
         rec = Attempt(
-            index=len(run.attempts),
+            index=len(self.run.attempts),
             fixed_added=tuple(added),
             score=score,
             status=result.status,
@@ -380,114 +439,161 @@ def generate(
             path=None if path is None else path.to_dict(),
             path_time=t_path,
         )
-        run.attempts.append(rec)
-        return rec, result, mech, path
+        self.run.attempts.append(rec)
+        return rec, _Trial(result, mech, path)
 
-    def record(rec: Attempt, result, mech, path) -> None:
-        if rec.outcome is AttemptOutcome.EXCEED:
-            run.n_exceed += 1
-        elif rec.outcome is AttemptOutcome.LOCK:
-            run.n_lock += 1
-        elif rec.outcome is AttemptOutcome.PATH:
-            run.n_path += 1
-        if on_attempt:
-            on_attempt(run, rec)
+    def record(self, rec: Attempt, trial: _Trial) -> None:
+        """Count an attempt, tell the callbacks, and keep an accepted one as a solution."""
+        run = self.run
+        run.n_exceed += rec.outcome is AttemptOutcome.EXCEED
+        run.n_lock += rec.outcome is AttemptOutcome.LOCK
+        run.n_path += rec.outcome is AttemptOutcome.PATH
+        if self.on_attempt:
+            self.on_attempt(run, rec)
         if rec.outcome is AttemptOutcome.ACCEPTED:
-            sol = Solution(len(run.solutions), result, mech, path)
+            assert trial.mechanism is not None  # an accepted attempt was analysed
+            sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
             run.solutions.append(sol)
-            if on_solution:
-                on_solution(run, sol)
+            if self.on_solution:
+                self.on_solution(run, sol)
 
-    # Steps 2-5 for the triangulated target surface
-    fixed = case.pattern.fixed.copy()
-    rec, result, mech, path = attempt(fixed, None, (), None)
-    if rec.outcome is not AttemptOutcome.ACCEPTED:
-        run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
-        rec.outcome = AttemptOutcome.INITIAL_FAILED
-        record(rec, result, mech, path)
-        return run
-    assert mech is not None  # an accepted attempt was analysed
-    run.initial_dof = mech.dof
-    record(rec, result, mech, path)
-
-    while run.solutions[-1].mechanism.dof > target_dof:  # run.final_dof, never None here
-        current = run.solutions[-1]
+    def rank(self, current: Solution) -> tuple[list, Iterator[Choice], float]:
+        """Step 6 at the shape ``current``: the ranked crease groups with their scores, the
+        order to try them in (look-ahead: lazy, forecast block by block) and the seconds."""
         t1 = time.perf_counter()
-        K = hinge_stiffness(current.mechanism.frame.n_hinges, int(rng.integers(2**32)), settings)
+        settings = self.settings
+        K = hinge_stiffness(
+            current.mechanism.frame.n_hinges, int(self.rng.integers(2**32)), settings
+        )
         scores = score_creases(current.mechanism, K=K, settings=settings)
-        ranked = rank_candidates(scores, criterion, groups=groups, rng=rng)
+        ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
         order: Iterator[Choice] = (
             lookahead_order(
                 current.mechanism,
                 [g for g, _ in ranked],
                 settings=settings,
-                dof0_ends=zero_ends,
-                locked_before=locked_before,
+                dof0_ends=self.zero_ends,
+                locked_before=self.locked_before,
             )
-            if lookahead
+            if self.options.lookahead
             else (Choice(k) for k in range(len(ranked)))
         )
-        t_sel = time.perf_counter() - t1
+        return ranked, order, time.perf_counter() - t1
+
+    def annotate(self, rec: Attempt, choice: Choice, ranked: list, current: Solution) -> None:
+        """The look-ahead's record of a candidate's attempt (what it skipped, what it was
+        predicted to lock, what it carried) and the forecast's view of the creases it locked."""
+        group = ranked[choice.index][0]
+        if self.options.lookahead:
+            rec.predicted_locks = [] if len(choice.carried) else choice.locks.tolist()
+            rec.carried = choice.carried.tolist()
+            rec.skipped = len(choice.passed)
+            rec.skipped_locks = [
+                {
+                    "fixed": list(ranked[c.index][0]),
+                    "locks": c.locks.tolist(),
+                    "locked_before": c.locked_before.tolist(),
+                }
+                for c in choice.passed
+            ]
+        if rec.locked:
+            rec.locked_predicted, rec.locked_left = _explain_lock(
+                rec, current.mechanism, self.settings
+            )
+            if self.options.lookahead and not len(choice.carried):
+                self.locked_before[group] = rec.locked
+
+    def reduce(self, current: Solution) -> Stop | None:
+        """Steps 6-7 at the shape ``current``: fix the best candidate, replacing it with the
+        next on failure, until one is accepted (None) or the run ends (its Stop)."""
+        ranked, order, t_sel = self.rank(current)
         undeployable = 0  # candidates of this shape whose paths do not reach the flat state
-        while True:  # Step 6, then Step 7 on failure
+        while True:
             t1 = time.perf_counter()
             choice = next(order, None)  # look-ahead: lazy forecast
             t_sel += time.perf_counter() - t1
             if choice is None:
-                run.stop = Stop.NO_CANDIDATE
-                return _deployable_final(run, deploy, support_face, settings)
+                return Stop.NO_CANDIDATE
             group, score = ranked[choice.index]
             fix = (*group, *choice.carried.tolist())
-            trial = current.result.pattern.fixed.copy()
-            trial[list(fix)] = True
-            rec, result, mech, path = attempt(trial, current.result.coords, fix, score)
+            trial_fixed = current.result.pattern.fixed.copy()
+            trial_fixed[list(fix)] = True
+            rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
             rec.selection_time, t_sel = t_sel, 0.0
-            if lookahead:
-                rec.predicted_locks = [] if len(choice.carried) else choice.locks.tolist()
-                rec.carried = choice.carried.tolist()
-                rec.skipped = len(choice.passed)
-                rec.skipped_locks = [
-                    {
-                        "fixed": list(ranked[c.index][0]),
-                        "locks": c.locks.tolist(),
-                        "locked_before": c.locked_before.tolist(),
-                    }
-                    for c in choice.passed
-                ]
-            if rec.locked:
-                rec.locked_predicted, rec.locked_left = _explain_lock(
-                    rec, current.mechanism, settings
-                )
-                if lookahead and not len(choice.carried):
-                    locked_before[group] = rec.locked
-            record(rec, result, mech, path)
-            if rec.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.ZERO_DOF):
-                break
+            self.annotate(rec, choice, ranked, current)
+            self.record(rec, trial)
+            if rec.outcome is AttemptOutcome.ACCEPTED:
+                return None
+            if rec.outcome is AttemptOutcome.ZERO_DOF:
+                return Stop.ZERO_DOF
             undeployable += rec.outcome is AttemptOutcome.PATH
-            if undeployable >= settings.deploy_max_candidates > 0:  # bounded cost
-                run.stop, run.stop_detail = Stop.NO_DEPLOYABLE, str(undeployable)
-                return _deployable_final(run, deploy, support_face, settings)
-        if rec.outcome is AttemptOutcome.ZERO_DOF:
-            run.stop = Stop.ZERO_DOF
-            return _deployable_final(run, deploy, support_face, settings)
-    run.stop, run.stop_detail = Stop.TARGET_REACHED, str(target_dof)
+            if undeployable >= self.settings.deploy_max_candidates > 0:  # bounded cost
+                self.run.stop_detail = str(undeployable)
+                return Stop.NO_DEPLOYABLE
+
+
+@one_blas_thread()  # the same path on every machine (see one_blas_thread)
+def generate(
+    case: Case,
+    options: GenerateOptions | None = None,
+    *,
+    on_attempt: Callable[[Generation, Attempt], None] | None = None,
+    on_solution: Callable[[Generation, Solution], None] | None = None,
+    **changes,
+) -> Generation:
+    """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
+
+    ``options`` (default :class:`GenerateOptions`'s defaults) with ``changes`` to its fields
+    given as keywords, e.g. ``generate(case, criterion="s", target_dof=2)``. With mirror
+    planes in the case, creases are fixed in mirror groups (2 or 4 at once). A
+    KeyboardInterrupt propagates after the callbacks of everything finished so far.
+    """
+    opts = (options or GenerateOptions()).replace(**changes)
+    check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
+    steps = _Steps(case, opts, on_attempt, on_solution)
+    run = steps.run
+    # Steps 2-5 for the triangulated target surface
+    rec, trial = steps.solve(case.pattern.fixed.copy(), None, (), None)
+    if rec.outcome is not AttemptOutcome.ACCEPTED:
+        run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
+        rec.outcome = AttemptOutcome.INITIAL_FAILED
+        steps.record(rec, trial)
+        return run
+    assert trial.mechanism is not None  # an accepted attempt was analysed
+    run.initial_dof = trial.mechanism.dof
+    steps.record(rec, trial)
+    while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
+        stop = steps.reduce(run.solutions[-1])
+        if stop is not None:
+            run.stop = stop
+            return _deployable_final(run, opts, case.settings)
+    run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
     return run
 
 
-def _deployable_final(
-    run: Generation, deploy: bool, support_face: int | None, settings: Settings
-) -> Generation:
+def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
+    """Steps 4-5 on a solve's mechanism (None: not accepted, not analysed)."""
+    if mech is None:
+        return AttemptOutcome.EXCEED
+    if mech.dof == 0:
+        # the paper's final cycle (Step 5 -> Step 8); optionally, with a target >= 1, an
+        # over-reduction counted as a lock: every folded free crease has stopped moving
+        return AttemptOutcome.ZERO_DOF if zero_ends else AttemptOutcome.LOCK
+    return AttemptOutcome.LOCK if mech.has_lock else AttemptOutcome.ACCEPTED
+
+
+def _deployable_final(run: Generation, options: GenerateOptions, settings: Settings) -> Generation:
     """With the deployability check, a run that ends short of its target names as its final
     design the lowest-DOF solution whose folding path reaches the flat state (tracing the
     paths not yet traced, from the last solution back); none: the last solution."""
-    if not deploy:
+    if not options.deploy_check:
         return run
     for solution in reversed(run.solutions):
         if solution.path is None:
             solution.path = trace_path(
                 solution.result.pattern,
                 dof=solution.mechanism.dof,
-                support_face=support_face,
+                support_face=options.support_face,
                 settings=settings,
             )
         if solution.path.deploys:
@@ -496,11 +602,11 @@ def _deployable_final(
     return run
 
 
-def _checked(mech: Mechanism | None, target_dof: int, settings: Settings) -> bool:
+def _checked(mech: Mechanism | None, options: GenerateOptions, settings: Settings) -> bool:
     """Whether the deployability check runs on an accepted solution with this mechanism: at
-    most ``Settings.deploy_check_max_dof`` or ``target_dof`` DOF (0: every solution)."""
+    most ``Settings.deploy_check_max_dof`` or the target DOF (0: every solution)."""
     limit = settings.deploy_check_max_dof
-    return mech is not None and (limit <= 0 or mech.dof <= max(limit, target_dof))
+    return mech is not None and (limit <= 0 or mech.dof <= max(limit, options.target_dof))
 
 
 def _explain_lock(

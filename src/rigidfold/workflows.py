@@ -1,7 +1,7 @@
 """The workflows behind the command line: read, compute, write, and return a result.
 
 Each function takes validated library objects (or a file path, validated on reading), runs
-the library, writes its files through the shared writers of :mod:`rigidfold.report` and
+the library, writes its files through the shared writers of :mod:`rigidfold.run` and
 :mod:`rigidfold.io`, and returns a frozen result whose ``to_dict()`` is what ``--json``
 prints. ``rigidfold.cli`` only parses arguments, calls these functions and prints.
 
@@ -10,7 +10,7 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``develop_file``       Step 8 of a FOLD shape: FOLD with its diagram, and an SVG
 ``deform_file``        Steps 8-9 and the folding motion of a FOLD shape
 ``optimize_case``      one solve of problem (6): ``solution.fold`` and ``summary.json``
-``generate_case``      Steps 2-9 into a :class:`rigidfold.report.RunWriter`
+``generate_case``      Steps 2-9 into a :class:`rigidfold.run.RunWriter`
 ``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
 ``report_run``         ``DIR/report.html`` and ``DIR/figures/`` of a generate run
 =====================  ====================================================================
@@ -52,8 +52,8 @@ from rigidfold.io import (
 )
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
-from rigidfold.report import RunWriter, clear_earlier_run, write_checked_shape
-from rigidfold.reporting import RunData, load_run, page, render_figures, view_figure
+from rigidfold.reporting import page, render_figures, view_figure
+from rigidfold.run import RunData, RunWriter, clear_earlier_run, load_run, write_checked_shape
 
 # ------------------------------------------------------------------------------ analyze
 FLAT_NOTE = (
@@ -245,7 +245,7 @@ def optimize_case(
 
     Before any work, ValueError when one of the files would replace one of ``case.inputs``,
     and when OUT holds them from an earlier run, unless ``overwrite`` (then they are removed
-    first, like ``generate --overwrite``: :func:`rigidfold.report.clear_earlier_run`)."""
+    first, like ``generate --overwrite``: :func:`rigidfold.run.clear_earlier_run`)."""
     refuse_replacing_inputs(case.inputs, [Path(out) / name for name in OPTIMIZE_FILES])
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=case.inputs, names=OPTIMIZE_FILES)
@@ -267,22 +267,15 @@ def optimize_case(
 def generate_case(
     writer: RunWriter,
     *,
-    criterion: str,
-    target_dof: int,
-    seed: int,
-    solver: str,
-    lookahead: bool = False,
-    deploy_check: bool | None = None,
     progress: Callable[[Generation, Attempt | None], None] | None = None,
     report: bool = True,
 ) -> Generation:
-    """Steps 2-9 on ``writer.case``, every attempt and solution written by ``writer`` as it
-    comes (so an interrupt loses nothing); ``progress(run, attempt)`` after each of them.
-    ``lookahead``, ``deploy_check``: ``generate``'s options.
-    ``summary.json`` is written once more at the end, with the run's verdict
-    (``writer.verdict``, :func:`rigidfold.report.run_verdict`); then, with ``report``,
-    ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is released at the
-    end, however the run ends."""
+    """Steps 2-9 on ``writer.case`` with ``writer.options``, every attempt and solution
+    written by ``writer`` as it comes (so an interrupt loses nothing); ``progress(run,
+    attempt)`` after each of them. ``summary.json`` is written once more at the end, with
+    the run's verdict (``writer.verdict``, :func:`rigidfold.run.run_verdict`); then, with
+    ``report``, ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is
+    released at the end, however the run ends."""
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
         writer.on_attempt(run, attempt)
@@ -295,17 +288,7 @@ def generate_case(
             progress(run, None)
 
     try:
-        run = generate(
-            writer.case,
-            criterion=criterion,
-            target_dof=target_dof,
-            seed=seed,
-            solver=solver,
-            lookahead=lookahead,
-            deploy_check=deploy_check,
-            on_attempt=on_attempt,
-            on_solution=on_solution,
-        )
+        run = generate(writer.case, writer.options, on_attempt=on_attempt, on_solution=on_solution)
         writer.finish(run)
         if report:
             report_run(writer.out)
@@ -405,8 +388,8 @@ class RunReport:
             "size_bytes": self.html.stat().st_size,
             "figures": [str(p) for p in self.figures],
             "final_design": None if final is None else final.name,
-            "final_dof": self.run.summary.get("final_dof"),
-            "N_lock": self.run.summary.get("N_lock"),
+            "final_dof": self.run.summary.final_dof,
+            "N_lock": self.run.summary.n_lock,
             "checks": {c.name: c.word for c in self.run.checks()},
             "seconds": self.seconds,
         }

@@ -41,6 +41,7 @@ import numpy as np
 
 from rigidfold.exports.sheet import Sheet
 from rigidfold.io.files import atomic_write
+from rigidfold.io.svg_read import OS_STROKES
 
 CONVENTIONS = ("rigidfold", "origami-simulator")
 """SVG conventions of :func:`sheet_svg_text`."""
@@ -71,8 +72,10 @@ LAYERS = (
 CREASE_LAYERS = {"B": "BOUNDARY", "M": "MOUNTAIN", "V": "VALLEY", "F": "FLAT"}
 """Layer of the edges of each assignment letter; fixed creases (``"J"``) are in none."""
 
-OS_STROKES = {"B": "#000000", "M": "#ff0000", "V": "#0000ff", "J": "#ffff00", "F": "#ff00ff"}
-"""Origami Simulator's stroke colour of each assignment letter."""
+OS_LETTERS = {"B": "B", "M": "M", "V": "V", "J": "F", "F": "U"}
+"""Origami Simulator's letter (colour, :data:`rigidfold.io.svg_read.OS_STROKES`) of each
+assignment letter: a fixed crease is a facet crease (yellow), a free crease left flat an
+undriven one (magenta)."""
 
 _LAYER = {layer.name: layer for layer in LAYERS}
 
@@ -226,7 +229,7 @@ def _origami_simulator(sheet: Sheet, lw: float) -> list[str]:
             opacity = f' stroke-opacity="{abs(sheet.fold_angles_deg[e]) / 180:.6g}"'
         out.append(
             f'<line id="crease-{e}" {_segment(X, Y, u, v)} fill="none" '
-            f'stroke="{OS_STROKES[letter]}"{opacity} stroke-width="{_n(lw)}"/>'
+            f'stroke="{OS_STROKES[OS_LETTERS[letter]][1]}"{opacity} stroke-width="{_n(lw)}"/>'
         )
     return out
 

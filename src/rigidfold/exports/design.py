@@ -36,7 +36,7 @@ from rigidfold.exports.fold_os import write_origami_simulator_fold
 from rigidfold.exports.mesh3d import MESH_FORMATS, write_mesh
 from rigidfold.exports.schedule import write_schedule
 from rigidfold.exports.sheet import MARGIN_MM, layout_sheet
-from rigidfold.io import FoldData, prepare_output_dir, read_fold
+from rigidfold.io import FoldData, crease_pattern_frames, prepare_output_dir, read_fold
 from rigidfold.mesh import CreasePattern
 
 EXPORT_FORMATS = (*MESH_FORMATS, "dxf", "svg", "csv", "fold-os")
@@ -185,11 +185,7 @@ def read_design(path: str | os.PathLike, *, up: str = "z", settings: Settings = 
     computed diagram with non-finite coordinates.
     """
     data = read_fold(path, up=up, settings=settings)
-    frames = data.raw.get("file_frames", [])
-    for k in range(len(frames), 0, -1):
-        classes = frames[k - 1].get("frame_classes")
-        if not (isinstance(classes, list) and "creasePattern" in classes):
-            continue
+    for k in crease_pattern_frames(data.raw):
         try:
             flat = read_fold(data.raw, k, settings=settings).pattern
         except ValueError:

@@ -11,14 +11,18 @@ from rigidfold.io.files import (
     write_json,
 )
 from rigidfold.io.fold import (
+    FRACTION_KEY,
     UNITS,
     UP_AXES,
+    DesignFrames,
     FoldData,
     crease_pattern_frame,
+    crease_pattern_frames,
     fold_dict,
     motion_frames,
     pattern_from_fold,
     read_fold,
+    read_frames,
     round_trip_dict,
     write_document,
     write_fold,
@@ -27,13 +31,16 @@ from rigidfold.io.svg import svg_text, write_svg
 from rigidfold.io.svg_read import SvgDrawing, read_svg
 
 __all__ = [
+    "FRACTION_KEY",
     "UNITS",
     "UP_AXES",
+    "DesignFrames",
     "FoldData",
     "SvgDrawing",
     "atomic_write",
     "check_json_depth",
     "crease_pattern_frame",
+    "crease_pattern_frames",
     "fold_dict",
     "jsonable",
     "motion_frames",
@@ -41,6 +48,7 @@ __all__ = [
     "pattern_from_fold",
     "prepare_output_dir",
     "read_fold",
+    "read_frames",
     "read_svg",
     "refuse_replacing_inputs",
     "round_trip_dict",

@@ -25,6 +25,7 @@ import json
 import math
 import numbers
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -299,9 +300,94 @@ def motion_frames(
             "vertices_coords": np.asarray(x, dtype=float).tolist(),
             "edges_assignment": letters,
             "edges_foldAngle": np.degrees(pattern.with_coords(x).fold_angles).tolist(),
+            FRACTION_KEY: float(s),
         }
         for x, s in zip(frames, parameter, strict=True)
     ]
+
+
+FRACTION_KEY = "rigidfold:fraction"
+"""The key of a motion frame (:func:`motion_frames`) that holds its fraction folded, 0 (flat)
+to 1 (the design)."""
+
+_LEGACY_FRACTION = re.compile(r"folding motion: ([0-9.]+)% folded")
+"""The fraction in the title of a motion frame written before :data:`FRACTION_KEY`."""
+
+
+@dataclass(frozen=True, eq=False)
+class DesignFrames:
+    """rigidfold's frames of a design's FOLD file, read back (the contract of
+    :func:`crease_pattern_frame` and :func:`motion_frames`).
+
+    diagram : (V, 2) float64 development diagram of the last ``creasePattern`` frame, or
+    None; motion : (K, V, 3) float64 ``foldedForm`` frames from flat to the design;
+    fraction : (K,) float64 fraction folded of each (:data:`FRACTION_KEY`; files written
+    before it: the fraction in the frame's title; frames of another writer: evenly spaced).
+    """
+
+    diagram: np.ndarray | None
+    motion: np.ndarray
+    fraction: np.ndarray
+
+
+def crease_pattern_frames(raw: dict) -> list[int]:
+    """The frame numbers (``k >= 1`` is ``file_frames[k - 1]``, as :func:`read_fold` counts)
+    of the ``creasePattern`` frames of a FOLD document, last first."""
+    frames = raw.get("file_frames") or []
+    return [
+        k
+        for k in range(len(frames), 0, -1)
+        if isinstance(frames[k - 1], dict)
+        and isinstance(frames[k - 1].get("frame_classes"), list)
+        and "creasePattern" in frames[k - 1]["frame_classes"]
+    ]
+
+
+def read_frames(raw: dict, n_vertices: int, where: str) -> DesignFrames:
+    """The :class:`DesignFrames` of a FOLD document ``raw`` whose model has ``n_vertices``;
+    ValueError naming ``where`` and the frame for coordinates of another shape."""
+    diagram, motion, fraction = None, [], []
+    for k, frame in enumerate(raw.get("file_frames") or []):
+        classes = frame.get("frame_classes") or []
+        if "creasePattern" in classes:
+            diagram = _frame_coords(frame, n_vertices, 2, f"{where}: file_frames[{k}]")
+        elif "foldedForm" in classes:
+            motion.append(_frame_coords(frame, n_vertices, 3, f"{where}: file_frames[{k}]"))
+            fraction.append(_fraction(frame))
+    if np.isnan(fraction).any():  # frames of another writer: evenly spaced
+        fraction = np.linspace(0.0, 1.0, len(motion)).tolist()
+    return DesignFrames(
+        diagram,
+        np.asarray(motion, dtype=float).reshape(-1, n_vertices, 3),
+        np.asarray(fraction, dtype=float),
+    )
+
+
+def _fraction(frame: dict) -> float:
+    """A motion frame's fraction folded; NaN when it has none."""
+    value = frame.get(FRACTION_KEY)
+    if isinstance(value, int | float) and not isinstance(value, bool) and 0 <= value <= 1:
+        return float(value)
+    legacy = _LEGACY_FRACTION.search(str(frame.get("frame_title", "")))
+    return float(legacy.group(1)) / 100 if legacy else math.nan
+
+
+def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndarray:
+    """(V, dim) float64 ``vertices_coords`` of a frame (2D frames padded with z = 0 to 3D
+    when ``dim`` is 3)."""
+    try:
+        xy = np.asarray(frame["vertices_coords"], dtype=float)
+    except (KeyError, TypeError, ValueError):
+        raise ValueError(f"{where} has no numeric vertices_coords") from None
+    if xy.ndim != 2 or xy.shape[0] != n_vertices or xy.shape[1] not in (2, 3):
+        raise ValueError(
+            f"{where}: vertices_coords of shape {xy.shape}, expected ({n_vertices}, 2|3)"
+        )
+    if not np.isfinite(xy).all():
+        raise ValueError(f"{where}: non-finite vertices_coords")
+    if dim == 3 and xy.shape[1] == 2:
+        xy = np.column_stack([xy, np.zeros(n_vertices)])
+    return xy[:, :dim]
 
 
 def write_fold(path: str | os.PathLike, pattern: CreasePattern, **kwargs) -> Path:

@@ -63,7 +63,19 @@ from scipy.spatial import cKDTree
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.io.fold import UNITS
 
-COLOURS = {"B": "black", "M": "red", "V": "blue", "F": "yellow", "U": "magenta", "C": "green"}
+OS_STROKES = {
+    "B": ("black", "#000000"),
+    "M": ("red", "#ff0000"),
+    "V": ("blue", "#0000ff"),
+    "F": ("yellow", "#ffff00"),
+    "U": ("magenta", "#ff00ff"),
+    "C": ("green", "#00ff00"),
+}
+"""Origami Simulator's stroke colours by FOLD letter, (name, hex): boundary, mountain,
+valley, facet (flat) crease, undriven crease, cut. The one table of the convention: read by
+:func:`read_svg` (by hue) and written by the cut sheets (:mod:`rigidfold.exports.cutsheet`)."""
+
+COLOURS = {letter: name for letter, (name, _) in OS_STROKES.items()}
 """Origami Simulator's stroke colours by FOLD letter. A stroke whose brightest channel is
 below 25 % is black; one with saturation and brightness of at least 50 % whose hue is less
 than :data:`HUE_TOLERANCE` degrees from red (0), yellow (60), green (120), blue (240) or
@@ -79,7 +91,12 @@ again, at most: cutting off an overshoot can leave another loose end."""
 _LARGEST = 1e150
 """Largest extent of a drawing in its own units: squares of its lengths stay finite."""
 
-_HUES = {"M": 0.0, "F": 60.0, "C": 120.0, "V": 240.0, "U": 300.0}
+_HUES = {
+    letter: 360.0 * colorsys.rgb_to_hsv(*(int(hex_[k : k + 2], 16) / 255 for k in (1, 3, 5)))[0]
+    for letter, (_, hex_) in OS_STROKES.items()
+    if letter != "B"
+}
+"""The hue (degrees) of each colour of :data:`OS_STROKES` but black."""
 _SHAPES = (se.SimpleLine, se.Polyline, se.Polygon, se.Rect, se.Path, se.Circle, se.Ellipse)
 
 

@@ -1,15 +1,9 @@
 """IPOPT (through CasADi) on problem (6), with exact gradient, Jacobian and Hessian.
 
-On large patterns (``Settings.projection_vertices``) IPOPT gets the gradient of F and the
-constraint Jacobian in closed form (``rigidfold.optimize.jacobian``), and the solver does
-three things: the projection onto F = 0 from the start (``rigidfold.optimize.projection``),
-which is all that is needed after one more crease is fixed (a projection that stops,
-feasible, at F <= ``Settings.ipopt_stop_f`` is taken too: IPOPT would stop there at once);
-otherwise IPOPT, stopped at its first feasible iterate with F <= ``ipopt_stop_f`` by an
-iteration callback; then the projection from there. IPOPT's last iterations on (6) creep
-along the family of zeros of F: on a 41 x 41 grid it reaches F = 1.5e-11 at iteration 98 of
-180, and steps from a start that is already a solution can take 158 iterations that leave F
-where it was (``docs/scale.md``).
+The first derivatives are the problem's (CasADi's) or, for large patterns, given in closed
+form, and IPOPT can be stopped early by an iteration callback (:class:`EarlyStop`): both
+are what the composite solver of large patterns (:mod:`rigidfold.optimize.large`) asks of
+it.
 """
 
 from __future__ import annotations
@@ -19,9 +13,6 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
-from rigidfold.optimize.jacobian import ClosedFormJacobian, closed_form_first_derivatives
-from rigidfold.optimize.projection import Projection
-from rigidfold.optimize.residuals import Residuals
 from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
 from rigidfold.quiet import native_quiet
 
@@ -32,7 +23,7 @@ _OUTCOME = {
     "Maximum_Iterations_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_WallTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
-    "User_Requested_Stop": SolverOutcome.SOLVED,  # only _EarlyStop asks, at F <= ipopt_stop_f
+    "User_Requested_Stop": SolverOutcome.SOLVED,  # only EarlyStop asks, at F <= ipopt_stop_f
 }
 
 
@@ -72,21 +63,21 @@ class IpoptSolver:
         CasADi's IPOPT solver; ``nlpsol.stats()`` holds the statistics of the last solve.
     """
 
-    def __init__(self, problem: SolverProblem) -> None:
+    def __init__(
+        self,
+        problem: SolverProblem,
+        *,
+        first_derivatives: tuple[ca.Function, ca.Function] | None = None,
+        early_stop: EarlyStop | None = None,
+    ) -> None:
         nlp = problem.nlp
         self._lbg, self._ubg = nlp.lbg, nlp.ubg
-        self._stop_f = problem.settings.ipopt_stop_f
-        self.projection: Projection | None = None
-        self._stop: _EarlyStop | None = None
-        if problem.pattern.n_vertices >= problem.settings.projection_vertices:
-            residuals = Residuals(problem.pattern, problem.map)
-            jacobian = ClosedFormJacobian(problem)
-            self.projection = Projection(problem, residuals, jacobian)
-            self._stop = _EarlyStop(problem, self._stop_f)
-            # closed-form first derivatives: CasADi's cost most of a large build
-            self._first = closed_form_first_derivatives(problem, residuals, jacobian)
-        else:  # the problem's, so that CasADi does not differentiate (6) again
-            self._first = (problem.objective_gradient, problem.constraint_jacobian)
+        self._stop = early_stop  # kept alive: CasADi keeps no reference to a callback
+        # default: the problem's, so that CasADi does not differentiate (6) again
+        self._first = first_derivatives or (
+            problem.objective_gradient,
+            problem.constraint_jacobian,
+        )
         options = ipopt_options(problem.settings) | {
             "grad_f": self._first[0],
             "jac_g": self._first[1],
@@ -105,28 +96,8 @@ class IpoptSolver:
             self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 
     def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
-        """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
-
-        The run's message is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``, and on
-        large patterns what the projection did before or after it.
-        """
-        if self.projection is None:
-            return self._ipopt(xi0, w)
-        first = self.projection(xi0, w)
-        if first.converged or (first.feasible and first.F <= self._stop_f):
-            # IPOPT would stop at once and hand the same point back
-            return SolverRun(
-                first.xi, first.iterations, SolverOutcome.SOLVED, f"projection: {first.reason}"
-            )
-        run = self._ipopt(xi0, w)
-        polish = self.projection(run.xi, w)
-        iterations = first.iterations + run.iterations + polish.iterations
-        message = f"projection: {first.reason}; {run.message}; projection: {polish.reason}"
-        if polish.converged:
-            return SolverRun(polish.xi, iterations, SolverOutcome.SOLVED, message)
-        return SolverRun(polish.xi, iterations, run.outcome, message)
-
-    def _ipopt(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
+        """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,); the run's message
+        is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``."""
         with native_quiet():
             sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
         stats = self.nlpsol.stats()
@@ -139,7 +110,7 @@ class IpoptSolver:
         )
 
 
-class _EarlyStop(ca.Callback):
+class EarlyStop(ca.Callback):
     """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f``.
 
     CasADi calls it with nlpsol's outputs (x, f, g, lam_x, lam_g, lam_p) after each iteration;

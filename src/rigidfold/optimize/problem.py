@@ -19,7 +19,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.mesh import CreasePattern
-from rigidfold.optimize.ipopt import IpoptSolver
+from rigidfold.optimize.large import ipopt_solver
 from rigidfold.optimize.nlp import NLP, build_nlp
 from rigidfold.optimize.projection import Projection
 from rigidfold.optimize.result import OptimizeResult, Status
@@ -31,7 +31,7 @@ from rigidfold.protocols import SymmetryPlane, TargetSurface
 #: name -> solver factory ``(problem) -> Solver``; the one list of solver names
 SOLVER_FACTORIES: Mapping[str, Callable[[SolverProblem], Solver]] = MappingProxyType(
     {
-        "ipopt": IpoptSolver,
+        "ipopt": ipopt_solver,
         "slsqp": partial(SlsqpSolver, exact=True),
         "slsqp-fd": partial(SlsqpSolver, exact=False),
     }

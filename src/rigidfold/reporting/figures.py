@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigidfold.reporting.run import Design, RunData
+from rigidfold.run import RunData, SolutionFile
 
 KINDS = {
     "F": ("flat crease", "#bbbbbb", 0.6, "-"),
@@ -90,7 +90,7 @@ def plan_rotation(flat: np.ndarray, plan: np.ndarray) -> np.ndarray:
     return a @ np.array([[c, s], [-s, c]]) + plan.mean(axis=0)
 
 
-def _development(plt, design: Design):
+def _development(plt, design: SolutionFile):
     from matplotlib.collections import LineCollection
 
     assert design.coords2d is not None
@@ -123,28 +123,26 @@ def _development(plt, design: Design):
 
 def _attempts(plt, run: RunData):
     attempts = run.attempts
-    index = np.array([a.get("index", k) for k, a in enumerate(attempts)])
+    index = np.array([a.index for a in attempts])
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(6.4, 4.6), dpi=120, sharex=True)
-    accepted = [
-        (i, a["dof"]) for i, a in zip(index, attempts, strict=True) if a["outcome"] == "accepted"
-    ]
+    accepted = [(i, a.dof) for i, a in zip(index, attempts, strict=True) if a.outcome == "accepted"]
     if accepted:
         top.step(*zip(*accepted, strict=True), where="post", color="#1f77b4", lw=1.0, alpha=0.6)
     for outcome, (marker, colour, label) in OUTCOME_STYLE.items():
-        rows = [(i, a) for i, a in zip(index, attempts, strict=True) if a["outcome"] == outcome]
+        rows = [(i, a) for i, a in zip(index, attempts, strict=True) if a.outcome == outcome]
         if not rows:
             continue
-        dof = [(i, a["dof"]) for i, a in rows if a.get("dof") is not None]
+        dof = [(i, a.dof) for i, a in rows if a.dof is not None]
         if dof:
             top.scatter(*zip(*dof, strict=True), marker=marker, color=colour, s=22, zorder=3)
-        f = [(i, a["F"]) for i, a in rows if a.get("F") is not None and a["F"] > 0]
+        f = [(i, a.F) for i, a in rows if a.F is not None and a.F > 0]
         if f:
             bottom.scatter(*zip(*f, strict=True), marker=marker, color=colour, s=22, label=label)
         if outcome == "lock":
             for i, _ in rows:
                 for ax in (top, bottom):
                     ax.axvline(i, color=colour, lw=0.8, alpha=0.35)
-    f_tol = (run.summary.get("case") or {}).get("F_tol")
+    f_tol = run.summary.case.get("F_tol")
     if f_tol:
         bottom.axhline(f_tol, color="k", ls=":", lw=0.9, label="F_tol")
     bottom.set_yscale("log")
@@ -154,8 +152,8 @@ def _attempts(plt, run: RunData):
     top.grid(alpha=0.3)
     bottom.grid(alpha=0.3)
     top.set_title(
-        f"DOF and F per attempt: N_lock = {run.summary.get('N_lock')}, "
-        f"N_exceed = {run.summary.get('N_exceed')}, N_path = {run.summary.get('N_path', 0)}"
+        f"DOF and F per attempt: N_lock = {run.summary.n_lock}, "
+        f"N_exceed = {run.summary.n_exceed}, N_path = {run.summary.n_path or 0}"
     )
     bottom.legend(fontsize=7, loc="best")
     return (
@@ -172,7 +170,7 @@ def _fit(plt, run: RunData, fit: np.ndarray):
     fig, ax = plt.subplots(figsize=(6.4, 3.6), dpi=120)
     ax.plot(steps, fit[:, 0] * 1e3, "o-", ms=3, label="max |z - target|")
     ax.plot(steps, fit[:, 1] * 1e3, "s-", ms=3, label="RMS |z - target|")
-    dz = (run.summary.get("case") or {}).get("dz_m")
+    dz = run.summary.case.get("dz_m")
     if dz:
         ax.axhline(dz * 1e3, color="k", ls=":", lw=0.9, label="bound |dz|")
     ax.set_xlabel("solution step")
@@ -193,7 +191,7 @@ def _fit(plt, run: RunData, fit: np.ndarray):
     )
 
 
-def _fold_angles(plt, design: Design):
+def _fold_angles(plt, design: SolutionFile):
     kinds = np.asarray(design.assignment)
     creases = np.flatnonzero(kinds != "B")
     fig, ax = plt.subplots(figsize=(6.4, 3.8), dpi=120)
@@ -220,7 +218,7 @@ def _fold_angles(plt, design: Design):
     )
 
 
-def _deformation(plt, design: Design):
+def _deformation(plt, design: SolutionFile):
     h = design.history
     lam = [s["load_factor"] for s in h]
     fig, ax = plt.subplots(figsize=(6.4, 3.6), dpi=120)

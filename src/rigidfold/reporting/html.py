@@ -15,8 +15,9 @@ from importlib.metadata import PackageNotFoundError, version
 
 import numpy as np
 
+from rigidfold.generate import Stop
 from rigidfold.reporting.figures import Figure
-from rigidfold.reporting.run import Check, RunData
+from rigidfold.run import Check, RunData
 
 CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, Arial, sans-serif;
@@ -53,9 +54,9 @@ def page(run: RunData, figures: list[Figure], view: dict | None) -> str:
     """The whole HTML document of ``run`` with its ``figures`` and 3D ``view`` (a plotly
     figure dict, None when the run has no solution)."""
     s = run.summary
-    case = s.get("case") or {}
+    case = s.case
     surface = (case.get("surface") or {}).get("name", "?")
-    options = s.get("options") or {}
+    options = s.options
     title = f"rigidfold generate: {surface} surface, pattern {case.get('pattern', '?')}"
     parts = [
         '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">',
@@ -84,38 +85,42 @@ def _answer(run: RunData) -> list[str]:
     checks = run.checks()
     failed = [c.name for c in checks if c.passed is False]
     not_run = [c.name for c in checks if c.passed is None]
-    stop, target = s.get("stop"), run.target_dof
+    stop, target = s.stop, run.target_dof
     if final is None:
         verdict = "No solution"
     elif failed:
         verdict = "Failed: " + ", ".join(failed)
     else:
         verdict = "Every check passed" + (f" ({', '.join(not_run)} not run)" if not_run else "")
-    if stop == "target_reached":
+    if stop == Stop.TARGET_REACHED:
         outcome = f"target DOF {target} reached"
-    elif stop == "running":
+    elif stop == Stop.RUNNING:
         outcome = "the run has not finished: this is its state so far"
     else:
-        outcome = f"target DOF {target} not reached: {s.get('stop_reason')}"
+        outcome = f"target DOF {target} not reached: {s.stop_reason}"
     # green: all done and passed; grey: passed, but a stage did not run or the run goes on
-    css = "bad" if final is None or failed or stop not in ("target_reached", "running") else "ok"
-    if css == "ok" and (not_run or stop == "running"):
+    css = (
+        "bad"
+        if final is None or failed or stop not in (Stop.TARGET_REACHED, Stop.RUNNING)
+        else "ok"
+    )
+    if css == "ok" and (not_run or stop == Stop.RUNNING):
         css = "none"
-    given = s.get("verdict")  # the verdict generate judged its exit code by, when finished
+    given = s.verdict  # the verdict generate judged its exit code by, when finished
     if given is not None:
         passed = given["outcome"] == "passed"
         verdict, outcome = ("Passed" if passed else "Fell short"), given["message"]
         css = "ok" if passed else "bad"
     items = [
-        ("final DOF", "–" if s.get("final_dof") is None else str(s["final_dof"])),
+        ("final DOF", "–" if s.final_dof is None else str(s.final_dof)),
         ("target DOF", "–" if target is None else str(target)),
-        ("N_lock", str(s.get("N_lock"))),
-        *((("N_path", str(s["N_path"])),) if s.get("deploy_check") else ()),
+        ("N_lock", str(s.n_lock)),
+        *((("N_path", str(s.n_path)),) if s.deploy_check else ()),
         (
             "deploys",
             "–"
-            if s.get("final_deploys") is None
-            else ("yes: its folding path reaches the flat state" if s["final_deploys"] else "no"),
+            if s.final_deploys is None
+            else ("yes: its folding path reaches the flat state" if s.final_deploys else "no"),
         ),
         ("final design", "none" if final is None else final.name),
     ]
@@ -185,7 +190,7 @@ def _figure(figure: Figure) -> str:
 
 
 def _tables(run: RunData) -> list[str]:
-    s = run.summary
+    s = run.summary.document
     run_keys = (
         "stop_reason initial_dof final_dof N_reduce N_lock N_exceed N_path deploy_check "
         "final_deploys n_solutions n_solves n_skipped mean_F_accepted mean_F_all_solves"
@@ -228,13 +233,13 @@ def _solutions(run: RunData) -> str:
         "RMS (mm)",
     ]
     rows = []
-    for k, r in enumerate(run.summary["per_solution"]):
-        dev, mot, dfm = r.get("development") or {}, r.get("motion") or {}, r.get("deformation")
+    for k, r in enumerate(run.summary.per_solution):
+        dev, mot, dfm = r.development or {}, r.motion or {}, r.deformation
         name = run.designs[k].name if k < len(run.designs) else ""
         rows.append(
             [
-                r.get("step"),
-                r.get("dof"),
+                r.step,
+                r.dof,
                 name,
                 dev.get("status"),
                 dev.get("D"),
@@ -242,7 +247,7 @@ def _solutions(run: RunData) -> str:
                 "not run" if not dfm else dfm.get("status"),
                 None if not dfm else dfm.get("max_dl_mm"),
                 None if not dfm else dfm.get("max_drho_fix_deg"),
-                _agreement(r.get("verdicts")),
+                _agreement(r.verdicts),
                 *(fit[k] if k < len(fit) else (None, None)),
             ]
         )
@@ -264,13 +269,13 @@ def _attempts(run: RunData) -> list[str]:
     head = ["attempt", "fixed added", "outcome", "DOF", "F", "iterations", "locked creases"]
     rows = [
         [
-            a.get("index"),
-            a.get("fixed_added"),
-            a.get("outcome"),
-            a.get("dof"),
-            a.get("F"),
-            a.get("iterations"),
-            a.get("locked"),
+            a.index,
+            a.fixed_added,
+            a.outcome,
+            a.dof,
+            a.F,
+            a.iterations,
+            a.locked,
         ]
         for a in run.attempts
     ]

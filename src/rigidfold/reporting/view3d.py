@@ -16,7 +16,7 @@ import numpy as np
 from rigidfold.mesh.geometry import best_fit
 from rigidfold.protocols import TargetSurface
 from rigidfold.reporting.figures import KINDS
-from rigidfold.reporting.run import Design
+from rigidfold.run import SolutionFile
 
 GRID = 40
 """Samples per side of the target surface overlay."""
@@ -46,7 +46,7 @@ def _lines(coords: np.ndarray, edges: np.ndarray) -> tuple[list, list, list]:
     return x, y, z
 
 
-def _shape_traces(coords: np.ndarray, design: Design, kinds: np.ndarray) -> list[dict]:
+def _shape_traces(coords: np.ndarray, design: SolutionFile, kinds: np.ndarray) -> list[dict]:
     """The moving traces at ``coords``: the mesh, then one line trace per crease kind."""
     x, y, z = np.round(coords, 5).T
     traces = [{"type": "mesh3d", "x": x.tolist(), "y": y.tolist(), "z": z.tolist()}]
@@ -56,7 +56,7 @@ def _shape_traces(coords: np.ndarray, design: Design, kinds: np.ndarray) -> list
     return traces
 
 
-def view_figure(design: Design, surface: TargetSurface | None) -> dict:
+def view_figure(design: SolutionFile, surface: TargetSurface | None) -> dict:
     """The plotly figure dict of ``design`` (see the module's text); without ``surface`` the
     mesh is coloured by height and no overlay is drawn."""
     kinds = np.asarray(design.assignment)
@@ -137,7 +137,7 @@ def _surface_trace(surface: TargetSurface, coords: np.ndarray) -> tuple[dict, np
     return trace, samples[np.isfinite(samples[:, 2])]
 
 
-def _layout(points: np.ndarray, design: Design, frames: list[dict]) -> dict:
+def _layout(points: np.ndarray, design: SolutionFile, frames: list[dict]) -> dict:
     """Fixed axes around every frame (so the view does not jump), legend, and the slider."""
     lo, hi = points.min(axis=0), points.max(axis=0)
     pad = 0.03 * float((hi - lo).max())

@@ -1,6 +1,14 @@
 """Studies of many generation runs: Dask execution, SQLite store, reports (Tables 5-8)."""
 
-from rigidfold.study.runner import PRESETS, StudyConfig, plan, preset, run_one, run_study
+from rigidfold.study.runner import (
+    PRESETS,
+    STUDY_OPTIONS,
+    StudyConfig,
+    plan,
+    preset,
+    run_one,
+    run_study,
+)
 from rigidfold.study.session import (
     STUDY_DEFAULTS,
     StudyInterrupted,
@@ -13,6 +21,7 @@ from rigidfold.study.store import Key, Store, StoreWriteError, run_stop
 __all__ = [
     "PRESETS",
     "STUDY_DEFAULTS",
+    "STUDY_OPTIONS",
     "Key",
     "Store",
     "StoreWriteError",

@@ -18,10 +18,8 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 
-import numpy as np
-
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
-from rigidfold.optimize import SOLVERS
+from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
 from rigidfold.study.store import ERROR_PREFIX, Key, Store
@@ -33,32 +31,39 @@ PRESETS = {
 }
 
 
+STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check="all")
+"""The generate options of a study by default: the paper's Step 5 (no deployability check;
+the final design's path is traced after the run), no Step 9."""
+
+
 @dataclass(frozen=True)
 class StudyConfig:
-    """What makes the numbers of two runs comparable; stored in the database.
+    """What makes the numbers of two runs comparable; stored in the database
+    (:meth:`as_dict`) and handed to the Dask workers as it is.
 
-    lookahead : generate skips the candidates predicted to lock (``generate(lookahead=...)``);
-    a database written before the option existed ran without it and resumes with False.
-    deploy_check : generate accepts only solutions whose folding path reaches the flat state
-    (``generate(deploy_check=...)``); False (the paper's method, for Tables 5-8) by default
-    and for databases written before the option existed.
+    options : the generate options every run shares (its criterion and seed are the run's
+        :class:`~rigidfold.study.store.Key`'s). ``deform``: Steps 8-9 of the solutions
+        ``check`` names (a study writes no diagram, so Step 8 runs only with Step 9);
+        ``lookahead`` (False for databases written before it existed); ``deploy_check``
+        (False, the paper's method, for Tables 5-8, by default and for databases written
+        before it existed).
+    settings : the tolerances.
     """
 
-    deform: bool = False
-    target_dof: int = DEFAULTS.target_dof
-    solver: str = SOLVERS[0]
+    options: GenerateOptions = STUDY_OPTIONS
     settings: Settings = field(default=DEFAULTS)
-    lookahead: bool = False
-    deploy_check: bool = False
 
     def as_dict(self) -> dict:
+        """The stored configuration (the keys every version has written, and ``check``)."""
+        o = self.options
         return {
-            "deform": self.deform,
-            "target_dof": self.target_dof,
-            "solver": self.solver,
+            "deform": o.deform,
+            "target_dof": o.target_dof,
+            "solver": o.solver,
             "settings": asdict(self.settings),
-            "lookahead": self.lookahead,
-            "deploy_check": self.deploy_check,
+            "lookahead": o.lookahead,
+            "deploy_check": o.deploy_check,
+            "check": o.check,
         }
 
 
@@ -119,8 +124,9 @@ def preset(name: str) -> list[Key]:
     return sorted(keys, key=lambda k: k.symmetric)
 
 
-def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
-    """Execute one run (in a worker): generate, and Steps 8-9 of every solution if asked.
+def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
+    """Execute one run (in a worker): generate, and Steps 8-9 of the solutions
+    ``config.options.check`` names if ``config.options.deform``.
 
     The run's row holds the ``runs`` columns, and ``error`` (the message) for a run that
     could not run; its status is then "error: <message>".
@@ -130,24 +136,23 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
     from rigidfold.deform import verify
     from rigidfold.generate import generate
     from rigidfold.mechanism.path import trace_path
-
-    settings = Settings(**config["settings"])
-    t0 = time.perf_counter()
-    checks: list[dict] = []
-
-    def on_solution(run, solution) -> None:
-        if config["deform"]:
-            c = verify(solution.result.pattern, run_motion=False, settings=settings)
-            assert c.deformation is not None  # verify runs the analysis by default
-            checks.append({"D": c.development.D, **c.deformation.to_dict(), "times": c.times})
-
     from rigidfold.numerics import numeric_environment
+    from rigidfold.run import SolutionRecord, aggregate
+
+    settings, options = config.settings, config.options
+    t0 = time.perf_counter()
+    records: list[SolutionRecord] = []
+
+    def check(solution) -> None:
+        c = verify(solution.result.pattern, run_motion=False, settings=settings)
+        records.append(SolutionRecord.from_check(solution.step, solution.mechanism.dof, c))
 
     row: dict = {
         "version": __version__,
         "worker": f"{socket.gethostname()}:{os.getpid()}",
         "numerics": numeric_environment().key,
     }
+    every = options.deform and options.check == "all"
     try:
         case = make_case(
             key.study,
@@ -158,13 +163,8 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
         )
         run = generate(
             case,
-            criterion=key.criterion,
-            target_dof=config["target_dof"],
-            seed=key.seed,
-            solver=config["solver"],
-            lookahead=config["lookahead"],
-            deploy_check=config.get("deploy_check", False),
-            on_solution=on_solution,
+            options.replace(criterion=key.criterion, seed=key.seed),
+            on_solution=(lambda _run, solution: check(solution)) if every else None,
         )
         final = run.final
         if final is not None and final.path is None:  # the paper's method: trace it after
@@ -173,6 +173,8 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
                 final.result.pattern, dof=final.mechanism.dof, settings=settings
             )
             row["time_path_final"] = time.perf_counter() - t_path
+        if final is not None and options.deform and not every:
+            check(final)
     except ValueError as exc:  # a configuration that cannot run: recorded, not retried
         row.update(
             status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
@@ -197,14 +199,15 @@ def run_one(key: Key, config: dict) -> tuple[Key, dict, list[dict]]:
         final_deploys=None if final is None or final.path is None else int(final.path.deploys),
         time_path=s["time_s"]["path"] + row.pop("time_path_final", 0.0),
     )
-    if checks:
+    if records:
+        figures = aggregate(records)
         row.update(
-            mean_d=float(np.mean([c["D"] for c in checks])),
-            mean_dl_mm=float(np.mean([c["mean_dl_mm"] for c in checks])),
-            mean_drho_fix_deg=float(np.mean([c["mean_drho_fix_deg"] for c in checks])),
-            reached_plane=int(all(c["reached_plane"] for c in checks)),
-            time_develop=sum(c["times"].get("develop", 0.0) for c in checks),
-            time_deform=sum(c["times"].get("deform", 0.0) for c in checks),
+            mean_d=figures["development"]["mean_D"],
+            mean_dl_mm=figures["deformation"]["mean_dl_mm"],
+            mean_drho_fix_deg=figures["deformation"]["mean_drho_fix_deg"],
+            reached_plane=int(figures["deformation"]["reached_plane"] == len(records)),
+            time_develop=sum(r.time_s.get("develop", 0.0) for r in records),
+            time_deform=sum(r.time_s.get("deform", 0.0) for r in records),
         )
     row["time_total"] = time.perf_counter() - t0
     return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in run.attempts]
@@ -441,8 +444,7 @@ def run_study(
             check_worker_numerics(client.run(worker_numerics), numerics_key)
         named = {f"run-{i}-{k.row()}": k for i, k in enumerate(todo)}
         futures = [
-            client.submit(run_one, k, config.as_dict(), pure=False, key=name)
-            for name, k in named.items()
+            client.submit(run_one, k, config, pure=False, key=name) for name, k in named.items()
         ]
         for future in as_completed(futures):
             try:

@@ -202,10 +202,14 @@ RETIRED_SETTINGS = frozenset(
         "motion_probe",
         "motion_arc_min_step",
         "motion_turn_back",
+        # the options of a run, moved to rigidfold.generate.GenerateOptions (issue 28): the
+        # configuration keeps target_dof and deploy_check at its top level
+        "target_dof",
+        "deploy_check",
     }
 )
 # configuration entries added later, at the value that reproduces the studies made before
-LEGACY_CONFIG = {"lookahead": False, "deploy_check": False}
+LEGACY_CONFIG = {"lookahead": False, "deploy_check": False, "check": "all"}
 
 
 def config_differences(stored: dict, current: dict) -> list[str]:

@@ -1,0 +1,148 @@
+"""The run directory of ``rigidfold generate``: its files, its lock, and ``--overwrite``.
+
+One running ``generate`` per directory (:func:`lock_run_dir`), and an earlier run's files
+refused or, with ``--overwrite``, removed (:func:`clear_earlier_run`), never an input.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+RUN_FILES = ("summary.json", "log.json", "report.html")
+"""The files a generation run writes at the top of its directory."""
+
+RUN_DIRS = ("solutions", "figures", "final")
+"""The directories a generation run writes (solution files, figures, exports)."""
+
+
+LOCK_NAME = ".rigidfold-run.lock"
+"""The file that marks a directory as in use by a running ``generate`` (it holds the pid)."""
+
+
+def lock_run_dir(out: Path) -> Path:
+    """Claim ``out`` for one run: :data:`LOCK_NAME` in it holding this process's id. Returns
+    the lock's path; ValueError when another live run holds it.
+
+    The lock file is opened (created when absent; a symbolic link is refused, never
+    followed) and decided on under an exclusive ``flock`` of it, which every claimant takes
+    before it reads the pid: a live pid refuses; a lock that is empty, unreadable, or left
+    by a process that no longer runs is taken over in place (this pid written over it). So
+    of two processes taking over one stale lock, one gets it and the other finds it held,
+    and a lock being created is never taken for a stale one. A lock released (removed) while
+    it was waited for is made again.
+    """
+    import fcntl
+
+    path = out / LOCK_NAME
+    for _ in range(100):
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+        except OSError as exc:
+            if path.is_symlink():
+                raise ValueError(
+                    f"cannot lock output directory '{out}': its {LOCK_NAME} is a symbolic "
+                    "link, not a rigidfold lock; remove it"
+                ) from None
+            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)  # held only while deciding; closing drops it
+            try:
+                same = os.stat(path, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if not same:  # released (and maybe made again) while we waited: start over
+                continue
+            pid = _lock_owner(fd)
+            if pid is not None and _alive(pid):
+                raise ValueError(
+                    f"output directory '{out}' is in use by another rigidfold run (pid {pid}); "
+                    "wait for it to end, or use another --out"
+                )
+            os.ftruncate(fd, 0)  # new, or stale: its run is gone
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            return path
+        except OSError as exc:
+            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+        finally:
+            os.close(fd)
+    raise ValueError(f"cannot lock output directory '{out}': its lock keeps coming back")
+
+
+def _lock_owner(fd: int) -> int | None:
+    """The pid written in the open lock file ``fd``, None when there is none: empty, not a
+    number, or not a possible pid (0 or less names a process group in ``kill``)."""
+    try:
+        pid = int(os.pread(fd, 64, 0).decode("ascii").strip())
+    except (OSError, ValueError):  # UnicodeDecodeError is a ValueError
+        return None
+    return pid if pid > 0 else None
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process with this id runs (on this machine)."""
+    try:
+        os.kill(pid, 0)
+    except (ProcessLookupError, OverflowError):  # OverflowError: no pid is that large
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clear_earlier_run(
+    out: str | Path,
+    *,
+    overwrite: bool,
+    inputs: tuple[Path, ...] = (),
+    names: tuple[str, ...] = (*RUN_FILES, *RUN_DIRS),
+) -> Path:
+    """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
+
+    Only the run's own files and directories, ``names`` (a generation run's by default:
+    :data:`RUN_FILES`, :data:`RUN_DIRS`), count and are removed; other files in ``out``
+    stay. With ``overwrite`` the temporary files of those names that a killed run left
+    (``.report.html.<random>.tmp``: :func:`rigidfold.io.files.temp_files`) are removed too.
+    A symbolic link among them is removed itself, never followed. Removing one of the
+    run's ``inputs`` (e.g. an earlier solution used as the pattern) is refused. Returns
+    ``out`` as a Path. Raises ValueError naming what was found.
+    """
+    from rigidfold.io.files import temp_files
+
+    out = Path(out)
+    found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
+    if found and not overwrite:
+        raise ValueError(
+            f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
+            "give --overwrite to replace it, or another --out"
+        )
+    if overwrite:
+        found += temp_files(out, names)
+    if not found:
+        return out
+    for path in found:
+        for given in inputs:
+            doomed = (
+                given.absolute() == path.absolute()
+                if path.is_symlink()
+                else (
+                    path.resolve() == given.resolve() or path.resolve() in given.resolve().parents
+                )
+            )
+            if doomed:
+                raise ValueError(
+                    f"--overwrite would remove the input file '{given}' with the earlier run's "
+                    f"{path.name}: copy it out of '{out}' first, or use another --out"
+                )
+    try:
+        for path in found:
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink(missing_ok=True)
+    except OSError as exc:
+        raise ValueError(
+            f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"
+        ) from None
+    return out

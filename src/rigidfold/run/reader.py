@@ -1,0 +1,292 @@
+"""A finished (or running) ``rigidfold generate`` directory, read back.
+
+:func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.run.RunSummary`),
+``DIR/log.json`` (:class:`~rigidfold.run.AttemptRecord`) and every solution's FOLD file
+(``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its development diagram and folding
+motion as frames (:func:`rigidfold.io.read_frames`), and the figures of Steps 8-9 with the
+large-deformation history under ``rigidfold:deformation``), and rebuilds the target surface
+from the case's metadata where it can. Anything that is not a generate run is a one-line
+``ValueError``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.io import parse_json, read_fold, read_frames
+from rigidfold.protocols import TargetSurface
+from rigidfold.run.schema import (
+    DESIGN_SHAPE,
+    LOG_SHAPE,
+    AttemptRecord,
+    RunSummary,
+    SolutionRecord,
+    Stage,
+    check_shape,
+    received,
+)
+from rigidfold.surfaces import Bezier, get_surface
+
+
+@dataclass(frozen=True, eq=False)
+class SolutionFile:
+    """One accepted solution of the run, read from its FOLD file.
+
+    name : str, the file's path relative to the run directory; step, dof : int.
+    coords : (V, 3) float64, the folded form in metres (z up); faces : (F, 3) int64;
+    edges : (E, 2) int64; assignment : E FOLD letters (``B`` boundary, ``M`` mountain, ``V``
+    valley, ``F`` flat, ``J`` fixed); fold_deg : (E,) float64, fold angles in degrees (valley
+    > 0). coords2d : (V, 2) float64 development diagram, or None when the file has none.
+    motion : (K, V, 3) float64, the folding motion from flat to folded ((0, V, 3) when it was
+    not traced); fraction : (K,) fraction folded of each motion frame. history : the
+    large-deformation load steps (dicts of ``load_factor``, ``mean_dl_mm``, ``max_dl_mm``,
+    ``max_drho_fix_deg``), empty when Step 9 did not run.
+    """
+
+    name: str
+    step: int
+    dof: int
+    coords: np.ndarray
+    faces: np.ndarray
+    edges: np.ndarray
+    assignment: list[str]
+    fold_deg: np.ndarray
+    coords2d: np.ndarray | None
+    motion: np.ndarray
+    fraction: np.ndarray
+    history: list[dict]
+
+    def dz(self, surface: TargetSurface) -> np.ndarray:
+        """(V,) float64: z minus the target's height at each vertex's (x, y), metres."""
+        x, y, z = self.coords.T
+        return z - np.broadcast_to(np.asarray(surface.height(x, y), dtype=float), z.shape)
+
+
+def read_solution(path: Path, name: str) -> SolutionFile:
+    """The :class:`SolutionFile` in the FOLD file ``path`` (``name``: its path in the run)."""
+    data = read_fold(path)
+    pattern, meta = data.pattern, data.metadata
+    check_shape(data.raw, DESIGN_SHAPE, path)
+    frames = read_frames(data.raw, pattern.n_vertices, str(path))
+    deformation = meta.get("deformation") or {}
+    return SolutionFile(
+        name=name,
+        step=int(meta.get("step", -1)),
+        dof=int(meta.get("dof", -1)),
+        coords=pattern.coords,
+        faces=pattern.faces,
+        edges=pattern.edges,
+        assignment=["F" if a == "U" else a for a in data.assignment],
+        fold_deg=np.degrees(pattern.fold_angles),
+        coords2d=frames.diagram,
+        motion=frames.motion,
+        fraction=frames.fraction,
+        history=list(deformation.get("history") or []),
+    )
+
+
+def target_surface(metadata: dict) -> tuple[TargetSurface | None, str]:
+    """(surface, "") rebuilt from ``summary.json``'s ``case.surface``, or (None, why not).
+
+    A Bezier surface is rebuilt from its control heights, the dome and the hyperbolic
+    paraboloid from their plan box, an expression from its text: the surface the run used.
+    """
+    name = metadata.get("name")
+    try:
+        box = tuple(float(v) for v in metadata.get("plan_box_m") or (3.0, 3.0))
+        if name == "bezier" and metadata.get("control_heights") is not None:
+            heights = np.asarray(metadata["control_heights"], dtype=float)
+            return Bezier.from_heights(heights, box=(box[0], box[1])), ""
+        if name in ("dome", "hp"):
+            return get_surface(name, box=(box[0], box[1])), ""
+        if name == "expr":
+            return get_surface("expr", expr=metadata.get("expression")), ""
+    except (TypeError, ValueError) as exc:
+        return None, f"the target surface could not be rebuilt ({' '.join(str(exc).split())})"
+    return None, f"the target surface {name!r} cannot be rebuilt from summary.json"
+
+
+@dataclass(frozen=True, eq=False)
+class Check:
+    """One verification stage over the run's solutions.
+
+    name : str; passed : True, False, or None when the stage did not run; detail : str.
+    """
+
+    name: str
+    passed: bool | None
+    detail: str
+
+    @property
+    def word(self) -> str:
+        """ "passed", "FAILED" or "not run"."""
+        return {True: "passed", False: "FAILED", None: "not run"}[self.passed]
+
+
+@dataclass(frozen=True, eq=False)
+class RunData:
+    """Everything the report shows of one generate run.
+
+    directory : Path; summary : ``summary.json``; attempts : ``log.json``'s attempts;
+    designs : every solution in order (the last is the final design); surface : the target
+    surface, or None with ``surface_note`` saying why.
+    """
+
+    directory: Path
+    summary: RunSummary
+    attempts: tuple[AttemptRecord, ...]
+    designs: tuple[SolutionFile, ...]
+    surface: TargetSurface | None
+    surface_note: str
+
+    @property
+    def final(self) -> SolutionFile | None:
+        """The final design (the last solution, or the one ``final_step`` of summary.json
+        names: the lowest-DOF solution that deploys of a run that fell short), None when the
+        run has no solution."""
+        if not self.designs:
+            return None
+        step = self.summary.final_step
+        if step is not None and 0 <= step < len(self.designs):
+            return self.designs[step]
+        return self.designs[-1]
+
+    @property
+    def target_dof(self) -> int | None:
+        return self.summary.target_dof
+
+    def fit(self) -> np.ndarray:
+        """(S, 2) float64: max and RMS of |z - target| per solution, metres (NaN without a
+        surface)."""
+        out = np.full((len(self.designs), 2), np.nan)
+        if self.surface is not None:
+            for k, design in enumerate(self.designs):
+                dz = np.abs(design.dz(self.surface))
+                out[k] = dz.max(), np.sqrt(np.mean(dz**2))
+        return out
+
+    def checks(self) -> list[Check]:
+        """Development (Step 8), folding motion and large deformation (Step 9) over every
+        solution, from ``summary.json``'s ``per_solution``
+        (:meth:`rigidfold.run.SolutionRecord.passed`)."""
+        rows = self.summary.per_solution
+        n = len(rows)
+        dev = [r.development or {} for r in rows]
+        bad = _failed(rows, Stage.DEVELOPMENT)
+        max_d = max((d.get("D") or 0.0 for d in dev), default=0.0)
+        checks = [
+            Check(
+                "development",
+                None if n == 0 else not bad,
+                f"{n - len(bad)}/{n} converged, "
+                f"{sum(max(d.get('flipped') or 0, 0) for d in dev)} flipped, "
+                f"{sum(max(d.get('overlaps') or 0, 0) for d in dev)} overlapping, "
+                f"max D = {max_d:.2g}" + _steps(bad),
+            )
+        ]
+        motions = [r.motion for r in rows if r.motion is not None]
+        bad = _failed(rows, Stage.MOTION)
+        err = max((m.get("max_length_error") or 0.0 for m in motions), default=0.0)
+        checks.append(
+            Check(
+                "folding motion",
+                None if not motions else not bad,
+                f"{len(motions) - len(bad)}/{len(motions)} traced{_checked(len(motions), n)}, "
+                f"max |dl|/l = {err:.2g}" + _steps(bad)
+                if motions
+                else "no motion was traced",
+            )
+        )
+        deformed = [r.deformation for r in rows if r.deformation is not None]
+        bad = _failed(rows, Stage.DEFORMATION)
+        checks.append(
+            Check(
+                "large deformation",
+                None if not deformed else not bad,
+                f"{len(deformed) - len(bad)}/{len(deformed)} reached the plane"
+                f"{_checked(len(deformed), n)}, max |dl| = "
+                f"{max(d.get('max_dl_mm') or 0.0 for d in deformed):.3g} mm, max |drho_fix| "
+                f"= {max(d.get('max_drho_fix_deg') or 0.0 for d in deformed):.3g} deg" + _steps(bad)
+                if deformed
+                else "Step 9 did not run (--no-deform)",
+            )
+        )
+        return checks
+
+
+def _failed(rows: tuple[SolutionRecord, ...], stage: Stage) -> list:
+    """The steps of the solutions on which ``stage`` ran and failed."""
+    return [r.step for r in rows if r.passed(stage) is False]
+
+
+def _checked(checked: int, solutions: int) -> str:
+    """ " (the final design only; --check all for every solution)" where a stage ran on fewer
+    than all ``solutions``, "" otherwise."""
+    if checked >= solutions:
+        return ""
+    which = "the final design only" if checked == 1 else f"{checked} of {solutions} solutions"
+    return f" ({which}; --check all for every solution)"
+
+
+def _steps(bad: list) -> str:
+    return f" (failed at step {', '.join(map(str, bad))})" if bad else ""
+
+
+def load_run(directory: str | os.PathLike) -> RunData:
+    """Read the generate run in ``directory`` (see the module's text).
+
+    Raises ValueError (one line) when ``directory`` is not a generate run: no directory, no
+    or malformed ``summary.json`` / ``log.json`` (what the report reads of them not of the
+    shape it must have, :data:`SUMMARY_SHAPE` and :data:`LOG_SHAPE`: the error names the
+    file and the key), or a listed solution file that is not in the directory, is missing or
+    is not a FOLD file of a generate run.
+    """
+    root = Path(directory)
+    if not root.is_dir():
+        raise ValueError(f"{str(root)!r} is not a directory (give the --out of rigidfold generate)")
+    summary = RunSummary.from_dict(_json_object(root, "summary.json"), root / "summary.json")
+    log = _json_object(root, "log.json")
+    if not isinstance(log.get("attempts"), list):
+        raise ValueError(f"{str(root / 'log.json')!r} has no list of attempts")
+    check_shape(log, LOG_SHAPE, root / "log.json")
+    attempts = tuple(AttemptRecord.from_dict(a, k) for k, a in enumerate(log["attempts"]))
+    for k, attempt in enumerate(attempts):
+        if attempt.outcome == "accepted" and attempt.dof is None:
+            raise ValueError(
+                f"'{root / 'log.json'}': 'attempts[{k}].dof' is null, expected a whole number "
+                "(an accepted shape has a DOF)"
+            )
+    names = summary.solutions
+    designs = []
+    for k, name in enumerate(names):
+        parts = Path(name).parts
+        if not parts or Path(name).is_absolute() or ".." in parts:
+            raise ValueError(
+                f"'{root / 'summary.json'}': 'solutions[{k}]' is {received(name)}, expected "
+                "a file in the run's directory"
+            )
+        path = root / name
+        if not path.is_file():
+            raise ValueError(f"solution file {str(path)!r} listed in summary.json is missing")
+        designs.append(read_solution(path, name))
+    surface, note = target_surface(summary.case.get("surface") or {})
+    return RunData(root, summary, attempts, tuple(designs), surface, note)
+
+
+def _json_object(root: Path, name: str) -> dict:
+    path = root / name
+    try:
+        data = parse_json(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ValueError(
+            f"{str(root)!r} is not a rigidfold generate run: it has no {name}"
+        ) from None
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{str(path)!r} is not a JSON object")
+    return data

@@ -1,0 +1,458 @@
+"""The schema of a run directory: summary.json, log.json and the solution files, read and
+written through one set of types.
+
+:class:`SolutionRecord` is one solution's checks (``summary.json``'s ``per_solution``; the
+figures in its FOLD file), :class:`AttemptRecord` one solve (``log.json``),
+:class:`RunSummary` the whole of ``summary.json``. What the readers rely on is checked
+against a shape first (:data:`SUMMARY_SHAPE`, :data:`LOG_SHAPE`, :func:`check_shape`), so a
+damaged file is a one-line ValueError naming the file and the key. :class:`Stage` and
+:meth:`SolutionRecord.failed_stages` say, once for the writer, the report and the study,
+which check of a solution failed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+from rigidfold.deform import DeformStatus, MotionStatus, Verification
+from rigidfold.develop import DevelopStatus
+from rigidfold.generate import Stop
+from rigidfold.status import Outcome
+
+
+@dataclass(frozen=True)
+class Nullable:
+    """A shape (see :data:`SUMMARY_SHAPE`) that may also be JSON ``null``."""
+
+    shape: object
+
+
+@dataclass(frozen=True)
+class Record:
+    """A JSON object whose keys, when present (``required``: always), have these shapes;
+    other keys may hold anything."""
+
+    keys: dict
+    required: tuple[str, ...] = ()
+
+
+_NUMBERS = Nullable(float)
+SUMMARY_SHAPE = Record(
+    {
+        "stop": str,
+        "stop_reason": str,
+        "final_dof": Nullable(int),
+        "initial_dof": Nullable(int),
+        "N_reduce": Nullable(int),
+        "N_lock": Nullable(int),
+        "N_exceed": Nullable(int),
+        "N_path": Nullable(int),
+        "deploy_check": Nullable(bool),
+        "final_step": Nullable(int),
+        "final_deploys": Nullable(bool),
+        "solutions": [str],
+        "per_solution": [
+            Record(
+                {
+                    "step": Nullable(int),
+                    "dof": Nullable(int),
+                    "development": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "D": _NUMBERS,
+                                "flipped": Nullable(int),
+                                "overlaps": Nullable(int),
+                            }
+                        )
+                    ),
+                    "motion": Nullable(
+                        Record({"status": Nullable(str), "max_length_error": _NUMBERS})
+                    ),
+                    "deployability": Nullable(
+                        Record({"status": Nullable(str), "deploys": Nullable(bool)})
+                    ),
+                    "deformation": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "reached_plane": Nullable(bool),
+                                "max_dl_mm": _NUMBERS,
+                                "max_drho_fix_deg": _NUMBERS,
+                            }
+                        )
+                    ),
+                    "verdicts": Nullable(
+                        Record({"agreement": Nullable(str), "reason": Nullable(str)})
+                    ),
+                }
+            )
+        ],
+        "case": Record(
+            {
+                "surface": Nullable(
+                    Record(
+                        {
+                            "name": Nullable(str),
+                            "plan_box_m": Nullable((float, float)),
+                            "control_heights": Nullable([[float]]),
+                            "expression": Nullable(str),
+                        }
+                    )
+                ),
+                "F_tol": _NUMBERS,
+                "dz_m": _NUMBERS,
+            }
+        ),
+        "options": Nullable(Record({"target_dof": Nullable(int)})),
+        "verdict": Nullable(Record({"outcome": str, "message": str}, ("outcome", "message"))),
+    },
+    ("stop", "stop_reason", "final_dof", "N_lock", "solutions", "per_solution", "case"),
+)
+"""What the report reads of ``summary.json`` and the shape it must have (:func:`check_shape`):
+``int`` a whole number, ``float`` a finite number, ``str`` text, ``bool`` true or false, a
+list ``[S]`` a list of S, a tuple a list of that many items of those shapes, a
+:class:`Record` an object, :class:`Nullable` also null."""
+
+LOG_SHAPE = Record(
+    {
+        "attempts": [
+            Record(
+                {
+                    "index": int,
+                    "outcome": str,
+                    "dof": Nullable(int),
+                    "F": _NUMBERS,
+                    "iterations": Nullable(int),
+                    "path": Nullable(Record({"status": Nullable(str), "deploys": Nullable(bool)})),
+                },
+                ("outcome", "dof"),
+            )
+        ]
+    },
+    ("attempts",),
+)
+"""What the report reads of ``log.json`` (see :data:`SUMMARY_SHAPE`)."""
+
+HISTORY_SHAPE = [
+    Record(
+        {k: float for k in ("load_factor", "mean_dl_mm", "max_dl_mm", "max_drho_fix_deg")},
+        ("load_factor", "mean_dl_mm", "max_dl_mm", "max_drho_fix_deg"),
+    )
+]
+"""The large-deformation history of a solution file (``deformation.history``)."""
+
+
+def check_shape(value, shape, file: str | os.PathLike, where: str = "") -> None:
+    """ValueError naming ``file`` and the key (``per_solution[0].development.D``) of the
+    first part of ``value`` (JSON data) that does not have ``shape`` (:data:`SUMMARY_SHAPE`
+    says how shapes are written), and what it holds instead."""
+    stack = [(value, shape, where)]
+    while stack:
+        value, given, where = stack.pop()
+        shape = given.shape if isinstance(given, Nullable) else given
+        if value is None and shape is not given:
+            continue
+        if not _has_shape(value, shape):
+            key = f"{where!r}" if where else "the document"
+            raise ValueError(f"'{file}': {key} is {received(value)}, expected {_expected(given)}")
+        if isinstance(shape, Record):
+            missing = [k for k in shape.required if k not in value]
+            if missing:
+                key = f"{where!r}" if where else "the document"
+                raise ValueError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
+            stack += [
+                (value[k], s, f"{where}.{k}" if where else k)
+                for k, s in reversed(shape.keys.items())
+                if k in value
+            ]
+        elif isinstance(shape, list):
+            stack += [(v, shape[0], f"{where}[{i}]") for i, v in reversed(list(enumerate(value)))]
+        elif isinstance(shape, tuple):
+            stack += [
+                (v, s, f"{where}[{i}]") for i, (v, s) in enumerate(zip(value, shape, strict=True))
+            ]
+
+
+def _has_shape(value, shape) -> bool:
+    """Whether ``value`` is of the kind of ``shape`` (its items are checked apart)."""
+    if shape is bool:
+        return isinstance(value, bool)
+    if shape is int:  # within int64: numpy and matplotlib take it
+        return isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2**63
+    if shape is float:
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            return False
+        try:
+            return math.isfinite(value)
+        except OverflowError:  # an integer beyond the floats
+            return False
+    if shape is str:
+        return isinstance(value, str)
+    if isinstance(shape, Record):
+        return isinstance(value, dict)
+    if isinstance(shape, tuple):
+        return isinstance(value, list) and len(value) == len(shape)
+    return isinstance(value, list)
+
+
+def _expected(shape) -> str:
+    if isinstance(shape, Nullable):
+        return f"{_expected(shape.shape)} or null"
+    words = {
+        bool: "true or false",
+        int: "a whole number (64 bits)",
+        float: "a finite number",
+        str: "text",
+    }
+    if isinstance(shape, type):
+        return words[shape]
+    if isinstance(shape, Record):
+        return "an object"
+    if isinstance(shape, tuple):
+        return f"a list of {len(shape)} items"
+    return "a list"
+
+
+def received(value) -> str:
+    """``value`` as JSON text, cut to 40 characters."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= 40 else text[:39] + "…"
+
+
+DESIGN_SHAPE = Record(
+    {
+        "rigidfold:step": int,
+        "rigidfold:dof": int,
+        "rigidfold:deformation": Nullable(Record({"history": Nullable(HISTORY_SHAPE)})),
+    }
+)
+"""What the report reads of rigidfold's keys in a solution file (see :data:`SUMMARY_SHAPE`)."""
+
+
+class Stage(Outcome):
+    """A check of a solution after generation; the message says how it fails."""
+
+    DEVELOPMENT = "development", "development diagram (Step 8) failed"
+    MOTION = "motion", "folding motion not traced"
+    DEFORMATION = "deformation", "large deformation (Step 9) did not reach the plane"
+
+
+@dataclass(frozen=True)
+class SolutionRecord:
+    """The checks of one accepted solution: an entry of ``summary.json``'s ``per_solution``.
+
+    step, dof : int (None in a damaged file); fit : ``max_abs_dz_m``, ``rms_dz_m``;
+    development, motion, deformation, verdicts : each stage's figures (its ``to_dict()``;
+    None where it did not run); deployability : the folding path's
+    (:meth:`rigidfold.mechanism.path.FoldingPath.to_dict`), None where it was not traced;
+    time_s : seconds per stage.
+    """
+
+    step: int | None
+    dof: int | None
+    fit: dict | None = None
+    development: dict | None = None
+    deformation: dict | None = None
+    motion: dict | None = None
+    verdicts: dict | None = None
+    time_s: dict = field(default_factory=dict)
+    deployability: dict | None = None
+
+    @classmethod
+    def from_check(
+        cls,
+        step: int,
+        dof: int,
+        check: Verification,
+        *,
+        fit: dict | None = None,
+        deployability: dict | None = None,
+    ) -> SolutionRecord:
+        """The record of Steps 8-9 run on a solution (:func:`rigidfold.deform.verify`)."""
+        figures = check.to_dict()
+        return cls(
+            step=step,
+            dof=dof,
+            fit=fit,
+            development=figures["development"],
+            deformation=figures["deformation"],
+            motion=figures["motion"],
+            verdicts=figures["verdicts"],
+            time_s=figures["time_s"],
+            deployability=deployability,
+        )
+
+    @classmethod
+    def from_dict(cls, data: dict) -> SolutionRecord:
+        """A record of ``summary.json`` (checked with :data:`SUMMARY_SHAPE`); keys of
+        other versions are ignored, missing ones are None."""
+        names = {f.name for f in fields(cls)}
+        known = {k: v for k, v in data.items() if k in names}
+        known["time_s"] = dict(known.get("time_s") or {})
+        return cls(**{"step": None, "dof": None, **known})
+
+    def to_dict(self, *, history: bool = True) -> dict:
+        """The record as JSON values; ``history=False`` leaves out the large-deformation
+        history (``summary.json`` keeps it in the solution's FOLD file only)."""
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        if not history and self.deformation is not None:
+            out["deformation"] = {k: v for k, v in self.deformation.items() if k != "history"}
+        return out
+
+    def ran(self, stage: Stage) -> bool:
+        """Whether ``stage`` ran on this solution (the development always does)."""
+        return stage is Stage.DEVELOPMENT or getattr(self, stage.value) is not None
+
+    def passed(self, stage: Stage) -> bool | None:
+        """Whether ``stage`` passed: the development converged, the motion was traced, the
+        frame reached the plane; None where it did not run."""
+        if not self.ran(stage):
+            return None
+        figures = getattr(self, stage.value) or {}
+        status = figures.get("status")
+        return {
+            Stage.DEVELOPMENT: status == DevelopStatus.CONVERGED,
+            Stage.MOTION: status == MotionStatus.OK,
+            Stage.DEFORMATION: status == DeformStatus.REACHED_PLANE,
+        }[stage]
+
+    def failed_stages(self) -> list[Stage]:
+        """The stages that ran on this solution and failed, in :class:`Stage` order."""
+        return [stage for stage in Stage if self.passed(stage) is False]
+
+
+@dataclass(frozen=True)
+class AttemptRecord:
+    """What the report reads of one solve in ``log.json`` (checked with :data:`LOG_SHAPE`).
+
+    index : int; outcome : the :class:`rigidfold.generate.AttemptOutcome` value; dof : None
+    when the solve was not analysed; F, iterations : the solve's; fixed_added, locked : the
+    creases fixed by it and locked at the shape found; path : the deployability check's
+    figures or None.
+    """
+
+    index: int
+    outcome: str
+    dof: int | None
+    F: float | None = None
+    iterations: int | None = None
+    fixed_added: list | None = None
+    locked: list | None = None
+    path: dict | None = None
+
+    @classmethod
+    def from_dict(cls, data: dict, k: int = 0) -> AttemptRecord:
+        names = {f.name for f in fields(cls)}
+        return cls(**{"index": k, **{n: v for n, v in data.items() if n in names}})
+
+
+def aggregate(records: list[SolutionRecord]) -> dict:
+    """The run-wide figures of ``summary.json`` (``development``, ``deformation``,
+    ``motion``) over the solutions' records: means and maxima of what ran."""
+    dev = [r.development or {} for r in records]
+    deformed = [r.deformation for r in records if r.deformation is not None]
+    motions = [r.motion for r in records if r.motion is not None]
+
+    def stat(values, fn):
+        return float(fn(values)) if values else None
+
+    return {
+        "development": {
+            "mean_D": stat([d["D"] for d in dev], np.mean),
+            "max_D": stat([d["D"] for d in dev], np.max),
+            "flipped": sum(max(d["flipped"], 0) for d in dev),
+            "overlaps": sum(max(d["overlaps"], 0) for d in dev),
+        },
+        "deformation": {
+            "checked": len(deformed),
+            "reached_plane": sum(d["reached_plane"] for d in deformed),
+            "mean_dl_mm": stat([d["mean_dl_mm"] for d in deformed], np.mean),
+            "max_dl_mm": stat([d["max_dl_mm"] for d in deformed], np.max),
+            "mean_drho_fix_deg": stat([d["mean_drho_fix_deg"] for d in deformed], np.mean),
+            "max_drho_fix_deg": stat([d["max_drho_fix_deg"] for d in deformed], np.max),
+        },
+        "motion": {
+            "traced": sum(m["status"] == MotionStatus.OK for m in motions),
+            "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
+        },
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class RunSummary:
+    """``summary.json`` read back (checked with :data:`SUMMARY_SHAPE` first).
+
+    stop, stop_reason : how the run ended (:class:`rigidfold.generate.Stop` value and words);
+    initial_dof, final_dof, n_reduce, n_lock, n_exceed, n_path : the paper's counters and
+    N_path (None in a file without them); deploy_check : whether the deployability check
+    ran; final_step, final_deploys : the final design's step and whether its path reaches
+    the flat state; solutions : the solution files, relative to the run's directory;
+    per_solution : their records; case, options : the case's metadata and the generate
+    options as written; verdict : the verdict's dict, None while the run goes on;
+    document : the whole file (for tables of everything it holds).
+    """
+
+    stop: str
+    stop_reason: str
+    initial_dof: int | None
+    final_dof: int | None
+    n_reduce: int | None
+    n_lock: int | None
+    n_exceed: int | None
+    n_path: int | None
+    deploy_check: bool
+    final_step: int | None
+    final_deploys: bool | None
+    solutions: tuple[str, ...]
+    per_solution: tuple[SolutionRecord, ...]
+    case: dict
+    options: dict
+    verdict: dict | None
+    document: dict
+
+    @classmethod
+    def from_dict(cls, data: dict, file: str | os.PathLike) -> RunSummary:
+        """The summary in ``data``, the JSON of ``file``: ValueError (one line, naming the
+        file and the key) when what is read does not have the shape it must have."""
+        missing = [k for k in SUMMARY_SHAPE.required if k not in data]
+        if missing:
+            raise ValueError(
+                f"{str(file)!r} is not the summary of rigidfold generate (no {', '.join(missing)})"
+            )
+        check_shape(data, SUMMARY_SHAPE, file)
+        return cls(
+            stop=data["stop"],
+            stop_reason=data["stop_reason"],
+            initial_dof=data.get("initial_dof"),
+            final_dof=data["final_dof"],
+            n_reduce=data.get("N_reduce"),
+            n_lock=data["N_lock"],
+            n_exceed=data.get("N_exceed"),
+            n_path=data.get("N_path"),
+            deploy_check=bool(data.get("deploy_check")),
+            final_step=data.get("final_step"),
+            final_deploys=data.get("final_deploys"),
+            solutions=tuple(data["solutions"]),
+            per_solution=tuple(SolutionRecord.from_dict(r) for r in data["per_solution"]),
+            case=data["case"],
+            options=data.get("options") or {},
+            verdict=data.get("verdict"),
+            document=data,
+        )
+
+    @property
+    def target_dof(self) -> int | None:
+        return self.options.get("target_dof")
+
+    @property
+    def running(self) -> bool:
+        return self.stop == Stop.RUNNING

@@ -1,0 +1,94 @@
+"""The verdict on a finished generation run: whether it delivered, and the exit code of
+``rigidfold generate`` that follows (0 or 1)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from rigidfold.generate import Generation, Stop
+from rigidfold.run.schema import SolutionRecord, Stage
+from rigidfold.status import Outcome
+
+
+class RunOutcome(Outcome):
+    """Whether a generation run delivered: the command's exit code follows it (0 or 1)."""
+
+    PASSED = "passed", "the target DOF was reached and every check of the final design passed"
+    FELL_SHORT = "fell_short", "the run fell short"
+
+
+@dataclass(frozen=True)
+class RunVerdict:
+    """The verdict on a finished generation run.
+
+    outcome : RunOutcome; shortfalls : what fell short, one sentence each (empty when
+    passed); warnings : checks that failed on earlier solutions, which are not the design
+    delivered (one sentence each); final_design : the last solution written (the lowest DOF),
+    None without any.
+    """
+
+    outcome: RunOutcome
+    shortfalls: tuple[str, ...]
+    warnings: tuple[str, ...]
+    final_design: Path | None
+
+    @property
+    def message(self) -> str:
+        """One line: what fell short, or that everything passed; then the warnings."""
+        head = "; ".join(self.shortfalls) if self.shortfalls else self.outcome.message
+        return "; ".join([head, *(f"note: {w}" for w in self.warnings)])
+
+    def to_dict(self) -> dict:
+        return {
+            "outcome": self.outcome.value,
+            "message": self.message,
+            "shortfalls": list(self.shortfalls),
+            "warnings": list(self.warnings),
+            "final_design": None if self.final_design is None else self.final_design.as_posix(),
+        }
+
+
+def run_verdict(
+    run: Generation, records: list[SolutionRecord], files: list[Path], target: int
+) -> RunVerdict:
+    """The verdict on ``run``: passed when it reached ``target`` (Stop.TARGET_REACHED, or
+    DOF 0 for a target of 0) and every check that ran on the final design
+    (:attr:`rigidfold.generate.Generation.final`) passed: development diagram converged,
+    folding motion traced, large deformation reached the plane. A check that failed on
+    another solution is a warning. With the deployability check, a run that fell short
+    says so when no deployable design was found at a lower DOF (N_path > 0).
+
+    records : each solution's checks, in the order of ``files`` (their FOLD paths, relative
+    to the run's DIR); :meth:`SolutionRecord.failed_stages` says what failed.
+    """
+    short = []
+    reached = run.stop is Stop.TARGET_REACHED or (run.stop is Stop.ZERO_DOF and target == 0)
+    final = run.final
+    k = -1 if final is None else final.step
+    if final is None:
+        short.append(f"no solution: {run.stop_reason}")
+    elif not reached:
+        short.append(
+            f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"
+        )
+        if run.deploy_check and run.n_path:
+            short.append(
+                f"no deployable design below DOF {final.mechanism.dof}: the folding paths of "
+                f"{run.n_path} solution{'s' if run.n_path > 1 else ''} did not reach the flat "
+                "state (N_path)"
+            )
+    if records:
+        short += [f"{s.message} for the final design" for s in records[k].failed_stages()]
+    earlier: dict[Stage, list[str]] = {stage: [] for stage in Stage}
+    for i, (record, path) in enumerate(zip(records, files, strict=True)):
+        if i != (k % len(records)):
+            for stage in record.failed_stages():
+                earlier[stage].append(path.name)
+    warnings = tuple(f"{s.message} for {', '.join(n)}" for s, n in earlier.items() if n)
+    return RunVerdict(
+        RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
+        tuple(short),
+        warnings,
+        files[k] if files else None,
+    )

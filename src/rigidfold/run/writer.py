@@ -1,0 +1,253 @@
+"""Files of a generation run, written as the run goes so an interrupt loses nothing.
+
+``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form, a
+``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
+``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.json``
+(every attempt) and ``DIR/summary.json`` (the paper's counters, the development and
+deformation figures (Step 9), each solution's :class:`~rigidfold.run.SolutionRecord`, the
+options, the verdict and stage times). Every file is written atomically (temporary file,
+then rename), so each one on disk is always valid.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.case import Case
+from rigidfold.deform import MotionStatus, Verification, verify
+from rigidfold.exports import export_design
+from rigidfold.generate import Attempt, GenerateOptions, Generation, Solution
+from rigidfold.io import (
+    FoldData,
+    crease_pattern_frame,
+    motion_frames,
+    prepare_output_dir,
+    refuse_replacing_inputs,
+    round_trip_dict,
+    write_document,
+    write_fold,
+    write_json,
+    write_svg,
+)
+from rigidfold.mesh import CreasePattern
+from rigidfold.run.lock import RUN_FILES, clear_earlier_run, lock_run_dir
+from rigidfold.run.schema import SolutionRecord, aggregate
+from rigidfold.run.verdict import RunVerdict, run_verdict
+
+
+def verification_frames(pattern: CreasePattern, check: Verification) -> list[dict]:
+    """FOLD ``file_frames`` of a checked shape ``pattern``: its development diagram
+    (``creasePattern``), then its folding motion from flat to folded (``foldedForm``, each
+    frame with its own fold angles) when it was traced."""
+    frames = [crease_pattern_frame(check.development.coords2d)]
+    motion = _traced_motion(check)
+    if motion is not None:
+        frames += motion_frames(pattern, *motion)
+    return frames
+
+
+def _traced_motion(check: Verification) -> tuple[np.ndarray, np.ndarray] | None:
+    """(frames (K, V, 3), parameter (K,)) of the folding motion, None unless it was traced."""
+    if check.motion is None or check.motion.status is not MotionStatus.OK:
+        return None
+    return check.motion.frames, check.motion.parameter
+
+
+def write_checked_shape(
+    path: Path,
+    pattern: CreasePattern,
+    check: Verification,
+    *,
+    title: str,
+    metadata: dict,
+    svg_title: str,
+    source: FoldData | None = None,
+) -> list[Path]:
+    """Write a shape checked by Steps 8-9: ``path`` (FOLD) and the development diagram
+    beside it as SVG. Returns [FOLD, SVG].
+
+    Without ``source`` the FOLD is written from scratch: the folded form titled ``title``,
+    its development diagram and motion frames (:func:`verification_frames`), ``metadata``
+    and every figure of the check. With ``source`` (the FOLD file read, whose pattern is
+    ``pattern``) it is that file's document, kept whole, plus rigidfold's frames
+    (development diagram, motion, folded form) and keys
+    (:func:`rigidfold.io.round_trip_dict`), and the SVG keeps the file's crease assignment.
+    """
+    coords2d = check.development.coords2d
+    figures = {**metadata, **check.to_dict()}
+    if source is None:
+        letters = None
+        fold = write_fold(
+            path, pattern, frames=verification_frames(pattern, check), title=title, metadata=figures
+        )
+    else:
+        letters = source.shape_assignment()
+        document = round_trip_dict(
+            source, coords2d, motion=_traced_motion(check), title=title, metadata=figures
+        )
+        fold = write_document(path, document)
+    svg = write_svg(
+        path.with_suffix(".svg"), pattern, coords2d, title=svg_title, assignment=letters
+    )
+    return [fold, svg]
+
+
+class RunWriter:
+    """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date.
+
+    The development diagram (Step 8) runs on every solution as it comes; the folding motion
+    and, with ``options.deform``, the large-deformation check (Step 9) run on the solutions
+    ``options.check`` names (:data:`rigidfold.config.CHECKS`): the final design only, once
+    the run has ended (its FOLD file is then written again with them), or every solution as
+    it comes. ``overwrite``: replace the files of an earlier run in ``out``
+    (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
+    target the verdict (:meth:`finish`) judges by.
+    """
+
+    def __init__(
+        self,
+        out: str | Path,
+        case: Case,
+        options: GenerateOptions,
+        *,
+        overwrite: bool = False,
+    ) -> None:
+        refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
+        self.out = prepare_output_dir(out)
+        self.lock = lock_run_dir(self.out)
+        try:
+            clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
+            self.solutions_dir = prepare_output_dir(self.out / "solutions")
+        except ValueError:
+            self.release()
+            raise
+        self.case, self.options = case, options
+        self.solutions: list[Solution] = []
+        self.developments: dict[int, np.ndarray] = {}  # step -> the development, (V, 2)
+        self.files: list[Path] = []
+        self.records: list[SolutionRecord] = []
+        self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
+        self.verdict: RunVerdict | None = None
+        self.final: tuple[CreasePattern, np.ndarray] | None = None
+        self.final_step: int | None = None
+        self.exports: list[Path] = []
+
+    @property
+    def final_verdicts(self) -> str | None:
+        """The final design's verdicts of the large-deformation analysis and the folding motion
+        in one line, and why they differ when they do (:class:`rigidfold.deform.Verdicts`);
+        None without a solution, or when one of the two did not run."""
+        if not self.records:
+            return None
+        step = -1 if self.final_step is None else self.final_step
+        verdicts = self.records[step].verdicts
+        return None if verdicts is None else verdicts["line"]
+
+    def release(self) -> None:
+        """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""
+        self.lock.unlink(missing_ok=True)
+
+    def on_attempt(self, run: Generation, attempt: Attempt) -> None:
+        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
+        self.write_summary(run)
+
+    def on_solution(self, run: Generation, solution: Solution) -> None:
+        full = self.options.check == "all"
+        self.solutions.append(solution)
+        self.records.append(SolutionRecord(solution.step, solution.mechanism.dof))
+        deform = full and self.options.deform
+        self.files.append(self._write_solution(solution, deform=deform, motion=full))
+        self.write_summary(run)
+
+    def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
+        """Check one solution (Step 8; the motion and Step 9 as asked) and write its FOLD and
+        SVG files; its record replaces ``records[solution.step]``. Returns the FOLD path."""
+        dof = solution.mechanism.dof
+        pattern = solution.result.pattern
+        check = verify(
+            pattern,
+            run_deform=deform,
+            run_motion=motion,
+            dof=dof,
+            path=solution.path,
+            support_face=self.options.support_face,
+            settings=self.case.settings,
+        )
+        for stage, t in check.times.items():
+            self.stage_times[stage] += t
+        dz = self.case.deviation(pattern.coords)
+        fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
+        self.records[solution.step] = SolutionRecord.from_check(
+            solution.step,
+            dof,
+            check,
+            fit=fit,
+            deployability=None if solution.path is None else solution.path.to_dict(),
+        )
+        self.developments[solution.step] = check.development.coords2d
+        path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
+        write_checked_shape(
+            path,
+            pattern,
+            check,
+            title=f"rigidfold generate: step {solution.step}, DOF {dof}",
+            svg_title=f"step {solution.step}, DOF {dof}: development diagram",
+            metadata={
+                **self.case.metadata(),
+                **solution.result.to_dict(),
+                "step": solution.step,
+                "dof": dof,
+                "criterion": self.options.criterion,
+                "lookahead": self.options.lookahead,
+            },
+        )
+        return path
+
+    def finish(self, run: Generation) -> RunVerdict:
+        """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
+        and the final design (:attr:`rigidfold.generate.Generation.final`) exported to
+        ``DIR/final/`` in every format of :func:`rigidfold.exports.export_design`, named
+        after its solution file. With ``check="final"`` the final design's folding motion and
+        Step 9 run first and its files are written again with them."""
+        final = run.final
+        if final is not None:
+            self.final_step = final.step
+            if self.options.check == "final":
+                self.solutions[final.step] = final  # its path may have been traced since
+                self._write_solution(final, deform=self.options.deform, motion=True)
+            pattern = final.result.pattern
+            coords2d = self.developments[final.step]
+            self.final = (pattern, coords2d)
+        self.verdict = run_verdict(
+            run,
+            self.records,
+            [p.relative_to(self.out) for p in self.files],
+            self.options.target_dof,
+        )
+        if self.final is not None:
+            pattern, coords2d = self.final
+            stem = self.files[-1 if final is None else final.step].stem
+            self.exports = export_design(
+                pattern, coords2d, self.out / "final", name=stem, title=f"rigidfold: {stem}"
+            )
+        self.write_summary(run)
+        return self.verdict
+
+    def write_summary(self, run: Generation) -> None:
+        summary = run.to_dict()
+        summary["time_s"].update(self.stage_times)
+        write_json(
+            self.out / "summary.json",
+            {
+                **summary,
+                **aggregate(self.records),
+                "per_solution": [r.to_dict(history=False) for r in self.records],
+                "options": self.options.to_dict() | {"symmetric": bool(self.case.planes)},
+                "case": self.case.metadata(),
+                "solutions": [str(p.relative_to(self.out)) for p in self.files],
+                "verdict": None if self.verdict is None else self.verdict.to_dict(),
+                "exports": [str(p.relative_to(self.out)) for p in self.exports],
+            },
+        )

@@ -1,0 +1,160 @@
+"""The run artifact (issue 28): one schema for summary.json, log.json and the solution files,
+one set of generate options, the FOLD frame contract, and runs of the previous version."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rigidfold.generate import GenerateOptions
+from rigidfold.io import FRACTION_KEY, motion_frames, read_frames
+from rigidfold.mesh import CreasePattern
+from rigidfold.patterns import pattern1
+from rigidfold.run import RunSummary, SolutionRecord, Stage, aggregate, load_run
+from rigidfold.workflows import report_run
+
+LEGACY_RUN = Path(__file__).parent / "data" / "legacy_run"
+"""A generate run written by rigidfold before the run artifact (commit 7b0ce6b): ``rigidfold
+generate --surface bezier --seed 1 --pattern 1 --criterion shat --target-dof 17
+--no-report`` (summary.json, log.json and the solution FOLD files; final/ left out)."""
+
+
+def _record(development="converged", motion=None, deformation=None) -> SolutionRecord:
+    return SolutionRecord.from_dict(
+        {
+            "step": 3,
+            "dof": 2,
+            "development": {"status": development, "D": 1e-9, "flipped": 0, "overlaps": 0},
+            "motion": None if motion is None else {"status": motion, "max_length_error": 0.0},
+            "deformation": None
+            if deformation is None
+            else {
+                "status": deformation,
+                "reached_plane": deformation == "reached_plane",
+                "mean_dl_mm": 0.1,
+                "max_dl_mm": 0.2,
+                "mean_drho_fix_deg": 0.0,
+                "max_drho_fix_deg": 0.0,
+            },
+        }
+    )
+
+
+@pytest.mark.parametrize(
+    ("record", "failed"),
+    [
+        (_record(), []),
+        (_record("failed"), [Stage.DEVELOPMENT]),
+        (_record(motion="ok", deformation="reached_plane"), []),
+        (_record(motion="failed"), [Stage.MOTION]),
+        (_record(deformation="failed"), [Stage.DEFORMATION]),
+        (_record("failed", "failed", "failed"), list(Stage)),
+    ],
+)
+def test_failed_stages_are_decided_once(record, failed):
+    """A stage that did not run neither passes nor fails; the others by their status."""
+    assert record.failed_stages() == failed
+    for stage in Stage:
+        ran = stage is Stage.DEVELOPMENT or getattr(record, stage.value) is not None
+        assert record.ran(stage) is ran
+        assert record.passed(stage) is (None if not ran else stage not in failed)
+
+
+def test_record_round_trip_and_aggregate():
+    record = _record(motion="ok", deformation="reached_plane")
+    assert SolutionRecord.from_dict(json.loads(json.dumps(record.to_dict()))) == record
+    figures = aggregate([record, _record(deformation="failed")])
+    assert figures["deformation"]["checked"] == 2
+    assert figures["deformation"]["reached_plane"] == 1
+    assert figures["motion"]["traced"] == 1
+    assert figures["development"]["max_D"] == pytest.approx(1e-9)
+
+
+def test_generate_options_validate_and_round_trip():
+    options = GenerateOptions(criterion="s", target_dof=3, lookahead=True)
+    assert GenerateOptions.from_dict(options.to_dict() | {"symmetric": True}) == options
+    assert options.replace(seed=5).seed == 5
+    with pytest.raises(ValueError, match="unknown generate option 'target'"):
+        options.replace(target=2)
+    with pytest.raises(ValueError, match="unknown criterion 'x'"):
+        GenerateOptions(criterion="x")
+    with pytest.raises(ValueError, match="target DOF must be an integer >= 0, got -1"):
+        GenerateOptions(target_dof=-1)
+    with pytest.raises(ValueError, match="unknown check 'some'"):
+        GenerateOptions(check="some")
+
+
+def test_settings_hold_no_run_options():
+    """The target DOF and the deployability check are options of a run, not tolerances."""
+    from rigidfold.config import Settings
+
+    names = set(Settings.__dataclass_fields__)
+    assert not names & {"target_dof", "deploy_check"}
+
+
+def test_motion_frames_carry_their_fraction():
+    """The fraction folded of each motion frame is a key of the frame, read back as written
+    (not recovered from the title); frames of another writer are spaced evenly."""
+    xy, faces = pattern1()
+    pattern = CreasePattern.from_faces(np.column_stack([xy, np.zeros(len(xy))]), faces)
+    coords = np.repeat(pattern.coords[None], 3, axis=0)
+    fractions = np.array([0.0, 0.37, 1.0])
+    frames = motion_frames(pattern, coords, fractions)
+    assert [f[FRACTION_KEY] for f in frames] == fractions.tolist()
+    read = read_frames({"file_frames": frames}, pattern.n_vertices, "test")
+    np.testing.assert_array_equal(read.fraction, fractions)
+    assert read.diagram is None and read.motion.shape == (3, pattern.n_vertices, 3)
+    for f in frames:
+        del f[FRACTION_KEY]
+        f["frame_title"] = "a motion frame"
+    other = read_frames({"file_frames": frames}, pattern.n_vertices, "test")
+    np.testing.assert_array_equal(other.fraction, [0.0, 0.5, 1.0])
+
+
+def test_a_run_of_the_previous_version_still_reads(tmp_path):
+    """summary.json, log.json and solution files written before the run artifact: the same
+    counters, checks, final design and motion (fractions from the frames' titles), and a
+    report."""
+    run_dir = shutil.copytree(LEGACY_RUN, tmp_path / "run")
+    run = load_run(run_dir)
+    summary = json.loads((LEGACY_RUN / "summary.json").read_text())
+    assert isinstance(run.summary, RunSummary)
+    assert (run.summary.final_dof, run.summary.n_lock) == (summary["final_dof"], summary["N_lock"])
+    assert run.summary.options["symmetric"] is False and run.target_dof == 17
+    assert [d.name for d in run.designs] == summary["solutions"]
+    assert run.final is not None and run.final.name == summary["solutions"][-1]
+    assert [c.word for c in run.checks()] == ["passed", "passed", "passed"]
+    fraction = run.final.fraction
+    assert len(fraction) == len(run.final.motion) > 2
+    assert fraction[0] == 0.0 and fraction[-1] == 1.0 and np.all(np.diff(fraction) > 0)
+    assert GenerateOptions.from_dict(run.summary.options).target_dof == 17
+    report = report_run(run_dir)
+    assert report.html.is_file() and report.to_dict()["checks"]["development"] == "passed"
+
+
+LEGACY_STUDY = Path(__file__).parent / "data" / "legacy_study.sqlite"
+"""A study database written by rigidfold before the run artifact (commit 7b0ce6b): ``rigidfold
+study --patterns 1 --criteria s --surfaces 1 --no-deform --workers 1``."""
+
+
+def test_a_study_of_the_previous_version_resumes(tmp_path):
+    """Its configuration (target_dof and deploy_check still among the settings, no
+    ``check``) is the one the same command makes now: the study resumes, its run is done."""
+    from rigidfold.config import DEFAULTS
+    from rigidfold.study import STUDY_OPTIONS, Key, Store, StudyConfig
+
+    db = shutil.copy(LEGACY_STUDY, tmp_path / "study.sqlite")
+    config = StudyConfig(STUDY_OPTIONS.replace(deform=False), DEFAULTS)
+    store = Store(db, config.as_dict(), allow_mixed_numerics=True)
+    try:
+        assert store.done() == {Key("bezier", 0, "1", "s")}
+        (row,) = store.runs()
+        assert row["n_lock"] is not None and row["final_dof"] is not None
+    finally:
+        store.close()
+    with pytest.raises(ValueError, match="lookahead"):
+        Store(db, StudyConfig(STUDY_OPTIONS.replace(lookahead=True), DEFAULTS).as_dict())
