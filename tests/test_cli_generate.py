@@ -7,6 +7,7 @@ import os
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -368,3 +369,39 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     final = json.loads((tmp_path / "b" / "summary.json").read_text())["per_solution"][-1]
     assert final["verdicts"]["agreement"] == "differ"
     assert final["verdicts"]["line"] == lines[-2].removeprefix("final design: ")
+
+
+# ------------------------------------------------- issue 30, item 20: --target-dof 0 and 50
+def test_target_dof_0_saves_and_names_the_dof_0_shape(tmp_path, capsys):
+    """``--target-dof 0``: the DOF-0 shape the run ends at is a solution, written and named
+    as the final design (was: "passed" naming the DOF-1 file, the DOF-0 shape never saved).
+    A DOF-0 design has no mechanism: no folding motion or Step 9 is asked of it, a note says
+    so."""
+    argv = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "grid:4x4"]
+    code = main([*argv, "--target-dof", "0", "--no-deform", "--quiet", "--out", str(tmp_path)])
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert (
+        code == 0
+        and summary["final_dof"] == 0
+        and summary["stop_reason"] == ("target DOF 0 reached")
+    )
+    final = summary["verdict"]["final_design"]
+    assert final == summary["solutions"][-1] and final.endswith("_dof_00.fold")
+    assert last.startswith("passed: ") and last.endswith(f"final design: {tmp_path / final}")
+    assert "a DOF-0 design has no mechanism: it does not fold" in last
+    assert read_fold(tmp_path / final).pattern.n_vertices == 16
+    proc = run_cli("analyze", str(tmp_path / final))
+    assert proc.returncode == 0 and "DOF: 0" in proc.stdout
+    assert (tmp_path / "final" / Path(final).with_suffix(".obj").name).is_file()
+
+
+def test_target_dof_at_or_above_the_initial_dof_says_so(tmp_path, capsys):
+    """``--target-dof 50`` on a 9-DOF shape: the run says the initial DOF is already at or
+    below the target (no crease was fixed), not only "the target DOF was reached"."""
+    code = main(["generate", *SHORT_RUN, "--target-dof", "50", "--out", str(tmp_path)])
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert code == 0
+    assert "the initial DOF 5 is already at or below the target DOF 50" in last
+    verdict = json.loads((tmp_path / "summary.json").read_text())["verdict"]
+    assert any("already at or below the target DOF 50" in w for w in verdict["warnings"])

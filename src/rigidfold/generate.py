@@ -183,8 +183,9 @@ class Attempt:
 
 @dataclass
 class Solution:
-    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease; with the deployability
-    check, also its folding path to the flat state (``path``, None where it did not run)."""
+    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease (or, for a target DOF of 0,
+    the DOF-0 shape that ends the run); with the deployability check, also its folding path
+    to the flat state (``path``, None where it did not run)."""
 
     step: int
     result: OptimizeResult
@@ -308,6 +309,8 @@ def generate(
     on solutions of at most ``Settings.deploy_check_max_dof`` DOF, 0: all); one that does not
     counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape (which cannot
     deploy) is retried like a lock where the target is >= 1. False is the paper's method.
+    With ``target_dof=0`` the DOF-0 shape that ends the run is its last solution (its
+    attempt's outcome stays ZERO_DOF) and the stop is TARGET_REACHED.
     A KeyboardInterrupt propagates after the callbacks of everything finished so far.
     """
     if criterion not in CRITERIA:
@@ -383,6 +386,12 @@ def generate(
         run.attempts.append(rec)
         return rec, result, mech, path
 
+    def solution(rec: Attempt) -> bool:
+        """Whether an attempt gives a solution: accepted, or the DOF-0 shape of a target 0."""
+        return rec.outcome is AttemptOutcome.ACCEPTED or (
+            rec.outcome is AttemptOutcome.ZERO_DOF and target_dof == 0
+        )
+
     def record(rec: Attempt, result, mech, path) -> None:
         if rec.outcome is AttemptOutcome.EXCEED:
             run.n_exceed += 1
@@ -392,7 +401,7 @@ def generate(
             run.n_path += 1
         if on_attempt:
             on_attempt(run, rec)
-        if rec.outcome is AttemptOutcome.ACCEPTED:
+        if solution(rec):
             sol = Solution(len(run.solutions), result, mech, path)
             run.solutions.append(sol)
             if on_solution:
@@ -401,7 +410,7 @@ def generate(
     # Steps 2-5 for the triangulated target surface
     fixed = case.pattern.fixed.copy()
     rec, result, mech, path = attempt(fixed, None, (), None)
-    if rec.outcome is not AttemptOutcome.ACCEPTED:
+    if not solution(rec):
         run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
         rec.outcome = AttemptOutcome.INITIAL_FAILED
         record(rec, result, mech, path)
@@ -467,7 +476,7 @@ def generate(
             if undeployable >= settings.deploy_max_candidates > 0:  # bounded cost
                 run.stop, run.stop_detail = Stop.NO_DEPLOYABLE, str(undeployable)
                 return _deployable_final(run, deploy, support_face, settings)
-        if rec.outcome is AttemptOutcome.ZERO_DOF:
+        if rec.outcome is AttemptOutcome.ZERO_DOF and target_dof > 0:
             run.stop = Stop.ZERO_DOF
             return _deployable_final(run, deploy, support_face, settings)
     run.stop, run.stop_detail = Stop.TARGET_REACHED, str(target_dof)

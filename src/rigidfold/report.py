@@ -110,8 +110,9 @@ def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: 
     DOF 0 for a target of 0) and every check that ran on the final design
     (:attr:`rigidfold.generate.Generation.final`) passed: development diagram converged,
     folding motion traced, large deformation reached the plane. A check that failed on
-    another solution is a warning. With the deployability check, a run that fell short
-    says so when no deployable design was found at a lower DOF (N_path > 0).
+    another solution is a warning, and so is a target at or above the initial DOF (no crease
+    fixed) and a DOF-0 final design (it does not fold). With the deployability check, a run
+    that fell short says so when no deployable design was found at a lower DOF (N_path > 0).
 
     checks : the figures of each solution's check (``Verification.to_dict()`` with its
     ``step``), in the order of ``files`` (their FOLD paths, relative to the run's DIR).
@@ -140,6 +141,16 @@ def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: 
             for stage in _failed_checks(check):
                 earlier[stage].append(path.name)
     warnings = tuple(f"{_CHECKS[s]} for {', '.join(n)}" for s, n in earlier.items() if n)
+    if run.initial_dof is not None and run.initial_dof <= target:
+        warnings += (
+            f"the initial DOF {run.initial_dof} is already at or below the target DOF "
+            f"{target}: no crease was fixed",
+        )
+    if final is not None and final.mechanism.dof == 0 and reached:
+        warnings += (
+            "a DOF-0 design has no mechanism: it does not fold (no folding motion or "
+            "large-deformation check)",
+        )
     return RunVerdict(
         RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
         tuple(short),
@@ -406,10 +417,10 @@ class RunWriter:
         SVG files; its figures replace ``checks[solution.step]``. Returns the FOLD path."""
         dof = solution.mechanism.dof
         pattern = solution.result.pattern
-        check = verify(
+        check = verify(  # a DOF-0 shape (a target of 0) has no motion to trace or check
             pattern,
-            run_deform=deform,
-            run_motion=motion,
+            run_deform=deform and dof > 0,
+            run_motion=motion and dof > 0,
             dof=dof,
             path=solution.path,
             settings=self.case.settings,
