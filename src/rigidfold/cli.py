@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from rigidfold import __version__
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
+from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
@@ -34,7 +35,6 @@ LOOKAHEAD_HELP = (
     "together with the nearly flat creases they would lock)"
 )
 EXIT_FAILED = 1  # generate fell short; runs of a study failed
-EXIT_INTERRUPTED = 130
 EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE
 OUT_HELP = "output directory (created if absent)"
 WORKERS_HELP = "local worker processes, each running one generate at a time (default: %(default)s)"
@@ -956,4 +956,5 @@ def _quiet_exit() -> None:
 
 
 if __name__ == "__main__":
+    terminate_interrupts()
     sys.exit(main())

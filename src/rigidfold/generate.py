@@ -85,6 +85,7 @@ class Stop(Outcome):
         "the folding paths of the last candidates do not reach the flat state (Step 7, N_path)",
     )
     INITIAL_FAILED = "initial_failed", "no developable polyhedron from the initial shape"
+    INTERRUPTED = "interrupted", "the run was interrupted (Ctrl-C or SIGTERM)"
 
     def reason(self, detail: str = "") -> str:
         """The stop reason's words with the run's ``detail`` (see :data:`STOP_REASONS`)."""
@@ -111,6 +112,7 @@ STOP_REASONS = {
     Stop.NO_CANDIDATE: "no candidate crease succeeds",
     Stop.NO_DEPLOYABLE: "no deployable solution in {} candidates",
     Stop.INITIAL_FAILED: "no developable polyhedron from the initial shape ({})",
+    Stop.INTERRUPTED: "interrupted",
 }
 """The words of each :class:`Stop`, ``{}`` standing for the detail (the target DOF, or the
 outcome of the initial solve). Every rigidfold version has written these texts to

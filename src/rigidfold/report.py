@@ -397,6 +397,16 @@ class RunWriter:
         verdicts = self.checks[-1]["verdicts"] if self.checks else None
         return None if verdicts is None else verdicts["line"]
 
+    def interrupted(self, run: Generation | None) -> None:
+        """Write summary.json of a run stopped by Ctrl-C or SIGTERM: ``run`` (None when it
+        was stopped before its first attempt ended) with the stop INTERRUPTED and no
+        verdict."""
+        if run is None:
+            run = Generation()
+        run.stop, run.stop_detail = Stop.INTERRUPTED, ""
+        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
+        self.write_summary(run)
+
     def release(self) -> None:
         """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""
         self.lock.unlink(missing_ok=True)
