@@ -120,6 +120,7 @@ def make_case(
     else:
         surf = get_surface(surface, seed=seed, expr=expr, box=plan.box, up=up, settings=settings)
     shape = patterns.build(plan, surf, settings=settings)
+    check_sector_angles(shape, settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
         raise ValueError(
@@ -127,6 +128,34 @@ def make_case(
             "(dome or hp)"
         )
     return Case(surf, plan, shape, planes, settings, _input_files(pattern, surface))
+
+
+def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> None:
+    """Refuse an initial shape with more than ``settings.theta_far_share`` of its sector
+    angles far outside [theta_min, theta_max] (below theta_min / 2 or above
+    (theta_max + pi) / 2), before any problem is built: one line saying how many angles lie
+    below and above the bounds, the smallest and the largest, and which options move the
+    bounds. Raises ValueError."""
+    angles = shape.corner_angles
+    lo, hi = settings.theta_min, settings.theta_max
+    far = (angles < lo / 2) | (angles > (hi + math.pi) / 2)
+    if far.sum() <= settings.theta_far_share * angles.size:
+        return
+    deg = np.degrees(angles)
+    below, above = int((angles < lo).sum()), int((angles > hi).sum())
+    parts = []
+    if below:
+        parts.append(f"{below} below {math.degrees(lo):g} degrees (the smallest {deg.min():.2g})")
+    if above:
+        parts.append(f"{above} above {math.degrees(hi):g} degrees (the largest {deg.max():.4g})")
+    raise ValueError(
+        f"the crease pattern's initial shape has {below + above} of {angles.size} sector angles "
+        f"outside the bounds [{math.degrees(lo):g}, {math.degrees(hi):g}] degrees: "
+        f"{' and '.join(parts)}; {int(far.sum())} of them are far outside (more than "
+        f"{settings.theta_far_share:.0%} of the angles, Settings.theta_far_share), which problem "
+        "(6) cannot bring inside: allow them with --theta-min DEG / --theta-max DEG, or choose "
+        "a pattern without such slivers"
+    )
 
 
 def _input_files(pattern: str, surface: str | Surface) -> tuple[Path, ...]:

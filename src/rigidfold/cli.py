@@ -596,6 +596,10 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         f"{out.build_time:.2f} s build, {result.n_variables} variables"
     )
     print(f"wrote {' and '.join(str(p) for p in out.written)}")
+    if not result.converged:
+        from rigidfold.report import SOLVE_HINT
+
+        print(f"not accepted: {SOLVE_HINT}")
     return 0 if result.converged else 1
 
 

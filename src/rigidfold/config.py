@@ -291,6 +291,14 @@ class Settings:
     mesh_angle_cap : float
         A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
         (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    theta_far_share : float
+        A crease pattern whose initial shape (its plan lifted onto the target) has more than
+        this share of its sector angles far outside [theta_min, theta_max] (below
+        theta_min / 2 or above (theta_max + 180 degrees) / 2) is refused before any problem is
+        built: the solver cannot bring that many slivers inside the bounds, and a solve from
+        there ends at collapsed triangles (Origami Simulator's hypar.svg: a third of its
+        angles under 15 degrees). A few are brought inside (huffmanWaterbomb.svg: 8 of 2418
+        under 1 degree, converged); 1 checks nothing.
     min_pattern_size : float
         Smallest larger side (metres) of a crease pattern's plan (1 mm): the solvers'
         tolerances are absolute (``f_tol``, ``dz``), and on a smaller plan (a file read in the
@@ -431,6 +439,7 @@ class Settings:
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
+    theta_far_share: float = 0.05
     min_pattern_size: float = 1e-3
     max_pattern_faces: int = 20000
     max_analysis_bytes: int = 8 * 2**30
@@ -458,6 +467,8 @@ class Settings:
             )
         if not (isinstance(self.target_dof, int) and self.target_dof >= 0):
             raise ValueError(f"target DOF must be an integer >= 0, got {self.target_dof!r}")
+        if not 0 <= self.theta_far_share <= 1:
+            raise ValueError(f"theta_far_share must lie in [0, 1], got {self.theta_far_share!r}")
         if not self.f_tol > 0:
             raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
         nodes = self.surface_grid_nodes

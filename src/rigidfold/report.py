@@ -85,6 +85,14 @@ class RunVerdict:
         }
 
 
+SOLVE_HINT = (
+    "to try: a larger --dz (the distance allowed from the surface), wider --theta-min / "
+    "--theta-max (the sector-angle bounds), or another triangulation (--diagonals parallel or "
+    "alternate for a grid)"
+)
+"""What the command line suggests when problem (6) has no accepted solution from the target
+surface (``generate``'s verdict, ``optimize``'s last line)."""
+
 _CHECKS = {
     "development": "development diagram (Step 8) failed",
     "motion": "folding motion not traced",
@@ -122,7 +130,8 @@ def run_verdict(run: Generation, checks: list[dict], files: list[Path], target: 
     final = run.final
     k = -1 if final is None else final.step
     if final is None:
-        short.append(f"no solution: {run.stop_reason}")
+        hint = f" ({SOLVE_HINT})" if run.stop is Stop.INITIAL_FAILED else ""
+        short.append(f"no solution: {run.stop_reason}{hint}")
     elif not reached:
         short.append(
             f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"

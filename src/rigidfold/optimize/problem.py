@@ -202,6 +202,8 @@ class FormFindingProblem:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
         ``solver`` is one of ``SOLVERS``; the result's ``wall_time`` is that of the solve alone.
+        A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
+        failed: the result is the start, Status.FAILED, its message saying why.
         """
         backend = self.solver(solver)
         mask = self.fixed_mask(fixed)
@@ -213,9 +215,16 @@ class FormFindingProblem:
         wall = time.perf_counter() - t0
         xi = run.xi
         coords = self.map.expand(xi)
+        try:
+            viol = self.violation(coords, mask)
+            status, verdict = None, ""
+        except ValueError as exc:  # the solver's point is no shape: keep the start
+            xi, coords = xi0, self.map.expand(xi0)
+            viol = self.violation(coords, mask)
+            status, verdict = Status.FAILED, f"its point is no shape ({exc}): the start is kept"
         F, F1, F2 = (float(v) for v in self.objective(xi, w))
-        viol = self.violation(coords, mask)
-        status, verdict = classify(run.outcome, F, viol, self.settings)
+        if status is None:
+            status, verdict = classify(run.outcome, F, viol, self.settings)
         return OptimizeResult(
             pattern=CreasePattern(
                 coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings
