@@ -108,3 +108,50 @@ def test_a_solver_point_with_a_collapsed_face_is_a_failed_solve(monkeypatch):
     assert result.status is Status.FAILED
     assert "degenerate" in result.message
     np.testing.assert_array_equal(result.coords, case.pattern.coords)
+
+
+# ---------------------------------------------------- item 24: misspelt options, millimetres
+@pytest.mark.parametrize(
+    ("argv", "suggestion"),
+    [
+        (["generate", "--surface", "dome", "--targetdof", "0"], "did you mean --target-dof?"),
+        (["optimize", "--surface", "dome", "--overwite"], "did you mean --overwrite?"),
+        (["genrate", "--surface", "dome"], "did you mean 'generate'?"),
+        (["generate", "--criterion", "shta"], "did you mean 'shat'?"),
+        (["export", "x.fold", "--convention", "origami-simulater"], "'origami-simulator'?"),
+    ],
+)
+def test_a_misspelt_option_or_choice_gets_did_you_mean(argv, suggestion, tmp_path, capsys):
+    code, _, err = run([*argv, "--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and err.count("\n") == 1, err
+    assert suggestion in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_unknown_option_without_a_near_name_gets_no_guess(tmp_path, capsys):
+    code, _, err = run(["optimize", "--zzzzzz", "--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and "unrecognized arguments: --zzzzzz" in err and "did you mean" not in err
+
+
+@pytest.mark.parametrize(
+    ("options", "warning"),
+    [
+        (["--size", "3000x3000"], "the plan is 3000 m x 3000 m"),
+        (["--dz", "300"], "--dz 300 m is larger than the plan (3 m x 3 m)"),
+    ],
+)
+def test_sizes_that_look_like_millimetres_get_a_warning(options, warning, tmp_path, capsys):
+    """``--size 3000x3000`` (millimetres meant) designs a 3 km shelter: a warning on
+    stderr says the sizes are metres; the run goes on."""
+    argv = ["optimize", "--surface", "dome", "--pattern", "grid:3x3", *options]
+    code, _, err = run([*argv, "--out", str(tmp_path / "o")], capsys)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("rigidfold: warning: "), err
+    assert warning in lines[0] and "metres" in lines[0]
+    assert code in (0, 1) and (tmp_path / "o" / "summary.json").is_file()
+
+
+def test_sizes_in_metres_get_no_warning(tmp_path, capsys):
+    argv = ["optimize", "--surface", "dome", "--pattern", "grid:3x3", "--size", "12x8"]
+    code, _, err = run([*argv, "--dz", "0.5", "--out", str(tmp_path / "o")], capsys)
+    assert code in (0, 1) and err == ""

@@ -39,6 +39,26 @@ class Case:
     settings: Settings
     inputs: tuple[Path, ...] = ()
 
+    @property
+    def warnings(self) -> list[str]:
+        """What looks like a slip, one sentence each (the case is built all the same): a plan
+        with a side of ``settings.unit_warning_size`` metres or more, or a ``dz`` larger than
+        the plan, given in millimetres rather than metres."""
+        width, height = self.plan.box
+        size, dz = f"{width:g} m x {height:g} m", self.settings.dz
+        out = []
+        if max(width, height) >= self.settings.unit_warning_size:
+            out.append(
+                f"the plan is {size}: sizes are in metres; for millimetres divide by 1000 "
+                f"(--size {width / 1000:g}x{height / 1000:g})"
+            )
+        if dz > max(width, height):
+            out.append(
+                f"--dz {dz:g} m is larger than the plan ({size}): it is in metres (the default "
+                f"{DEFAULTS.dz:g} m is {DEFAULTS.dz * 1000:g} mm)"
+            )
+        return out
+
     def problem(self, *, build_ipopt: bool = True) -> FormFindingProblem:
         """Build problem (6) for this case."""
         return FormFindingProblem(

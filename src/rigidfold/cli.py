@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import difflib
 import io
 import json
 import math
 import os
+import re
 import sys
 import unicodedata
 from collections.abc import Sequence
@@ -47,10 +49,47 @@ FOLD_HELP = (
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (no usage dump) and exit code 2."""
+    """argparse with one-line errors (no usage dump) and exit code 2; an invalid choice gets
+    the nearest one ("did you mean 'generate'?")."""
 
     def error(self, message: str):
+        choice = _INVALID_CHOICE.search(message)
+        if choice is not None:
+            near = _nearest(choice[1], re.findall(r"'([^']*)'", choice[2]))
+            message += f" (did you mean '{near}'?)" if near else ""
         self.exit(EXIT_USAGE, f"{self.prog}: error: {one_line(message)}\n")
+
+
+_INVALID_CHOICE = re.compile(r"invalid choice: '(.*)' \(choose from (.*)\)$")
+
+
+def _nearest(word: str, names: Sequence[str]) -> str | None:
+    """The name of ``names`` nearest to a misspelt ``word``; None when none is near."""
+    near = difflib.get_close_matches(word, names, n=1, cutoff=0.6)
+    return near[0] if near else None
+
+
+def _unknown_options(parser: argparse.ArgumentParser, argv: Sequence[str]) -> None:
+    """Refuse, through the command's parser, the first ``--option`` of ``argv`` that the
+    command does not know (nor abbreviates), naming the nearest option it has ("did you mean
+    --target-dof?"); before argparse's own checks, so that a misspelt required option is
+    called misspelt rather than missing."""
+    commands = next(
+        (a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), {}
+    )
+    at = next((k for k, a in enumerate(argv) if not a.startswith("-")), None)
+    sub = commands.get(argv[at]) if at is not None else None
+    if at is None or not isinstance(sub, argparse.ArgumentParser):
+        return
+    known = [o for a in sub._actions for o in a.option_strings if o.startswith("--")]
+    for arg in argv[at + 1 :]:  # those before the command are the program's (--verbose)
+        if arg == "--":
+            return
+        name = arg.partition("=")[0]
+        if not name.startswith("--") or any(o.startswith(name) for o in known):
+            continue
+        near = _nearest(name, known)
+        sub.error(f"unrecognized arguments: {arg}" + (f" (did you mean {near}?)" if near else ""))
 
 
 _ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
@@ -567,7 +606,7 @@ def _case(args: argparse.Namespace):
         ipopt_hessian=args.hessian,
         svg_snap_tol=args.svg_tolerance,
     )
-    return make_case(
+    case = make_case(
         args.surface,
         args.pattern,
         seed=args.seed,
@@ -581,6 +620,9 @@ def _case(args: argparse.Namespace):
         rigid_panels=args.rigid_panels,
         settings=settings,
     )
+    for warning in case.warnings:
+        print(one_line(f"rigidfold: warning: {warning}"), file=sys.stderr)
+    return case
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
@@ -873,7 +915,9 @@ def _names(text: str) -> list[str]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(_attached_values(sys.argv[1:] if argv is None else argv))
+    argv = _attached_values(sys.argv[1:] if argv is None else argv)
+    _unknown_options(parser, argv)
+    args = parser.parse_args(argv)
     if not (args.verbose or native_output_shown()):
         _quiet_exit()
     shown = os.environ.get(VERBOSE_ENV)

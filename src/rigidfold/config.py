@@ -291,6 +291,10 @@ class Settings:
     mesh_angle_cap : float
         A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
         (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    unit_warning_size : float
+        A plan with a side of at least this many metres (1 km), or a ``dz`` larger than the
+        plan's larger side, gets a warning that the sizes look like millimetres
+        (:attr:`rigidfold.case.Case.warnings`: ``--size 3000x3000`` is a 3 km plan).
     theta_far_share : float
         A crease pattern whose initial shape (its plan lifted onto the target) has more than
         this share of its sector angles far outside [theta_min, theta_max] (below
@@ -440,6 +444,7 @@ class Settings:
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
     theta_far_share: float = 0.05
+    unit_warning_size: float = 1000.0
     min_pattern_size: float = 1e-3
     max_pattern_faces: int = 20000
     max_analysis_bytes: int = 8 * 2**30
