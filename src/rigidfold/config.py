@@ -291,6 +291,10 @@ class Settings:
     mesh_angle_cap : float
         A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
         (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    dz_bound_tol : float
+        The report of a run flags a final design whose largest |z - target| is within this
+        fraction of ``dz`` of the bound (the constraint is active: the design is as far from
+        the target as ``dz`` allows).
     unit_warning_size : float
         A plan with a side of at least this many metres (1 km), or a ``dz`` larger than the
         plan's larger side, gets a warning that the sizes look like millimetres
@@ -445,6 +449,7 @@ class Settings:
     mesh_angle_cap: float = math.radians(33.0)
     theta_far_share: float = 0.05
     unit_warning_size: float = 1000.0
+    dz_bound_tol: float = 1e-3
     min_pattern_size: float = 1e-3
     max_pattern_faces: int = 20000
     max_analysis_bytes: int = 8 * 2**30

@@ -39,8 +39,13 @@ from rigidfold.io import (
 )
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
+from rigidfold.surfaces import SplineSurface
 
-RUN_FILES = ("summary.json", "log.json", "report.html")
+TARGET_FILE = "target_surface.json"
+"""The fitted spline of a mesh target (:meth:`rigidfold.surfaces.SplineSurface.grid`), which
+summary.json names under ``target_surface`` so that the report can show the fit."""
+
+RUN_FILES = ("summary.json", "log.json", "report.html", TARGET_FILE)
 """The files a generation run writes at the top of its directory."""
 
 RUN_DIRS = ("solutions", "figures", "final")
@@ -385,6 +390,10 @@ class RunWriter:
         try:
             clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
             self.solutions_dir = prepare_output_dir(self.out / "solutions")
+            self.target_file: str | None = None  # a mesh target's spline, for the report
+            if isinstance(case.surface, SplineSurface):
+                write_json(self.out / TARGET_FILE, case.surface.grid())
+                self.target_file = TARGET_FILE
         except ValueError:
             self.release()
             raise
@@ -545,5 +554,6 @@ class RunWriter:
                 "solutions": [str(p.relative_to(self.out)) for p in self.files],
                 "verdict": None if self.verdict is None else self.verdict.to_dict(),
                 "exports": [str(p.relative_to(self.out)) for p in self.exports],
+                "target_surface": self.target_file,
             },
         )

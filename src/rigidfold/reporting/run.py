@@ -19,9 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.config import DEFAULTS
 from rigidfold.io import parse_json, read_fold
 from rigidfold.protocols import TargetSurface
-from rigidfold.surfaces import Bezier, get_surface
+from rigidfold.surfaces import Bezier, SplineSurface, get_surface
 
 _PERCENT = re.compile(r"([0-9.]+)% folded")
 """The fraction folded in a motion frame's title (:func:`rigidfold.io.motion_frames`)."""
@@ -95,6 +96,7 @@ SUMMARY_SHAPE = Record(
                     "verdicts": Nullable(
                         Record({"agreement": Nullable(str), "reason": Nullable(str)})
                     ),
+                    "fit": Nullable(Record({"max_abs_dz_m": _NUMBERS})),
                 }
             )
         ],
@@ -116,6 +118,7 @@ SUMMARY_SHAPE = Record(
         ),
         "options": Nullable(Record({"target_dof": Nullable(int)})),
         "verdict": Nullable(Record({"outcome": str, "message": str}, ("outcome", "message"))),
+        "target_surface": Nullable(str),
     },
     SUMMARY_KEYS,
 )
@@ -354,16 +357,23 @@ def target_surface(metadata: dict) -> tuple[TargetSurface | None, str]:
 class Check:
     """One verification stage over the run's solutions.
 
-    name : str; passed : True, False, or None when the stage did not run; detail : str.
+    name : str; passed : True, False, or None when the stage did not run; detail : str;
+    failed_steps : the steps of the solutions it failed on; earlier : it failed on earlier
+    solutions only, not on the final design (then ``passed`` is the final design's: True).
     """
 
     name: str
     passed: bool | None
     detail: str
+    failed_steps: tuple = ()
+    earlier: bool = False
 
     @property
     def word(self) -> str:
-        """ "passed", "FAILED" or "not run"."""
+        """ "passed", "passed by the final design" (failed on earlier solutions), "FAILED"
+        or "not run"."""
+        if self.passed and self.earlier:
+            return "passed by the final design"
         return {True: "passed", False: "FAILED", None: "not run"}[self.passed]
 
 
@@ -396,6 +406,19 @@ class RunData:
         return self.designs[-1]
 
     @property
+    def at_dz_bound(self) -> float | None:
+        """The final design's max |z - target| (metres, summary.json's ``fit``) where it is at
+        the dz bound (within ``Settings.dz_bound_tol`` of ``case.dz_m``), else None."""
+        final, dz = self.final, (self.summary.get("case") or {}).get("dz_m")
+        rows = self.summary["per_solution"]
+        if final is None or dz is None or not 0 <= final.step < len(rows):
+            return None
+        reached = (rows[final.step].get("fit") or {}).get("max_abs_dz_m")
+        if reached is None or reached < dz * (1 - DEFAULTS.dz_bound_tol):
+            return None
+        return float(reached)
+
+    @property
     def target_dof(self) -> int | None:
         return (self.summary.get("options") or {}).get("target_dof")
 
@@ -411,7 +434,19 @@ class RunData:
 
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
-        solution, from ``summary.json``'s ``per_solution``."""
+        solution, from ``summary.json``'s ``per_solution``. A stage that failed on earlier
+        solutions only, not on the final design, passed (as generate's verdict judges), and
+        says at which steps it failed."""
+        final = None if self.final is None else self.final.step
+        return [
+            Check(c.name, True, f"{c.detail} (not the final design)", c.failed_steps, True)
+            if c.passed is False and final is not None and final not in c.failed_steps
+            else c
+            for c in self._stages()
+        ]
+
+    def _stages(self) -> list[Check]:
+        """:meth:`checks` as every solution counts."""
         rows = self.summary["per_solution"]
         n = len(rows)
         dev = [r.get("development") or {} for r in rows]
@@ -427,6 +462,7 @@ class RunData:
                 f"{sum(max(d.get('flipped') or 0, 0) for d in dev)} flipped, "
                 f"{sum(max(d.get('overlaps') or 0, 0) for d in dev)} overlapping, "
                 f"max D = {max_d:.2g}" + _steps(bad),
+                tuple(bad),
             )
         ]
         motions = [(r.get("step"), r["motion"]) for r in rows if r.get("motion") is not None]
@@ -440,6 +476,7 @@ class RunData:
                 f"max |dl|/l = {err:.2g}" + _steps(bad)
                 if motions
                 else "no motion was traced",
+                tuple(bad),
             )
         )
         deformed = [(r.get("step"), r["deformation"]) for r in rows if r.get("deformation")]
@@ -455,6 +492,7 @@ class RunData:
                 + _steps(bad)
                 if deformed
                 else "Step 9 did not run (--no-deform)",
+                tuple(bad),
             )
         )
         return checks
@@ -470,7 +508,7 @@ def _checked(checked: int, solutions: int) -> str:
 
 
 def _steps(bad: list) -> str:
-    return f" (failed at step {', '.join(map(str, bad))})" if bad else ""
+    return f"; failed at step {', '.join(map(str, bad))}" if bad else ""
 
 
 def load_run(directory: str | os.PathLike) -> RunData:
@@ -518,7 +556,27 @@ def load_run(directory: str | os.PathLike) -> RunData:
             raise ValueError(f"solution file {str(path)!r} listed in summary.json is missing")
         designs.append(read_design(path, name))
     surface, note = target_surface((summary.get("case") or {}).get("surface") or {})
+    if surface is None and summary.get("target_surface") is not None:
+        surface, note = _stored_surface(root, summary["target_surface"])
     return RunData(root, summary, attempts, tuple(designs), surface, note)
+
+
+def _stored_surface(root: Path, name: str) -> tuple[TargetSurface | None, str]:
+    """(surface, "") of the fitted spline of a mesh target that the run stored in the file
+    ``name`` of its directory (summary.json's ``target_surface``), or (None, why not)."""
+    parts = Path(name).parts
+    if len(parts) != 1 or parts[0] in (".", ".."):
+        return None, f"the target surface could not be rebuilt: {name!r} is not a file name"
+    if not (root / name).is_file():
+        return None, f"the target surface could not be rebuilt: its file {name} is missing"
+    try:
+        grid = _json_object(root, name)
+        x, y, z = grid.get("x"), grid.get("y"), grid.get("z")
+        return SplineSurface(x, y, z, source=str(grid.get("source", "mesh"))), ""
+    except ValueError as exc:
+        return None, (
+            f"the target surface could not be rebuilt from {name} ({' '.join(str(exc).split())})"
+        )
 
 
 def _json_object(root: Path, name: str) -> dict:

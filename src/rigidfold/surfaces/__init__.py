@@ -16,6 +16,7 @@ from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
 from rigidfold.surfaces.mesh import (
     MESH_FORMATS,
     MeshSurface,
+    SplineSurface,
     mesh_surface,
     read_mesh,
     sample_mesh,
@@ -83,6 +84,7 @@ __all__ = [
     "HyperbolicParaboloid",
     "MeshSurface",
     "MirrorPlane",
+    "SplineSurface",
     "Surface",
     "get_surface",
     "mesh_surface",
