@@ -340,3 +340,14 @@ def test_a_failed_check_of_an_earlier_solution_is_not_drawn_failed(copy):
     (copy / "summary.json").write_text(json.dumps(summary))
     answer = html.unescape(report_run(copy).html.read_text())
     assert "<b>development</b>: FAILED" in answer and "failed at step 1, 3" in answer
+
+
+def test_an_interrupted_run_says_so(copy):
+    """Issue 30, item 21: summary.json of a run stopped by Ctrl-C says "interrupted"; the
+    report says the run was interrupted, not that the target was not reached."""
+    summary = json.loads((copy / "summary.json").read_text())
+    interrupted = {**summary, "stop": "interrupted", "stop_reason": "interrupted", "verdict": None}
+    (copy / "summary.json").write_text(json.dumps(interrupted))
+    text = html.unescape(report_run(copy).html.read_text())
+    assert "the run was interrupted (Ctrl-C or SIGTERM): this is its state then" in text
+    assert "not reached" not in text[: text.index('id="view"')]
