@@ -13,6 +13,7 @@ import numpy as np
 
 from rigidfold import patterns
 from rigidfold.config import DEFAULTS, Settings, check_seed
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.fold import read_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
@@ -143,7 +144,7 @@ def make_case(
     check_sector_angles(shape, settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
-        raise ValueError(
+        raise RigidfoldError(
             f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
             "(dome or hp)"
         )
@@ -168,7 +169,7 @@ def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> 
         parts.append(f"{below} below {math.degrees(lo):g} degrees (the smallest {deg.min():.2g})")
     if above:
         parts.append(f"{above} above {math.degrees(hi):g} degrees (the largest {deg.max():.4g})")
-    raise ValueError(
+    raise RigidfoldError(
         f"the crease pattern's initial shape has {below + above} of {angles.size} sector angles "
         f"outside the bounds [{math.degrees(lo):g}, {math.degrees(hi):g}] degrees: "
         f"{' and '.join(parts)}; {int(far.sum())} of them are far outside (more than "
@@ -206,13 +207,13 @@ def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:
         try:
             e = int(token)
         except ValueError:
-            raise ValueError(
+            raise RigidfoldError(
                 f"--fixed expects comma-separated edge indices, got {token!r}"
             ) from None
         if not 0 <= e < pattern.n_edges:
-            raise ValueError(f"--fixed edge {e} out of range 0..{pattern.n_edges - 1}")
+            raise RigidfoldError(f"--fixed edge {e} out of range 0..{pattern.n_edges - 1}")
         if pattern.is_boundary_edge[e]:
-            raise ValueError(f"--fixed edge {e} is a boundary edge, not a crease line")
+            raise RigidfoldError(f"--fixed edge {e} is a boundary edge, not a crease line")
         mask[e] = True
     return mask
 

@@ -1,7 +1,8 @@
 """Command-line interface: parses arguments and calls library functions.
 
 Every user error (bad option value, refused expression, unwritable directory, malformed
-file) is reported as one line on stderr with exit code 2, never a traceback.
+file: a :class:`rigidfold.RigidfoldError`, or another ``ValueError``) is reported as one line
+on stderr with exit code 2, never a traceback.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from collections.abc import Sequence
 
 from rigidfold import __version__
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
 from rigidfold.io import UP_AXES, jsonable
@@ -594,9 +596,9 @@ def _case(args: argparse.Namespace):
     from rigidfold.config import Settings
 
     if args.surface == "expr" and not args.expr:
-        raise ValueError("--surface expr needs --expr TEXT, e.g. --expr '0.3*sin(x)*cos(y)'")
+        raise RigidfoldError("--surface expr needs --expr TEXT, e.g. --expr '0.3*sin(x)*cos(y)'")
     if args.expr and args.surface != "expr":
-        raise ValueError(f"--expr is only used with --surface expr, not {args.surface}")
+        raise RigidfoldError(f"--expr is only used with --surface expr, not {args.surface}")
     settings = Settings.from_degrees(
         dz=args.dz,
         theta_min_deg=args.theta_min,
@@ -651,7 +653,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.workflows import generate_case
 
     if args.target_dof < 0:
-        raise ValueError(f"--target-dof must be >= 0, got {args.target_dof}")
+        raise RigidfoldError(f"--target-dof must be >= 0, got {args.target_dof}")
     options = {
         "criterion": args.criterion,
         "target_dof": args.target_dof,
@@ -931,7 +933,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits
         return code
-    except ValueError as exc:
+    except ValueError as exc:  # rigidfold.RigidfoldError, and those of the libraries below
         _error(str(exc))
         return EXIT_USAGE
     except KeyboardInterrupt:

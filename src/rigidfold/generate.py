@@ -42,6 +42,7 @@ import numpy as np
 
 from rigidfold.case import Case
 from rigidfold.config import DEFAULT_SEED, Settings, check_seed, one_blas_thread
+from rigidfold.errors import RigidfoldError
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.stiffness import hinge_stiffness
@@ -102,7 +103,7 @@ class Stop(Outcome):
             fits = text.startswith(head) and text.endswith(tail)
             if fits and (len(text) >= len(head) + len(tail) if slot else text == template):
                 return stop, text[len(head) : len(text) - len(tail)]
-        raise ValueError(f"{text!r} is not the stop reason of a generation run")
+        raise RigidfoldError(f"{text!r} is not the stop reason of a generation run")
 
 
 STOP_REASONS = {
@@ -316,11 +317,11 @@ def generate(
     A KeyboardInterrupt propagates after the callbacks of everything finished so far.
     """
     if criterion not in CRITERIA:
-        raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
+        raise RigidfoldError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
     if target_dof is None:
         target_dof = case.settings.target_dof
     if target_dof < 0:
-        raise ValueError(f"target DOF must be >= 0, got {target_dof}")
+        raise RigidfoldError(f"target DOF must be >= 0, got {target_dof}")
     rng = np.random.default_rng(check_seed(seed))
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
     settings = case.settings

@@ -23,6 +23,7 @@ from rigidfold.case import Case
 from rigidfold.config import CHECKS
 from rigidfold.deform import DeformStatus, MotionStatus, Verification, verify
 from rigidfold.develop import DevelopStatus
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports import export_design
 from rigidfold.generate import Attempt, Generation, Solution, Stop
 from rigidfold.io import (
@@ -197,11 +198,11 @@ def lock_run_dir(out: Path) -> Path:
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
         except OSError as exc:
             if path.is_symlink():
-                raise ValueError(
+                raise RigidfoldError(
                     f"cannot lock output directory '{out}': its {LOCK_NAME} is a symbolic "
                     "link, not a rigidfold lock; remove it"
                 ) from None
-            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+            raise RigidfoldError(f"cannot lock output directory '{out}': {exc.strerror}") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX)  # held only while deciding; closing drops it
             try:
@@ -212,7 +213,7 @@ def lock_run_dir(out: Path) -> Path:
                 continue
             pid = _lock_owner(fd)
             if pid is not None and _alive(pid):
-                raise ValueError(
+                raise RigidfoldError(
                     f"output directory '{out}' is in use by another rigidfold run (pid {pid}); "
                     "wait for it to end, or use another --out"
                 )
@@ -220,10 +221,10 @@ def lock_run_dir(out: Path) -> Path:
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
             return path
         except OSError as exc:
-            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+            raise RigidfoldError(f"cannot lock output directory '{out}': {exc.strerror}") from None
         finally:
             os.close(fd)
-    raise ValueError(f"cannot lock output directory '{out}': its lock keeps coming back")
+    raise RigidfoldError(f"cannot lock output directory '{out}': its lock keeps coming back")
 
 
 def _lock_owner(fd: int) -> int | None:
@@ -269,7 +270,7 @@ def clear_earlier_run(
     out = Path(out)
     found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
     if found and not overwrite:
-        raise ValueError(
+        raise RigidfoldError(
             f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
             "give --overwrite to replace it, or another --out"
         )
@@ -287,7 +288,7 @@ def clear_earlier_run(
                 )
             )
             if doomed:
-                raise ValueError(
+                raise RigidfoldError(
                     f"--overwrite would remove the input file '{given}' with the earlier run's "
                     f"{path.name}: copy it out of '{out}' first, or use another --out"
                 )
@@ -298,7 +299,7 @@ def clear_earlier_run(
             else:
                 path.unlink(missing_ok=True)
     except OSError as exc:
-        raise ValueError(
+        raise RigidfoldError(
             f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"
         ) from None
     return out
@@ -383,7 +384,7 @@ class RunWriter:
         check: str = CHECKS[0],
     ) -> None:
         if check not in CHECKS:
-            raise ValueError(f"unknown check {check!r} (choose from {', '.join(CHECKS)})")
+            raise RigidfoldError(f"unknown check {check!r} (choose from {', '.join(CHECKS)})")
         refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
         self.out = prepare_output_dir(out)
         self.lock = lock_run_dir(self.out)

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS
+from rigidfold.errors import RigidfoldError
 from rigidfold.io import parse_json, read_fold
 from rigidfold.protocols import TargetSurface
 from rigidfold.surfaces import Bezier, SplineSurface, get_surface
@@ -168,12 +169,14 @@ def check_shape(value, shape, file: str | os.PathLike, where: str = "") -> None:
             continue
         if not _has_shape(value, shape):
             key = f"{where!r}" if where else "the document"
-            raise ValueError(f"'{file}': {key} is {_received(value)}, expected {_expected(given)}")
+            raise RigidfoldError(
+                f"'{file}': {key} is {_received(value)}, expected {_expected(given)}"
+            )
         if isinstance(shape, Record):
             missing = [k for k in shape.required if k not in value]
             if missing:
                 key = f"{where!r}" if where else "the document"
-                raise ValueError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
+                raise RigidfoldError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
             stack += [
                 (value[k], s, f"{where}.{k}" if where else k)
                 for k, s in reversed(shape.keys.items())
@@ -320,13 +323,13 @@ def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndar
     try:
         xy = np.asarray(frame["vertices_coords"], dtype=float)
     except (KeyError, TypeError, ValueError):
-        raise ValueError(f"{where} has no numeric vertices_coords") from None
+        raise RigidfoldError(f"{where} has no numeric vertices_coords") from None
     if xy.ndim != 2 or xy.shape[0] != n_vertices or xy.shape[1] not in (2, 3):
-        raise ValueError(
+        raise RigidfoldError(
             f"{where}: vertices_coords of shape {xy.shape}, expected ({n_vertices}, 2|3)"
         )
     if not np.isfinite(xy).all():
-        raise ValueError(f"{where}: non-finite vertices_coords")
+        raise RigidfoldError(f"{where}: non-finite vertices_coords")
     if dim == 3 and xy.shape[1] == 2:
         xy = np.column_stack([xy, np.zeros(n_vertices)])
     return xy[:, :dim]
@@ -522,23 +525,25 @@ def load_run(directory: str | os.PathLike) -> RunData:
     """
     root = Path(directory)
     if not root.is_dir():
-        raise ValueError(f"{str(root)!r} is not a directory (give the --out of rigidfold generate)")
+        raise RigidfoldError(
+            f"{str(root)!r} is not a directory (give the --out of rigidfold generate)"
+        )
     summary = _json_object(root, "summary.json")
     missing = [k for k in SUMMARY_KEYS if k not in summary]
     if missing:
-        raise ValueError(
+        raise RigidfoldError(
             f"{str(root / 'summary.json')!r} is not the summary of rigidfold generate "
             f"(no {', '.join(missing)})"
         )
     check_shape(summary, SUMMARY_SHAPE, root / "summary.json")
     log = _json_object(root, "log.json")
     if not isinstance(log.get("attempts"), list):
-        raise ValueError(f"{str(root / 'log.json')!r} has no list of attempts")
+        raise RigidfoldError(f"{str(root / 'log.json')!r} has no list of attempts")
     check_shape(log, LOG_SHAPE, root / "log.json")
     attempts = log["attempts"]
     for k, attempt in enumerate(attempts):
         if attempt["outcome"] == "accepted" and attempt["dof"] is None:
-            raise ValueError(
+            raise RigidfoldError(
                 f"'{root / 'log.json'}': 'attempts[{k}].dof' is null, expected a whole number "
                 "(an accepted shape has a DOF)"
             )
@@ -547,13 +552,13 @@ def load_run(directory: str | os.PathLike) -> RunData:
     for k, name in enumerate(names):
         parts = Path(name).parts
         if not parts or Path(name).is_absolute() or ".." in parts:
-            raise ValueError(
+            raise RigidfoldError(
                 f"'{root / 'summary.json'}': 'solutions[{k}]' is {_received(name)}, expected "
                 "a file in the run's directory"
             )
         path = root / name
         if not path.is_file():
-            raise ValueError(f"solution file {str(path)!r} listed in summary.json is missing")
+            raise RigidfoldError(f"solution file {str(path)!r} listed in summary.json is missing")
         designs.append(read_design(path, name))
     surface, note = target_surface((summary.get("case") or {}).get("surface") or {})
     if surface is None and summary.get("target_surface") is not None:
@@ -584,11 +589,11 @@ def _json_object(root: Path, name: str) -> dict:
     try:
         data = parse_json(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise ValueError(
+        raise RigidfoldError(
             f"{str(root)!r} is not a rigidfold generate run: it has no {name}"
         ) from None
     except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise ValueError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
+        raise RigidfoldError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
     if not isinstance(data, dict):
-        raise ValueError(f"{str(path)!r} is not a JSON object")
+        raise RigidfoldError(f"{str(path)!r} is not a JSON object")
     return data

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.surfaces.builtin import Bezier, Dome, HyperbolicParaboloid, MirrorPlane, Surface
 from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
 from rigidfold.surfaces.mesh import (
@@ -51,13 +52,13 @@ def get_surface(
         return HyperbolicParaboloid(box=box)
     if name == "expr":
         if expr is None:
-            raise ValueError("surface 'expr' needs an expression z = f(x, y)")
+            raise RigidfoldError("surface 'expr' needs an expression z = f(x, y)")
         return ExpressionSurface(expr)
     kind, colon, path = str(name).partition(":")
     if colon and kind.strip().lower() == "mesh" and path.strip():
         vertices, triangles = read_mesh(path.strip(), up=up, settings=settings)
         return placed_mesh(vertices, triangles, source=Path(path.strip()).name, settings=settings)
-    raise ValueError(f"unknown surface {name!r} (choose from {SURFACE_FORMS})")
+    raise RigidfoldError(f"unknown surface {name!r} (choose from {SURFACE_FORMS})")
 
 
 def placed_mesh(

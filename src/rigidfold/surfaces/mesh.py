@@ -37,6 +37,7 @@ import casadi as ca
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.surfaces.builtin import Surface
 
 MESH_FORMATS = ("obj", "stl", "ply", "off")
@@ -113,17 +114,17 @@ def _grid_problem(gx: Any, gy: Any, z: Any) -> tuple[np.ndarray, np.ndarray, np.
     try:
         gx, gy, z = (np.asarray(a, dtype=float) for a in (gx, gy, z))
     except (TypeError, ValueError):
-        raise ValueError("the grid of a mesh fit must hold numbers only") from None
+        raise RigidfoldError("the grid of a mesh fit must hold numbers only") from None
     for axis, g in (("x", gx), ("y", gy)):
         if g.ndim != 1 or not 4 <= len(g) <= MAX_GRID_NODES:
-            raise ValueError(
+            raise RigidfoldError(
                 f"the grid's {axis} must be a list of 4 to {MAX_GRID_NODES} nodes, got shape "
                 f"{g.shape}"
             )
         if not (np.isfinite(g).all() and (np.diff(g) > 0).all()):
-            raise ValueError(f"the grid's {axis} nodes must be finite and increasing")
+            raise RigidfoldError(f"the grid's {axis} nodes must be finite and increasing")
     if z.shape != (len(gx), len(gy)) or not np.isfinite(z).all():
-        raise ValueError(
+        raise RigidfoldError(
             f"the grid's heights must be finite numbers of shape ({len(gx)}, {len(gy)}), got "
             f"shape {z.shape}"
         )
@@ -154,7 +155,7 @@ class MeshSurface(SplineSurface):
     ) -> None:
         problem = _mesh_problem(vertices, triangles, settings)
         if problem:
-            raise ValueError(f"mesh {source}: {problem}")
+            raise RigidfoldError(f"mesh {source}: {problem}")
         self.vertices = np.asarray(vertices, dtype=float)
         self.triangles = np.asarray(triangles, dtype=np.int64)
         self.source = source
@@ -179,7 +180,7 @@ class MeshSurface(SplineSurface):
         nodes = np.stack(np.meshgrid(gx, gy, indexing="ij"), axis=-1).reshape(-1, 2)
         z = self._top(nodes).reshape(self.grid_shape)
         if np.isnan(z).all():
-            raise ValueError(
+            raise RigidfoldError(
                 f"mesh {source}: its footprint covers no node of the {len(gx)} x {len(gy)} grid "
                 "over its plan box; raise surface_grid_nodes"
             )
@@ -203,7 +204,7 @@ class MeshSurface(SplineSurface):
         if not inside.all():
             i = int(np.flatnonzero(~inside)[0])
             (x0, y0), (x1, y1) = self.bounds
-            raise ValueError(
+            raise RigidfoldError(
                 f"plan point {i} at (x, y) = ({points[i, 0]:g}, {points[i, 1]:g}) lies outside "
                 f"the footprint of mesh {self.source} (plan box x {x0:g}..{x1:g}, "
                 f"y {y0:g}..{y1:g} m)"
@@ -302,29 +303,29 @@ def read_mesh(
     ValueError naming the file when it cannot be read or is no mesh surface.
     """
     if up not in ("z", "y"):
-        raise ValueError(f"up must be z or y, got {up!r}")
+        raise RigidfoldError(f"up must be z or y, got {up!r}")
     path = Path(path)
     kind = path.suffix.lower().lstrip(".")
     if kind not in MESH_FORMATS:
-        raise ValueError(
+        raise RigidfoldError(
             f"mesh {path}: unknown extension {path.suffix!r} (read: "
             f"{', '.join('.' + k for k in MESH_FORMATS)})"
         )
     if not path.is_file():
-        raise ValueError(f"cannot read mesh {path}: no such file")
+        raise RigidfoldError(f"cannot read mesh {path}: no such file")
     if kind == "stl":
         count = _check_stl(path)
         if count is not None and count > settings.max_mesh_triangles:
-            raise ValueError(f"mesh {path}: {_too_many(count, settings)}")
+            raise RigidfoldError(f"mesh {path}: {_too_many(count, settings)}")
     import trimesh
 
     try:
         mesh = trimesh.load(str(path), file_type=kind, force="mesh", process=False)
     except Exception as exc:  # the parsers raise anything from KeyError to struct.error
         reason = " ".join(f"{type(exc).__name__}: {exc}".split())
-        raise ValueError(f"cannot read mesh {path} as {kind.upper()} ({reason})") from None
+        raise RigidfoldError(f"cannot read mesh {path} as {kind.upper()} ({reason})") from None
     if not isinstance(mesh, trimesh.Trimesh):  # force="mesh" makes one of any scene
-        raise ValueError(f"mesh {path}: holds a {type(mesh).__name__}, not a triangle mesh")
+        raise RigidfoldError(f"mesh {path}: holds a {type(mesh).__name__}, not a triangle mesh")
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     triangles = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     if up == "y":
@@ -332,7 +333,7 @@ def read_mesh(
     hint = "; is the file y-up? (--up y)" if up == "z" else "; is the file z-up? (--up z)"
     problem = _mesh_problem(vertices, triangles, settings, hint)
     if problem:
-        raise ValueError(f"mesh {path}: {problem}")
+        raise RigidfoldError(f"mesh {path}: {problem}")
     return vertices, triangles
 
 
@@ -353,7 +354,7 @@ def _check_stl(path: Path) -> int | None:
                 file.read().decode("utf-8")
                 return None
     except OSError as exc:
-        raise ValueError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
+        raise RigidfoldError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
         pass
     if len(head) < 84:
@@ -361,7 +362,7 @@ def _check_stl(path: Path) -> int | None:
     else:
         count = int.from_bytes(head[80:], "little")
         found = f"its header counts {count} triangles, {84 + 50 * count} bytes, but it has {size}"
-    raise ValueError(
+    raise RigidfoldError(
         f"mesh {path}: a damaged binary STL ({found}) and no ASCII STL (UTF-8 text starting "
         "with 'solid')"
     )
