@@ -7,6 +7,7 @@ import os
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -197,6 +198,8 @@ def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     assert "interrupted" in capsys.readouterr().err
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["n_solutions"] == 2
+    assert summary["stop"] == "interrupted" and summary["verdict"] is None  # never "running"
+    assert len(json.loads((tmp_path / "log.json").read_text())["attempts"]) == 2
     for path in (tmp_path / "solutions").glob("*.fold"):
         read_fold(path)
     assert not list(tmp_path.rglob("*.tmp"))
@@ -368,3 +371,143 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     final = json.loads((tmp_path / "b" / "summary.json").read_text())["per_solution"][-1]
     assert final["verdicts"]["agreement"] == "differ"
     assert final["verdicts"]["line"] == lines[-2].removeprefix("final design: ")
+
+
+# ------------------------------------------------- issue 30, item 20: --target-dof 0 and 50
+def test_target_dof_0_saves_and_names_the_dof_0_shape(tmp_path, capsys):
+    """``--target-dof 0``: the DOF-0 shape the run ends at is a solution, written and named
+    as the final design (was: "passed" naming the DOF-1 file, the DOF-0 shape never saved).
+    A DOF-0 design has no mechanism: no folding motion or Step 9 is asked of it, a note says
+    so."""
+    argv = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "grid:4x4"]
+    code = main([*argv, "--target-dof", "0", "--no-deform", "--quiet", "--out", str(tmp_path)])
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert (
+        code == 0
+        and summary["final_dof"] == 0
+        and summary["stop_reason"] == ("target DOF 0 reached")
+    )
+    final = summary["verdict"]["final_design"]
+    assert final == summary["solutions"][-1] and final.endswith("_dof_00.fold")
+    assert last.startswith("passed: ") and last.endswith(f"final design: {tmp_path / final}")
+    assert "a DOF-0 design has no mechanism: it does not fold" in last
+    assert read_fold(tmp_path / final).pattern.n_vertices == 16
+    proc = run_cli("analyze", str(tmp_path / final))
+    assert proc.returncode == 0 and "DOF: 0" in proc.stdout
+    assert (tmp_path / "final" / Path(final).with_suffix(".obj").name).is_file()
+
+
+def test_target_dof_at_or_above_the_initial_dof_says_so(tmp_path, capsys):
+    """``--target-dof 50`` on a 9-DOF shape: the run says the initial DOF is already at or
+    below the target (no crease was fixed), not only "the target DOF was reached"."""
+    code = main(["generate", *SHORT_RUN, "--target-dof", "50", "--out", str(tmp_path)])
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert code == 0
+    assert "the initial DOF 5 is already at or below the target DOF 50" in last
+    verdict = json.loads((tmp_path / "summary.json").read_text())["verdict"]
+    assert any("already at or below the target DOF 50" in w for w in verdict["warnings"])
+
+
+# ----------------------------------------- issue 30, item 21: Ctrl-C and SIGTERM in a solve
+SIGNAL_IN_SOLVE = """
+import os, signal, sys
+from rigidfold.optimize import hessian
+real = hessian.ClosedFormHessian.values
+calls = []
+def values(self, *args):  # IPOPT is running: its Hessian callback is being evaluated
+    calls.append(1)
+    if len(calls) == 3:
+        os.kill(os.getpid(), getattr(signal, sys.argv[1]))
+    return real(self, *args)
+hessian.ClosedFormHessian.values = values
+from rigidfold.launch import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
+def test_a_signal_during_an_ipopt_solve_is_an_interrupt(tmp_path, name):
+    """Ctrl-C (SIGINT) or SIGTERM while IPOPT runs: CasADi catches the KeyboardInterrupt
+    its callback raised and IPOPT ends as a failed solve ("NonIpopt_Exception_Thrown"), which
+    was reported as "no developable polyhedron from the initial shape", exit 1. It is an
+    interrupt: exit 130, one line, summary.json's stop "interrupted" (never "running")."""
+    out = tmp_path / "run"
+    argv = ["generate", "--surface", "dome", "--pattern", "grid:6x6", "--quiet", "--out", str(out)]
+    proc = subprocess.run(
+        [sys.executable, "-c", SIGNAL_IN_SOLVE, name, *argv],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr.strip().splitlines() == [
+        f"rigidfold: interrupted; 0 solutions, log.json and summary.json are in {out}"
+    ]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stop"] == "interrupted" and summary["stop_reason"] == "interrupted"
+    assert summary["n_solutions"] == 0 and summary["verdict"] is None
+    assert not (out / ".rigidfold-run.lock").exists()
+
+
+def test_an_ipopt_solve_raises_keyboard_interrupt(monkeypatch):
+    """In Python too: a SIGINT while IPOPT runs raises KeyboardInterrupt from ``solve``
+    instead of returning a failed solve."""
+    import signal
+
+    from rigidfold.case import make_case
+    from rigidfold.optimize import hessian
+
+    real, calls = hessian.ClosedFormHessian.values, []
+
+    def values(self, *args):
+        calls.append(1)
+        if len(calls) == 3:
+            os.kill(os.getpid(), signal.SIGINT)
+        return real(self, *args)
+
+    monkeypatch.setattr(hessian.ClosedFormHessian, "values", values)
+    problem = make_case("dome", "grid:5x5").problem()
+    with pytest.raises(KeyboardInterrupt):
+        problem.solve()
+    assert len(calls) == 3  # stopped at once
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_sigterm_to_a_running_generate_exits_130(tmp_path):
+    """A real SIGTERM to ``rigidfold generate`` on a large grid once its run has started
+    (whatever it is doing then: building, solving, analysing): exit 130, one line, and any
+    summary.json written says "interrupted"."""
+    import signal
+    import time
+
+    out = tmp_path / "run"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "rigidfold",
+            "generate",
+            "--surface",
+            "dome",
+            "--pattern",
+            "grid:30x30",
+            "--quiet",
+            "--no-report",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 60
+    while not (out / ".rigidfold-run.lock").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert len(err.strip().splitlines()) == 1 and "interrupted" in err
+    summary = out / "summary.json"
+    assert json.loads(summary.read_text())["stop"] == "interrupted"

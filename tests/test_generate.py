@@ -160,12 +160,16 @@ def test_generate_uses_the_requested_support():
 
 
 def test_zero_dof_solution_ends_generation_as_in_step5():
-    """Paper, Step 5: a 0-DOF solution goes to Step 8; it is not a lock (Section 6.3)."""
+    """Paper, Step 5: a 0-DOF solution goes to Step 8; it is not a lock (Section 6.3). With
+    a target of 0 it is the target: the last solution and the final design (issue 30, item
+    20: it was dropped, and the DOF-1 shape named instead)."""
     case = make_case("bezier", "1", seed=1)
     run = generate(case, criterion="shat", target_dof=0, seed=1)
-    assert run.stop_reason == "DOF 0 reached"
+    assert run.stop_reason == "target DOF 0 reached"
     assert run.attempts[-1].outcome == "zero_dof" and run.attempts[-1].dof == 0
-    assert run.final_dof == 1 and run.n_reduce == 20
+    assert run.final_dof == 0 and run.n_reduce == 21
+    assert run.final is run.solutions[-1] and run.final.mechanism.dof == 0
+    assert run.solutions[-2].mechanism.dof == 1
     assert all(a.outcome != "lock" or a.dof >= 1 for a in run.attempts)
 
 

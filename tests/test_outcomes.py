@@ -35,6 +35,7 @@ VALUES = {
         "no_candidate",
         "no_deployable",
         "initial_failed",
+        "interrupted",
     ],
     DevelopStatus: ["converged", "flipped", "overlap", "failed"],
     DeformStatus: ["reached_plane", "failed"],
@@ -61,6 +62,7 @@ def test_stop_reasons_are_the_texts_of_every_version():
         (Stop.NO_DEPLOYABLE, "30"): "no deployable solution in 30 candidates",
         (Stop.INITIAL_FAILED, "lock"): "no developable polyhedron from the initial shape (lock)",
         (Stop.RUNNING, ""): "running",
+        (Stop.INTERRUPTED, ""): "interrupted",
     }
     assert set(STOP_REASONS) == set(Stop)
     for (stop, detail), text in texts.items():

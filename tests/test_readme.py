@@ -70,6 +70,9 @@ def test_readme_python_example_runs(capsys):
     status, F, n_variables = capsys.readouterr().out.split()
     assert status == "converged" and float(F) < 1e-7 and int(n_variables) == 83
     assert namespace["check"].motion.frames.shape[1:] == (namespace["shape"].n_vertices, 3)
+    # the generation function itself (issue 30, item 26)
+    assert namespace["run"].stop_reason == "target DOF 1 reached"
+    assert namespace["design"].n_vertices == 49
 
 
 def test_readme_parser_reads_commands_and_outputs():

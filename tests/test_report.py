@@ -7,6 +7,7 @@ import json
 import re
 import shutil
 from html.parser import HTMLParser
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -276,3 +277,78 @@ def test_the_solutions_table_says_whether_deformation_and_motion_agree(reported)
     text = reported.html.read_text()
     assert "<th>deformation vs motion</th>" in text
     assert text.count("<td>agree</td>") == 4  # every solution of the run
+
+
+# ----------------------------------------------------------------- issue 30, item 25
+MESH = Path(__file__).parent / "data" / "dome_yup.obj"
+
+
+def test_a_mesh_target_is_shown_with_its_fit(tmp_path):
+    """A ``mesh:`` target is stored in the run (target_surface.json, the fitted spline's
+    grid, named in summary.json), so the report draws the overlay, the deviation colours
+    and surface_fit.png: the same heights as the run's surface."""
+    out = tmp_path / "run"
+    argv = ["generate", "--surface", f"mesh:{MESH}", "--up", "y", "--pattern", "grid:4x4"]
+    assert main([*argv, "--target-dof", "8", "--no-deform", "--quiet", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["target_surface"] == "target_surface.json"
+    report = report_run(out)
+    assert "surface_fit.png" in [p.name for p in report.figures]
+    text = html.unescape(report.html.read_text())
+    assert "cannot be rebuilt" not in text and "the target surface is the grey overlay" in text
+    run = load_run(out)
+    case = make_case(f"mesh:{MESH}", "grid:4x4", up="y")
+    x, y = np.meshgrid(np.linspace(0, 3, 7), np.linspace(0, 3, 5))
+    assert run.surface is not None
+    assert np.allclose(run.surface.height(x, y), case.surface.height(x, y), rtol=0, atol=1e-12)
+    assert view_figure(run.final, run.surface)["data"][-1]["name"] == "target surface"
+    # a damaged or missing fit file: the report is written without the fit, saying why
+    (out / "target_surface.json").write_text('{"x": [0, 1], "y": [0, 1], "z": [[0, "a"]]}')
+    text = html.unescape(report_run(out).html.read_text())
+    assert "the target surface could not be rebuilt" in text and "target_surface.json" in text
+    (out / "target_surface.json").unlink()
+    assert "surface_fit.png" not in [p.name for p in report_run(out).figures]
+
+
+def test_a_fit_at_the_dz_bound_is_flagged(copy):
+    """The final design touches the dz bound: the report says so (a larger --dz, or
+    another pattern, may fit the target better)."""
+    summary = json.loads((copy / "summary.json").read_text())
+    text = html.unescape(report_run(copy).html.read_text())
+    assert "dz bound" not in text
+    reached = summary["per_solution"][-1]["fit"]["max_abs_dz_m"]
+    summary["case"]["dz_m"] = reached
+    (copy / "summary.json").write_text(json.dumps(summary))
+    text = html.unescape(report_run(copy).html.read_text())
+    assert f"at the dz bound: max |z - target| = {reached * 1e3:.1f} mm = dz" in text
+
+
+def test_a_failed_check_of_an_earlier_solution_is_not_drawn_failed(copy):
+    """The development diagram of step 1 failed, the final design's passed: under the green
+    "Passed" the check says which step failed instead of "FAILED"."""
+    summary = json.loads((copy / "summary.json").read_text())
+    summary["per_solution"][1]["development"]["status"] = "failed"
+    (copy / "summary.json").write_text(json.dumps(summary))
+    report = report_run(copy)
+    text = html.unescape(report.html.read_text())
+    answer = text[: text.index('id="view"')]
+    assert '"verdict ok">Passed' in answer
+    assert "<b>development</b>: FAILED" not in answer
+    assert "<b>development</b>: passed by the final design" in answer
+    assert "failed at step 1 (not the final design)" in answer
+    assert report.to_dict()["checks"]["development"] == "passed by the final design"
+    summary["per_solution"][-1]["development"]["status"] = "failed"  # the final's: FAILED
+    (copy / "summary.json").write_text(json.dumps(summary))
+    answer = html.unescape(report_run(copy).html.read_text())
+    assert "<b>development</b>: FAILED" in answer and "failed at step 1, 3" in answer
+
+
+def test_an_interrupted_run_says_so(copy):
+    """Issue 30, item 21: summary.json of a run stopped by Ctrl-C says "interrupted"; the
+    report says the run was interrupted, not that the target was not reached."""
+    summary = json.loads((copy / "summary.json").read_text())
+    interrupted = {**summary, "stop": "interrupted", "stop_reason": "interrupted", "verdict": None}
+    (copy / "summary.json").write_text(json.dumps(interrupted))
+    text = html.unescape(report_run(copy).html.read_text())
+    assert "the run was interrupted (Ctrl-C or SIGTERM): this is its state then" in text
+    assert "not reached" not in text[: text.index('id="view"')]

@@ -13,6 +13,7 @@ import numpy as np
 
 from rigidfold import patterns
 from rigidfold.config import DEFAULTS, Settings, check_seed
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.fold import read_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
@@ -38,6 +39,26 @@ class Case:
     planes: tuple[SymmetryPlane, ...]
     settings: Settings
     inputs: tuple[Path, ...] = ()
+
+    @property
+    def warnings(self) -> list[str]:
+        """What looks like a slip, one sentence each (the case is built all the same): a plan
+        with a side of ``settings.unit_warning_size`` metres or more, or a ``dz`` larger than
+        the plan, given in millimetres rather than metres."""
+        width, height = self.plan.box
+        size, dz = f"{width:g} m x {height:g} m", self.settings.dz
+        out = []
+        if max(width, height) >= self.settings.unit_warning_size:
+            out.append(
+                f"the plan is {size}: sizes are in metres; for millimetres divide by 1000 "
+                f"(--size {width / 1000:g}x{height / 1000:g})"
+            )
+        if dz > max(width, height):
+            out.append(
+                f"--dz {dz:g} m is larger than the plan ({size}): it is in metres (the default "
+                f"{DEFAULTS.dz:g} m is {DEFAULTS.dz * 1000:g} mm)"
+            )
+        return out
 
     def problem(self, *, build_ipopt: bool = True) -> FormFindingProblem:
         """Build problem (6) for this case."""
@@ -120,13 +141,42 @@ def make_case(
     else:
         surf = get_surface(surface, seed=seed, expr=expr, box=plan.box, up=up, settings=settings)
     shape = patterns.build(plan, surf, settings=settings)
+    check_sector_angles(shape, settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
-        raise ValueError(
+        raise RigidfoldError(
             f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
             "(dome or hp)"
         )
     return Case(surf, plan, shape, planes, settings, _input_files(pattern, surface))
+
+
+def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> None:
+    """Refuse an initial shape with more than ``settings.theta_far_share`` of its sector
+    angles far outside [theta_min, theta_max] (below theta_min / 2 or above
+    (theta_max + pi) / 2), before any problem is built: one line saying how many angles lie
+    below and above the bounds, the smallest and the largest, and which options move the
+    bounds. Raises ValueError."""
+    angles = shape.corner_angles
+    lo, hi = settings.theta_min, settings.theta_max
+    far = (angles < lo / 2) | (angles > (hi + math.pi) / 2)
+    if far.sum() <= settings.theta_far_share * angles.size:
+        return
+    deg = np.degrees(angles)
+    below, above = int((angles < lo).sum()), int((angles > hi).sum())
+    parts = []
+    if below:
+        parts.append(f"{below} below {math.degrees(lo):g} degrees (the smallest {deg.min():.2g})")
+    if above:
+        parts.append(f"{above} above {math.degrees(hi):g} degrees (the largest {deg.max():.4g})")
+    raise RigidfoldError(
+        f"the crease pattern's initial shape has {below + above} of {angles.size} sector angles "
+        f"outside the bounds [{math.degrees(lo):g}, {math.degrees(hi):g}] degrees: "
+        f"{' and '.join(parts)}; {int(far.sum())} of them are far outside (more than "
+        f"{settings.theta_far_share:.0%} of the angles, Settings.theta_far_share), which problem "
+        "(6) cannot bring inside: allow them with --theta-min DEG / --theta-max DEG, or choose "
+        "a pattern without such slivers"
+    )
 
 
 def _input_files(pattern: str, surface: str | Surface) -> tuple[Path, ...]:
@@ -157,13 +207,13 @@ def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:
         try:
             e = int(token)
         except ValueError:
-            raise ValueError(
+            raise RigidfoldError(
                 f"--fixed expects comma-separated edge indices, got {token!r}"
             ) from None
         if not 0 <= e < pattern.n_edges:
-            raise ValueError(f"--fixed edge {e} out of range 0..{pattern.n_edges - 1}")
+            raise RigidfoldError(f"--fixed edge {e} out of range 0..{pattern.n_edges - 1}")
         if pattern.is_boundary_edge[e]:
-            raise ValueError(f"--fixed edge {e} is a boundary edge, not a crease line")
+            raise RigidfoldError(f"--fixed edge {e} is a boundary edge, not a crease line")
         mask[e] = True
     return mask
 

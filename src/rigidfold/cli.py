@@ -1,25 +1,30 @@
 """Command-line interface: parses arguments and calls library functions.
 
 Every user error (bad option value, refused expression, unwritable directory, malformed
-file) is reported as one line on stderr with exit code 2, never a traceback.
+file: a :class:`rigidfold.RigidfoldError`, or another ``ValueError``) is reported as one line
+on stderr with exit code 2, never a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
 import atexit
+import difflib
 import io
 import json
 import math
 import os
+import re
 import sys
 import unicodedata
 from collections.abc import Sequence
 
 from rigidfold import __version__
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.generate import GenerateOptions
+from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
 from rigidfold.io import UP_AXES, jsonable
 from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
@@ -38,7 +43,6 @@ LOOKAHEAD_HELP = (
     "together with the nearly flat creases they would lock)"
 )
 EXIT_FAILED = 1  # generate fell short; runs of a study failed
-EXIT_INTERRUPTED = 130
 EXIT_PIPE = 141  # as a shell reports a process ended by SIGPIPE
 OUT_HELP = "output directory (created if absent)"
 WORKERS_HELP = "local worker processes, each running one generate at a time (default: %(default)s)"
@@ -51,10 +55,47 @@ FOLD_HELP = (
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (no usage dump) and exit code 2."""
+    """argparse with one-line errors (no usage dump) and exit code 2; an invalid choice gets
+    the nearest one ("did you mean 'generate'?")."""
 
     def error(self, message: str):
+        choice = _INVALID_CHOICE.search(message)
+        if choice is not None:
+            near = _nearest(choice[1], re.findall(r"'([^']*)'", choice[2]))
+            message += f" (did you mean '{near}'?)" if near else ""
         self.exit(EXIT_USAGE, f"{self.prog}: error: {one_line(message)}\n")
+
+
+_INVALID_CHOICE = re.compile(r"invalid choice: '(.*)' \(choose from (.*)\)$")
+
+
+def _nearest(word: str, names: Sequence[str]) -> str | None:
+    """The name of ``names`` nearest to a misspelt ``word``; None when none is near."""
+    near = difflib.get_close_matches(word, names, n=1, cutoff=0.6)
+    return near[0] if near else None
+
+
+def _unknown_options(parser: argparse.ArgumentParser, argv: Sequence[str]) -> None:
+    """Refuse, through the command's parser, the first ``--option`` of ``argv`` that the
+    command does not know (nor abbreviates), naming the nearest option it has ("did you mean
+    --target-dof?"); before argparse's own checks, so that a misspelt required option is
+    called misspelt rather than missing."""
+    commands = next(
+        (a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), {}
+    )
+    at = next((k for k, a in enumerate(argv) if not a.startswith("-")), None)
+    sub = commands.get(argv[at]) if at is not None else None
+    if at is None or not isinstance(sub, argparse.ArgumentParser):
+        return
+    known = [o for a in sub._actions for o in a.option_strings if o.startswith("--")]
+    for arg in argv[at + 1 :]:  # those before the command are the program's (--verbose)
+        if arg == "--":
+            return
+        name = arg.partition("=")[0]
+        if not name.startswith("--") or any(o.startswith(name) for o in known):
+            continue
+        near = _nearest(name, known)
+        sub.error(f"unrecognized arguments: {arg}" + (f" (did you mean {near}?)" if near else ""))
 
 
 _ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
@@ -561,9 +602,9 @@ def _case(args: argparse.Namespace):
     from rigidfold.config import Settings
 
     if args.surface == "expr" and not args.expr:
-        raise ValueError("--surface expr needs --expr TEXT, e.g. --expr '0.3*sin(x)*cos(y)'")
+        raise RigidfoldError("--surface expr needs --expr TEXT, e.g. --expr '0.3*sin(x)*cos(y)'")
     if args.expr and args.surface != "expr":
-        raise ValueError(f"--expr is only used with --surface expr, not {args.surface}")
+        raise RigidfoldError(f"--expr is only used with --surface expr, not {args.surface}")
     settings = Settings.from_degrees(
         dz=args.dz,
         theta_min_deg=args.theta_min,
@@ -573,7 +614,7 @@ def _case(args: argparse.Namespace):
         ipopt_hessian=args.hessian,
         svg_snap_tol=args.svg_tolerance,
     )
-    return make_case(
+    case = make_case(
         args.surface,
         args.pattern,
         seed=args.seed,
@@ -587,6 +628,9 @@ def _case(args: argparse.Namespace):
         rigid_panels=args.rigid_panels,
         settings=settings,
     )
+    for warning in case.warnings:
+        print(one_line(f"rigidfold: warning: {warning}"), file=sys.stderr)
+    return case
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
@@ -602,6 +646,10 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         f"{out.build_time:.2f} s build, {result.n_variables} variables"
     )
     print(f"wrote {' and '.join(str(p) for p in out.written)}")
+    if not result.converged:
+        from rigidfold.run.verdict import SOLVE_HINT
+
+        print(f"not accepted: {SOLVE_HINT}")
     return 0 if result.converged else 1
 
 
@@ -611,7 +659,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.workflows import generate_case
 
     if args.target_dof < 0:
-        raise ValueError(f"--target-dof must be >= 0, got {args.target_dof}")
+        raise RigidfoldError(f"--target-dof must be >= 0, got {args.target_dof}")
     options = GenerateOptions(
         criterion=args.criterion,
         target_dof=args.target_dof,
@@ -858,7 +906,9 @@ def _names(text: str) -> list[str]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(_attached_values(sys.argv[1:] if argv is None else argv))
+    argv = _attached_values(sys.argv[1:] if argv is None else argv)
+    _unknown_options(parser, argv)
+    args = parser.parse_args(argv)
     if not (args.verbose or native_output_shown()):
         _quiet_exit()
     shown = os.environ.get(VERBOSE_ENV)
@@ -872,7 +922,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, not while Python exits
         return code
-    except ValueError as exc:
+    except ValueError as exc:  # rigidfold.RigidfoldError, and those of the libraries below
         _error(str(exc))
         return EXIT_USAGE
     except KeyboardInterrupt:
@@ -945,4 +995,5 @@ def _quiet_exit() -> None:
 
 
 if __name__ == "__main__":
+    terminate_interrupts()
     sys.exit(main())

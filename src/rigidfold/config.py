@@ -14,6 +14,8 @@ import numbers
 import threading
 from dataclasses import dataclass, replace
 
+from rigidfold.errors import RigidfoldError
+
 HESSIANS = ("closed-form", "casadi")
 """The Hessians of the Lagrangian IPOPT can use (``Settings.ipopt_hessian``)."""
 
@@ -34,10 +36,10 @@ def check_seed(seed, what: str = "seed") -> int:
     """``seed`` as an int. Raises ValueError ``"<what> must be a non-negative integer below
     2**63, got <seed>"`` for anything else (a bool, a float, a negative or too large number)."""
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
-        raise ValueError(f"{what} must be a non-negative integer below 2**63, got {seed!r}")
+        raise RigidfoldError(f"{what} must be a non-negative integer below 2**63, got {seed!r}")
     value = int(seed)
     if not 0 <= value < SEED_LIMIT:
-        raise ValueError(f"{what} must be a non-negative integer below 2**63, got {value}")
+        raise RigidfoldError(f"{what} must be a non-negative integer below 2**63, got {value}")
     return value
 
 
@@ -285,6 +287,22 @@ class Settings:
     mesh_angle_cap : float
         A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
         (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    dz_bound_tol : float
+        The report of a run flags a final design whose largest |z - target| is within this
+        fraction of ``dz`` of the bound (the constraint is active: the design is as far from
+        the target as ``dz`` allows).
+    unit_warning_size : float
+        A plan with a side of at least this many metres (1 km), or a ``dz`` larger than the
+        plan's larger side, gets a warning that the sizes look like millimetres
+        (:attr:`rigidfold.case.Case.warnings`: ``--size 3000x3000`` is a 3 km plan).
+    theta_far_share : float
+        A crease pattern whose initial shape (its plan lifted onto the target) has more than
+        this share of its sector angles far outside [theta_min, theta_max] (below
+        theta_min / 2 or above (theta_max + 180 degrees) / 2) is refused before any problem is
+        built: the solver cannot bring that many slivers inside the bounds, and a solve from
+        there ends at collapsed triangles (Origami Simulator's hypar.svg: a third of its
+        angles under 15 degrees). A few are brought inside (huffmanWaterbomb.svg: 8 of 2418
+        under 1 degree, converged); 1 checks nothing.
     min_pattern_size : float
         Smallest larger side (metres) of a crease pattern's plan (1 mm): the solvers'
         tolerances are absolute (``f_tol``, ``dz``), and on a smaller plan (a file read in the
@@ -423,6 +441,9 @@ class Settings:
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
+    theta_far_share: float = 0.05
+    unit_warning_size: float = 1000.0
+    dz_bound_tol: float = 1e-3
     min_pattern_size: float = 1e-3
     max_pattern_faces: int = 20000
     max_analysis_bytes: int = 8 * 2**30
@@ -437,35 +458,41 @@ class Settings:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):
-            raise ValueError(f"dz must be a positive number of metres, got {self.dz!r}")
+            raise RigidfoldError(f"dz must be a positive number of metres, got {self.dz!r}")
         if not (0 < self.theta_min < self.theta_max < math.pi):
-            raise ValueError(
+            raise RigidfoldError(
                 "sector-angle bounds must satisfy 0 < theta_min < theta_max < 180 degrees, got "
                 f"theta_min={math.degrees(self.theta_min):g}, "
                 f"theta_max={math.degrees(self.theta_max):g} degrees"
             )
         if self.rho_bar is not None and not (0 < self.rho_bar < math.pi):
-            raise ValueError(
+            raise RigidfoldError(
                 f"rho_bar must lie in (0, 180) degrees, got {math.degrees(self.rho_bar):g}"
             )
+        if not 0 <= self.theta_far_share <= 1:
+            raise RigidfoldError(
+                f"theta_far_share must lie in [0, 1], got {self.theta_far_share!r}"
+            )
         if not self.f_tol > 0:
-            raise ValueError(f"f_tol must be positive, got {self.f_tol!r}")
+            raise RigidfoldError(f"f_tol must be positive, got {self.f_tol!r}")
         nodes = self.surface_grid_nodes
         if isinstance(nodes, bool) or not isinstance(nodes, int) or not 4 <= nodes <= 513:
-            raise ValueError(f"surface_grid_nodes must be an integer from 4 to 513, got {nodes!r}")
+            raise RigidfoldError(
+                f"surface_grid_nodes must be an integer from 4 to 513, got {nodes!r}"
+            )
         tol = self.surface_footprint_tol
         if not (math.isfinite(tol) and tol >= 0):
-            raise ValueError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
+            raise RigidfoldError(f"surface_footprint_tol must be a finite number >= 0, got {tol!r}")
         for name in ("projection_tol", "projection_damping", "projection_margin", "ipopt_stop_f"):
             value = getattr(self, name)
             if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number, got {value!r}")
+                raise RigidfoldError(f"{name} must be a positive number, got {value!r}")
         for name in ("svg_merge_tol", "svg_snap_tol"):
             value = getattr(self, name)
             if not (isinstance(value, float | int) and 0 <= value < 1):
-                raise ValueError(f"{name} must be a fraction from 0 to below 1, got {value!r}")
+                raise RigidfoldError(f"{name} must be a fraction from 0 to below 1, got {value!r}")
         if not 0 < self.sparse_shift < 1:
-            raise ValueError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
+            raise RigidfoldError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
         least = {
             "sparse_analysis_vertices": 3,
             "sparse_oversampling": 2,
@@ -479,9 +506,9 @@ class Settings:
         for name, low in least.items():
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+                raise RigidfoldError(f"{name} must be an integer >= {low}, got {value!r}")
         if self.ipopt_hessian not in HESSIANS:
-            raise ValueError(
+            raise RigidfoldError(
                 f"ipopt_hessian must be one of {', '.join(HESSIANS)}, got {self.ipopt_hessian!r}"
             )
 

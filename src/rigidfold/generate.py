@@ -42,6 +42,7 @@ import numpy as np
 
 from rigidfold.case import Case
 from rigidfold.config import CHECKS, DEFAULT_SEED, Settings, check_seed, one_blas_thread
+from rigidfold.errors import RigidfoldError
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.stiffness import hinge_stiffness
@@ -85,6 +86,7 @@ class Stop(Outcome):
         "the folding paths of the last candidates do not reach the flat state (Step 7, N_path)",
     )
     INITIAL_FAILED = "initial_failed", "no developable polyhedron from the initial shape"
+    INTERRUPTED = "interrupted", "the run was interrupted (Ctrl-C or SIGTERM)"
 
     def reason(self, detail: str = "") -> str:
         """The stop reason's words with the run's ``detail`` (see :data:`STOP_REASONS`)."""
@@ -101,7 +103,7 @@ class Stop(Outcome):
             fits = text.startswith(head) and text.endswith(tail)
             if fits and (len(text) >= len(head) + len(tail) if slot else text == template):
                 return stop, text[len(head) : len(text) - len(tail)]
-        raise ValueError(f"{text!r} is not the stop reason of a generation run")
+        raise RigidfoldError(f"{text!r} is not the stop reason of a generation run")
 
 
 STOP_REASONS = {
@@ -111,6 +113,7 @@ STOP_REASONS = {
     Stop.NO_CANDIDATE: "no candidate crease succeeds",
     Stop.NO_DEPLOYABLE: "no deployable solution in {} candidates",
     Stop.INITIAL_FAILED: "no developable polyhedron from the initial shape ({})",
+    Stop.INTERRUPTED: "interrupted",
 }
 """The words of each :class:`Stop`, ``{}`` standing for the detail (the target DOF, or the
 outcome of the initial solve). Every rigidfold version has written these texts to
@@ -183,8 +186,9 @@ class Attempt:
 
 @dataclass
 class Solution:
-    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease; with the deployability
-    check, also its folding path to the flat state (``path``, None where it did not run)."""
+    """An accepted shape: DOF >= 1, F <= F_tol, no locked crease (or, for a target DOF of 0,
+    the DOF-0 shape that ends the run); with the deployability check, also its folding path
+    to the flat state (``path``, None where it did not run)."""
 
     step: int
     result: OptimizeResult
@@ -318,19 +322,21 @@ class GenerateOptions:
 
     def __post_init__(self) -> None:
         if self.criterion not in CRITERIA:
-            raise ValueError(
+            raise RigidfoldError(
                 f"unknown criterion {self.criterion!r} (choose from {', '.join(CRITERIA)})"
             )
         if self.solver not in SOLVERS:
-            raise ValueError(f"unknown solver {self.solver!r} (choose from {', '.join(SOLVERS)})")
+            raise RigidfoldError(
+                f"unknown solver {self.solver!r} (choose from {', '.join(SOLVERS)})"
+            )
         if self.check not in CHECKS:
-            raise ValueError(f"unknown check {self.check!r} (choose from {', '.join(CHECKS)})")
+            raise RigidfoldError(f"unknown check {self.check!r} (choose from {', '.join(CHECKS)})")
         target = self.target_dof
         if isinstance(target, bool) or not isinstance(target, int | np.integer) or target < 0:
-            raise ValueError(f"target DOF must be an integer >= 0, got {target!r}")
+            raise RigidfoldError(f"target DOF must be an integer >= 0, got {target!r}")
         face = self.support_face
         if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
-            raise ValueError(f"support face must be a face index, got {face!r}")
+            raise RigidfoldError(f"support face must be a face index, got {face!r}")
         check_seed(self.seed)
 
     def replace(self, **changes) -> GenerateOptions:
@@ -338,7 +344,7 @@ class GenerateOptions:
         ValueError naming them."""
         unknown = sorted(set(changes) - {f.name for f in fields(self)})
         if unknown:
-            raise ValueError(f"unknown generate option {', '.join(map(repr, unknown))}")
+            raise RigidfoldError(f"unknown generate option {', '.join(map(repr, unknown))}")
         return replace(self, **changes) if changes else self
 
     def to_dict(self) -> dict:
@@ -442,16 +448,22 @@ class _Steps:
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
 
+    def is_solution(self, rec: Attempt) -> bool:
+        """Whether an attempt gives a solution: accepted, or the DOF-0 shape of a target 0."""
+        return rec.outcome is AttemptOutcome.ACCEPTED or (
+            rec.outcome is AttemptOutcome.ZERO_DOF and self.options.target_dof == 0
+        )
+
     def record(self, rec: Attempt, trial: _Trial) -> None:
-        """Count an attempt, tell the callbacks, and keep an accepted one as a solution."""
+        """Count an attempt, tell the callbacks, and keep a solution (:meth:`is_solution`)."""
         run = self.run
         run.n_exceed += rec.outcome is AttemptOutcome.EXCEED
         run.n_lock += rec.outcome is AttemptOutcome.LOCK
         run.n_path += rec.outcome is AttemptOutcome.PATH
         if self.on_attempt:
             self.on_attempt(run, rec)
-        if rec.outcome is AttemptOutcome.ACCEPTED:
-            assert trial.mechanism is not None  # an accepted attempt was analysed
+        if self.is_solution(rec):
+            assert trial.mechanism is not None  # a solution was analysed
             sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
             run.solutions.append(sol)
             if self.on_solution:
@@ -522,7 +534,7 @@ class _Steps:
             rec.selection_time, t_sel = t_sel, 0.0
             self.annotate(rec, choice, ranked, current)
             self.record(rec, trial)
-            if rec.outcome is AttemptOutcome.ACCEPTED:
+            if self.is_solution(rec):
                 return None
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
@@ -545,8 +557,10 @@ def generate(
 
     ``options`` (default :class:`GenerateOptions`'s defaults) with ``changes`` to its fields
     given as keywords, e.g. ``generate(case, criterion="s", target_dof=2)``. With mirror
-    planes in the case, creases are fixed in mirror groups (2 or 4 at once). A
-    KeyboardInterrupt propagates after the callbacks of everything finished so far.
+    planes in the case, creases are fixed in mirror groups (2 or 4 at once). With
+    ``target_dof=0`` the DOF-0 shape that ends the run is its last solution (its attempt's
+    outcome stays ZERO_DOF) and the stop is TARGET_REACHED. A KeyboardInterrupt propagates
+    after the callbacks of everything finished so far.
     """
     opts = (options or GenerateOptions()).replace(**changes)
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
@@ -554,12 +568,12 @@ def generate(
     run = steps.run
     # Steps 2-5 for the triangulated target surface
     rec, trial = steps.solve(case.pattern.fixed.copy(), None, (), None)
-    if rec.outcome is not AttemptOutcome.ACCEPTED:
+    if not steps.is_solution(rec):
         run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
         rec.outcome = AttemptOutcome.INITIAL_FAILED
         steps.record(rec, trial)
         return run
-    assert trial.mechanism is not None  # an accepted attempt was analysed
+    assert trial.mechanism is not None  # a solution was analysed
     run.initial_dof = trial.mechanism.dof
     steps.record(rec, trial)
     while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again

@@ -9,12 +9,13 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
-EXIT_INTERRUPTED = 130  # as rigidfold.cli, which is not imported yet
+from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; Ctrl-C at any time, while the libraries load too, exits 130
-    with one line ``rigidfold: interrupted``, not a traceback."""
+    with one line ``rigidfold: interrupted``, not a traceback; SIGTERM too."""
+    terminate_interrupts()
     try:
         from rigidfold.numerics import restart_pinned
 

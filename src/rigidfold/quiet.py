@@ -4,7 +4,8 @@ OpenSeesPy writes its messages (``opserr``: warnings, ``printModel``) and CasADi
 IPOPT's output and its own warnings through Python's ``sys.stdout`` and ``sys.stderr``.
 :func:`native_quiet` drops what the thread that runs a solver writes to them while the
 solver runs; what other threads write (a progress bar's refresh, Dask's logs) passes. It is
-a context manager and a decorator, used around every OpenSees analysis and IPOPT solve.
+a context manager and a decorator, used around every OpenSees analysis and IPOPT solve;
+it also keeps the interrupts that native code would swallow (:mod:`rigidfold.interrupts`).
 
 The output is shown instead when the environment variable :data:`VERBOSE_ENV` is set to
 anything but ``""`` or ``"0"`` (``rigidfold --verbose`` sets it for its own run, so the local
@@ -22,6 +23,8 @@ import sys
 import threading
 from collections.abc import Iterator
 from typing import TextIO
+
+from rigidfold.interrupts import kept_interrupts
 
 VERBOSE_ENV = "RIGIDFOLD_VERBOSE"
 """Environment variable that shows what OpenSees, CasADi and IPOPT print."""
@@ -82,12 +85,14 @@ def native_quiet() -> Iterator[None]:
     """Drop what this thread prints through ``sys.stdout`` and ``sys.stderr`` while the block
     runs (OpenSees's and CasADi's messages), unless :func:`native_output_shown`. Nested and
     concurrent uses (threads of a Dask worker) are safe: the streams are replaced once, while
-    any thread is quiet."""
-    if native_output_shown():
-        yield
-        return
-    _enter()
-    try:
-        yield
-    finally:
-        _leave()
+    any thread is quiet. A Ctrl-C or SIGTERM that the native code swallows is raised when the
+    block ends (:func:`rigidfold.interrupts.kept_interrupts`)."""
+    with kept_interrupts():
+        if native_output_shown():
+            yield
+            return
+        _enter()
+        try:
+            yield
+        finally:
+            _leave()

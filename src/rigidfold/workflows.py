@@ -275,9 +275,13 @@ def generate_case(
     attempt)`` after each of them. ``summary.json`` is written once more at the end, with
     the run's verdict (``writer.verdict``, :func:`rigidfold.run.run_verdict`); then, with
     ``report``, ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is
-    released at the end, however the run ends."""
+    released at the end, however the run ends. A KeyboardInterrupt (Ctrl-C, SIGTERM from the
+    command line) propagates once summary.json says the run was interrupted
+    (:meth:`rigidfold.run.RunWriter.interrupted`)."""
+    seen: list[Generation] = []  # the run, once an attempt has been written
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
+        seen[:] = [run]
         writer.on_attempt(run, attempt)
         if progress:
             progress(run, attempt)
@@ -292,6 +296,10 @@ def generate_case(
         writer.finish(run)
         if report:
             report_run(writer.out)
+    except KeyboardInterrupt:
+        if writer.verdict is None:  # the run had not ended
+            writer.interrupted(seen[0] if seen else None)
+        raise
     finally:
         writer.release()
     return run

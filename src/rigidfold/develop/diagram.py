@@ -34,6 +34,7 @@ import numpy as np
 import shapely
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.ipopt import ipopt_options
 from rigidfold.quiet import native_quiet
@@ -125,11 +126,11 @@ class Development:
             needs counter-clockwise, non-degenerate faces), or the vertex counts differ.
         """
         if len(self.coords2d) != pattern.n_vertices:
-            raise ValueError(
+            raise RigidfoldError(
                 f"the diagram has {len(self.coords2d)} vertices, the pattern {pattern.n_vertices}"
             )
         if self.flipped != 0:
-            raise ValueError(
+            raise RigidfoldError(
                 f"the development diagram is invalid ({self.flipped} flipped facets, or "
                 "non-finite coordinates); it is not a crease pattern"
             )

@@ -39,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import Sheet
 from rigidfold.io.files import atomic_write
 from rigidfold.io.svg_read import OS_STROKES
@@ -153,7 +154,9 @@ def write_dxf(path: str | os.PathLike, sheet: Sheet) -> Path:
 def check_convention(convention: str) -> None:
     """ValueError naming ``convention`` unless it is one of :data:`CONVENTIONS`."""
     if convention not in CONVENTIONS:
-        raise ValueError(f"convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")
+        raise RigidfoldError(
+            f"convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}"
+        )
 
 
 def sheet_svg_text(sheet: Sheet, *, title: str = "", convention: str = "rigidfold") -> str:

@@ -31,6 +31,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.develop import Development, develop
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports.cutsheet import CONVENTIONS, check_convention, write_dxf, write_sheet_svg
 from rigidfold.exports.fold_os import write_origami_simulator_fold
 from rigidfold.exports.mesh3d import MESH_FORMATS, write_mesh
@@ -60,11 +61,11 @@ def parse_formats(formats: str | Sequence[str]) -> tuple[str, ...]:
     wanted = {str(name).strip().lower() for name in names} - {""}
     unknown = sorted(wanted - set(EXPORT_FORMATS))
     if unknown:
-        raise ValueError(
+        raise RigidfoldError(
             f"unknown export format {unknown[0]!r}; choose from {', '.join(EXPORT_FORMATS)}"
         )
     if not wanted:
-        raise ValueError(f"no export format given; choose from {', '.join(EXPORT_FORMATS)}")
+        raise RigidfoldError(f"no export format given; choose from {', '.join(EXPORT_FORMATS)}")
     return tuple(f for f in EXPORT_FORMATS if f in wanted)
 
 
@@ -130,7 +131,7 @@ def export_design(
     chosen = parse_formats(formats)
     check_convention(convention)
     if not name or Path(name).name != name or name in (".", ".."):
-        raise ValueError(f"name must be a plain file name, got {name!r}")
+        raise RigidfoldError(f"name must be a plain file name, got {name!r}")
     sheet = layout_sheet(pattern, coords2d, margin_mm=margin_mm)
     out = prepare_output_dir(out_dir)
     written: list[Path] = []
@@ -194,7 +195,7 @@ def read_design(path: str | os.PathLike, *, up: str = "z", settings: Settings = 
             return Design(data, flat.coords[:, :2].copy(), f"frame {k}", None)
     development = develop(data.pattern, settings=settings)
     if not np.isfinite(development.coords2d).all():
-        raise ValueError(
+        raise RigidfoldError(
             f"{path}: the development diagram could not be computed ({development.message})"
         )
     return Design(data, development.coords2d, "computed", development)

@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.io import write_document
 from rigidfold.io.fold import FOLD_SPEC, PREFIX
 from rigidfold.mesh import CreasePattern
@@ -55,7 +56,7 @@ def origami_simulator_fold(pattern: CreasePattern, *, title: str = "") -> dict:
     from +z. Raises ValueError for more than :data:`MAX_VERTICES` vertices.
     """
     if pattern.n_vertices > MAX_VERTICES:
-        raise ValueError(
+        raise RigidfoldError(
             f"Origami Simulator reads at most {MAX_VERTICES} vertices (16-bit indices), the "
             f"design has {pattern.n_vertices}"
         )

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.files import atomic_write
 from rigidfold.mesh import CreasePattern
 
@@ -126,7 +127,7 @@ def mesh_bytes(pattern: CreasePattern, fmt: str, *, title: str = "") -> bytes:
         return obj_text(pattern, title=title).encode("utf-8")
     writers = {"stl": stl_bytes, "ply": ply_bytes, "glb": glb_bytes}
     if fmt not in writers:
-        raise ValueError(f"3D format must be one of {', '.join(MESH_FORMATS)}, got {fmt!r}")
+        raise RigidfoldError(f"3D format must be one of {', '.join(MESH_FORMATS)}, got {fmt!r}")
     return writers[fmt](pattern)
 
 
@@ -139,7 +140,7 @@ def write_mesh(path: str | os.PathLike, pattern: CreasePattern, *, title: str = 
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in MESH_FORMATS:
-        raise ValueError(
+        raise RigidfoldError(
             f"cannot tell the 3D format of '{path}': its suffix must be one of "
             f"{', '.join('.' + f for f in MESH_FORMATS)}"
         )

@@ -19,6 +19,7 @@ from functools import cached_property
 import numpy as np
 import shapely
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.fold import edge_assignments
 from rigidfold.mesh import CreasePattern
 
@@ -112,14 +113,14 @@ def layout_sheet(
     """
     xy = np.asarray(coords2d, dtype=np.float64)
     if xy.shape != (pattern.n_vertices, 2):
-        raise ValueError(
+        raise RigidfoldError(
             f"coords2d must be a ({pattern.n_vertices}, 2) array (the development diagram of "
             f"the pattern), got shape {xy.shape}"
         )
     if not np.isfinite(xy).all():
-        raise ValueError("the development diagram has non-finite coordinates")
+        raise RigidfoldError("the development diagram has non-finite coordinates")
     if not (np.isfinite(margin_mm) and margin_mm >= 0):
-        raise ValueError(f"margin_mm must be a finite number >= 0, got {margin_mm!r}")
+        raise RigidfoldError(f"margin_mm must be a finite number >= 0, got {margin_mm!r}")
     xy = xy * MM_PER_M
     angle = min_area_angle(xy)
     turned = _rotate(xy, angle)

@@ -32,6 +32,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import skew
 
@@ -54,7 +55,9 @@ class FrameModel:
         if support_face is None:
             support_face = default_support_face(pattern)
         if not 0 <= support_face < pattern.n_faces:
-            raise ValueError(f"support face {support_face} out of range 0..{pattern.n_faces - 1}")
+            raise RigidfoldError(
+                f"support face {support_face} out of range 0..{pattern.n_faces - 1}"
+            )
         return cls(pattern, int(support_face))
 
     # ------------------------------------------------------------------ sizes

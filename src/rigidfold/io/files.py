@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS
+from rigidfold.errors import RigidfoldError
 
 _TEMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
 
@@ -38,7 +39,7 @@ def prepare_output_dir(path: str | os.PathLike) -> Path:
         os.close(fd)
         probe.unlink()
     except OSError as exc:
-        raise ValueError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
+        raise RigidfoldError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
     return out
 
 
@@ -58,7 +59,7 @@ def refuse_replacing_inputs(
     for output in outputs:
         for path in given:
             if _same_file(Path(output), path):
-                raise ValueError(
+                raise RigidfoldError(
                     f"the output '{output}' would replace the input file '{path}'; choose "
                     "another output directory"
                 )
@@ -90,7 +91,7 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
     if isinstance(data, str):
         data = data.encode("utf-8")
     elif not isinstance(data, bytes):
-        raise ValueError(
+        raise RigidfoldError(
             f"cannot write '{path}': data must be str or bytes, got {type(data).__name__}"
         )
     tmp = None
@@ -106,7 +107,7 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
             with contextlib.suppress(OSError):
                 tmp.unlink(missing_ok=True)
         if isinstance(exc, OSError):
-            raise ValueError(f"cannot write '{path}': {_reason(exc)}") from None
+            raise RigidfoldError(f"cannot write '{path}': {_reason(exc)}") from None
         raise
     return path
 
@@ -130,7 +131,7 @@ def parse_json(text: str | bytes, *, max_depth: int = DEFAULTS.max_json_depth):
     try:
         value = json.loads(text)
     except RecursionError:
-        raise ValueError(_too_deep(max_depth)) from None
+        raise RigidfoldError(_too_deep(max_depth)) from None
     check_json_depth(value, max_depth=max_depth)
     return value
 
@@ -148,7 +149,7 @@ def check_json_depth(value, *, max_depth: int = DEFAULTS.max_json_depth) -> None
         else:
             continue
         if depth > max_depth:
-            raise ValueError(_too_deep(max_depth))
+            raise RigidfoldError(_too_deep(max_depth))
         stack.extend((child, depth + 1) for child in children)
 
 
@@ -172,7 +173,7 @@ def jsonable(value, *, where: str = "the value"):
     try:
         check_json_depth(value)
     except ValueError as exc:
-        raise ValueError(f"{where} is {exc}") from None
+        raise RigidfoldError(f"{where} is {exc}") from None
     return _clean(value, where)
 
 
@@ -188,7 +189,7 @@ def _clean(value, where: str):
         return value if math.isfinite(value) else None
     if value is None or isinstance(value, str | bool | int):
         return value
-    raise ValueError(f"{where} holds a {type(value).__name__}, which is not JSON data")
+    raise RigidfoldError(f"{where} holds a {type(value).__name__}, which is not JSON data")
 
 
 def _create_temp(directory: Path, stem: str) -> tuple[int, Path]:

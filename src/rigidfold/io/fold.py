@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.files import atomic_write, check_json_depth, jsonable, parse_json
 from rigidfold.mesh import CreasePattern, geometry, topology
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
@@ -378,13 +379,13 @@ def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndar
     try:
         xy = np.asarray(frame["vertices_coords"], dtype=float)
     except (KeyError, TypeError, ValueError):
-        raise ValueError(f"{where} has no numeric vertices_coords") from None
+        raise RigidfoldError(f"{where} has no numeric vertices_coords") from None
     if xy.ndim != 2 or xy.shape[0] != n_vertices or xy.shape[1] not in (2, 3):
-        raise ValueError(
+        raise RigidfoldError(
             f"{where}: vertices_coords of shape {xy.shape}, expected ({n_vertices}, 2|3)"
         )
     if not np.isfinite(xy).all():
-        raise ValueError(f"{where}: non-finite vertices_coords")
+        raise RigidfoldError(f"{where}: non-finite vertices_coords")
     if dim == 3 and xy.shape[1] == 2:
         xy = np.column_stack([xy, np.zeros(n_vertices)])
     return xy[:, :dim]
@@ -453,7 +454,7 @@ def _prefixed(metadata: dict | None) -> dict:
     keys = {}
     for key, value in (metadata or {}).items():
         if not isinstance(key, str):
-            raise ValueError(f"metadata keys must be strings, got {key!r}")
+            raise RigidfoldError(f"metadata keys must be strings, got {key!r}")
         keys[PREFIX + key] = jsonable(value, where=f"metadata {key!r}")
     return keys
 
@@ -527,12 +528,12 @@ def read_fold(
         flat-folded sheet), a surface that is not an oriented disc.
     """
     if up not in UP_AXES:
-        raise ValueError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
+        raise RigidfoldError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
     label, raw = _load(source)
     try:
         return _parse(raw, frame, up, rigid_panels, settings)
     except ValueError as exc:
-        raise ValueError(f"{label}: {' '.join(str(exc).split())}") from None
+        raise RigidfoldError(f"{label}: {' '.join(str(exc).split())}") from None
 
 
 def pattern_from_fold(
@@ -552,27 +553,27 @@ def _load(source) -> tuple[str, dict]:
         try:
             check_json_depth(source)
         except ValueError as exc:
-            raise ValueError(f"FOLD data: {exc}") from None
+            raise RigidfoldError(f"FOLD data: {exc}") from None
         return "FOLD data", source
     if not isinstance(source, str | os.PathLike):
-        raise ValueError(f"read_fold needs a file path or a dict, got {type(source).__name__}")
+        raise RigidfoldError(f"read_fold needs a file path or a dict, got {type(source).__name__}")
     path = Path(source)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise RigidfoldError(f"cannot read {path}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
-        raise ValueError(f"not a FOLD file: {path}: not UTF-8 text") from None
+        raise RigidfoldError(f"not a FOLD file: {path}: not UTF-8 text") from None
     try:
         raw = parse_json(text)
     except json.JSONDecodeError as exc:
-        raise ValueError(
+        raise RigidfoldError(
             f"not a FOLD file: {path}: invalid JSON at line {exc.lineno} column {exc.colno}"
         ) from None
     except ValueError as exc:
-        raise ValueError(f"not a FOLD file: {path}: {exc}") from None
+        raise RigidfoldError(f"not a FOLD file: {path}: {exc}") from None
     if not isinstance(raw, dict):
-        raise ValueError(
+        raise RigidfoldError(
             f"not a FOLD file: {path}: the top level is {_kind(raw)}, not a JSON object"
         )
     return str(path), raw
@@ -582,7 +583,7 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
     data = _frame(raw, frame)
     unit = data.get("frame_unit", "unit")
     if not isinstance(unit, str) or unit not in UNITS:
-        raise ValueError(
+        raise RigidfoldError(
             f"frame_unit {_short(unit)} is not a unit rigidfold knows; use one of "
             f"{', '.join(UNITS)}"
         )
@@ -590,7 +591,7 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
     far = np.abs(coords).max(axis=1, initial=0.0) > settings.max_coordinate
     if far.any():
         i = int(np.argmax(far))
-        raise ValueError(
+        raise RigidfoldError(
             f"vertices_coords[{i}] = {_short(data['vertices_coords'][i])} lies farther than "
             f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
         )
@@ -613,7 +614,7 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
     )
     classes = data.get("frame_classes", [])
     if not isinstance(classes, list) or not all(isinstance(c, str) for c in classes):
-        raise ValueError(f"frame_classes must be a list of strings, got {_short(classes)}")
+        raise RigidfoldError(f"frame_classes must be a list of strings, got {_short(classes)}")
     return FoldData(
         pattern=pattern,
         n_file_edges=len(file_edges),
@@ -638,12 +639,12 @@ def _check_plan(coords: np.ndarray, triangles: np.ndarray, up: str, tol: float) 
     if not geometry.plan_area(coords, triangles, tol)[2]:
         return
     if up == "z":
-        raise ValueError(
+        raise RigidfoldError(
             "the faces' projection onto the xy plane has zero area: rigidfold needs z up and "
             "a sheet that covers an area in plan (not closed, not folded flat); is the file "
             "y-up? (--up y)"
         )
-    raise ValueError(
+    raise RigidfoldError(
         "read y-up, the faces' projection onto the file's xz plane has zero area: rigidfold "
         "needs the file's y axis up and a sheet that covers an area in plan (not closed, not "
         "folded flat); is the file z-up? (--up z)"
@@ -653,21 +654,21 @@ def _check_plan(coords: np.ndarray, triangles: np.ndarray, up: str, tol: float) 
 def _frame(raw: dict, index: int) -> dict:
     """The keys of frame ``index`` (0 = top level), inherited keys included."""
     if not (_is_integer(index) and index >= 0):
-        raise ValueError(f"frame must be a non-negative integer, got {index!r}")
+        raise RigidfoldError(f"frame must be a non-negative integer, got {index!r}")
     frames = raw.get("file_frames", [])
     if not isinstance(frames, list) or not all(isinstance(f, dict) for f in frames):
-        raise ValueError("file_frames must be a list of objects")
+        raise RigidfoldError("file_frames must be a list of objects")
     frames = [raw, *frames]
     if index >= len(frames):
-        raise ValueError(f"frame {index} does not exist (frames 0..{len(frames) - 1})")
+        raise RigidfoldError(f"frame {index} does not exist (frames 0..{len(frames) - 1})")
     chain = [index]
     data = dict(frames[index])
     while chain[-1] != 0 and frames[chain[-1]].get("frame_inherit") is True:
         parent = frames[chain[-1]].get("frame_parent", 0)
         if not (_is_integer(parent) and 0 <= parent < len(frames)):
-            raise ValueError(f"frame {chain[-1]} has an invalid frame_parent {_short(parent)}")
+            raise RigidfoldError(f"frame {chain[-1]} has an invalid frame_parent {_short(parent)}")
         if parent in chain:
-            raise ValueError(f"frames {chain} inherit from each other in a cycle")
+            raise RigidfoldError(f"frames {chain} inherit from each other in a cycle")
         chain.append(parent)
         data = {**frames[parent], **data}
     return data
@@ -679,15 +680,15 @@ def _coords(data: dict) -> np.ndarray:
     coords = np.zeros((len(rows), 3))
     for i, row in enumerate(rows):
         if not (isinstance(row, list) and len(row) in (2, 3) and all(map(_is_number, row))):
-            raise ValueError(f"vertices_coords[{i}] must be 2 or 3 numbers, got {_short(row)}")
+            raise RigidfoldError(f"vertices_coords[{i}] must be 2 or 3 numbers, got {_short(row)}")
         try:
             coords[i, : len(row)] = row
         except OverflowError:  # an integer too large for a float
             coords[i] = math.inf
         if not np.isfinite(coords[i]).all():
-            raise ValueError(f"vertices_coords[{i}] is not finite: {_short(row)}")
+            raise RigidfoldError(f"vertices_coords[{i}] is not finite: {_short(row)}")
         if len(row) != len(rows[0]):
-            raise ValueError(
+            raise RigidfoldError(
                 f"vertices_coords[{i}] has {len(row)} coordinates, vertices_coords[0] has "
                 f"{len(rows[0])}: a file's vertices are all 2D or all 3D, got {_short(row)}"
             )
@@ -699,13 +700,13 @@ def _polygons(data: dict, n_vertices: int) -> list[list[int]]:
     rows = _required_list(data, "faces_vertices")
     for k, row in enumerate(rows):
         if not (isinstance(row, list) and len(row) >= 3 and all(map(_is_integer, row))):
-            raise ValueError(
+            raise RigidfoldError(
                 f"faces_vertices[{k}] must be a list of at least 3 vertex indices, "
                 f"got {_short(row)}"
             )
         _check_range(row, n_vertices, f"faces_vertices[{k}]")
         if len(set(row)) != len(row):
-            raise ValueError(f"faces_vertices[{k}] repeats a vertex: {_short(row)}")
+            raise RigidfoldError(f"faces_vertices[{k}] repeats a vertex: {_short(row)}")
     return [[int(v) for v in row] for row in rows]
 
 
@@ -713,25 +714,27 @@ def _file_edges(data: dict, n_vertices: int) -> tuple[list[tuple[int, int]], lis
     """``edges_vertices`` (checked) and ``edges_assignment`` (None when absent)."""
     rows = data.get("edges_vertices", [])
     if not isinstance(rows, list):
-        raise ValueError(f"edges_vertices must be a list, got {_kind(rows)}")
+        raise RigidfoldError(f"edges_vertices must be a list, got {_kind(rows)}")
     for k, row in enumerate(rows):
         if not (isinstance(row, list) and len(row) == 2 and all(map(_is_integer, row))):
-            raise ValueError(f"edges_vertices[{k}] must be 2 vertex indices, got {_short(row)}")
+            raise RigidfoldError(f"edges_vertices[{k}] must be 2 vertex indices, got {_short(row)}")
         _check_range(row, n_vertices, f"edges_vertices[{k}]")
     edges = [(int(u), int(v)) for u, v in rows]
     if "edges_assignment" not in data:
         return edges, None
     assignment = data["edges_assignment"]
     if not isinstance(assignment, list) or len(assignment) != len(edges):
-        raise ValueError(
+        raise RigidfoldError(
             f"edges_assignment must be a list of {len(edges)} letters (one per edge in "
             f"edges_vertices), got {_kind(assignment)}"
         )
     for k, letter in enumerate(assignment):
         if not isinstance(letter, str) or letter not in ASSIGNMENTS:
-            raise ValueError(f"edges_assignment[{k}] is {_short(letter)}, not one of B M V F U C J")
+            raise RigidfoldError(
+                f"edges_assignment[{k}] is {_short(letter)}, not one of B M V F U C J"
+            )
         if letter == "C":
-            raise ValueError(
+            raise RigidfoldError(
                 f'edge {k} is a cut ("C"): rigidfold handles crease patterns without cuts only'
             )
     return edges, list(assignment)
@@ -751,7 +754,7 @@ def _mark_fixed(
         and len(marks) == len(file_edges)
         and all(isinstance(m, bool) for m in marks)
     ):
-        raise ValueError(
+        raise RigidfoldError(
             f"{key} must be a list of {len(file_edges)} booleans (one per edge in "
             f"edges_vertices), got {_kind(marks)}"
         )
@@ -789,7 +792,7 @@ def _complete_edges(
     assignment = [a or derived(u, v) for a, (u, v) in zip(letters, file_edges, strict=True)]
     for e, (u, v) in enumerate(file_edges):
         if assignment[e] == "J" and key(u, v) in boundary:
-            raise ValueError(
+            raise RigidfoldError(
                 f'edge {e} is a fixed crease ("J" or {PREFIX}fixed) but lies on the boundary'
             )
     edges = list(file_edges)
@@ -807,17 +810,19 @@ def _complete_edges(
 # ---------------------------------------------------------------------------------- helpers
 def _required_list(data: dict, key: str) -> list:
     if key not in data:
-        raise ValueError(f"missing {key}")
+        raise RigidfoldError(f"missing {key}")
     value = data[key]
     if not isinstance(value, list) or not value:
-        raise ValueError(f"{key} must be a non-empty list, got {_kind(value)}")
+        raise RigidfoldError(f"{key} must be a non-empty list, got {_kind(value)}")
     return value
 
 
 def _check_range(indices: list, n_vertices: int, where: str) -> None:
     for v in indices:
         if not 0 <= v < n_vertices:
-            raise ValueError(f"{where} refers to vertex {v}, but there are {n_vertices} vertices")
+            raise RigidfoldError(
+                f"{where} refers to vertex {v}, but there are {n_vertices} vertices"
+            )
 
 
 def _is_number(x) -> bool:

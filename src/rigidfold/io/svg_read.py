@@ -61,6 +61,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.fold import UNITS
 
 OS_STROKES = {
@@ -161,25 +162,25 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise RigidfoldError(f"cannot read {path}: {exc.strerror or exc}") from None
     try:
         _check_xml(data, settings)
     except ElementTree.ParseError as exc:
-        raise ValueError(f"not an SVG file: {path}: {exc}") from None
+        raise RigidfoldError(f"not an SVG file: {path}: {exc}") from None
     except ValueError as exc:
-        raise ValueError(f"{path}: {exc}") from None
+        raise RigidfoldError(f"{path}: {exc}") from None
     try:
         svg = se.SVG.parse(BytesIO(data))
     except (ElementTree.ParseError, ValueError) as exc:
-        raise ValueError(f"not an SVG file: {path}: {exc}") from None
+        raise RigidfoldError(f"not an SVG file: {path}: {exc}") from None
     except _SVGELEMENTS_ERRORS as exc:
-        raise ValueError(f"{path}: {_cannot_read(exc)}") from None
+        raise RigidfoldError(f"{path}: {_cannot_read(exc)}") from None
     if not isinstance(svg, se.SVG):
-        raise ValueError(f"not an SVG file: {path}: the root element is not <svg>")
+        raise RigidfoldError(f"not an SVG file: {path}: the root element is not <svg>")
     try:
         return _read(svg, settings)
     except ValueError as exc:
-        raise ValueError(f"{path}: {exc}") from None
+        raise RigidfoldError(f"{path}: {exc}") from None
 
 
 def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
@@ -257,7 +258,7 @@ def _check_xml(data: bytes, settings: Settings) -> None:
                 continue
             depth += 1
             if depth > settings.max_svg_depth:
-                raise ValueError(
+                raise RigidfoldError(
                     f"its elements nest more than {settings.max_svg_depth} levels deep (at "
                     f"<{_local(element.tag)}>; Settings.max_svg_depth)"
                 )
@@ -277,7 +278,7 @@ def _check_attributes(element: ElementTree.Element) -> None:
             text = element.get(size)
             length = None if text is None else _LENGTH.fullmatch(text)
             if text is not None and not (length and 0 < float(length[1]) < math.inf):
-                raise ValueError(
+                raise RigidfoldError(
                     f'{name} has {size}="{text}": a {size} is a positive finite length, such '
                     "as 210mm or 800"
                 )
@@ -288,13 +289,13 @@ def _check_attributes(element: ElementTree.Element) -> None:
         except ValueError:
             box = []
         if not (len(box) == 4 and all(map(math.isfinite, box)) and min(box[2:]) > 0):
-            raise ValueError(
+            raise RigidfoldError(
                 f'{name} has viewBox="{text}": a viewBox is four finite numbers "min-x min-y '
                 'width height", the width and height positive'
             )
     text = element.get("transform")
     if text is not None and not _transform_ok(text):
-        raise ValueError(
+        raise RigidfoldError(
             f'{name} has transform="{text}": a transform is a list of matrix(a,b,c,d,e,f), '
             "translate, scale, rotate, skewX or skewY of finite numbers"
         )
@@ -345,7 +346,7 @@ def _svgelements():
     try:
         yield
     except _SVGELEMENTS_ERRORS as exc:
-        raise ValueError(_cannot_read(exc)) from None
+        raise RigidfoldError(_cannot_read(exc)) from None
 
 
 # ------------------------------------------------------------------------- the drawing
@@ -361,7 +362,7 @@ def _units(svg: se.SVG) -> tuple[str, float, se.Matrix]:
         return unit, UNITS["in"] / 96, to_user  # a user unit is a CSS pixel
     px_x, px_y = abs(1 / to_user.a), abs(1 / to_user.d)  # pixels per user unit
     if not math.isclose(px_x, px_y, rel_tol=1e-9):
-        raise ValueError("the width, height and viewBox scale x and y differently")
+        raise RigidfoldError("the width, height and viewBox scale x and y differently")
     return unit, px_x * float(match.group(1)) * UNITS[unit] / svg.width, to_user
 
 
@@ -378,7 +379,7 @@ def _to_user(svg: se.SVG) -> se.Matrix:
         a, d = np.float64(1.0) / m.a, np.float64(1.0) / m.d
         inverse = [a, 0.0, 0.0, d, -m.e * a, -m.f * d]
     if m.b or m.c or not np.isfinite([m.a, m.d, m.e, m.f, *inverse]).all() or 0 in (a, d):
-        raise ValueError(
+        raise RigidfoldError(
             f'the viewBox="{svg.values.get("viewBox")}" scales the drawing to its width="'
             f'{svg.values.get("width")}" and height="{svg.values.get("height")}" by '
             f"{m.a:.3g} x {m.d:.3g}, which cannot be computed with"
@@ -401,7 +402,7 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
         angle = {"M": -180.0 * opacity, "V": 180.0 * opacity, "U": math.nan}.get(letter, 0.0)
         m = shape.transform
         if not np.isfinite([m.a, m.b, m.c, m.d, m.e, m.f]).all():
-            raise ValueError(
+            raise RigidfoldError(
                 f"{name} is drawn with a transform that is not finite, matrix({m.a:g}, {m.b:g}, "
                 f"{m.c:g}, {m.d:g}, {m.e:g}, {m.f:g}) (its transforms and the viewBox multiplied)"
             )
@@ -411,7 +412,7 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
             if isinstance(piece, se.Move):
                 continue
             if not isinstance(piece, se.Line | se.Close):
-                raise ValueError(
+                raise RigidfoldError(
                     f"{name} has a curved piece ({type(piece).__name__}): creases and the "
                     "boundary must be straight lines"
                 )
@@ -420,7 +421,7 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
                 to_user.point_in_matrix_space(piece.end),
             )
             if not np.isfinite([a.x, a.y, b.x, b.y]).all():
-                raise ValueError(
+                raise RigidfoldError(
                     f"{name} has a line from ({a.x:g}, {a.y:g}) to ({b.x:g}, {b.y:g}): "
                     "coordinates must be finite numbers (transforms and the viewBox applied)"
                 )
@@ -428,17 +429,17 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
             letters.append(letter)
             angles.append(angle)
     if not ends:
-        raise ValueError(
+        raise RigidfoldError(
             "no lines drawn: a crease pattern is <line>, <polyline>, <polygon>, <rect> or "
             "<path> elements with a stroke"
         )
     if "B" not in letters:
-        raise ValueError("no boundary: no black lines (Origami Simulator draws it black)")
+        raise RigidfoldError("no boundary: no black lines (Origami Simulator draws it black)")
     drawn = np.array(ends, dtype=float)
     with np.errstate(over="ignore"):
         across = float(np.linalg.norm(np.ptp(drawn.reshape(-1, 2), axis=0)))
     if not across <= _LARGEST:
-        raise ValueError(
+        raise RigidfoldError(
             f"its lines span {across:.3g} drawing units (their transforms and viewBox "
             f"applied): more than {_LARGEST:g}, too large to compute with"
         )
@@ -452,7 +453,7 @@ def _opacity(shape: se.Shape, name: str) -> float:
         opacity = float(values.get("stroke-opacity", shape.stroke.opacity))
         opacity *= float(values.get("opacity", 1.0))
     except ValueError:
-        raise ValueError(f"{name} has an opacity that is not a number") from None
+        raise RigidfoldError(f"{name} has an opacity that is not a number") from None
     return min(max(opacity, 0.0), 1.0)
 
 
@@ -467,12 +468,12 @@ def _letter(colour: se.Color, written: str | None, name: str) -> str:
         for letter, centre in _HUES.items():
             if abs((360 * hue - centre + 180) % 360 - 180) < HUE_TOLERANCE:
                 if letter == "C":
-                    raise ValueError(f"{name} is green, a cut: cuts are not supported")
+                    raise RigidfoldError(f"{name} is green, a cut: cuts are not supported")
                 return letter
     shown = colour.hex[:7]
     if written and written.strip().lower() != shown:
         shown = f"{written.strip()} ({shown})"
-    raise ValueError(
+    raise RigidfoldError(
         f"{name} has stroke colour {shown}, none of Origami Simulator's: black boundary, red "
         "mountain, blue valley, yellow flat, magenta undriven"
     )
@@ -502,7 +503,7 @@ def _node(
     length = np.linalg.norm(b - a, axis=1)
     drawn = np.flatnonzero(length > tol)
     if not len(drawn):
-        raise ValueError("the lines drawn have no length")
+        raise RigidfoldError("the lines drawn have no length")
     a, b, length = a[drawn], b[drawn], length[drawn]
     seg, t, points = _splits(a, b, length, tol, max_pairs)
     n = len(drawn)
@@ -538,7 +539,7 @@ def _node(
             dropped.discard(e)
         elif out_letters[e] not in ("B", letter):
             if np.linalg.norm(points[first[u]] - points[first[v]]) > snap:
-                raise ValueError(
+                raise RigidfoldError(
                     f"the line from {_at(points[first[u]])} to {_at(points[first[v]])} is "
                     f"drawn both {COLOURS[out_letters[e]]} and {COLOURS[letter]}"
                 )
@@ -647,7 +648,7 @@ def _splits(
         i, j = i[i < j], j[i < j]
         pairs += len(i)
         if pairs > max_pairs:
-            raise ValueError(
+            raise RigidfoldError(
                 f"more than {max_pairs} pairs of its {len(lines)} line pieces meet, cross or "
                 "come within the merge distance of each other (Settings.max_svg_pairs): too "
                 "many lines cross or are drawn over each other"
@@ -789,28 +790,28 @@ def _check_boundary(xy: np.ndarray, edges: np.ndarray, letters: list[str]) -> li
     black = edges[np.array(letters) == "B"]
     degree = np.bincount(black.ravel(), minlength=len(xy))
     if (degree == 1).any():
-        raise ValueError(
+        raise RigidfoldError(
             f"the boundary (black) is not closed: it ends at {_at(xy[degree == 1][0])}"
         )
     if (degree > 2).any():
         w = int(np.argmax(degree))
-        raise ValueError(
+        raise RigidfoldError(
             f"the boundary (black) is not one outline: {degree[w]} black lines meet at {_at(xy[w])}"
         )
     loops = [cycle for cycle, area in _cycles(xy, black) if area > 0]
     if len(loops) == 1:
         return loops[0]
     if not loops:
-        raise ValueError("the boundary (black) encloses no area")
+        raise RigidfoldError("the boundary (black) encloses no area")
     outlines = [shapely.Polygon(xy[loop]) for loop in loops]
     for loop in loops:
         x, y = xy[loop[0]]
         if sum(shapely.contains_xy(outlines, x, y)) > 0:
-            raise ValueError(
+            raise RigidfoldError(
                 f"the black outline through {_at(xy[loop[0]])} lies inside another: holes "
                 "are not supported"
             )
-    raise ValueError(f"the boundary (black) is {len(loops)} separate outlines, not one sheet")
+    raise RigidfoldError(f"the boundary (black) is {len(loops)} separate outlines, not one sheet")
 
 
 def _inside(
@@ -839,17 +840,19 @@ def _check_creases(
     outside = ~shapely.contains_xy(outline, mid[:, 0], mid[:, 1]) & (np.array(letters) != "B")
     if outside.any():
         u, v = edges[np.argmax(outside)]
-        raise ValueError(f"the crease from {_at(xy[u])} to {_at(xy[v])} lies outside the boundary")
+        raise RigidfoldError(
+            f"the crease from {_at(xy[u])} to {_at(xy[v])} lies outside the boundary"
+        )
     degree = np.bincount(edges.ravel(), minlength=len(xy))
     if (degree == 1).any():
-        raise ValueError(
+        raise RigidfoldError(
             f"a crease ends inside a face at {_at(xy[degree == 1][0])}: creases must end on "
             f"another line (an end within {tol:.3g} drawing units of a line is joined to it; "
             "Settings.svg_snap_tol)"
         )
     n, component = connected_components(_graph(edges, len(xy)), directed=False)
     if n > 1:
-        raise ValueError(
+        raise RigidfoldError(
             f"creases around {_at(xy[component != component[0]][0])} are not connected to the "
             "boundary: the face around them would have a hole"
         )
@@ -863,7 +866,7 @@ def _faces(xy: np.ndarray, edges: np.ndarray) -> list[list[int]]:
         seen: set[int] = set()
         for w in face:
             if w in seen:
-                raise ValueError(
+                raise RigidfoldError(
                     f"a face is not a simple polygon: its outline passes twice through "
                     f"{_at(xy[w])} (a crease with the same face on both sides, or crease "
                     "loops touching at one point)"

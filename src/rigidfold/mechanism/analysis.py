@@ -27,6 +27,7 @@ import numpy as np
 import scipy.linalg
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
+from rigidfold.errors import RigidfoldError
 from rigidfold.frame import FrameModel
 from rigidfold.mechanism import kinematics
 from rigidfold.mechanism.sparse import sparse_analysis_bytes, sparse_kernel
@@ -145,7 +146,9 @@ def chosen_method(pattern: CreasePattern, method: str, settings: Settings = DEFA
     """The method :func:`analyze` runs for ``method`` (one of ``METHODS``): ``"auto"`` is
     ``"sparse"`` from ``settings.sparse_analysis_vertices`` vertices on, else ``"kinematic"``."""
     if method not in METHODS:
-        raise ValueError(f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})")
+        raise RigidfoldError(
+            f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})"
+        )
     if method != "auto":
         return method
     return "sparse" if pattern.n_vertices >= settings.sparse_analysis_vertices else "kinematic"
@@ -181,7 +184,7 @@ def check_analysis_size(
     (:func:`analysis_memory`); ``generate`` calls it before its first solve."""
     need = analysis_memory(pattern, method, settings)
     if need > settings.max_analysis_bytes:
-        raise ValueError(
+        raise RigidfoldError(
             f"the mechanism analysis of {pattern.n_vertices} vertices and {pattern.n_edges} "
             f"edges needs about {need / 2**30:.3g} GiB, more than the limit of "
             f"{settings.max_analysis_bytes / 2**30:.3g} GiB (Settings.max_analysis_bytes): "

@@ -43,6 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.frame.model import default_support_face
 from rigidfold.mechanism.analysis import analyze
 from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System, correct
@@ -413,7 +414,7 @@ def _first_tangent(
     projection of -grad(m^2 / 2) onto the null space of J."""
     t = System(J, J_rho, "projection", None, settings).direction(-(J_rho.T @ rho), rho)
     if not np.isfinite(t).all():
-        raise ValueError("the shape's folding path has no tangent at the design")
+        raise RigidfoldError("the shape's folding path has no tangent at the design")
     return t
 
 

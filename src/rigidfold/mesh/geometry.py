@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.protocols import SymmetryPlane
 
 
@@ -172,7 +173,7 @@ def mirror_pairs(coords: np.ndarray, plane: SymmetryPlane, tol: float) -> np.nda
     dist, idx = cKDTree(xy).query(plane.reflect(xy))
     if (dist > tol).any():
         v = int(np.argmax(dist))
-        raise ValueError(
+        raise RigidfoldError(
             f"the crease pattern is not symmetric about the plane {plane}: vertex {v} at "
             f"({xy[v, 0]:g}, {xy[v, 1]:g}) has no mirror image"
         )

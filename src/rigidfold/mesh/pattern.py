@@ -8,6 +8,7 @@ from functools import cached_property
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import geometry, topology
 
 
@@ -57,18 +58,18 @@ class CreasePattern:
 
     def __post_init__(self) -> None:
         if not isinstance(self.settings, Settings):
-            raise ValueError(f"settings must be a Settings, got {type(self.settings).__name__}")
+            raise RigidfoldError(f"settings must be a Settings, got {type(self.settings).__name__}")
         coords = np.array(self.coords, dtype=np.float64)
         if coords.ndim != 2 or coords.shape[1] != 3:
-            raise ValueError(f"coords must be a (V, 3) array, got shape {coords.shape}")
+            raise RigidfoldError(f"coords must be a (V, 3) array, got shape {coords.shape}")
         if not np.isfinite(coords).all():
             bad = int(np.flatnonzero(~np.isfinite(coords).all(axis=1))[0])
-            raise ValueError(f"vertex {bad} has a non-finite coordinate: {coords[bad]}")
+            raise RigidfoldError(f"vertex {bad} has a non-finite coordinate: {coords[bad]}")
         faces = _as_int_array(self.faces, "faces")
         edges = _as_int_array(self.edges, "edges")
         fixed = np.asarray(self.fixed)
         if fixed.shape != (len(edges),) or fixed.dtype != bool:
-            raise ValueError(
+            raise RigidfoldError(
                 f"fixed must be a boolean array of shape ({len(edges)},), got "
                 f"{fixed.dtype} array of shape {fixed.shape}"
             )
@@ -81,23 +82,23 @@ class CreasePattern:
         object.__setattr__(self, "fixed", fixed)
         if (fixed & self.is_boundary_edge).any():
             e = int(np.flatnonzero(fixed & self.is_boundary_edge)[0])
-            raise ValueError(f"edge {e} is on the boundary and cannot be a fixed crease")
+            raise RigidfoldError(f"edge {e} is on the boundary and cannot be a fixed crease")
         areas = geometry.face_areas(coords, faces)
         longest = geometry.edge_lengths(coords, edges).max()
         small = areas <= self.settings.degenerate_area * longest**2
         if small.any():
             f = int(np.flatnonzero(small)[0])
-            raise ValueError(
+            raise RigidfoldError(
                 f"face {f} {tuple(faces[f].tolist())} is degenerate (area {areas[f]:.3g} m^2)"
             )
         plan, surface, zero = geometry.plan_area(coords, faces, self.settings.plan_area_tol)
         if zero:
-            raise ValueError(
+            raise RigidfoldError(
                 f"the faces' projection onto the xy plane has zero area ({plan:.3g} m^2 for "
                 f"{surface:.3g} m^2 of faces): rigidfold needs a sheet with z up"
             )
         if plan < 0:
-            raise ValueError(
+            raise RigidfoldError(
                 "faces must be counter-clockwise seen from +z: the sheet's projected area is "
                 f"negative ({plan:.3g} m^2; reverse the vertex order of every face)"
             )
@@ -122,7 +123,7 @@ class CreasePattern:
             coords = np.column_stack([coords, np.zeros(len(coords))])
         faces = _as_int_array(faces, "faces")
         if faces.ndim != 2 or faces.shape[1] != 3:
-            raise ValueError(f"faces must be an (F, 3) array of triangles, got {faces.shape}")
+            raise RigidfoldError(f"faces must be an (F, 3) array of triangles, got {faces.shape}")
         edges = topology.edges_from_faces(faces)
         fixed = np.zeros(len(edges), dtype=bool)
         if fixed_edges is not None and len(fixed_edges):
@@ -131,7 +132,9 @@ class CreasePattern:
             want = topology.edge_keys(_as_int_array(fixed_edges, "fixed_edges"), n)
             missing = ~np.isin(want, keys)
             if missing.any():
-                raise ValueError(f"fixed edge {fixed_edges[int(np.argmax(missing))]} is no edge")
+                raise RigidfoldError(
+                    f"fixed edge {fixed_edges[int(np.argmax(missing))]} is no edge"
+                )
             fixed = np.isin(keys, want)
         return cls(coords=coords, faces=faces, edges=edges, fixed=fixed, settings=settings)
 
@@ -361,5 +364,5 @@ def _as_int_array(value, name: str) -> np.ndarray:
         if np.issubdtype(arr.dtype, np.floating) and np.all(np.isfinite(arr)):
             if np.all(arr == np.round(arr)):
                 return arr.astype(np.int64)
-        raise ValueError(f"{name} must hold integer vertex indices, got dtype {arr.dtype}")
+        raise RigidfoldError(f"{name} must hold integer vertex indices, got dtype {arr.dtype}")
     return arr.astype(np.int64)

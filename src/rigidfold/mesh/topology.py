@@ -10,6 +10,8 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from rigidfold.errors import RigidfoldError
+
 
 def half_edges(faces: np.ndarray) -> np.ndarray:
     """Directed edges of all faces.
@@ -50,7 +52,7 @@ def half_edge_edges(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> np
     found = keys[order][pos] == he_keys
     if not found.all():
         u, v = he[np.flatnonzero(~found)[0]].tolist()
-        raise ValueError(f"edge ({u}, {v}) of a face is missing from the edge list")
+        raise RigidfoldError(f"edge ({u}, {v}) of a face is missing from the edge list")
     return order[pos].astype(np.int64)
 
 
@@ -73,7 +75,7 @@ def edge_faces(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndar
     if counts.max(initial=0) > 1:
         e = int(np.argmax(counts) // 2)
         u, v = edges[e].tolist()
-        raise ValueError(
+        raise RigidfoldError(
             f"edge ({u}, {v}) is shared by more than two faces or by two faces with "
             "inconsistent orientation (not an oriented edge-manifold)"
         )
@@ -112,18 +114,18 @@ def boundary_loop(edges: np.ndarray, boundary: np.ndarray, n_vertices: int) -> n
     nxt = np.full(n_vertices, -1, dtype=np.int64)
     if np.bincount(boundary[:, 0], minlength=n_vertices).max(initial=0) > 1:
         v = int(np.argmax(np.bincount(boundary[:, 0], minlength=n_vertices)))
-        raise ValueError(f"boundary vertex {v} is a pinch point (the surface is not a disc)")
+        raise RigidfoldError(f"boundary vertex {v} is a pinch point (the surface is not a disc)")
     nxt[boundary[:, 0]] = boundary[:, 1]
     start = int(boundary[0, 0])
     loop = [start]
     v = int(nxt[start])
     while v != start:
         if v < 0 or len(loop) > len(boundary):
-            raise ValueError("the boundary is not a single closed loop")
+            raise RigidfoldError("the boundary is not a single closed loop")
         loop.append(v)
         v = int(nxt[v])
     if len(loop) != len(boundary):
-        raise ValueError(
+        raise RigidfoldError(
             f"the boundary has several loops ({len(boundary)} boundary edges, the loop through "
             f"vertex {start} has {len(loop)}): the crease pattern must be a disc without holes"
         )
@@ -148,11 +150,11 @@ def validate_topology(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> 
     Raises ValueError naming the first problem found.
     """
     if faces.ndim != 2 or faces.shape[1] != 3:
-        raise ValueError(f"faces must be an (F, 3) array of triangles, got shape {faces.shape}")
+        raise RigidfoldError(f"faces must be an (F, 3) array of triangles, got shape {faces.shape}")
     if len(faces) == 0:
-        raise ValueError("the crease pattern has no faces")
+        raise RigidfoldError("the crease pattern has no faces")
     if faces.min() < 0 or faces.max() >= n_vertices:
-        raise ValueError(
+        raise RigidfoldError(
             f"face vertex index out of range 0..{n_vertices - 1}: "
             f"got {int(faces.min())}..{int(faces.max())}"
         )
@@ -160,42 +162,42 @@ def validate_topology(faces: np.ndarray, edges: np.ndarray, n_vertices: int) -> 
         (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
     )
     if repeated.any():
-        raise ValueError(
+        raise RigidfoldError(
             f"face {int(np.argmax(repeated))} repeats a vertex: {faces[repeated][0].tolist()}"
         )
     if edges.ndim != 2 or edges.shape[1] != 2 or len(edges) == 0:
-        raise ValueError(f"edges must be a non-empty (E, 2) array, got shape {edges.shape}")
+        raise RigidfoldError(f"edges must be a non-empty (E, 2) array, got shape {edges.shape}")
     if edges.min() < 0 or edges.max() >= n_vertices:
-        raise ValueError(f"edge vertex index out of range 0..{n_vertices - 1}")
+        raise RigidfoldError(f"edge vertex index out of range 0..{n_vertices - 1}")
     if (edges[:, 0] == edges[:, 1]).any():
-        raise ValueError(f"edge {int(np.argmax(edges[:, 0] == edges[:, 1]))} is a loop")
+        raise RigidfoldError(f"edge {int(np.argmax(edges[:, 0] == edges[:, 1]))} is a loop")
     keys = edge_keys(edges, n_vertices)
     uniq, first, counts = np.unique(keys, return_index=True, return_counts=True)
     if len(uniq) != len(keys):
         e = int(first[np.argmax(counts > 1)])
-        raise ValueError(f"the edge list contains edge {tuple(edges[e].tolist())} twice")
+        raise RigidfoldError(f"the edge list contains edge {tuple(edges[e].tolist())} twice")
     face_keys = np.unique(edge_keys(half_edges(faces), n_vertices))
     if len(face_keys) != len(keys):
         extra = np.setdiff1d(keys, face_keys)
         if len(extra):
             e = int(np.flatnonzero(np.isin(keys, extra))[0])
-            raise ValueError(f"edge {e} {tuple(edges[e].tolist())} belongs to no face")
+            raise RigidfoldError(f"edge {e} {tuple(edges[e].tolist())} belongs to no face")
     ef = edge_faces(faces, edges, n_vertices)  # raises on non-manifold / inconsistent orientation
     used = np.zeros(n_vertices, dtype=bool)
     used[faces.ravel()] = True
     if not used.all():
-        raise ValueError(f"vertex {int(np.argmin(used))} belongs to no face")
+        raise RigidfoldError(f"vertex {int(np.argmin(used))} belongs to no face")
     labels = face_components(len(faces), ef, np.ones(len(edges), dtype=bool))
     if labels.max() > 0:
-        raise ValueError(f"the crease pattern has {labels.max() + 1} disconnected parts")
+        raise RigidfoldError(f"the crease pattern has {labels.max() + 1} disconnected parts")
     euler = n_vertices - len(edges) + len(faces)
     is_boundary = (ef < 0).any(axis=1)
     if not is_boundary.any():
-        raise ValueError("the crease pattern is a closed surface; it must be a disc")
+        raise RigidfoldError("the crease pattern is a closed surface; it must be a disc")
     boundary_he = boundary_half_edges(edges, ef)
     boundary_loop(edges, boundary_he, n_vertices)
     if euler != 1:
-        raise ValueError(f"the crease pattern is not a disc (V - E + F = {euler}, expected 1)")
+        raise RigidfoldError(f"the crease pattern is not a disc (V - E + F = {euler}, expected 1)")
 
 
 def boundary_half_edges(edges: np.ndarray, edge_faces_: np.ndarray) -> np.ndarray:

@@ -19,6 +19,8 @@ import math
 import mapbox_earcut
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
+
 
 def triangulate_polygons(
     coords: np.ndarray,
@@ -62,7 +64,7 @@ def triangulate_polygons(
         try:
             local_triangles, local_diagonals = triangulate_polygon(xy, area_tol=area_tol)
         except ValueError as exc:
-            raise ValueError(f"{name}[{k}]: {exc}") from None
+            raise RigidfoldError(f"{name}[{k}]: {exc}") from None
         triangles += [[polygon[i] for i in tri] for tri in local_triangles]
         diagonals += [(polygon[a], polygon[b]) for a, b in local_diagonals]
     return np.asarray(triangles, dtype=np.int64).reshape(-1, 3), diagonals
@@ -130,7 +132,7 @@ def triangulate_polygon(
         and all((b, a) in half for (a, b), turn in zip(half, turns, strict=True) if turn != 1)
     )
     if not tiles:
-        raise ValueError("the polygon is degenerate or self-intersecting")
+        raise RigidfoldError("the polygon is degenerate or self-intersecting")
     tri = delaunay_flips(xy, tri, half, area_floor=area_floor, circle_floor=area_tol * size**4)
     return tri, [(a, b) for a, b in half if a < b and (b - a) % n not in (1, n - 1)]
 
@@ -239,7 +241,7 @@ def plane_coords(
     length = np.linalg.norm(normal, axis=1)
     if (length == 0).any():
         k = int(np.argmin(length))
-        raise ValueError(f"{name}[{k}]: the polygon is degenerate (zero area)")
+        raise RigidfoldError(f"{name}[{k}]: the polygon is degenerate (zero area)")
     normal /= length[:, None]
     u = np.cross(normal, np.eye(3)[np.argmin(np.abs(normal), axis=1)])
     u /= np.linalg.norm(u, axis=1, keepdims=True)

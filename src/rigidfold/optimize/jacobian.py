@@ -27,6 +27,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.optimize.hessian import (
     angle_corners,
     coordinate_rows,
@@ -60,7 +61,7 @@ class ClosedFormJacobian:
             blocks.append(self.stencils)
         self.m = n_dz + n_theta + (len(self.stencils) if self.rho_bar is not None else 0)
         if self.m != problem.nlp.g.shape[0]:
-            raise ValueError(f"{self.m} constraint rows, the NLP has {problem.nlp.g.shape[0]}")
+            raise RigidfoldError(f"{self.m} constraint rows, the NLP has {problem.nlp.g.shape[0]}")
         # every element entry: its row of g and its row of P (vertex-major, then x, y, z)
         rows, P_rows, start = [], [], 0
         for vertices in blocks:

@@ -18,6 +18,7 @@ import casadi as ca
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.large import ipopt_solver
 from rigidfold.optimize.nlp import NLP, build_nlp
@@ -151,19 +152,19 @@ class FormFindingProblem:
         arr = np.asarray(fixed)
         if arr.dtype == bool:
             if arr.shape != (E,):
-                raise ValueError(f"fixed mask must have shape ({E},), got {arr.shape}")
+                raise RigidfoldError(f"fixed mask must have shape ({E},), got {arr.shape}")
             mask = arr.copy()
         else:
             idx = arr.astype(np.int64).ravel()
             bad = idx[(idx < 0) | (idx >= E)]
             if len(bad):
-                raise ValueError(f"fixed crease index {int(bad[0])} out of range 0..{E - 1}")
+                raise RigidfoldError(f"fixed crease index {int(bad[0])} out of range 0..{E - 1}")
             mask = np.zeros(E, dtype=bool)
             mask[idx] = True
         on_boundary = mask & self.pattern.is_boundary_edge
         if on_boundary.any():
             e = int(np.flatnonzero(on_boundary)[0])
-            raise ValueError(f"edge {e} is a boundary edge and cannot be fixed")
+            raise RigidfoldError(f"edge {e} is a boundary edge and cannot be fixed")
         return mask
 
     def start_point(self, coords: np.ndarray | None = None) -> np.ndarray:
@@ -191,7 +192,7 @@ class FormFindingProblem:
     def solver(self, name: str) -> Solver:
         """The solver ``name`` (one of ``SOLVERS``) of this problem, built on first use and kept."""
         if name not in SOLVER_FACTORIES:
-            raise ValueError(f"unknown solver {name!r} (choose from {', '.join(SOLVERS)})")
+            raise RigidfoldError(f"unknown solver {name!r} (choose from {', '.join(SOLVERS)})")
         if name not in self._solvers:
             self._solvers[name] = SOLVER_FACTORIES[name](self)
         return self._solvers[name]
@@ -202,6 +203,8 @@ class FormFindingProblem:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
         ``solver`` is one of ``SOLVERS``; the result's ``wall_time`` is that of the solve alone.
+        A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
+        failed: the result is the start, Status.FAILED, its message saying why.
         """
         backend = self.solver(solver)
         mask = self.fixed_mask(fixed)
@@ -213,9 +216,16 @@ class FormFindingProblem:
         wall = time.perf_counter() - t0
         xi = run.xi
         coords = self.map.expand(xi)
+        try:
+            viol = self.violation(coords, mask)
+            status, verdict = None, ""
+        except ValueError as exc:  # the solver's point is no shape: keep the start
+            xi, coords = xi0, self.map.expand(xi0)
+            viol = self.violation(coords, mask)
+            status, verdict = Status.FAILED, f"its point is no shape ({exc}): the start is kept"
         F, F1, F2 = (float(v) for v in self.objective(xi, w))
-        viol = self.violation(coords, mask)
-        status, verdict = classify(run.outcome, F, viol, self.settings)
+        if status is None:
+            status, verdict = classify(run.outcome, F, viol, self.settings)
         return OptimizeResult(
             pattern=CreasePattern(
                 coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings

@@ -27,6 +27,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import mirror_pairs
 from rigidfold.protocols import SymmetryPlane
@@ -211,7 +212,7 @@ def _eliminate_block(
     rank = int(np.sum(diag > settings.linear_rank_tol * largest))
     qc = q.T @ rhs
     if np.abs(qc[rank:]).max(initial=0.0) > settings.constraint_tol:
-        raise ValueError(
+        raise RigidfoldError(
             "the boundary, corner and symmetry constraints (7)-(9) contradict each other for "
             "this shape (is the target surface symmetric about the chosen planes?)"
         )

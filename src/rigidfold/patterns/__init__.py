@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns.files import FILE_FORMATS, PatternFile, is_pattern_file, read_pattern_file
 from rigidfold.patterns.footprint import check_footprint, footprint_mesh, read_footprint
@@ -41,7 +42,7 @@ def build(
     z = np.broadcast_to(np.asarray(surface.height(xy[:, 0], xy[:, 1]), dtype=float), len(xy))
     if not np.isfinite(z).all():
         bad = int(np.flatnonzero(~np.isfinite(z))[0])
-        raise ValueError(
+        raise RigidfoldError(
             f"surface {surface!r} is not finite at (x, y) = ({xy[bad, 0]:g}, {xy[bad, 1]:g})"
         )
     return CreasePattern.from_faces(

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.io.fold import read_fold
 from rigidfold.mesh import geometry
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
@@ -79,7 +80,7 @@ def read_pattern_file(
     path = Path(path)
     kind = FILE_FORMATS.get(path.suffix.lower())
     if kind is None:
-        raise ValueError(
+        raise RigidfoldError(
             f"a crease pattern file is {' or '.join(FILE_FORMATS)}, got {os.fspath(path)!r}"
         )
     if kind == "FOLD":
@@ -99,7 +100,7 @@ def read_pattern_file(
         plan, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
         count = sum(len(polygon) - 2 for polygon in drawing.polygons)  # n - 2 per polygon
         if count > settings.max_pattern_faces:
-            raise ValueError(
+            raise RigidfoldError(
                 f"{path}: its {len(drawing.polygons)} faces make {count} triangles, more than "
                 f"{settings.max_pattern_faces} (Settings.max_pattern_faces)"
             )
@@ -141,17 +142,17 @@ def _scaled(
     width, height = (float(v) for v in np.ptp(xy, axis=0))
     if unit != "unit":
         if size is not None or scale is not None:
-            raise ValueError(
+            raise RigidfoldError(
                 f"{path} is drawn in {unit} ({width:.6g} m x {height:.6g} m): --size and "
                 "--scale are for drawings without units"
             )
         check_extent(width, height, f"{path} (drawn in {unit})", settings)
         return xy, None, per_unit
     if size is not None and scale is not None:
-        raise ValueError(f"{path}: give --size or --scale, not both")
+        raise RigidfoldError(f"{path}: give --size or --scale, not both")
     if scale is not None:
         if not (np.isfinite(scale) and scale > 0):
-            raise ValueError(f"a scale is metres per drawing unit, > 0, got {scale!r}")
+            raise RigidfoldError(f"a scale is metres per drawing unit, > 0, got {scale!r}")
         check_extent(width * scale, height * scale, f"{path} at --scale {scale:g}", settings)
         return xy * scale, None, float(scale)
     box = DEFAULT_SIZE if size is None else size
@@ -169,7 +170,7 @@ def _check_unfolded(xy: np.ndarray, faces: np.ndarray, path: Path, settings: Set
     if bad.size:
         f = int(bad[0])
         how = "upside down (the sheet overlaps itself)" if area[f] < 0 else "vertical (edge-on)"
-        raise ValueError(
+        raise RigidfoldError(
             f"{path}: face {f} {tuple(faces[f].tolist())} is {how} in plan: a folded form "
             "cannot be lifted onto a surface z = f(x, y); give its crease pattern"
         )

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.patterns.grids import check_extent, counter_clockwise
 
 _PAIR = re.compile(r"^\s*(\S+?)\s*(?:,|\s)\s*(\S+)\s*$")
@@ -37,13 +38,13 @@ def read_footprint(text: str, settings: Settings = DEFAULTS) -> np.ndarray:
     else:
         path = Path(text).expanduser()
         if not path.is_file():
-            raise ValueError(
+            raise RigidfoldError(
                 f"mesh footprint {text!r} is neither 'x1,y1;x2,y2;...' nor an existing file"
             )
         try:
             lines = path.read_text(encoding="utf-8").splitlines()
         except (OSError, UnicodeDecodeError) as exc:
-            raise ValueError(f"cannot read footprint file {os.fspath(path)!r}: {exc}") from None
+            raise RigidfoldError(f"cannot read footprint file {os.fspath(path)!r}: {exc}") from None
         where = f"footprint file {os.fspath(path)!r}: line"
     points = []
     for k, line in enumerate(lines, 1):
@@ -55,7 +56,7 @@ def read_footprint(text: str, settings: Settings = DEFAULTS) -> np.ndarray:
                 raise ValueError
             points.append((float(match[1]), float(match[2])))
         except ValueError:
-            raise ValueError(
+            raise RigidfoldError(
                 f"{where} {k} is not an 'x,y' pair of numbers: {line.strip()!r}"
             ) from None
     xy = np.asarray(points, dtype=float).reshape(-1, 2)
@@ -78,14 +79,14 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
 
     xy = np.asarray(xy, dtype=float)
     if xy.ndim != 2 or xy.shape[1] != 2 or len(xy) < 3:
-        raise ValueError(f"a footprint needs at least 3 (x, y) points, got {len(xy)}")
+        raise RigidfoldError(f"a footprint needs at least 3 (x, y) points, got {len(xy)}")
     if not np.isfinite(xy).all():
         bad = int(np.flatnonzero(~np.isfinite(xy).all(axis=1))[0])
-        raise ValueError(f"footprint point {bad + 1} is not finite: {_point(xy[bad])}")
+        raise RigidfoldError(f"footprint point {bad + 1} is not finite: {_point(xy[bad])}")
     far = np.abs(xy).max(axis=1) > settings.max_coordinate  # before any sum could overflow
     if far.any():
         bad = int(np.argmax(far))
-        raise ValueError(
+        raise RigidfoldError(
             f"footprint point {bad + 1} {_point(xy[bad])} lies farther than "
             f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
         )
@@ -95,16 +96,18 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
     if (counts > 1).any():
         again = unique[counts > 1][0]
         repeats = np.flatnonzero((xy == again).all(axis=1)) + 1
-        raise ValueError(
+        raise RigidfoldError(
             f"footprint point {_point(again)} is repeated (points {', '.join(map(str, repeats))})"
         )
     hull = shapely.MultiPoint(xy).convex_hull.area
     if hull <= settings.degenerate_area * np.ptp(xy, axis=0).max() ** 2:
-        raise ValueError(f"the footprint {_points(xy)} has zero area (its points lie on a line)")
+        raise RigidfoldError(
+            f"the footprint {_points(xy)} has zero area (its points lie on a line)"
+        )
     reason = shapely.is_valid_reason(shapely.Polygon(xy))
     if reason != "Valid Geometry":
         where = reason[reason.find("[") :] if "[" in reason else ""
-        raise ValueError(
+        raise RigidfoldError(
             f"the footprint {_points(xy)} is not a simple polygon: its sides intersect "
             f"at {where or 'a point'}"
         )
@@ -132,16 +135,18 @@ def footprint_mesh(
     import triangle
 
     if not (math.isfinite(edge_length) and edge_length > 0):
-        raise ValueError(f"the edge length must be a positive number of metres, got {edge_length}")
+        raise RigidfoldError(
+            f"the edge length must be a positive number of metres, got {edge_length}"
+        )
     if edge_length > settings.max_coordinate:  # its square would overflow
-        raise ValueError(
+        raise RigidfoldError(
             f"the edge length must be at most {settings.max_coordinate:g} m, the largest plan "
             f"(Settings.max_coordinate), got {edge_length:g} m"
         )
     area = abs(_signed_area(xy))
     triangle_area = math.sqrt(3) / 4 * edge_length**2
     if area / triangle_area > settings.max_pattern_faces:
-        raise ValueError(
+        raise RigidfoldError(
             f"edge length {edge_length:g} m makes about {area / triangle_area:.0f} triangles on "
             f"a footprint of {area:g} m^2, more than {settings.max_pattern_faces} "
             "(Settings.max_pattern_faces)"
@@ -149,7 +154,7 @@ def footprint_mesh(
     ends = np.roll(xy, -1, axis=0)
     pieces = np.maximum(1, np.rint(np.hypot(*(ends - xy).T) / edge_length).astype(int))
     if int(pieces.sum()) - 2 > settings.max_pattern_faces:  # n points on the outline: >= n - 2
-        raise ValueError(
+        raise RigidfoldError(
             f"the footprint of {len(xy)} corners, its sides divided at edge length "
             f"{edge_length:g} m, has {int(pieces.sum())} points on its outline: at least "
             f"{int(pieces.sum()) - 2} triangles, more than {settings.max_pattern_faces} "

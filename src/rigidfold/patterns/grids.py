@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import Delaunay
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 
 DIAGONALS = ("centre", "parallel", "alternate")
 """How :func:`grid` splits each rectangle: see its docstring."""
@@ -30,7 +31,7 @@ def check_extent(width: float, height: float, what: str, settings: Settings = DE
     across (its larger side)."""
     across = max(width, height)
     if not settings.min_pattern_size <= across <= settings.max_coordinate:
-        raise ValueError(
+        raise RigidfoldError(
             f"{what} is {width:.3g} m x {height:.3g} m: a crease pattern is "
             f"{settings.min_pattern_size:g} m to {settings.max_coordinate:g} m across "
             "(Settings.min_pattern_size, Settings.max_coordinate)"
@@ -64,12 +65,16 @@ def grid(
     """
     for n in (nx, ny):
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-            raise ValueError(f"a grid needs at least 2 x 2 vertices, got {nx!r} x {ny!r}")
+            raise RigidfoldError(f"a grid needs at least 2 x 2 vertices, got {nx!r} x {ny!r}")
     for name, size in (("width", width), ("height", height)):
         if not (np.isfinite(size) and size > 0):
-            raise ValueError(f"a grid's {name} must be a positive number of metres, got {size!r}")
+            raise RigidfoldError(
+                f"a grid's {name} must be a positive number of metres, got {size!r}"
+            )
     if diagonals not in DIAGONALS:
-        raise ValueError(f"unknown diagonals {diagonals!r} (choose from {', '.join(DIAGONALS)})")
+        raise RigidfoldError(
+            f"unknown diagonals {diagonals!r} (choose from {', '.join(DIAGONALS)})"
+        )
     i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="xy")
     x = np.where(i == nx - 1, width, i * (width / (nx - 1)))  # the far sides exactly
     y = np.where(j == ny - 1, height, j * (height / (ny - 1)))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 
 
@@ -25,7 +26,7 @@ def miura(
     ``height = 0`` gives the flat crease pattern.
     """
     if nx < 1 or ny < 1:
-        raise ValueError(f"a Miura-ori needs at least 1 x 1 cells, got {nx} x {ny}")
+        raise RigidfoldError(f"a Miura-ori needs at least 1 x 1 cells, got {nx} x {ny}")
     gi, gj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="xy")
     i, j = gi.ravel(), gj.ravel()
     coords = np.column_stack([i * length + (j % 2) * offset, j * width, (i % 2) * height])

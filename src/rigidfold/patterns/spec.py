@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.patterns.files import is_pattern_file, read_pattern_file
 from rigidfold.patterns.footprint import default_edge_length, footprint_mesh, read_footprint
 from rigidfold.patterns.grids import (
@@ -131,7 +132,7 @@ def parse_pattern(
         _refuse_options(text, given, keep=("size", "diagonals"))
         counts = _COUNTS.fullmatch(rest)
         if counts is None:
-            raise ValueError(
+            raise RigidfoldError(
                 f"a grid pattern is grid:NXxNY (vertex counts, e.g. grid:15x9), got {text!r}"
             )
         nx, ny = int(counts[1]), int(counts[2])
@@ -160,7 +161,7 @@ def parse_pattern(
         )
         check_faces(len(read.faces), f"pattern {text!r}", settings)
         return Plan(text, read.xy, read.faces, fixed=read.fixed, source=read.source)
-    raise ValueError(f"unknown pattern {spec!r} (choose from {FORMS})")
+    raise RigidfoldError(f"unknown pattern {spec!r} (choose from {FORMS})")
 
 
 def check_faces(count: int, what: str, settings: Settings = DEFAULTS) -> None:
@@ -168,7 +169,7 @@ def check_faces(count: int, what: str, settings: Settings = DEFAULTS) -> None:
     (Settings.max_pattern_faces)"`` when a pattern's real triangle count passes the limit:
     checked after triangulation, before any problem is built on it."""
     if count > settings.max_pattern_faces:
-        raise ValueError(
+        raise RigidfoldError(
             f"{what} has {count} triangles, more than {settings.max_pattern_faces} "
             "(Settings.max_pattern_faces)"
         )
@@ -186,7 +187,9 @@ def parse_size(size: str | tuple[float, float] | None) -> tuple[float, float]:
     except (TypeError, ValueError):
         width = height = float("nan")
     if not (np.isfinite([width, height]).all() and width > 0 and height > 0):
-        raise ValueError(f"a pattern size is WxH in metres with W, H > 0 (e.g. 12x8), got {size!r}")
+        raise RigidfoldError(
+            f"a pattern size is WxH in metres with W, H > 0 (e.g. 12x8), got {size!r}"
+        )
     return width, height
 
 
@@ -194,7 +197,7 @@ def _refuse_options(text: str, given: dict, keep: tuple[str, ...]) -> None:
     """A one-line ValueError for the options given that pattern ``text`` does not take."""
     extra = [name for name, value in given.items() if value is not None and name not in keep]
     if extra:
-        raise ValueError(
+        raise RigidfoldError(
             f"pattern {text!r} takes no {' or '.join(extra)} (a size and diagonals are for "
             "grid:NXxNY patterns, an edge length for mesh:POLYGON, a size, scale and rigid "
             "panels for FOLD and SVG files)"

@@ -33,6 +33,7 @@ h2 { font-size: 1.2em; border-bottom: 1px solid #ddd; padding-bottom: 0.2em; mar
 .ok { background: #e6f4ea; color: #1e6b34; } .bad { background: #fce8e6; color: #a50e0e; }
 .none { background: #f1f3f4; color: #555; }
 .passed { color: #1e6b34; } .FAILED { color: #a50e0e; } .notrun { color: #777; }
+.passedbythefinaldesign { color: #8a5a00; }
 .note { color: #8a5300; }
 table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.9em; }
 th, td { border: 1px solid #ddd; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
@@ -96,6 +97,8 @@ def _answer(run: RunData) -> list[str]:
         outcome = f"target DOF {target} reached"
     elif stop == Stop.RUNNING:
         outcome = "the run has not finished: this is its state so far"
+    elif stop == "interrupted":
+        outcome = "the run was interrupted (Ctrl-C or SIGTERM): this is its state then"
     else:
         outcome = f"target DOF {target} not reached: {s.stop_reason}"
     # green: all done and passed; grey: passed, but a stage did not run or the run goes on
@@ -135,6 +138,13 @@ def _answer(run: RunData) -> list[str]:
     ]
     if run.surface_note:
         out.append(f'<p class="note">{_e(run.surface_note)}: the fit is not shown.</p>')
+    bound = run.at_dz_bound
+    if bound is not None:
+        out.append(
+            f'<p class="note">The final design is at the dz bound: max |z - target| = '
+            f"{bound * 1e3:.1f} mm = dz, as far from the target as --dz allows; a finer "
+            "pattern may approximate the target more closely.</p>"
+        )
     return out
 
 

@@ -10,7 +10,13 @@ import os
 import shutil
 from pathlib import Path
 
-RUN_FILES = ("summary.json", "log.json", "report.html")
+from rigidfold.errors import RigidfoldError
+
+TARGET_FILE = "target_surface.json"
+"""The fitted spline of a mesh target (:meth:`rigidfold.surfaces.SplineSurface.grid`), which
+summary.json names under ``target_surface`` so that the report can show the fit."""
+
+RUN_FILES = ("summary.json", "log.json", "report.html", TARGET_FILE)
 """The files a generation run writes at the top of its directory."""
 
 RUN_DIRS = ("solutions", "figures", "final")
@@ -41,11 +47,11 @@ def lock_run_dir(out: Path) -> Path:
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
         except OSError as exc:
             if path.is_symlink():
-                raise ValueError(
+                raise RigidfoldError(
                     f"cannot lock output directory '{out}': its {LOCK_NAME} is a symbolic "
                     "link, not a rigidfold lock; remove it"
                 ) from None
-            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+            raise RigidfoldError(f"cannot lock output directory '{out}': {exc.strerror}") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX)  # held only while deciding; closing drops it
             try:
@@ -56,7 +62,7 @@ def lock_run_dir(out: Path) -> Path:
                 continue
             pid = _lock_owner(fd)
             if pid is not None and _alive(pid):
-                raise ValueError(
+                raise RigidfoldError(
                     f"output directory '{out}' is in use by another rigidfold run (pid {pid}); "
                     "wait for it to end, or use another --out"
                 )
@@ -64,10 +70,10 @@ def lock_run_dir(out: Path) -> Path:
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
             return path
         except OSError as exc:
-            raise ValueError(f"cannot lock output directory '{out}': {exc.strerror}") from None
+            raise RigidfoldError(f"cannot lock output directory '{out}': {exc.strerror}") from None
         finally:
             os.close(fd)
-    raise ValueError(f"cannot lock output directory '{out}': its lock keeps coming back")
+    raise RigidfoldError(f"cannot lock output directory '{out}': its lock keeps coming back")
 
 
 def _lock_owner(fd: int) -> int | None:
@@ -113,7 +119,7 @@ def clear_earlier_run(
     out = Path(out)
     found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
     if found and not overwrite:
-        raise ValueError(
+        raise RigidfoldError(
             f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
             "give --overwrite to replace it, or another --out"
         )
@@ -131,7 +137,7 @@ def clear_earlier_run(
                 )
             )
             if doomed:
-                raise ValueError(
+                raise RigidfoldError(
                     f"--overwrite would remove the input file '{given}' with the earlier run's "
                     f"{path.name}: copy it out of '{out}' first, or use another --out"
                 )
@@ -142,7 +148,7 @@ def clear_earlier_run(
             else:
                 path.unlink(missing_ok=True)
     except OSError as exc:
-        raise ValueError(
+        raise RigidfoldError(
             f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"
         ) from None
     return out

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.config import DEFAULTS
+from rigidfold.errors import RigidfoldError
 from rigidfold.io import parse_json, read_fold, read_frames
 from rigidfold.protocols import TargetSurface
 from rigidfold.run.schema import (
@@ -29,7 +31,7 @@ from rigidfold.run.schema import (
     check_shape,
     received,
 )
-from rigidfold.surfaces import Bezier, get_surface
+from rigidfold.surfaces import Bezier, SplineSurface, get_surface
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,16 +116,23 @@ def target_surface(metadata: dict) -> tuple[TargetSurface | None, str]:
 class Check:
     """One verification stage over the run's solutions.
 
-    name : str; passed : True, False, or None when the stage did not run; detail : str.
+    name : str; passed : True, False, or None when the stage did not run; detail : str;
+    failed_steps : the steps of the solutions it failed on; earlier : it failed on earlier
+    solutions only, not on the final design (then ``passed`` is the final design's: True).
     """
 
     name: str
     passed: bool | None
     detail: str
+    failed_steps: tuple = ()
+    earlier: bool = False
 
     @property
     def word(self) -> str:
-        """ "passed", "FAILED" or "not run"."""
+        """ "passed", "passed by the final design" (failed on earlier solutions), "FAILED"
+        or "not run"."""
+        if self.passed and self.earlier:
+            return "passed by the final design"
         return {True: "passed", False: "FAILED", None: "not run"}[self.passed]
 
 
@@ -156,6 +165,19 @@ class RunData:
         return self.designs[-1]
 
     @property
+    def at_dz_bound(self) -> float | None:
+        """The final design's max |z - target| (metres, summary.json's ``fit``) where it is at
+        the dz bound (within ``Settings.dz_bound_tol`` of ``case.dz_m``), else None."""
+        final, dz = self.final, self.summary.case.get("dz_m")
+        rows = self.summary.per_solution
+        if final is None or dz is None or not 0 <= final.step < len(rows):
+            return None
+        reached = (rows[final.step].fit or {}).get("max_abs_dz_m")
+        if reached is None or reached < dz * (1 - DEFAULTS.dz_bound_tol):
+            return None
+        return float(reached)
+
+    @property
     def target_dof(self) -> int | None:
         return self.summary.target_dof
 
@@ -172,7 +194,19 @@ class RunData:
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
         solution, from ``summary.json``'s ``per_solution``
-        (:meth:`rigidfold.run.SolutionRecord.passed`)."""
+        (:meth:`rigidfold.run.SolutionRecord.passed`). A stage that failed on earlier
+        solutions only, not on the final design, passed (as generate's verdict judges), and
+        says at which steps it failed."""
+        final = None if self.final is None else self.final.step
+        return [
+            Check(c.name, True, f"{c.detail} (not the final design)", c.failed_steps, True)
+            if c.passed is False and final is not None and final not in c.failed_steps
+            else c
+            for c in self._stages()
+        ]
+
+    def _stages(self) -> list[Check]:
+        """:meth:`checks` as every solution counts."""
         rows = self.summary.per_solution
         n = len(rows)
         dev = [r.development or {} for r in rows]
@@ -186,6 +220,7 @@ class RunData:
                 f"{sum(max(d.get('flipped') or 0, 0) for d in dev)} flipped, "
                 f"{sum(max(d.get('overlaps') or 0, 0) for d in dev)} overlapping, "
                 f"max D = {max_d:.2g}" + _steps(bad),
+                tuple(bad),
             )
         ]
         motions = [r.motion for r in rows if r.motion is not None]
@@ -199,6 +234,7 @@ class RunData:
                 f"max |dl|/l = {err:.2g}" + _steps(bad)
                 if motions
                 else "no motion was traced",
+                tuple(bad),
             )
         )
         deformed = [r.deformation for r in rows if r.deformation is not None]
@@ -213,6 +249,7 @@ class RunData:
                 f"= {max(d.get('max_drho_fix_deg') or 0.0 for d in deformed):.3g} deg" + _steps(bad)
                 if deformed
                 else "Step 9 did not run (--no-deform)",
+                tuple(bad),
             )
         )
         return checks
@@ -233,7 +270,7 @@ def _checked(checked: int, solutions: int) -> str:
 
 
 def _steps(bad: list) -> str:
-    return f" (failed at step {', '.join(map(str, bad))})" if bad else ""
+    return f"; failed at step {', '.join(map(str, bad))}" if bad else ""
 
 
 def load_run(directory: str | os.PathLike) -> RunData:
@@ -247,16 +284,18 @@ def load_run(directory: str | os.PathLike) -> RunData:
     """
     root = Path(directory)
     if not root.is_dir():
-        raise ValueError(f"{str(root)!r} is not a directory (give the --out of rigidfold generate)")
+        raise RigidfoldError(
+            f"{str(root)!r} is not a directory (give the --out of rigidfold generate)"
+        )
     summary = RunSummary.from_dict(_json_object(root, "summary.json"), root / "summary.json")
     log = _json_object(root, "log.json")
     if not isinstance(log.get("attempts"), list):
-        raise ValueError(f"{str(root / 'log.json')!r} has no list of attempts")
+        raise RigidfoldError(f"{str(root / 'log.json')!r} has no list of attempts")
     check_shape(log, LOG_SHAPE, root / "log.json")
     attempts = tuple(AttemptRecord.from_dict(a, k) for k, a in enumerate(log["attempts"]))
     for k, attempt in enumerate(attempts):
         if attempt.outcome == "accepted" and attempt.dof is None:
-            raise ValueError(
+            raise RigidfoldError(
                 f"'{root / 'log.json'}': 'attempts[{k}].dof' is null, expected a whole number "
                 "(an accepted shape has a DOF)"
             )
@@ -265,16 +304,36 @@ def load_run(directory: str | os.PathLike) -> RunData:
     for k, name in enumerate(names):
         parts = Path(name).parts
         if not parts or Path(name).is_absolute() or ".." in parts:
-            raise ValueError(
+            raise RigidfoldError(
                 f"'{root / 'summary.json'}': 'solutions[{k}]' is {received(name)}, expected "
                 "a file in the run's directory"
             )
         path = root / name
         if not path.is_file():
-            raise ValueError(f"solution file {str(path)!r} listed in summary.json is missing")
+            raise RigidfoldError(f"solution file {str(path)!r} listed in summary.json is missing")
         designs.append(read_solution(path, name))
     surface, note = target_surface(summary.case.get("surface") or {})
+    if surface is None and summary.target_surface is not None:
+        surface, note = _stored_surface(root, summary.target_surface)
     return RunData(root, summary, attempts, tuple(designs), surface, note)
+
+
+def _stored_surface(root: Path, name: str) -> tuple[TargetSurface | None, str]:
+    """(surface, "") of the fitted spline of a mesh target that the run stored in the file
+    ``name`` of its directory (summary.json's ``target_surface``), or (None, why not)."""
+    parts = Path(name).parts
+    if len(parts) != 1 or parts[0] in (".", ".."):
+        return None, f"the target surface could not be rebuilt: {name!r} is not a file name"
+    if not (root / name).is_file():
+        return None, f"the target surface could not be rebuilt: its file {name} is missing"
+    try:
+        grid = _json_object(root, name)
+        x, y, z = grid.get("x"), grid.get("y"), grid.get("z")
+        return SplineSurface(x, y, z, source=str(grid.get("source", "mesh"))), ""
+    except ValueError as exc:
+        return None, (
+            f"the target surface could not be rebuilt from {name} ({' '.join(str(exc).split())})"
+        )
 
 
 def _json_object(root: Path, name: str) -> dict:
@@ -282,11 +341,11 @@ def _json_object(root: Path, name: str) -> dict:
     try:
         data = parse_json(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise ValueError(
+        raise RigidfoldError(
             f"{str(root)!r} is not a rigidfold generate run: it has no {name}"
         ) from None
     except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise ValueError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
+        raise RigidfoldError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
     if not isinstance(data, dict):
-        raise ValueError(f"{str(path)!r} is not a JSON object")
+        raise RigidfoldError(f"{str(path)!r} is not a JSON object")
     return data

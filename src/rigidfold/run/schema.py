@@ -21,6 +21,7 @@ import numpy as np
 
 from rigidfold.deform import DeformStatus, MotionStatus, Verification
 from rigidfold.develop import DevelopStatus
+from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop
 from rigidfold.status import Outcome
 
@@ -90,6 +91,7 @@ SUMMARY_SHAPE = Record(
                     "verdicts": Nullable(
                         Record({"agreement": Nullable(str), "reason": Nullable(str)})
                     ),
+                    "fit": Nullable(Record({"max_abs_dz_m": _NUMBERS})),
                 }
             )
         ],
@@ -111,6 +113,7 @@ SUMMARY_SHAPE = Record(
         ),
         "options": Nullable(Record({"target_dof": Nullable(int)})),
         "verdict": Nullable(Record({"outcome": str, "message": str}, ("outcome", "message"))),
+        "target_surface": Nullable(str),
     },
     ("stop", "stop_reason", "final_dof", "N_lock", "solutions", "per_solution", "case"),
 )
@@ -160,12 +163,14 @@ def check_shape(value, shape, file: str | os.PathLike, where: str = "") -> None:
             continue
         if not _has_shape(value, shape):
             key = f"{where!r}" if where else "the document"
-            raise ValueError(f"'{file}': {key} is {received(value)}, expected {_expected(given)}")
+            raise RigidfoldError(
+                f"'{file}': {key} is {received(value)}, expected {_expected(given)}"
+            )
         if isinstance(shape, Record):
             missing = [k for k in shape.required if k not in value]
             if missing:
                 key = f"{where!r}" if where else "the document"
-                raise ValueError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
+                raise RigidfoldError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
             stack += [
                 (value[k], s, f"{where}.{k}" if where else k)
                 for k, s in reversed(shape.keys.items())
@@ -398,7 +403,9 @@ class RunSummary:
     the flat state; solutions : the solution files, relative to the run's directory;
     per_solution : their records; case, options : the case's metadata and the generate
     options as written; verdict : the verdict's dict, None while the run goes on;
-    document : the whole file (for tables of everything it holds).
+    target_surface : the file in the run's directory that holds a mesh target's fitted
+    spline (``TARGET_FILE``), None for other targets; document : the whole file (for tables
+    of everything it holds).
     """
 
     stop: str
@@ -417,6 +424,7 @@ class RunSummary:
     case: dict
     options: dict
     verdict: dict | None
+    target_surface: str | None
     document: dict
 
     @classmethod
@@ -425,7 +433,7 @@ class RunSummary:
         file and the key) when what is read does not have the shape it must have."""
         missing = [k for k in SUMMARY_SHAPE.required if k not in data]
         if missing:
-            raise ValueError(
+            raise RigidfoldError(
                 f"{str(file)!r} is not the summary of rigidfold generate (no {', '.join(missing)})"
             )
         check_shape(data, SUMMARY_SHAPE, file)
@@ -446,6 +454,7 @@ class RunSummary:
             case=data["case"],
             options=data.get("options") or {},
             verdict=data.get("verdict"),
+            target_surface=data.get("target_surface"),
             document=data,
         )
 

@@ -49,6 +49,15 @@ class RunVerdict:
         }
 
 
+SOLVE_HINT = (
+    "to try: a larger --dz (the distance allowed from the surface), wider --theta-min / "
+    "--theta-max (the sector-angle bounds), or another triangulation (--diagonals parallel or "
+    "alternate for a grid)"
+)
+"""What the command line suggests when problem (6) has no accepted solution from the target
+surface (``generate``'s verdict, ``optimize``'s last line)."""
+
+
 def run_verdict(
     run: Generation, records: list[SolutionRecord], files: list[Path], target: int
 ) -> RunVerdict:
@@ -56,8 +65,9 @@ def run_verdict(
     DOF 0 for a target of 0) and every check that ran on the final design
     (:attr:`rigidfold.generate.Generation.final`) passed: development diagram converged,
     folding motion traced, large deformation reached the plane. A check that failed on
-    another solution is a warning. With the deployability check, a run that fell short
-    says so when no deployable design was found at a lower DOF (N_path > 0).
+    another solution is a warning, and so is a target at or above the initial DOF (no crease
+    fixed) and a DOF-0 final design (it does not fold). With the deployability check, a run
+    that fell short says so when no deployable design was found at a lower DOF (N_path > 0).
 
     records : each solution's checks, in the order of ``files`` (their FOLD paths, relative
     to the run's DIR); :meth:`SolutionRecord.failed_stages` says what failed.
@@ -67,7 +77,8 @@ def run_verdict(
     final = run.final
     k = -1 if final is None else final.step
     if final is None:
-        short.append(f"no solution: {run.stop_reason}")
+        hint = f" ({SOLVE_HINT})" if run.stop is Stop.INITIAL_FAILED else ""
+        short.append(f"no solution: {run.stop_reason}{hint}")
     elif not reached:
         short.append(
             f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"
@@ -86,6 +97,16 @@ def run_verdict(
             for stage in record.failed_stages():
                 earlier[stage].append(path.name)
     warnings = tuple(f"{s.message} for {', '.join(n)}" for s, n in earlier.items() if n)
+    if run.initial_dof is not None and run.initial_dof <= target:
+        warnings += (
+            f"the initial DOF {run.initial_dof} is already at or below the target DOF "
+            f"{target}: no crease was fixed",
+        )
+    if final is not None and final.mechanism.dof == 0 and reached:
+        warnings += (
+            "a DOF-0 design has no mechanism: it does not fold (no folding motion or "
+            "large-deformation check)",
+        )
     return RunVerdict(
         RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
         tuple(short),

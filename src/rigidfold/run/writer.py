@@ -18,7 +18,7 @@ import numpy as np
 from rigidfold.case import Case
 from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.exports import export_design
-from rigidfold.generate import Attempt, GenerateOptions, Generation, Solution
+from rigidfold.generate import Attempt, GenerateOptions, Generation, Solution, Stop
 from rigidfold.io import (
     FoldData,
     crease_pattern_frame,
@@ -32,9 +32,10 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
-from rigidfold.run.lock import RUN_FILES, clear_earlier_run, lock_run_dir
+from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
 from rigidfold.run.schema import SolutionRecord, aggregate
 from rigidfold.run.verdict import RunVerdict, run_verdict
+from rigidfold.surfaces import SplineSurface
 
 
 def verification_frames(pattern: CreasePattern, check: Verification) -> list[dict]:
@@ -120,6 +121,10 @@ class RunWriter:
         try:
             clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
             self.solutions_dir = prepare_output_dir(self.out / "solutions")
+            self.target_file: str | None = None  # a mesh target's spline, for the report
+            if isinstance(case.surface, SplineSurface):
+                write_json(self.out / TARGET_FILE, case.surface.grid())
+                self.target_file = TARGET_FILE
         except ValueError:
             self.release()
             raise
@@ -145,6 +150,16 @@ class RunWriter:
         verdicts = self.records[step].verdicts
         return None if verdicts is None else verdicts["line"]
 
+    def interrupted(self, run: Generation | None) -> None:
+        """Write summary.json of a run stopped by Ctrl-C or SIGTERM: ``run`` (None when it
+        was stopped before its first attempt ended) with the stop INTERRUPTED and no
+        verdict."""
+        if run is None:
+            run = Generation()
+        run.stop, run.stop_detail = Stop.INTERRUPTED, ""
+        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
+        self.write_summary(run)
+
     def release(self) -> None:
         """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""
         self.lock.unlink(missing_ok=True)
@@ -166,10 +181,10 @@ class RunWriter:
         SVG files; its record replaces ``records[solution.step]``. Returns the FOLD path."""
         dof = solution.mechanism.dof
         pattern = solution.result.pattern
-        check = verify(
+        check = verify(  # a DOF-0 shape (a target of 0) has no motion to trace or check
             pattern,
-            run_deform=deform,
-            run_motion=motion,
+            run_deform=deform and dof > 0,
+            run_motion=motion and dof > 0,
             dof=dof,
             path=solution.path,
             support_face=self.options.support_face,
@@ -249,5 +264,6 @@ class RunWriter:
                 "solutions": [str(p.relative_to(self.out)) for p in self.files],
                 "verdict": None if self.verdict is None else self.verdict.to_dict(),
                 "exports": [str(p.relative_to(self.out)) for p in self.exports],
+                "target_surface": self.target_file,
             },
         )

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.mechanism import Mechanism
 from rigidfold.mechanism.stiffness import PseudoStiffness, hinge_stiffness
 
@@ -54,7 +55,7 @@ class Scores:
             return self.S_S
         if criterion == "random":
             return np.full(len(self.hinges), np.nan)
-        raise ValueError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
+        raise RigidfoldError(f"unknown criterion {criterion!r} (choose from {', '.join(CRITERIA)})")
 
 
 def _ratio(num: np.ndarray, den: np.ndarray) -> np.ndarray:

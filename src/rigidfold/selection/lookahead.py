@@ -60,6 +60,7 @@ from functools import cached_property
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.mechanism import Mechanism
 
 
@@ -140,7 +141,7 @@ def group_bases(
     H_phi = np.asarray(H_phi, dtype=float)
     members = np.asarray(members, dtype=np.int64)
     if members.ndim != 2 or H_phi.ndim != 2:
-        raise ValueError(
+        raise RigidfoldError(
             f"need H_phi (h, d) and members (n, k), got {H_phi.shape} and {members.shape}"
         )
     rows = np.where(members >= 0, members, 0)
@@ -232,7 +233,7 @@ def _rows(groups: tuple[tuple[int, ...], ...], hinges: np.ndarray, n_edges: int)
     if (rows < 0).any() or (sizes == 0).any():
         owner = np.repeat(np.arange(len(groups)), sizes)
         bad = int(np.concatenate([owner[rows < 0], np.flatnonzero(sizes == 0)]).min())
-        raise ValueError(f"candidate {list(groups[bad])} is not a set of free creases")
+        raise RigidfoldError(f"candidate {list(groups[bad])} is not a set of free creases")
     if (sizes == 1).all():
         return rows[:, None]
     owner = np.repeat(np.arange(len(groups)), sizes)
@@ -361,7 +362,7 @@ def lookahead_order(
     iteration reaches them.
     """
     if block < 1:
-        raise ValueError(f"block must be >= 1, got {block}")
+        raise RigidfoldError(f"block must be >= 1, got {block}")
     known = locked_before or {}
     put_off: list[Choice] = []
     moving: list[Choice] = []  # put off, leaving a mechanism: a group may close one of its modes

@@ -15,6 +15,8 @@ import os
 import socket
 from pathlib import Path
 
+from rigidfold.errors import RigidfoldError
+
 
 class StudyLock:
     """An exclusive lock on the study database ``db``, held until :meth:`release`."""
@@ -28,7 +30,7 @@ class StudyLock:
                     self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644
                 )
             except OSError as exc:
-                raise ValueError(
+                raise RigidfoldError(
                     f"{str(db)!r}: cannot create its lock file {str(self.path)!r}: {exc.strerror}"
                 ) from None
             try:
@@ -37,7 +39,7 @@ class StudyLock:
                 holder = os.read(fd, 200).decode(errors="replace").split()
                 os.close(fd)
                 who = f"pid {' on '.join(holder[:2])}" if holder else f"lock {str(self.path)!r}"
-                raise ValueError(
+                raise RigidfoldError(
                     f"{str(db)!r} is in use by another rigidfold study ({who}); wait for it "
                     "or use another --db"
                 ) from None
@@ -50,7 +52,7 @@ class StudyLock:
         except OSError as exc:  # a full disk
             self.path.unlink(missing_ok=True)
             os.close(fd)
-            raise ValueError(
+            raise RigidfoldError(
                 f"{str(db)!r}: cannot write its lock file {str(self.path)!r}: {exc.strerror}"
             ) from None
         self._fd: int | None = fd

@@ -19,6 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
+from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
@@ -88,16 +89,16 @@ def plan(
         parse_pattern(p, settings=settings)
     for c in criteria:
         if c not in CRITERIA:
-            raise ValueError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
+            raise RigidfoldError(f"unknown criterion {c!r} (choose from {', '.join(CRITERIA)})")
     if surfaces < 1:
-        raise ValueError(f"--surfaces must be >= 1, got {surfaces}")
+        raise RigidfoldError(f"--surfaces must be >= 1, got {surfaces}")
     check_seed(first_seed, "--first-seed")
     check_seed(first_seed + surfaces - 1, "--first-seed + --surfaces - 1 (the last seed)")
     if not patterns or not criteria:
-        raise ValueError("at least one pattern and one criterion are needed")
+        raise RigidfoldError("at least one pattern and one criterion are needed")
     runs = surfaces * len(patterns) * len(criteria)
     if runs > settings.max_study_runs:
-        raise ValueError(
+        raise RigidfoldError(
             f"--surfaces {surfaces} makes {runs} runs ({surfaces} surfaces x {len(patterns)} "
             f"patterns x {len(criteria)} criteria), more than the limit of "
             f"{settings.max_study_runs} (Settings.max_study_runs)"
@@ -119,7 +120,7 @@ def preset(name: str) -> list[Key]:
     names = [n.strip() for n in name.split(",") if n.strip()]
     for n in names or [name]:
         if n not in PRESETS:
-            raise ValueError(f"unknown preset {n!r} (choose from {', '.join(PRESETS)})")
+            raise RigidfoldError(f"unknown preset {n!r} (choose from {', '.join(PRESETS)})")
     keys = [k for n in dict.fromkeys(names) for k in PRESETS[n]]
     return sorted(keys, key=lambda k: k.symmetric)
 
@@ -307,12 +308,12 @@ def check_workers(workers: int) -> None:
     """ValueError unless ``workers`` local Dask workers are at least 1 and at most
     :func:`max_workers`, naming the limit."""
     if isinstance(workers, bool) or not isinstance(workers, int):
-        raise ValueError(f"--workers must be a whole number, got {workers!r}")
+        raise RigidfoldError(f"--workers must be a whole number, got {workers!r}")
     if workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {workers}")
+        raise RigidfoldError(f"--workers must be >= 1, got {workers}")
     limit, reason = max_workers()
     if workers > limit:
-        raise ValueError(
+        raise RigidfoldError(
             f"--workers {workers} is more than this machine runs: at most {limit} local "
             f"workers ({reason}); use --scheduler for a larger cluster"
         )
@@ -321,9 +322,9 @@ def check_workers(workers: int) -> None:
 def check_connect_timeout(timeout: float) -> None:
     """ValueError unless ``timeout`` (``--connect-timeout``) is a finite number > 0."""
     if isinstance(timeout, bool) or not isinstance(timeout, int | float):
-        raise ValueError(f"--connect-timeout must be a number of seconds, got {timeout!r}")
+        raise RigidfoldError(f"--connect-timeout must be a number of seconds, got {timeout!r}")
     if not (math.isfinite(timeout) and timeout > 0):
-        raise ValueError(
+        raise RigidfoldError(
             f"--connect-timeout must be a finite number of seconds > 0, got {timeout:g}"
         )
 
@@ -350,7 +351,7 @@ def connect(scheduler: str, timeout: float):
         return Client(scheduler, timeout=timeout)
     except (OSError, ValueError) as exc:  # TimeoutError is an OSError
         reason = str(exc) or "no Dask handshake (is it a Dask scheduler?)"
-        raise ValueError(
+        raise RigidfoldError(
             f"cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s: {reason}"
         ) from None
 
@@ -367,7 +368,7 @@ def check_worker_numerics(keys: dict[str, str], expected: str) -> None:
     not ``expected``."""
     for address, key in sorted(keys.items()):
         if key != expected:
-            raise ValueError(
+            raise RigidfoldError(
                 f"Dask worker {address} computes with numerics {key!r}, this process with "
                 f"{expected!r}: start the workers with `python -m rigidfold.pinned "
                 "dask worker ...` on machines with the same library versions, or pass "

@@ -24,6 +24,7 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop
 from rigidfold.study.lock import StudyLock
 
@@ -166,7 +167,7 @@ def run_stop(status: str) -> Stop | None:
     return Stop.from_reason(status)[0]
 
 
-class StoreWriteError(ValueError):
+class StoreWriteError(RigidfoldError):
     """A study database could not be written (a full disk, a read-only file): the run or
     command being written is not stored, every run stored before is (one transaction each)."""
 
@@ -301,18 +302,20 @@ class Store:
         self._allow_mixed = allow_mixed_numerics
         if readonly:
             if config is not None or numerics is not None:
-                raise ValueError("a study database opened read-only takes no configuration")
+                raise RigidfoldError("a study database opened read-only takes no configuration")
             if not self.path.is_file():
-                raise ValueError(f"no study database at {str(self.path)!r}")
+                raise RigidfoldError(f"no study database at {str(self.path)!r}")
             self.db = self._connect_readonly()
             self._check(self.db)
             self._attempt_columns = self._columns("attempts")
             return
         if self.path.is_dir():
-            raise ValueError(f"database path {str(self.path)!r} is a directory")
+            raise RigidfoldError(f"database path {str(self.path)!r} is a directory")
         parent = self.path.parent if str(self.path.parent) else Path(".")
         if not parent.is_dir():
-            raise ValueError(f"cannot create study database {str(self.path)!r}: no such directory")
+            raise RigidfoldError(
+                f"cannot create study database {str(self.path)!r}: no such directory"
+            )
         self._lock = StudyLock(self.path)
         try:
             if self.path.exists() and self.path.stat().st_size > 0:
@@ -375,7 +378,7 @@ class Store:
                 state.append(None)
                 continue
             except OSError as exc:
-                raise ValueError(f"{str(self.path)!r}: cannot open: {exc.strerror}") from None
+                raise RigidfoldError(f"{str(self.path)!r}: cannot open: {exc.strerror}") from None
             state.append((st.st_ino, st.st_size, st.st_mtime_ns))
         return tuple(state)
 
@@ -385,16 +388,16 @@ class Store:
         cannot make the ``-shm`` it needs), else a damaged file."""
         name = str(self.path)
         if getattr(exc, "sqlite_errorname", "") != "SQLITE_CANTOPEN":
-            return ValueError(f"{name!r}: damaged SQLite file: {exc}")
+            return RigidfoldError(f"{name!r}: damaged SQLite file: {exc}")
         if not os.access(self.path, os.R_OK):
-            return ValueError(f"{name!r}: cannot open: no permission to read it")
+            return RigidfoldError(f"{name!r}: cannot open: no permission to read it")
         if not os.access(self.path.parent if str(self.path.parent) else ".", os.W_OK):
-            return ValueError(
+            return RigidfoldError(
                 f"{name!r}: cannot read its write-ahead log ({self.path.name}-wal) in a "
                 f"read-only directory: SQLite needs to create {self.path.name}-shm beside it; "
                 "copy the database with its -wal file to a writable directory"
             )
-        return ValueError(f"{name!r}: cannot open: {exc}")
+        return RigidfoldError(f"{name!r}: cannot open: {exc}")
 
     def _open_writable(self, config: dict | None) -> None:
         try:
@@ -422,7 +425,7 @@ class Store:
                 )
             self.db.commit()
         except sqlite3.Error as exc:
-            raise ValueError(f"cannot open study database {str(self.path)!r}: {exc}") from None
+            raise RigidfoldError(f"cannot open study database {str(self.path)!r}: {exc}") from None
 
     def _check(self, con: sqlite3.Connection, config: dict | None = None) -> None:
         """Refuse, reading ``con`` only, a damaged SQLite file, one without the tables and
@@ -434,18 +437,18 @@ class Store:
             verdict = con.execute("PRAGMA quick_check").fetchone()[0]
             if verdict != "ok":
                 first = [line for line in verdict.splitlines() if not line.startswith("***")]
-                raise ValueError(f"{name!r}: damaged SQLite file: {(first or [verdict])[0]}")
+                raise RigidfoldError(f"{name!r}: damaged SQLite file: {(first or [verdict])[0]}")
             for table, columns in schema_columns().items():
                 have = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
                 if not have and table == "invocations":  # older databases lack it
                     continue
                 if not have:
-                    raise ValueError(
+                    raise RigidfoldError(
                         f"{name!r}: not a rigidfold study database: no table {table!r}"
                     )
                 for column, kind in columns.items():
                     if column not in have and column not in ADDED_COLUMNS.get(table, {}):
-                        raise ValueError(
+                        raise RigidfoldError(
                             f"{name!r}: not a rigidfold study database: table {table!r} "
                             f"lacks column {column!r}"
                         )
@@ -455,28 +458,28 @@ class Store:
                             f"WHERE typeof({column}) NOT IN ('integer', 'real', 'null') LIMIT 1"
                         ).fetchone()
                         if bad is not None:
-                            raise ValueError(
+                            raise RigidfoldError(
                                 f"{name!r}: not a rigidfold study database: {table}.{column} "
                                 f"holds {bad[0]!r}, not a number"
                             )
             row = con.execute("SELECT value FROM meta WHERE key='config'").fetchone()
         except sqlite3.Error as exc:
-            raise ValueError(f"{name!r}: damaged SQLite file: {exc}") from None
+            raise RigidfoldError(f"{name!r}: damaged SQLite file: {exc}") from None
         try:
             stored = None if row is None else json.loads(row[0])
         except (TypeError, json.JSONDecodeError):
             stored = "?"
         if row is not None and not isinstance(stored, dict):
-            raise ValueError(
+            raise RigidfoldError(
                 f"{name!r}: not a rigidfold study database: its config is not a JSON object"
             )
         if config is None:
             return
         if stored is None:
-            raise ValueError(f"{name!r}: not a rigidfold study database (no config)")
+            raise RigidfoldError(f"{name!r}: not a rigidfold study database (no config)")
         diff = config_differences(stored, json.loads(json.dumps(config)))
         if diff:
-            raise ValueError(
+            raise RigidfoldError(
                 f"{name!r} holds a study with another configuration "
                 f"(differs in: {', '.join(diff)}); use another --db"
             )
@@ -490,7 +493,7 @@ class Store:
             row = con.execute("SELECT value FROM meta WHERE key='numerics'").fetchone()
             n_runs = con.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
         except sqlite3.Error as exc:
-            raise ValueError(f"{name!r}: damaged SQLite file: {exc}") from None
+            raise RigidfoldError(f"{name!r}: damaged SQLite file: {exc}") from None
         try:
             stored = None if row is None else json.loads(row[0])
         except (TypeError, json.JSONDecodeError):
@@ -503,7 +506,7 @@ class Store:
             if stored_key
             else "numerics that were not recorded (an earlier rigidfold)"
         )
-        raise ValueError(
+        raise RigidfoldError(
             f"{name!r} holds runs computed with {was}, this machine computes with "
             f"{current.get('key')!r}: mixing them makes the study depend on the machines; "
             "use another --db, or pass --allow-mixed-numerics"
@@ -549,7 +552,7 @@ class Store:
                 key.row() + tuple(run.get(f) for f in RUN_FIELDS),
             ).rowcount
             if not added:
-                raise ValueError(f"{str(self.path)!r} already holds the run {key.row()}")
+                raise RigidfoldError(f"{str(self.path)!r} already holds the run {key.row()}")
             names = ("study", "seed", "pattern", "criterion", "symmetric", *ATTEMPT_FIELDS)
             self.db.executemany(
                 f"INSERT INTO attempts ({', '.join(names)}) VALUES ({', '.join('?' * len(names))})",
@@ -646,7 +649,9 @@ class Store:
         """
         unknown = [c for c in columns if c not in ATTEMPT_FIELDS]
         if unknown:
-            raise ValueError(f"unknown attempt columns {unknown} (choose from {ATTEMPT_FIELDS})")
+            raise RigidfoldError(
+                f"unknown attempt columns {unknown} (choose from {ATTEMPT_FIELDS})"
+            )
         selected = [c if c in self._attempt_columns else f"NULL AS {c}" for c in columns]
         decode = [c in JSON_ATTEMPT_FIELDS for c in columns]
         cur = self.db.execute(

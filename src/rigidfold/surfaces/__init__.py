@@ -11,11 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.surfaces.builtin import Bezier, Dome, HyperbolicParaboloid, MirrorPlane, Surface
 from rigidfold.surfaces.expression import ExpressionSurface, parse_expression
 from rigidfold.surfaces.mesh import (
     MESH_FORMATS,
     MeshSurface,
+    SplineSurface,
     mesh_surface,
     read_mesh,
     sample_mesh,
@@ -50,13 +52,13 @@ def get_surface(
         return HyperbolicParaboloid(box=box)
     if name == "expr":
         if expr is None:
-            raise ValueError("surface 'expr' needs an expression z = f(x, y)")
+            raise RigidfoldError("surface 'expr' needs an expression z = f(x, y)")
         return ExpressionSurface(expr)
     kind, colon, path = str(name).partition(":")
     if colon and kind.strip().lower() == "mesh" and path.strip():
         vertices, triangles = read_mesh(path.strip(), up=up, settings=settings)
         return placed_mesh(vertices, triangles, source=Path(path.strip()).name, settings=settings)
-    raise ValueError(f"unknown surface {name!r} (choose from {SURFACE_FORMS})")
+    raise RigidfoldError(f"unknown surface {name!r} (choose from {SURFACE_FORMS})")
 
 
 def placed_mesh(
@@ -83,6 +85,7 @@ __all__ = [
     "HyperbolicParaboloid",
     "MeshSurface",
     "MirrorPlane",
+    "SplineSurface",
     "Surface",
     "get_surface",
     "mesh_surface",

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from rigidfold.config import DEFAULT_SEED, check_seed
+from rigidfold.errors import RigidfoldError
 
 
 @dataclass(frozen=True)
@@ -32,7 +33,7 @@ class MirrorPlane:
 
     def __post_init__(self) -> None:
         if not np.isfinite([self.a, self.b, self.c]).all() or self.a == self.b == 0:
-            raise ValueError(f"not a mirror plane: {self.a} x + {self.b} y + {self.c} = 0")
+            raise RigidfoldError(f"not a mirror plane: {self.a} x + {self.b} y + {self.c} = 0")
 
     def signed_distance(self, xy: np.ndarray) -> np.ndarray:
         """Distance of plan points (N, 2) from the plane, positive where a x + b y + c > 0.  (N,)"""
@@ -137,7 +138,9 @@ class Bezier(Surface):
         """A patch with given control heights h (4, 4) over the plan box (W, H)."""
         h = np.asarray(heights, dtype=float)
         if h.shape != (4, 4) or not np.isfinite(h).all():
-            raise ValueError(f"Bezier control heights must be a finite (4, 4) array, got {h.shape}")
+            raise RigidfoldError(
+                f"Bezier control heights must be a finite (4, 4) array, got {h.shape}"
+            )
         surface = cls.__new__(cls)
         surface.seed, surface.heights, surface.box = None, h, _box(box)
         return surface
@@ -287,9 +290,9 @@ def _box(box: tuple[float, float]) -> tuple[float, float]:
     try:
         width, height = (float(v) for v in box)
     except (TypeError, ValueError):
-        raise ValueError(f"a plan box is (W, H) in metres, got {box!r}") from None
+        raise RigidfoldError(f"a plan box is (W, H) in metres, got {box!r}") from None
     if not (np.isfinite([width, height]).all() and width > 0 and height > 0):
-        raise ValueError(f"a plan box needs a positive finite width and height, got {box!r}")
+        raise RigidfoldError(f"a plan box needs a positive finite width and height, got {box!r}")
     return width, height
 
 

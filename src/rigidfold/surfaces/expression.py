@@ -19,6 +19,7 @@ from typing import Any, Literal
 import casadi as ca
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.surfaces.builtin import MirrorPlane, Surface
 
 # function name -> (number of arguments, NumPy implementation, CasADi implementation)
@@ -87,26 +88,26 @@ def parse_expression(text: str) -> ast.Expression:
     if not isinstance(text, str):
         raise TypeError(f"an expression must be text, got {type(text).__name__}")
     if not text.strip():
-        raise ValueError("empty expression: give z = f(x, y), e.g. '0.3*sin(x)*cos(y)'")
+        raise RigidfoldError("empty expression: give z = f(x, y), e.g. '0.3*sin(x)*cos(y)'")
     shown = " ".join(text.split())
     if len(shown) > 60:
         shown = shown[:57] + "..."
     if len(text) > MAX_LENGTH:
-        raise ValueError(f"refused expression {shown!r}: longer than {MAX_LENGTH} characters")
+        raise RigidfoldError(f"refused expression {shown!r}: longer than {MAX_LENGTH} characters")
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
         reason = " ".join(str(getattr(exc, "msg", exc) or "nested too deeply").split())
-        raise ValueError(f"invalid expression {shown!r}: {reason}") from None
+        raise RigidfoldError(f"invalid expression {shown!r}: {reason}") from None
     if _depth(tree) > MAX_DEPTH:
-        raise ValueError(f"refused expression {shown!r}: nested deeper than {MAX_DEPTH} levels")
+        raise RigidfoldError(f"refused expression {shown!r}: nested deeper than {MAX_DEPTH} levels")
     called = {id(n.func) for n in ast.walk(tree) if isinstance(n, ast.Call)}
     for node in ast.walk(tree):
         if id(node) in called and isinstance(node, ast.Name):
             continue  # a function name, checked with its call
         problem = _check(node)
         if problem:
-            raise ValueError(f"refused expression {shown!r}: {problem}")
+            raise RigidfoldError(f"refused expression {shown!r}: {problem}")
     return tree
 
 
@@ -189,7 +190,9 @@ def evaluate(tree: ast.Expression, x: Any, y: Any, xp: ModuleType = np) -> Any:
         if isinstance(node, ast.Call):
             assert isinstance(node.func, ast.Name)  # parse_expression admits no other call
             return FUNCTIONS[node.func.id][column](*(ev(a) for a in node.args))
-        raise ValueError(f"unchecked node {type(node).__name__}")  # parse_expression excludes it
+        raise RigidfoldError(
+            f"unchecked node {type(node).__name__}"
+        )  # parse_expression excludes it
 
     return ev(tree)
 
@@ -235,7 +238,9 @@ class ExpressionSurface(Surface):
         bad = np.flatnonzero(~np.isfinite(self.height(x, y)))
         if bad.size:
             px, py = x.ravel()[bad[0]], y.ravel()[bad[0]]
-            raise ValueError(f"expression {self.text!r} is not finite at (x, y) = ({px:g}, {py:g})")
+            raise RigidfoldError(
+                f"expression {self.text!r} is not finite at (x, y) = ({px:g}, {py:g})"
+            )
 
     def metadata(self) -> dict[str, Any]:
         return {"name": self.name, "expression": self.text}

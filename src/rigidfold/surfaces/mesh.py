@@ -37,6 +37,7 @@ import casadi as ca
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
 from rigidfold.surfaces.builtin import Surface
 
 MESH_FORMATS = ("obj", "stl", "ply", "off")
@@ -48,7 +49,89 @@ _MEMBRANE = 1e-3
 footprint: makes it unique however few grid nodes the footprint covers."""
 
 
-class MeshSurface(Surface):
+class SplineSurface(Surface):
+    """The bicubic spline of a :class:`MeshSurface` through its grid heights, without the
+    mesh: what a run stores of a mesh target (:meth:`grid`) and its report reads back
+    (``target_surface.json``), the same heights and derivatives.
+
+    gx (nx,), gy (ny,) : float64 strictly increasing grid nodes, 4 to
+    :data:`MAX_GRID_NODES` each; z (nx, ny) float64 : finite heights there; source : the
+    mesh's name. Raises ValueError naming what is wrong with them.
+    """
+
+    name = "mesh"
+
+    def __init__(self, gx: Any, gy: Any, z: Any, *, source: str = "mesh") -> None:
+        gx, gy, z = _grid_problem(gx, gy, z)
+        self._grid = (gx, gy, z)
+        self.source = source
+        self._spline = _bspline(gx, gy, z)
+        xy = ca.MX.sym("xy", 2)
+        self._gradient = ca.Function("mesh_gradient", [xy], [ca.gradient(self._spline(xy), xy)])
+
+    def grid(self) -> dict[str, Any]:
+        """The spline's data as JSON: ``{"source", "x" (nx,), "y" (ny,), "z" (nx, ny)}``;
+        ``SplineSurface(d["x"], d["y"], d["z"], source=d["source"])`` rebuilds it."""
+        gx, gy, z = self._grid
+        return {"source": self.source, "x": gx.tolist(), "y": gy.tolist(), "z": z.tolist()}
+
+    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
+        """z at plan points: NumPy x, y broadcast together (z has their shape), or CasADi
+        symbols with ``xp=casadi`` (z has the shape of x)."""
+        if xp is not np:
+            z = self._spline(ca.horzcat(ca.vec(x), ca.vec(y)).T)  # one column per point
+            return ca.reshape(z, x.shape[0], x.shape[1])
+        return self._at(self._spline, x, y)[0]
+
+    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(dz/dx, dz/dy) of the spline at plan points, each of the broadcast shape of x, y."""
+        dx, dy = self._at(self._gradient, x, y)
+        return dx, dy
+
+    def metadata(self) -> dict[str, Any]:
+        gx, gy, _ = self._grid
+        return {"name": self.name, "source": self.source, "grid": [len(gx), len(gy)]}
+
+    @staticmethod
+    def _at(function: ca.Function, x: Any, y: Any) -> np.ndarray:
+        """A Function of one plan point (2, 1) -> (k, 1) at the plan points x, y (broadcast
+        together).  -> (k, *shape)"""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        k = function.size1_out(0)
+        if x.size == 0:
+            return np.zeros((k, *x.shape))
+        # a (2, n) matrix evaluates the function at n points, one column each
+        return np.asarray(function(np.vstack([x.ravel(), y.ravel()]))).reshape(k, *x.shape)
+
+
+MAX_GRID_NODES = 513
+"""Most grid nodes along one side of a mesh fit (``Settings.surface_grid_nodes`` at most)."""
+
+
+def _grid_problem(gx: Any, gy: Any, z: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """gx, gy, z of a :class:`SplineSurface` as float64 arrays; ValueError naming the first
+    thing wrong (not numbers, sizes, order, non-finite)."""
+    try:
+        gx, gy, z = (np.asarray(a, dtype=float) for a in (gx, gy, z))
+    except (TypeError, ValueError):
+        raise RigidfoldError("the grid of a mesh fit must hold numbers only") from None
+    for axis, g in (("x", gx), ("y", gy)):
+        if g.ndim != 1 or not 4 <= len(g) <= MAX_GRID_NODES:
+            raise RigidfoldError(
+                f"the grid's {axis} must be a list of 4 to {MAX_GRID_NODES} nodes, got shape "
+                f"{g.shape}"
+            )
+        if not (np.isfinite(g).all() and (np.diff(g) > 0).all()):
+            raise RigidfoldError(f"the grid's {axis} nodes must be finite and increasing")
+    if z.shape != (len(gx), len(gy)) or not np.isfinite(z).all():
+        raise RigidfoldError(
+            f"the grid's heights must be finite numbers of shape ({len(gx)}, {len(gy)}), got "
+            f"shape {z.shape}"
+        )
+    return gx, gy, z
+
+
+class MeshSurface(SplineSurface):
     """z = f(x, y) fitted to a triangle mesh seen from above (see the module's notes).
 
     vertices : (N, 3) float64, metres, z up;  triangles : (M, 3) int64 indices into vertices;
@@ -72,7 +155,7 @@ class MeshSurface(Surface):
     ) -> None:
         problem = _mesh_problem(vertices, triangles, settings)
         if problem:
-            raise ValueError(f"mesh {source}: {problem}")
+            raise RigidfoldError(f"mesh {source}: {problem}")
         self.vertices = np.asarray(vertices, dtype=float)
         self.triangles = np.asarray(triangles, dtype=np.int64)
         self.source = source
@@ -97,13 +180,11 @@ class MeshSurface(Surface):
         nodes = np.stack(np.meshgrid(gx, gy, indexing="ij"), axis=-1).reshape(-1, 2)
         z = self._top(nodes).reshape(self.grid_shape)
         if np.isnan(z).all():
-            raise ValueError(
+            raise RigidfoldError(
                 f"mesh {source}: its footprint covers no node of the {len(gx)} x {len(gy)} grid "
                 "over its plan box; raise surface_grid_nodes"
             )
-        self._spline = _bspline(gx, gy, _continue(z))
-        xy = ca.MX.sym("xy", 2)
-        self._gradient = ca.Function("mesh_gradient", [xy], [ca.gradient(self._spline(xy), xy)])
+        super().__init__(gx, gy, _continue(z), source=source)
 
         mid = ((gx[:-1] + gx[1:]) / 2, (gy[:-1] + gy[1:]) / 2)
         centres = np.stack(np.meshgrid(*mid, indexing="ij"), axis=-1).reshape(-1, 2)
@@ -112,19 +193,6 @@ class MeshSurface(Surface):
         found = ~np.isnan(mesh_z)
         gap = np.abs(self.height(check[found, 0], check[found, 1]) - mesh_z[found])
         self.fit_error = float(gap.max())
-
-    def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
-        """z at plan points: NumPy x, y broadcast together (z has their shape), or CasADi
-        symbols with ``xp=casadi`` (z has the shape of x)."""
-        if xp is not np:
-            z = self._spline(ca.horzcat(ca.vec(x), ca.vec(y)).T)  # one column per point
-            return ca.reshape(z, x.shape[0], x.shape[1])
-        return self._at(self._spline, x, y)[0]
-
-    def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
-        """(dz/dx, dz/dy) of the spline at plan points, each of the broadcast shape of x, y."""
-        dx, dy = self._at(self._gradient, x, y)
-        return dx, dy
 
     def check_finite(self, x: Any, y: Any) -> None:
         """Raise ValueError naming the first plan point outside the mesh's footprint.  x, y (N,)"""
@@ -136,7 +204,7 @@ class MeshSurface(Surface):
         if not inside.all():
             i = int(np.flatnonzero(~inside)[0])
             (x0, y0), (x1, y1) = self.bounds
-            raise ValueError(
+            raise RigidfoldError(
                 f"plan point {i} at (x, y) = ({points[i, 0]:g}, {points[i, 1]:g}) lies outside "
                 f"the footprint of mesh {self.source} (plan box x {x0:g}..{x1:g}, "
                 f"y {y0:g}..{y1:g} m)"
@@ -158,17 +226,6 @@ class MeshSurface(Surface):
             f"MeshSurface(<{len(self.vertices)} vertices, {len(self.triangles)} triangles>, "
             f"source={self.source!r})"
         )
-
-    @staticmethod
-    def _at(function: ca.Function, x: Any, y: Any) -> np.ndarray:
-        """A Function of one plan point (2, 1) -> (k, 1) at the plan points x, y (broadcast
-        together).  -> (k, *shape)"""
-        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        k = function.size1_out(0)
-        if x.size == 0:
-            return np.zeros((k, *x.shape))
-        # a (2, n) matrix evaluates the function at n points, one column each
-        return np.asarray(function(np.vstack([x.ravel(), y.ravel()]))).reshape(k, *x.shape)
 
     def _top(self, points: np.ndarray) -> np.ndarray:
         """Height of the highest triangle within the footprint tolerance above or below each
@@ -246,29 +303,29 @@ def read_mesh(
     ValueError naming the file when it cannot be read or is no mesh surface.
     """
     if up not in ("z", "y"):
-        raise ValueError(f"up must be z or y, got {up!r}")
+        raise RigidfoldError(f"up must be z or y, got {up!r}")
     path = Path(path)
     kind = path.suffix.lower().lstrip(".")
     if kind not in MESH_FORMATS:
-        raise ValueError(
+        raise RigidfoldError(
             f"mesh {path}: unknown extension {path.suffix!r} (read: "
             f"{', '.join('.' + k for k in MESH_FORMATS)})"
         )
     if not path.is_file():
-        raise ValueError(f"cannot read mesh {path}: no such file")
+        raise RigidfoldError(f"cannot read mesh {path}: no such file")
     if kind == "stl":
         count = _check_stl(path)
         if count is not None and count > settings.max_mesh_triangles:
-            raise ValueError(f"mesh {path}: {_too_many(count, settings)}")
+            raise RigidfoldError(f"mesh {path}: {_too_many(count, settings)}")
     import trimesh
 
     try:
         mesh = trimesh.load(str(path), file_type=kind, force="mesh", process=False)
     except Exception as exc:  # the parsers raise anything from KeyError to struct.error
         reason = " ".join(f"{type(exc).__name__}: {exc}".split())
-        raise ValueError(f"cannot read mesh {path} as {kind.upper()} ({reason})") from None
+        raise RigidfoldError(f"cannot read mesh {path} as {kind.upper()} ({reason})") from None
     if not isinstance(mesh, trimesh.Trimesh):  # force="mesh" makes one of any scene
-        raise ValueError(f"mesh {path}: holds a {type(mesh).__name__}, not a triangle mesh")
+        raise RigidfoldError(f"mesh {path}: holds a {type(mesh).__name__}, not a triangle mesh")
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     triangles = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     if up == "y":
@@ -276,7 +333,7 @@ def read_mesh(
     hint = "; is the file y-up? (--up y)" if up == "z" else "; is the file z-up? (--up z)"
     problem = _mesh_problem(vertices, triangles, settings, hint)
     if problem:
-        raise ValueError(f"mesh {path}: {problem}")
+        raise RigidfoldError(f"mesh {path}: {problem}")
     return vertices, triangles
 
 
@@ -297,7 +354,7 @@ def _check_stl(path: Path) -> int | None:
                 file.read().decode("utf-8")
                 return None
     except OSError as exc:
-        raise ValueError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
+        raise RigidfoldError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
         pass
     if len(head) < 84:
@@ -305,7 +362,7 @@ def _check_stl(path: Path) -> int | None:
     else:
         count = int.from_bytes(head[80:], "little")
         found = f"its header counts {count} triangles, {84 + 50 * count} bytes, but it has {size}"
-    raise ValueError(
+    raise RigidfoldError(
         f"mesh {path}: a damaged binary STL ({found}) and no ASCII STL (UTF-8 text starting "
         "with 'solid')"
     )

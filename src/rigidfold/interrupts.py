@@ -1,0 +1,81 @@
+"""Ctrl-C and SIGTERM are never lost in native code.
+
+Python turns SIGINT into a KeyboardInterrupt raised in the main thread at the next Python
+instruction. While IPOPT runs, that instruction is in one of rigidfold's callbacks (the
+closed-form Hessian, the early stop): CasADi catches the exception there and IPOPT ends with
+"NonIpopt_Exception_Thrown", a solve that merely failed, and generation went on as if the
+shape were infeasible ("no developable polyhedron from the initial shape", exit 1).
+
+:func:`kept_interrupts` notes every SIGINT (and SIGTERM, where :func:`terminate_interrupts`
+made it an interrupt) received while its block runs, raises KeyboardInterrupt in the handler
+as Python's own does (so a callback stops the solver at once), and raises it again when the
+block ends, whatever the native code made of the first: the run stops as interrupted. It is
+used around every IPOPT solve (:func:`rigidfold.quiet.native_quiet`). Outside the main
+thread, or where the program installed handlers of its own, it does nothing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+from types import FrameType
+
+EXIT_INTERRUPTED = 130
+"""The exit code of an interrupted command (128 + SIGINT), after SIGTERM too."""
+
+
+def _interrupt(signum: int, frame: FrameType | None) -> None:
+    """The handler of SIGTERM set by :func:`terminate_interrupts`: as Ctrl-C."""
+    raise KeyboardInterrupt
+
+
+def terminate_interrupts() -> None:
+    """Make SIGTERM raise KeyboardInterrupt in the main thread, as Ctrl-C does, so that a
+    run stopped by ``kill`` (or a batch system) ends like an interrupted one: its files
+    written, its lock released, summary.json saying "interrupted", exit 130. Only while
+    SIGTERM has its default action (a program's own handler is kept), and only from the main
+    thread."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, _interrupt)
+
+
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_INTERRUPTING = (signal.default_int_handler, _interrupt)
+_ACTIVE: list[bool] = []  # the outermost kept_interrupts of the main thread is active
+
+
+@contextlib.contextmanager
+def kept_interrupts() -> Iterator[None]:
+    """Run the block with SIGINT (and SIGTERM where it interrupts) noted: a KeyboardInterrupt
+    is raised in the handler as usual, and again when the block ends if native code swallowed
+    the first (see the module's text). Nested uses rely on the outermost."""
+    if _ACTIVE or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+
+    def note(signum: int, frame: FrameType | None) -> None:
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    saved = {s: signal.getsignal(s) for s in _SIGNALS}
+    kept = [s for s, handler in saved.items() if handler in _INTERRUPTING]
+    for s in kept:
+        signal.signal(s, note)
+    _ACTIVE.append(True)
+    try:
+        yield
+    except BaseException as exc:
+        if received and not isinstance(exc, KeyboardInterrupt):
+            raise KeyboardInterrupt from exc  # what the native code made of it
+        raise
+    finally:
+        _ACTIVE.pop()
+        for s in kept:
+            signal.signal(s, saved[s])
+    if received:
+        raise KeyboardInterrupt

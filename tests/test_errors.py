@@ -1,0 +1,68 @@
+"""The Python API's front (issue 30, item 26): the package docstring's example runs, and the
+user errors that the library's entry points raise are one family, ``RigidfoldError``, a
+``ValueError``."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+import rigidfold
+from rigidfold import RigidfoldError
+from rigidfold.case import make_case, parse_fixed
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.exports import parse_formats
+from rigidfold.io import read_fold
+from rigidfold.patterns import parse_pattern
+from rigidfold.surfaces import get_surface, mesh_surface, parse_expression
+from rigidfold.workflows import analyze_file, report_run
+
+
+def test_the_package_docstring_shows_the_generation_function_and_runs():
+    doc = rigidfold.__doc__
+    assert doc is not None and "generate(case" in doc and "RigidfoldError" in doc
+    code = "\n".join(
+        line[4:] for line in re.search(r"::\n\n((?:    .*\n|\n)+)", doc)[1].splitlines()
+    )
+    scope: dict = {}
+    exec(code, scope)  # the example as written
+    assert scope["run"].final_dof == 1 and scope["design"].n_vertices == 49
+
+
+def test_rigidfold_error_is_a_value_error_exported_lightly():
+    assert issubclass(RigidfoldError, ValueError) and rigidfold.RigidfoldError is RigidfoldError
+    code = (
+        "import sys, rigidfold; "
+        "print(rigidfold.RigidfoldError.__mro__[1].__name__, 'numpy' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["ValueError", "False"]  # import rigidfold stays light
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda tmp: make_case("nosuch", "1"),
+        lambda tmp: make_case("dome", "grid:1500x900"),
+        lambda tmp: make_case("dome", "grid:3x3", size="axb"),
+        lambda tmp: make_case("dome", "1", symmetric=True, seed=-1),
+        lambda tmp: parse_pattern("mesh:0,0;1,0"),
+        lambda tmp: get_surface("expr", expr="__import__('os')"),
+        lambda tmp: parse_expression("x +* y"),
+        lambda tmp: mesh_surface(tmp / "none.obj"),
+        lambda tmp: read_fold(tmp / "none.fold"),
+        lambda tmp: parse_fixed("a,b", make_case("dome", "grid:3x3").pattern),
+        lambda tmp: parse_formats("obj,docx"),
+        lambda tmp: Settings(dz=-1.0),
+        lambda tmp: DEFAULTS.with_(theta_min=2.0, theta_max=1.0),
+        lambda tmp: analyze_file(tmp / "none.fold"),
+        lambda tmp: report_run(tmp / "no-run"),
+    ],
+)
+def test_user_errors_are_rigidfold_errors(call, tmp_path):
+    with pytest.raises(RigidfoldError) as info:
+        call(tmp_path)
+    assert "\n" not in str(info.value) and str(info.value)
