@@ -253,10 +253,15 @@ class Settings:
     structure_tol, structure_max_iter : float, int
         Newton convergence of the static analysis: norm of the displacement increment (m)
         and iteration limit.
+    structure_soft_modes : float
+        Motions of the design whose singular value of the kinematic constraint matrix (rows
+        of unit norm) is at most this fraction of the largest are free motions that the
+        supports must hold (the rigid-body motions, the mechanisms, and the near-mechanisms
+        of nearly flat vertices), ``rigidfold.structure.supports``.
     structure_rigidity_tol : float
-        The supports make the mechanism first-order rigid when the smallest eigenvalue of
-        the support stiffness on the mechanism and rigid-body modes exceeds this fraction of
-        the largest (``rigidfold.structure.supports``).
+        The supports make the design first-order rigid when the smallest eigenvalue of the
+        stiffness on those motions (their own, sigma^2, plus the supports', rows of unit
+        norm) exceeds this.
     structure_max_support_sets : int
         ``--supports auto`` tries every set of this many candidate sets or fewer of one size
         (the smallest that can be rigid first); more, and it searches greedily.
@@ -442,7 +447,8 @@ class Settings:
     structure_max_halvings: int = 6
     structure_tol: float = 1e-10
     structure_max_iter: int = 30
-    structure_rigidity_tol: float = 1e-10
+    structure_soft_modes: float = 1e-2
+    structure_rigidity_tol: float = 1e-6
     structure_max_support_sets: int = 100_000
     structure_ground_tol: float = 1e-3
     # rigid-folding path (Step 5, beyond the paper)

@@ -305,9 +305,9 @@ def build_model(
         float(thickness),
         float(material.density),
     )
-    kind = "ShellNLDKGT" if nonlinear else "ShellDKGT"
+    extra = ["-corotational"] if nonlinear else []
     for t, (a, b, c) in enumerate(mesh.triangles):
-        ops.element(kind, t + 1, int(a) + 1, int(b) + 1, int(c) + 1, 1)
+        ops.element("ASDShellT3", t + 1, int(a) + 1, int(b) + 1, int(c) + 1, 1, *extra)
     if hinge_stiffness > 0:
         tag = mesh.n_elements
         for s, ((a, b), axis) in enumerate(zip(mesh.springs, mesh.spring_axis, strict=True)):
