@@ -931,9 +931,7 @@ def _cmd_structure(args: argparse.Namespace) -> int:
             f"{c.balance_error:.1e}; largest displacement {c.max_displacement * 1e3:.4g} mm; "
             f"largest von Mises stress {c.response.von_mises.max(initial=0.0) / 1e6:.3g} MPa"
             + (
-                "; frequencies "
-                + ", ".join(f"{f:.3g}" for f in c.response.frequencies)
-                + " Hz"
+                "; frequencies " + ", ".join(f"{f:.3g}" for f in c.response.frequencies) + " Hz"
                 if len(c.response.frequencies)
                 else ""
             )

@@ -465,7 +465,11 @@ class StructureRun:
         return self.check.status
 
     def to_dict(self) -> dict:
-        return {"file": self.file, **self.check.to_dict(), "written": [str(p) for p in self.written]}
+        return {
+            "file": self.file,
+            **self.check.to_dict(),
+            "written": [str(p) for p in self.written],
+        }
 
 
 def structure(

@@ -167,9 +167,7 @@ class StructureCheck:
                     "vertices": self.pattern.edges[e].tolist(),
                     "max_rotation_deg": float(np.degrees(np.abs(rot[sel]).max())),
                     "moment_Nm": float(moment[sel].sum()),
-                    "max_moment_Nm_per_m": float(
-                        self.hinge_stiffness * np.abs(rot[sel]).max()
-                    ),
+                    "max_moment_Nm_per_m": float(self.hinge_stiffness * np.abs(rot[sel]).max()),
                 }
             )
         return rows

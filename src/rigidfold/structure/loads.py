@@ -55,9 +55,7 @@ def parse_load(text: str) -> Load:
     """``uniform=KPA``, ``pressure=KPA`` or ``point=V:FX,FY,FZ`` (see the module's text);
     ValueError naming what was received for anything else."""
     if not isinstance(text, str) or "=" not in text:
-        raise ValueError(
-            f"a load is uniform=KPA, pressure=KPA or point=V:FX,FY,FZ, got {text!r}"
-        )
+        raise ValueError(f"a load is uniform=KPA, pressure=KPA or point=V:FX,FY,FZ, got {text!r}")
     kind, _, value = (s.strip() for s in text.partition("="))
     kind = kind.lower()
     if kind in ("uniform", "pressure"):
@@ -76,7 +74,9 @@ def parse_load(text: str) -> Load:
             raise ValueError(f"a point load's vertex must be >= 0, got {text!r}")
         fx, fy, fz = (_number(p, text) for p in parts)
         return Load("point", vertex=v, force=(fx, fy, fz))
-    raise ValueError(f"unknown load kind {kind!r} in {text!r} (choose from {', '.join(LOAD_KINDS)})")
+    raise ValueError(
+        f"unknown load kind {kind!r} in {text!r} (choose from {', '.join(LOAD_KINDS)})"
+    )
 
 
 def _number(value: str, text: str) -> float:

@@ -61,10 +61,7 @@ class Material:
 
     def describe(self) -> str:
         """``plywood (E = 10 GPa, nu = 0.3, 700 kg/m^3)``."""
-        return (
-            f"{self.name} (E = {self.E / 1e9:g} GPa, nu = {self.nu:g}, "
-            f"{self.density:g} kg/m^3)"
-        )
+        return f"{self.name} (E = {self.E / 1e9:g} GPa, nu = {self.nu:g}, {self.density:g} kg/m^3)"
 
 
 MATERIALS: dict[str, Material] = {
@@ -113,6 +110,4 @@ def parse_material(text: str | Material) -> Material:
 
 def presets_help() -> str:
     """One line listing the presets with their values and sources (for ``--help``)."""
-    return "; ".join(
-        f"{m.describe()}, {MATERIAL_SOURCES[name]}" for name, m in MATERIALS.items()
-    )
+    return "; ".join(f"{m.describe()}, {MATERIAL_SOURCES[name]}" for name, m in MATERIALS.items())

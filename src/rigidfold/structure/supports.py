@@ -137,7 +137,7 @@ class SupportModes:
     def __init__(self, pattern: CreasePattern, settings: Settings = DEFAULTS) -> None:
         self.pattern = pattern
         self.settings = settings
-        C = constraint_matrix(pattern, 0)[: -9].toarray()  # the support triangle's rows dropped
+        C = constraint_matrix(pattern, 0)[:-9].toarray()  # the support triangle's rows dropped
         _, sv, vt = np.linalg.svd(C, full_matrices=True)
         sigma = np.zeros(3 * pattern.n_vertices)
         sigma[: len(sv)] = sv
@@ -222,7 +222,8 @@ class SupportModes:
         free = pat.free_creases
         rates = fold_angle_gradients(pat, free) @ motion if len(free) else np.zeros(0)
         coef, *_ = np.linalg.lstsq(self.rigid, motion, rcond=None)
-        rest = np.linalg.norm(motion - self.rigid @ coef) / max(np.linalg.norm(motion), 1e-300)
+        size = max(float(np.linalg.norm(motion)), 1e-300)
+        rest = float(np.linalg.norm(motion - self.rigid @ coef)) / size
         if len(rates) and rest > 1e-3:
             order = np.argsort(-np.abs(rates))[:3]
             top = np.abs(rates[order[0]])
