@@ -444,9 +444,9 @@ class Settings:
     structure_gravity: float = 9.81
     structure_modes: int = 3
     structure_steps: int = 10
-    structure_max_halvings: int = 6
-    structure_tol: float = 1e-10
-    structure_max_iter: int = 30
+    structure_max_halvings: int = 4
+    structure_tol: float = 1e-8
+    structure_max_iter: int = 20
     structure_soft_modes: float = 1e-2
     structure_rigidity_tol: float = 1e-6
     structure_max_support_sets: int = 100_000
