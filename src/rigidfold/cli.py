@@ -354,12 +354,12 @@ def build_parser() -> argparse.ArgumentParser:
         default=DEFAULTS.structure_hinge_stiffness,
         metavar="K",
         help="rotational stiffness of every free crease, N m/rad per metre of crease "
-        "(default: %(default)g, a free hinge)",
+        "(default: %(default)s, a free hinge)",
     )
     stc.add_argument(
         "--load",
         action="append",
-        default=[],
+        default=None,
         metavar="KIND=VALUE",
         help="a load, repeatable: uniform=KPA (kN/m^2 of plan, downwards: snow), "
         "pressure=KPA (kN/m^2 normal to the panels, positive pressing on the upper face: "
@@ -902,7 +902,7 @@ def _cmd_structure(args: argparse.Namespace) -> int:
         clamped=args.clamped,
         actuators=args.actuators,
         hinge_stiffness=args.hinge_stiffness,
-        loads=tuple(args.load),
+        loads=tuple(args.load or ()),
         self_weight=not args.no_self_weight,
         limit=args.limit,
         nonlinear=args.nonlinear,
