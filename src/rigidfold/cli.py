@@ -30,6 +30,7 @@ from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.selection import CRITERIA
+from rigidfold.structure import presets_help
 from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACE_FORMS
 
@@ -329,6 +330,116 @@ def build_parser() -> argparse.ArgumentParser:
         help="of the SVG cut sheet: rigidfold's (layers, labels, legend, scale bar) or "
         "origami-simulator (red/blue/black lines, fold angle as stroke opacity, opens in "
         "Origami Simulator) (default: %(default)s)",
+    )
+
+    stc = _file_command(
+        sub,
+        "structure",
+        _cmd_structure,
+        out=True,
+        help="supports that hold a FOLD design and its panels and hinges under load (OpenSees)",
+        description="Check the deployed structure of a FOLD design: the supports (given, or "
+        "the fewest boundary vertices that make its mechanism first-order rigid with "
+        "--supports auto), then a shell model in OpenSees (panels as plates of the material "
+        "and thickness, free creases as hinges, fixed creases continuous) under self-weight "
+        "and the --load terms: reactions, displacements, hinge moments, panel stresses and "
+        "natural frequencies. Writes DIR/structure.json and DIR/structure.png (the deflected "
+        "shape, scaled). Exit code 0 when the supports hold the mechanism and the largest "
+        "displacement is within the limit, 1 when they leave a mechanism (named), the "
+        "analysis does not converge or the limit is exceeded, 2 on bad input.",
+    )
+    stc.add_argument(
+        "--thickness",
+        type=_positive,
+        default=DEFAULTS.structure_thickness,
+        metavar="T",
+        help="panel thickness in metres (default: %(default)g)",
+    )
+    stc.add_argument(
+        "--material",
+        default=DEFAULTS.structure_material,
+        metavar="NAME|E,nu,density",
+        help=f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units "
+        "(Pa, -, kg/m^3), e.g. 10e9,0.3,700 (default: %(default)s)",
+    )
+    stc.add_argument(
+        "--supports",
+        default="auto",
+        metavar="V,V,...|auto",
+        help="pinned vertices (indices of the FOLD file's vertices_coords), or auto: the "
+        "fewest --support-candidates that make the mechanism first-order rigid, of the "
+        "largest smallest stiffness eigenvalue. A boundary edge whose ends are both supported "
+        "is supported along its length (default: %(default)s)",
+    )
+    stc.add_argument(
+        "--support-candidates",
+        default=None,
+        metavar="boundary|ground|V,V,...",
+        help="the vertices auto may choose: every boundary vertex, the boundary vertices at "
+        f"the lowest height (within {DEFAULTS.structure_ground_tol:g} m), or a list "
+        "(default: boundary)",
+    )
+    stc.add_argument(
+        "--clamped",
+        default="",
+        metavar="V,V,...",
+        help="clamped vertices: translations and the rotations of the panels there held "
+        "(default: none)",
+    )
+    stc.add_argument(
+        "--actuators",
+        default="",
+        metavar="I,J,...",
+        help="free creases (indices into the FOLD file's edges_vertices) held at their angle "
+        "by actuators: supports of a hinge (default: none)",
+    )
+    stc.add_argument(
+        "--hinge-stiffness",
+        type=float,
+        default=DEFAULTS.structure_hinge_stiffness,
+        metavar="K",
+        help="rotational stiffness of every free crease, N m/rad per metre of crease "
+        "(default: %(default)s, a free hinge)",
+    )
+    stc.add_argument(
+        "--load",
+        action="append",
+        default=None,
+        metavar="KIND=VALUE",
+        help="a load, repeatable: uniform=KPA (kN/m^2 of plan, downwards: snow), "
+        "pressure=KPA (kN/m^2 normal to the panels, positive pressing on the upper face: "
+        "wind), point=V:FX,FY,FZ (newtons at vertex V)",
+    )
+    stc.add_argument(
+        "--no-self-weight",
+        action="store_true",
+        help="leave out the panels' weight (density x g x thickness)",
+    )
+    stc.add_argument(
+        "--limit",
+        default=f"L/{DEFAULTS.structure_limit:g}",
+        metavar="L/N",
+        help="serviceability: the largest displacement may be at most the span over N; the "
+        "span is the largest plan distance between supports (twice the reach of a "
+        "cantilever) (default: %(default)s)",
+    )
+    stc.add_argument(
+        "--nonlinear",
+        action="store_true",
+        help="geometrically nonlinear analysis (corotational shells, "
+        f"{DEFAULTS.structure_steps} load steps) instead of a linear one",
+    )
+    stc.add_argument(
+        "--modes",
+        type=int,
+        default=DEFAULTS.structure_modes,
+        metavar="N",
+        help="natural frequencies to compute, 0 for none (default: %(default)s)",
+    )
+    stc.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace DIR/structure.json and DIR/structure.png of an earlier check",
     )
 
     stu = sub.add_parser(
@@ -811,6 +922,59 @@ def _cmd_export(args: argparse.Namespace) -> int:
         print(f"{args.file}: {panels} panels; development diagram: {done.design.diagram}{verdict}")
         print(f"wrote {', '.join(str(p) for p in done.written)}")
     return 0 if done.diagram_ok else 1
+
+
+def _cmd_structure(args: argparse.Namespace) -> int:
+    from rigidfold.structure import StructureStatus
+    from rigidfold.workflows import structure
+
+    run = structure(
+        args.file,
+        args.out,
+        thickness=args.thickness,
+        material=args.material,
+        supports=args.supports,
+        candidates=args.support_candidates,
+        clamped=args.clamped,
+        actuators=args.actuators,
+        hinge_stiffness=args.hinge_stiffness,
+        loads=tuple(args.load or ()),
+        self_weight=not args.no_self_weight,
+        limit=args.limit,
+        nonlinear=args.nonlinear,
+        modes=args.modes,
+        up=args.up,
+        overwrite=args.overwrite,
+    )
+    code = 0 if run.status is StructureStatus.PASSED else EXIT_FAILED
+    if args.json:
+        print(json.dumps(jsonable(run.to_dict())))
+        return code
+    c = run.check
+    sup = c.rigidity.supports
+    how = "chosen" if c.auto else "given"
+    print(
+        f"supports ({how}): pinned {sup.pinned.tolist()}"
+        + (f", clamped {sup.clamped.tolist()}" if len(sup.clamped) else "")
+        + f"; mechanism DOF {c.rigidity.dof} without them; smallest stiffness eigenvalue "
+        f"{c.rigidity.smallest:.3g}"
+    )
+    if c.response is not None:
+        load = c.total_load
+        print(
+            f"{c.material.describe()}, {c.thickness * 1e3:g} mm: total load "
+            f"{math.sqrt(sum(float(f) ** 2 for f in load)) / 1e3:.4g} kN, reactions balance to "
+            f"{c.balance_error:.1e}; largest displacement {c.max_displacement * 1e3:.4g} mm; "
+            f"largest von Mises stress {c.response.von_mises.max(initial=0.0) / 1e6:.3g} MPa"
+            + (
+                "; frequencies " + ", ".join(f"{f:.3g}" for f in c.response.frequencies) + " Hz"
+                if len(c.response.frequencies)
+                else ""
+            )
+        )
+    print(f"{c.status}: {c.message}")
+    print(f"wrote {', '.join(str(p) for p in run.written)}")
+    return code
 
 
 def _cmd_study(args: argparse.Namespace) -> int:

@@ -231,6 +231,44 @@ class Settings:
     deform_load_tol : float
         The analysis has reached the plane when the load factor is within this of 1.
 
+    Structure under load (``rigidfold structure``, ``rigidfold.structure``)
+    ---------------------------------------------------------------------
+    structure_thickness : float
+        Panel thickness, metres (18 mm: a common plywood sheet).
+    structure_material : str
+        The panels' material preset (``rigidfold.structure.MATERIALS``).
+    structure_hinge_stiffness : float
+        Rotational stiffness of a free crease's hinge, N m/rad per metre of crease (0: free).
+    structure_subdivisions : int
+        Each triangle of the pattern is divided into this squared shell elements.
+    structure_limit : float
+        Serviceability: the largest displacement may be at most span / this (L/250).
+    structure_gravity : float
+        Acceleration of gravity for the self-weight, m/s^2.
+    structure_modes : int
+        Natural frequencies computed (0: none).
+    structure_steps, structure_max_halvings : int
+        Load steps of the geometrically nonlinear analysis, and how often a step that does
+        not converge is halved before it stops.
+    structure_tol, structure_max_iter : float, int
+        Newton convergence of the static analysis: norm of the displacement increment (m)
+        and iteration limit.
+    structure_soft_modes : float
+        Motions of the design whose singular value of the kinematic constraint matrix (rows
+        of unit norm) is at most this fraction of the largest are free motions that the
+        supports must hold (the rigid-body motions, the mechanisms, and the near-mechanisms
+        of nearly flat vertices), ``rigidfold.structure.supports``.
+    structure_rigidity_tol : float
+        The supports make the design first-order rigid when the smallest eigenvalue of the
+        stiffness on those motions (their own, sigma^2, plus the supports', rows of unit
+        norm) exceeds this.
+    structure_max_support_sets : int
+        ``--supports auto`` tries every set of this many candidate sets or fewer of one size
+        (the smallest that can be rigid first); more, and it searches greedily.
+    structure_ground_tol : float
+        ``--support-candidates ground``: boundary vertices within this (m) of the lowest
+        boundary vertex's height.
+
     Rigid-folding path (``rigidfold.mechanism.path``, Step 5 beyond the paper)
     -------------------------------------------------------------------------
     path_flat_tol : float
@@ -408,6 +446,22 @@ class Settings:
     motion_length_tol: float = 1e-3
     deform_penalty: float = 1e6
     deform_load_tol: float = 1e-12
+    # the structure under load
+    structure_thickness: float = 0.018
+    structure_material: str = "plywood"
+    structure_hinge_stiffness: float = 0.0
+    structure_subdivisions: int = 2
+    structure_limit: float = 250.0
+    structure_gravity: float = 9.81
+    structure_modes: int = 3
+    structure_steps: int = 10
+    structure_max_halvings: int = 4
+    structure_tol: float = 1e-8
+    structure_max_iter: int = 20
+    structure_soft_modes: float = 1e-2
+    structure_rigidity_tol: float = 1e-6
+    structure_max_support_sets: int = 100_000
+    structure_ground_tol: float = 1e-3
     # rigid-folding path (Step 5, beyond the paper)
     path_flat_tol: float = math.radians(0.5)
     path_fold_limit: float = math.radians(179.0)

@@ -13,6 +13,7 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``generate_case``      Steps 2-9 into a :class:`rigidfold.run.RunWriter`
 ``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
 ``report_run``         ``DIR/report.html`` and ``DIR/figures/`` of a generate run
+``structure``          supports and loads of a FOLD design (``rigidfold structure``)
 =====================  ====================================================================
 """
 
@@ -30,6 +31,7 @@ from rigidfold.case import Case, parse_fixed, shape_report
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.check import Verification, verify
 from rigidfold.develop import DevelopStatus
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports import (
     CONVENTIONS,
     EXPORT_FORMATS,
@@ -54,6 +56,22 @@ from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
 from rigidfold.reporting import page, render_figures, view_figure
 from rigidfold.run import RunData, RunWriter, clear_earlier_run, load_run, write_checked_shape
+from rigidfold.structure import (
+    Material,
+    StructureCheck,
+    StructureStatus,
+    Supports,
+    auto_supports,
+    check_inputs,
+    check_structure,
+    check_supports,
+    parse_indices,
+    parse_limit,
+    parse_load,
+    parse_material,
+    support_candidates,
+)
+from rigidfold.structure.figure import deflection_png
 
 # ------------------------------------------------------------------------------ analyze
 FLAT_NOTE = (
@@ -416,3 +434,104 @@ def report_run(directory: str | os.PathLike) -> RunReport:
     written = tuple(atomic_write(figure_dir / f.name, f.png) for f in figures)
     html = atomic_write(run.directory / "report.html", text)
     return RunReport(run, html, written, time.perf_counter() - t0)
+
+
+# ----------------------------------------------------------------------------- structure
+STRUCTURE_FILES = ("structure.json", "structure.png")
+"""The files ``structure`` writes into its directory."""
+
+
+@dataclass(frozen=True, eq=False)
+class StructureRun:
+    """The structure check of a FOLD design and the files written.
+
+    file : str; check : :class:`rigidfold.structure.StructureCheck`; written : the files.
+    """
+
+    file: str
+    check: StructureCheck
+    written: tuple[Path, ...]
+
+    @property
+    def status(self) -> StructureStatus:
+        return self.check.status
+
+    def to_dict(self) -> dict:
+        return {
+            "file": self.file,
+            **self.check.to_dict(),
+            "written": [str(p) for p in self.written],
+        }
+
+
+def structure(
+    path: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    thickness: float = DEFAULTS.structure_thickness,
+    material: str | Material = DEFAULTS.structure_material,
+    supports: str = "auto",
+    candidates: str | None = None,
+    clamped: str = "",
+    actuators: str = "",
+    hinge_stiffness: float = DEFAULTS.structure_hinge_stiffness,
+    loads: tuple[str, ...] = (),
+    self_weight: bool = True,
+    limit: str | float = DEFAULTS.structure_limit,
+    nonlinear: bool = False,
+    modes: int = DEFAULTS.structure_modes,
+    up: str = "z",
+    overwrite: bool = False,
+    settings: Settings = DEFAULTS,
+) -> StructureRun:
+    """Supports, loads and serviceability of the design in a FOLD file (read with ``up``):
+    ``OUT/structure.json`` and ``OUT/structure.png`` (:mod:`rigidfold.structure`).
+
+    supports : ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
+    ``"V,V,..."``) or ``"V,V,..."`` pinned vertices; clamped : ``"V,V,..."`` clamped
+    vertices; actuators : ``"I,J,..."`` free creases held at their angle; loads : ``--load``
+    texts (:func:`rigidfold.structure.parse_load`); limit : ``"L/250"``. Every input is
+    checked before anything is written (ValueError, one line).
+    """
+    mat = parse_material(material)
+    divisor = parse_limit(limit)
+    parsed = tuple(parse_load(text) for text in loads)
+    if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
+        raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
+    refuse_replacing_inputs([path], [Path(out) / name for name in STRUCTURE_FILES])
+    data = read_fold(path, up=up, settings=settings)
+    pattern = data.pattern
+    check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=parsed)
+    V = pattern.n_vertices
+    clamp = parse_indices(clamped, V, "clamped vertices")
+    held = parse_indices(actuators, pattern.n_edges, "actuators")
+    auto = supports.strip().lower() == "auto"
+    if auto:
+        pool = support_candidates(pattern, candidates, settings)
+        rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
+    else:
+        pins = parse_indices(supports, V, "supports")
+        if not len(pins) and not len(clamp):
+            raise RigidfoldError("give --supports V,V,... or auto, or --clamped vertices")
+        rigidity = check_supports(pattern, Supports(pins, clamp, held), settings)
+    out_dir = prepare_output_dir(out)
+    clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
+    check = check_structure(
+        pattern,
+        rigidity,
+        material=mat,
+        thickness=thickness,
+        loads=parsed,
+        self_weight=self_weight,
+        hinge_stiffness=hinge_stiffness,
+        nonlinear=nonlinear,
+        limit=divisor,
+        modes=modes,
+        auto=auto,
+        settings=settings,
+    )
+    written = [write_json(out_dir / "structure.json", {"file": str(path), **check.to_dict()})]
+    png = deflection_png(check)
+    if png is not None:
+        written.append(atomic_write(out_dir / "structure.png", png))
+    return StructureRun(str(path), check, tuple(written))

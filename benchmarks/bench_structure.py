@@ -1,0 +1,77 @@
+"""Benchmark of ``rigidfold structure`` on an 11 x 11 design (target: under 10 s).
+
+Run with ``python benchmarks/bench_structure.py [--repeat 3]``.
+
+The design is tests/data/dome_sym_dof1.fold (121 vertices, 200 triangles, DOF 1). Timed,
+median over ``--repeat`` runs: the whole workflow behind the command (read, ``--supports
+auto``, shell model in OpenSees under self-weight and 0.5 kPa of snow, 3 natural
+frequencies, structure.json and structure.png) with free hinges and with hinges of
+1000 N m/rad per m, its support search alone, and the geometrically nonlinear analysis
+(``--nonlinear``, hinges of 1000 N m/rad per m, timed once: it is not under the target).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+from rigidfold.io import read_fold
+from rigidfold.structure import auto_supports, support_candidates
+from rigidfold.workflows import structure
+
+DESIGN = Path(__file__).resolve().parents[1] / "tests" / "data" / "dome_sym_dof1.fold"
+
+
+def timed(repeat: int, run) -> tuple[float, object]:
+    times, result = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        result = run()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args()
+    pattern = read_fold(DESIGN).pattern
+    t_sup, rigidity = timed(
+        args.repeat, lambda: auto_supports(pattern, support_candidates(pattern))
+    )
+    with tempfile.TemporaryDirectory() as tmp:
+        for nonlinear, k in ((False, 0.0), (False, 1000.0), (True, 1000.0)):
+            t, run = timed(
+                1 if nonlinear else args.repeat,
+                lambda k=k, nonlinear=nonlinear: structure(
+                    DESIGN,
+                    Path(tmp) / "out",
+                    loads=("uniform=0.5",),
+                    hinge_stiffness=k,
+                    nonlinear=nonlinear,
+                    modes=0 if nonlinear else 3,
+                    overwrite=True,
+                ),
+            )
+            c = run.check
+            print(
+                f"{'nonlinear' if nonlinear else 'linear   '}, hinges {k:g} N m/rad/m: "
+                f"{c.status}, "
+                f"{len(c.rigidity.supports.pinned)} supports, {c.mesh.n_elements} shells, "
+                f"max displacement {c.max_displacement * 1e3:.3g} mm, balance "
+                f"{c.balance_error:.1e}; median {t:.2f} s over "
+                f"{1 if nonlinear else args.repeat}",
+                flush=True,
+            )
+    print(
+        f"support search (auto, {len(rigidity.supports.pinned)} of "
+        f"{len(pattern.boundary_vertices)} boundary vertices): median {t_sup:.2f} s"
+    )
+    print("target: the structure command on an 11 x 11 design under 10 s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,55 @@
+"""The deployed structure: supports that stabilise the mechanism, and its panels and hinges
+under load in OpenSees (``rigidfold structure``).
+
+:mod:`~rigidfold.structure.material` (the panels' material, presets),
+:mod:`~rigidfold.structure.supports` (first-order rigidity of a design on its supports, and
+the fewest supports that give it), :mod:`~rigidfold.structure.model` (the shell model:
+panels as plates, free creases as hinges), :mod:`~rigidfold.structure.loads` (self-weight,
+snow, wind, point loads), :mod:`~rigidfold.structure.analysis` (static and eigen analysis
+in OpenSees), :mod:`~rigidfold.structure.check` (the check and its verdict) and
+:mod:`~rigidfold.structure.figure` (the deflected shape). OpenSees and matplotlib are
+imported only when an analysis runs or a figure is drawn.
+"""
+
+from rigidfold.structure.check import (
+    StructureCheck,
+    StructureStatus,
+    check_inputs,
+    check_structure,
+    parse_limit,
+)
+from rigidfold.structure.loads import LOAD_KINDS, Load, parse_load
+from rigidfold.structure.material import MATERIALS, Material, parse_material, presets_help
+from rigidfold.structure.supports import (
+    CANDIDATE_FORMS,
+    Rigidity,
+    SupportModes,
+    Supports,
+    auto_supports,
+    check_supports,
+    parse_indices,
+    support_candidates,
+)
+
+__all__ = [
+    "CANDIDATE_FORMS",
+    "LOAD_KINDS",
+    "MATERIALS",
+    "Load",
+    "Material",
+    "Rigidity",
+    "StructureCheck",
+    "StructureStatus",
+    "SupportModes",
+    "Supports",
+    "auto_supports",
+    "check_inputs",
+    "check_structure",
+    "check_supports",
+    "parse_indices",
+    "parse_limit",
+    "parse_load",
+    "parse_material",
+    "presets_help",
+    "support_candidates",
+]

@@ -1,0 +1,209 @@
+"""The shell model under load in OpenSees: static (linear or geometrically nonlinear) and the
+first natural frequencies.
+
+* **Linear static**: one load step, ``Linear`` algorithm, ``ShellDKGT`` elements.
+* **Geometrically nonlinear**: ``ShellNLDKGT`` elements (corotational kinematics),
+  ``Settings.structure_steps`` load steps with Newton iterations, a step that does not
+  converge is halved up to ``structure_max_halvings`` times; the result is the last
+  converged step and its load factor.
+* **Frequencies**: ``eigen`` of the linear model without load, mass from the section's
+  density times its thickness; f = sqrt(lambda) / 2 pi.
+
+Constraints are imposed by the ``Transformation`` handler (the ties of
+:mod:`rigidfold.structure.model` are exact). What OpenSees prints is hidden
+(:func:`rigidfold.quiet.native_quiet`). Stresses: the elements' stress resultants at their
+Gauss points (N11, N22, N12, M11, M22, M12, Q13, Q23 per unit length) give the membrane and
+bending stresses on both faces, sigma = N / t +- 6 M / t^2; the largest von Mises stress of
+this plane stress state is reported.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.quiet import native_quiet
+from rigidfold.structure.material import Material
+from rigidfold.structure.model import ShellMesh, build_model
+
+
+@dataclass(frozen=True, eq=False)
+class ShellResponse:
+    """What the shell model did under the loads.
+
+    converged : the static analysis reached the full load (load_factor 1);
+    load_factor : fraction of the loads carried at the last converged step;
+    displacements : (N, 6) node displacements and rotations at that step;
+    reactions : (k, 3) forces from the supports, newtons, one row per supported vertex
+        (pinned, then clamped), summed over its nodes;
+    applied : (N, 3) the nodal loads, newtons (before moving tied nodes' loads);
+    frequencies : (m,) Hz, ascending (empty when not asked or the eigen solver failed);
+    von_mises : (T,) largest von Mises stress of each element, Pa;
+    hinge_rotation : (S,) rotation of each spring pair about the crease axis, radians.
+    """
+
+    converged: bool
+    load_factor: float
+    steps: int
+    displacements: np.ndarray
+    reactions: np.ndarray
+    applied: np.ndarray
+    frequencies: np.ndarray
+    von_mises: np.ndarray
+    hinge_rotation: np.ndarray
+    message: str = ""
+    wall_time: float = field(default=0.0, compare=False)
+
+
+@native_quiet()
+def solve_shell(
+    mesh: ShellMesh,
+    material: Material,
+    thickness: float,
+    forces: np.ndarray,
+    *,
+    pinned: np.ndarray,
+    clamped: np.ndarray,
+    hinge_stiffness: float = 0.0,
+    nonlinear: bool = False,
+    modes: int = 0,
+    settings: Settings = DEFAULTS,
+) -> ShellResponse:
+    """Static analysis of the shell model under nodal ``forces`` (N, 3) newtons, then
+    ``modes`` natural frequencies of the unloaded linear model."""
+    import openseespy.opensees as ops  # heavy: only when an analysis runs
+
+    t0 = time.perf_counter()
+    pinned = np.asarray(pinned, dtype=np.int64)
+    clamped = np.asarray(clamped, dtype=np.int64)
+    ties = build_model(
+        ops,
+        mesh,
+        material,
+        thickness,
+        hinge_stiffness=hinge_stiffness,
+        pinned=pinned,
+        clamped=clamped,
+        nonlinear=nonlinear,
+    )
+    moved = np.array(forces, dtype=np.float64)
+    np.add.at(moved, ties[:, 0], moved[ties[:, 1]])
+    moved[ties[:, 1]] = 0.0
+    ops.timeSeries("Linear", 1)
+    ops.pattern("Plain", 1, 1)
+    for i in np.flatnonzero(np.any(moved != 0, axis=1)):
+        ops.load(int(i) + 1, *map(float, moved[i]), 0.0, 0.0, 0.0)
+    ops.constraints("Transformation")
+    ops.numberer("RCM")
+    ops.system("UmfPack")
+    ops.test("NormDispIncr", float(settings.structure_tol), int(settings.structure_max_iter), 0)
+    steps = settings.structure_steps if nonlinear else 1
+    ops.algorithm("Newton" if nonlinear else "Linear")
+    ops.integrator("LoadControl", 1.0 / steps)
+    ops.analysis("Static")
+    lam, step, halvings, done = 0.0, 1.0 / steps, 0, 0
+    message = ""
+    while lam < 1.0 - 1e-12:
+        inc = min(step, 1.0 - lam)
+        ops.integrator("LoadControl", inc)
+        if ops.analyze(1) != 0:
+            halvings += 1
+            if not nonlinear or halvings > settings.structure_max_halvings:
+                message = f"no convergence at load factor {lam:.4g}"
+                break
+            step = inc / 2
+            continue
+        lam += inc
+        done += 1
+    converged = not message
+    n = mesh.n_nodes
+    disp = np.array([ops.nodeDisp(i + 1) for i in range(n)], dtype=np.float64).reshape(n, 6)
+    ops.reactions()
+    nodes, _, shares = mesh.supported_nodes(pinned, clamped)
+    held = np.array([ops.nodeReaction(int(i) + 1)[:3] for i in nodes]).reshape(-1, 3)
+    reactions = shares.T @ held
+    von_mises = _von_mises(ops, mesh.n_elements, thickness)
+    rotation = _hinge_rotations(mesh, disp)
+    frequencies = np.zeros(0)
+    if modes > 0:
+        frequencies, note = _frequencies(
+            ops, mesh, material, thickness, pinned, clamped, hinge_stiffness, modes, settings
+        )
+        message = "; ".join(m for m in (message, note) if m)
+    ops.wipe()
+    return ShellResponse(
+        converged=converged,
+        load_factor=lam,
+        steps=done,
+        displacements=disp,
+        reactions=reactions,
+        applied=np.asarray(forces, dtype=np.float64),
+        frequencies=frequencies,
+        von_mises=von_mises,
+        hinge_rotation=rotation,
+        message=message,
+        wall_time=time.perf_counter() - t0,
+    )
+
+
+def _von_mises(ops, n_elements: int, thickness: float) -> np.ndarray:
+    """(T,) each element's largest von Mises stress over its Gauss points and both faces."""
+    out = np.zeros(n_elements)
+    for t in range(n_elements):
+        r = np.asarray(ops.eleResponse(t + 1, "stresses"), dtype=np.float64).reshape(-1, 8)
+        N, M = r[:, :3], r[:, 3:6]
+        worst = 0.0
+        for sign in (1.0, -1.0):
+            s = N / thickness + sign * 6.0 * M / thickness**2
+            vm = np.sqrt(s[:, 0] ** 2 - s[:, 0] * s[:, 1] + s[:, 1] ** 2 + 3 * s[:, 2] ** 2)
+            worst = max(worst, float(vm.max(initial=0.0)))
+        out[t] = worst
+    return out
+
+
+def _hinge_rotations(mesh: ShellMesh, disp: np.ndarray) -> np.ndarray:
+    """(S,) relative rotation (right minus left) of each spring pair about its crease axis."""
+    if not len(mesh.springs):
+        return np.zeros(0)
+    theta = disp[:, 3:]
+    rel = theta[mesh.springs[:, 1]] - theta[mesh.springs[:, 0]]
+    return np.einsum("ij,ij->i", rel, mesh.spring_axis)
+
+
+def _frequencies(
+    ops, mesh, material, thickness, pinned, clamped, hinge_stiffness, modes, settings
+) -> tuple[np.ndarray, str]:
+    """The first ``modes`` natural frequencies (Hz) of the linear model, and a note when the
+    eigen solver failed."""
+    if material.density <= 0:
+        return np.zeros(0), "no frequencies: the material has no density"
+    build_model(
+        ops,
+        mesh,
+        material,
+        thickness,
+        hinge_stiffness=hinge_stiffness,
+        pinned=pinned,
+        clamped=clamped,
+        nonlinear=False,
+    )
+    ops.constraints("Transformation")
+    ops.numberer("RCM")
+    ops.system("UmfPack")
+    ops.algorithm("Linear")
+    ops.integrator("LoadControl", 0.0)
+    ops.analysis("Static")
+    free_dofs = 6 * mesh.n_nodes
+    k = int(min(modes, max(free_dofs // 4, 1)))
+    try:
+        lam = ops.eigen(k)
+    except Exception as exc:  # OpenSees raises a bare OpenSeesError
+        return np.zeros(0), f"no frequencies: the eigen solver failed ({exc})"
+    lam = np.asarray(lam if isinstance(lam, list) else [lam], dtype=np.float64)
+    if not len(lam) or not np.all(np.isfinite(lam)):
+        return np.zeros(0), "no frequencies: the eigen solver failed"
+    return np.sqrt(np.clip(lam, 0.0, None)) / (2 * math.pi), ""

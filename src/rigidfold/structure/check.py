@@ -1,0 +1,304 @@
+"""The structure check of a design: supports, loads, the shell model's response and the
+serviceability verdict, in one result.
+
+:func:`check_structure` checks that the supports make the mechanism first-order rigid
+(:mod:`rigidfold.structure.supports`; chosen by ``auto`` when asked), then loads the shell
+model (:mod:`rigidfold.structure.model`, :mod:`rigidfold.structure.loads`) and runs it
+(:mod:`rigidfold.structure.analysis`). Serviceability: the largest displacement of any node
+must be at most span / ``limit`` (``--limit L/250``). The span is the largest plan distance
+between two supports; where the supports lie on one line or at one point (a cantilever), it
+is twice the largest plan distance from a support to a vertex (the cantilever convention).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
+from rigidfold.mesh import CreasePattern
+from rigidfold.status import Outcome
+from rigidfold.structure.analysis import ShellResponse, solve_shell
+from rigidfold.structure.loads import Load, check_loads, nodal_loads
+from rigidfold.structure.material import Material
+from rigidfold.structure.model import ShellMesh, shell_mesh
+from rigidfold.structure.supports import Rigidity
+
+
+class StructureStatus(Outcome):
+    """How the structure check ended."""
+
+    PASSED = "passed", "the supports hold the mechanism and the deflection is within the limit"
+    DEFLECTION = "deflection", "the largest displacement exceeds the serviceability limit"
+    MECHANISM = "mechanism", "the supports leave a mechanism"
+    NOT_CONVERGED = "not_converged", "the static analysis did not carry the whole load"
+
+
+def parse_limit(text: str | float) -> float:
+    """``"L/250"`` (or ``250``) as the divisor 250.0; ValueError naming what was received."""
+    if isinstance(text, int | float) and not isinstance(text, bool):
+        value = float(text)
+    else:
+        match = re.fullmatch(r"\s*(?:[lL]\s*/\s*)?([0-9.eE+-]+)\s*", str(text))
+        try:
+            value = float(match.group(1)) if match else float("nan")
+        except ValueError:
+            value = float("nan")
+    if not (np.isfinite(value) and value > 0):
+        raise RigidfoldError(
+            f"the deflection limit must be L/N with N > 0 (e.g. L/250), got {text!r}"
+        )
+    return value
+
+
+@dataclass(frozen=True, eq=False)
+class StructureCheck:
+    """The structure check of one design.
+
+    pattern : the design (actuated creases fixed); material, thickness (m); rigidity : the
+    supports' first-order rigidity; loads : the load terms; self_weight : whether included;
+    hinge_stiffness : N m/rad per m; nonlinear : geometrically nonlinear analysis; limit :
+    the deflection limit's divisor (span / limit); mesh and response : the shell model and
+    its response (None when the supports leave a mechanism).
+    """
+
+    pattern: CreasePattern
+    material: Material
+    thickness: float
+    rigidity: Rigidity
+    loads: tuple[Load, ...]
+    self_weight: bool
+    hinge_stiffness: float
+    nonlinear: bool
+    limit: float
+    mesh: ShellMesh | None
+    response: ShellResponse | None
+    auto: bool = False
+
+    # ------------------------------------------------------------------ verdict
+    @property
+    def status(self) -> StructureStatus:
+        if not self.rigidity.rigid or self.response is None:
+            return StructureStatus.MECHANISM
+        if not self.response.converged:
+            return StructureStatus.NOT_CONVERGED
+        if self.max_displacement > self.allowed_displacement:
+            return StructureStatus.DEFLECTION
+        return StructureStatus.PASSED
+
+    @property
+    def passed(self) -> bool:
+        return self.status is StructureStatus.PASSED
+
+    @property
+    def message(self) -> str:
+        """The status's message with this run's detail."""
+        status = self.status
+        if status is StructureStatus.MECHANISM:
+            return status.describe(self.rigidity.mode)
+        if status is StructureStatus.NOT_CONVERGED:
+            assert self.response is not None
+            return status.describe(
+                f"load factor {self.response.load_factor:.3g}; {self.response.message}"
+            )
+        return status.describe(
+            f"{self.max_displacement * 1e3:.3g} mm, limit L/{self.limit:g} = "
+            f"{self.allowed_displacement * 1e3:.3g} mm on a span of {self.span:.3g} m"
+        )
+
+    # ------------------------------------------------------------------ figures
+    @cached_property
+    def span(self) -> float:
+        """The span L of the serviceability limit, m (see the module's text)."""
+        xy = self.pattern.coords[self.rigidity.supports.vertices, :2]
+        if len(xy) == 0:
+            return 0.0
+        d = np.linalg.norm(xy[:, None] - xy[None], axis=2)
+        longest = float(d.max(initial=0.0))
+        centred = xy - xy.mean(axis=0)
+        s = np.linalg.svd(centred, compute_uv=False) if len(xy) > 1 else np.zeros(2)
+        if len(xy) < 3 or s[-1] <= 1e-6 * max(s[0], 1e-300):  # on one line or one point
+            reach = np.linalg.norm(self.pattern.coords[:, None, :2] - xy[None], axis=2)
+            return float(2 * reach.min(axis=1).max(initial=0.0))
+        return longest
+
+    @property
+    def allowed_displacement(self) -> float:
+        return self.span / self.limit
+
+    @cached_property
+    def _magnitudes(self) -> np.ndarray:
+        assert self.response is not None
+        return np.linalg.norm(self.response.displacements[:, :3], axis=1)
+
+    @property
+    def max_displacement(self) -> float:
+        """Largest displacement magnitude of any node, m (0 without a response)."""
+        return float(self._magnitudes.max(initial=0.0)) if self.response is not None else 0.0
+
+    @property
+    def total_load(self) -> np.ndarray:
+        """(3,) the sum of the loads, N."""
+        return self.response.applied.sum(axis=0) if self.response is not None else np.zeros(3)
+
+    @property
+    def balance_error(self) -> float:
+        """|sum of reactions + sum of loads| / |sum of loads|."""
+        if self.response is None:
+            return float("nan")
+        total = np.linalg.norm(self.total_load)
+        residual = np.linalg.norm(self.response.reactions.sum(axis=0) + self.total_load)
+        return float(residual / total) if total > 0 else float(residual)
+
+    def hinge_table(self) -> list[dict]:
+        """Per free crease: its largest rotation (deg) and its moment (total N m and largest
+        N m per metre) from the hinge springs."""
+        if self.response is None or self.mesh is None or not len(self.mesh.springs):
+            return []
+        mesh, rot = self.mesh, self.response.hinge_rotation
+        moment = self.hinge_stiffness * mesh.spring_length * rot
+        rows = []
+        for e in np.unique(mesh.spring_crease):
+            sel = mesh.spring_crease == e
+            rows.append(
+                {
+                    "crease": int(e),
+                    "vertices": self.pattern.edges[e].tolist(),
+                    "max_rotation_deg": float(np.degrees(np.abs(rot[sel]).max())),
+                    "moment_Nm": float(moment[sel].sum()),
+                    "max_moment_Nm_per_m": float(self.hinge_stiffness * np.abs(rot[sel]).max()),
+                }
+            )
+        return rows
+
+    def to_dict(self) -> dict:
+        """What ``DIR/structure.json`` holds."""
+        out = {
+            "status": self.status.value,
+            "message": self.message,
+            "material": self.material.to_dict(),
+            "thickness_m": self.thickness,
+            "hinge_stiffness_Nm_per_rad_per_m": self.hinge_stiffness,
+            "loads": [load.to_dict() for load in self.loads],
+            "self_weight": self.self_weight,
+            "analysis": "nonlinear" if self.nonlinear else "linear",
+            "supports": {**self.rigidity.to_dict(), "chosen": "auto" if self.auto else "given"},
+            "limit": f"L/{self.limit:g}",
+            "span_m": self.span,
+        }
+        if self.response is None or self.mesh is None:
+            return out
+        r, mesh, coords = self.response, self.mesh, self.pattern.coords
+        worst = int(np.argmax(self._magnitudes))
+        at = mesh.coords[worst]
+        nearest = int(np.argmin(np.linalg.norm(coords - at, axis=1)))
+        hot = int(np.argmax(r.von_mises)) if len(r.von_mises) else 0
+        face = int(mesh.triangle_face[hot])
+        hinges = self.hinge_table()
+        out.update(
+            {
+                "shell_elements": mesh.n_elements,
+                "nodes": mesh.n_nodes,
+                "load_factor": r.load_factor,
+                "reactions_N": {
+                    str(int(v)): f.tolist()
+                    for v, f in zip(self.rigidity.supports.vertices, r.reactions, strict=True)
+                },
+                "total_load_N": self.total_load.tolist(),
+                "reaction_sum_N": r.reactions.sum(axis=0).tolist(),
+                "balance_error": self.balance_error,
+                "max_displacement_m": self.max_displacement,
+                "max_displacement_at": {
+                    "position_m": at.tolist(),
+                    "displacement_m": r.displacements[worst, :3].tolist(),
+                    "nearest_vertex": nearest,
+                },
+                "max_vertical_displacement_m": float(np.abs(r.displacements[:, 2]).max()),
+                "allowed_displacement_m": self.allowed_displacement,
+                "serviceability_ok": self.max_displacement <= self.allowed_displacement,
+                "frequencies_Hz": r.frequencies.tolist(),
+                "max_von_mises_Pa": float(r.von_mises.max(initial=0.0)),
+                "max_stress_at": {
+                    "triangle": face,
+                    "panel": int(self.pattern.facets[face]),
+                    "position_m": mesh.coords[mesh.triangles[hot]].mean(axis=0).tolist(),
+                },
+                "max_hinge_moment_Nm_per_m": max(
+                    (h["max_moment_Nm_per_m"] for h in hinges), default=0.0
+                ),
+                "hinges": hinges,
+                "note": r.message,
+                "wall_time_s": r.wall_time,
+            }
+        )
+        return out
+
+
+def check_inputs(
+    pattern: CreasePattern, *, thickness: float, hinge_stiffness: float, loads: tuple[Load, ...]
+) -> None:
+    """ValueError (one line, naming the value) for a thickness that is not a positive number
+    of metres, a negative hinge stiffness, a point load at a vertex the design lacks."""
+    if isinstance(thickness, bool) or not (np.isfinite(thickness) and thickness > 0):
+        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
+    if isinstance(hinge_stiffness, bool) or not (
+        np.isfinite(hinge_stiffness) and hinge_stiffness >= 0
+    ):
+        raise RigidfoldError(f"hinge stiffness must be >= 0 N m/rad per m, got {hinge_stiffness!r}")
+    check_loads(tuple(loads), pattern.n_vertices)
+
+
+def check_structure(
+    pattern: CreasePattern,
+    rigidity: Rigidity,
+    *,
+    material: Material,
+    thickness: float,
+    loads: tuple[Load, ...] = (),
+    self_weight: bool = True,
+    hinge_stiffness: float = 0.0,
+    nonlinear: bool = False,
+    limit: float = DEFAULTS.structure_limit,
+    modes: int = DEFAULTS.structure_modes,
+    auto: bool = False,
+    settings: Settings = DEFAULTS,
+) -> StructureCheck:
+    """Load the design on the supports of ``rigidity`` (from
+    :func:`~rigidfold.structure.supports.check_supports` or ``auto_supports``) and check
+    it; no analysis when the supports leave a mechanism."""
+    check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=loads)
+    held = rigidity.supports.held(pattern)
+    common = dict(
+        pattern=held,
+        material=material,
+        thickness=thickness,
+        rigidity=rigidity,
+        loads=tuple(loads),
+        self_weight=self_weight,
+        hinge_stiffness=hinge_stiffness,
+        nonlinear=nonlinear,
+        limit=limit,
+        auto=auto,
+    )
+    if not rigidity.rigid:
+        return StructureCheck(mesh=None, response=None, **common)  # type: ignore[arg-type]
+    mesh = shell_mesh(held, settings.structure_subdivisions)
+    weight = material.density * settings.structure_gravity * thickness if self_weight else 0.0
+    forces = nodal_loads(mesh, tuple(loads), self_weight=weight)
+    response = solve_shell(
+        mesh,
+        material,
+        thickness,
+        forces,
+        pinned=rigidity.supports.pinned,
+        clamped=rigidity.supports.clamped,
+        hinge_stiffness=hinge_stiffness,
+        nonlinear=nonlinear,
+        modes=modes,
+        settings=settings,
+    )
+    return StructureCheck(mesh=mesh, response=response, **common)  # type: ignore[arg-type]

@@ -1,0 +1,367 @@
+"""Supports that stabilise the mechanism: are they enough, and which are the fewest?
+
+A design of DOF d moves, with nothing holding it, in d mechanism modes (the kernel of the
+frame model's compatibility matrix, :mod:`rigidfold.mechanism`) and 6 rigid-body motions.
+Let Q (v-space x (d + 6)) be an orthonormal basis of these motions of the frame model
+(:mod:`rigidfold.frame.model`; translations in units of the mean edge length L). A pinned
+vertex v of triangle f holds its velocity ``u_b + theta_b x (x_v - x_b)`` (b: f's barycentre
+node) at zero: three rows ``B_v`` of ``P Q``; a clamped vertex also holds the rotation of
+every triangle at it. The supports are springs of unit stiffness on these rows, and their
+stiffness on the free motions is the pseudo stiffness matrix of Section 4 (Eq. 19),
+``K~ = (P Q)^T (P Q) = sum_v B_v^T B_v`` (:class:`rigidfold.mechanism.stiffness.PseudoStiffness`
+with the supports for the hinges). The supports make the mechanism **first-order rigid**
+when K~ is positive definite: its smallest eigenvalue exceeds
+``Settings.structure_rigidity_tol`` times its largest. Otherwise the eigenvector of the
+smallest eigenvalue is the motion they leave free, named by its largest hinge rotations (a
+mechanism) or as a rigid-body motion.
+
+Actuated creases (``--actuators``) are held at their angle: they count as fixed creases
+(supports of a hinge) in the frame model and in the shell model.
+
+``auto``: the smallest set of candidate vertices (boundary vertices by default, a list, or
+the boundary vertices at ground level) that is first-order rigid, and among those of that
+size the one of the largest smallest eigenvalue. Every set of one size is tried, smallest
+size first (from ceil((d + 6) / 3), as each pin gives three rows), while the number of sets
+is at most ``Settings.structure_max_support_sets``; beyond, a greedy search adds the
+candidate that raises log det of K~ (eigenvalues floored) the most until rigid, then drops
+any support not needed. First-order rigidity is what is checked: a set that is rigid only at
+second order (prestress stability) is reported as a mechanism.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
+from rigidfold.mechanism.kinematics import (
+    angular_velocity_blocks,
+    constraint_matrix,
+    fold_angle_gradients,
+)
+from rigidfold.mechanism.stiffness import PseudoStiffness
+from rigidfold.mesh import CreasePattern
+
+CANDIDATE_FORMS = ("boundary", "ground", "V,V,...")
+
+
+def parse_indices(text: str, count: int, what: str) -> np.ndarray:
+    """``"3,7,12"`` as a sorted (k,) int64 array of distinct indices below ``count``;
+    ``""`` is none. ValueError naming ``what`` and the text for anything else."""
+    if not isinstance(text, str):
+        raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}")
+    items = [t.strip() for t in text.split(",") if t.strip()]
+    try:
+        values = [int(t) for t in items]
+    except ValueError:
+        raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}") from None
+    bad = [v for v in values if not 0 <= v < count]
+    if bad:
+        raise RigidfoldError(f"{what}: {bad[0]} is out of range 0..{count - 1} (got {text!r})")
+    return np.array(sorted(set(values)), dtype=np.int64)
+
+
+def support_candidates(
+    pattern: CreasePattern, spec: str | None = None, settings: Settings = DEFAULTS
+) -> np.ndarray:
+    """The vertices ``auto`` may choose (sorted, int64): ``None`` or ``"boundary"``: the
+    boundary vertices; ``"ground"``: those within ``settings.structure_ground_tol`` of the
+    lowest boundary vertex's height; ``"V,V,..."``: these vertices."""
+    boundary = pattern.boundary_vertices
+    if spec is None or spec.strip().lower() == "boundary":
+        return boundary
+    if spec.strip().lower() == "ground":
+        z = pattern.coords[boundary, 2]
+        return boundary[z <= z.min() + settings.structure_ground_tol]
+    return parse_indices(spec, pattern.n_vertices, "support candidates")
+
+
+@dataclass(frozen=True, eq=False)
+class Supports:
+    """Pinned and clamped vertices, and actuated creases (held at their angle).
+
+    pinned : (k,) int64; clamped : (c,) int64; actuated : (a,) int64 edge indices.
+    """
+
+    pinned: np.ndarray
+    clamped: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    actuated: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    def __post_init__(self) -> None:
+        for name in ("pinned", "clamped", "actuated"):
+            arr = np.array(sorted(set(np.asarray(getattr(self, name)).ravel().tolist())))
+            arr = arr.astype(np.int64)
+            arr.flags.writeable = False
+            object.__setattr__(self, name, arr)
+        both = np.intersect1d(self.pinned, self.clamped)
+        if len(both):
+            raise RigidfoldError(f"vertex {int(both[0])} is both pinned and clamped")
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(k + c,) the supported vertices: pinned, then clamped."""
+        return np.concatenate([self.pinned, self.clamped])
+
+    def held(self, pattern: CreasePattern) -> CreasePattern:
+        """``pattern`` with the actuated creases fixed."""
+        if not len(self.actuated):
+            return pattern
+        bad = [int(e) for e in self.actuated if e not in set(pattern.free_creases.tolist())]
+        if bad:
+            raise RigidfoldError(f"actuator {bad[0]} is not a free crease of the design")
+        fixed = pattern.fixed.copy()
+        fixed[self.actuated] = True
+        return pattern.with_fixed(fixed)
+
+    def to_dict(self) -> dict:
+        return {
+            "pinned": self.pinned.tolist(),
+            "clamped": self.clamped.tolist(),
+            "actuated_creases": self.actuated.tolist(),
+        }
+
+
+class SupportModes:
+    """The free motions of a design and the support rows on them (see the module's text).
+
+    pattern : the design with its actuated creases fixed. ``Q`` (3V, m) holds, as columns,
+    the right singular vectors of the kinematic constraint matrix C (edge lengths and fixed
+    creases, rows of unit norm, no gauge: :func:`rigidfold.mechanism.kinematics.constraint_matrix`)
+    whose singular values ``sigma`` (m,) are at most ``structure_soft_modes`` times the
+    largest: the 6 rigid-body motions, the d mechanisms and the near-mechanisms.
+    """
+
+    def __init__(self, pattern: CreasePattern, settings: Settings = DEFAULTS) -> None:
+        self.pattern = pattern
+        self.settings = settings
+        C = constraint_matrix(pattern, 0)[:-9].toarray()  # the support triangle's rows dropped
+        _, sv, vt = np.linalg.svd(C, full_matrices=True)
+        sigma = np.zeros(3 * pattern.n_vertices)
+        sigma[: len(sv)] = sv
+        top = float(sv[0]) if len(sv) else 1.0
+        soft = sigma <= settings.structure_soft_modes * top
+        self.sigma = sigma[soft]
+        self.Q = vt[soft].T
+        self.dof = int(np.sum(sigma <= settings.mechanism_rank_tol * top)) - 6
+        self.near = int(soft.sum()) - 6 - self.dof
+        x = pattern.coords - pattern.coords.mean(axis=0)
+        V = pattern.n_vertices
+        rigid = np.zeros((3 * V, 6))
+        for a in range(3):
+            rigid[a::3, a] = 1.0
+            rigid[:, 3 + a] = np.cross(np.eye(3)[a], x).ravel()
+        self.rigid = rigid
+        self.scale = float(np.mean(pattern.edge_lengths))
+        self._grams: dict[int, np.ndarray] = {}
+
+    @property
+    def n_modes(self) -> int:
+        """m: 6 + d + the near-mechanisms."""
+        return self.Q.shape[1]
+
+    def pin_rows(self, vertex: int) -> np.ndarray:
+        """(3, m) velocity of ``vertex`` on the motions Q."""
+        return self.Q[3 * vertex : 3 * vertex + 3]
+
+    def clamp_rows(self, vertex: int) -> np.ndarray:
+        """(3 + 3k, m) velocity of ``vertex`` and the angular velocities (times the mean edge
+        length) of the k triangles at it."""
+        faces = np.flatnonzero(np.any(self.pattern.faces == vertex, axis=1))
+        W = angular_velocity_blocks(self.pattern)[faces]  # (k, 3, 3, 3)
+        rows = [self.pin_rows(vertex)]
+        for f, block in zip(faces, W, strict=True):
+            cols = (3 * self.pattern.faces[f][:, None] + np.arange(3)).ravel()
+            rows.append(self.scale * block.reshape(3, 9) @ self.Q[cols])
+        return np.vstack(rows)
+
+    def gram(self, vertex: int, clamp: bool = False) -> np.ndarray:
+        """(m, m) B_v^T B_v of one support."""
+        key = -1 - vertex if clamp else vertex
+        if key not in self._grams:
+            B = self.clamp_rows(vertex) if clamp else self.pin_rows(vertex)
+            self._grams[key] = B.T @ B
+        return self._grams[key]
+
+    @property
+    def own(self) -> np.ndarray:
+        """(m, m) diag(sigma^2): the motions' own stiffness."""
+        return np.diag(self.sigma**2)
+
+    def stiffness(self, supports: Supports) -> PseudoStiffness:
+        """K~ = diag(sigma^2) + sum of the supports' B^T B, as the PseudoStiffness of the
+        stacked rows [diag(sigma); B] with unit stiffnesses."""
+        rows = [np.diag(self.sigma)]
+        rows += [self.pin_rows(int(v)) for v in supports.pinned]
+        rows += [self.clamp_rows(int(v)) for v in supports.clamped]
+        B = np.vstack(rows)
+        return PseudoStiffness(B, np.ones(len(B)))
+
+    def rigidity(self, supports: Supports) -> Rigidity:
+        """Whether ``supports`` make the design first-order rigid, and the motion they leave
+        free when they do not."""
+        stiff = self.stiffness(supports)
+        lam = stiff.eigenvalues
+        rigid = bool(lam[0] > self.settings.structure_rigidity_tol)
+        weakest = self.Q @ stiff.eigenvectors[:, 0]
+        return Rigidity(
+            supports=supports,
+            dof=self.dof,
+            near_mechanisms=self.near,
+            eigenvalues=lam,
+            rigid=rigid,
+            mode=None if rigid else self.describe(weakest),
+        )
+
+    def describe(self, motion: np.ndarray) -> str:
+        """A motion (3V,) of the vertices in words: the creases it folds most, or the
+        rigid-body motion it is."""
+        pat = self.pattern
+        free = pat.free_creases
+        rates = fold_angle_gradients(pat, free) @ motion if len(free) else np.zeros(0)
+        coef, *_ = np.linalg.lstsq(self.rigid, motion, rcond=None)
+        size = max(float(np.linalg.norm(motion)), 1e-300)
+        rest = float(np.linalg.norm(motion - self.rigid @ coef)) / size
+        if len(rates) and rest > 1e-3:
+            order = np.argsort(-np.abs(rates))[:3]
+            top = np.abs(rates[order[0]])
+            names = [
+                f"{int(free[j])} ({'-'.join(map(str, pat.edges[free[j]]))})"
+                for j in order
+                if np.abs(rates[j]) > 0.1 * top
+            ]
+            return "a mechanism that folds crease " + ", ".join(names)
+        t, w = coef[:3], coef[3:]
+        if np.linalg.norm(w) * self.scale > 1e-6 * np.linalg.norm(t):
+            return "a rigid-body rotation about the axis " + _vector(w / np.linalg.norm(w))
+        return "a rigid-body translation along " + _vector(t / np.linalg.norm(t))
+
+
+def _vector(v: np.ndarray) -> str:
+    return "(" + ", ".join(f"{c:.3g}" for c in v + 0.0) + ")"
+
+
+@dataclass(frozen=True, eq=False)
+class Rigidity:
+    """Whether supports make the design first-order rigid.
+
+    supports : Supports; dof : the mechanism's DOF without supports; near_mechanisms : the
+    motions of small stiffness counted with them; eigenvalues : (m,) ascending eigenvalues of
+    K~ (m = 6 + dof + near_mechanisms); rigid : bool; mode : the motion left free, in words
+    (None when rigid).
+    """
+
+    supports: Supports
+    dof: int
+    near_mechanisms: int
+    eigenvalues: np.ndarray
+    rigid: bool
+    mode: str | None
+
+    @property
+    def smallest(self) -> float:
+        return float(self.eigenvalues[0]) if len(self.eigenvalues) else 0.0
+
+    def to_dict(self) -> dict:
+        return {
+            **self.supports.to_dict(),
+            "mechanism_dof": self.dof,
+            "near_mechanisms": self.near_mechanisms,
+            "first_order_rigid": self.rigid,
+            "smallest_eigenvalue": self.smallest,
+            "mode": self.mode,
+        }
+
+
+def check_supports(
+    pattern: CreasePattern, supports: Supports, settings: Settings = DEFAULTS
+) -> Rigidity:
+    """First-order rigidity of ``pattern`` (actuated creases held) on ``supports``."""
+    return SupportModes(supports.held(pattern), settings).rigidity(supports)
+
+
+def auto_supports(
+    pattern: CreasePattern,
+    candidates: np.ndarray,
+    *,
+    clamped: np.ndarray | None = None,
+    actuated: np.ndarray | None = None,
+    settings: Settings = DEFAULTS,
+) -> Rigidity:
+    """The smallest set of pinned ``candidates`` (with the ``clamped`` vertices and the
+    ``actuated`` creases) that makes ``pattern`` first-order rigid, of the largest smallest
+    eigenvalue among the sets of that size tried (see the module's text). When even all
+    candidates leave a mechanism, the result for all of them (``rigid`` False)."""
+    none = np.zeros(0, dtype=np.int64)
+    base = Supports(
+        none,
+        none if clamped is None else np.asarray(clamped),
+        none if actuated is None else np.asarray(actuated),
+    )
+    modes = SupportModes(base.held(pattern), settings)
+    cand = np.setdiff1d(np.asarray(candidates, dtype=np.int64), base.clamped)
+    if not len(cand):
+        raise RigidfoldError("no candidate vertex for the supports")
+    G0 = modes.own + sum(
+        (modes.gram(int(v), clamp=True) for v in base.clamped), np.zeros((modes.n_modes,) * 2)
+    )
+    G = np.stack([modes.gram(int(v)) for v in cand])
+    tol = settings.structure_rigidity_tol
+    everything = modes.rigidity(Supports(cand, base.clamped, base.actuated))
+    if not everything.rigid:
+        return everything
+    need = int(np.sum(modes.sigma**2 <= tol))  # motions that only supports can hold
+    k0 = max(1, math.ceil((need - 6 * len(base.clamped)) / 3))
+    for k in range(k0, len(cand) + 1):
+        if math.comb(len(cand), k) > settings.structure_max_support_sets:
+            chosen = _greedy(G0, G, tol)
+            return modes.rigidity(Supports(cand[chosen], base.clamped, base.actuated))
+        best, best_lam = None, 0.0
+        combos = itertools.combinations(range(len(cand)), k)
+        while True:
+            chunk = np.array(list(itertools.islice(combos, 8192)), dtype=np.int64)
+            if not len(chunk):
+                break
+            lam = np.linalg.eigvalsh(G0 + G[chunk].sum(axis=1))
+            ok = lam[:, 0] > tol
+            if ok.any():
+                i = int(np.argmax(np.where(ok, lam[:, 0], -np.inf)))
+                if best is None or lam[i, 0] > best_lam:
+                    best, best_lam = chunk[i], float(lam[i, 0])
+        if best is not None:
+            return modes.rigidity(Supports(cand[best], base.clamped, base.actuated))
+    return everything  # not reached: all candidates together are rigid
+
+
+def _greedy(G0: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
+    """Indices into G (c, m, m) of a rigid set: add the support that raises the floored log
+    det the most until rigid, then drop supports while rigid (the one whose removal keeps
+    the largest smallest eigenvalue first)."""
+    floor = tol
+
+    def rigid(lam: np.ndarray) -> bool:
+        return bool(lam[0] > tol)
+
+    chosen: list[int] = []
+    current = G0.copy()
+    while not chosen or not rigid(np.linalg.eigvalsh(current)):
+        rest = [i for i in range(len(G)) if i not in chosen]
+        lam = np.linalg.eigvalsh(current[None] + G[rest])
+        score = np.log(np.maximum(lam, floor)).sum(axis=1)
+        pick = rest[int(np.argmax(score))]
+        chosen.append(pick)
+        current = current + G[pick]
+    while len(chosen) > 1:
+        trials = []
+        for i in chosen:
+            lam = np.linalg.eigvalsh(current - G[i])
+            trials.append((float(lam[0]) if rigid(lam) else -np.inf, i))
+        value, drop = max(trials)
+        if value == -np.inf:
+            break
+        chosen.remove(drop)
+        current = current - G[drop]
+    return np.array(sorted(chosen), dtype=np.int64)
