@@ -359,8 +359,8 @@ class Settings:
         Where two such panels still come closer than ``fabricate_clearance`` near a shared
         vertex, the relief there is doubled and the check run again, this many times at most.
     fabricate_frame_step : float
-        Largest rotation, radians, of one panel relative to another between two frames of
-        the motion that are checked (1 degree): the design file's motion frames when they
+        Largest change of a hinge's fold angle, radians, between two frames of the motion
+        that are checked (2 degrees): the design file's motion frames when they
         are that fine, else the traced folding path sampled that finely.
     fabricate_subdivisions : int
         Between two frames, the motion is halved at most this many times where the bound on
@@ -492,7 +492,7 @@ class Settings:
     fabricate_clearance: float = 1e-3
     fabricate_vertex_relief: float = 1.0
     fabricate_relief_rounds: int = 4
-    fabricate_frame_step: float = math.radians(1.0)
+    fabricate_frame_step: float = math.radians(2.0)
     fabricate_subdivisions: int = 8
     fabricate_min_depth: float = 1.0
     fabricate_trimmed_away: float = 0.2

@@ -226,8 +226,14 @@ def _evaluate(
     relief = np.zeros(panels.pattern.n_vertices)
     relief[panels.relief_vertices] = settings.fabricate_vertex_relief * thickness
     rounds = 0
+    solids = thicken(panels, thickness, bevel, relief)
+    around = [h for h, (a, b) in enumerate(solids.hinge_limits[1]) if a or b]
+    if around:  # pieces reaching around a hinge's axis touch the neighbour at its ends
+        ends = panels.hinge_vertices[around].ravel()
+        relief[ends] = np.maximum(relief[ends], settings.fabricate_vertex_relief * thickness)
     while True:
-        solids = thicken(panels, thickness, bevel, relief)
+        if rounds or around:
+            solids = thicken(panels, thickness, bevel, relief)
         check = None
         if motion is not None:
             check = check_clearance(
@@ -305,3 +311,40 @@ def _verdict(
         f"smallest gap {check.min_gap * 1e3:.1f} mm between panels {check.gap_panels[0]} and "
         f"{check.gap_panels[1]} at {100 * check.gap_fraction:.0f}% folded"
     )
+
+
+_UNITS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
+
+
+def parse_length(text: str, what: str = "thickness") -> float:
+    """A length in metres from ``"0.018"``, ``"18mm"``, ``"1.8cm"`` or ``"0.018m"``. Raises
+    ValueError naming ``what`` and the text for anything else, or a length that is not
+    positive and finite."""
+    raw = str(text).strip().lower()
+    scale = 1.0
+    for unit in ("mm", "cm", "m"):
+        if raw.endswith(unit):
+            raw, scale = raw[: -len(unit)].strip(), _UNITS[unit]
+            break
+    try:
+        value = float(raw) * scale
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(
+            f"{what} must be a positive length in metres or with a unit (18mm, 1.8cm, "
+            f"0.018), got {text!r}"
+        )
+    return value
+
+
+def parse_sheet(text: str) -> tuple[float, float]:
+    """(width, height) in mm from ``"2440x1220"``. Raises ValueError naming the text."""
+    parts = str(text).lower().replace(" ", "").split("x")
+    try:
+        w, h = (float(x) for x in parts)
+    except ValueError:
+        w = h = math.nan
+    if not all(math.isfinite(x) and x > 0 for x in (w, h)):
+        raise ValueError(f"sheet must be WIDTHxHEIGHT in millimetres (2440x1220), got {text!r}")
+    return w, h

@@ -124,48 +124,78 @@ class Clearance:
 
 
 class _Distances:
-    """Exact distances between two solids in a relative position, through python-fcl."""
+    """Exact distances between two solids (or some of their pieces) in a relative position,
+    through python-fcl."""
 
     def __init__(self, solids: Solids) -> None:
         import fcl
 
         self.fcl = fcl
-        self.request = fcl.DistanceRequest(enable_nearest_points=True, enable_signed_distance=True)
-        self.objects: list[list] = [[] for _ in range(solids.panels.n)]
-        self.spheres: list[list[tuple[np.ndarray, float]]] = [[] for _ in range(solids.panels.n)]
-        for piece in solids.pieces:
+        # unsigned: libccd's penetration depth (EPA) aborts the process on some touching
+        # configurations (fcl throws std::logic_error through the binding)
+        self.request = fcl.DistanceRequest(enable_nearest_points=True)
+        self.objects = []
+        self.of_panel: list[list[int]] = [[] for _ in range(solids.panels.n)]
+        for i, piece in enumerate(solids.pieces):
             tris = piece.triangles
             faces = np.hstack([np.full((len(tris), 1), 3), tris]).ravel()
             shape = fcl.Convex(piece.vertices, len(tris), faces)
-            self.objects[piece.panel].append(fcl.CollisionObject(shape, fcl.Transform()))
-            self.spheres[piece.panel].append((piece.centre, piece.radius))
+            self.objects.append(fcl.CollisionObject(shape, fcl.Transform()))
+            self.of_panel[piece.panel].append(i)
+        self.centres = np.asarray([piece.centre for piece in solids.pieces]).reshape(-1, 3)
+        self.radii = np.asarray([piece.radius for piece in solids.pieces])
         self.identity = fcl.Transform()
         self.queries = 0
+        self.cache: dict[_Pair, np.ndarray] = {}
 
-    def gap(self, a: int, b: int, rot: np.ndarray, shift: np.ndarray) -> tuple[float, np.ndarray]:
-        """(distance, point): the signed distance between solid ``a`` in the design and solid
-        ``b`` moved by ``x -> rot @ x + shift``, and the nearest point on ``a``."""
+    def gap(
+        self, pair: _Pair, rot: np.ndarray, shift: np.ndarray
+    ) -> tuple[float, np.ndarray]:
+        """(distance, point): the signed distance between the pieces of ``pair`` (solid a in
+        the design, solid b moved by ``x -> rot @ x + shift``), and the nearest point on a."""
         fcl = self.fcl
         best, where = math.inf, np.zeros(3)
         moved = fcl.Transform(rot, shift)
-        order = []
-        for j, (cb, rb) in enumerate(self.spheres[b]):
-            cbm = rot @ cb + shift
-            for i, (ca, ra) in enumerate(self.spheres[a]):
-                order.append((float(np.linalg.norm(ca - cbm)) - ra - rb, i, j))
-        order.sort()
-        for lower, i, j in order:
-            if lower >= best:
+        both = self.cache.get(pair)
+        if both is None:
+            both = self.cache[pair] = pair.pieces(self.of_panel)
+        ia, ib = both.T
+        diff = self.centres[ia] - self.centres[ib] @ rot.T - shift
+        lower = np.sqrt(np.einsum("ij,ij->i", diff, diff)) - self.radii[ia] - self.radii[ib]
+        for n in np.argsort(lower).tolist():
+            if lower[n] >= best:
                 break
-            oa, ob = self.objects[a][i], self.objects[b][j]
+            pa, pb = int(ia[n]), int(ib[n])
+            oa, ob = self.objects[pa], self.objects[pb]
             oa.setTransform(self.identity)
             ob.setTransform(moved)
             result = fcl.DistanceResult()
-            d = fcl.distance(oa, ob, self.request, result)
+            d = max(fcl.distance(oa, ob, self.request, result), 0.0)  # -1: they overlap
             self.queries += 1
             if d < best:
                 best, where = d, np.asarray(result.nearest_points[0], dtype=np.float64)
         return best, where
+
+
+@dataclass(frozen=True)
+class _Pair:
+    """Two solids whose pieces must keep the clearance: all of them (panels that are not
+    neighbours), or, for neighbours, those that reach around their hinge's axis
+    (``around_a`` of a against all of b, and the rest of a against ``around_b``)."""
+
+    a: int
+    b: int
+    around_a: frozenset | None = None
+    around_b: frozenset | None = None
+
+    def pieces(self, of_panel: list[list[int]]) -> np.ndarray:
+        """(n, 2) int: the pairs of pieces (indices into ``Solids.pieces``) to check."""
+        pa, pb = of_panel[self.a], of_panel[self.b]
+        if self.around_a is None or self.around_b is None:
+            out = [(i, j) for i in pa for j in pb]
+        else:
+            out = [(i, j) for i in pa for j in pb if i in self.around_a or j in self.around_b]
+        return np.asarray(out, dtype=np.int64).reshape(-1, 2)
 
 
 def _relative(motion: PanelMotion, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -272,24 +302,57 @@ class _GapCheck:
             joined[panels.neighbours[:, 0], panels.neighbours[:, 1]] = True
         ia, ib = np.triu_indices(n, 1)
         keep = ~joined[ia, ib] & (solids.radii[ia] > 0) & (solids.radii[ib] > 0)
-        self.ia, self.ib = ia[keep], ib[keep]
+        pairs = [_Pair(int(a), int(b)) for a, b in zip(ia[keep], ib[keep], strict=True)]
+        for h, (wrap_a, wrap_b) in enumerate(solids.hinge_limits[1]):
+            if wrap_a or wrap_b:
+                a, b = (int(x) for x in panels.hinge_panels[h])
+                pairs.append(_Pair(a, b, wrap_a, wrap_b))
+        self.pairs = pairs
+        self.ia = np.asarray([q.a for q in pairs], dtype=np.int64)
+        self.ib = np.asarray([q.b for q in pairs], dtype=np.int64)
         self.bound = math.inf
         if len(self.ia):
             self._run()
 
     def _exact(self, j: int, rot: np.ndarray, shift: np.ndarray, fraction: float) -> float:
-        a, b = int(self.ia[j]), int(self.ib[j])
-        gap, point = self.dist.gap(a, b, rot, shift)
+        a, b = sorted((int(self.ia[j]), int(self.ib[j])))
+        gap, point = self.dist.gap(self.pairs[j], rot, shift)
         if gap < self.min_gap:
             self.min_gap, self.min_panels, self.min_fraction = gap, (a, b), fraction
         if gap < self.clearance and ((a, b) not in self.close or gap < self.close[(a, b)][0]):
             self.close[(a, b)] = (gap, fraction, point)
         return gap
 
+    def _prefilter(self) -> None:
+        """Drop the pairs whose bounding spheres stay apart by more than the clearance over
+        every interval, each solid's own motion bounded in the world (cheap: per panel, not
+        per pair)."""
+        solids, motion = self.solids, self.motion
+        centres = np.einsum("kpij,pj->kpi", motion.rotations, solids.centres)
+        centres += motion.translations
+        ia, ib = self.ia, self.ib
+        lower = np.linalg.norm(centres[:, ia] - centres[:, ib], axis=2)
+        lower -= (solids.radii[ia] + solids.radii[ib])[None]
+        if motion.n_frames > 1:
+            turn = np.linalg.norm(_turn(motion.rotations[:-1], motion.rotations[1:]), axis=-1)
+            moved = np.linalg.norm(np.diff(centres, axis=0), axis=2)
+            eps = _move_bound(moved, turn, solids.radii[None])
+            proven = np.minimum(lower[:-1], lower[1:]) - eps[:, ia] - eps[:, ib]
+        else:
+            proven = lower
+        near = (proven < self.clearance + solids.thickness).any(axis=0)
+        far = proven[:, ~near]
+        self.bound = float(far.min()) if far.size else math.inf
+        self.pairs = [q for q, keep in zip(self.pairs, near, strict=True) if keep]
+        self.ia, self.ib = ia[near], ib[near]
+
     def _run(self) -> None:
         solids, motion = self.solids, self.motion
         frac = motion.fraction
+        self._prefilter()
         ia, ib = self.ia, self.ib
+        if not len(ia):
+            return
         rot, shift = _relative(motion, ia, ib)
         self.centre_b = solids.centres[ib]
         cb = np.einsum("knij,nj->kni", rot, self.centre_b) + shift  # b's centre seen from a
@@ -297,15 +360,32 @@ class _GapCheck:
         lower -= (solids.radii[ia] + solids.radii[ib])[None]
         known = lower.copy()
         exact = np.zeros(lower.shape, dtype=bool)
-        for k, j in zip(*np.nonzero(lower < self.clearance + solids.thickness), strict=True):
-            known[k, j] = self._exact(j, rot[k, j], shift[k, j], float(frac[k]))
-            exact[k, j] = True
         if motion.n_frames < 2:
-            self.bound = float(known.min())
+            for j in np.flatnonzero(lower[0] < self.clearance + solids.thickness).tolist():
+                known[0, j] = self._exact(j, rot[0, j], shift[0, j], float(frac[0]))
+            self.bound = min(self.bound, float(known.min()))
             return
         turn = np.linalg.norm(_turn(rot[:-1], rot[1:]), axis=-1)
         moved = np.linalg.norm(np.diff(cb, axis=0), axis=2)
-        eps = _move_bound(moved, turn, solids.radii[ib][None])
+        radius = solids.radii[ib][None]
+        eps = _move_bound(moved, turn, radius)
+        # the most any point of b moves relative to a over a whole interval
+        sweep = moved + 2 * radius * np.sin(np.minimum(turn, math.pi) / 2)
+        # walk the frames: measure a pair only where the bound carried from its last
+        # measurement (minus its moves since) and its spheres' gap both fall below what its
+        # two intervals need
+        need = self.clearance + np.maximum(
+            np.vstack([eps, eps[-1:]]), np.vstack([eps[:1], eps])
+        )
+        carried = np.full(len(ia), -np.inf)
+        for k in range(motion.n_frames):
+            if k:
+                carried -= sweep[k - 1]
+            known[k] = np.maximum(lower[k], carried)
+            for j in np.flatnonzero(known[k] < need[k]).tolist():
+                known[k, j] = self._exact(j, rot[k, j], shift[k, j], float(frac[k]))
+                exact[k, j] = True
+                carried[j] = known[k, j]
         proven = np.minimum(known[:-1], known[1:]) - eps
         for k, j in zip(*np.nonzero(proven < self.clearance), strict=True):
             for m in (k, k + 1):
@@ -323,7 +403,7 @@ class _GapCheck:
                     (float(frac[k]), float(frac[k + 1])),
                     self.subdivisions,
                 )
-        self.bound = float(proven.min())
+        self.bound = min(self.bound, float(proven.min()))
 
     def _halve(
         self,

@@ -115,6 +115,27 @@ class Panels:
         """Outline loops of each panel (:func:`rigidfold.exports.sheet.panel_loops`)."""
         return panel_loops(self.pattern)
 
+    @cached_property
+    def corner_angles(self) -> tuple[dict[int, float], ...]:
+        """{vertex: interior angle} of each panel's outline, radians, in the development
+        (where the panel is flat); the largest where a vertex comes twice. Above pi: the
+        panel wraps around that vertex (a reflex corner)."""
+        xy = self.coords2d
+        out = []
+        for loops in self.loops:
+            angles: dict[int, float] = {}
+            for loop in loops:
+                d_in = xy[loop] - xy[np.roll(loop, 1)]
+                d_out = xy[np.roll(loop, -1)] - xy[loop]
+                turn = np.arctan2(
+                    d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0],
+                    np.einsum("ij,ij->i", d_in, d_out),
+                )
+                for v, a in zip(loop.tolist(), (np.pi - turn).tolist(), strict=True):
+                    angles[v] = max(angles.get(v, 0.0), a)
+            out.append(angles)
+        return tuple(out)
+
     # ------------------------------------------------------------------ hinges
     @cached_property
     def hinge_edges(self) -> np.ndarray:
@@ -173,17 +194,23 @@ class Panels:
 
     @cached_property
     def relief_vertices(self) -> np.ndarray:
-        """(k,) int, sorted: vertices where two panels that are not neighbours meet (their
-        solids get a relief there: :mod:`rigidfold.fabricate.solids`)."""
+        """(k,) int, sorted: vertices where two panels that are not neighbours meet, and the
+        ends of hinges where a panel wraps around (a reflex corner: there it reaches around
+        the hinge's axis line); their solids get a relief there
+        (:mod:`rigidfold.fabricate.solids`)."""
         joined = {tuple(p) for p in self.neighbours.tolist()}
-        out = []
+        ends = set(self.hinge_vertices.ravel().tolist())
+        out = [
+            v
+            for corners in self.corner_angles
+            for v, angle in corners.items()
+            if angle > np.pi + 1e-9 and v in ends
+        ]
         for v, ks in enumerate(self.vertex_panels):
             ks_ = ks.tolist()
-            if any(
-                (a, b) not in joined for i, a in enumerate(ks_) for b in ks_[i + 1 :]
-            ):
+            if any((a, b) not in joined for i, a in enumerate(ks_) for b in ks_[i + 1 :]):
                 out.append(v)
-        return np.asarray(out, dtype=np.int64)
+        return np.unique(np.asarray(out, dtype=np.int64))
 
     def shared_vertices(self, a: int, b: int) -> np.ndarray:
         """(k,) int: the vertices that panels ``a`` and ``b`` both have."""

@@ -158,40 +158,48 @@ class Solids:
         return self.thickness / np.tan(np.maximum(self.bevel, 1e-12))
 
     @cached_property
-    def fold_limit(self) -> np.ndarray:
-        """(H,) float64: the closing fold, radians, up to which the two solids of each hinge
-        meet only along its axis, ``pi - a - b`` with ``a``, ``b`` the largest angles that a
-        vertex of either solid makes with its surface around the axis line (the bevels, for
-        convex panels). ``-inf`` where a solid reaches around the axis line (a vertex on
-        the far side of the surface, or across the line's extension: only a panel that
-        wraps around a hinge's end), so the wedge argument does not apply."""
-        p = self.panels
-        out = np.empty(p.n_hinges)
-        for h in range(p.n_hinges):
-            spans = [self._span(h, int(k)) for k in p.hinge_panels[h]]
-            if any(s is None for s in spans):
-                out[h] = -np.inf
-            else:
-                out[h] = math.pi - sum(s for s in spans if s is not None)
-        return out
+    def hinge_limits(self) -> tuple[np.ndarray, tuple[tuple[frozenset, frozenset], ...]]:
+        """(fold_limit (H,), around (H,)): per hinge, the closing fold (radians) up to which
+        its two solids meet only along its axis, and the pieces (indices into ``pieces``) of
+        either solid that reach around the axis line.
 
-    def _span(self, h: int, panel: int) -> float | None:
-        """Largest angle around hinge h's axis between panel's surface and a vertex of its
-        solid (into the material), or None when a vertex lies outside [0, pi/2]."""
-        verts = self.meshes[panel][0]
-        if not len(verts):
-            return 0.0
-        origin, e, inward = _hinge_frame(self.panels, h, panel)
-        d = verts - origin
-        s = d @ inward
-        w = d @ self.panels.material[panel]
-        r = np.hypot(s, w)
-        keep = r > 1e-9 * max(self.thickness, 1e-12)
-        phi = np.arctan2(w[keep], s[keep])
-        tol = 1e-7
-        if phi.size and (phi.min() < -tol or phi.max() > math.pi / 2 + tol):
-            return None
-        return float(max(phi.max(initial=0.0), 0.0))
+        Seen around the axis line, a piece lies within the angles [0, a] from its panel's
+        surface into the material, ``a`` its largest angle (the bevel, for a piece the bevel
+        trims); two pieces on the two sides then meet only on the axis while the fold stays
+        at most ``pi - a - b``. The limit is the least over the pairs of pieces of the two
+        solids. A piece with a point on the far side of the surface or of the axis (a panel
+        that wraps around a hinge's end) has no such angle: it is in ``around``, and its
+        distance to every piece of the other solid is checked like that of two panels that
+        are not neighbours (:mod:`rigidfold.fabricate.collision`)."""
+        p = self.panels
+        limits = np.full(p.n_hinges, math.pi)
+        around = []
+        of_panel: list[list[int]] = [[] for _ in range(p.n)]
+        for i, piece in enumerate(self.pieces):
+            of_panel[piece.panel].append(i)
+        for h in range(p.n_hinges):
+            spans, wraps = [], []
+            for k in p.hinge_panels[h].tolist():
+                origin, _, inward = _hinge_frame(p, h, k)
+                best, wrap = 0.0, set()
+                for i in of_panel[k]:
+                    span = _span(self.pieces[i].vertices, origin, inward, p.material[k],
+                                 self.thickness)
+                    if span is None:
+                        wrap.add(i)
+                    else:
+                        best = max(best, span)
+                spans.append(best)
+                wraps.append(frozenset(wrap))
+            limits[h] = math.pi - spans[0] - spans[1]
+            around.append((wraps[0], wraps[1]))
+        return limits, tuple(around)
+
+    @property
+    def fold_limit(self) -> np.ndarray:
+        """(H,) float64: the closing fold of each hinge up to which its solids meet only along
+        its axis, radians (:attr:`hinge_limits`)."""
+        return self.hinge_limits[0]
 
     @property
     def total_volume(self) -> float:
@@ -203,6 +211,24 @@ class Solids:
         remove."""
         full = float(self.panels.areas.sum()) * self.thickness
         return 1.0 - self.total_volume / full if full > 0 else 0.0
+
+
+def _span(
+    verts: np.ndarray, origin: np.ndarray, inward: np.ndarray, material: np.ndarray, t: float
+) -> float | None:
+    """Largest angle around an axis (through ``origin``, square to ``inward`` and
+    ``material``) between a panel's surface and the points ``verts`` (n, 3) of one convex
+    piece of its solid, into the material; None when one lies outside [0, pi/2] (on the far
+    side of the surface or of the axis). Points on the axis itself are skipped."""
+    d = verts - origin
+    s = d @ inward
+    w = d @ material
+    keep = np.hypot(s, w) > 1e-9 * max(t, 1e-12)
+    phi = np.arctan2(w[keep], s[keep])
+    tol = 1e-7
+    if phi.size and (phi.min() < -tol or phi.max() > math.pi / 2 + tol):
+        return None
+    return float(max(phi.max(initial=0.0), 0.0))
 
 
 def bevel_angles(fold_max: np.ndarray, clearance_angle: float) -> np.ndarray:
@@ -232,24 +258,6 @@ def _hinge_frame(panels: Panels, h: int, panel: int) -> tuple[np.ndarray, np.nda
     return origin, e, inward
 
 
-def _corner_angles(panels: Panels, panel: int) -> dict[int, float]:
-    """The panel's interior angle at each vertex of its outline, radians (in the development,
-    where the panel is flat; the largest where a vertex comes twice)."""
-    xy = panels.coords2d
-    out: dict[int, float] = {}
-    for loop in panels.loops[panel]:
-        prev, nxt = np.roll(loop, 1), np.roll(loop, -1)
-        d_in = xy[loop] - xy[prev]
-        d_out = xy[nxt] - xy[loop]
-        turn = np.arctan2(
-            d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0],
-            np.einsum("ij,ij->i", d_in, d_out),
-        )
-        for v, a in zip(loop.tolist(), (math.pi - turn).tolist(), strict=True):
-            out[v] = max(out.get(v, 0.0), a)
-    return out
-
-
 @dataclass(frozen=True)
 class _Bevel:
     """The material that one hinge's bevel removes from one panel: points at depth w below
@@ -268,7 +276,7 @@ class _Bevel:
 
 def _bevels(panels: Panels, panel: int, bevel: np.ndarray) -> list[_Bevel]:
     p = panels.pattern
-    corners = _corner_angles(panels, panel)
+    corners = panels.corner_angles[panel]
     span = float(np.ptp(panels.coords2d[panels.vertices[panel]], axis=0).max()) * 4
     out = []
     for h in panels.hinges_of[panel].tolist():
