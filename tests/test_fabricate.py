@@ -45,8 +45,9 @@ def built(design, tmp_path_factory):
     runs = {}
     for t in (0.02, 0.05):
         out = tmp_path_factory.mktemp(f"fab{int(t * 1e3)}")
-        code = main_code(["fabricate", str(design), "--thickness", f"{t * 1e3:g}mm", "--out",
-                          str(out)])
+        code = main_code(
+            ["fabricate", str(design), "--thickness", f"{t * 1e3:g}mm", "--out", str(out)]
+        )
         summary = json.loads((out / f"{design.stem}_fabricate.json").read_text())
         runs[t] = (code, out, summary)
     runs["result"] = fabricate_file(design, tmp_path_factory.mktemp("lib"), thickness=0.02)
@@ -103,7 +104,9 @@ def test_independent_no_interpenetration(built):
     if carried is not None:
         frames = np.concatenate([frames, carried[0]])
     solids = [
-        mf.Manifold(mf.Mesh64(vert_properties=np.ascontiguousarray(v), tri_verts=f.astype(np.uint64)))
+        mf.Manifold(
+            mf.Mesh64(vert_properties=np.ascontiguousarray(v), tri_verts=f.astype(np.uint64))
+        )
         for v, f in fab.solids.meshes
     ]
     worst = 0.0
@@ -134,8 +137,9 @@ def test_collision_reported_with_panels_and_fraction(design, tmp_path, capsys):
     from rigidfold.fabricate import FabricationStatus
     from rigidfold.workflows import fabricate_file
 
-    settings = DEFAULTS.with_(fabricate_vertex_relief=0.0, fabricate_relief_rounds=0,
-                              fabricate_thickness_tries=2)
+    settings = DEFAULTS.with_(
+        fabricate_vertex_relief=0.0, fabricate_relief_rounds=0, fabricate_thickness_tries=2
+    )
     done = fabricate_file(design, tmp_path, thickness=0.05, settings=settings)
     fab = done.fabrication
     assert fab.status is FabricationStatus.COLLISION
@@ -205,8 +209,9 @@ def test_cut_sheets_every_panel_once_within_stock(built):
         pts = np.array([p[:2] for p in poly.get_points()])
         w, h = np.ptp(pts, axis=0)
         assert max(w, h) > min(width, height) and (max(w, h) > width or min(w, h) > height)
-        seen += [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')
-                 if t.dxf.text.startswith("P")]
+        seen += [
+            t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]') if t.dxf.text.startswith("P")
+        ]
     assert len(oversize) == len(list(out.glob("*_oversize_*.dxf")))
     assert sorted(seen) == sorted(f"P{k}" for k in range(summary["panels"]))
     assert len(list(out.glob("*_sheet_*.svg"))) == summary["cut_sheets"]["sheets"]
@@ -222,8 +227,7 @@ def test_schedules(built):
         assert float(row["fold_max_deg"]) + summary["clearance_angle_deg"] <= (
             float(row["fold_limit_deg"]) + 1e-6
         )
-        assert math.isclose(bevel, (180 - max(float(row["fold_max_deg"]), 0) - 2) / 2,
-                            abs_tol=1e-3)
+        assert math.isclose(bevel, (180 - max(float(row["fold_max_deg"]), 0) - 2) / 2, abs_tol=1e-3)
     vertices = list(csv.DictReader(next(out.glob("*_vertices.csv")).read_text().splitlines()))
     assert vertices and {"x_m", "flat_x_m", "relief_mm"} <= set(vertices[0])
     per_panel = summary["per_panel"]
@@ -248,8 +252,16 @@ def test_bad_input_exits_2(design, tmp_path, capsys, args):
 
 
 def test_missing_file_exits_2(tmp_path, capsys):
-    code = main_code(["fabricate", str(tmp_path / "none.fold"), "--thickness", "20mm",
-                      "--out", str(tmp_path / "o")])
+    code = main_code(
+        [
+            "fabricate",
+            str(tmp_path / "none.fold"),
+            "--thickness",
+            "20mm",
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
     assert code == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
 

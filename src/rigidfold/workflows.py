@@ -517,7 +517,12 @@ def fabricate_file(
     title = f"{label}: thick panels {thickness * 1e3:g} mm, {side} side"
     written = write_solid_files(fab, out_dir, stem, title=title)
     sheets_written, sheets = write_cut_sheets(
-        fab, out_dir, stem, width=width, height=height, gap=settings.fabricate_sheet_gap,
+        fab,
+        out_dir,
+        stem,
+        width=width,
+        height=height,
+        gap=settings.fabricate_sheet_gap,
         title=label,
     )
     written += sheets_written

@@ -112,7 +112,7 @@ class Fabrication:
     def to_dict(self) -> dict:
         s = self.solids
         p = s.panels
-        low, high = self.fold_range
+        _low, high = self.fold_range
         area = float(p.areas.sum())
         return {
             "status": self.status.value,

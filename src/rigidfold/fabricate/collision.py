@@ -148,9 +148,7 @@ class _Distances:
         self.queries = 0
         self.cache: dict[_Pair, np.ndarray] = {}
 
-    def gap(
-        self, pair: _Pair, rot: np.ndarray, shift: np.ndarray
-    ) -> tuple[float, np.ndarray]:
+    def gap(self, pair: _Pair, rot: np.ndarray, shift: np.ndarray) -> tuple[float, np.ndarray]:
         """(distance, point): the signed distance between the pieces of ``pair`` (solid a in
         the design, solid b moved by ``x -> rot @ x + shift``), and the nearest point on a."""
         fcl = self.fcl
@@ -268,9 +266,9 @@ def _check_hinges(
     if not panels.n_hinges:
         return math.inf, (-1, -1), math.nan, []
     margin = solids.fold_limit[None, :] - motion.closing
-    i, h = np.unravel_index(int(np.argmin(margin)), margin.shape)
-    a, b = sorted(int(x) for x in panels.hinge_panels[h])
-    least = (float(margin[i, h]), (a, b), float(motion.fraction[i]))
+    i, worst = (int(x) for x in np.unravel_index(int(np.argmin(margin)), margin.shape))
+    a, b = sorted(int(x) for x in panels.hinge_panels[worst])
+    least = (float(margin[i, worst]), (a, b), float(motion.fraction[i]))
     meetings: dict[tuple[int, int], Meeting] = {}
     for h in np.flatnonzero((margin < 0).any(axis=0)).tolist():
         first = int(np.flatnonzero(margin[:, h] < 0)[0])
@@ -374,9 +372,7 @@ class _GapCheck:
         # walk the frames: measure a pair only where the bound carried from its last
         # measurement (minus its moves since) and its spheres' gap both fall below what its
         # two intervals need
-        need = self.clearance + np.maximum(
-            np.vstack([eps, eps[-1:]]), np.vstack([eps[:1], eps])
-        )
+        need = self.clearance + np.maximum(np.vstack([eps, eps[-1:]]), np.vstack([eps[:1], eps]))
         carried = np.full(len(ia), -np.inf)
         for k in range(motion.n_frames):
             if k:
@@ -429,13 +425,32 @@ class _GapCheck:
         mid = self._exact(j, rot, c_mid - rot @ self.centre_b[j], f_mid)
         self.midpoints += 1
         radius = self.solids.radii[self.ib[j]]
-        half = float(_move_bound(np.linalg.norm(centres[1] - centres[0]) / 2,
-                                 np.linalg.norm(step) / 2, radius))
+        half = float(
+            _move_bound(
+                np.asarray(np.linalg.norm(centres[1] - centres[0]) / 2),
+                np.asarray(np.linalg.norm(step) / 2),
+                radius,
+            )
+        )
         return min(
-            self._halve(j, (rots[0], rot), (centres[0], c_mid), (ends[0], mid), half,
-                        (fractions[0], f_mid), depth - 1),
-            self._halve(j, (rot, rots[1]), (c_mid, centres[1]), (mid, ends[1]), half,
-                        (f_mid, fractions[1]), depth - 1),
+            self._halve(
+                j,
+                (rots[0], rot),
+                (centres[0], c_mid),
+                (ends[0], mid),
+                half,
+                (fractions[0], f_mid),
+                depth - 1,
+            ),
+            self._halve(
+                j,
+                (rot, rots[1]),
+                (c_mid, centres[1]),
+                (mid, ends[1]),
+                half,
+                (f_mid, fractions[1]),
+                depth - 1,
+            ),
         )
 
     def meetings(self) -> list[Meeting]:

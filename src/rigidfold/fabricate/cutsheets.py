@@ -117,19 +117,19 @@ def parts(fab: Fabrication) -> list[Part]:
         angle = min_area_angle(ring)
         c, sn = math.cos(angle), math.sin(angle)
         turn = np.array([[c, sn], [-sn, c]])  # row vectors: xy @ turn turns by angle
-        cut_t = shapely.transform(cut, lambda x: x @ turn)
-        far_t = shapely.transform(far, lambda x: x @ turn)
+        cut_t = _moved(cut, turn)
+        far_t = _moved(far, turn)
         lab = [(np.array([x, y]) @ turn, t) for x, y, t in labels]
         x0, y0, x1, y1 = cut_t.bounds
         if (y1 - y0) > (x1 - x0):
             quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
-            cut_t = shapely.transform(cut_t, lambda x: x @ quarter)
-            far_t = shapely.transform(far_t, lambda x: x @ quarter)
+            cut_t = _moved(cut_t, quarter)
+            far_t = _moved(far_t, quarter)
             lab = [(q @ quarter, t) for q, t in lab]
             x0, y0, x1, y1 = cut_t.bounds
         shift = np.array([x0, y0])
-        cut_t = shapely.transform(cut_t, lambda x: x - shift)
-        far_t = shapely.transform(far_t, lambda x: x - shift)
+        cut_t = _moved(cut_t, None, -shift)
+        far_t = _moved(far_t, None, -shift)
         labels_t = tuple((float(q[0] - x0), float(q[1] - y0), t) for q, t in lab)
         out.append(Part(k, cut_t, far_t, labels_t, x1 - x0, y1 - y0))
     return out
@@ -140,14 +140,14 @@ def nest(items: list[Part], width: float, height: float, gap: float) -> list[Sto
     parts and from the edges (see the module's text)."""
     import rectpack
 
-    inner_w, inner_h = int(math.floor(width - gap)), int(math.floor(height - gap))
-    boxes = {}
+    inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
+    boxes: dict[int, tuple[int, int, Part]] = {}
     oversize = []
     for part in items:
         if part.cut.is_empty:
             continue
-        w = int(math.ceil(part.width + gap))
-        h = int(math.ceil(part.height + gap))
+        w = math.ceil(part.width + gap)
+        h = math.ceil(part.height + gap)
         fits = (w <= inner_w and h <= inner_h) or (h <= inner_w and w <= inner_h)
         if fits:
             boxes[part.panel] = (w, h, part)
@@ -169,9 +169,22 @@ def nest(items: list[Part], width: float, height: float, gap: float) -> list[Sto
             raise ValueError("the nesting lost a part (rectpack placed fewer than it was given)")
         sheets += [StockSheet(width, height, tuple(placed[b])) for b in sorted(placed)]
     for part in oversize:
-        w, h = part.width + 2 * gap, part.height + 2 * gap
-        sheets.append(StockSheet(w, h, (_place(part, gap, gap, False),), oversize=True))
+        sheets.append(
+            StockSheet(
+                part.width + 2 * gap,
+                part.height + 2 * gap,
+                (_place(part, gap, gap, False),),
+                oversize=True,
+            )
+        )
     return sheets
+
+
+def _moved(geometry, matrix: np.ndarray | None = None, offset=(0.0, 0.0)):
+    """``geometry`` with every point x (row) taken to ``x @ matrix + offset``."""
+    m = np.eye(2) if matrix is None else np.asarray(matrix, dtype=np.float64)
+    o = np.asarray(offset, dtype=np.float64)
+    return shapely.transform(geometry, lambda x: x @ m + o)
 
 
 def _place(part: Part, x: float, y: float, turned: bool) -> Placed:
@@ -179,11 +192,11 @@ def _place(part: Part, x: float, y: float, turned: bool) -> Placed:
     labels = [(np.array([lx, ly]), t) for lx, ly, t in part.labels]
     if turned:  # a quarter turn, back into the box [0, height] x [0, width]
         quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
-        cut = shapely.transform(cut, lambda q: q @ quarter + [part.height, 0.0])
-        far = shapely.transform(far, lambda q: q @ quarter + [part.height, 0.0])
+        cut = _moved(cut, quarter, (part.height, 0.0))
+        far = _moved(far, quarter, (part.height, 0.0))
         labels = [(q @ quarter + [part.height, 0.0], t) for q, t in labels]
-    cut = shapely.transform(cut, lambda q: q + [x, y])
-    far = shapely.transform(far, lambda q: q + [x, y])
+    cut = _moved(cut, None, (x, y))
+    far = _moved(far, None, (x, y))
     moved = tuple((float(q[0] + x), float(q[1] + y), t) for q, t in labels)
     c = cut.representative_point()
     return Placed(part, cut, far, moved, (float(c.x), float(c.y)))
@@ -268,8 +281,7 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
         cut = " ".join(path(r) for r in _rings(placed.cut))
         far = " ".join(path(r) for r in _rings(placed.far))
         items.append(
-            f'<path d="{cut}" fill="none" stroke="#000" stroke-width="0.5" '
-            'fill-rule="evenodd"/>'
+            f'<path d="{cut}" fill="none" stroke="#000" stroke-width="0.5" fill-rule="evenodd"/>'
         )
         if far:
             items.append(

@@ -122,12 +122,12 @@ def obj_text(fab: Fabrication, *, title: str = "") -> str:
 def rhino_bytes(fab: Fabrication, directory: Path) -> bytes:
     """The Rhino model (see the module's text), written through a temporary file in
     ``directory`` (rhino3dm writes files only)."""
-    import rhino3dm
+    import rhino3dm  # its stubs do not know the setters and the attribute arguments
 
     p = fab.panels
     pattern = p.pattern
     model = rhino3dm.File3dm()
-    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters
+    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters  # type: ignore[misc]
     layers = {}
     for name, colour in (
         ("PANELS", (200, 170, 120, 255)),
@@ -142,8 +142,8 @@ def rhino_bytes(fab: Fabrication, directory: Path) -> bytes:
 
     def attributes(layer: str, name: str):
         attr = rhino3dm.ObjectAttributes()
-        attr.LayerIndex = layers[layer]
-        attr.Name = name
+        attr.LayerIndex = layers[layer]  # type: ignore[misc]
+        attr.Name = name  # type: ignore[misc]
         return attr
 
     for name, verts, faces in _meshes(fab):
@@ -155,20 +155,21 @@ def rhino_bytes(fab: Fabrication, directory: Path) -> bytes:
         for a, b, c in faces.tolist():
             mesh.Faces.AddFace(a, b, c)
         mesh.Normals.ComputeNormals()
-        model.Objects.AddMesh(mesh, attributes("PANELS", name))
+        model.Objects.AddMesh(mesh, attributes("PANELS", name))  # type: ignore[call-arg]
     coords = pattern.coords
     for h, e in enumerate(p.hinge_edges.tolist()):
         u, v = p.hinge_vertices[h].tolist()
         line = rhino3dm.LineCurve(rhino3dm.Point3d(*coords[u]), rhino3dm.Point3d(*coords[v]))
-        model.Objects.AddCurve(line, attributes("HINGES", f"hinge_{e}"))
+        model.Objects.AddCurve(line, attributes("HINGES", f"hinge_{e}"))  # type: ignore[call-arg]
     for e, (u, v) in enumerate(pattern.edges.tolist()):
         if pattern.fixed[e]:
             continue
         line = rhino3dm.LineCurve(rhino3dm.Point3d(*coords[u]), rhino3dm.Point3d(*coords[v]))
-        model.Objects.AddCurve(line, attributes("CREASES", f"edge_{e}"))
+        model.Objects.AddCurve(line, attributes("CREASES", f"edge_{e}"))  # type: ignore[call-arg]
     for k, name in enumerate(panel_names(pattern)):
         centre = coords[p.vertices[k]].mean(axis=0)
-        model.Objects.AddTextDot(str(k), rhino3dm.Point3d(*centre), attributes("LABELS", name))
+        point = rhino3dm.Point3d(*centre)
+        model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))  # type: ignore[call-arg]
     fd, tmp = tempfile.mkstemp(prefix=".rigidfold-", suffix=".3dm", dir=directory)
     os.close(fd)
     try:
@@ -197,8 +198,11 @@ def hinge_rows(fab: Fabrication) -> list[dict]:
                 "panel_b": b,
                 "vertex_a": u,
                 "vertex_b": v,
-                **{f"{c}{x}_m": f"{coords[w][i]:.6f}" for c, w in (("a", u), ("b", v))
-                   for i, x in enumerate("xyz")},
+                **{
+                    f"{c}{x}_m": f"{coords[w][i]:.6f}"
+                    for c, w in (("a", u), ("b", v))
+                    for i, x in enumerate("xyz")
+                },
                 "length_m": f"{np.linalg.norm(coords[v] - coords[u]):.6f}",
                 "fold_design_deg": f"{fold[e]:.3f}",
                 "fold_min_deg": f"{math.degrees(low[h]):.3f}",

@@ -144,9 +144,7 @@ def file_frames(design: Design, *, up: str = "z", settings: Settings = DEFAULTS)
             shape = read_fold(raw, k, up=up, settings=settings).pattern
         except ValueError:
             continue
-        if shape.n_vertices != pattern.n_vertices or not np.array_equal(
-            shape.faces, pattern.faces
-        ):
+        if shape.n_vertices != pattern.n_vertices or not np.array_equal(shape.faces, pattern.faces):
             continue
         frames.append(shape.coords)
         share = _PERCENT.search(str(frame.get("frame_title", "")))
@@ -174,7 +172,8 @@ def design_motion(
     step = settings.fabricate_frame_step
     carried = None if design is None else file_frames(design, up=up, settings=settings)
     if carried is not None:
-        motion = panel_motion(panels, *carried, f"the design file's {len(carried[0])} frames")
+        frames, fraction = carried
+        motion = panel_motion(panels, frames, fraction, f"the design file's {len(frames)} frames")
         if motion.largest_step <= step:
             return motion, motion.source
     pattern = panels.pattern
@@ -184,11 +183,11 @@ def design_motion(
             return motion, f"{motion.source} (the path could not be traced finer: {path.message})"
         return None, f"{path.status.message}: {path.message}"
     largest = float(np.abs(panels.closing(pattern.fold_angles)).max(initial=0.0))
-    n = min(max(int(math.ceil(largest / step)) + 1, 3), MAX_FRAMES)
+    n = min(max(math.ceil(largest / step) + 1, 3), MAX_FRAMES)
     for _ in range(3):
         frames, fraction = path.frames(pattern, n, settings=settings)
         motion = panel_motion(panels, frames, fraction, f"the traced folding path at {n} frames")
         if motion.largest_step <= step or n >= MAX_FRAMES:
             break
-        n = min(int(math.ceil((n - 1) * motion.largest_step / step)) + 1, MAX_FRAMES)
+        n = min(math.ceil((n - 1) * motion.largest_step / step) + 1, MAX_FRAMES)
     return motion, motion.source

@@ -137,9 +137,11 @@ class Solids:
         """(P, 3) float64: centre of each solid's bounding sphere (its vertices' mean)."""
         out = np.zeros((self.panels.n, 3))
         for k, (verts, _) in enumerate(self.meshes):
-            out[k] = verts.mean(axis=0) if len(verts) else self.panels.pattern.coords[
-                self.panels.vertices[k]
-            ].mean(axis=0)
+            out[k] = (
+                verts.mean(axis=0)
+                if len(verts)
+                else self.panels.pattern.coords[self.panels.vertices[k]].mean(axis=0)
+            )
         return out
 
     @cached_property
@@ -183,8 +185,9 @@ class Solids:
                 origin, _, inward = _hinge_frame(p, h, k)
                 best, wrap = 0.0, set()
                 for i in of_panel[k]:
-                    span = _span(self.pieces[i].vertices, origin, inward, p.material[k],
-                                 self.thickness)
+                    span = _span(
+                        self.pieces[i].vertices, origin, inward, p.material[k], self.thickness
+                    )
                     if span is None:
                         wrap.add(i)
                     else:
@@ -324,8 +327,12 @@ def _wedge(b: _Bevel, d: np.ndarray, thickness: float):
 
     eps = 1e-3 * thickness
     tan = math.tan(b.alpha)
-    section = [(-eps / tan, -eps), (-10 * eps - eps / tan, -eps), (-10 * eps - eps / tan,
-               thickness + eps), ((thickness + eps) / tan, thickness + eps)]
+    section = [
+        (-eps / tan, -eps),
+        (-10 * eps - eps / tan, -eps),
+        (-10 * eps - eps / tan, thickness + eps),
+        ((thickness + eps) / tan, thickness + eps),
+    ]
     pts = [
         b.origin + along * b.e + s * b.inward + w * d
         for along in (b.start, b.stop)
@@ -393,8 +400,9 @@ def _relief_tool(panels: Panels, panel: int, w: int, reach: dict[int, float], th
     ring = np.asarray([outside, *ends])
     eps = 1e-3 * thickness
     n = len(ring)
-    points = np.vstack([x - eps * d, ring - eps * d, x + (thickness + eps) * d,
-                        ring + (thickness + eps) * d])
+    points = np.vstack(
+        [x - eps * d, ring - eps * d, x + (thickness + eps) * d, ring + (thickness + eps) * d]
+    )
     top = [(0, 1 + i, 1 + (i + 1) % n) for i in range(n)]
     faces = [*top, *[(n + 1, b + n + 1, a + n + 1) for _, a, b in top]]
     for i in range(n):
