@@ -323,25 +323,26 @@ def build_parser() -> argparse.ArgumentParser:
     fab.add_argument(
         "--clearance-angle",
         type=float,
-        default=math.degrees(DEFAULTS.fabricate_clearance_angle),
+        default=round(math.degrees(DEFAULTS.fabricate_clearance_angle), 9),
         metavar="DEG",
-        help="bevels leave this angle to spare beyond each hinge's largest fold (default: "
-        "%(default)g degrees)",
+        help="bevels leave this angle, degrees, to spare beyond each hinge's largest fold "
+        "(default: %(default)s)",
     )
     fab.add_argument(
         "--density",
         type=_positive,
         default=DEFAULTS.fabricate_density,
         metavar="KG/M3",
-        help="density of the panel material for the masses (default: %(default)g, plywood)",
+        help="density of the panel material for the masses, plywood by default (default: "
+        "%(default)s)",
     )
     fab.add_argument(
         "--sheet",
         type=_sheet,
-        default=(DEFAULTS.fabricate_sheet_width, DEFAULTS.fabricate_sheet_height),
+        default=f"{DEFAULTS.fabricate_sheet_width:g}x{DEFAULTS.fabricate_sheet_height:g}",
         metavar="WxH",
         help="stock sheet size in millimetres that the cut sheets are nested onto (default: "
-        f"{DEFAULTS.fabricate_sheet_width:g}x{DEFAULTS.fabricate_sheet_height:g})",
+        "%(default)s)",
     )
     fab.add_argument(
         "--min-thickness",
