@@ -54,6 +54,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_numerics.py
 	$(PY) benchmarks/bench_path.py
 	$(PY) benchmarks/deploy_share.py
+	$(PY) benchmarks/bench_fabricate.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
