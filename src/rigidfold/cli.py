@@ -20,7 +20,7 @@ import unicodedata
 from collections.abc import Sequence
 
 from rigidfold import __version__
-from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
+from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, SIDES, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.generate import GenerateOptions
@@ -440,6 +440,73 @@ def build_parser() -> argparse.ArgumentParser:
         "--overwrite",
         action="store_true",
         help="replace DIR/structure.json and DIR/structure.png of an earlier check",
+    )
+
+    fab = _file_command(
+        sub,
+        "fabricate",
+        _cmd_fabricate,
+        out=True,
+        help="thick panels of a FOLD design that deploy without collision: solids, hinge "
+        "and vertex schedules, nested cut sheets",
+        description="Turn the panels of a FOLD design (a solution of rigidfold generate) into "
+        "solids of the given thickness on one side of the design surface, the hinge axes on "
+        "the crease lines (Tachi's tapered thick panels): every hinge is bevelled for its fold "
+        "range from flat to the design plus a clearance angle, and panels that meet at a vertex "
+        "without a common hinge are relieved there. Every pair of solids is checked over the "
+        "whole folding motion (the file's motion frames, or its traced folding path). Writes "
+        "DIR/<name>_solids.glb, .stl, .obj and .3dm (Rhino: layers PANELS, HINGES, CREASES, "
+        "LABELS), DIR/<name>_hinges.csv, DIR/<name>_vertices.csv, cut sheets in mm nested onto "
+        "stock sheets (DIR/<name>_sheet_NN.dxf and .svg) and DIR/<name>_fabricate.json. Exit "
+        "code 0 when the deployment is collision-free, 1 when not (the files are written; the "
+        "last line names the panels, the fraction folded where they meet and a thickness that "
+        "would pass), 2 on bad input.",
+    )
+    fab.add_argument(
+        "--thickness",
+        required=True,
+        type=_length("thickness"),
+        metavar="T",
+        help="panel thickness in metres, or with a unit: 18mm, 1.8cm",
+    )
+    fab.add_argument(
+        "--side",
+        default=DEFAULTS.fabricate_side,
+        choices=SIDES,
+        help="the side of the design surface the solids lie on: bottom (below it, the surface "
+        "is their outer face) or top (default: %(default)s)",
+    )
+    fab.add_argument(
+        "--clearance-angle",
+        type=float,
+        default=round(math.degrees(DEFAULTS.fabricate_clearance_angle), 9),
+        metavar="DEG",
+        help="bevels leave this angle, degrees, to spare beyond each hinge's largest fold "
+        "(default: %(default)s)",
+    )
+    fab.add_argument(
+        "--density",
+        type=_positive,
+        default=DEFAULTS.fabricate_density,
+        metavar="KG/M3",
+        help="density of the panel material for the masses, plywood by default (default: "
+        "%(default)s)",
+    )
+    fab.add_argument(
+        "--sheet",
+        type=_sheet,
+        default=f"{DEFAULTS.fabricate_sheet_width:g}x{DEFAULTS.fabricate_sheet_height:g}",
+        metavar="WxH",
+        help="stock sheet size in millimetres that the cut sheets are nested onto (default: "
+        "%(default)s)",
+    )
+    fab.add_argument(
+        "--min-thickness",
+        type=_length("min-thickness"),
+        default=None,
+        metavar="T",
+        help="a panel whose solid is nowhere this deep once bevelled fails (default: "
+        f"{DEFAULTS.fabricate_min_depth:g} x the thickness)",
     )
 
     stu = sub.add_parser(
@@ -975,6 +1042,56 @@ def _cmd_structure(args: argparse.Namespace) -> int:
     print(f"{c.status}: {c.message}")
     print(f"wrote {', '.join(str(p) for p in run.written)}")
     return code
+
+
+def _cmd_fabricate(args: argparse.Namespace) -> int:
+    from rigidfold.workflows import fabricate_file
+
+    done = fabricate_file(
+        args.file,
+        args.out,
+        thickness=args.thickness,
+        side=args.side,
+        clearance_angle_deg=args.clearance_angle,
+        density=args.density,
+        sheet=args.sheet,
+        min_thickness=args.min_thickness,
+        up=args.up,
+    )
+    fab = done.fabrication
+    if args.json:
+        print(json.dumps(jsonable(done.to_dict())))
+    else:
+        s = fab.solids
+        print(
+            f"{args.file}: {fab.panels.n} panels, {fab.panels.n_hinges} hinges; "
+            f"{s.total_volume:.4g} m^3 of panels ({100 * s.trimming_loss:.1f}% trimmed off "
+            f"the {fab.thickness * 1e3:g} mm slab), {fab.masses.sum():.1f} kg"
+        )
+        print(f"wrote {len(done.written)} files to {args.out}")
+        print(one_line(fab.last_line()))
+    return 0 if done.ok else 1
+
+
+def _length(what: str):
+    def parse(text: str) -> float:
+        from rigidfold.fabricate.build import parse_length
+
+        try:
+            return parse_length(text, what)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    return parse
+
+
+def _sheet(text: str) -> tuple[float, float]:
+    from rigidfold.fabricate.build import parse_sheet
+
+    try:
+        return parse_sheet(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _cmd_study(args: argparse.Namespace) -> int:

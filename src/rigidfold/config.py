@@ -23,6 +23,10 @@ CHECKS = ("final", "all")
 """Which solutions of a generation run get the folding motion and Step 9 (``generate
 --check``): the final design only (the default), or every solution."""
 
+SIDES = ("bottom", "top")
+"""The sides of the design surface that thick panels can lie on (``fabricate --side``):
+below it (against the faces' normals, which point up) or above it."""
+
 SEED_LIMIT = 2**63
 """Seeds (of Bezier surfaces, of generate's random draws) are integers 0 <= seed <
 SEED_LIMIT: a study stores them as SQLite's signed 64-bit integers."""
@@ -386,6 +390,46 @@ class Settings:
         A plan point within this fraction of the longer side of the mesh's plan box of its
         footprint (its triangles seen from above) counts as inside it: pattern vertices
         farther out are refused (``MeshSurface.check_finite``).
+
+    Thick panels (``rigidfold fabricate``, :mod:`rigidfold.fabricate`)
+    ----------------------------------------------------------------
+    fabricate_side : str
+        Which side of the design surface the solids lie on: ``"bottom"`` (below it, against
+        the faces' normals, which point up: the surface is the outer skin) or ``"top"``.
+    fabricate_clearance_angle : float
+        Every solid is bevelled along each hinge so that the two solids stay apart up to the
+        crease's largest fold over the motion plus this angle, radians (2 degrees).
+    fabricate_clearance : float
+        Smallest gap, metres, that solids of panels without a common hinge keep at every
+        point of the motion (1 mm).
+    fabricate_vertex_relief : float
+        Where panels without a common hinge meet at a vertex, every solid's corner there is
+        cut off at this many thicknesses from the vertex (a relief; the hinges end there).
+    fabricate_relief_rounds : int
+        Where two such panels still come closer than ``fabricate_clearance`` near a shared
+        vertex, the relief there is doubled and the check run again, this many times at most.
+    fabricate_frame_step : float
+        Largest change of a hinge's fold angle, radians, between two frames of the motion
+        that are checked (2 degrees): the design file's motion frames when they
+        are that fine, else the traced folding path sampled that finely.
+    fabricate_subdivisions : int
+        Between two frames, the motion is halved at most this many times where the bound on
+        the gap between two solids does not yet prove the clearance.
+    fabricate_min_depth : float
+        A panel is too thin when its solid is nowhere this share of the thickness deep (its
+        bevels meet above it); ``fabricate --min-thickness`` gives the length itself.
+    fabricate_trimmed_away : float
+        A panel is trimmed away when its solid keeps less than this share of its area times
+        the thickness, or one of its triangles keeps nothing.
+    fabricate_density : float
+        Density of the panels' material, kg/m^3, for their masses (600: plywood).
+    fabricate_sheet_width, fabricate_sheet_height : float
+        Stock sheet, millimetres, that the cut sheets are nested onto (2440 x 1220).
+    fabricate_sheet_gap : float
+        Gap between parts and from the stock sheet's edge, millimetres.
+    fabricate_thickness_tries : int
+        When a thickness fails, thinner ones (halving, then bisection) are tried this many
+        times to name one that passes.
     """
 
     # design parameters of problem (6)
@@ -509,6 +553,21 @@ class Settings:
     max_mesh_triangles: int = 500_000
     # the plan of a crease pattern
     plan_area_tol: float = 1e-6
+    # thick panels (rigidfold fabricate)
+    fabricate_side: str = "bottom"
+    fabricate_clearance_angle: float = math.radians(2.0)
+    fabricate_clearance: float = 1e-3
+    fabricate_vertex_relief: float = 1.0
+    fabricate_relief_rounds: int = 4
+    fabricate_frame_step: float = math.radians(2.0)
+    fabricate_subdivisions: int = 8
+    fabricate_min_depth: float = 1.0
+    fabricate_trimmed_away: float = 0.2
+    fabricate_density: float = 600.0
+    fabricate_sheet_width: float = 2440.0
+    fabricate_sheet_height: float = 1220.0
+    fabricate_sheet_gap: float = 10.0
+    fabricate_thickness_tries: int = 8
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dz) and self.dz > 0):
@@ -556,11 +615,40 @@ class Settings:
             "max_svg_depth": 1,
             "max_svg_pairs": 1,
             "max_mesh_triangles": 1,
+            "fabricate_relief_rounds": 0,
+            "fabricate_subdivisions": 0,
+            "fabricate_thickness_tries": 0,
         }
         for name, low in least.items():
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise RigidfoldError(f"{name} must be an integer >= {low}, got {value!r}")
+        if self.fabricate_side not in SIDES:
+            raise RigidfoldError(
+                f"fabricate_side must be one of {', '.join(SIDES)}, got {self.fabricate_side!r}"
+            )
+        if not 0 <= self.fabricate_clearance_angle < math.pi / 2:
+            raise RigidfoldError(
+                "fabricate_clearance_angle must lie in [0, 90) degrees, got "
+                f"{math.degrees(self.fabricate_clearance_angle):g}"
+            )
+        for name in ("fabricate_clearance", "fabricate_vertex_relief", "fabricate_sheet_gap"):
+            value = getattr(self, name)
+            if not (isinstance(value, float | int) and math.isfinite(value) and value >= 0):
+                raise RigidfoldError(f"{name} must be a finite number >= 0, got {value!r}")
+        for name in (
+            "fabricate_frame_step",
+            "fabricate_density",
+            "fabricate_sheet_width",
+            "fabricate_sheet_height",
+        ):
+            value = getattr(self, name)
+            if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
+                raise RigidfoldError(f"{name} must be a positive number, got {value!r}")
+        for name in ("fabricate_min_depth", "fabricate_trimmed_away"):
+            value = getattr(self, name)
+            if not (isinstance(value, float | int) and 0 <= value <= 1):
+                raise RigidfoldError(f"{name} must be a fraction from 0 to 1, got {value!r}")
         if self.ipopt_hessian not in HESSIANS:
             raise RigidfoldError(
                 f"ipopt_hessian must be one of {', '.join(HESSIANS)}, got {self.ipopt_hessian!r}"

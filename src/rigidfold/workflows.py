@@ -14,6 +14,8 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
 ``report_run``         ``DIR/report.html`` and ``DIR/figures/`` of a generate run
 ``structure``          supports and loads of a FOLD design (``rigidfold structure``)
+``fabricate_file``     thick panels of a FOLD design, checked over its deployment, and their
+                       solids, schedules and nested cut sheets (``rigidfold fabricate``)
 =====================  ====================================================================
 """
 
@@ -42,6 +44,7 @@ from rigidfold.exports import (
     parse_formats,
     read_design,
 )
+from rigidfold.fabricate import Fabrication, Panels, design_motion, fabricate_panels
 from rigidfold.generate import Attempt, Generation, generate
 from rigidfold.io import (
     FoldData,
@@ -535,3 +538,107 @@ def structure(
     if png is not None:
         written.append(atomic_write(out_dir / "structure.png", png))
     return StructureRun(str(path), check, tuple(written))
+
+
+# ------------------------------------------------------------------------------ fabricate
+@dataclass(frozen=True, eq=False)
+class FabricateOutput:
+    """Thick panels of a FOLD design and the files written.
+
+    fabrication : rigidfold.fabricate.Fabrication (status, solids, check); design : Design;
+    sheets : the cut sheets' summary; written : the files, in the order written.
+    """
+
+    file: str
+    design: Design
+    fabrication: Fabrication
+    sheets: dict
+    written: tuple[Path, ...]
+
+    @property
+    def ok(self) -> bool:
+        return self.fabrication.ok
+
+    def to_dict(self) -> dict:
+        return {
+            "file": self.file,
+            **self.fabrication.to_dict(),
+            "cut_sheets": self.sheets,
+            "written": [str(p) for p in self.written],
+        }
+
+
+def fabricate_file(
+    path: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    thickness: float,
+    side: str | None = None,
+    clearance_angle_deg: float | None = None,
+    density: float | None = None,
+    sheet: tuple[float, float] | None = None,
+    min_thickness: float | None = None,
+    up: str = "z",
+    settings: Settings = DEFAULTS,
+) -> FabricateOutput:
+    """Thick panels of the FOLD design ``path`` (``rigidfold fabricate``): solids of
+    ``thickness`` metres on ``side``, bevelled and relieved so that they deploy from flat to
+    the design without collision, checked over its folding motion
+    (:func:`rigidfold.fabricate.fabricate_panels`), and their files in OUT: the solids
+    (GLB, STL, OBJ, 3DM), the hinge and vertex schedules, the cut sheets nested onto
+    ``sheet`` (mm) stock, and ``NAME_fabricate.json``. Defaults from ``settings``. The
+    files are written whatever the verdict."""
+    import math as _math
+
+    from rigidfold.fabricate.cutsheets import sheets_summary, write_cut_sheets
+    from rigidfold.fabricate.files import SOLID_FILES, write_solid_files
+
+    side = settings.fabricate_side if side is None else side
+    if side not in ("bottom", "top"):
+        raise RigidfoldError(f"side must be bottom or top, got {side!r}")
+    if not (isinstance(thickness, float | int) and _math.isfinite(thickness) and thickness > 0):
+        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
+    angle = settings.fabricate_clearance_angle
+    if clearance_angle_deg is not None:
+        if not (_math.isfinite(clearance_angle_deg) and 0 <= clearance_angle_deg < 90):
+            raise RigidfoldError(
+                f"clearance angle must be from 0 to below 90 degrees, got {clearance_angle_deg!r}"
+            )
+        angle = _math.radians(clearance_angle_deg)
+    width, height = sheet or (settings.fabricate_sheet_width, settings.fabricate_sheet_height)
+    stem = Path(path).stem
+    label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    names = [t.format(stem) for t in SOLID_FILES] + [f"{stem}_fabricate.json"]
+    refuse_replacing_inputs([path], [Path(out) / n for n in names])
+    out_dir = prepare_output_dir(out)
+    design = read_design(path, up=up, settings=settings)
+    panels = Panels(design.pattern, design.coords2d, side)
+    motion, message = design_motion(panels, design, up=up, settings=settings)
+    fab = fabricate_panels(
+        panels,
+        motion,
+        float(thickness),
+        clearance_angle=angle,
+        min_thickness=min_thickness,
+        density=density,
+        motion_message=message,
+        settings=settings,
+    )
+    title = f"{label}: thick panels {thickness * 1e3:g} mm, {side} side"
+    written = write_solid_files(fab, out_dir, stem, title=title)
+    sheets_written, sheets = write_cut_sheets(
+        fab,
+        out_dir,
+        stem,
+        width=width,
+        height=height,
+        gap=settings.fabricate_sheet_gap,
+        title=label,
+    )
+    written += sheets_written
+    summary = sheets_summary(sheets)
+    summary["stock_mm"] = [width, height]
+    result = FabricateOutput(str(path), design, fab, summary, tuple(written))
+    report = result.to_dict()
+    written.append(write_json(out_dir / f"{stem}_fabricate.json", report))
+    return FabricateOutput(str(path), design, fab, summary, tuple(written))

@@ -1,0 +1,343 @@
+"""Cut sheets of thick panels, nested onto stock sheets: one DXF and one SVG per sheet, in mm.
+
+Each panel is drawn as seen from its face on the design surface: that face's outline (the cut
+line, layer CUT), the outline of its far face (where the bevels and reliefs end, layer
+BEVEL), its number ``P K`` (the ``panel_K`` of the 3D files and the schedules) and, on each
+bevelled edge, the hinge's crease ``E`` and the bevel angle between the bevel face and the
+surface (``E12 64.2°``: tilt the saw blade by 90° minus it). Both outlines are taken from
+the solid itself (its faces on the surface and at the full depth), so the sheets and the 3D
+files agree.
+
+Nesting: each part is turned to its smallest bounding rectangle
+(:func:`rigidfold.exports.sheet.min_area_angle`), its box rounded up to whole millimetres
+plus the gap, and the boxes are packed onto as many stock sheets as needed by ``rectpack``
+(MaxRects, best short side fit; parts may turn a quarter). A part larger than the stock in
+either direction is put on a sheet of its own size and reported (``oversize``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from rigidfold.errors import RigidfoldError
+from rigidfold.exports.sheet import min_area_angle
+from rigidfold.fabricate.build import Fabrication
+from rigidfold.io.files import atomic_write
+
+MM = 1000.0
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """One panel drawn flat, millimetres, its bounding box starting at (0, 0).
+
+    panel : int; cut : shapely geometry of the surface face; far : of the far face (may be
+    empty); labels : ((x, y, text), ...) of the bevelled edges; width, height : its box.
+    """
+
+    panel: int
+    cut: shapely.Geometry
+    far: shapely.Geometry
+    labels: tuple[tuple[float, float, str], ...]
+    width: float
+    height: float
+
+
+@dataclass(frozen=True, eq=False)
+class Placed:
+    """A part on a sheet: its geometry moved there, mm."""
+
+    part: Part
+    cut: shapely.Geometry
+    far: shapely.Geometry
+    labels: tuple[tuple[float, float, str], ...]
+    centre: tuple[float, float]
+
+
+@dataclass(frozen=True, eq=False)
+class StockSheet:
+    """One stock sheet: its size (mm), its parts, and whether it is an oversize one."""
+
+    width: float
+    height: float
+    parts: tuple[Placed, ...]
+    oversize: bool = False
+
+
+def _frame(fab: Fabrication, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(origin, a1, a2): a frame in panel k's surface, seen from outside its surface face."""
+    p = fab.panels
+    origin = p.pattern.coords[p.vertices[k]].mean(axis=0)
+    out = -p.material[k]
+    a1 = p.pattern.coords[p.vertices[k][0]] - origin
+    a1 -= (a1 @ out) * out
+    a1 /= np.linalg.norm(a1)
+    return origin, a1, np.cross(out, a1)
+
+
+def _faces_at(fab: Fabrication, k: int, depth: float, origin, a1, a2) -> shapely.Geometry:
+    verts, tris = fab.solids.meshes[k]
+    if not len(tris):
+        return shapely.Polygon()
+    d = fab.panels.material[k]
+    w = (verts - origin) @ d
+    tol = 1e-6 * fab.solids.thickness
+    on = np.abs(w[tris] - depth).max(axis=1) <= tol
+    if not on.any():
+        return shapely.Polygon()
+    xy = np.column_stack([(verts - origin) @ a1, (verts - origin) @ a2]) * MM
+    polys = shapely.polygons(xy[tris[on]])
+    return shapely.union_all(polys, grid_size=1e-6).buffer(0)
+
+
+def parts(fab: Fabrication) -> list[Part]:
+    """Every panel's :class:`Part`, turned to its smallest box."""
+    p, s = fab.panels, fab.solids
+    out = []
+    for k in range(p.n):
+        origin, a1, a2 = _frame(fab, k)
+        cut = _faces_at(fab, k, 0.0, origin, a1, a2)
+        far = _faces_at(fab, k, s.thickness, origin, a1, a2)
+        labels = []
+        for h in p.hinges_of[k].tolist():
+            u, v = p.hinge_vertices[h].tolist()
+            mid = 0.5 * (p.pattern.coords[u] + p.pattern.coords[v]) - origin
+            inward = p.pattern.coords[p.vertices[k]].mean(axis=0) - origin - mid
+            at = mid + 0.15 * inward
+            text = f"E{int(p.hinge_edges[h])} {math.degrees(s.bevel[h]):.1f}°"
+            labels.append((float(at @ a1) * MM, float(at @ a2) * MM, text))
+        if cut.is_empty:
+            out.append(Part(k, cut, far, tuple(labels), 0.0, 0.0))
+            continue
+        ring = np.asarray(shapely.get_coordinates(cut))
+        angle = min_area_angle(ring)
+        c, sn = math.cos(angle), math.sin(angle)
+        turn = np.array([[c, sn], [-sn, c]])  # row vectors: xy @ turn turns by angle
+        cut_t = _moved(cut, turn)
+        far_t = _moved(far, turn)
+        lab = [(np.array([x, y]) @ turn, t) for x, y, t in labels]
+        x0, y0, x1, y1 = cut_t.bounds
+        if (y1 - y0) > (x1 - x0):
+            quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
+            cut_t = _moved(cut_t, quarter)
+            far_t = _moved(far_t, quarter)
+            lab = [(q @ quarter, t) for q, t in lab]
+            x0, y0, x1, y1 = cut_t.bounds
+        shift = np.array([x0, y0])
+        cut_t = _moved(cut_t, None, -shift)
+        far_t = _moved(far_t, None, -shift)
+        labels_t = tuple((float(q[0] - x0), float(q[1] - y0), t) for q, t in lab)
+        out.append(Part(k, cut_t, far_t, labels_t, x1 - x0, y1 - y0))
+    return out
+
+
+def nest(items: list[Part], width: float, height: float, gap: float) -> list[StockSheet]:
+    """Pack ``items`` onto stock sheets ``width`` x ``height`` mm with ``gap`` mm between
+    parts and from the edges (see the module's text)."""
+    import rectpack
+
+    inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
+    boxes: dict[int, tuple[int, int, Part]] = {}
+    oversize = []
+    for part in items:
+        if part.cut.is_empty:
+            continue
+        w = math.ceil(part.width + gap)
+        h = math.ceil(part.height + gap)
+        fits = (w <= inner_w and h <= inner_h) or (h <= inner_w and w <= inner_h)
+        if fits:
+            boxes[part.panel] = (w, h, part)
+        else:
+            oversize.append(part)
+    sheets: list[StockSheet] = []
+    if boxes:
+        packer = rectpack.newPacker(rotation=True)
+        for rid, (w, h, _) in boxes.items():
+            packer.add_rect(w, h, rid)
+        packer.add_bin(inner_w, inner_h, count=float("inf"))
+        packer.pack()
+        placed: dict[int, list[Placed]] = {}
+        for b, x, y, w, h, rid in packer.rect_list():
+            bw, bh, part = boxes[rid]
+            turned = (w, h) != (bw, bh)
+            placed.setdefault(b, []).append(_place(part, x + gap, y + gap, turned))
+        if sum(len(v) for v in placed.values()) != len(boxes):
+            raise RigidfoldError(
+                "the nesting lost a part (rectpack placed fewer than it was given)"
+            )
+        sheets += [StockSheet(width, height, tuple(placed[b])) for b in sorted(placed)]
+    for part in oversize:
+        sheets.append(
+            StockSheet(
+                part.width + 2 * gap,
+                part.height + 2 * gap,
+                (_place(part, gap, gap, False),),
+                oversize=True,
+            )
+        )
+    return sheets
+
+
+def _moved(geometry, matrix: np.ndarray | None = None, offset=(0.0, 0.0)):
+    """``geometry`` with every point x (row) taken to ``x @ matrix + offset``."""
+    m = np.eye(2) if matrix is None else np.asarray(matrix, dtype=np.float64)
+    o = np.asarray(offset, dtype=np.float64)
+    return shapely.transform(geometry, lambda x: x @ m + o)
+
+
+def _place(part: Part, x: float, y: float, turned: bool) -> Placed:
+    cut, far = part.cut, part.far
+    labels = [(np.array([lx, ly]), t) for lx, ly, t in part.labels]
+    if turned:  # a quarter turn, back into the box [0, height] x [0, width]
+        quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
+        cut = _moved(cut, quarter, (part.height, 0.0))
+        far = _moved(far, quarter, (part.height, 0.0))
+        labels = [(q @ quarter + [part.height, 0.0], t) for q, t in labels]
+    cut = _moved(cut, None, (x, y))
+    far = _moved(far, None, (x, y))
+    moved = tuple((float(q[0] + x), float(q[1] + y), t) for q, t in labels)
+    c = cut.representative_point()
+    return Placed(part, cut, far, moved, (float(c.x), float(c.y)))
+
+
+def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
+    """The closed rings (exterior and holes) of a polygonal geometry, (n, 2) each."""
+    out = []
+    for poly in getattr(geometry, "geoms", [geometry]):
+        if poly.is_empty or poly.geom_type != "Polygon":
+            continue
+        out.append(np.asarray(poly.exterior.coords)[:-1])
+        out += [np.asarray(r.coords)[:-1] for r in poly.interiors]
+    return out
+
+
+def text_height(sheet: StockSheet) -> float:
+    return max(min(sheet.width, sheet.height) / 60.0, 5.0)
+
+
+def dxf_bytes(sheet: StockSheet, *, title: str = "") -> bytes:
+    """One stock sheet as DXF (R2010, mm): layers SHEET, CUT, BEVEL, LABELS."""
+    import io
+
+    import ezdxf
+    from ezdxf import units
+
+    doc = ezdxf.new("R2010", setup=True)
+    doc.units = units.MM
+    doc.header["$INSUNITS"] = units.MM
+    for name, colour in (("SHEET", 8), ("CUT", 7), ("BEVEL", 1), ("LABELS", 5)):
+        doc.layers.add(name, color=colour)
+    msp = doc.modelspace()
+    msp.add_lwpolyline(
+        [(0, 0), (sheet.width, 0), (sheet.width, sheet.height), (0, sheet.height)],
+        close=True,
+        dxfattribs={"layer": "SHEET"},
+    )
+    size = text_height(sheet)
+    for placed in sheet.parts:
+        for ring in _rings(placed.cut):
+            msp.add_lwpolyline(ring.tolist(), close=True, dxfattribs={"layer": "CUT"})
+        for ring in _rings(placed.far):
+            msp.add_lwpolyline(ring.tolist(), close=True, dxfattribs={"layer": "BEVEL"})
+        msp.add_text(
+            f"P{placed.part.panel}", height=size, dxfattribs={"layer": "LABELS"}
+        ).set_placement(placed.centre, align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        for x, y, text in placed.labels:
+            msp.add_text(text, height=size * 0.5, dxfattribs={"layer": "LABELS"}).set_placement(
+                (x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER
+            )
+    if title:
+        msp.add_text(title, height=size * 0.5, dxfattribs={"layer": "LABELS"}).set_placement(
+            (size, sheet.height - size)
+        )
+    out = io.StringIO()
+    doc.write(out)
+    return out.getvalue().encode("utf-8")
+
+
+def svg_text(sheet: StockSheet, *, title: str = "") -> str:
+    """One stock sheet as SVG at 1:1 in mm (y up in the drawing's numbers, flipped for
+    SVG): the sheet in grey, cut lines black, far-face lines red, labels blue."""
+    from xml.sax.saxutils import escape
+
+    w, h = sheet.width, sheet.height
+    size = text_height(sheet)
+
+    def path(ring: np.ndarray) -> str:
+        pts = " L ".join(f"{x:.3f} {h - y:.3f}" for x, y in ring.tolist())
+        return f"M {pts} Z"
+
+    items = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.3f}mm" height="{h:.3f}mm" '
+        f'viewBox="0 0 {w:.3f} {h:.3f}">',
+        f"<title>{escape(title)}</title>",
+        f'<rect x="0" y="0" width="{w:.3f}" height="{h:.3f}" fill="none" stroke="#999" '
+        'stroke-width="1"/>',
+    ]
+    for placed in sheet.parts:
+        cut = " ".join(path(r) for r in _rings(placed.cut))
+        far = " ".join(path(r) for r in _rings(placed.far))
+        items.append(
+            f'<path d="{cut}" fill="none" stroke="#000" stroke-width="0.5" fill-rule="evenodd"/>'
+        )
+        if far:
+            items.append(
+                f'<path d="{far}" fill="none" stroke="#d62728" stroke-width="0.4" '
+                'stroke-dasharray="4 2" fill-rule="evenodd"/>'
+            )
+        cx, cy = placed.centre
+        items.append(
+            f'<text x="{cx:.2f}" y="{h - cy:.2f}" font-size="{size:.2f}" fill="#1f3fbf" '
+            f'text-anchor="middle" dominant-baseline="middle">P{placed.part.panel}</text>'
+        )
+        for x, y, text in placed.labels:
+            items.append(
+                f'<text x="{x:.2f}" y="{h - y:.2f}" font-size="{size * 0.5:.2f}" '
+                f'fill="#1f3fbf" text-anchor="middle">{escape(text)}</text>'
+            )
+    items.append("</svg>")
+    return "\n".join(items) + "\n"
+
+
+def write_cut_sheets(
+    fab: Fabrication,
+    out: Path,
+    name: str,
+    *,
+    width: float,
+    height: float,
+    gap: float,
+    title: str = "",
+) -> tuple[list[Path], list[StockSheet]]:
+    """Nest the panels onto ``width`` x ``height`` mm stock and write
+    ``NAME_sheet_NN.dxf`` and ``.svg`` per sheet (``NAME_oversize_NN`` for a part larger than
+    the stock); returns the files and the sheets."""
+    sheets = nest(parts(fab), width, height, gap)
+    written: list[Path] = []
+    stock = oversize = 0
+    for sheet in sheets:
+        if sheet.oversize:
+            oversize += 1
+            stem = f"{name}_oversize_{oversize:02d}"
+        else:
+            stock += 1
+            stem = f"{name}_sheet_{stock:02d}"
+        label = f"{title} {stem} ({sheet.width:.0f} x {sheet.height:.0f} mm)".strip()
+        written.append(atomic_write(out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
+        written.append(atomic_write(out / f"{stem}.svg", svg_text(sheet, title=label)))
+    return written, sheets
+
+
+def sheets_summary(sheets: list[StockSheet]) -> dict:
+    """JSON-ready: the sheets and which panel is on which."""
+    return {
+        "sheets": sum(not s.oversize for s in sheets),
+        "oversize_panels": [p.part.panel for s in sheets if s.oversize for p in s.parts],
+        "panels_on_sheet": [[p.part.panel for p in s.parts] for s in sheets if not s.oversize],
+    }

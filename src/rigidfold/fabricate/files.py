@@ -1,0 +1,268 @@
+"""The files of thick panels: 3D solids, a Rhino model, the hinge and vertex schedules.
+
+All lengths are metres unless a column says mm; the solids are in the design's place (z up),
+one per panel, named ``panel_K`` as in the design's own exports
+(:func:`rigidfold.exports.mesh3d.panel_names`).
+
+* ``NAME_solids.glb``: one node ``panel_K`` per panel, each its own mesh, under a node that
+  turns z up into glTF's y up (as :mod:`rigidfold.exports.mesh3d` does).
+* ``NAME_solids.stl`` (binary) and ``NAME_solids.obj`` (one group ``g panel_K`` per panel).
+* ``NAME_solids.3dm`` (rhino3dm): layer PANELS with one mesh per panel named ``panel_K``,
+  HINGES with each hinge's axis as a line named ``hinge_E`` (E: the crease), CREASES with
+  every crease and boundary edge of the design, LABELS with a text dot of each panel's number
+  on its surface.
+* ``NAME_hinges.csv``: per hinge, see :data:`HINGE_COLUMNS`.
+* ``NAME_vertices.csv``: per vertex, its place in the design and on the flat sheet.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.errors import RigidfoldError
+from rigidfold.exports.mesh3d import Y_UP, panel_colours, panel_names
+from rigidfold.fabricate.build import Fabrication
+from rigidfold.io.files import atomic_write
+
+HINGE_COLUMNS = (
+    "hinge",
+    "crease",
+    "panel_a",
+    "panel_b",
+    "vertex_a",
+    "vertex_b",
+    "ax_m",
+    "ay_m",
+    "az_m",
+    "bx_m",
+    "by_m",
+    "bz_m",
+    "length_m",
+    "fold_design_deg",
+    "fold_min_deg",
+    "fold_max_deg",
+    "side",
+    "bevel_deg",
+    "setback_mm",
+    "fold_limit_deg",
+)
+"""Columns of the hinge schedule: the hinge's number and its crease (edge index of the FOLD
+file), the panels on its left and right (of vertex_a -> vertex_b), its axis end points in the
+design, its length, its fold angle in the design (valley > 0) and its closing fold range from
+flat to the design over the motion (towards the solids' side > 0), ``side``: ``closes`` when
+it folds towards the solids, ``opens`` when away, the bevel of both panels' edges (angle
+between the bevel face and the surface), how far the far face is set back from the axis, and
+the fold up to which the two solids meet only along the axis."""
+
+VERTEX_COLUMNS = ("vertex", "x_m", "y_m", "z_m", "flat_x_m", "flat_y_m", "relief_mm")
+"""Columns of the vertex schedule: the vertex, its place in the design (z up), on the flat
+sheet (the development diagram), and the relief radius of the solids there (0: none)."""
+
+
+def _meshes(fab: Fabrication) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    names = panel_names(fab.panels.pattern)
+    return [(names[k], v, f) for k, (v, f) in enumerate(fab.solids.meshes)]
+
+
+def glb_bytes(fab: Fabrication) -> bytes:
+    """glTF binary of the solids: one node per panel under a y-up node."""
+    import trimesh
+
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from=scene.graph.base_frame, frame_to="rigidfold", matrix=Y_UP)
+    colours = panel_colours(fab.panels.pattern)
+    for k, (name, verts, faces) in enumerate(_meshes(fab)):
+        if not len(faces):
+            continue
+        mesh = trimesh.Trimesh(
+            vertices=verts,
+            faces=faces,
+            face_colors=np.repeat(colours[k : k + 1], len(faces), axis=0),
+            process=False,
+        )
+        scene.add_geometry(mesh, node_name=name, geom_name=name, parent_node_name="rigidfold")
+    return scene.export(file_type="glb")
+
+
+def stl_bytes(fab: Fabrication) -> bytes:
+    """Binary STL of all the solids."""
+    import trimesh
+    from trimesh.exchange.stl import export_stl
+
+    parts = [(v, f) for _, v, f in _meshes(fab) if len(f)]
+    offsets = np.cumsum([0] + [len(v) for v, _ in parts])
+    verts = np.vstack([v for v, _ in parts])
+    faces = np.vstack([f + o for (_, f), o in zip(parts, offsets, strict=False)])
+    return export_stl(trimesh.Trimesh(vertices=verts, faces=faces, process=False))
+
+
+def obj_text(fab: Fabrication, *, title: str = "") -> str:
+    """OBJ of the solids, one group per panel, metres, z up."""
+    lines = ["# rigidfold fabricate: thick panels, metres, z up"]
+    if title:
+        lines.append(f"# {' '.join(title.split())}")
+    base = 1
+    for name, verts, faces in _meshes(fab):
+        if not len(faces):
+            continue
+        lines.append(f"o {name}")
+        lines.append(f"g {name}")
+        lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in verts.tolist()]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces.tolist()]
+        base += len(verts)
+    return "\n".join(lines) + "\n"
+
+
+def rhino_bytes(fab: Fabrication, directory: Path) -> bytes:
+    """The Rhino model (see the module's text), written through a temporary file in
+    ``directory`` (rhino3dm writes files only)."""
+    import rhino3dm  # its stubs do not know the setters and the attribute arguments
+
+    p = fab.panels
+    pattern = p.pattern
+    model = rhino3dm.File3dm()
+    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters  # type: ignore[misc]
+    layers = {}
+    for name, colour in (
+        ("PANELS", (200, 170, 120, 255)),
+        ("HINGES", (220, 40, 40, 255)),
+        ("CREASES", (60, 60, 60, 255)),
+        ("LABELS", (30, 30, 200, 255)),
+    ):
+        layer = rhino3dm.Layer()
+        layer.Name = name
+        layer.Color = colour
+        layers[name] = model.Layers.Add(layer)
+
+    def attributes(layer: str, name: str):
+        attr = rhino3dm.ObjectAttributes()
+        attr.LayerIndex = layers[layer]  # type: ignore[misc]
+        attr.Name = name  # type: ignore[misc]
+        return attr
+
+    for name, verts, faces in _meshes(fab):
+        if not len(faces):
+            continue
+        mesh = rhino3dm.Mesh()
+        for x, y, z in verts.tolist():
+            mesh.Vertices.Add(x, y, z)
+        for a, b, c in faces.tolist():
+            mesh.Faces.AddFace(a, b, c)
+        mesh.Normals.ComputeNormals()
+        model.Objects.AddMesh(mesh, attributes("PANELS", name))  # type: ignore[call-arg]
+    coords = pattern.coords
+    for h, e in enumerate(p.hinge_edges.tolist()):
+        u, v = p.hinge_vertices[h].tolist()
+        line = rhino3dm.LineCurve(rhino3dm.Point3d(*coords[u]), rhino3dm.Point3d(*coords[v]))
+        model.Objects.AddCurve(line, attributes("HINGES", f"hinge_{e}"))  # type: ignore[call-arg]
+    for e, (u, v) in enumerate(pattern.edges.tolist()):
+        if pattern.fixed[e]:
+            continue
+        line = rhino3dm.LineCurve(rhino3dm.Point3d(*coords[u]), rhino3dm.Point3d(*coords[v]))
+        model.Objects.AddCurve(line, attributes("CREASES", f"edge_{e}"))  # type: ignore[call-arg]
+    for k, name in enumerate(panel_names(pattern)):
+        centre = coords[p.vertices[k]].mean(axis=0)
+        point = rhino3dm.Point3d(*centre)
+        model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))  # type: ignore[call-arg]
+    fd, tmp = tempfile.mkstemp(prefix=".rigidfold-", suffix=".3dm", dir=directory)
+    os.close(fd)
+    try:
+        if not model.Write(tmp, 7):
+            raise RigidfoldError(f"cannot write the Rhino model in '{directory}'")
+        return Path(tmp).read_bytes()
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+
+
+def hinge_rows(fab: Fabrication) -> list[dict]:
+    """The rows of the hinge schedule (:data:`HINGE_COLUMNS`)."""
+    p, s = fab.panels, fab.solids
+    coords = p.pattern.coords
+    fold = np.degrees(p.pattern.fold_angles)
+    low, high = fab.fold_range
+    rows = []
+    for h, e in enumerate(p.hinge_edges.tolist()):
+        u, v = p.hinge_vertices[h].tolist()
+        a, b = p.hinge_panels[h].tolist()
+        rows.append(
+            {
+                "hinge": h,
+                "crease": e,
+                "panel_a": a,
+                "panel_b": b,
+                "vertex_a": u,
+                "vertex_b": v,
+                **{
+                    f"{c}{x}_m": f"{coords[w][i]:.6f}"
+                    for c, w in (("a", u), ("b", v))
+                    for i, x in enumerate("xyz")
+                },
+                "length_m": f"{np.linalg.norm(coords[v] - coords[u]):.6f}",
+                "fold_design_deg": f"{fold[e]:.3f}",
+                "fold_min_deg": f"{math.degrees(low[h]):.3f}",
+                "fold_max_deg": f"{math.degrees(high[h]):.3f}",
+                "side": "closes" if high[h] > 0 else "opens",
+                "bevel_deg": f"{math.degrees(s.bevel[h]):.3f}",
+                "setback_mm": f"{s.inset[h] * 1e3:.2f}",
+                "fold_limit_deg": f"{math.degrees(s.fold_limit[h]):.3f}",
+            }
+        )
+    return rows
+
+
+def vertex_rows(fab: Fabrication) -> list[dict]:
+    """The rows of the vertex schedule (:data:`VERTEX_COLUMNS`)."""
+    p = fab.panels
+    xyz, xy = p.pattern.coords, p.coords2d
+    return [
+        {
+            "vertex": v,
+            "x_m": f"{xyz[v, 0]:.6f}",
+            "y_m": f"{xyz[v, 1]:.6f}",
+            "z_m": f"{xyz[v, 2]:.6f}",
+            "flat_x_m": f"{xy[v, 0]:.6f}",
+            "flat_y_m": f"{xy[v, 1]:.6f}",
+            "relief_mm": f"{fab.solids.relief[v] * 1e3:.2f}",
+        }
+        for v in range(p.pattern.n_vertices)
+    ]
+
+
+def csv_text(columns: tuple[str, ...], rows: list[dict]) -> str:
+    out = io.StringIO()
+    writer = csv.DictWriter(out, fieldnames=columns, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return out.getvalue()
+
+
+def write_solid_files(fab: Fabrication, out: Path, name: str, *, title: str = "") -> list[Path]:
+    """Write the 3D files and the schedules of ``fab`` into ``out`` (which exists) as
+    ``NAME_solids.glb/.stl/.obj/.3dm``, ``NAME_hinges.csv`` and ``NAME_vertices.csv``;
+    returns them."""
+    return [
+        atomic_write(out / f"{name}_solids.glb", glb_bytes(fab)),
+        atomic_write(out / f"{name}_solids.stl", stl_bytes(fab)),
+        atomic_write(out / f"{name}_solids.obj", obj_text(fab, title=title)),
+        atomic_write(out / f"{name}_solids.3dm", rhino_bytes(fab, out)),
+        atomic_write(out / f"{name}_hinges.csv", csv_text(HINGE_COLUMNS, hinge_rows(fab))),
+        atomic_write(out / f"{name}_vertices.csv", csv_text(VERTEX_COLUMNS, vertex_rows(fab))),
+    ]
+
+
+SOLID_FILES = (
+    "{}_solids.glb",
+    "{}_solids.stl",
+    "{}_solids.obj",
+    "{}_solids.3dm",
+    "{}_hinges.csv",
+    "{}_vertices.csv",
+)
+"""The names :func:`write_solid_files` writes, ``{}`` for the design's name."""

@@ -1,0 +1,193 @@
+"""The folding motion as rigid motions of the panels, from flat to the design.
+
+The motion is a sequence of frames, vertex positions (K, V, 3) from the flat sheet
+(fraction 0) to the design (fraction 1): the design file's own motion frames
+(``foldedForm`` frames, as ``rigidfold generate`` writes them for a checked design) when
+they are fine enough, else the design's rigid-folding path
+(:func:`rigidfold.mechanism.path.trace_path`) sampled at equal arclength
+(:meth:`rigidfold.mechanism.path.FoldingPath.frames`) so finely that no hinge turns more
+than ``settings.fabricate_frame_step`` between two frames. Each panel moves rigidly: at
+frame i its points are ``R[i, k] @ x + t[i, k]`` for ``x`` in the design, ``R, t`` the
+least-squares fit (Kabsch) of the panel's vertices in the design onto theirs in the frame.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.exports import Design
+from rigidfold.fabricate.panels import Panels
+from rigidfold.io import read_fold
+
+_PERCENT = re.compile(r"([0-9.]+)% folded")
+"""The fraction folded in a motion frame's title (:func:`rigidfold.io.motion_frames`)."""
+
+MAX_FRAMES = 4000
+"""Most frames a traced motion is sampled at (a motion that needs more is checked at these)."""
+
+
+@dataclass(frozen=True, eq=False)
+class PanelMotion:
+    """Rigid motions of the panels along the folding motion, flat first.
+
+    rotations : (K, P, 3, 3) float64 and translations : (K, P, 3) float64: panel k at frame
+        i holds ``rotations[i, k] @ x + translations[i, k]`` for a point x of it in the design.
+    fraction : (K,) float64, fraction folded of each frame: 0 flat .. 1 the design.
+    closing : (K, H) float64, how far each hinge has folded towards the solids' side at each
+        frame, radians (:meth:`rigidfold.fabricate.panels.Panels.closing`).
+    source : where the frames come from, in words.
+    """
+
+    rotations: np.ndarray
+    translations: np.ndarray
+    fraction: np.ndarray
+    closing: np.ndarray
+    source: str
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.fraction)
+
+    @property
+    def largest_step(self) -> float:
+        """Largest change of one hinge's fold angle between two frames, radians."""
+        if self.n_frames < 2 or self.closing.shape[1] == 0:
+            return 0.0
+        return float(np.abs(np.diff(self.closing, axis=0)).max())
+
+    @property
+    def range(self) -> tuple[np.ndarray, np.ndarray]:
+        """((H,), (H,)): the least and the largest closing fold angle of each hinge over the
+        motion, the flat state (0) included, radians."""
+        low = np.minimum(self.closing.min(axis=0, initial=0.0), 0.0)
+        high = np.maximum(self.closing.max(axis=0, initial=0.0), 0.0)
+        return low, high
+
+    def to_dict(self) -> dict:
+        return {
+            "frames": self.n_frames,
+            "source": self.source,
+            "largest_step_deg": math.degrees(self.largest_step),
+        }
+
+
+def fit_panels(panels: Panels, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(rotations (K, P, 3, 3), translations (K, P, 3)): each panel's rigid motion from the
+    design onto each of ``frames`` (K, V, 3), by least squares over its vertices (Kabsch)."""
+    frames = np.asarray(frames, dtype=np.float64)
+    design = panels.pattern.coords
+    n_frames = len(frames)
+    rotations = np.empty((n_frames, panels.n, 3, 3))
+    translations = np.empty((n_frames, panels.n, 3))
+    for k, verts in enumerate(panels.vertices):
+        src = design[verts]
+        dst = frames[:, verts]
+        c_src = src.mean(axis=0)
+        c_dst = dst.mean(axis=1)
+        h = np.einsum("vi,kvj->kij", src - c_src, dst - c_dst[:, None])
+        u, _, vt = np.linalg.svd(h)
+        d = np.sign(np.linalg.det(np.einsum("kij,kjl->kil", u, vt)))
+        u[:, :, 2] *= d[:, None]
+        r = np.einsum("kij,kjl->kli", u, vt)  # R = (U V^T)^T maps src onto dst
+        rotations[:, k] = r
+        translations[:, k] = c_dst - np.einsum("kij,j->ki", r, c_src)
+    return rotations, translations
+
+
+def closing_angles(panels: Panels, rotations: np.ndarray) -> np.ndarray:
+    """(..., H) float64: the closing fold angle of each hinge for panel rotations
+    (..., P, 3, 3), from the two panels' turned normals and the turned hinge direction
+    (the fold angle of :func:`rigidfold.mesh.geometry.fold_angles`)."""
+    p = panels.pattern
+    left, right = panels.hinge_panels.T
+    u, v = panels.hinge_vertices.T
+    t0 = p.coords[v] - p.coords[u]
+    t0 /= np.linalg.norm(t0, axis=1, keepdims=True)
+    ra = rotations[..., left, :, :]
+    rb = rotations[..., right, :, :]
+    na = np.einsum("...hij,hj->...hi", ra, panels.normals[left])
+    nb = np.einsum("...hij,hj->...hi", rb, panels.normals[right])
+    t = np.einsum("...hij,hj->...hi", ra, t0)
+    sin = -np.einsum("...i,...i->...", np.cross(na, nb), t)
+    cos = np.einsum("...i,...i->...", na, nb)
+    return panels.sign * np.arctan2(sin, cos)
+
+
+def panel_motion(
+    panels: Panels, frames: np.ndarray, fraction: np.ndarray, source: str
+) -> PanelMotion:
+    """The :class:`PanelMotion` of ``frames`` (K, V, 3), flat first, at ``fraction`` (K,)."""
+    rotations, translations = fit_panels(panels, frames)
+    closing = closing_angles(panels, rotations)
+    return PanelMotion(
+        rotations, translations, np.asarray(fraction, dtype=np.float64), closing, source
+    )
+
+
+def file_frames(design: Design, *, up: str = "z", settings: Settings = DEFAULTS):
+    """(frames (K, V, 3), fraction (K,)) of the folding motion the design file carries
+    (its ``foldedForm`` frames of the same model, flat first), or None when it has fewer
+    than two."""
+    raw = design.data.raw
+    frames, fraction = [], []
+    pattern = design.pattern
+    for k, frame in enumerate(raw.get("file_frames") or [], start=1):
+        classes = frame.get("frame_classes")
+        if not (isinstance(classes, list) and "foldedForm" in classes):
+            continue
+        try:
+            shape = read_fold(raw, k, up=up, settings=settings).pattern
+        except ValueError:
+            continue
+        if shape.n_vertices != pattern.n_vertices or not np.array_equal(shape.faces, pattern.faces):
+            continue
+        frames.append(shape.coords)
+        share = _PERCENT.search(str(frame.get("frame_title", "")))
+        fraction.append(float(share.group(1)) / 100 if share else math.nan)
+    if len(frames) < 2:
+        return None
+    s = np.asarray(fraction)
+    if np.isnan(s).any() or np.any(np.diff(s) < 0):
+        s = np.linspace(0.0, 1.0, len(frames))
+    return np.asarray(frames), s
+
+
+def design_motion(
+    panels: Panels,
+    design: Design | None = None,
+    *,
+    up: str = "z",
+    settings: Settings = DEFAULTS,
+) -> tuple[PanelMotion | None, str]:
+    """(motion, message): the folding motion of ``panels``' design (see the module's text),
+    or (None, why) when it has no motion from flat: its file carries none fine enough and
+    its folding path does not reach the flat state."""
+    from rigidfold.mechanism.path import trace_path
+
+    step = settings.fabricate_frame_step
+    carried = None if design is None else file_frames(design, up=up, settings=settings)
+    if carried is not None:
+        frames, fraction = carried
+        motion = panel_motion(panels, frames, fraction, f"the design file's {len(frames)} frames")
+        if motion.largest_step <= step:
+            return motion, motion.source
+    pattern = panels.pattern
+    path = trace_path(pattern, settings=settings)
+    if not path.deploys:
+        if carried is not None:
+            return motion, f"{motion.source} (the path could not be traced finer: {path.message})"
+        return None, f"{path.status.message}: {path.message}"
+    largest = float(np.abs(panels.closing(pattern.fold_angles)).max(initial=0.0))
+    n = min(max(math.ceil(largest / step) + 1, 3), MAX_FRAMES)
+    for _ in range(3):
+        frames, fraction = path.frames(pattern, n, settings=settings)
+        motion = panel_motion(panels, frames, fraction, f"the traced folding path at {n} frames")
+        if motion.largest_step <= step or n >= MAX_FRAMES:
+            break
+        n = min(math.ceil((n - 1) * motion.largest_step / step) + 1, MAX_FRAMES)
+    return motion, motion.source

@@ -1,0 +1,277 @@
+"""Thick panels (rigidfold fabricate): solids, the check over the motion, files, exit codes."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from conftest import main_code
+
+DESIGN_ARGS = [
+    "generate",
+    "--surface",
+    "bezier",
+    "--seed",
+    "1",
+    "--pattern",
+    "grid:5x5",
+    "--size",
+    "3x3",
+    "--lookahead",
+    "--no-deform",
+    "--quiet",
+    "--no-report",
+]
+
+
+@pytest.fixture(scope="module")
+def design(tmp_path_factory):
+    """A small generated design (5 x 5 grid on 3 m x 3 m) with its motion frames."""
+    out = tmp_path_factory.mktemp("design")
+    assert main_code([*DESIGN_ARGS, "--out", str(out)]) == 0
+    (final,) = sorted((out / "solutions").glob("*_dof_01.fold"))
+    return final
+
+
+@pytest.fixture(scope="module")
+def built(design, tmp_path_factory):
+    """``rigidfold fabricate`` at 20 mm and 50 mm: {thickness: (exit code, out dir, summary)}."""
+    from rigidfold.workflows import fabricate_file
+
+    runs = {}
+    for t in (0.02, 0.05):
+        out = tmp_path_factory.mktemp(f"fab{int(t * 1e3)}")
+        code = main_code(
+            ["fabricate", str(design), "--thickness", f"{t * 1e3:g}mm", "--out", str(out)]
+        )
+        summary = json.loads((out / f"{design.stem}_fabricate.json").read_text())
+        runs[t] = (code, out, summary)
+    runs["result"] = fabricate_file(design, tmp_path_factory.mktemp("lib"), thickness=0.02)
+    return runs
+
+
+@pytest.mark.parametrize("t", [0.02, 0.05])
+def test_deploys_collision_free(built, t):
+    code, _, summary = built[t]
+    assert code == 0
+    assert summary["status"] == "collision_free"
+    check = summary["check"]
+    assert check["collision_free"]
+    assert check["proven_gap_m"] >= check["required_gap_m"]
+    assert check["hinge_margin_deg"] >= 0
+    assert summary["motion"]["frames"] >= 2
+
+
+@pytest.mark.parametrize("t", [0.02, 0.05])
+def test_solids_watertight_one_per_panel(built, t):
+    import trimesh
+
+    _, out, summary = built[t]
+    scene = trimesh.load(next(out.glob("*_solids.glb")), force="scene")
+    names = sorted(scene.geometry)
+    assert len(names) == summary["panels"]
+    for name in names:
+        mesh = scene.geometry[name]
+        assert mesh.is_watertight and mesh.is_winding_consistent, name
+        assert mesh.volume > 0
+    area, volume = summary["area_m2"], summary["volume_m3"]
+    assert abs(volume - area * t) <= 0.4 * area * t
+    assert summary["trimming_loss"] == pytest.approx(1 - volume / (area * t))
+    assert 0 <= summary["trimming_loss"] < 0.4
+
+
+def test_independent_no_interpenetration(built):
+    """Every solid moved rigidly onto every motion frame (its vertices fitted by least
+    squares, here, not by the code under test) overlaps no other solid: manifold3d
+    intersection volumes are round-off only."""
+    import manifold3d as mf
+
+    fab = built["result"].fabrication
+    panels = fab.panels
+    pattern = panels.pattern
+    from rigidfold.fabricate.motion import file_frames
+
+    carried = file_frames(built["result"].design)
+    from rigidfold.mechanism.path import trace_path
+
+    path = trace_path(pattern)
+    assert path.deploys
+    frames, _ = path.frames(pattern, 15)
+    if carried is not None:
+        frames = np.concatenate([frames, carried[0]])
+    solids = [
+        mf.Manifold(
+            mf.Mesh64(vert_properties=np.ascontiguousarray(v), tri_verts=f.astype(np.uint64))
+        )
+        for v, f in fab.solids.meshes
+    ]
+    worst = 0.0
+    for frame in frames:
+        moved = []
+        for k, solid in enumerate(solids):
+            idx = panels.vertices[k]
+            src, dst = pattern.coords[idx], frame[idx]
+            cs, cd = src.mean(axis=0), dst.mean(axis=0)
+            u, _, vt = np.linalg.svd((src - cs).T @ (dst - cd))
+            d = np.sign(np.linalg.det(vt.T @ u.T))
+            rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+            moved.append(solid.transform(np.hstack([rot, (cd - rot @ cs)[:, None]])))
+        boxes = np.array([m.bounding_box() for m in moved])
+        for a in range(len(moved)):
+            for b in range(a + 1, len(moved)):
+                if np.any(boxes[a, 3:] < boxes[b, :3]) or np.any(boxes[b, 3:] < boxes[a, :3]):
+                    continue
+                worst = max(worst, (moved[a] ^ moved[b]).volume())
+    smallest = float(fab.solids.volumes.min())
+    assert worst <= 1e-9 * smallest
+
+
+def test_collision_reported_with_panels_and_fraction(design, tmp_path, capsys):
+    """Without reliefs at the vertices, panels that meet at a vertex only touch there all the
+    way: the check names them and the fraction (exit 1), and a thinner try is reported."""
+    from rigidfold.config import DEFAULTS
+    from rigidfold.fabricate import FabricationStatus
+    from rigidfold.workflows import fabricate_file
+
+    settings = DEFAULTS.with_(
+        fabricate_vertex_relief=0.0, fabricate_relief_rounds=0, fabricate_thickness_tries=2
+    )
+    done = fabricate_file(design, tmp_path, thickness=0.05, settings=settings)
+    fab = done.fabrication
+    assert fab.status is FabricationStatus.COLLISION
+    meeting = fab.clearance.meetings[0]
+    assert meeting.panels[0] < meeting.panels[1]
+    assert 0.0 <= meeting.fraction <= 1.0
+    line = fab.last_line()
+    assert f"panels {meeting.panels[0]} and {meeting.panels[1]}" in line
+    assert "% folded" in line
+    assert (tmp_path / f"{design.stem}_fabricate.json").exists()
+
+
+def test_cli_exit_1_too_thick(design, tmp_path, capsys):
+    """Panels too thick for their bevels and reliefs: exit 1, the files written all the
+    same, and the last line names a panel and a thinner thickness that passes."""
+    code = main_code(["fabricate", str(design), "--thickness", "400mm", "--out", str(tmp_path)])
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert code == 1
+    assert "at 400 mm" in last and "panel" in last and "would pass" in last
+    assert any(tmp_path.glob("*_solids.3dm"))
+    summary = json.loads(next(tmp_path.glob("*_fabricate.json")).read_text())
+    assert summary["status"] in ("panel_trimmed_away", "too_thin", "collision")
+    assert 0 < summary["passing_thickness_m"] < 0.4
+
+
+def test_rhino_model(built):
+    import rhino3dm
+
+    _, out, summary = built[0.02]
+    model = rhino3dm.File3dm.Read(str(next(out.glob("*_solids.3dm"))))
+    layers = {model.Layers[i].Name: i for i in range(len(model.Layers))}
+    assert set(layers) >= {"PANELS", "HINGES", "CREASES", "LABELS"}
+    on = {name: [] for name in layers}
+    for obj in model.Objects:
+        on[model.Layers[obj.Attributes.LayerIndex].Name].append(obj)
+    panels = on["PANELS"]
+    assert len(panels) == summary["panels"]
+    assert len({o.Attributes.Name for o in panels}) == summary["panels"]
+    assert all(isinstance(o.Geometry, rhino3dm.Mesh) for o in panels)
+    assert len(on["HINGES"]) == summary["hinges"]
+    assert len(on["LABELS"]) == summary["panels"]
+
+
+def test_cut_sheets_every_panel_once_within_stock(built):
+    import ezdxf
+
+    _, out, summary = built[0.02]
+    width, height = summary["cut_sheets"]["stock_mm"]
+    seen = []
+    for path in sorted(out.glob("*_sheet_*.dxf")):
+        doc = ezdxf.readfile(path)
+        msp = doc.modelspace()
+        (sheet,) = msp.query('LWPOLYLINE[layer=="SHEET"]')
+        pts = np.array([p[:2] for p in sheet.get_points()])
+        assert np.ptp(pts[:, 0]) <= width + 1e-6 and np.ptp(pts[:, 1]) <= height + 1e-6
+        for poly in msp.query('LWPOLYLINE[layer=="CUT"]'):
+            q = np.array([p[:2] for p in poly.get_points()])
+            assert q.min() >= -1e-6 and q[:, 0].max() <= width + 1e-6
+            assert q[:, 1].max() <= height + 1e-6
+        seen += [
+            t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]') if t.dxf.text.startswith("P")
+        ]
+    oversize = summary["cut_sheets"]["oversize_panels"]
+    for path in sorted(out.glob("*_oversize_*.dxf")):  # a part larger than the stock
+        msp = ezdxf.readfile(path).modelspace()
+        (poly,) = msp.query('LWPOLYLINE[layer=="SHEET"]')
+        pts = np.array([p[:2] for p in poly.get_points()])
+        w, h = np.ptp(pts, axis=0)
+        assert max(w, h) > min(width, height) and (max(w, h) > width or min(w, h) > height)
+        seen += [
+            t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]') if t.dxf.text.startswith("P")
+        ]
+    assert len(oversize) == len(list(out.glob("*_oversize_*.dxf")))
+    assert sorted(seen) == sorted(f"P{k}" for k in range(summary["panels"]))
+    assert len(list(out.glob("*_sheet_*.svg"))) == summary["cut_sheets"]["sheets"]
+
+
+def test_schedules(built):
+    _, out, summary = built[0.02]
+    hinges = list(csv.DictReader(next(out.glob("*_hinges.csv")).read_text().splitlines()))
+    assert len(hinges) == summary["hinges"]
+    for row in hinges:
+        bevel = float(row["bevel_deg"])
+        assert 0 < bevel < 90
+        assert float(row["fold_max_deg"]) + summary["clearance_angle_deg"] <= (
+            float(row["fold_limit_deg"]) + 1e-6
+        )
+        assert math.isclose(bevel, (180 - max(float(row["fold_max_deg"]), 0) - 2) / 2, abs_tol=1e-3)
+    vertices = list(csv.DictReader(next(out.glob("*_vertices.csv")).read_text().splitlines()))
+    assert vertices and {"x_m", "flat_x_m", "relief_mm"} <= set(vertices[0])
+    per_panel = summary["per_panel"]
+    assert len(per_panel) == summary["panels"]
+    assert all(p["mass_kg"] == pytest.approx(600 * p["volume_m3"]) for p in per_panel)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--thickness", "-3mm"],
+        ["--thickness", "abc"],
+        ["--thickness", "20mm", "--sheet", "2440by1220"],
+        ["--thickness", "20mm", "--clearance-angle", "95"],
+    ],
+)
+def test_bad_input_exits_2(design, tmp_path, capsys, args):
+    code = main_code(["fabricate", str(design), "--out", str(tmp_path), *args])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+
+
+def test_missing_file_exits_2(tmp_path, capsys):
+    code = main_code(
+        [
+            "fabricate",
+            str(tmp_path / "none.fold"),
+            "--thickness",
+            "20mm",
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
+    assert code == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_parse_length():
+    from rigidfold.fabricate.build import parse_length, parse_sheet
+
+    assert parse_length("18mm") == pytest.approx(0.018)
+    assert parse_length("1.8cm") == pytest.approx(0.018)
+    assert parse_length("0.018") == pytest.approx(0.018)
+    assert parse_sheet("2440x1220") == (2440.0, 1220.0)
+    with pytest.raises(ValueError, match="thickness"):
+        parse_length("0")
