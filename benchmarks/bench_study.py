@@ -31,7 +31,7 @@ def measure(keys, config, workers: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         store = Store(Path(tmp) / "bench.sqlite", config.as_dict())
         result = run_study(keys, store, config, workers=workers)
-        result["run_s"] = sum(r["time_total"] for r in store.runs())
+        result["run_s"] = sum(r.time_total or 0.0 for r in store.runs())
         store.close()
     return result
 

@@ -186,7 +186,7 @@ def test_a_study_database_refuses_runs_of_other_numerics(tmp_path):
     mixed = Store(db, {"c": 1}, numerics=NUMERICS_B, allow_mixed_numerics=True)
     mixed.add(Key("bezier", 2, "1", "s", False), ROW | {"numerics": "bbbb"}, [])
     assert mixed.numerics() == NUMERICS_A  # the first runs' environment is kept
-    assert {r["numerics"] for r in mixed.runs()} == {"aaaa", "bbbb"}
+    assert {r.numerics for r in mixed.runs()} == {"aaaa", "bbbb"}
     mixed.close()
     report = markdown(Store(db, readonly=True))
     assert "Numerics: pinned, `aaaa numpy=1`; the runs come from 2 numeric environments" in report

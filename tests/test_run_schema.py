@@ -153,7 +153,8 @@ def test_a_study_of_the_previous_version_resumes(tmp_path):
     try:
         assert store.done() == {Key("bezier", 0, "1", "s")}
         (row,) = store.runs()
-        assert row["n_lock"] is not None and row["final_dof"] is not None
+        assert row.n_lock is not None and row.final_dof is not None
+        assert row.stop is not None  # filled from the old status words when opened
     finally:
         store.close()
     with pytest.raises(ValueError, match="lookahead"):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -49,10 +50,16 @@ def n_runs(db) -> int:
         return 0
 
 
-def comparable(rows: list[dict]) -> list[dict]:
-    """Rows without the timings and the worker's name (which differ between runs)."""
+def comparable(rows: list) -> list[dict]:
+    """Rows (dicts, or stored runs) without the timings and the worker's name (which differ
+    between runs)."""
     return [
-        {k: v for k, v in r.items() if not k.startswith("time") and k != "worker"} for r in rows
+        {
+            k: v
+            for k, v in (r if isinstance(r, dict) else dataclasses.asdict(r)).items()
+            if not k.startswith("time") and k != "worker"
+        }
+        for r in rows
     ]
 
 
@@ -69,14 +76,15 @@ def test_study_stores_every_run_once(uninterrupted):
     store = Store(uninterrupted, readonly=True)
     runs = store.runs()
     assert len(runs) == 6
-    assert {(r["seed"], r["criterion"]) for r in runs} == {
+    assert {(r.seed, r.criterion) for r in runs} == {
         (s, c) for s in range(3) for c in ("shat", "s")
     }
     for r in runs:
-        assert r["status"] == "target DOF 1 reached" and r["final_dof"] == 1
-        assert r["n_reduce"] == 20 and r["n_solves"] >= 21
+        assert r.status == "target DOF 1 reached" and r.final_dof == 1
+        assert r.stop is Stop.TARGET_REACHED
+        assert r.n_reduce == 20 and r.n_solves >= 21
     # one attempts row per solve of (6)
-    assert store.count_attempts() == sum(r["n_solves"] for r in runs)
+    assert store.count_attempts() == sum(r.n_solves for r in runs)
 
 
 def test_rerun_skips_finished_runs(uninterrupted):
@@ -128,7 +136,7 @@ def test_report_tables_and_figures(uninterrupted, tmp_path):
 
 def test_report_pairs_costs_and_commands(uninterrupted):
     store = Store(uninterrupted, readonly=True)
-    runs = {(r["criterion"], r["seed"]): r["n_lock"] for r in store.runs("bezier")}
+    runs = {(r.criterion, r.seed): r.n_lock for r in store.runs("bezier")}
     (pair,) = paired_comparisons(store)  # only S-hat and S ran
     d = [runs[("shat", k)] - runs[("s", k)] for k in range(3)]
     assert (pair["a"], pair["b"], pair["n"]) == ("shat", "s", 3)
@@ -156,10 +164,10 @@ def test_plan_and_store_units(tmp_path):
         plan(["grid:5"], ["s"], 1)
     store = Store(tmp_path / "u.sqlite", StudyConfig().as_dict())
     key = Key("bezier", 5, "1", "shat")
-    store.add(key, {"status": "x", "version": "v"}, [])
+    store.add(key, {"status": "DOF 0 reached", "version": "v"}, [])
     assert store.done() == {key}
     with pytest.raises(ValueError, match="already holds the run"):
-        store.add(key, {"status": "x", "version": "v"}, [])  # never counted twice
+        store.add(key, {"status": "DOF 0 reached", "version": "v"}, [])  # never counted twice
     assert len(store.runs()) == 1
 
 
@@ -314,8 +322,8 @@ def test_dof_steps_add_up_to_the_dof_reduced(uninterrupted):
     for row in tables_5_6(store):
         st = steps[row["criterion"]]
         assert st["runs"] == row["n"] == 3
-        runs = [r for r in store.runs("bezier") if r["criterion"] == row["criterion"]]
-        accepted_fixes = np.mean([r["n_solutions"] - 1 for r in runs])
+        runs = [r for r in store.runs("bezier") if r.criterion == row["criterion"]]
+        accepted_fixes = np.mean([r.n_solutions - 1 for r in runs])
         assert sum(st["per_kind"].values()) == pytest.approx(accepted_fixes)
         assert st["per_kind"]["-1"] >= 0
     assert "### How fixing a crease changes the DOF" in markdown(store)
@@ -395,12 +403,12 @@ def old_database(path) -> None:
 
 
 def test_databases_of_earlier_versions_read_and_resume_the_same(tmp_path):
-    from rigidfold.study import run_stop
+    from rigidfold.study import legacy_stop
 
     db = tmp_path / "old.sqlite"
     old_database(db)
     store = Store(db, readonly=True)
-    assert [run_stop(r["status"]) for r in store.runs()] == [s for _, s in OLD_STATUSES.values()]
+    assert [r.stop for r in store.runs()] == [s for _, s in OLD_STATUSES.values()]
     (row,) = tables_5_6(store)
     assert (row["n"], row["reached_target"], row["n_lock"]) == (4, 1, 1.5)
     (stage,) = locks_by_stage(store)
@@ -415,7 +423,7 @@ def test_databases_of_earlier_versions_read_and_resume_the_same(tmp_path):
     (row,) = tables_5_6(Store(db, readonly=True))
     assert (row["n"], row["reached_target"]) == (5, 2)
     with pytest.raises(ValueError, match="not the stop reason"):
-        run_stop("stopped somehow")
+        legacy_stop("stopped somehow")
 
 
 def test_readonly_store_takes_no_configuration(uninterrupted, tmp_path):

@@ -22,7 +22,7 @@ STUDY = ["study", "--patterns", "1", "--criteria", "s", "--no-deform", "--quiet"
 
 def fake_run(key, config):
     """A run computed in no time, whose 40 attempts take several database pages."""
-    row = {f: 1 for f in RUN_FIELDS if f not in ("status", "version", "worker", "numerics")}
+    row = {f: 1 for f in RUN_FIELDS if f not in ("status", "stop", "version", "worker", "numerics")}
     from rigidfold.numerics import numeric_environment
 
     row |= {"status": "target DOF 1 reached", "version": "t", "numerics": numeric_environment().key}
@@ -60,7 +60,7 @@ def test_a_full_disk_stops_the_study_in_one_line_and_keeps_the_runs(tmp_path, mo
         "command to resume"
     ]
     store = Store(db, readonly=True)
-    assert [r["seed"] for r in store.runs()] == [calls[0].seed]  # whole, with its attempts
+    assert [r.seed for r in store.runs()] == [calls[0].seed]  # whole, with its attempts
     assert store.count_attempts() == 40
     store.close()
     assert not (tmp_path / "s.sqlite.lock").exists()  # released

@@ -120,9 +120,9 @@ def test_a_second_client_is_refused_and_a_dead_ones_lock_taken_over(tmp_path):
         holder.stdout.close()
     assert (tmp_path / "s.sqlite.lock").exists()  # left by the killed client, taken over:
     store = Store(db, config)
-    store.add(Key("bezier", 0, "1", "s"), {"status": "x", "version": "v"}, [])
+    store.add(Key("bezier", 0, "1", "s"), {"status": "DOF 0 reached", "version": "v"}, [])
     with pytest.raises(ValueError, match="already holds the run"):
-        store.add(Key("bezier", 0, "1", "s"), {"status": "x", "version": "v"}, [])
+        store.add(Key("bezier", 0, "1", "s"), {"status": "DOF 0 reached", "version": "v"}, [])
     store.close()
     assert not (tmp_path / "s.sqlite.lock").exists()
 
@@ -217,14 +217,15 @@ def test_a_run_whose_worker_dies_is_recorded_as_failed_and_the_others_go_on(
         "killed, out of memory, or a crash in native code)"
     ]
     store = Store(db, readonly=True)
-    runs = {r["seed"]: r for r in store.runs()}
+    runs = {r.seed: r for r in store.runs()}
     assert sorted(runs) == [0, 1]
-    assert runs[0]["status"] == "target DOF 1 reached" and runs[0]["n_lock"] is not None
-    assert runs[1]["status"] == (
+    assert runs[0].status == "target DOF 1 reached" and runs[0].n_lock is not None
+    assert runs[1].stop is None and runs[1].status == (
         "error: the Dask worker running it died 1 time (KilledWorker: killed, out of memory, "
         "or a crash in native code)"
     )
-    assert runs[1]["worker"].startswith("tcp://") and runs[1]["n_lock"] is None
+    assert runs[1].worker is not None and runs[1].worker.startswith("tcp://")
+    assert runs[1].n_lock is None
     [invocation] = store.invocations()
     assert (invocation["ran"], invocation["outcome"]) == (2, "completed, 1 failed")
     store.close()
@@ -275,9 +276,9 @@ def test_a_run_that_raises_unexpectedly_is_recorded_as_failed_and_the_others_go_
         f"study-report lists them): 1 x {message}"
     ]
     store = Store(db, readonly=True)
-    runs = {r["seed"]: r for r in store.runs()}
-    assert runs[0]["status"] == "target DOF 1 reached"
-    assert runs[1]["status"] == "error: " + message
+    runs = {r.seed: r for r in store.runs()}
+    assert runs[0].status == "target DOF 1 reached"
+    assert runs[1].status == "error: " + message
     store.close()
 
 
@@ -362,7 +363,7 @@ def test_a_database_named_with_uri_characters_resumes_without_stray_files(tmp_pa
     assert store.done() == {key}
     store.close()
     report = Store(db, readonly=True)
-    assert [r["n_lock"] for r in report.runs()] == [2]
+    assert [r.n_lock for r in report.runs()] == [2]
     report.close()
     left = sorted(p.name for p in tmp_path.iterdir())
     assert left == sorted(n for n in (name, f"{name}-wal", f"{name}-shm") if n in left)

@@ -92,19 +92,6 @@ class Stop(Outcome):
         """The stop reason's words with the run's ``detail`` (see :data:`STOP_REASONS`)."""
         return STOP_REASONS[self].format(detail)
 
-    @classmethod
-    def from_reason(cls, text: str) -> tuple[Stop, str]:
-        """The member and detail of a stop reason: the inverse of :meth:`reason`.
-
-        Raises ValueError when ``text`` is none of :data:`STOP_REASONS`.
-        """
-        for stop, template in STOP_REASONS.items():
-            head, slot, tail = template.partition("{}")
-            fits = text.startswith(head) and text.endswith(tail)
-            if fits and (len(text) >= len(head) + len(tail) if slot else text == template):
-                return stop, text[len(head) : len(text) - len(tail)]
-        raise RigidfoldError(f"{text!r} is not the stop reason of a generation run")
-
 
 STOP_REASONS = {
     Stop.RUNNING: "running",

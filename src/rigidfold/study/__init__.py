@@ -16,23 +16,24 @@ from rigidfold.study.session import (
     failure_summary,
     run_study_command,
 )
-from rigidfold.study.store import Key, Store, StoreWriteError, run_stop
+from rigidfold.study.store import Key, RunRow, Store, StoreWriteError, legacy_stop
 
 __all__ = [
     "PRESETS",
     "STUDY_DEFAULTS",
     "STUDY_OPTIONS",
     "Key",
+    "RunRow",
     "Store",
     "StoreWriteError",
     "StudyConfig",
     "StudyInterrupted",
     "StudyPlan",
     "failure_summary",
+    "legacy_stop",
     "plan",
     "preset",
     "run_one",
-    "run_stop",
     "run_study",
     "run_study_command",
 ]

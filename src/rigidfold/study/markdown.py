@@ -107,7 +107,7 @@ def markdown(stores: Store | list[Store], figures: list[dict] | dict | None = No
 
 def _configuration_lines(store: Store) -> list[str]:
     config = store.config() or {}
-    versions = sorted({r["version"] for r in store.runs()})
+    versions = sorted({r.version for r in store.runs()})
     if not config:
         return []
     from rigidfold.study.store import LEGACY_CONFIG, LEGACY_SETTINGS
@@ -133,7 +133,7 @@ def _numerics_lines(store: Store) -> list[str]:
     """Which numeric environments computed the runs (rigidfold.numerics); none before they
     were recorded."""
     numerics = store.numerics()
-    keys = {r.get("numerics") for r in store.runs()} - {None}
+    keys = {r.numerics for r in store.runs()} - {None}
     if numerics is None and not keys:
         return []
     status = (numerics or {}).get("status", "?")
@@ -461,15 +461,13 @@ def box_plots(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    runs = [r for r in store.runs("bezier") if r["n_lock"] is not None]
+    runs = [r for r in store.runs("bezier") if r.n_lock is not None]
     files = {}
     used = set() if used is None else used
-    for pattern in sorted({r["pattern"] for r in runs}):
-        crits = [
-            c for c in ORDER if any(r["criterion"] == c and r["pattern"] == pattern for r in runs)
-        ]
+    for pattern in sorted({r.pattern for r in runs}):
+        crits = [c for c in ORDER if any(r.criterion == c and r.pattern == pattern for r in runs)]
         data = [
-            [r["n_lock"] for r in runs if r["pattern"] == pattern and r["criterion"] == c]
+            [float(r.n_lock or 0) for r in runs if r.pattern == pattern and r.criterion == c]
             for c in crits
         ]
         fig, ax = plt.subplots(figsize=(5, 3.5), dpi=120)

@@ -183,6 +183,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         return key, row, []
     s = run.to_dict()
     row.update(
+        stop=s["stop"],
         status=s["stop_reason"],
         n_reduce=s["N_reduce"],
         n_lock=s["N_lock"],

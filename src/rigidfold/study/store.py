@@ -9,8 +9,11 @@ The ``meta`` table holds the study *configuration* (settings, solver, target DOF
 Steps 8-9 run). Opening a database with another configuration is refused before anything is
 written: its numbers would not be comparable.
 
-A run's ``status`` column holds the generator's stop reason (``Generation.stop_reason``) or
-"error: <message>"; :func:`run_stop` reads it back as a :class:`~rigidfold.generate.Stop`.
+A run's ``stop`` column holds how it ended, the :class:`~rigidfold.generate.Stop` value (NULL
+for a run that could not run), and ``status`` the words (``Generation.stop_reason``) or
+"error: <message>". Databases written before the ``stop`` column get it filled from the
+words once, when opened for writing (:func:`legacy_stop`); :meth:`Store.runs` returns typed
+rows (:class:`RunRow`).
 """
 
 from __future__ import annotations
@@ -21,11 +24,11 @@ import json
 import os
 import sqlite3
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 from rigidfold.errors import RigidfoldError
-from rigidfold.generate import Stop
+from rigidfold.generate import STOP_REASONS, Stop
 from rigidfold.study.lock import StudyLock
 
 SCHEMA = """
@@ -87,6 +90,7 @@ ADDED_RUN_COLUMNS = {
     "n_path": "INTEGER",
     "final_deploys": "INTEGER",
     "time_path": "REAL",
+    "stop": "TEXT",
 }
 """Columns of ``runs`` added later, as :data:`ADDED_ATTEMPT_COLUMNS`: ``numerics`` is the
 key of the numeric environment of the worker that computed the run
@@ -94,7 +98,8 @@ key of the numeric environment of the worker that computed the run
 because their folding path does not reach the flat state (N_path, 0 without the
 deployability check), ``final_deploys`` whether the final design's folding path reaches the
 flat state (1 or 0), ``time_path`` the seconds of tracing; NULL for runs of older
-versions."""
+versions. ``stop`` is the :class:`~rigidfold.generate.Stop` value (NULL for an error),
+filled for the runs of older versions when the database is opened for writing."""
 ADDED_COLUMNS = {"attempts": ADDED_ATTEMPT_COLUMNS, "runs": ADDED_RUN_COLUMNS}
 JSON_ATTEMPT_FIELDS = (
     "fixed_added",
@@ -155,16 +160,97 @@ ERROR_PREFIX = "error: "
 """Start of the ``status`` of a run that could not run (a configuration error)."""
 
 
-def run_stop(status: str) -> Stop | None:
-    """How a stored run ended, from its ``status``: a Stop, or None for "error: <message>".
-
-    The one place that interprets the column. Every rigidfold version has written there the
-    generator's ``stop_reason`` (the same words since the first) or "error: <message>", so
-    this reads databases of any version. Raises ValueError for any other text.
-    """
+def legacy_stop(status: str) -> Stop | None:
+    """How a run of a database written before the ``stop`` column ended, from its
+    ``status``: a Stop, or None for "error: <message>". Every rigidfold version has written
+    there the generator's ``stop_reason`` (:data:`rigidfold.generate.STOP_REASONS`, the
+    same words since the first) or "error: <message>". Raises RigidfoldError for any other
+    text."""
     if status.startswith(ERROR_PREFIX):
         return None
-    return Stop.from_reason(status)[0]
+    for stop, template in STOP_REASONS.items():
+        head, slot, tail = template.partition("{}")
+        fits = status.startswith(head) and status.endswith(tail)
+        if fits and (len(status) >= len(head) + len(tail) if slot else status == template):
+            return stop
+    raise RigidfoldError(f"{status!r} is not the stop reason of a generation run")
+
+
+@dataclass(frozen=True)
+class RunRow:
+    """One stored run (a row of ``runs``).
+
+    study, seed, pattern, criterion, symmetric : its :class:`Key`; stop : how it ended
+    (None: it could not run, ``status`` then "error: <message>"); status : the words; the
+    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, the final
+    design's ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9
+    figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the
+    times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
+    ``numerics``); a figure the run (or its version) did not record is None.
+    """
+
+    study: str
+    seed: int
+    pattern: str
+    criterion: str
+    symmetric: bool
+    stop: Stop | None
+    status: str
+    n_reduce: int | None = None
+    n_lock: int | None = None
+    n_exceed: int | None = None
+    mean_f: float | None = None
+    initial_dof: int | None = None
+    final_dof: int | None = None
+    n_solutions: int | None = None
+    n_solves: int | None = None
+    mean_d: float | None = None
+    mean_dl_mm: float | None = None
+    mean_drho_fix_deg: float | None = None
+    reached_plane: int | None = None
+    time_build: float | None = None
+    time_solve: float | None = None
+    time_analysis: float | None = None
+    time_selection: float | None = None
+    time_develop: float | None = None
+    time_deform: float | None = None
+    time_total: float | None = None
+    version: str = ""
+    worker: str | None = None
+    numerics: str | None = None
+    n_path: int | None = None
+    final_deploys: int | None = None
+    time_path: float | None = None
+
+    @property
+    def key(self) -> Key:
+        return Key(self.study, self.seed, self.pattern, self.criterion, bool(self.symmetric))
+
+    @property
+    def error(self) -> str | None:
+        """The message of a run that could not run, None for the others."""
+        return self.status.removeprefix(ERROR_PREFIX) if self.stop is None else None
+
+    @classmethod
+    def from_columns(cls, values: dict) -> RunRow:
+        """The row of the ``runs`` columns ``values`` (a column of a later version that the
+        database lacks: None; ``stop`` NULL in a database opened read-only that has not been
+        migrated: :func:`legacy_stop` of the status)."""
+        names = {f.name for f in fields(cls)}
+        known = {k: v for k, v in values.items() if k in names}
+        stop = known.pop("stop", None)
+        known["symmetric"] = bool(known["symmetric"])
+        return cls(stop=legacy_stop(known["status"]) if stop is None else Stop(stop), **known)
+
+
+def _stop_value(run: dict) -> str | None:
+    """The ``stop`` column of a run to add: its ``stop`` (a Stop value), or, for a row that
+    gives only the words of ``status``, the Stop they say (:func:`legacy_stop`)."""
+    stop = run.get("stop")
+    if stop is None:
+        legacy = legacy_stop(run["status"])
+        return None if legacy is None else legacy.value
+    return Stop(stop).value
 
 
 class StoreWriteError(RigidfoldError):
@@ -410,6 +496,7 @@ class Store:
                 for name, kind in added.items():
                     if name not in have:  # a database of an earlier version: new columns
                         self.db.execute(f"ALTER TABLE {table} ADD COLUMN {name} {kind}")
+            self._fill_stops()
             self._attempt_columns = self._columns("attempts")
             if config is not None:
                 self.db.execute(
@@ -426,6 +513,18 @@ class Store:
             self.db.commit()
         except sqlite3.Error as exc:
             raise RigidfoldError(f"cannot open study database {str(self.path)!r}: {exc}") from None
+
+    def _fill_stops(self) -> None:
+        """The ``stop`` of the runs stored before the column existed, from their words
+        (:func:`legacy_stop`); errors keep NULL."""
+        statuses = self.db.execute("SELECT DISTINCT status FROM runs WHERE stop IS NULL").fetchall()
+        for (status,) in statuses:
+            stop = legacy_stop(status)
+            if stop is not None:
+                self.db.execute(
+                    "UPDATE runs SET stop = ? WHERE stop IS NULL AND status = ?",
+                    (stop.value, status),
+                )
 
     def _check(self, con: sqlite3.Connection, config: dict | None = None) -> None:
         """Refuse, reading ``con`` only, a damaged SQLite file, one without the tables and
@@ -549,7 +648,8 @@ class Store:
             added = self.db.execute(
                 f"INSERT OR IGNORE INTO runs ({', '.join(names)}) "
                 f"VALUES ({', '.join('?' * len(names))})",
-                key.row() + tuple(run.get(f) for f in RUN_FIELDS),
+                key.row()
+                + tuple(_stop_value(run) if f == "stop" else run.get(f) for f in RUN_FIELDS),
             ).rowcount
             if not added:
                 raise RigidfoldError(f"{str(self.path)!r} already holds the run {key.row()}")
@@ -611,8 +711,8 @@ class Store:
             r["argv"] = json.loads(r["argv"])
         return rows
 
-    def runs(self, study: str | None = None) -> list[dict]:
-        """Every run as a dict, ordered by key."""
+    def runs(self, study: str | None = None) -> list[RunRow]:
+        """Every run (:class:`RunRow`), ordered by key."""
         cur = self.db.execute(
             "SELECT * FROM runs"
             + (" WHERE study = ?" if study else "")
@@ -620,7 +720,7 @@ class Store:
             (study,) if study else (),
         )
         names = [d[0] for d in cur.description]
-        return [dict(zip(names, row, strict=True)) for row in cur]
+        return [RunRow.from_columns(dict(zip(names, row, strict=True))) for row in cur]
 
     def count_attempts(self) -> int:
         return int(self.db.execute("SELECT COUNT(*) FROM attempts").fetchone()[0])

@@ -9,6 +9,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections import Counter
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from rigidfold.generate import AttemptOutcome, Stop
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import TABLES_5_6, TABLES_7_8
 from rigidfold.study.runner import PRESETS
-from rigidfold.study.store import ERROR_PREFIX, Store, run_stop
+from rigidfold.study.store import ERROR_PREFIX, Store
 
 ORDER = tuple(sorted(CRITERIA, key=[c for _, c in TABLES_5_6].index))
 """The criteria in the order of the rows of the paper's Tables 5 and 6."""
@@ -25,7 +26,7 @@ PAPER_PATTERN = {"1p": "1"}
 LABEL = {"s": "S", "shat": "S-hat", "ss": "S^S", "random": "random"}
 
 
-def _mean_se(values: list[float]) -> tuple[float, float]:
+def _mean_se(values: Sequence[float | None]) -> tuple[float, float]:
     x = np.asarray([v for v in values if v is not None and math.isfinite(v)], dtype=float)
     if len(x) == 0:
         return math.nan, math.nan
@@ -36,17 +37,17 @@ def _mean_se(values: list[float]) -> tuple[float, float]:
 def tables_5_6(store: Store) -> list[dict]:
     """Per (pattern, criterion) of the Bezier study: n, mean and standard error of N_reduce,
     N_lock, N_exceed and F, the runs that reached the target, and the paper's values."""
-    runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
+    runs = [r for r in store.runs("bezier") if r.stop is not None]
     rows = []
-    for pattern in sorted({r["pattern"] for r in runs}):
-        for crit in [c for c in ORDER if any(r["criterion"] == c for r in runs)]:
-            sel = [r for r in runs if r["pattern"] == pattern and r["criterion"] == crit]
+    for pattern in sorted({r.pattern for r in runs}):
+        for crit in [c for c in ORDER if any(r.criterion == c for r in runs)]:
+            sel = [r for r in runs if r.pattern == pattern and r.criterion == crit]
             row = {"pattern": pattern, "criterion": crit, "n": len(sel)}
             for name in ("n_reduce", "n_lock", "n_exceed", "mean_f"):
-                row[name], row[name + "_se"] = _mean_se([r[name] for r in sel])
-            row["reached_target"] = sum(run_stop(r["status"]) is Stop.TARGET_REACHED for r in sel)
-            row["seeds"] = (min(r["seed"] for r in sel), max(r["seed"] for r in sel))
-            row["time_total_median"] = float(np.median([r["time_total"] for r in sel]))
+                row[name], row[name + "_se"] = _mean_se([getattr(r, name) for r in sel])
+            row["reached_target"] = sum(r.stop is Stop.TARGET_REACHED for r in sel)
+            row["seeds"] = (min(r.seed for r in sel), max(r.seed for r in sel))
+            row["time_total_median"] = float(np.median([r.time_total for r in sel]))
             row["paper"] = TABLES_5_6.get((PAPER_PATTERN.get(pattern, pattern), crit))
             rows.append(row)
     return rows
@@ -65,17 +66,21 @@ def paired_comparisons(store: Store) -> list[dict]:
     """
     from scipy.stats import wilcoxon
 
-    runs = [r for r in store.runs("bezier") if r["n_lock"] is not None]
-    by = {(r["pattern"], r["criterion"], r["seed"]): r["n_lock"] for r in runs}
+    by: dict[tuple[str, str, int], int] = {
+        (r.pattern, r.criterion, r.seed): r.n_lock
+        for r in store.runs("bezier")
+        if r.n_lock is not None
+    }
+    runs = {(p, c) for p, c, _ in by}
     out = []
-    for pattern in sorted({r["pattern"] for r in runs}):
+    for pattern in sorted({p for p, _ in runs}):
         for a, b in PAIRS:
             seeds = sorted(
                 seed for (p, c, seed) in by if p == pattern and c == a and (p, b, seed) in by
             )
             if len(seeds) < 2:
                 continue
-            d = np.array([by[(pattern, a, k)] - by[(pattern, b, k)] for k in seeds], dtype=float)
+            d = np.array([float(by[(pattern, a, k)]) - float(by[(pattern, b, k)]) for k in seeds])
             p_value = 1.0 if not d.any() else float(wilcoxon(d).pvalue)
             mean, se = _mean_se(d.tolist())
             out.append(
@@ -100,20 +105,18 @@ def costs(store: Store) -> list[dict]:
     solve, and run times (median and total CPU seconds in the workers)."""
     rows = []
     runs = store.runs()
-    groups = sorted({(r["study"], r["pattern"], r["criterion"]) for r in runs})
+    groups = sorted({(r.study, r.pattern, r.criterion) for r in runs})
     for study, pattern, crit in groups:
-        sel = [
-            r for r in runs if (r["study"], r["pattern"], r["criterion"]) == (study, pattern, crit)
-        ]
+        sel = [r for r in runs if (r.study, r.pattern, r.criterion) == (study, pattern, crit)]
         its = store.solve_means(study, pattern, crit)
-        t = [r["time_total"] for r in sel if r["time_total"] is not None]
+        t = [r.time_total for r in sel if r.time_total is not None]
         rows.append(
             {
                 "study": study,
                 "pattern": pattern,
                 "criterion": crit,
                 "runs": len(sel),
-                "solves_per_run": float(np.mean([r["n_solves"] or 0 for r in sel])),
+                "solves_per_run": float(np.mean([r.n_solves or 0 for r in sel])),
                 "iterations_per_solve": its[0],
                 "solve_s": its[1],
                 "median_run_s": float(np.median(t)) if t else math.nan,
@@ -148,9 +151,7 @@ def locks_by_stage(store: Store) -> list[dict]:
                     if stage >= lo and (hi is None or stage <= hi):
                         c["locks"][k] += 1
     ended = Counter(
-        (r["pattern"], r["criterion"])
-        for r in store.runs("bezier")
-        if run_stop(r["status"]) is Stop.NO_CANDIDATE
+        (r.pattern, r.criterion) for r in store.runs("bezier") if r.stop is Stop.NO_CANDIDATE
     )
     return _per_run_rows(
         counts,
@@ -214,7 +215,7 @@ def criterion_summary(store: Store) -> list[dict]:
     flat state, candidates skipped by the look-ahead and fixes of a group of nearly flat
     creases (``Attempt.carried``) per run (None where the database does not store them), and
     the mean selection and total seconds per run."""
-    runs = [r for r in store.runs("bezier") if run_stop(r["status"]) is not None]
+    runs = [r for r in store.runs("bezier") if r.stop is not None]
     skipped: dict[tuple[str, str], list[int]] = {}
     carried: dict[tuple[str, str], list[int]] = {}
     for group, _, attempts in store.attempt_runs("bezier", ("skipped", "carried")):
@@ -225,20 +226,20 @@ def criterion_summary(store: Store) -> list[dict]:
         if fixes:
             carried.setdefault(group, []).append(sum(fixes))
     rows = []
-    for pattern, crit in sorted({(r["pattern"], r["criterion"]) for r in runs}):
-        sel = [r for r in runs if (r["pattern"], r["criterion"]) == (pattern, crit)]
+    for pattern, crit in sorted({(r.pattern, r.criterion) for r in runs}):
+        sel = [r for r in runs if (r.pattern, r.criterion) == (pattern, crit)]
         row: dict = {"pattern": pattern, "criterion": crit, "runs": len(sel)}
         for name in ("n_reduce", "n_lock", "n_exceed", "mean_f", "n_solves"):
-            row[name] = _mean_se([r[name] for r in sel])[0]
+            row[name] = _mean_se([getattr(r, name) for r in sel])[0]
         for name, counts in (("skipped_per_run", skipped), ("groups_per_run", carried)):
             done = counts.get((pattern, crit))
             row[name] = float(np.sum(done)) / len(sel) if done else None
-        paths = [r["n_path"] for r in sel if r.get("n_path") is not None]
+        paths = [r.n_path for r in sel if r.n_path is not None]
         row["n_path"] = _mean_se(paths)[0] if paths else None
-        deploys = [r["final_deploys"] for r in sel if r.get("final_deploys") is not None]
+        deploys = [r.final_deploys for r in sel if r.final_deploys is not None]
         row["deploys_share"] = float(np.mean(deploys)) if deploys else None
-        row["selection_s"] = _mean_se([r["time_selection"] for r in sel])[0]
-        row["run_s"] = _mean_se([r["time_total"] for r in sel])[0]
+        row["selection_s"] = _mean_se([r.time_selection for r in sel])[0]
+        row["run_s"] = _mean_se([r.time_total for r in sel])[0]
         rows.append(row)
     return rows
 
@@ -331,12 +332,12 @@ def failed_runs(store: Store) -> list[dict]:
     seed, pattern, criterion, symmetric (bool) and ``error`` (the message)."""
     return [
         {
-            **{k: r[k] for k in ("study", "seed", "pattern", "criterion")},
-            "symmetric": bool(r["symmetric"]),
-            "error": r["status"].removeprefix(ERROR_PREFIX),
+            **{k: getattr(r, k) for k in ("study", "seed", "pattern", "criterion")},
+            "symmetric": bool(r.symmetric),
+            "error": r.status.removeprefix(ERROR_PREFIX),
         }
         for r in store.runs()
-        if run_stop(r["status"]) is None
+        if r.stop is None
     ]
 
 
@@ -344,26 +345,26 @@ def tables_7_8(store: Store) -> list[dict]:
     """Per preset run (dome / hp, with / without symmetry): the rows of Tables 7 and 8."""
     out = []
     for r in store.runs():
-        if r["study"] not in PRESETS:
+        if r.study not in PRESETS:
             continue
         values = (
-            r["n_lock"],
-            r["n_exceed"],
-            r["final_dof"],
-            r["n_solves"],
-            r["mean_f"],
-            r["mean_d"],
-            r["mean_dl_mm"],
-            r["mean_drho_fix_deg"],
+            r.n_lock,
+            r.n_exceed,
+            r.final_dof,
+            r.n_solves,
+            r.mean_f,
+            r.mean_d,
+            r.mean_dl_mm,
+            r.mean_drho_fix_deg,
         )
         out.append(
             {
-                "preset": r["study"],
-                "symmetric": bool(r["symmetric"]),
+                "preset": r.study,
+                "symmetric": bool(r.symmetric),
                 "values": values,
-                "status": r["status"],
-                "time_total": r["time_total"],
-                "paper": TABLES_7_8.get((r["study"], bool(r["symmetric"]))),
+                "status": r.status,
+                "time_total": r.time_total,
+                "paper": TABLES_7_8.get((r.study, bool(r.symmetric))),
             }
         )
     return out
