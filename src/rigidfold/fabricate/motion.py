@@ -14,7 +14,6 @@ least-squares fit (Kabsch) of the panel's vertices in the design onto theirs in 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,10 +21,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.exports import Design
 from rigidfold.fabricate.panels import Panels
-from rigidfold.io import read_fold
-
-_PERCENT = re.compile(r"([0-9.]+)% folded")
-"""The fraction folded in a motion frame's title (:func:`rigidfold.io.motion_frames`)."""
+from rigidfold.io import motion_fraction, read_fold
 
 MAX_FRAMES = 4000
 """Most frames a traced motion is sampled at (a motion that needs more is checked at these)."""
@@ -147,8 +143,7 @@ def file_frames(design: Design, *, up: str = "z", settings: Settings = DEFAULTS)
         if shape.n_vertices != pattern.n_vertices or not np.array_equal(shape.faces, pattern.faces):
             continue
         frames.append(shape.coords)
-        share = _PERCENT.search(str(frame.get("frame_title", "")))
-        fraction.append(float(share.group(1)) / 100 if share else math.nan)
+        fraction.append(motion_fraction(frame))
     if len(frames) < 2:
         return None
     s = np.asarray(fraction)

@@ -354,7 +354,7 @@ def read_frames(raw: dict, n_vertices: int, where: str) -> DesignFrames:
             diagram = _frame_coords(frame, n_vertices, 2, f"{where}: file_frames[{k}]")
         elif "foldedForm" in classes:
             motion.append(_frame_coords(frame, n_vertices, 3, f"{where}: file_frames[{k}]"))
-            fraction.append(_fraction(frame))
+            fraction.append(motion_fraction(frame))
     if np.isnan(fraction).any():  # frames of another writer: evenly spaced
         fraction = np.linspace(0.0, 1.0, len(motion)).tolist()
     return DesignFrames(
@@ -364,8 +364,9 @@ def read_frames(raw: dict, n_vertices: int, where: str) -> DesignFrames:
     )
 
 
-def _fraction(frame: dict) -> float:
-    """A motion frame's fraction folded; NaN when it has none."""
+def motion_fraction(frame: dict) -> float:
+    """A motion frame's fraction folded (:data:`FRACTION_KEY`; files written before it: the
+    fraction in its title); NaN when it has none."""
     value = frame.get(FRACTION_KEY)
     if isinstance(value, int | float) and not isinstance(value, bool) and 0 <= value <= 1:
         return float(value)
