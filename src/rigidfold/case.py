@@ -218,7 +218,7 @@ def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:
     return mask
 
 
-def shape_report(case: Case, result: OptimizeResult, build_time: float) -> dict:
+def shape_summary(case: Case, result: OptimizeResult, build_time: float) -> dict:
     """summary.json content: solver figures, sizes and shape measures of a solution."""
     shape = result.pattern
     dz = case.deviation(shape.coords)

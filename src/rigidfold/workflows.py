@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import Case, parse_fixed, shape_report
+from rigidfold.case import Case, parse_fixed, shape_summary
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.check import Verification, verify
 from rigidfold.develop import DevelopStatus
@@ -273,7 +273,7 @@ def optimize_case(
     mask = parse_fixed(fixed, case.pattern)
     problem = case.problem(build_ipopt=solver == "ipopt")
     result = problem.solve(fixed=mask, solver=solver)
-    report = shape_report(case, result, problem.build_time)
+    report = shape_summary(case, result, problem.build_time)
     fold = write_fold(
         out_dir / "solution.fold",
         result.pattern,
