@@ -57,7 +57,7 @@ from rigidfold.io import (
 )
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
-from rigidfold.reporting import page, render_figures, view_figure
+from rigidfold.reporting import page, render_figures, thick_figure, view_figure
 from rigidfold.run import RunData, RunWriter, clear_earlier_run, load_run, write_checked_shape
 from rigidfold.structure import (
     Material,
@@ -428,7 +428,9 @@ def report_run(directory: str | os.PathLike) -> RunReport:
     figure_dir = prepare_output_dir(run.directory / "figures")
     figures = render_figures(run)
     view = None if run.final is None else view_figure(run.final, run.surface)
-    text = page(run, figures, view)
+    thick, note = run.thick_panels()
+    solids = None if thick is None or run.final is None else thick_figure(thick, run.final)
+    text = page(run, figures, view, solids, note)
     written = tuple(atomic_write(figure_dir / f.name, f.png) for f in figures)
     html = atomic_write(run.directory / "report.html", text)
     return RunReport(run, html, written, time.perf_counter() - t0)
