@@ -12,7 +12,7 @@ from the case's metadata where it can. Anything that is not a generate run is a 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +48,7 @@ class SolutionFile:
     large-deformation load steps (dicts of ``load_factor``, ``mean_dl_mm``, ``max_dl_mm``,
     ``max_drho_fix_deg``), empty when Step 9 did not run. panels : (F,) int64, the panel
     (facets joined by fixed creases, numbered as the exports and the thick panels number
-    them) of each face.
+    them) of each face (empty where not known).
     """
 
     name: str
@@ -63,7 +63,7 @@ class SolutionFile:
     motion: np.ndarray
     fraction: np.ndarray
     history: list[dict]
-    panels: np.ndarray
+    panels: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     def panel_vertices(self) -> list[np.ndarray]:
         """The vertices ((k,) int, sorted) of each panel."""
