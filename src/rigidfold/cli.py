@@ -939,11 +939,18 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     if writer.final_verdicts is not None:
         print(f"final design: {writer.final_verdicts}")
     if writer.fabrication is not None:
-        print(one_line(f"thick panels ({writer.out / 'final' / 'thick'}): "
-                       f"{writer.fabrication.last_line()}"))
+        print(
+            one_line(
+                f"thick panels ({writer.out / 'final' / 'thick'}): {writer.fabrication.last_line()}"
+            )
+        )
     if writer.structure is not None:
-        print(one_line(f"structure ({writer.out / 'final' / 'structure'}): "
-                       f"{writer.structure.status}: {writer.structure.message}"))
+        print(
+            one_line(
+                f"structure ({writer.out / 'final' / 'structure'}): "
+                f"{writer.structure.status}: {writer.structure.message}"
+            )
+        )
     if not args.no_report:
         print(f"report: {writer.out / 'report.html'}")
     verdict = writer.verdict

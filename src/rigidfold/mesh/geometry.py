@@ -120,9 +120,7 @@ def best_fit(
     return np.einsum("kvi,kij->kvj", frames - mean, rotation) + centre
 
 
-def rigid_motions(
-    coords: np.ndarray, frames: np.ndarray, groups
-) -> tuple[np.ndarray, np.ndarray]:
+def rigid_motions(coords: np.ndarray, frames: np.ndarray, groups) -> tuple[np.ndarray, np.ndarray]:
     """(rotations (K, G, 3, 3), translations (K, G, 3)): the rigid motion of each group of
     vertices from ``coords`` onto each of ``frames``, by least squares over its vertices
     (Kabsch), so that group g at frame k holds ``rotations[k, g] @ x + translations[k, g]``

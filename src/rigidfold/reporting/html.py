@@ -255,7 +255,11 @@ def _thick(run: RunData, view: dict | None, note: str) -> list[str]:
     pair = closest.get("panels")
     what = (
         f"panels {pair[0]} and {pair[1]} (red) come closest"
-        + (f", at {100 * closest['fraction']:.0f}% folded" if closest.get("fraction") is not None else "")
+        + (
+            f", at {100 * closest['fraction']:.0f}% folded"
+            if closest.get("fraction") is not None
+            else ""
+        )
         if pair
         else "no two panels that are not neighbours come near each other"
     )
@@ -332,7 +336,9 @@ def _structure(run: RunData) -> list[str]:
 
 
 def _mm(metres) -> float | None:
-    return metres * 1e3 if isinstance(metres, int | float) and not isinstance(metres, bool) else None
+    return (
+        metres * 1e3 if isinstance(metres, int | float) and not isinstance(metres, bool) else None
+    )
 
 
 def _figure(figure: Figure) -> str:

@@ -195,9 +195,8 @@ def thick_figure(thick: ThickPanels, design: SolutionFile) -> dict:
         points = np.vstack([points, placed[chosen].reshape(-1, 3)])
     layout = _layout(points, design, frames)
     t = thick.figures.get("thickness_m")
-    layout["title"]["text"] = (
-        f"{html.escape(design.name, quote=False)}: thick panels"
-        + (f" {1e3 * t:g} mm" if isinstance(t, int | float) else "")
+    layout["title"]["text"] = f"{html.escape(design.name, quote=False)}: thick panels" + (
+        f" {1e3 * t:g} mm" if isinstance(t, int | float) else ""
     )
     return {"data": data, "layout": layout, "frames": frames}
 

@@ -95,7 +95,9 @@ def run_verdict(
         final_record = records[k]
         for stage in final_record.failed_stages():
             detail = final_record.detail(stage)
-            short.append(f"{stage.message} for the final design" + (f" ({detail})" if detail else ""))
+            short.append(
+                f"{stage.message} for the final design" + (f" ({detail})" if detail else "")
+            )
     earlier: dict[Stage, list[str]] = {stage: [] for stage in Stage}
     for i, (record, path) in enumerate(zip(records, files, strict=True)):
         if i != (k % len(records)):

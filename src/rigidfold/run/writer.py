@@ -34,11 +34,11 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
-from rigidfold.structure import StructureCheck
 from rigidfold.run.built import check_built_options, structure_check, thick_panels
 from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
 from rigidfold.run.schema import SolutionRecord, aggregate
 from rigidfold.run.verdict import RunVerdict, run_verdict
+from rigidfold.structure import StructureCheck
 from rigidfold.surfaces import SplineSurface
 
 
@@ -213,9 +213,9 @@ class RunWriter:
             deployability=None if solution.path is None else solution.path.to_dict(),
         )
         self.developments[solution.step] = check.development.coords2d
-        motion = _traced_motion(check)
-        if motion is not None:
-            self.motions[solution.step] = motion
+        traced = _traced_motion(check)
+        if traced is not None:
+            self.motions[solution.step] = traced
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
             path,
