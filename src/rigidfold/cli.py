@@ -184,7 +184,8 @@ def build_parser() -> argparse.ArgumentParser:
         "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes; the "
         "last line names the final design (the last solution). Exit code 0 when the target DOF "
         "was reached and every check that ran on the final design (development diagram, "
-        "folding motion, large deformation) passed, 1 when the run fell short (the files are "
+        "folding motion, large deformation; thick panels and structure with --thickness and "
+        "--structure) passed, 1 when the run fell short (the files are "
         "written all the same; the last line says what fell short, and notes the checks that "
         "failed on earlier solutions), 2 on bad input, 130 when interrupted.",
     )
