@@ -30,7 +30,7 @@ from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.selection import CRITERIA
-from rigidfold.structure import presets_help
+from rigidfold.structure import MATERIALS, presets_help
 from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACE_FORMS
 
@@ -184,7 +184,8 @@ def build_parser() -> argparse.ArgumentParser:
         "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes; the "
         "last line names the final design (the last solution). Exit code 0 when the target DOF "
         "was reached and every check that ran on the final design (development diagram, "
-        "folding motion, large deformation) passed, 1 when the run fell short (the files are "
+        "folding motion, large deformation; thick panels and structure with --thickness and "
+        "--structure) passed, 1 when the run fell short (the files are "
         "written all the same; the last line says what fell short, and notes the checks that "
         "failed on earlier solutions), 2 on bad input, 130 when interrupted.",
     )
@@ -237,6 +238,59 @@ def build_parser() -> argparse.ArgumentParser:
         help="which solutions get the folding motion and the large-deformation check: the "
         "final design only, or all (default: %(default)s; the development diagram is drawn "
         "for every solution)",
+    )
+    gen.add_argument(
+        "--thickness",
+        type=_length("thickness"),
+        default=GENERATE_DEFAULTS.thickness,
+        metavar="T",
+        help="make the final design's thick panels of this thickness (metres, or 18mm, "
+        "1.8cm) as rigidfold fabricate does, from the motion the run traced: DIR/final/thick/; "
+        "the run falls short when they collide over the deployment or are trimmed away. Also "
+        "the panels' thickness of --structure (default: no thick panels; --structure alone: "
+        f"{DEFAULTS.structure_thickness:g})",
+    )
+    gen.add_argument(
+        "--side",
+        default=GENERATE_DEFAULTS.side,
+        choices=SIDES,
+        help="the side of the design surface the thick panels lie on (default: %(default)s)",
+    )
+    gen.add_argument(
+        "--structure",
+        action="store_true",
+        help="check the final design as a structure as rigidfold structure does (supports, "
+        "self-weight and --load in OpenSees, the deflection limit): DIR/final/structure/; the "
+        "run falls short when the check fails",
+    )
+    gen.add_argument(
+        "--material",
+        default=GENERATE_DEFAULTS.material,
+        metavar="NAME|E,nu,density",
+        help=f"the panels' material for --structure and the thick panels' masses: a preset "
+        f"({', '.join(MATERIALS)}) or E,nu,density in SI units (default: %(default)s)",
+    )
+    gen.add_argument(
+        "--supports",
+        default=GENERATE_DEFAULTS.supports,
+        metavar="V,V,...|auto",
+        help="--structure: pinned vertices, or auto: the fewest boundary vertices that make "
+        "the mechanism first-order rigid (default: %(default)s)",
+    )
+    gen.add_argument(
+        "--load",
+        action="append",
+        default=None,
+        metavar="KIND=VALUE",
+        help="--structure: a load besides self-weight, repeatable: uniform=KPA (snow), "
+        "pressure=KPA (wind), point=V:FX,FY,FZ (newtons)",
+    )
+    gen.add_argument(
+        "--limit",
+        default=f"L/{GENERATE_DEFAULTS.limit:g}",
+        metavar="L/N",
+        help="--structure: the largest displacement may be at most the span over N (default: "
+        "%(default)s)",
     )
     gen.add_argument(
         "--quiet", action="store_true", help="no progress bar (the result lines are printed)"
@@ -847,6 +901,13 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         deploy_check=not args.no_deploy_check,
         deform=not args.no_deform,
         check=args.check,
+        thickness=args.thickness,
+        side=args.side,
+        structure=args.structure,
+        material=args.material,
+        supports=args.supports,
+        loads=tuple(args.load or ()),
+        limit=args.limit,
     )
     writer = RunWriter(args.out, _case(args), options, overwrite=args.overwrite)
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
@@ -878,6 +939,19 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         print(f"exported the final design to {writer.out / 'final'}: {names}")
     if writer.final_verdicts is not None:
         print(f"final design: {writer.final_verdicts}")
+    if writer.fabrication is not None:
+        print(
+            one_line(
+                f"thick panels ({writer.out / 'final' / 'thick'}): {writer.fabrication.last_line()}"
+            )
+        )
+    if writer.structure is not None:
+        print(
+            one_line(
+                f"structure ({writer.out / 'final' / 'structure'}): "
+                f"{writer.structure.status}: {writer.structure.message}"
+            )
+        )
     if not args.no_report:
         print(f"report: {writer.out / 'report.html'}")
     verdict = writer.verdict

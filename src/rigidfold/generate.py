@@ -41,7 +41,15 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.config import CHECKS, DEFAULT_SEED, Settings, check_seed, one_blas_thread
+from rigidfold.config import (
+    CHECKS,
+    DEFAULT_SEED,
+    DEFAULTS,
+    SIDES,
+    Settings,
+    check_seed,
+    one_blas_thread,
+)
 from rigidfold.errors import RigidfoldError
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.path import FoldingPath, trace_path
@@ -58,6 +66,7 @@ from rigidfold.selection import (
     score_creases,
 )
 from rigidfold.status import Outcome
+from rigidfold.structure import parse_limit, parse_load, parse_material
 
 
 class AttemptOutcome(Outcome):
@@ -295,6 +304,18 @@ class GenerateOptions:
     deform : run Step 9 (the large-deformation check) on the checked solutions.
     check : one of ``CHECKS``: the folding motion and Step 9 on the final design only
         ("final") or on every solution ("all").
+    thickness : metres, or None (the default): thick panels of this thickness on ``side``
+        (one of ``SIDES``) are made of the final design and checked over its folding motion
+        (:func:`rigidfold.fabricate.fabricate_panels`); with ``structure``, also the panels'
+        thickness (None: ``Settings.structure_thickness``).
+    structure : check the final design as a structure (:mod:`rigidfold.structure`): on
+        ``supports`` (``"auto"`` or ``"V,V,..."`` pinned vertices) under self-weight and
+        ``loads`` (``--load`` texts), its largest displacement within span / ``limit``.
+    material : the panels' material (a preset name or ``"E,nu,density"``), for the
+        structure and for the masses of the thick panels.
+
+    Studies do not store the options of the thick panels and the structure
+    (:meth:`rigidfold.study.StudyConfig.as_dict`): they run neither.
     """
 
     criterion: str = CRITERIA[0]
@@ -306,6 +327,13 @@ class GenerateOptions:
     support_face: int | None = None
     deform: bool = True
     check: str = CHECKS[0]
+    thickness: float | None = None
+    side: str = DEFAULTS.fabricate_side
+    structure: bool = False
+    material: str = DEFAULTS.structure_material
+    supports: str = "auto"
+    loads: tuple[str, ...] = ()
+    limit: float = DEFAULTS.structure_limit
 
     def __post_init__(self) -> None:
         if self.criterion not in CRITERIA:
@@ -325,6 +353,39 @@ class GenerateOptions:
         if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
             raise RigidfoldError(f"support face must be a face index, got {face!r}")
         check_seed(self.seed)
+        self._check_panels()
+
+    def _check_panels(self) -> None:
+        """Validate the options of the thick panels and the structure (ValueError naming
+        what was received); ``loads`` and ``limit`` kept as a tuple and a float."""
+        t = self.thickness
+        if t is not None and (
+            isinstance(t, bool)
+            or not isinstance(t, int | float | np.number)
+            or not (np.isfinite(t) and t > 0)
+        ):
+            raise RigidfoldError(f"thickness must be a positive number of metres, got {t!r}")
+        if t is not None:
+            object.__setattr__(self, "thickness", float(t))
+        if self.side not in SIDES:
+            raise RigidfoldError(f"side must be one of {', '.join(SIDES)}, got {self.side!r}")
+        if not isinstance(self.structure, bool):
+            raise RigidfoldError(f"structure must be true or false, got {self.structure!r}")
+        parse_material(self.material)
+        supports = self.supports
+        if not isinstance(supports, str) or not (
+            supports.strip().lower() == "auto"
+            or all(p.strip().isdigit() for p in supports.split(","))
+        ):
+            raise RigidfoldError(
+                f"supports must be auto or comma-separated vertex indices, got {supports!r}"
+            )
+        if isinstance(self.loads, str):
+            raise RigidfoldError(f"loads must be a list of load texts, got {self.loads!r}")
+        object.__setattr__(self, "loads", tuple(self.loads))
+        for text in self.loads:
+            parse_load(text)
+        object.__setattr__(self, "limit", parse_limit(self.limit))
 
     def replace(self, **changes) -> GenerateOptions:
         """These options with ``changes`` (field names), validated; unknown names are a

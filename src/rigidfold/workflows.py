@@ -57,24 +57,19 @@ from rigidfold.io import (
 )
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
-from rigidfold.reporting import page, render_figures, view_figure
+from rigidfold.reporting import page, render_figures, thick_figure, view_figure
 from rigidfold.run import RunData, RunWriter, clear_earlier_run, load_run, write_checked_shape
 from rigidfold.structure import (
     Material,
     StructureCheck,
     StructureStatus,
-    Supports,
-    auto_supports,
     check_inputs,
     check_structure,
-    check_supports,
-    parse_indices,
     parse_limit,
     parse_load,
     parse_material,
-    support_candidates,
 )
-from rigidfold.structure.figure import deflection_png
+from rigidfold.structure.design import STRUCTURE_FILES, design_supports, write_structure
 
 # ------------------------------------------------------------------------------ analyze
 FLAT_NOTE = (
@@ -433,17 +428,15 @@ def report_run(directory: str | os.PathLike) -> RunReport:
     figure_dir = prepare_output_dir(run.directory / "figures")
     figures = render_figures(run)
     view = None if run.final is None else view_figure(run.final, run.surface)
-    text = page(run, figures, view)
+    thick, note = run.thick_panels()
+    solids = None if thick is None or run.final is None else thick_figure(thick, run.final)
+    text = page(run, figures, view, solids, note)
     written = tuple(atomic_write(figure_dir / f.name, f.png) for f in figures)
     html = atomic_write(run.directory / "report.html", text)
     return RunReport(run, html, written, time.perf_counter() - t0)
 
 
 # ----------------------------------------------------------------------------- structure
-STRUCTURE_FILES = ("structure.json", "structure.png")
-"""The files ``structure`` writes into its directory."""
-
-
 @dataclass(frozen=True, eq=False)
 class StructureRun:
     """The structure check of a FOLD design and the files written.
@@ -505,18 +498,14 @@ def structure(
     data = read_fold(path, up=up, settings=settings)
     pattern = data.pattern
     check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=parsed)
-    V = pattern.n_vertices
-    clamp = parse_indices(clamped, V, "clamped vertices")
-    held = parse_indices(actuators, pattern.n_edges, "actuators")
-    auto = supports.strip().lower() == "auto"
-    if auto:
-        pool = support_candidates(pattern, candidates, settings)
-        rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
-    else:
-        pins = parse_indices(supports, V, "supports")
-        if not len(pins) and not len(clamp):
-            raise RigidfoldError("give --supports V,V,... or auto, or --clamped vertices")
-        rigidity = check_supports(pattern, Supports(pins, clamp, held), settings)
+    rigidity, auto = design_supports(
+        pattern,
+        supports,
+        candidates=candidates,
+        clamped=clamped,
+        actuators=actuators,
+        settings=settings,
+    )
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
     check = check_structure(
@@ -533,10 +522,7 @@ def structure(
         auto=auto,
         settings=settings,
     )
-    written = [write_json(out_dir / "structure.json", {"file": str(path), **check.to_dict()})]
-    png = deflection_png(check)
-    if png is not None:
-        written.append(atomic_write(out_dir / "structure.png", png))
+    written = write_structure(check, out_dir, str(path))
     return StructureRun(str(path), check, tuple(written))
 
 
@@ -590,8 +576,7 @@ def fabricate_file(
     files are written whatever the verdict."""
     import math as _math
 
-    from rigidfold.fabricate.cutsheets import sheets_summary, write_cut_sheets
-    from rigidfold.fabricate.files import SOLID_FILES, write_solid_files
+    from rigidfold.fabricate.files import FABRICATE_JSON, SOLID_FILES, write_fabrication
 
     side = settings.fabricate_side if side is None else side
     if side not in ("bottom", "top"):
@@ -608,7 +593,7 @@ def fabricate_file(
     width, height = sheet or (settings.fabricate_sheet_width, settings.fabricate_sheet_height)
     stem = Path(path).stem
     label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
-    names = [t.format(stem) for t in SOLID_FILES] + [f"{stem}_fabricate.json"]
+    names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)]
     refuse_replacing_inputs([path], [Path(out) / n for n in names])
     out_dir = prepare_output_dir(out)
     design = read_design(path, up=up, settings=settings)
@@ -625,20 +610,14 @@ def fabricate_file(
         settings=settings,
     )
     title = f"{label}: thick panels {thickness * 1e3:g} mm, {side} side"
-    written = write_solid_files(fab, out_dir, stem, title=title)
-    sheets_written, sheets = write_cut_sheets(
+    written, summary = write_fabrication(
         fab,
         out_dir,
         stem,
-        width=width,
-        height=height,
+        source=str(path),
+        title=title,
+        label=label,
+        sheet=(width, height),
         gap=settings.fabricate_sheet_gap,
-        title=label,
     )
-    written += sheets_written
-    summary = sheets_summary(sheets)
-    summary["stock_mm"] = [width, height]
-    result = FabricateOutput(str(path), design, fab, summary, tuple(written))
-    report = result.to_dict()
-    written.append(write_json(out_dir / f"{stem}_fabricate.json", report))
     return FabricateOutput(str(path), design, fab, summary, tuple(written))

@@ -257,6 +257,46 @@ def write_solid_files(fab: Fabrication, out: Path, name: str, *, title: str = ""
     ]
 
 
+def write_fabrication(
+    fab: Fabrication,
+    out: Path,
+    name: str,
+    *,
+    source: str,
+    title: str = "",
+    label: str = "",
+    sheet: tuple[float, float],
+    gap: float,
+) -> tuple[list[Path], dict]:
+    """Every file of thick panels into ``out`` (which exists): the solids and schedules
+    (:func:`write_solid_files`), the cut sheets nested onto ``sheet`` (width, height) mm stock
+    ``gap`` mm apart (:func:`rigidfold.fabricate.cutsheets.write_cut_sheets`, titled
+    ``label``), and ``NAME_fabricate.json``: ``{"file": source, **fab.to_dict(),
+    "cut_sheets": ..., "written": [the other files]}``. Returns (the files in the order
+    written, the cut sheets' summary)."""
+    from rigidfold.fabricate.cutsheets import sheets_summary, write_cut_sheets
+    from rigidfold.io import write_json
+
+    width, height = sheet
+    written = write_solid_files(fab, out, name, title=title)
+    more, sheets = write_cut_sheets(
+        fab, out, name, width=width, height=height, gap=gap, title=label
+    )
+    written += more
+    summary = sheets_summary(sheets) | {"stock_mm": [width, height]}
+    report = {
+        "file": source,
+        **fab.to_dict(),
+        "cut_sheets": summary,
+        "written": [str(p) for p in written],
+    }
+    written.append(write_json(out / FABRICATE_JSON.format(name), report))
+    return written, summary
+
+
+FABRICATE_JSON = "{}_fabricate.json"
+"""The summary file :func:`write_fabrication` writes, ``{}`` for the design's name."""
+
 SOLID_FILES = (
     "{}_solids.glb",
     "{}_solids.stl",

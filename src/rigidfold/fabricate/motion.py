@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,10 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.exports import Design
 from rigidfold.fabricate.panels import Panels
 from rigidfold.io import motion_fraction, read_fold
+from rigidfold.mesh.geometry import rigid_motions
+
+if TYPE_CHECKING:
+    from rigidfold.mechanism.path import FoldingPath
 
 MAX_FRAMES = 4000
 """Most frames a traced motion is sampled at (a motion that needs more is checked at these)."""
@@ -74,25 +79,9 @@ class PanelMotion:
 
 def fit_panels(panels: Panels, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(rotations (K, P, 3, 3), translations (K, P, 3)): each panel's rigid motion from the
-    design onto each of ``frames`` (K, V, 3), by least squares over its vertices (Kabsch)."""
-    frames = np.asarray(frames, dtype=np.float64)
-    design = panels.pattern.coords
-    n_frames = len(frames)
-    rotations = np.empty((n_frames, panels.n, 3, 3))
-    translations = np.empty((n_frames, panels.n, 3))
-    for k, verts in enumerate(panels.vertices):
-        src = design[verts]
-        dst = frames[:, verts]
-        c_src = src.mean(axis=0)
-        c_dst = dst.mean(axis=1)
-        h = np.einsum("vi,kvj->kij", src - c_src, dst - c_dst[:, None])
-        u, _, vt = np.linalg.svd(h)
-        d = np.sign(np.linalg.det(np.einsum("kij,kjl->kil", u, vt)))
-        u[:, :, 2] *= d[:, None]
-        r = np.einsum("kij,kjl->kli", u, vt)  # R = (U V^T)^T maps src onto dst
-        rotations[:, k] = r
-        translations[:, k] = c_dst - np.einsum("kij,j->ki", r, c_src)
-    return rotations, translations
+    design onto each of ``frames`` (K, V, 3), by least squares over its vertices (Kabsch:
+    :func:`rigidfold.mesh.geometry.rigid_motions`)."""
+    return rigid_motions(panels.pattern.coords, frames, panels.vertices)
 
 
 def closing_angles(panels: Panels, rotations: np.ndarray) -> np.ndarray:
@@ -156,23 +145,34 @@ def design_motion(
     panels: Panels,
     design: Design | None = None,
     *,
+    frames: tuple[np.ndarray, np.ndarray] | None = None,
+    path: FoldingPath | None = None,
     up: str = "z",
     settings: Settings = DEFAULTS,
 ) -> tuple[PanelMotion | None, str]:
     """(motion, message): the folding motion of ``panels``' design (see the module's text),
     or (None, why) when it has no motion from flat: its file carries none fine enough and
-    its folding path does not reach the flat state."""
+    its folding path does not reach the flat state.
+
+    frames : (frames (K, V, 3), fraction (K,)) of a motion already at hand (a run's traced
+    motion), used instead of the design file's; path : the design's folding path already
+    traced (:func:`rigidfold.mechanism.path.trace_path`), sampled instead of tracing it
+    again when the frames are too coarse."""
     from rigidfold.mechanism.path import trace_path
 
     step = settings.fabricate_frame_step
-    carried = None if design is None else file_frames(design, up=up, settings=settings)
+    carried = frames
+    where = "the traced motion's"
+    if carried is None and design is not None:
+        carried, where = file_frames(design, up=up, settings=settings), "the design file's"
     if carried is not None:
-        frames, fraction = carried
-        motion = panel_motion(panels, frames, fraction, f"the design file's {len(frames)} frames")
+        shapes, fraction = carried
+        motion = panel_motion(panels, shapes, fraction, f"{where} {len(shapes)} frames")
         if motion.largest_step <= step:
             return motion, motion.source
     pattern = panels.pattern
-    path = trace_path(pattern, settings=settings)
+    if path is None:
+        path = trace_path(pattern, settings=settings)
     if not path.deploys:
         if carried is not None:
             return motion, f"{motion.source} (the path could not be traced finer: {path.message})"
@@ -180,8 +180,8 @@ def design_motion(
     largest = float(np.abs(panels.closing(pattern.fold_angles)).max(initial=0.0))
     n = min(max(math.ceil(largest / step) + 1, 3), MAX_FRAMES)
     for _ in range(3):
-        frames, fraction = path.frames(pattern, n, settings=settings)
-        motion = panel_motion(panels, frames, fraction, f"the traced folding path at {n} frames")
+        sampled, fraction = path.frames(pattern, n, settings=settings)
+        motion = panel_motion(panels, sampled, fraction, f"the traced folding path at {n} frames")
         if motion.largest_step <= step or n >= MAX_FRAMES:
             break
         n = min(math.ceil((n - 1) * motion.largest_step / step) + 1, MAX_FRAMES)

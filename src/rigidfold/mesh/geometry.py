@@ -120,6 +120,34 @@ def best_fit(
     return np.einsum("kvi,kij->kvj", frames - mean, rotation) + centre
 
 
+def rigid_motions(coords: np.ndarray, frames: np.ndarray, groups) -> tuple[np.ndarray, np.ndarray]:
+    """(rotations (K, G, 3, 3), translations (K, G, 3)): the rigid motion of each group of
+    vertices from ``coords`` onto each of ``frames``, by least squares over its vertices
+    (Kabsch), so that group g at frame k holds ``rotations[k, g] @ x + translations[k, g]``
+    for a point x of it at ``coords``.
+
+    coords : (V, 3) float64; frames : (K, V, 3) float64; groups : G vertex index arrays,
+    each of >= 3 vertices not on one line.
+    """
+    frames = np.asarray(frames, dtype=np.float64)
+    n_frames, n_groups = len(frames), len(groups)
+    rotations = np.empty((n_frames, n_groups, 3, 3))
+    translations = np.empty((n_frames, n_groups, 3))
+    for k, verts in enumerate(groups):
+        src = coords[verts]
+        dst = frames[:, verts]
+        c_src = src.mean(axis=0)
+        c_dst = dst.mean(axis=1)
+        h = np.einsum("vi,kvj->kij", src - c_src, dst - c_dst[:, None])
+        u, _, vt = np.linalg.svd(h)
+        d = np.sign(np.linalg.det(np.einsum("kij,kjl->kil", u, vt)))
+        u[:, :, 2] *= d[:, None]
+        r = np.einsum("kij,kjl->kli", u, vt)  # R = (U V^T)^T maps src onto dst
+        rotations[:, k] = r
+        translations[:, k] = c_dst - np.einsum("kij,j->ki", r, c_src)
+    return rotations, translations
+
+
 def fold_angles(
     coords: np.ndarray, faces: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray
 ) -> np.ndarray:

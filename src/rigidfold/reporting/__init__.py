@@ -9,6 +9,6 @@ files.
 
 from rigidfold.reporting.figures import Figure, render_figures
 from rigidfold.reporting.html import page
-from rigidfold.reporting.view3d import view_figure
+from rigidfold.reporting.view3d import thick_figure, view_figure
 
-__all__ = ["Figure", "page", "render_figures", "view_figure"]
+__all__ = ["Figure", "page", "render_figures", "thick_figure", "view_figure"]

@@ -2,7 +2,10 @@
 
 It opens with the answer (final DOF against the target, N_lock, the verdict of every check,
 the final design's file), then the interactive 3D view (plotly, its JavaScript embedded),
-the figures (PNG as ``data:`` URIs) and the tables of ``summary.json`` and ``log.json``.
+the final design's thick panels (``generate --thickness``: a table and their 3D view along
+the folding slider) and structure (``--structure``: a table and the deflected shape) where
+they were made, the figures (PNG as ``data:`` URIs) and the tables of ``summary.json`` and
+``log.json``.
 Nothing in the page is fetched: no CDN, no web font, no external image.
 """
 
@@ -51,9 +54,16 @@ PLOT_CONFIG = {"displaylogo": False, "responsive": True, "scrollZoom": True}
 """plotly's options: no link to plotly's site; zoom with the wheel."""
 
 
-def page(run: RunData, figures: list[Figure], view: dict | None) -> str:
+def page(
+    run: RunData,
+    figures: list[Figure],
+    view: dict | None,
+    thick: dict | None = None,
+    thick_note: str = "",
+) -> str:
     """The whole HTML document of ``run`` with its ``figures`` and 3D ``view`` (a plotly
-    figure dict, None when the run has no solution)."""
+    figure dict, None when the run has no solution), and the 3D view of its thick panels
+    (``thick``, None when there is none to show: ``thick_note`` says why)."""
     s = run.summary
     case = s.case
     surface = (case.get("surface") or {}).get("name", "?")
@@ -70,6 +80,8 @@ def page(run: RunData, figures: list[Figure], view: dict | None) -> str:
         *_answer(run),
         '<h2 id="view">Final design in 3D</h2>',
         *_view(run, view),
+        *_thick(run, thick, thick_note),
+        *_structure(run),
         '<h2 id="figures">Figures</h2>',
         *(_figure(f) for f in figures),
         '<h2 id="tables">Tables</h2>',
@@ -187,6 +199,146 @@ def _view(run: RunData, view: dict | None) -> list[str]:
         validate=False,
     )
     return [div, f"<p class='sub'>{_e(motion)} {_e(colour)}</p>"]
+
+
+def _thick(run: RunData, view: dict | None, note: str) -> list[str]:
+    """The thick panels' section, [] where they were not made."""
+    record = run.final_record
+    f = None if record is None else record.fabrication
+    if f is None:
+        return []
+    import plotly.io
+
+    closest = f.get("closest") or {}
+    rows = {
+        "verdict": f.get("message"),
+        "thickness (mm)": _mm(f.get("thickness_m")),
+        "side of the design surface": f.get("side"),
+        "panels": f.get("panels"),
+        "hinges": f.get("hinges"),
+        "smallest gap (mm)": _mm(f.get("min_gap_m")),
+        "closest pair": closest.get("detail"),
+        "gap required (mm)": _mm(f.get("required_gap_m")),
+        "hinge margin (deg)": f.get("hinge_margin_deg"),
+        "trimming loss (share of area x thickness)": f.get("trimming_loss"),
+        "volume (m^3)": f.get("volume_m3"),
+        "mass (kg)": f.get("mass_kg"),
+        "density (kg/m^3)": f.get("density_kg_m3"),
+        "thinnest panel depth (mm)": _mm(f.get("thinnest_depth_m")),
+        "thinner thickness that passes (mm)": _mm(f.get("passing_thickness_m")),
+        "frames checked": f.get("frames_checked"),
+        "motion": (f.get("motion") or {}).get("source"),
+        "cut sheets (stock sheets)": f.get("cut_sheets"),
+        "files": f"{len(f.get('files') or [])} in final/thick/",
+    }
+    out = [
+        '<h2 id="thick">Thick panels</h2>',
+        "<p>The final design's panels as solids (Tachi's tapered thick panels, hinge axes on "
+        "the creases), checked pair by pair over the whole folding motion; their solids "
+        "(GLB, STL, OBJ, 3DM), hinge and vertex schedules and nested cut sheets are in "
+        "<code>final/thick/</code>.</p>",
+        _pairs(rows),
+    ]
+    if view is None:
+        out.append(f'<p class="note">{_e(note or "The thick panels cannot be shown.")}</p>')
+        return out
+    div = plotly.io.to_html(
+        view,
+        config=PLOT_CONFIG,
+        auto_play=False,
+        include_plotlyjs=False,  # the 3D view above embeds it
+        full_html=False,
+        div_id="thick3d",
+        default_width="100%",
+        validate=False,
+    )
+    pair = closest.get("panels")
+    what = (
+        f"panels {pair[0]} and {pair[1]} (red) come closest"
+        + (
+            f", at {100 * closest['fraction']:.0f}% folded"
+            if closest.get("fraction") is not None
+            else ""
+        )
+        if pair
+        else "no two panels that are not neighbours come near each other"
+    )
+    motion = (
+        "The slider folds the solids from flat (0%) to the design (100%), each moving with "
+        "its panel."
+        if view["frames"]
+        else "The folding motion was not traced: the solids are shown in the design."
+    )
+    return [*out, div, f"<p class='sub'>{_e(motion)} Of every pair, {_e(what)}.</p>"]
+
+
+def _structure(run: RunData) -> list[str]:
+    """The structure section, [] where the structure was not checked."""
+    record = run.final_record
+    f = None if record is None else record.structure
+    if f is None:
+        return []
+    supports = f.get("supports") or {}
+    at = f.get("max_displacement_at") or {}
+    material = f.get("material") or {}
+    rows = {
+        "verdict": f"{f.get('status')}: {f.get('message')}",
+        "material": material.get("name"),
+        "E (Pa), nu, density (kg/m^3)": [
+            material.get("E_Pa"),
+            material.get("nu"),
+            material.get("density_kg_m3"),
+        ],
+        "thickness (mm)": _mm(f.get("thickness_m")),
+        "loads": ["self-weight"] * bool(f.get("self_weight"))
+        + [_fmt(load) for load in f.get("loads") or []],
+        "supports (pinned vertices)": f"{supports.get('pinned')} ({supports.get('chosen')})",
+        "first-order rigid on them": supports.get("first_order_rigid"),
+        "mechanism left": supports.get("mode"),
+        "total load (N)": f.get("total_load_N"),
+        "reactions balance to": f.get("balance_error"),
+        "largest displacement (mm)": _mm(f.get("max_displacement_m")),
+        "where (nearest vertex)": at.get("nearest_vertex"),
+        "allowed (mm)": _mm(f.get("allowed_displacement_m")),
+        "limit, span (m)": f"{f.get('limit')}, {_fmt(f.get('span_m'))}",
+        "natural frequencies (Hz)": f.get("frequencies_Hz"),
+        "largest von Mises stress (MPa)": None
+        if f.get("max_von_mises_Pa") is None
+        else f["max_von_mises_Pa"] / 1e6,
+    }
+    reactions = f.get("reactions_N") or {}
+    out = [
+        '<h2 id="structure">Structure</h2>',
+        "<p>The final design as a structure: panels as shells of the material, free creases "
+        "as hinges, on its supports under its loads (OpenSees); <code>final/structure/"
+        "structure.json</code> holds every figure.</p>",
+        _pairs(rows),
+    ]
+    if reactions:
+        out += [
+            "<h3>Reactions</h3>",
+            _grid(
+                ["support (vertex)", "Fx (N)", "Fy (N)", "Fz (N)"],
+                [[int(v), *force] for v, force in reactions.items()],
+            ),
+        ]
+    png = run.structure_figure()
+    if png is not None:
+        data = base64.b64encode(png).decode("ascii")
+        out.append(
+            '<figure id="structure.png"><img alt="deflected shape" '
+            f'src="data:image/png;base64,{data}"><figcaption><b>Deflected shape.</b> The '
+            "design (grey) and its deflected shape, scaled, coloured by the displacement; the "
+            "supports as red triangles (<code>final/structure/structure.png</code>)."
+            "</figcaption></figure>"
+        )
+    return out
+
+
+def _mm(metres) -> float | None:
+    return (
+        metres * 1e3 if isinstance(metres, int | float) and not isinstance(metres, bool) else None
+    )
 
 
 def _figure(figure: Figure) -> str:

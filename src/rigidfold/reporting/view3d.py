@@ -5,6 +5,10 @@ The folded form is a ``mesh3d`` coloured by the signed distance to the target su
 :data:`rigidfold.reporting.figures.KINDS`), the target surface a translucent overlay, and the
 folding motion from flat to folded a slider with play and pause buttons. Each motion frame
 is turned and moved as a rigid body to best fit the folded form, so the sheet folds in place.
+
+:func:`thick_figure` shows the final design's thick panels (``generate --thickness``) the
+same way: each solid moves with its panel's rigid motion along the folding slider, the two
+panels that come closest (or meet first) in red.
 """
 
 from __future__ import annotations
@@ -13,13 +17,20 @@ import html
 
 import numpy as np
 
-from rigidfold.mesh.geometry import best_fit
+from rigidfold.mesh.geometry import best_fit, rigid_motions
 from rigidfold.protocols import TargetSurface
 from rigidfold.reporting.figures import KINDS
-from rigidfold.run import SolutionFile
+from rigidfold.run import SolutionFile, ThickPanels
 
 GRID = 40
 """Samples per side of the target surface overlay."""
+
+THICK_FRAMES = 21
+"""Most motion frames of the thick panels' view (evenly chosen, flat and folded kept): its
+solids have many more vertices than the sheet."""
+
+SOLID_COLOUR = "#c8a878"
+CLOSEST_COLOUR = "#d62728"
 
 SURFACE_COLOUR = "#8c8c8c"
 MESH_SCALE = [
@@ -111,6 +122,83 @@ def view_figure(design: SolutionFile, surface: TargetSurface | None) -> dict:
         traces.append(overlay)
         points.append(samples)
     return {"data": traces, "layout": _layout(np.vstack(points), design, frames), "frames": frames}
+
+
+def thick_figure(thick: ThickPanels, design: SolutionFile) -> dict:
+    """The plotly figure dict of the thick panels of ``design`` (see the module's text):
+    one ``mesh3d`` of the solids, one of the closest pair, moved along ``design``'s motion
+    (at most :data:`THICK_FRAMES` frames) by each panel's rigid motion (Kabsch over its
+    vertices: :func:`rigidfold.mesh.geometry.rigid_motions`)."""
+    pair = set(thick.closest or ())
+    hot = np.array([k in pair for k in thick.panel.tolist()], dtype=bool)
+    groups = design.panel_vertices()
+    known = np.array([0 <= k < len(groups) for k in thick.panel.tolist()], dtype=bool)
+    hot &= known
+    placed = best_fit(design.motion, design.coords) if len(design.motion) > 1 else None
+    chosen = np.arange(0)
+    if placed is not None:
+        chosen = np.unique(np.linspace(0, len(placed) - 1, THICK_FRAMES).round().astype(int))
+        rotations, translations = rigid_motions(design.coords, placed[chosen], groups)
+
+    def traces(frame: int | None) -> list[dict]:
+        out = []
+        for which in (~hot & known, hot):
+            verts, faces, base = [], [], 0
+            for s in np.flatnonzero(which):
+                v = thick.vertices[s]
+                if frame is not None:
+                    k = thick.panel[s]
+                    v = v @ rotations[frame, k].T + translations[frame, k]
+                verts.append(v)
+                faces.append(thick.faces[s] + base)
+                base += len(v)
+            xyz = np.round(np.vstack(verts), 5) if verts else np.zeros((0, 3))
+            tri = np.vstack(faces) if faces else np.zeros((0, 3), dtype=np.int64)
+            out.append(
+                {
+                    "type": "mesh3d",
+                    "x": xyz[:, 0].tolist(),
+                    "y": xyz[:, 1].tolist(),
+                    "z": xyz[:, 2].tolist(),
+                    "i": tri[:, 0].tolist(),
+                    "j": tri[:, 1].tolist(),
+                    "k": tri[:, 2].tolist(),
+                }
+            )
+        return out
+
+    data = traces(None)
+    a, b = thick.closest if thick.closest is not None else (None, None)
+    for trace, (name, colour) in zip(
+        data,
+        (
+            ("thick panels", SOLID_COLOUR),
+            (f"closest pair: panels {a} and {b}", CLOSEST_COLOUR),
+        ),
+        strict=True,
+    ):
+        trace.update(
+            name=name,
+            color=colour,
+            flatshading=True,
+            showlegend=True,
+            lighting={"ambient": 0.55, "diffuse": 0.6, "specular": 0.05},
+            hoverinfo="skip",
+        )
+    share = design.fraction[chosen] if len(chosen) else np.zeros(0)
+    frames = [
+        {"name": f"{100 * f:.0f}%", "data": traces(i), "traces": [0, 1]}
+        for i, f in enumerate(share)
+    ]
+    points = np.vstack([*thick.vertices, design.coords])
+    if placed is not None:
+        points = np.vstack([points, placed[chosen].reshape(-1, 3)])
+    layout = _layout(points, design, frames)
+    t = thick.figures.get("thickness_m")
+    layout["title"]["text"] = f"{html.escape(design.name, quote=False)}: thick panels" + (
+        f" {1e3 * t:g} mm" if isinstance(t, int | float) else ""
+    )
+    return {"data": data, "layout": layout, "frames": frames}
 
 
 def _surface_trace(surface: TargetSurface, coords: np.ndarray) -> tuple[dict, np.ndarray]:

@@ -12,7 +12,7 @@ from the case's metadata where it can. Anything that is not a generate run is a 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -46,7 +46,9 @@ class SolutionFile:
     motion : (K, V, 3) float64, the folding motion from flat to folded ((0, V, 3) when it was
     not traced); fraction : (K,) fraction folded of each motion frame. history : the
     large-deformation load steps (dicts of ``load_factor``, ``mean_dl_mm``, ``max_dl_mm``,
-    ``max_drho_fix_deg``), empty when Step 9 did not run.
+    ``max_drho_fix_deg``), empty when Step 9 did not run. panels : (F,) int64, the panel
+    (facets joined by fixed creases, numbered as the exports and the thick panels number
+    them) of each face (empty where not known).
     """
 
     name: str
@@ -61,6 +63,12 @@ class SolutionFile:
     motion: np.ndarray
     fraction: np.ndarray
     history: list[dict]
+    panels: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    def panel_vertices(self) -> list[np.ndarray]:
+        """The vertices ((k,) int, sorted) of each panel."""
+        n = int(self.panels.max(initial=-1)) + 1
+        return [np.unique(self.faces[self.panels == k]) for k in range(n)]
 
     def dz(self, surface: TargetSurface) -> np.ndarray:
         """(V,) float64: z minus the target's height at each vertex's (x, y), metres."""
@@ -88,6 +96,7 @@ def read_solution(path: Path, name: str) -> SolutionFile:
         motion=frames.motion,
         fraction=frames.fraction,
         history=list(deformation.get("history") or []),
+        panels=np.asarray(pattern.facets, dtype=np.int64),
     )
 
 
@@ -110,6 +119,60 @@ def target_surface(metadata: dict) -> tuple[TargetSurface | None, str]:
     except (TypeError, ValueError) as exc:
         return None, f"the target surface could not be rebuilt ({' '.join(str(exc).split())})"
     return None, f"the target surface {name!r} cannot be rebuilt from summary.json"
+
+
+@dataclass(frozen=True, eq=False)
+class ThickPanels:
+    """The final design's thick panels, read back from the run's files.
+
+    figures : the final design's ``fabrication`` record (thickness, verdict, closest pair);
+    names : each solid's name (``panel_K``); panel : (P,) int64, the panel of each solid;
+    vertices : P arrays (n, 3) float64, each solid's vertices in the design's place, metres,
+    z up; faces : P arrays (m, 3) int64, its triangles; closest : the two panels that come
+    closest over the motion (or meet first where they collide), None when no pair does.
+    """
+
+    figures: dict
+    names: tuple[str, ...]
+    panel: np.ndarray
+    vertices: tuple[np.ndarray, ...]
+    faces: tuple[np.ndarray, ...]
+    closest: tuple[int, int] | None
+
+
+def read_solids(path: Path) -> tuple[list[str], list[np.ndarray], list[np.ndarray]]:
+    """(names, vertices, faces) of the objects of the OBJ file ``path`` that
+    :func:`rigidfold.fabricate.files.obj_text` wrote (``o``/``g`` name, ``v``, ``f`` lines,
+    one object per solid). ValueError (one line) for a file that is not of that form."""
+    names: list[str] = []
+    verts: list[list[list[float]]] = []
+    faces: list[list[list[int]]] = []
+    base, count = 1, 0  # OBJ's indices are global and 1-based
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RigidfoldError(f"cannot read {str(path)!r}: {' '.join(str(exc).split())}") from None
+    for n, line in enumerate(text.splitlines(), start=1):
+        head, _, rest = line.strip().partition(" ")
+        try:
+            if head == "o":
+                names.append(rest.strip())
+                verts.append([])
+                faces.append([])
+                base = count + 1
+            elif head == "v" and names:
+                verts[-1].append([float(x) for x in rest.split()[:3]])
+                count += 1
+            elif head == "f" and names:
+                faces[-1].append([int(x.split("/")[0]) - base for x in rest.split()[:3]])
+        except ValueError:
+            raise RigidfoldError(f"{str(path)!r}, line {n}: {received(line)} is not OBJ") from None
+    out_v = [np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in verts]
+    out_f = [np.asarray(f, dtype=np.int64).reshape(-1, 3) for f in faces]
+    for name, v, f in zip(names, out_v, out_f, strict=True):
+        if len(f) and (f.min() < 0 or f.max() >= len(v)):
+            raise RigidfoldError(f"{str(path)!r}: object {name!r} has a face out of its vertices")
+    return names, out_v, out_f
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,9 +254,62 @@ class RunData:
                 out[k] = dz.max(), np.sqrt(np.mean(dz**2))
         return out
 
+    @property
+    def final_record(self) -> SolutionRecord | None:
+        """The checks of the final design (its entry of ``per_solution``), None without."""
+        final, rows = self.final, self.summary.per_solution
+        if final is None or not 0 <= final.step < len(rows):
+            return None
+        return rows[final.step]
+
+    def run_file(self, name: str | None) -> Path | None:
+        """The file ``name`` (relative to the run's directory, as summary.json names it),
+        None when there is none or it is not a file inside the directory."""
+        if not name:
+            return None
+        parts = Path(name).parts
+        if Path(name).is_absolute() or ".." in parts:
+            return None
+        path = self.directory / name
+        return path if path.is_file() else None
+
+    def thick_panels(self) -> tuple[ThickPanels | None, str]:
+        """(the final design's thick panels read back from their OBJ file, "") or (None,
+        why not): they were not made (``generate --thickness``), or their file is missing
+        or unreadable."""
+        record = self.final_record
+        figures = None if record is None else record.fabrication
+        if figures is None:
+            return None, "the thick panels were not made (generate --thickness T)"
+        path = self.run_file(figures.get("solids"))
+        if path is None:
+            return None, f"the thick panels' solids file {figures.get('solids')!r} is missing"
+        try:
+            names, verts, faces = read_solids(path)
+        except ValueError as exc:
+            return None, str(exc)
+        panel = np.array([_panel_number(n) for n in names], dtype=np.int64)
+        closest = (figures.get("closest") or {}).get("panels")
+        pair = None if closest is None else (int(closest[0]), int(closest[1]))
+        return ThickPanels(figures, tuple(names), panel, tuple(verts), tuple(faces), pair), ""
+
+    def structure_figure(self) -> bytes | None:
+        """The PNG of the final design's deflected shape (``structure.png``), None when the
+        structure was not checked or not analysed, or its file is missing."""
+        record = self.final_record
+        figures = None if record is None else record.structure
+        path = None if figures is None else self.run_file(figures.get("figure"))
+        if path is None:
+            return None
+        try:
+            return path.read_bytes()
+        except OSError:
+            return None
+
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
-        solution, from ``summary.json``'s ``per_solution``
+        solution, and the thick panels and the structure where they ran, from
+        ``summary.json``'s ``per_solution``
         (:meth:`rigidfold.run.SolutionRecord.passed`). A stage that failed on earlier
         solutions only, not on the final design, passed (as generate's verdict judges), and
         says at which steps it failed."""
@@ -252,7 +368,19 @@ class RunData:
                 tuple(bad),
             )
         )
+        for stage, name in ((Stage.FABRICATION, "thick panels"), (Stage.STRUCTURE, "structure")):
+            ran = [r for r in rows if r.ran(stage)]
+            if ran:  # only where asked: a run without them does not list them as not run
+                bad = _failed(rows, stage)
+                detail = "; ".join(r.detail(stage) for r in ran if r.detail(stage))
+                checks.append(Check(name, not bad, detail + _steps(bad), tuple(bad)))
         return checks
+
+
+def _panel_number(name: str) -> int:
+    """K of a solid named ``panel_K``, -1 for another name."""
+    head, _, number = name.rpartition("_")
+    return int(number) if head == "panel" and number.isdigit() else -1
 
 
 def _failed(rows: tuple[SolutionRecord, ...], stage: Stage) -> list:

@@ -22,8 +22,10 @@ import numpy as np
 from rigidfold.deform import DeformStatus, MotionStatus, Verification
 from rigidfold.develop import DevelopStatus
 from rigidfold.errors import RigidfoldError
+from rigidfold.fabricate import FabricationStatus
 from rigidfold.generate import Stop
 from rigidfold.status import Outcome
+from rigidfold.structure import StructureStatus
 
 
 @dataclass(frozen=True)
@@ -92,6 +94,40 @@ SUMMARY_SHAPE = Record(
                         Record({"agreement": Nullable(str), "reason": Nullable(str)})
                     ),
                     "fit": Nullable(Record({"max_abs_dz_m": _NUMBERS})),
+                    "fabrication": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "message": Nullable(str),
+                                "thickness_m": _NUMBERS,
+                                "panels": Nullable(int),
+                                "min_gap_m": _NUMBERS,
+                                "trimming_loss": _NUMBERS,
+                                "closest": Nullable(
+                                    Record(
+                                        {
+                                            "panels": Nullable((int, int)),
+                                            "fraction": _NUMBERS,
+                                            "detail": Nullable(str),
+                                        }
+                                    )
+                                ),
+                                "solids": Nullable(str),
+                            }
+                        )
+                    ),
+                    "structure": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "message": Nullable(str),
+                                "max_displacement_m": _NUMBERS,
+                                "allowed_displacement_m": _NUMBERS,
+                                "frequencies_Hz": Nullable([float]),
+                                "figure": Nullable(str),
+                            }
+                        )
+                    ),
                 }
             )
         ],
@@ -249,6 +285,11 @@ class Stage(Outcome):
     DEVELOPMENT = "development", "development diagram (Step 8) failed"
     MOTION = "motion", "folding motion not traced"
     DEFORMATION = "deformation", "large deformation (Step 9) did not reach the plane"
+    FABRICATION = (
+        "fabrication",
+        "thick panels collide, are trimmed away or cannot be checked over the motion",
+    )
+    STRUCTURE = "structure", "the structure check failed"
 
 
 @dataclass(frozen=True)
@@ -271,6 +312,8 @@ class SolutionRecord:
     verdicts: dict | None = None
     time_s: dict = field(default_factory=dict)
     deployability: dict | None = None
+    fabrication: dict | None = None
+    structure: dict | None = None
 
     @classmethod
     def from_check(
@@ -319,7 +362,8 @@ class SolutionRecord:
 
     def passed(self, stage: Stage) -> bool | None:
         """Whether ``stage`` passed: the development converged, the motion was traced, the
-        frame reached the plane; None where it did not run."""
+        frame reached the plane, the thick panels deploy without collision, the structure
+        check passed; None where it did not run."""
         if not self.ran(stage):
             return None
         figures = getattr(self, stage.value) or {}
@@ -328,7 +372,16 @@ class SolutionRecord:
             Stage.DEVELOPMENT: status == DevelopStatus.CONVERGED,
             Stage.MOTION: status == MotionStatus.OK,
             Stage.DEFORMATION: status == DeformStatus.REACHED_PLANE,
+            Stage.FABRICATION: status == FabricationStatus.COLLISION_FREE,
+            Stage.STRUCTURE: status == StructureStatus.PASSED,
         }[stage]
+
+    def detail(self, stage: Stage) -> str:
+        """The words of a stage that says more than its :class:`Stage` message (the thick
+        panels' and the structure's ``message``), "" for the others."""
+        if stage not in (Stage.FABRICATION, Stage.STRUCTURE):
+            return ""
+        return str((getattr(self, stage.value) or {}).get("message") or "")
 
     def failed_stages(self) -> list[Stage]:
         """The stages that ran on this solution and failed, in :class:`Stage` order."""
@@ -362,13 +415,20 @@ class AttemptRecord:
 
 def aggregate(records: list[SolutionRecord]) -> dict:
     """The run-wide figures of ``summary.json`` (``development``, ``deformation``,
-    ``motion``) over the solutions' records: means and maxima of what ran."""
+    ``motion``, ``fabrication``, ``structure``) over the solutions' records: means and
+    maxima of what ran."""
     dev = [r.development or {} for r in records]
     deformed = [r.deformation for r in records if r.deformation is not None]
     motions = [r.motion for r in records if r.motion is not None]
 
+    built = [r.fabrication for r in records if r.fabrication is not None]
+    loaded = [r.structure for r in records if r.structure is not None]
+
     def stat(values, fn):
         return float(fn(values)) if values else None
+
+    def known(figures: list[dict], key: str) -> list:
+        return [f[key] for f in figures if f.get(key) is not None]
 
     return {
         "development": {
@@ -388,6 +448,17 @@ def aggregate(records: list[SolutionRecord]) -> dict:
         "motion": {
             "traced": sum(m["status"] == MotionStatus.OK for m in motions),
             "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
+        },
+        "fabrication": {
+            "checked": len(built),
+            "collision_free": sum(f["status"] == FabricationStatus.COLLISION_FREE for f in built),
+            "min_gap_m": stat(known(built, "min_gap_m"), np.min),
+            "max_trimming_loss": stat(known(built, "trimming_loss"), np.max),
+        },
+        "structure": {
+            "checked": len(loaded),
+            "passed": sum(f["status"] == StructureStatus.PASSED for f in loaded),
+            "max_displacement_m": stat(known(loaded, "max_displacement_m"), np.max),
         },
     }
 

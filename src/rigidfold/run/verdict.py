@@ -64,7 +64,9 @@ def run_verdict(
     """The verdict on ``run``: passed when it reached ``target`` (Stop.TARGET_REACHED, or
     DOF 0 for a target of 0) and every check that ran on the final design
     (:attr:`rigidfold.generate.Generation.final`) passed: development diagram converged,
-    folding motion traced, large deformation reached the plane. A check that failed on
+    folding motion traced, large deformation reached the plane, and, where they ran, its
+    thick panels deploy without collision (``--thickness``) and its structure check passed
+    (``--structure``), each failure with its detail. A check that failed on
     another solution is a warning, and so is a target at or above the initial DOF (no crease
     fixed) and a DOF-0 final design (it does not fold). With the deployability check, a run
     that fell short says so when no deployable design was found at a lower DOF (N_path > 0).
@@ -90,7 +92,12 @@ def run_verdict(
                 "state (N_path)"
             )
     if records:
-        short += [f"{s.message} for the final design" for s in records[k].failed_stages()]
+        final_record = records[k]
+        for stage in final_record.failed_stages():
+            detail = final_record.detail(stage)
+            short.append(
+                f"{stage.message} for the final design" + (f" ({detail})" if detail else "")
+            )
     earlier: dict[Stage, list[str]] = {stage: [] for stage in Stage}
     for i, (record, path) in enumerate(zip(records, files, strict=True)):
         if i != (k % len(records)):

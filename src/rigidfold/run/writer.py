@@ -11,6 +11,7 @@ then rename), so each one on disk is always valid.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ import numpy as np
 from rigidfold.case import Case
 from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.exports import export_design
+from rigidfold.fabricate import Fabrication
 from rigidfold.generate import Attempt, GenerateOptions, Generation, Solution, Stop
 from rigidfold.io import (
     FoldData,
@@ -32,9 +34,11 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
+from rigidfold.run.built import check_built_options, structure_check, thick_panels
 from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
 from rigidfold.run.schema import SolutionRecord, aggregate
 from rigidfold.run.verdict import RunVerdict, run_verdict
+from rigidfold.structure import StructureCheck
 from rigidfold.surfaces import SplineSurface
 
 
@@ -104,7 +108,10 @@ class RunWriter:
     the run has ended (its FOLD file is then written again with them), or every solution as
     it comes. ``overwrite``: replace the files of an earlier run in ``out``
     (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
-    target the verdict (:meth:`finish`) judges by.
+    target the verdict (:meth:`finish`) judges by. With ``options.thickness`` and
+    ``options.structure`` the final design's thick panels and structure are checked too
+    (:mod:`rigidfold.run.built`; ``DIR/final/thick/``, ``DIR/final/structure/``), their
+    figures in its record; ``fabrication`` and ``structure`` hold the results.
     """
 
     def __init__(
@@ -116,6 +123,7 @@ class RunWriter:
         overwrite: bool = False,
     ) -> None:
         refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
+        check_built_options(case.pattern, options)
         self.out = prepare_output_dir(out)
         self.lock = lock_run_dir(self.out)
         try:
@@ -138,6 +146,9 @@ class RunWriter:
         self.final: tuple[CreasePattern, np.ndarray] | None = None
         self.final_step: int | None = None
         self.exports: list[Path] = []
+        self.motions: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # step -> traced motion
+        self.fabrication: Fabrication | None = None
+        self.structure: StructureCheck | None = None
 
     @property
     def final_verdicts(self) -> str | None:
@@ -202,6 +213,9 @@ class RunWriter:
             deployability=None if solution.path is None else solution.path.to_dict(),
         )
         self.developments[solution.step] = check.development.coords2d
+        traced = _traced_motion(check)
+        if traced is not None:
+            self.motions[solution.step] = traced
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
             path,
@@ -235,6 +249,7 @@ class RunWriter:
             pattern = final.result.pattern
             coords2d = self.developments[final.step]
             self.final = (pattern, coords2d)
+            self._build(final, coords2d)
         self.verdict = run_verdict(
             run,
             self.records,
@@ -249,6 +264,31 @@ class RunWriter:
             )
         self.write_summary(run)
         return self.verdict
+
+    def _build(self, final: Solution, coords2d: np.ndarray) -> None:
+        """The final design's thick panels and structure check, as the options ask, their
+        figures written into its record."""
+        opts = self.options
+        if opts.thickness is None and not opts.structure:
+            return
+        pattern = final.result.pattern
+        name = self.files[final.step].stem
+        record = self.records[final.step]
+        if opts.thickness is not None:
+            figures, self.fabrication = thick_panels(
+                self.out,
+                name,
+                pattern,
+                coords2d,
+                opts,
+                frames=self.motions.get(final.step),
+                path=final.path,
+            )
+            record = replace(record, fabrication=figures)
+        if opts.structure:
+            figures, self.structure = structure_check(self.out, name, pattern, opts)
+            record = replace(record, structure=figures)
+        self.records[final.step] = record
 
     def write_summary(self, run: Generation) -> None:
         summary = run.to_dict()

@@ -6,7 +6,8 @@ under load in OpenSees (``rigidfold structure``).
 the fewest supports that give it), :mod:`~rigidfold.structure.model` (the shell model:
 panels as plates, free creases as hinges), :mod:`~rigidfold.structure.loads` (self-weight,
 snow, wind, point loads), :mod:`~rigidfold.structure.analysis` (static and eigen analysis
-in OpenSees), :mod:`~rigidfold.structure.check` (the check and its verdict) and
+in OpenSees), :mod:`~rigidfold.structure.check` (the check and its verdict),
+:mod:`~rigidfold.structure.design` (the check from the options as given, and its files) and
 :mod:`~rigidfold.structure.figure` (the deflected shape). OpenSees and matplotlib are
 imported only when an analysis runs or a figure is drawn.
 """
@@ -17,6 +18,12 @@ from rigidfold.structure.check import (
     check_inputs,
     check_structure,
     parse_limit,
+)
+from rigidfold.structure.design import (
+    STRUCTURE_FILES,
+    check_design,
+    design_supports,
+    write_structure,
 )
 from rigidfold.structure.loads import LOAD_KINDS, Load, parse_load
 from rigidfold.structure.material import MATERIALS, Material, parse_material, presets_help
@@ -35,6 +42,7 @@ __all__ = [
     "CANDIDATE_FORMS",
     "LOAD_KINDS",
     "MATERIALS",
+    "STRUCTURE_FILES",
     "Load",
     "Material",
     "Rigidity",
@@ -43,13 +51,16 @@ __all__ = [
     "SupportModes",
     "Supports",
     "auto_supports",
+    "check_design",
     "check_inputs",
     "check_structure",
     "check_supports",
+    "design_supports",
     "parse_indices",
     "parse_limit",
     "parse_load",
     "parse_material",
     "presets_help",
     "support_candidates",
+    "write_structure",
 ]

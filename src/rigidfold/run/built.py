@@ -1,0 +1,182 @@
+"""The final design as built: its thick panels and its structure, run by the run writer.
+
+``rigidfold generate --thickness T`` makes the final design's thick panels
+(:func:`rigidfold.fabricate.fabricate_panels`) from the motion the run traced, checks them
+over it and writes their files into ``DIR/final/thick/`` (:func:`thick_panels`);
+``--structure`` checks the final design on its supports under load
+(:func:`rigidfold.structure.check_design`) and writes ``DIR/final/structure/``
+(:func:`structure_check`). Each returns the figures that the final design's
+:class:`~rigidfold.run.SolutionRecord` keeps (``fabrication``, ``structure``), with the
+files named relative to the run's directory, and the result itself.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from rigidfold.fabricate import Fabrication, FabricationStatus, Panels, fabricate_panels
+from rigidfold.fabricate.motion import design_motion
+from rigidfold.generate import GenerateOptions
+from rigidfold.io import prepare_output_dir
+from rigidfold.mechanism.path import FoldingPath
+from rigidfold.mesh import CreasePattern
+from rigidfold.structure import (
+    StructureCheck,
+    check_design,
+    parse_indices,
+    parse_load,
+    parse_material,
+    write_structure,
+)
+from rigidfold.structure.loads import check_loads
+
+THICK_DIR = Path("final") / "thick"
+"""Where the thick panels' files go in the run's directory."""
+
+STRUCTURE_DIR = Path("final") / "structure"
+"""Where the structure check's files go in the run's directory."""
+
+
+def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> None:
+    """ValueError (one line) for supports or point loads at vertices that ``pattern`` (the
+    run's crease pattern: every solution has its vertices) lacks, before the run starts."""
+    if not options.structure:
+        return
+    if options.supports.strip().lower() != "auto":
+        parse_indices(options.supports, pattern.n_vertices, "supports")
+    check_loads(tuple(parse_load(text) for text in options.loads), pattern.n_vertices)
+
+
+def thick_panels(
+    run_dir: Path,
+    name: str,
+    pattern: CreasePattern,
+    coords2d: np.ndarray,
+    options: GenerateOptions,
+    *,
+    frames: tuple[np.ndarray, np.ndarray] | None = None,
+    path: FoldingPath | None = None,
+) -> tuple[dict, Fabrication]:
+    """Thick panels of ``options.thickness`` on ``options.side`` of the design ``pattern``
+    (development ``coords2d`` (V, 2)), the panels' density that of ``options.material``,
+    checked over the run's traced motion (``frames``: (frames (K, V, 3), fraction (K,))) or
+    its folding ``path`` (traced again only when neither serves); their files
+    (:func:`rigidfold.fabricate.files.write_fabrication`) in ``run_dir/final/thick/``
+    named after ``name``. Returns (the record's figures, the result)."""
+    from rigidfold.fabricate.files import write_fabrication
+
+    assert options.thickness is not None
+    settings = pattern.settings
+    t0 = time.perf_counter()
+    panels = Panels(pattern, coords2d, options.side)
+    motion, message = design_motion(panels, frames=frames, path=path, settings=settings)
+    fab = fabricate_panels(
+        panels,
+        motion,
+        options.thickness,
+        density=parse_material(options.material).density,
+        motion_message=message,
+        settings=settings,
+    )
+    out = prepare_output_dir(run_dir / THICK_DIR)
+    title = f"{name}: thick panels {options.thickness * 1e3:g} mm, {options.side} side"
+    written, sheets = write_fabrication(
+        fab,
+        out,
+        name,
+        source=f"solutions/{name}.fold",
+        title=title,
+        label=name,
+        sheet=(settings.fabricate_sheet_width, settings.fabricate_sheet_height),
+        gap=settings.fabricate_sheet_gap,
+    )
+    return _fabrication_figures(fab, run_dir, written, sheets, time.perf_counter() - t0), fab
+
+
+def _fabrication_figures(
+    fab: Fabrication, run_dir: Path, written: list[Path], sheets: dict, seconds: float
+) -> dict:
+    """What the record keeps of thick panels (see :data:`rigidfold.run.schema.SUMMARY_SHAPE`):
+    the verdict, the slab and what was trimmed, the closest pair of panels (the worst
+    meeting where they collide, else the smallest gap) and the files."""
+    full = fab.to_dict()
+    c = fab.clearance
+    closest = None
+    if c is not None and c.meetings and fab.status is FabricationStatus.COLLISION:
+        m = c.meetings[0]
+        closest = {
+            "panels": [int(m.panels[0]), int(m.panels[1])],
+            "fraction": float(m.fraction),
+            "kind": m.kind,
+            "gap_m": float(m.amount) if m.kind != "hinge" else None,
+            "detail": m.describe(),
+        }
+    elif c is not None and np.isfinite(c.min_gap):
+        a, b = (int(k) for k in c.gap_panels)
+        closest = {
+            "panels": [a, b],
+            "fraction": float(c.gap_fraction),
+            "kind": "gap",
+            "gap_m": float(c.min_gap),
+            "detail": (
+                f"panels {a} and {b} come within {c.min_gap * 1e3:.1f} mm at "
+                f"{100 * c.gap_fraction:.0f}% folded"
+            ),
+        }
+    files = [str(p.relative_to(run_dir)) for p in written]
+    solids = next((f for f in files if f.endswith("_solids.obj")), None)
+    keep = (
+        "status thickness_m side min_thickness_m clearance_angle_deg density_kg_m3 panels "
+        "hinges area_m2 volume_m3 volume_share trimming_loss mass_kg relief_vertices "
+        "largest_fold_deg smallest_bevel_deg thinnest_panel thinnest_depth_m "
+        "passing_thickness_m motion"
+    ).split()
+    return {
+        **{k: full[k] for k in keep},
+        "message": fab.last_line(),
+        "min_gap_m": None if c is None or not np.isfinite(c.min_gap) else c.min_gap,
+        "required_gap_m": None if c is None else c.clearance,
+        "hinge_margin_deg": None if c is None else full["check"]["hinge_margin_deg"],
+        "frames_checked": None if c is None else c.frames,
+        "pairs_meeting": 0 if c is None else len(c.meetings),
+        "closest": closest,
+        "cut_sheets": sheets.get("sheets"),
+        "solids": solids,
+        "files": files,
+        "time_s": seconds,
+    }
+
+
+def structure_check(
+    run_dir: Path, name: str, pattern: CreasePattern, options: GenerateOptions
+) -> tuple[dict, StructureCheck]:
+    """The structure check of the design ``pattern`` with ``options`` (supports, loads,
+    material, limit; its thickness ``options.thickness`` or ``Settings.structure_thickness``)
+    and its files (``structure.json``, ``structure.png``) in ``run_dir/final/structure/``.
+    Returns (the record's figures, the check)."""
+    settings = pattern.settings
+    t0 = time.perf_counter()
+    thickness = settings.structure_thickness if options.thickness is None else options.thickness
+    check = check_design(
+        pattern,
+        supports=options.supports,
+        thickness=thickness,
+        material=options.material,
+        loads=options.loads,
+        limit=options.limit,
+        settings=settings,
+    )
+    out = prepare_output_dir(run_dir / STRUCTURE_DIR)
+    written = write_structure(check, out, f"solutions/{name}.fold")
+    files = [str(p.relative_to(run_dir)) for p in written]
+    full = check.to_dict()
+    full.pop("hinges", None)  # per crease: in structure.json
+    return {
+        **full,
+        "figure": next((f for f in files if f.endswith(".png")), None),
+        "files": files,
+        "time_s": time.perf_counter() - t0,
+    }, check

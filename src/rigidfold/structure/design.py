@@ -1,0 +1,120 @@
+"""The structure check of a design from its options as the user gives them, and its files.
+
+:func:`check_design` reads the supports (``"auto"`` or ``"V,V,..."``), the loads
+(``--load`` texts) and the material (a preset or ``"E,nu,density"``), chooses or checks the
+supports and runs :func:`rigidfold.structure.check.check_structure`; :func:`write_structure`
+writes ``structure.json`` and ``structure.png`` (:data:`STRUCTURE_FILES`). ``rigidfold
+structure`` and ``rigidfold generate --structure`` both go through them.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rigidfold.config import DEFAULTS, Settings
+from rigidfold.errors import RigidfoldError
+from rigidfold.io.files import atomic_write, write_json
+from rigidfold.mesh import CreasePattern
+from rigidfold.structure.check import StructureCheck, check_inputs, check_structure, parse_limit
+from rigidfold.structure.loads import parse_load
+from rigidfold.structure.material import Material, parse_material
+from rigidfold.structure.supports import (
+    Rigidity,
+    Supports,
+    auto_supports,
+    check_supports,
+    parse_indices,
+    support_candidates,
+)
+
+STRUCTURE_FILES = ("structure.json", "structure.png")
+"""The files :func:`write_structure` writes into its directory."""
+
+
+def design_supports(
+    pattern: CreasePattern,
+    supports: str = "auto",
+    *,
+    candidates: str | None = None,
+    clamped: str = "",
+    actuators: str = "",
+    settings: Settings = DEFAULTS,
+) -> tuple[Rigidity, bool]:
+    """(the supports' first-order rigidity, whether they were chosen): ``supports``
+    ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
+    ``"V,V,..."``) or ``"V,V,..."`` pinned vertices, with ``clamped`` vertices and
+    ``actuators`` (free creases held). ValueError (one line) for an index the design
+    lacks."""
+    V = pattern.n_vertices
+    clamp = parse_indices(clamped, V, "clamped vertices")
+    held = parse_indices(actuators, pattern.n_edges, "actuators")
+    if supports.strip().lower() == "auto":
+        pool = support_candidates(pattern, candidates, settings)
+        rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
+        return rigidity, True
+    pins = parse_indices(supports, V, "supports")
+    if not len(pins) and not len(clamp):
+        raise RigidfoldError("give --supports V,V,... or auto, or --clamped vertices")
+    return check_supports(pattern, Supports(pins, clamp, held), settings), False
+
+
+def check_design(
+    pattern: CreasePattern,
+    *,
+    supports: str = "auto",
+    candidates: str | None = None,
+    clamped: str = "",
+    actuators: str = "",
+    thickness: float = DEFAULTS.structure_thickness,
+    material: str | Material = DEFAULTS.structure_material,
+    hinge_stiffness: float = DEFAULTS.structure_hinge_stiffness,
+    loads: tuple[str, ...] = (),
+    self_weight: bool = True,
+    limit: str | float = DEFAULTS.structure_limit,
+    nonlinear: bool = False,
+    modes: int = DEFAULTS.structure_modes,
+    settings: Settings = DEFAULTS,
+) -> StructureCheck:
+    """The structure check of ``pattern`` (see the module's text and
+    :func:`design_supports`); every input is checked first (ValueError, one line)."""
+    mat = parse_material(material)
+    divisor = parse_limit(limit)
+    parsed = tuple(parse_load(text) for text in loads)
+    if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
+        raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
+    check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=parsed)
+    rigidity, auto = design_supports(
+        pattern,
+        supports,
+        candidates=candidates,
+        clamped=clamped,
+        actuators=actuators,
+        settings=settings,
+    )
+    return check_structure(
+        pattern,
+        rigidity,
+        material=mat,
+        thickness=thickness,
+        loads=parsed,
+        self_weight=self_weight,
+        hinge_stiffness=hinge_stiffness,
+        nonlinear=nonlinear,
+        limit=divisor,
+        modes=modes,
+        auto=auto,
+        settings=settings,
+    )
+
+
+def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:
+    """``OUT/structure.json`` (``{"file": source, **check.to_dict()}``) and, when the
+    structure was analysed, ``OUT/structure.png`` (the deflected shape,
+    :func:`rigidfold.structure.figure.deflection_png`); ``out`` exists. Returns them."""
+    from rigidfold.structure.figure import deflection_png
+
+    written = [write_json(out / STRUCTURE_FILES[0], {"file": source, **check.to_dict()})]
+    png = deflection_png(check)
+    if png is not None:
+        written.append(atomic_write(out / STRUCTURE_FILES[1], png))
+    return written
