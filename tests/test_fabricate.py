@@ -275,3 +275,60 @@ def test_parse_length():
     assert parse_sheet("2440x1220") == (2440.0, 1220.0)
     with pytest.raises(ValueError, match="thickness"):
         parse_length("0")
+
+
+def test_earlier_fabricate_refused_unless_overwrite(design, tmp_path, capsys):
+    """A second fabricate into the same DIR is refused (exit 2, one line naming the files,
+    nothing touched); with --overwrite the earlier files go first, every cut sheet of the
+    earlier run among them (a stale sheet 99 is not left behind); other files stay."""
+    out = tmp_path / "out"
+    args = ["fabricate", str(design), "--thickness", "20mm", "--out", str(out)]
+    assert main_code(args) == 0
+    stem = design.stem
+    summary = out / f"{stem}_fabricate.json"
+    before = summary.read_bytes()
+    stale = out / f"{stem}_sheet_99.svg"
+    stale.write_text("<svg/>")
+    other = out / "notes.txt"
+    other.write_text("mine")
+    capsys.readouterr()
+    assert main_code(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--overwrite" in err and f"{stem}_solids.glb" in err
+    assert summary.read_bytes() == before and stale.exists()
+    assert main_code([*args, "--overwrite"]) == 0
+    assert not stale.exists() and other.read_text() == "mine"
+    done = json.loads(summary.read_text())
+    assert len(list(out.glob(f"{stem}_sheet_*.svg"))) == done["cut_sheets"]["sheets"]
+
+
+def test_only_a_stale_sheet_counts_as_earlier(design, tmp_path, capsys):
+    """A cut sheet alone of an earlier fabricate of the same design is an earlier run's file;
+    another design's files are not."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "other_sheet_01.dxf").write_text("x")
+    args = ["fabricate", str(design), "--thickness", "20mm", "--out", str(out)]
+    (out / f"{design.stem}_oversize_03.dxf").write_text("x")
+    assert main_code(args) == 2
+    assert f"{design.stem}_oversize_03.dxf" in capsys.readouterr().err
+    (out / f"{design.stem}_oversize_03.dxf").unlink()
+    assert main_code(args) == 0
+    assert (out / "other_sheet_01.dxf").read_text() == "x"
+
+
+def test_never_replaces_its_input(design, tmp_path, capsys):
+    """An input named like one of the outputs is refused, with or without --overwrite, and
+    stays as it was."""
+    out = tmp_path / "out"
+    out.mkdir()
+    # an input whose name is one of the files fabricate of a design named "d" writes
+    source = out / "d_solids.glb"
+    source.write_bytes(design.read_bytes())
+    link = out / "d.fold"
+    link.symlink_to(source.name)
+    for extra in ([], ["--overwrite"]):
+        code = main_code(["fabricate", str(link), "--thickness", "20mm", "--out", str(out), *extra])
+        err = capsys.readouterr().err.strip()
+        assert code == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
+        assert source.read_bytes() == design.read_bytes()

@@ -18,6 +18,8 @@ either direction is put on a sheet of its own size and reported (``oversize``).
 from __future__ import annotations
 
 import math
+import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,6 +32,10 @@ from rigidfold.fabricate.build import Fabrication
 from rigidfold.io.files import atomic_write
 
 MM = 1000.0
+
+SHEET_FILE = r"{}_(?:sheet|oversize)_[0-9]{{2,}}\.(?:dxf|svg)"
+"""The names :func:`write_cut_sheets` writes (a regular expression, ``{}`` for the design's
+name, escaped): ``NAME_sheet_NN`` and ``NAME_oversize_NN``, ``.dxf`` and ``.svg``."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -332,6 +338,20 @@ def write_cut_sheets(
         written.append(atomic_write(out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
         written.append(atomic_write(out / f"{stem}.svg", svg_text(sheet, title=label)))
     return written, sheets
+
+
+def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:
+    """The names of the cut sheets of design ``name`` in ``directory`` (:data:`SHEET_FILE`:
+    left there by an earlier ``fabricate``; a symbolic link of such a name counts, a
+    directory does not), sorted; ``[]`` when it cannot be listed."""
+    pattern = re.compile(SHEET_FILE.format(re.escape(name)), re.DOTALL)
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return []
+    return sorted(
+        e.name for e in entries if pattern.fullmatch(e.name) and not e.is_dir(follow_symlinks=False)
+    )
 
 
 def sheets_summary(sheets: list[StockSheet]) -> dict:

@@ -266,3 +266,6 @@ SOLID_FILES = (
     "{}_vertices.csv",
 )
 """The names :func:`write_solid_files` writes, ``{}`` for the design's name."""
+
+SUMMARY_FILE = "{}_fabricate.json"
+"""The summary of ``rigidfold fabricate``, ``{}`` for the design's name."""
