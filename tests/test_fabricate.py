@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -332,3 +335,80 @@ def test_never_replaces_its_input(design, tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert code == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
         assert source.read_bytes() == design.read_bytes()
+
+
+AFRAME = Path(__file__).parent / "data" / "aframe.fold"
+"""An A-frame shelter: a 1 m x 1 m floor and two 0.9 m walls folded up 120 degrees."""
+
+AFRAME_THRESHOLD = (0.1 - 1e-3) / (2 * math.sin(math.radians(60)))
+"""The thickest walls of ``aframe.fold`` that keep the 1 mm clearance at the ridge (metres):
+the walls' top edges are 100 mm apart in the design, each wall leans 60 degrees from the
+floor, so a wall's inner top corner moves ``t sin(60)`` towards the other."""
+
+
+@pytest.fixture(scope="module")
+def aframe(tmp_path_factory):
+    """``fabricate`` of the A-frame shelter (tests/data/aframe.fold: a 1 m floor and two
+    0.9 m walls folded up 120 degrees, their top edges 100 mm apart) with 80 mm panels on
+    the side the walls fold towards: (exit code, last line, out dir, summary)."""
+    out = tmp_path_factory.mktemp("aframe")
+    args = ["fabricate", str(AFRAME), "--thickness", "80mm", "--side", "top", "--out", str(out)]
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main_code(args)
+    last = buf.getvalue().strip().splitlines()[-1]
+    return code, last, out, json.loads((out / "aframe_fabricate.json").read_text())
+
+
+def test_aframe_walls_collide_at_the_ridge(aframe):
+    """Two panels that are not neighbours (the walls, joined only through the floor) truly
+    collide at 80 mm while no panel is trimmed: exit 1, the last line names them, the
+    fraction folded where they meet and a thickness that would pass; that thickness lies
+    just below the ridge's exact limit (0.1 m - 1 mm) / (2 sin 60 degrees) = 57.2 mm."""
+    code, last, out, summary = aframe
+    assert code == 1
+    assert summary["status"] == "collision"
+    assert all(p["depth_m"] == pytest.approx(0.08) for p in summary["per_panel"])
+    assert summary["trimming_loss"] < 0.2
+    meeting = summary["check"]["meetings"][0]
+    assert meeting["panels"] == [1, 2] and meeting["kind"] == "gap"
+    assert meeting["vertex"] == -1  # no vertex in common: no relief can help
+    assert 0 < meeting["fraction"] <= meeting["worst_fraction"] <= 1
+    assert last.startswith("thick panels collide during the deployment at 80 mm")
+    assert "panels 1 and 2 meet at" in last and "% folded" in last and "would pass" in last
+    passing = summary["passing_thickness_m"]
+    assert 0.05 <= passing <= AFRAME_THRESHOLD
+    hinges = list(csv.DictReader(next(out.glob("*_hinges.csv")).read_text().splitlines()))
+    assert [row["side"] for row in hinges] == ["closes", "closes"]
+
+
+def test_aframe_collision_independent(aframe):
+    """The collision is real: the walls' solids as written (GLB) overlap in the design
+    (manifold3d intersection volume > 0)."""
+    import manifold3d as mf
+    import trimesh
+
+    _, _, out, _ = aframe
+    scene = trimesh.load(next(out.glob("*_solids.glb")), force="scene")
+    walls = []
+    for name in ("panel_1", "panel_2"):
+        mesh = scene.geometry[name]
+        verts = np.asarray(mesh.vertices, dtype=np.float64)
+        walls.append(
+            mf.Manifold(
+                mf.Mesh64(
+                    vert_properties=np.ascontiguousarray(verts),
+                    tri_verts=np.asarray(mesh.faces, dtype=np.uint64),
+                )
+            )
+        )
+    assert (walls[0] ^ walls[1]).volume() > 1e-6
+
+
+def test_aframe_passes_thinner_or_on_the_other_side(tmp_path):
+    """Just below the ridge's limit the same walls pass (exit 0), and so do 80 mm panels
+    on the side the walls fold away from."""
+    thin = f"{math.floor(AFRAME_THRESHOLD * 1e3) - 1}mm"
+    for args in (["--thickness", thin, "--side", "top"], ["--thickness", "80mm"]):
+        out = tmp_path / args[1]
+        assert main_code(["fabricate", str(AFRAME), "--out", str(out), *args]) == 0
