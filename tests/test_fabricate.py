@@ -216,8 +216,25 @@ def test_cut_sheets_every_panel_once_within_stock(built):
             t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]') if t.dxf.text.startswith("P")
         ]
     assert len(oversize) == len(list(out.glob("*_oversize_*.dxf")))
+
     assert sorted(seen) == sorted(f"P{k}" for k in range(summary["panels"]))
     assert len(list(out.glob("*_sheet_*.svg"))) == summary["cut_sheets"]["sheets"]
+
+
+def test_nesting_keeps_the_gap(built):
+    """Parts nested onto one sheet (joined in pairs or not) keep the gap between them, and
+    every panel is placed once."""
+    from rigidfold.fabricate.cutsheets import nest, parts
+
+    fab = built["result"].fabrication
+    sheets = nest(parts(fab), 2440, 1220, 10)
+    placed = sorted(p.part.panel for s in sheets for p in s.parts)
+    assert placed == list(range(fab.panels.n))
+    for sheet in sheets:
+        for i, a in enumerate(sheet.parts):
+            assert a.cut.bounds[0] >= 10 - 1e-6 and a.cut.bounds[2] <= sheet.width - 10 + 1e-6
+            for b in sheet.parts[i + 1 :]:
+                assert a.cut.distance(b.cut) >= 10 - 1e-6
 
 
 def test_schedules(built):
