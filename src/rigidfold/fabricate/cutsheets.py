@@ -223,9 +223,12 @@ def group(items: list[Part], width: float, height: float, gap: float) -> list[li
     live = [p for p in items if not p.cut.is_empty]
     longest = [_longest_side(p.cut) for p in live]
     sides = [x[2] for x in longest]
+    alone_fits = [fits(p.width, p.height) for p in live]
     offers = []
     for i, j in itertools.combinations(range(len(live)), 2):
-        if abs(sides[i] - sides[j]) > 0.2 * max(sides[i], sides[j]):
+        if abs(sides[i] - sides[j]) > 0.2 * max(sides[i], sides[j]) or not (
+            alone_fits[i] and alone_fits[j]
+        ):
             continue
         alone = box(live[i].width, live[i].height) + box(live[j].width, live[j].height)
         for pair in _joined(live[i], live[j], gap, (longest[i], longest[j])):
