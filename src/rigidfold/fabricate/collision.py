@@ -283,10 +283,10 @@ def _check_hinges(
         first = int(np.flatnonzero(margin[:, h] < 0)[0])
         a, b = sorted(int(x) for x in panels.hinge_panels[h])
         past = float(-margin[:, h].min())
-        worst = float(motion.fraction[int(np.argmin(margin[:, h]))])
+        at_worst = float(motion.fraction[int(np.argmin(margin[:, h]))])
         if (a, b) not in meetings or past > meetings[(a, b)].amount:
             meetings[(a, b)] = Meeting(
-                (a, b), float(motion.fraction[first]), "hinge", past, worst=worst
+                (a, b), float(motion.fraction[first]), "hinge", past, worst=at_worst
             )
     return (*least, list(meetings.values()))
 

@@ -477,7 +477,7 @@ def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:
     directory does not), sorted; ``[]`` when it cannot be listed."""
     pattern = re.compile(SHEET_FILE.format(re.escape(name)), re.DOTALL)
     try:
-        entries = list(os.scandir(directory))
+        entries = list(os.scandir(os.fsdecode(directory)))
     except OSError:
         return []
     return sorted(
