@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -213,8 +216,25 @@ def test_cut_sheets_every_panel_once_within_stock(built):
             t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]') if t.dxf.text.startswith("P")
         ]
     assert len(oversize) == len(list(out.glob("*_oversize_*.dxf")))
+
     assert sorted(seen) == sorted(f"P{k}" for k in range(summary["panels"]))
     assert len(list(out.glob("*_sheet_*.svg"))) == summary["cut_sheets"]["sheets"]
+
+
+def test_nesting_keeps_the_gap(built):
+    """Parts nested onto one sheet (joined in pairs or not) keep the gap between them, and
+    every panel is placed once."""
+    from rigidfold.fabricate.cutsheets import nest, parts
+
+    fab = built["result"].fabrication
+    sheets = nest(parts(fab), 2440, 1220, 10)
+    placed = sorted(p.part.panel for s in sheets for p in s.parts)
+    assert placed == list(range(fab.panels.n))
+    for sheet in sheets:
+        for i, a in enumerate(sheet.parts):
+            assert a.cut.bounds[0] >= 10 - 1e-6 and a.cut.bounds[2] <= sheet.width - 10 + 1e-6
+            for b in sheet.parts[i + 1 :]:
+                assert a.cut.distance(b.cut) >= 10 - 1e-6
 
 
 def test_schedules(built):
@@ -275,3 +295,137 @@ def test_parse_length():
     assert parse_sheet("2440x1220") == (2440.0, 1220.0)
     with pytest.raises(ValueError, match="thickness"):
         parse_length("0")
+
+
+def test_earlier_fabricate_refused_unless_overwrite(design, tmp_path, capsys):
+    """A second fabricate into the same DIR is refused (exit 2, one line naming the files,
+    nothing touched); with --overwrite the earlier files go first, every cut sheet of the
+    earlier run among them (a stale sheet 99 is not left behind); other files stay."""
+    out = tmp_path / "out"
+    args = ["fabricate", str(design), "--thickness", "20mm", "--out", str(out)]
+    assert main_code(args) == 0
+    stem = design.stem
+    summary = out / f"{stem}_fabricate.json"
+    before = summary.read_bytes()
+    stale = out / f"{stem}_sheet_99.svg"
+    stale.write_text("<svg/>")
+    other = out / "notes.txt"
+    other.write_text("mine")
+    capsys.readouterr()
+    assert main_code(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--overwrite" in err and f"{stem}_solids.glb" in err
+    assert summary.read_bytes() == before and stale.exists()
+    assert main_code([*args, "--overwrite"]) == 0
+    assert not stale.exists() and other.read_text() == "mine"
+    done = json.loads(summary.read_text())
+    assert len(list(out.glob(f"{stem}_sheet_*.svg"))) == done["cut_sheets"]["sheets"]
+
+
+def test_only_a_stale_sheet_counts_as_earlier(design, tmp_path, capsys):
+    """A cut sheet alone of an earlier fabricate of the same design is an earlier run's file;
+    another design's files are not."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "other_sheet_01.dxf").write_text("x")
+    args = ["fabricate", str(design), "--thickness", "20mm", "--out", str(out)]
+    (out / f"{design.stem}_oversize_03.dxf").write_text("x")
+    assert main_code(args) == 2
+    assert f"{design.stem}_oversize_03.dxf" in capsys.readouterr().err
+    (out / f"{design.stem}_oversize_03.dxf").unlink()
+    assert main_code(args) == 0
+    assert (out / "other_sheet_01.dxf").read_text() == "x"
+
+
+def test_never_replaces_its_input(design, tmp_path, capsys):
+    """An input named like one of the outputs is refused, with or without --overwrite, and
+    stays as it was."""
+    out = tmp_path / "out"
+    out.mkdir()
+    # an input whose name is one of the files fabricate of a design named "d" writes
+    source = out / "d_solids.glb"
+    source.write_bytes(design.read_bytes())
+    link = out / "d.fold"
+    link.symlink_to(source.name)
+    for extra in ([], ["--overwrite"]):
+        code = main_code(["fabricate", str(link), "--thickness", "20mm", "--out", str(out), *extra])
+        err = capsys.readouterr().err.strip()
+        assert code == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
+        assert source.read_bytes() == design.read_bytes()
+
+
+AFRAME = Path(__file__).parent / "data" / "aframe.fold"
+"""An A-frame shelter: a 1 m x 1 m floor and two 0.9 m walls folded up 120 degrees."""
+
+AFRAME_THRESHOLD = (0.1 - 1e-3) / (2 * math.sin(math.radians(60)))
+"""The thickest walls of ``aframe.fold`` that keep the 1 mm clearance at the ridge (metres):
+the walls' top edges are 100 mm apart in the design, each wall leans 60 degrees from the
+floor, so a wall's inner top corner moves ``t sin(60)`` towards the other."""
+
+
+@pytest.fixture(scope="module")
+def aframe(tmp_path_factory):
+    """``fabricate`` of the A-frame shelter (tests/data/aframe.fold: a 1 m floor and two
+    0.9 m walls folded up 120 degrees, their top edges 100 mm apart) with 80 mm panels on
+    the side the walls fold towards: (exit code, last line, out dir, summary)."""
+    out = tmp_path_factory.mktemp("aframe")
+    args = ["fabricate", str(AFRAME), "--thickness", "80mm", "--side", "top", "--out", str(out)]
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main_code(args)
+    last = buf.getvalue().strip().splitlines()[-1]
+    return code, last, out, json.loads((out / "aframe_fabricate.json").read_text())
+
+
+def test_aframe_walls_collide_at_the_ridge(aframe):
+    """Two panels that are not neighbours (the walls, joined only through the floor) truly
+    collide at 80 mm while no panel is trimmed: exit 1, the last line names them, the
+    fraction folded where they meet and a thickness that would pass; that thickness lies
+    just below the ridge's exact limit (0.1 m - 1 mm) / (2 sin 60 degrees) = 57.2 mm."""
+    code, last, out, summary = aframe
+    assert code == 1
+    assert summary["status"] == "collision"
+    assert all(p["depth_m"] == pytest.approx(0.08) for p in summary["per_panel"])
+    assert summary["trimming_loss"] < 0.2
+    meeting = summary["check"]["meetings"][0]
+    assert meeting["panels"] == [1, 2] and meeting["kind"] == "gap"
+    assert meeting["vertex"] == -1  # no vertex in common: no relief can help
+    assert 0 < meeting["fraction"] <= meeting["worst_fraction"] <= 1
+    assert last.startswith("thick panels collide during the deployment at 80 mm")
+    assert "panels 1 and 2 meet at" in last and "% folded" in last and "would pass" in last
+    passing = summary["passing_thickness_m"]
+    assert 0.05 <= passing <= AFRAME_THRESHOLD
+    hinges = list(csv.DictReader(next(out.glob("*_hinges.csv")).read_text().splitlines()))
+    assert [row["side"] for row in hinges] == ["closes", "closes"]
+
+
+def test_aframe_collision_independent(aframe):
+    """The collision is real: the walls' solids as written (GLB) overlap in the design
+    (manifold3d intersection volume > 0)."""
+    import manifold3d as mf
+    import trimesh
+
+    _, _, out, _ = aframe
+    scene = trimesh.load(next(out.glob("*_solids.glb")), force="scene")
+    walls = []
+    for name in ("panel_1", "panel_2"):
+        mesh = scene.geometry[name]
+        verts = np.asarray(mesh.vertices, dtype=np.float64)
+        walls.append(
+            mf.Manifold(
+                mf.Mesh64(
+                    vert_properties=np.ascontiguousarray(verts),
+                    tri_verts=np.asarray(mesh.faces, dtype=np.uint64),
+                )
+            )
+        )
+    assert (walls[0] ^ walls[1]).volume() > 1e-6
+
+
+def test_aframe_passes_thinner_or_on_the_other_side(tmp_path):
+    """Just below the ridge's limit the same walls pass (exit 0), and so do 80 mm panels
+    on the side the walls fold away from."""
+    thin = f"{math.floor(AFRAME_THRESHOLD * 1e3) - 1}mm"
+    for args in (["--thickness", thin, "--side", "top"], ["--thickness", "80mm"]):
+        out = tmp_path / args[1]
+        assert main_code(["fabricate", str(AFRAME), "--out", str(out), *args]) == 0

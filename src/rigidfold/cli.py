@@ -511,7 +511,9 @@ def build_parser() -> argparse.ArgumentParser:
         "whole folding motion (the file's motion frames, or its traced folding path). Writes "
         "DIR/<name>_solids.glb, .stl, .obj and .3dm (Rhino: layers PANELS, HINGES, CREASES, "
         "LABELS), DIR/<name>_hinges.csv, DIR/<name>_vertices.csv, cut sheets in mm nested onto "
-        "stock sheets (DIR/<name>_sheet_NN.dxf and .svg) and DIR/<name>_fabricate.json. Exit "
+        "stock sheets (DIR/<name>_sheet_NN.dxf and .svg) and DIR/<name>_fabricate.json; the "
+        "files of an earlier fabricate of the same design in DIR are refused unless "
+        "--overwrite, and replacing the input is refused always. Exit "
         "code 0 when the deployment is collision-free, 1 when not (the files are written; the "
         "last line names the panels, the fraction folded where they meet and a thickness that "
         "would pass), 2 on bad input.",
@@ -561,6 +563,12 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="T",
         help="a panel whose solid is nowhere this deep once bevelled fails (default: "
         f"{DEFAULTS.fabricate_min_depth:g} x the thickness)",
+    )
+    fab.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the files of an earlier fabricate of the same design in DIR (its cut "
+        "sheets included); without it they are refused",
     )
 
     stu = sub.add_parser(
@@ -1131,6 +1139,7 @@ def _cmd_fabricate(args: argparse.Namespace) -> int:
         sheet=args.sheet,
         min_thickness=args.min_thickness,
         up=args.up,
+        overwrite=args.overwrite,
     )
     fab = done.fabrication
     if args.json:

@@ -565,6 +565,7 @@ def fabricate_file(
     sheet: tuple[float, float] | None = None,
     min_thickness: float | None = None,
     up: str = "z",
+    overwrite: bool = False,
     settings: Settings = DEFAULTS,
 ) -> FabricateOutput:
     """Thick panels of the FOLD design ``path`` (``rigidfold fabricate``): solids of
@@ -573,9 +574,14 @@ def fabricate_file(
     (:func:`rigidfold.fabricate.fabricate_panels`), and their files in OUT: the solids
     (GLB, STL, OBJ, 3DM), the hinge and vertex schedules, the cut sheets nested onto
     ``sheet`` (mm) stock, and ``NAME_fabricate.json``. Defaults from ``settings``. The
-    files are written whatever the verdict."""
+    files are written whatever the verdict. Refused (ValueError, before anything is
+    written) when one of them would replace ``path``, and when OUT holds an earlier
+    fabricate's files of the same NAME (every cut sheet included), unless ``overwrite``
+    (then they are removed first, like ``generate --overwrite``:
+    :func:`rigidfold.run.clear_earlier_run`)."""
     import math as _math
 
+    from rigidfold.fabricate.cutsheets import sheet_files
     from rigidfold.fabricate.files import FABRICATE_JSON, SOLID_FILES, write_fabrication
 
     side = settings.fabricate_side if side is None else side
@@ -593,9 +599,10 @@ def fabricate_file(
     width, height = sheet or (settings.fabricate_sheet_width, settings.fabricate_sheet_height)
     stem = Path(path).stem
     label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
-    names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)]
+    names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)] + sheet_files(out, stem)
     refuse_replacing_inputs([path], [Path(out) / n for n in names])
     out_dir = prepare_output_dir(out)
+    clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=tuple(names))
     design = read_design(path, up=up, settings=settings)
     panels = Panels(design.pattern, design.coords2d, side)
     motion, message = design_motion(panels, design, up=up, settings=settings)

@@ -39,10 +39,12 @@ from rigidfold.fabricate.solids import Solids
 class Meeting:
     """Where two solids come too close.
 
-    panels : (a, b), a < b; fraction : the fraction folded there (0 flat, 1 the design);
-    kind : ``"hinge"`` (neighbours past their fold limit: ``amount`` radians past it) or
-    ``"gap"`` (other solids closer than the clearance: ``amount`` the gap, metres, < 0 for an
-    overlap); vertex : the vertex both panels have nearest to where they meet, or -1.
+    panels : (a, b), a < b; fraction : the fraction folded where they first meet, the first
+    frame (or midpoint) of the motion that is too close (0 flat, 1 the design);
+    kind : ``"hinge"`` (neighbours past their fold limit: ``amount`` radians past it at
+    worst) or ``"gap"`` (other solids closer than the clearance: ``amount`` the smallest gap,
+    metres, 0 where they touch or overlap); worst : the fraction folded of that worst
+    ``amount``; vertex : the vertex both panels have nearest to where they meet, or -1.
     """
 
     panels: tuple[int, int]
@@ -50,6 +52,7 @@ class Meeting:
     kind: str
     amount: float
     vertex: int = -1
+    worst: float = math.nan
 
     def describe(self) -> str:
         a, b = self.panels
@@ -59,9 +62,14 @@ class Meeting:
                 f"panels {a} and {b} meet beyond their hinge {at} (folded "
                 f"{math.degrees(self.amount):.2f} degrees past the bevels' limit)"
             )
-        what = "overlap" if self.amount < 0 else "come within"
-        size = abs(self.amount) * 1e3
-        return f"panels {a} and {b} {what} {size:.1f} mm {at}"
+        what = (
+            "they touch or overlap"
+            if self.amount <= 0
+            else f"they come within {self.amount * 1e3:.1f} mm"
+        )
+        if not math.isnan(self.worst) and round(100 * self.worst) != round(100 * self.fraction):
+            what += f" at {100 * self.worst:.0f}% folded"
+        return f"panels {a} and {b} meet {at} (closer than the clearance: {what})"
 
     def to_dict(self) -> dict:
         return {
@@ -69,6 +77,7 @@ class Meeting:
             "fraction": self.fraction,
             "kind": self.kind,
             "amount": self.amount,
+            "worst_fraction": self.worst,
             "vertex": self.vertex,
         }
 
@@ -274,8 +283,11 @@ def _check_hinges(
         first = int(np.flatnonzero(margin[:, h] < 0)[0])
         a, b = sorted(int(x) for x in panels.hinge_panels[h])
         past = float(-margin[:, h].min())
+        at_worst = float(motion.fraction[int(np.argmin(margin[:, h]))])
         if (a, b) not in meetings or past > meetings[(a, b)].amount:
-            meetings[(a, b)] = Meeting((a, b), float(motion.fraction[first]), "hinge", past)
+            meetings[(a, b)] = Meeting(
+                (a, b), float(motion.fraction[first]), "hinge", past, worst=at_worst
+            )
     return (*least, list(meetings.values()))
 
 
@@ -290,8 +302,10 @@ class _GapCheck:
         self.dist = _Distances(solids)
         self.midpoints = 0
         # (gap, fraction, nearest point on the first solid in the design) of the smallest
-        # exact distance below the clearance, per pair
+        # exact distance below the clearance, per pair, and the least fraction folded of
+        # such a distance (where the pair first meets)
         self.close: dict[tuple[int, int], tuple[float, float, np.ndarray]] = {}
+        self.first: dict[tuple[int, int], float] = {}
         self.min_gap, self.min_panels, self.min_fraction = math.inf, (-1, -1), math.nan
         panels = solids.panels
         n = panels.n
@@ -317,8 +331,10 @@ class _GapCheck:
         gap, point = self.dist.gap(self.pairs[j], rot, shift)
         if gap < self.min_gap:
             self.min_gap, self.min_panels, self.min_fraction = gap, (a, b), fraction
-        if gap < self.clearance and ((a, b) not in self.close or gap < self.close[(a, b)][0]):
-            self.close[(a, b)] = (gap, fraction, point)
+        if gap < self.clearance:
+            self.first[(a, b)] = min(self.first.get((a, b), math.inf), fraction)
+            if (a, b) not in self.close or gap < self.close[(a, b)][0]:
+                self.close[(a, b)] = (gap, fraction, point)
         return gap
 
     def _prefilter(self) -> None:
@@ -462,5 +478,5 @@ class _GapCheck:
             vertex = -1
             if len(shared):
                 vertex = int(shared[np.argmin(np.linalg.norm(coords[shared] - point, axis=1))])
-            out.append(Meeting((a, b), fraction, "gap", gap, vertex))
+            out.append(Meeting((a, b), self.first[(a, b)], "gap", gap, vertex, fraction))
         return out

@@ -8,21 +8,30 @@ surface (``E12 64.2°``: tilt the saw blade by 90° minus it). Both outlines are
 the solid itself (its faces on the surface and at the full depth), so the sheets and the 3D
 files agree.
 
-Nesting: each part is turned to its smallest bounding rectangle
-(:func:`rigidfold.exports.sheet.min_area_angle`), its box rounded up to whole millimetres
-plus the gap, and the boxes are packed onto as many stock sheets as needed by ``rectpack``
-(MaxRects, best short side fit; parts may turn a quarter). A part larger than the stock in
-either direction is put on a sheet of its own size and reported (``oversize``).
+Nesting: parts are first joined in pairs where that packs tighter (:func:`group`: two
+parts, most often triangles, whose convex hulls' longest sides are about as long, set side by
+side along them, the gap apart, the second turned half round, where the pair's smallest box
+is smaller than the two boxes alone), then each part or pair is turned to its smallest
+bounding rectangle (:func:`rigidfold.exports.sheet.min_area_angle`), its box rounded up to
+whole millimetres plus the gap, and the boxes are packed onto as many stock sheets as needed
+by ``rectpack`` (boxes may turn a quarter), the fewest sheets of a few of its heuristics
+(:func:`_pack`). Parts are never
+mirrored (their surface face stays up). A part larger than the stock in either direction is
+put on a sheet of its own size and reported (``oversize``).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
+import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import shapely
+import shapely.geometry
 
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import min_area_angle
@@ -30,6 +39,10 @@ from rigidfold.fabricate.build import Fabrication
 from rigidfold.io.files import atomic_write
 
 MM = 1000.0
+
+SHEET_FILE = r"{}_(?:sheet|oversize)_[0-9]{{2,}}\.(?:dxf|svg)"
+"""The names :func:`write_cut_sheets` writes (a regular expression, ``{}`` for the design's
+name, escaped): ``NAME_sheet_NN`` and ``NAME_oversize_NN``, ``.dxf`` and ``.svg``."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,62 +124,153 @@ def parts(fab: Fabrication) -> list[Part]:
             at = mid + 0.15 * inward
             text = f"E{int(p.hinge_edges[h])} {math.degrees(s.bevel[h]):.1f}°"
             labels.append((float(at @ a1) * MM, float(at @ a2) * MM, text))
-        if cut.is_empty:
-            out.append(Part(k, cut, far, tuple(labels), 0.0, 0.0))
-            continue
-        ring = np.asarray(shapely.get_coordinates(cut))
-        angle = min_area_angle(ring)
-        c, sn = math.cos(angle), math.sin(angle)
-        turn = np.array([[c, sn], [-sn, c]])  # row vectors: xy @ turn turns by angle
-        cut_t = _moved(cut, turn)
-        far_t = _moved(far, turn)
-        lab = [(np.array([x, y]) @ turn, t) for x, y, t in labels]
-        x0, y0, x1, y1 = cut_t.bounds
-        if (y1 - y0) > (x1 - x0):
-            quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
-            cut_t = _moved(cut_t, quarter)
-            far_t = _moved(far_t, quarter)
-            lab = [(q @ quarter, t) for q, t in lab]
-            x0, y0, x1, y1 = cut_t.bounds
-        shift = np.array([x0, y0])
-        cut_t = _moved(cut_t, None, -shift)
-        far_t = _moved(far_t, None, -shift)
-        labels_t = tuple((float(q[0] - x0), float(q[1] - y0), t) for q, t in lab)
-        out.append(Part(k, cut_t, far_t, labels_t, x1 - x0, y1 - y0))
+        part = Part(k, cut, far, tuple(labels), 0.0, 0.0)
+        out.append(part if cut.is_empty else _fit([part])[0])
     return out
+
+
+def _fit(members: list[Part]) -> list[Part]:
+    """``members`` (in one frame) turned together to their smallest bounding rectangle, its
+    longer side along x, moved to start at (0, 0); each gets that rectangle's size."""
+    ring = np.vstack([np.asarray(shapely.get_coordinates(m.cut)) for m in members])
+    angle = min_area_angle(ring)
+    c, sn = math.cos(angle), math.sin(angle)
+    turn = np.array([[c, sn], [-sn, c]])  # row vectors: xy @ turn turns by angle
+    x0, y0 = (ring @ turn).min(axis=0)
+    x1, y1 = (ring @ turn).max(axis=0)
+    if (y1 - y0) > (x1 - x0):
+        turn = turn @ np.array([[0.0, 1.0], [-1.0, 0.0]])
+        x0, y0 = (ring @ turn).min(axis=0)
+        x1, y1 = (ring @ turn).max(axis=0)
+    shift = -np.array([x0, y0])
+    out = []
+    for m in members:
+        labels = tuple(
+            (float(q[0]), float(q[1]), t)
+            for q, t in ((np.array([x, y]) @ turn + shift, t) for x, y, t in m.labels)
+        )
+        out.append(
+            Part(
+                m.panel,
+                _moved(m.cut, turn, shift),
+                _moved(m.far, turn, shift),
+                labels,
+                float(x1 - x0),
+                float(y1 - y0),
+            )
+        )
+    return out
+
+
+def _longest_side(cut: shapely.Geometry) -> tuple[np.ndarray, np.ndarray, float]:
+    """(a, b, length): the longest side of the convex hull of ``cut``, counter-clockwise (the
+    part on its left)."""
+    hull = shapely.geometry.polygon.orient(shapely.convex_hull(cut), 1.0)
+    ring = np.asarray(hull.exterior.coords)
+    sides = np.diff(ring, axis=0)
+    i = int(np.argmax(np.hypot(sides[:, 0], sides[:, 1])))
+    return ring[i], ring[i + 1], float(np.hypot(*sides[i]))
+
+
+def _joined(
+    first: Part,
+    second: Part,
+    gap: float,
+    sides: tuple[tuple[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray, float]],
+) -> list[list[Part]]:
+    """``second`` turned and moved so that the longest side of its convex hull runs along
+    that of ``first``'s (``sides``: both, :func:`_longest_side`), ``gap`` away on the other
+    side, its ends at either end: the two pairs, fitted (:func:`_fit`). The hulls lie on
+    the two sides of a strip ``gap`` wide, so the parts keep the gap."""
+    (a, b, _), (c, d, _) = sides
+    e = (b - a) / np.linalg.norm(b - a)
+    normal = np.array([e[1], -e[0]])  # right of a -> b: away from first
+    angle = math.atan2(*(a - b)[::-1]) - math.atan2(*(d - c)[::-1])
+    co, si = math.cos(angle), math.sin(angle)
+    turn = np.array([[co, si], [-si, co]])
+    out = []
+    for anchor, point in ((b, c), (a, d)):
+        shift = anchor + gap * normal - point @ turn
+        moved = Part(
+            second.panel,
+            _moved(second.cut, turn, shift),
+            _moved(second.far, turn, shift),
+            tuple(
+                (float(q[0]), float(q[1]), t)
+                for q, t in ((np.array([x, y]) @ turn + shift, t) for x, y, t in second.labels)
+            ),
+            0.0,
+            0.0,
+        )
+        out.append(_fit([first, moved]))
+    return out
+
+
+def group(items: list[Part], width: float, height: float, gap: float) -> list[list[Part]]:
+    """The parts in groups of one or two to be packed as one box each: two parts whose
+    hulls' longest sides are within a fifth of each other's length are joined along them
+    (:func:`_joined`) where that saves box area (with the gap) and still fits the stock,
+    the largest savings first; the rest alone."""
+
+    def box(w: float, h: float) -> float:
+        return (w + gap) * (h + gap)
+
+    def fits(w: float, h: float) -> bool:
+        w, h = math.ceil(w + gap), math.ceil(h + gap)
+        inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
+        return (w <= inner_w and h <= inner_h) or (h <= inner_w and w <= inner_h)
+
+    live = [p for p in items if not p.cut.is_empty]
+    longest = [_longest_side(p.cut) for p in live]
+    sides = [x[2] for x in longest]
+    alone_fits = [fits(p.width, p.height) for p in live]
+    offers = []
+    for i, j in itertools.combinations(range(len(live)), 2):
+        if abs(sides[i] - sides[j]) > 0.2 * max(sides[i], sides[j]) or not (
+            alone_fits[i] and alone_fits[j]
+        ):
+            continue
+        alone = box(live[i].width, live[i].height) + box(live[j].width, live[j].height)
+        for pair in _joined(live[i], live[j], gap, (longest[i], longest[j])):
+            w, h = pair[0].width, pair[0].height
+            if fits(w, h) and box(w, h) < alone:
+                offers.append((box(w, h) - alone, i, j, pair))
+    offers.sort(key=lambda o: (o[0], o[1], o[2]))
+    used: set[int] = set()
+    groups = []
+    for _, i, j, pair in offers:
+        if i not in used and j not in used:
+            used |= {i, j}
+            groups.append(pair)
+    groups += [[p] for k, p in enumerate(live) if k not in used]
+    return groups
 
 
 def nest(items: list[Part], width: float, height: float, gap: float) -> list[StockSheet]:
     """Pack ``items`` onto stock sheets ``width`` x ``height`` mm with ``gap`` mm between
     parts and from the edges (see the module's text)."""
-    import rectpack
-
     inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
-    boxes: dict[int, tuple[int, int, Part]] = {}
+    boxes: dict[int, tuple[int, int, list[Part]]] = {}
     oversize = []
-    for part in items:
-        if part.cut.is_empty:
-            continue
-        w = math.ceil(part.width + gap)
-        h = math.ceil(part.height + gap)
+    for g, members in enumerate(group(items, width, height, gap)):
+        first = members[0]
+        w = math.ceil(first.width + gap)
+        h = math.ceil(first.height + gap)
         fits = (w <= inner_w and h <= inner_h) or (h <= inner_w and w <= inner_h)
         if fits:
-            boxes[part.panel] = (w, h, part)
+            boxes[g] = (w, h, members)
         else:
-            oversize.append(part)
+            oversize += members
     sheets: list[StockSheet] = []
     if boxes:
-        packer = rectpack.newPacker(rotation=True)
-        for rid, (w, h, _) in boxes.items():
-            packer.add_rect(w, h, rid)
-        packer.add_bin(inner_w, inner_h, count=float("inf"))
-        packer.pack()
+        packer = _pack({rid: (w, h) for rid, (w, h, _) in boxes.items()}, inner_w, inner_h)
         placed: dict[int, list[Placed]] = {}
         for b, x, y, w, h, rid in packer.rect_list():
-            bw, bh, part = boxes[rid]
+            bw, bh, members = boxes[rid]
             turned = (w, h) != (bw, bh)
-            placed.setdefault(b, []).append(_place(part, x + gap, y + gap, turned))
-        if sum(len(v) for v in placed.values()) != len(boxes):
+            for part in members:
+                placed.setdefault(b, []).append(_place(part, x + gap, y + gap, turned))
+        if sum(len(v) for v in placed.values()) != sum(len(m) for *_, m in boxes.values()):
             raise RigidfoldError(
                 "the nesting lost a part (rectpack placed fewer than it was given)"
             )
@@ -181,6 +285,39 @@ def nest(items: list[Part], width: float, height: float, gap: float) -> list[Sto
             )
         )
     return sheets
+
+
+def _pack(boxes: dict[int, tuple[int, int]], width: int, height: int):
+    """The ``rectpack`` packer that puts ``boxes`` {id: (w, h)} on the fewest bins of
+    ``width`` x ``height`` among a few of its heuristics (MaxRects best short side, best
+    area, bottom-left and best long side fit; boxes sorted by area, perimeter, longer or
+    shorter side; bins filled first fit or best fit), the first of the fewest kept."""
+    import rectpack
+
+    best = None
+    for algo in (
+        rectpack.MaxRectsBssf,
+        rectpack.MaxRectsBaf,
+        rectpack.MaxRectsBl,
+        rectpack.MaxRectsBlsf,
+    ):
+        for order in (
+            rectpack.SORT_AREA,
+            rectpack.SORT_PERI,
+            rectpack.SORT_LSIDE,
+            rectpack.SORT_SSIDE,
+        ):
+            for bins in (rectpack.PackingBin.BFF, rectpack.PackingBin.BBF):
+                packer = rectpack.newPacker(
+                    bin_algo=bins, pack_algo=algo, sort_algo=order, rotation=True
+                )
+                for rid, (w, h) in boxes.items():
+                    packer.add_rect(w, h, rid)
+                packer.add_bin(width, height, count=float("inf"))
+                packer.pack()
+                if best is None or len(packer) < len(best):
+                    best = packer
+    return best
 
 
 def _moved(geometry, matrix: np.ndarray | None = None, offset=(0.0, 0.0)):
@@ -332,6 +469,20 @@ def write_cut_sheets(
         written.append(atomic_write(out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
         written.append(atomic_write(out / f"{stem}.svg", svg_text(sheet, title=label)))
     return written, sheets
+
+
+def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:
+    """The names of the cut sheets of design ``name`` in ``directory`` (:data:`SHEET_FILE`:
+    left there by an earlier ``fabricate``; a symbolic link of such a name counts, a
+    directory does not), sorted; ``[]`` when it cannot be listed."""
+    pattern = re.compile(SHEET_FILE.format(re.escape(name)), re.DOTALL)
+    try:
+        entries = list(os.scandir(os.fsdecode(directory)))
+    except OSError:
+        return []
+    return sorted(
+        e.name for e in entries if pattern.fullmatch(e.name) and not e.is_dir(follow_symlinks=False)
+    )
 
 
 def sheets_summary(sheets: list[StockSheet]) -> dict:
