@@ -145,6 +145,15 @@ class Settings:
         cross, about ten times that). Pieces of one colour drawn over each other along one
         line are made one first and count once. A 110 x 110 grid of lines has 12,100
         crossings, a drawing of ``max_pattern_faces`` triangles some 10^5 pairs.
+    max_svg_size : int
+        Largest size of an SVG drawing, with each ``<use>`` element counted as what it
+        refers to: the characters of its elements' attributes (path data, points,
+        coordinates, styles) plus ``rigidfold.io.svg_read.ELEMENT_SIZE`` (100) per element.
+        A larger drawing is refused in one line before svgelements, which copies what every
+        ``<use>`` refers to, reads it (about 0.6 s per million: 55,000 lines drawn one by one
+        are 6.2 million, 3.9 s). A file of 2 kB whose groups each use the one before twice
+        expands 65,536-fold at 16 groups (49 s and 1.3 GB before); 13 groups are refused.
+        Origami Simulator's largest example, huffmanWaterbomb.svg, is 32,075.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -536,6 +545,7 @@ class Settings:
     svg_snap_tol: float = 1e-2
     max_svg_depth: int = 100
     max_svg_pairs: int = 500_000
+    max_svg_size: int = 8_000_000
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
@@ -614,6 +624,7 @@ class Settings:
             "projection_max_iter": 1,
             "max_svg_depth": 1,
             "max_svg_pairs": 1,
+            "max_svg_size": 1,
             "max_mesh_triangles": 1,
             "fabricate_relief_rounds": 0,
             "fabricate_subdivisions": 0,
