@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import dome_mesh
+from conftest import dome_mesh, main_code
 from test_fuzz_svg import run_command
 
 NUMBERS = ["nan", "NaN", "inf", "-inf", "1e308", "-1e308", "1e400", "1e-300", "0", "-0", "",
@@ -68,8 +68,6 @@ def command(case: Path, out: Path) -> list[str]:
 
 
 def run(case: Path, out: Path) -> int:
-    from conftest import main_code
-
     return main_code(command(case, out))
 
 
@@ -284,3 +282,22 @@ def test_the_bases_are_the_dome():
     """The bases are the dome's formula on 6 x 6 vertices: a target the grid lies on."""
     vertices, triangles = dome_mesh(6)
     assert len(triangles) == 50 and np.ptp(vertices[:, :2], axis=0).tolist() == [3.0, 3.0]
+
+
+def test_defects_found_by_the_mutants(tmp_path, capsys):
+    """A mesh vertex at 1e308 overflowed (a RuntimeWarning); a footprint with two points
+    1e-300 apart crashed Triangle (a segmentation fault)."""
+    obj = tmp_path / "far.obj"
+    obj.write_text("v 0 0 0\nv 3 0 0\nv 0 3 1e308\nv 3 3 0\nf 1 2 4\nf 1 4 3\n")
+    footprint = tmp_path / "gap.txt"
+    footprint.write_text("0,0\n3,0\n3,1e-300\n1.5,3\n0,2\n")
+    for case, message in (
+        (obj, f"mesh {obj}: vertex 2 at [0.0, 3.0, 1e+308] lies farther than 1e+06 m from the "
+              "origin (Settings.max_coordinate)"),
+        (footprint, "has two points, or a point and a side, 0 m apart, less than 1e-09 of its "
+                    "size of 3 m (Settings.footprint_min_gap)"),  # GEOS's distance: 0
+    ):  # fmt: skip
+        assert run(case, tmp_path / "out") == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("rigidfold: error: ") and message in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["far.obj", "gap.txt"]

@@ -151,9 +151,14 @@ def set_attribute(text, rng):
         return text, "no element"
     tag = rng.choice(tags)
     name, values = rng.choice(
-        [("stroke", COLOURS), ("stroke-opacity", OPACITIES), ("transform", TRANSFORMS),
-         ("opacity", OPACITIES), ("style", ["stroke:#0f0", "stroke:url(#x)", "display:none"]),
-         ("id", ["&#10;x&#27;", "half", "a b"])]  # fmt: skip
+        [
+            ("stroke", COLOURS),
+            ("stroke-opacity", OPACITIES),
+            ("transform", TRANSFORMS),
+            ("opacity", OPACITIES),
+            ("style", ["stroke:#0f0", "stroke:url(#x)", "display:none"]),
+            ("id", ["&#10;x&#27;", "half", "a b"]),
+        ]
     )
     value = rng.choice(values)
     attributes = re.sub(rf'\s{name}="[^"]*"', "", tag[2]) + f' {name}="{value}"'
@@ -406,3 +411,41 @@ def test_mutated_svg_files_end_in_an_exit_code(name, tmp_path, monkeypatch, caps
         shutil.rmtree(case.parent)
     # the mutants reach past the first checks: some are still read, most are refused
     assert codes.count(2) >= count // 4 and codes.count(0) >= 1, codes
+
+
+# ------------------------------------------------------------- the defects the mutants found
+HEAD = ('<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '
+        'width="100" height="100" viewBox="0 0 100 100">'
+        '<rect x="0" y="0" width="100" height="100" fill="none" stroke="#000"/>')  # fmt: skip
+DOUBLING = '<g id="u0"><line x1="0" y1="50" x2="100" y2="50" stroke="#f00"/></g>' + "".join(
+    f'<g id="u{k}"><use xlink:href="#u{k - 1}"/><use xlink:href="#u{k - 1}"/></g>'
+    for k in range(1, 17)
+)
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        (DOUBLING, "its elements are larger than 8000000 characters of attributes and 100 per "
+                   "element, each <use> counted as what it refers to (Settings.max_svg_size)"),
+        ('<g id="a"><use href="#b"/></g><g id="b"><use xlink:href="#a"/></g>',
+         'its <use> elements refer to each other in a loop (through id="'),
+        ('<path stroke="#f00"/>', "<path> has no d: path data is"),
+        ('<path d="M0,50 h50 hnan" stroke="#f00"/>', '<path> has d="M0,50 h50 hnan": path data'),
+        ('<path d="M0,50 h" stroke="#f00"/>', '<path> has d="M0,50 h": path data'),
+        ('<path d="h50" stroke="#f00"/>', '<path> has d="h50": path data'),
+    ],
+)  # fmt: skip
+def test_defects_found_by_the_mutants(tmp_path, capsys, body, message):
+    """A 2 kB drawing whose groups each use the one before twice took 49 s and 1.3 GB; a
+    <path> without d or with malformed path data was svgelements' TypeError traceback."""
+    path = tmp_path / "found.svg"
+    path.write_text(HEAD + body + "</svg>")
+    argv = ["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path / "o")]
+    start = time.perf_counter()
+    assert main_code(argv) == 2
+    assert time.perf_counter() - start < SECONDS
+    err = capsys.readouterr().err
+    one_line_error(err, body)
+    assert f"{path}: {message}" in err
+    assert not (tmp_path / "o").exists()

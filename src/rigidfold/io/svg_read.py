@@ -274,12 +274,12 @@ def _check_xml(data: bytes, settings: Settings) -> None:
                 )
             _check_attributes(element)
             size = ELEMENT_SIZE + sum(len(value) for value in element.attrib.values())
-            uses: dict[str, int] = {}
+            used: dict[str, int] = {}
             if _local(element.tag) == "use":
                 target = element.get(_XLINK_HREF, element.get("href", ""))
                 if target.startswith("#"):
-                    uses[target[1:]] = 1
-            stack.append([size, uses])
+                    used[target[1:]] = 1
+            stack.append([size, used])
     size, uses = stack[0]
     total = _expanded_size(size, uses, found, settings.max_svg_size)
     if total > settings.max_svg_size:
@@ -318,9 +318,7 @@ def _expanded_size(
                 todo.pop()
                 open_.discard(key)
                 continue
-            waiting = [
-                t for _, inner in found[key] for t in inner if t not in sizes or t in open_
-            ]
+            waiting = [t for _, inner in found[key] for t in inner if t not in sizes or t in open_]
             loop = [t for t in waiting if t in open_]
             if loop:
                 raise RigidfoldError(
