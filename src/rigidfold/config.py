@@ -111,9 +111,9 @@ class Settings:
         error instead of exhausting Python's recursion limit (FOLD data nests 4 levels,
         rigidfold's own files about 10).
     max_coordinate : float
-        Largest |coordinate| in metres accepted in a FOLD file (1000 km), and largest width or
-        height of a crease pattern's plan: larger values are refused before any geometry is
-        computed on them, where they would overflow.
+        Largest |coordinate| in metres accepted in a FOLD file and a target mesh (1000 km),
+        and largest width or height of a crease pattern's plan: larger values are refused
+        before any geometry is computed on them, where they would overflow.
     triangulation_area_tol : float
         Triangulation of the polygon faces of FOLD and SVG files: a polygon is refused as
         degenerate when a triangle of it has a doubled signed area below this times the
@@ -145,6 +145,15 @@ class Settings:
         cross, about ten times that). Pieces of one colour drawn over each other along one
         line are made one first and count once. A 110 x 110 grid of lines has 12,100
         crossings, a drawing of ``max_pattern_faces`` triangles some 10^5 pairs.
+    max_svg_size : int
+        Largest size of an SVG drawing, with each ``<use>`` element counted as what it
+        refers to: the characters of its elements' attributes (path data, points,
+        coordinates, styles) plus ``rigidfold.io.svg_read.ELEMENT_SIZE`` (100) per element.
+        A larger drawing is refused in one line before svgelements, which copies what every
+        ``<use>`` refers to, reads it (about 0.6 s per million: 55,000 lines drawn one by one
+        are 6.2 million, 3.9 s). A file of 2 kB whose groups each use the one before twice
+        expands 65,536-fold at 16 groups (49 s and 1.3 GB before); 13 groups are refused.
+        Origami Simulator's largest example, huffmanWaterbomb.svg, is 32,075.
     plan_area_tol : float
         A sheet whose signed area in plan (its faces projected onto the xy plane) is within
         this fraction of its surface area of zero has no plan (a y-up file, a vertical sheet,
@@ -329,6 +338,11 @@ class Settings:
     mesh_angle_cap : float
         A ``mesh:`` triangulation asks for no plan angle below min(theta_min, this), radians
         (33 degrees: Triangle's quality refinement usually fails to end above 34 degrees).
+    footprint_min_gap : float
+        Smallest distance between two points of a ``mesh:`` footprint, or between a point
+        and a side it is not on, as a fraction of the larger side of its bounding box (its
+        minimum clearance): a closer one is refused, since Triangle's refinement toward it
+        runs away (a gap of 1e-30 of the size crashed it; 1e-15 still ends).
     dz_bound_tol : float
         The report of a run flags a final design whose largest |z - target| is within this
         fraction of ``dz`` of the bound (the constraint is active: the design is as far from
@@ -536,9 +550,11 @@ class Settings:
     svg_snap_tol: float = 1e-2
     max_svg_depth: int = 100
     max_svg_pairs: int = 500_000
+    max_svg_size: int = 8_000_000
     # crease patterns
     mesh_divisions: float = 6.0
     mesh_angle_cap: float = math.radians(33.0)
+    footprint_min_gap: float = 1e-9
     theta_far_share: float = 0.05
     unit_warning_size: float = 1000.0
     dz_bound_tol: float = 1e-3
@@ -600,7 +616,7 @@ class Settings:
             value = getattr(self, name)
             if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
                 raise RigidfoldError(f"{name} must be a positive number, got {value!r}")
-        for name in ("svg_merge_tol", "svg_snap_tol"):
+        for name in ("svg_merge_tol", "svg_snap_tol", "footprint_min_gap"):
             value = getattr(self, name)
             if not (isinstance(value, float | int) and 0 <= value < 1):
                 raise RigidfoldError(f"{name} must be a fraction from 0 to below 1, got {value!r}")
@@ -614,6 +630,7 @@ class Settings:
             "projection_max_iter": 1,
             "max_svg_depth": 1,
             "max_svg_pairs": 1,
+            "max_svg_size": 1,
             "max_mesh_triangles": 1,
             "fabricate_relief_rounds": 0,
             "fabricate_subdivisions": 0,

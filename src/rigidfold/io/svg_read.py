@@ -237,11 +237,15 @@ _TRANSFORM_NUMBERS = {
 
 def _check_xml(data: bytes, settings: Settings) -> None:
     """Walk the XML once before svgelements reads it, without recursion: ValueError for
-    elements nested deeper than ``settings.max_svg_depth`` and for the attributes svgelements
-    would fail on with a ZeroDivisionError or IndexError (:func:`_check_attributes`);
-    ``ElementTree.ParseError`` for text that is not XML."""
+    elements nested deeper than ``settings.max_svg_depth``, for the attributes svgelements
+    would fail on with a ZeroDivisionError, IndexError or TypeError
+    (:func:`_check_attributes`), and for a drawing larger than ``settings.max_svg_size``
+    once its ``<use>`` elements are expanded (:func:`_expanded_size`: a loop of them is
+    named); ``ElementTree.ParseError`` for text that is not XML."""
     parser: ElementTree.XMLPullParser = ElementTree.XMLPullParser(events=("start", "end"))
-    depth = 0
+    # per open element: [its size and its children's, {id: <use>s of it}] (Settings.max_svg_size)
+    stack: list[list] = [[0, {}]]
+    found: dict[str, list[tuple[int, dict[str, int]]]] = {}
     step = 1 << 16
     for start in range(0, len(data) + 1, step):
         if start < len(data):
@@ -253,16 +257,84 @@ def _check_xml(data: bytes, settings: Settings) -> None:
             if not isinstance(element, ElementTree.Element):
                 continue  # only "start" and "end" events are asked for
             if kind == "end":
-                depth -= 1
+                size, uses = stack.pop()
+                key = element.get("id")
+                if key is not None:
+                    found.setdefault(key, []).append((size, uses))
+                parent = stack[-1]
+                parent[0] += size
+                for target, count in uses.items():
+                    parent[1][target] = parent[1].get(target, 0) + count
                 element.clear()
                 continue
-            depth += 1
-            if depth > settings.max_svg_depth:
+            if len(stack) > settings.max_svg_depth:
                 raise RigidfoldError(
                     f"its elements nest more than {settings.max_svg_depth} levels deep (at "
                     f"<{_local(element.tag)}>; Settings.max_svg_depth)"
                 )
             _check_attributes(element)
+            size = ELEMENT_SIZE + sum(len(value) for value in element.attrib.values())
+            used: dict[str, int] = {}
+            if _local(element.tag) == "use":
+                target = element.get(_XLINK_HREF, element.get("href", ""))
+                if target.startswith("#"):
+                    used[target[1:]] = 1
+            stack.append([size, used])
+    size, uses = stack[0]
+    total = _expanded_size(size, uses, found, settings.max_svg_size)
+    if total > settings.max_svg_size:
+        raise RigidfoldError(
+            f"its elements are larger than {settings.max_svg_size} characters of attributes "
+            f"and {ELEMENT_SIZE} per element, each <use> counted as what it refers to "
+            "(Settings.max_svg_size)"
+        )
+
+
+ELEMENT_SIZE = 100
+"""What one element adds to the size of a drawing besides its attributes' characters
+(``Settings.max_svg_size``): svgelements takes about as long to read an element as to read
+a hundred characters of path data."""
+_XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
+
+
+def _expanded_size(
+    size: int,
+    uses: dict[str, int],
+    found: dict[str, list[tuple[int, dict[str, int]]]],
+    limit: int,
+) -> int:
+    """``size`` plus what the ``<use>`` elements counted in ``uses`` ({id: how many}) refer
+    to, each element with an id in ``found`` ([(its size, its uses)], the largest if several
+    share the id) expanded likewise, without recursion; at most ``limit + 1`` (it stops
+    there). ValueError naming an id whose element uses itself, directly or not."""
+    cap = limit + 1
+    sizes: dict[str, int] = {}
+    for first in uses:
+        todo, open_ = [first], {first}
+        while todo:
+            key = todo[-1]
+            if key in sizes or key not in found:
+                sizes.setdefault(key, 0)  # an unknown id draws nothing
+                todo.pop()
+                open_.discard(key)
+                continue
+            waiting = [t for _, inner in found[key] for t in inner if t not in sizes or t in open_]
+            loop = [t for t in waiting if t in open_]
+            if loop:
+                raise RigidfoldError(
+                    f'its <use> elements refer to each other in a loop (through id="{loop[0]}")'
+                )
+            if waiting:
+                todo += waiting
+                open_.update(waiting)
+                continue
+            sizes[key] = max(
+                min(cap, own + sum(count * sizes[t] for t, count in inner.items()))
+                for own, inner in found[key]
+            )
+            todo.pop()
+            open_.discard(key)
+    return min(cap, size + sum(count * sizes[t] for t, count in uses.items()))
 
 
 def _check_attributes(element: ElementTree.Element) -> None:
@@ -293,12 +365,46 @@ def _check_attributes(element: ElementTree.Element) -> None:
                 f'{name} has viewBox="{text}": a viewBox is four finite numbers "min-x min-y '
                 'width height", the width and height positive'
             )
+    if tag == "path":
+        text = element.get("d")
+        if text is None or not _path_data_ok(text):
+            flat = " ".join((text or "").split())  # the data's newlines and tabs as spaces
+            shown = "no d" if text is None else f'd="{flat[:40]}{"..." if len(flat) > 40 else ""}"'
+            raise RigidfoldError(
+                f"{name} has {shown}: path data is moveto, lineto and closepath commands (M, "
+                "L, H, V, Z) and numbers, starting with M"
+            )
     text = element.get("transform")
     if text is not None and not _transform_ok(text):
         raise RigidfoldError(
             f'{name} has transform="{text}": a transform is a list of matrix(a,b,c,d,e,f), '
             "translate, scale, rotate, skewX or skewY of finite numbers"
         )
+
+
+_PATH_TOKEN = re.compile(rf"({_NUMBER})|([A-Za-z])|[\s,]+|(.)", re.DOTALL)
+
+
+def _path_data_ok(text: str) -> bool:
+    """Whether svgelements reads the path data ``text`` as written: empty, or M first, then
+    commands each followed by numbers (Z by none). A command without its numbers, a word in
+    place of a number (``nan``) and no leading M end in its TypeError or AttributeError.
+    Curves pass here and are refused later by name. Linear in the text."""
+    command, numbers = "", 0
+    for number, letter, other in _PATH_TOKEN.findall(text):
+        if other:
+            return False
+        if letter:
+            if letter not in "MmLlHhVvCcSsQqTtAaZz" or (not command and letter not in "Mm"):
+                return False
+            if command and command not in "Zz" and not numbers:
+                return False
+            command, numbers = letter, 0
+        elif number:
+            if not command or command in "Zz":
+                return False
+            numbers += 1
+    return not command or command in "Zz" or numbers > 0
 
 
 def _transform_ok(text: str) -> bool:
@@ -325,18 +431,20 @@ def _local(tag: str) -> str:
     return tag.rpartition("}")[2]
 
 
-_SVGELEMENTS_ERRORS = (ArithmeticError, IndexError, RecursionError)
+_SVGELEMENTS_ERRORS = (ArithmeticError, IndexError, RecursionError, TypeError, AttributeError)
 """What svgelements raises on drawings it cannot compute with: arithmetic on degenerate or
-enormous numbers, a transform or style it misreads, references in a loop."""
+enormous numbers, a transform or style it misreads, references in a loop, a value it has
+not parsed (None) met in its arithmetic."""
 
 
 def _cannot_read(exc: BaseException) -> str:
     """The message of :data:`_SVGELEMENTS_ERRORS`."""
-    hint = (
-        "do its <use> elements refer to each other in a loop?"
-        if isinstance(exc, RecursionError)
-        else "check the numbers of its width, height, viewBox and transform attributes and styles"
-    )
+    if isinstance(exc, RecursionError):
+        hint = "do its <use> elements refer to each other in a loop?"
+    elif isinstance(exc, TypeError | AttributeError):
+        hint = "check the path data, points and coordinates of its shapes"
+    else:
+        hint = "check the numbers of its width, height, viewBox and transform attributes and styles"
     return f"svgelements cannot read the drawing ({type(exc).__name__}: {exc}): {hint}"
 
 

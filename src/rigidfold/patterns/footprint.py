@@ -70,8 +70,10 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
     first), or a one-line ValueError saying what is wrong.
 
     Refused: fewer than 3 points, non-finite coordinates, a plan too small or too large
-    (:func:`~rigidfold.patterns.grids.check_extent`), a repeated point, zero area and a
-    self-intersecting outline (sides that cross or touch anywhere but at shared corners);
+    (:func:`~rigidfold.patterns.grids.check_extent`), a repeated point, zero area, a
+    self-intersecting outline (sides that cross or touch anywhere but at shared corners) and
+    two points, or a point and a side, closer than ``settings.footprint_min_gap`` times the
+    larger side of the bounding box (where Triangle's refinement runs away);
     zero area is a convex hull smaller than ``settings.degenerate_area`` times the squared
     larger side of the bounding box.
     """
@@ -110,6 +112,14 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
         raise RigidfoldError(
             f"the footprint {_points(xy)} is not a simple polygon: its sides intersect "
             f"at {where or 'a point'}"
+        )
+    polygon = shapely.Polygon(xy)
+    gap, size = float(shapely.minimum_clearance(polygon)), float(np.ptp(xy, axis=0).max())
+    if gap < settings.footprint_min_gap * size:
+        raise RigidfoldError(
+            f"the footprint {_points(xy)} has two points, or a point and a side, {gap:.3g} m "
+            f"apart, less than {settings.footprint_min_gap:g} of its size of {size:g} m "
+            "(Settings.footprint_min_gap): merge them or move them apart"
         )
     return xy if _signed_area(xy) > 0 else np.concatenate([xy[:1], xy[:0:-1]])
 

@@ -270,6 +270,12 @@ def _mesh_problem(
     bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
     if bad.size:
         return f"vertex {bad[0]} has non-finite coordinates {v[bad[0]].tolist()}"
+    far = np.flatnonzero(np.abs(v).max(axis=1) > settings.max_coordinate)
+    if far.size:  # before the areas below overflow
+        return (
+            f"vertex {far[0]} at {v[far[0]].tolist()} lies farther than "
+            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+        )
     c = v[t].astype(float)
     e1, e2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
     plan = float((e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()) / 2
