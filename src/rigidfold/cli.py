@@ -1025,6 +1025,7 @@ def _cmd_structure(args: argparse.Namespace) -> int:
         + (f", clamped {sup.clamped.tolist()}" if len(sup.clamped) else "")
         + f"; mechanism DOF {c.rigidity.dof} without them; smallest stiffness eigenvalue "
         f"{c.rigidity.smallest:.3g}"
+        + ("" if c.rigidity.rigid else f"; {c.rigidity.stability.message}")
     )
     if c.response is not None:
         load = c.total_load
