@@ -24,8 +24,10 @@ Discrete Math. 9(3), 1996):
 * The supports are **prestress stable** when some self-stress makes Z^T Omega(w) Z positive
   definite and the weakest flex (the first, of the smallest first-order stiffness) does not
   extend to a finite motion (see below: near-mechanisms of nearly flat vertices give near
-  self-stresses, whose stress matrices need not vanish on a real motion). The stress matrices on the flexes span a space of symmetric k x k matrices
-  (at most k (k + 1) / 2 of them); the best w maximises lambda_min(Z^T Omega(w) Z) over a
+  self-stresses, whose stress matrices need not vanish on a real motion). The stress
+  matrices on the flexes span a space of symmetric k x k matrices (at most k (k + 1) / 2
+  of them; those below ``structure_prestress_tol`` times the largest second derivative of
+  one constraint on the flexes are dropped); the best w maximises lambda_min(Z^T Omega(w) Z) over a
   box, a concave maximisation solved by cutting planes on linear programs (scipy's HiGHS):
   each program's optimum bounds the answer from above, each trial w gives a value from
   below, so the search ends with either a positive definite stress matrix (prestress
@@ -248,9 +250,7 @@ def second_order(
         # (a rotation about two pins, say) is a mechanism whatever their stress matrices say
         moved = _finite_motion(cons, _unit(Z[:, 0]), settings)
         if moved is not None:
-            return SecondOrder(
-                Stability.MECHANISM, k, W.shape[1], len(basis), margin, bound, moved
-            )
+            return SecondOrder(Stability.MECHANISM, k, W.shape[1], len(basis), margin, bound, moved)
         witness = _unit(Z @ direction)
         return SecondOrder(Stability.PRESTRESS, k, W.shape[1], len(basis), margin, bound, witness)
     # a finite motion's tangent has zero energy under every self-stress: try the flex of the
