@@ -55,6 +55,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_path.py
 	$(PY) benchmarks/deploy_share.py
 	$(PY) benchmarks/bench_structure.py
+	$(PY) benchmarks/panel_pin_trend.py
 	$(PY) benchmarks/bench_fabricate.py
 
 lint: $(STAMP)

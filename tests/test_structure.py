@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ import pytest
 from conftest import folded_grid, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
-from rigidfold.io import write_fold
+from rigidfold.io import read_fold, write_fold
 from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import face_areas
@@ -29,6 +30,8 @@ from rigidfold.structure import (
     parse_load,
     parse_material,
 )
+
+DATA = Path(__file__).parent / "data"
 
 
 def plate(nx: int, ny: int, lx: float, ly: float) -> CreasePattern:
@@ -334,3 +337,32 @@ def test_cli_bad_input_is_one_line_exit_2(design_file, tmp_path, args):
     assert res.returncode == 2
     assert res.stderr.count("\n") == 1 and "Traceback" not in res.stderr
     assert not (tmp_path / "x" / "structure.json").exists()
+
+
+# ------------------------------------------------------------------ the 12 m x 8 m roof
+@pytest.fixture(scope="module")
+def roof() -> CreasePattern:
+    """The README's roof: ``rigidfold generate --pattern grid:9x6 --size 12x8 --surface expr
+    --expr "0.06*x*(12-x)/6 + 0.05*y*(8-y)" --no-deform``, its final design (DOF 1)."""
+    return read_fold(DATA / "roof_12x8_dof1.fold").pattern
+
+
+def test_roof_stands_on_auto_supports_under_self_weight(roof):
+    """--supports auto and self-weight: first-order rigid by an independent rank
+    computation, the reactions balance the panels' weight to 0.1 %, and removing any one
+    support is reported as a mechanism (and is one, by the same rank computation)."""
+    chosen = auto_supports(roof, roof.boundary_vertices)
+    assert chosen.rigid and chosen.dof == 1
+    pinned = chosen.supports.pinned
+    assert independent_kernel(roof, pinned) == 0
+    mat = MATERIALS["plywood"]
+    check = check_structure(roof, chosen, material=mat, thickness=0.018, modes=0)
+    area = float(face_areas(roof.coords, roof.faces).sum())
+    weight = mat.density * DEFAULTS.structure_gravity * 0.018 * area
+    assert check.total_load[2] == pytest.approx(-weight, rel=1e-9)
+    assert check.response.converged and check.balance_error < 1e-3
+    assert check.status is not StructureStatus.MECHANISM
+    for v in pinned:
+        fewer = check_supports(roof, Supports(np.setdiff1d(pinned, [v])))
+        assert not fewer.stable and "mechanism" in fewer.mode
+        assert independent_kernel(roof, fewer.supports.pinned) >= 1

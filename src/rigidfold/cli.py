@@ -337,7 +337,7 @@ def build_parser() -> argparse.ArgumentParser:
         "(the input plus a 'creasePattern' frame with 2D coordinates) and DIR/<name>.svg. Exit "
         "code 0 when the development converged, 1 when not, 2 on bad input.",
     )
-    _file_command(
+    dfm = _file_command(
         sub,
         "deform",
         _cmd_deform,
@@ -352,6 +352,23 @@ def build_parser() -> argparse.ArgumentParser:
         "DIR/<name>.svg (the development diagram) and DIR/<name>_deform.json (figures and the "
         "load-step history). Exit code 0 when the plane is reached, 1 when not, 2 on bad "
         "input.",
+    )
+    dfm.add_argument(
+        "--material",
+        default=None,
+        metavar="NAME|E,nu,density",
+        help="build the frame's members as strips of these panels instead of the paper's "
+        "tubes (each triangle's area shared by its three members, the panel's thickness): a "
+        f"preset ({', '.join(MATERIALS)}) or E,nu,density in SI units; with --thickness only, "
+        f"{DEFAULTS.structure_material} (default: the tubes)",
+    )
+    dfm.add_argument(
+        "--thickness",
+        type=float,
+        default=None,
+        metavar="T",
+        help="panel thickness in metres for --material (default with --material: "
+        f"{DEFAULTS.structure_thickness:g})",
     )
 
     exp = _file_command(
@@ -1034,7 +1051,9 @@ def _cmd_develop(args: argparse.Namespace) -> int:
 def _cmd_deform(args: argparse.Namespace) -> int:
     from rigidfold.workflows import deform_file
 
-    checked = deform_file(args.file, args.out, up=args.up)
+    checked = deform_file(
+        args.file, args.out, up=args.up, material=args.material, thickness=args.thickness
+    )
     d, m = checked.verification.deformation, checked.verification.motion
     assert d is not None  # deform_file runs the analysis
     if args.json:
@@ -1045,6 +1064,12 @@ def _cmd_deform(args: argparse.Namespace) -> int:
         f"{d.max_dl_mm:.4g} mm, mean/max |drho_fix| = {d.mean_drho_fix_deg:.4g}/"
         f"{d.max_drho_fix_deg:.4g} deg, {d.wall_time:.2f} s"
         + (f" ({d.message})" if d.message else "")
+        + (
+            f"; frame of {checked.section['material']['name']} strips "
+            f"{checked.section['thickness_m'] * 1e3:g} mm thick"
+            if checked.section is not None and checked.section["kind"] == "panel"
+            else ""
+        )
     )
     if m is not None:
         print(
@@ -1107,6 +1132,7 @@ def _cmd_structure(args: argparse.Namespace) -> int:
         + (f", clamped {sup.clamped.tolist()}" if len(sup.clamped) else "")
         + f"; mechanism DOF {c.rigidity.dof} without them; smallest stiffness eigenvalue "
         f"{c.rigidity.smallest:.3g}"
+        + ("" if c.rigidity.rigid else f"; {c.rigidity.stability.message}")
     )
     if c.response is not None:
         load = c.total_load

@@ -281,6 +281,20 @@ class Settings:
     structure_ground_tol : float
         ``--support-candidates ground``: boundary vertices within this (m) of the lowest
         boundary vertex's height.
+    structure_balance_tol : float
+        A static answer whose reactions miss the loads by more than this share of them did
+        not carry the load (0.1 %: a singular stiffness).
+    structure_prestress_tol : float
+        Second order (``rigidfold.structure.stability``): the supports are prestress stable
+        when the smallest eigenvalue of the best self-stress's stress matrix on the flexes
+        exceeds this fraction of the stress matrices' largest entry; stress matrices below
+        this fraction of the largest are dropped.
+    structure_prestress_cuts : int
+        Cutting planes (linear programs) of the search for that self-stress.
+    structure_flex_step, structure_flex_tol : float
+        A flex is a finite mechanism when the design moved this many mean edge lengths along
+        it is corrected (at right angles, Gauss-Newton, ``structure_max_iter`` iterations)
+        to meet every constraint within this fraction of the mean edge length.
 
     Rigid-folding path (``rigidfold.mechanism.path``, Step 5 beyond the paper)
     -------------------------------------------------------------------------
@@ -520,6 +534,11 @@ class Settings:
     structure_rigidity_tol: float = 1e-6
     structure_max_support_sets: int = 100_000
     structure_ground_tol: float = 1e-3
+    structure_balance_tol: float = 1e-3
+    structure_prestress_tol: float = 1e-8
+    structure_prestress_cuts: int = 200
+    structure_flex_step: float = 0.05
+    structure_flex_tol: float = 1e-10
     # rigid-folding path (Step 5, beyond the paper)
     path_flat_tol: float = math.radians(0.5)
     path_fold_limit: float = math.radians(179.0)

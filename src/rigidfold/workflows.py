@@ -164,15 +164,17 @@ class ShapeCheck:
     file: str
     verification: Verification
     written: tuple[Path, ...]
+    section: dict | None = None
 
     def to_dict(self) -> dict:
         """The checked stage's figures at the top level (the deformation's when Step 9 ran,
         else the development's, without the load-step history), the others under their
-        names."""
+        names; Step 9's frame section under ``frame_section`` when it ran."""
         figures = self.verification.to_dict()
         stage = "development" if figures["deformation"] is None else "deformation"
         top = {k: v for k, v in figures.pop(stage).items() if k != "history"}
-        return {**top, **{k: v for k, v in figures.items() if v is not None}}
+        extra = {} if self.section is None else {"frame_section": self.section}
+        return {**top, **{k: v for k, v in figures.items() if v is not None}, **extra}
 
 
 def develop_file(
@@ -193,16 +195,38 @@ def deform_file(
     out: str | os.PathLike,
     *,
     up: str = "z",
+    material: str | Material | None = None,
+    thickness: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> ShapeCheck:
     """Steps 8-9 and the folding motion of a FOLD shape (read with ``up``):
     ``OUT/<name>.fold`` (the input, kept whole, plus rigidfold's development diagram, motion
     frames, folded form and figures), ``OUT/<name>.svg`` and ``OUT/<name>_deform.json``
-    (every figure and the load-step history)."""
-    return _check_file(path, out, deform=True, up=up, settings=settings)
+    (every figure and the load-step history).
+
+    material, thickness : Step 9's frame as strips of these panels
+    (:func:`rigidfold.deform.analysis.panel_section`; a preset's name or ``E,nu,density``,
+    metres); either given, the other defaults to ``Settings.structure_material`` /
+    ``structure_thickness``; neither: the paper's tubes."""
+    mat, t = None, None
+    if material is not None or thickness is not None:
+        mat = parse_material(settings.structure_material if material is None else material)
+        t = settings.structure_thickness if thickness is None else thickness
+        if isinstance(t, bool) or not (isinstance(t, int | float) and np.isfinite(t) and t > 0):
+            raise RigidfoldError(f"thickness must be a positive number of metres, got {t!r}")
+    return _check_file(path, out, deform=True, up=up, settings=settings, material=mat, thickness=t)
 
 
-def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> ShapeCheck:
+def _check_file(
+    path,
+    out,
+    *,
+    deform: bool,
+    up: str,
+    settings: Settings,
+    material: Material | None = None,
+    thickness: float | None = None,
+) -> ShapeCheck:
     """Read, check and write back a FOLD shape. The output FOLD is the input document with
     rigidfold's frames (in metres, ``frame_unit: "m"``, z up) and ``rigidfold:`` keys added:
     nothing of the input is dropped or rewritten, so its unit, orientation, polygons and
@@ -215,7 +239,14 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
     refuse_replacing_inputs([path], [Path(out) / name for name in names])
     out_dir = prepare_output_dir(out)
     data = read_fold(path, up=up, settings=settings)
-    check = verify(data.pattern, run_deform=deform, run_motion=deform, settings=settings)
+    check = verify(
+        data.pattern,
+        run_deform=deform,
+        run_motion=deform,
+        material=material,
+        thickness=thickness,
+        settings=settings,
+    )
     written = write_checked_shape(
         out_dir / f"{stem}.fold",
         data.pattern,
@@ -225,9 +256,23 @@ def _check_file(path, out, *, deform: bool, up: str, settings: Settings) -> Shap
         svg_title=f"{label}: development",
         source=data,
     )
+    section = None
     if deform:
-        written.append(write_json(out_dir / f"{stem}_deform.json", check.to_dict()))
-    return ShapeCheck(str(path), check, tuple(written))
+        section = {
+            "kind": "tube",
+            "diameter_m": settings.tube_diameter,
+            "wall_m": settings.tube_wall,
+            "E_Pa": settings.youngs_modulus,
+            "nu": settings.poisson_ratio,
+        }
+        if material is not None:
+            section = {"kind": "panel", "material": material.to_dict(), "thickness_m": thickness}
+        written.append(
+            write_json(
+                out_dir / f"{stem}_deform.json", {**check.to_dict(), "frame_section": section}
+            )
+        )
+    return ShapeCheck(str(path), check, tuple(written), section)
 
 
 # ------------------------------------------------------------------------------ optimize

@@ -1,6 +1,13 @@
 """Step 9: large-deformation check (OpenSees), the folding motion, and both with Step 8."""
 
-from rigidfold.deform.analysis import DeformResult, DeformStatus, TubeSection, deform
+from rigidfold.deform.analysis import (
+    DeformResult,
+    DeformStatus,
+    PanelSection,
+    TubeSection,
+    deform,
+    panel_section,
+)
 from rigidfold.deform.check import Agreement, Verdicts, Verification, compare, verify
 from rigidfold.deform.motion import Motion, MotionStatus, folding_motion
 
@@ -10,11 +17,13 @@ __all__ = [
     "DeformStatus",
     "Motion",
     "MotionStatus",
+    "PanelSection",
     "TubeSection",
     "Verdicts",
     "Verification",
     "compare",
     "deform",
     "folding_motion",
+    "panel_section",
     "verify",
 ]

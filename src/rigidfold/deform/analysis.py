@@ -24,6 +24,17 @@ midsegments of each triangle's edge nodes (``l_e = 2 |m_a - m_b|``), and the cha
 dihedral angle of every fixed crease, from the triangles' edge nodes. ``mean_dl_mm`` is the
 mean over edges of each edge's largest |Delta l| during the analysis; ``max`` is the largest.
 
+With a ``material`` and ``thickness`` (the panels' own, :mod:`rigidfold.structure.material`),
+the members are strips of the panel instead of tubes (:class:`PanelSection`): the triangle's
+area is shared equally by its three members, so member k of length l_k in triangle f is a
+solid rectangle of width ``b = area_f / (3 l_k)`` and the panel's thickness t, lying in the
+panel's plane (A = b t; out-of-plane bending I = b t^3 / 12, in-plane I = t b^3 / 12;
+St Venant torsion J = b t^3 / 3 (1 - 0.63 t / b), the sides swapped where t > b; G = E / 2
+(1 + nu)). The frame then has the panels' volume, and a member's out-of-plane bending
+stiffness per unit width is the plate's E t^3 / 12 without the 1 / (1 - nu^2) of plate
+bending. A crease's axis member takes the section of its side's member to that crease.
+Without a material, the paper's tubes (``Settings.tube_*``), as before.
+
 OpenSees is imported only when an analysis runs (``openseespy``, free for research,
 education and internal use; see its licence).
 """
@@ -33,6 +44,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -41,6 +53,9 @@ from rigidfold.frame.model import default_support_face
 from rigidfold.mesh import CreasePattern
 from rigidfold.quiet import native_quiet
 from rigidfold.status import Outcome
+
+if TYPE_CHECKING:  # the material is the structure check's; only its fields are read here
+    from rigidfold.structure.material import Material
 
 
 @dataclass(frozen=True)
@@ -78,6 +93,75 @@ class TubeSection:
     @property
     def G(self) -> float:
         return self.E / (2 * (1 + self.nu))
+
+
+@dataclass(frozen=True, eq=False)
+class PanelSection:
+    """Per-member sections of the frame as strips of the panel (see the module's text).
+
+    E, nu : the material; thickness : t, m; width : (M,) b of every member, m; normal :
+    (M, 3) unit normal of each member's panel (the local x-z plane of its section).
+    """
+
+    E: float
+    nu: float
+    thickness: float
+    width: np.ndarray
+    normal: np.ndarray
+
+    @property
+    def G(self) -> float:
+        return self.E / (2 * (1 + self.nu))
+
+    @property
+    def A(self) -> np.ndarray:
+        """(M,) b t."""
+        return self.width * self.thickness
+
+    @property
+    def I_out(self) -> np.ndarray:
+        """(M,) out-of-plane bending, about the member's in-plane normal: b t^3 / 12."""
+        return self.width * self.thickness**3 / 12
+
+    @property
+    def I_in(self) -> np.ndarray:
+        """(M,) in-plane bending, about the panel's normal: t b^3 / 12."""
+        return self.thickness * self.width**3 / 12
+
+    @property
+    def J(self) -> np.ndarray:
+        """(M,) St Venant torsion of a b x t rectangle, a / 3 c^3 (1 - 0.63 c / a) with
+        a the longer side and c the shorter."""
+        a = np.maximum(self.width, self.thickness)
+        c = np.minimum(self.width, self.thickness)
+        return a * c**3 / 3 * (1 - 0.63 * c / a)
+
+
+def panel_section(pattern: CreasePattern, material: Material, thickness: float) -> PanelSection:
+    """The frame's members (:func:`_layout`'s order) as strips of ``thickness`` of
+    ``material`` (see the module's text)."""
+    lay = _layout(pattern)
+    x, faces = pattern.coords, pattern.faces
+    normal = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
+    area = 0.5 * np.linalg.norm(normal, axis=1)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    F = pattern.n_faces
+    ends = lay.coords[lay.members[: 3 * F, 1]] - lay.coords[lay.members[: 3 * F, 0]]
+    width = np.repeat(area / 3, 3) / np.linalg.norm(ends, axis=1)
+    face = np.repeat(np.arange(F), 3)
+    # the axis members of each free crease: the left side's, then the right side's
+    free = pattern.free_creases
+    side_width, side_face = [], []
+    for side in (0, 1):
+        f = pattern.edge_faces[free, side]
+        k = np.argmax(pattern.face_edges[f] == free[:, None], axis=1)
+        side_width.append(width[3 * f + k])
+        side_face.append(f)
+    width = np.concatenate([width, *side_width])
+    face = np.concatenate([face, *side_face])
+    return PanelSection(
+        float(material.E), float(material.nu), float(thickness), width, normal[face]
+    )
 
 
 class DeformStatus(Outcome):
@@ -226,9 +310,14 @@ def deform(
     *,
     support_face: int | None = None,
     plane_z: float = 0.0,
+    material: Material | None = None,
+    thickness: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> DeformResult:
     """Drive the frame model of ``pattern`` to the plane z = ``plane_z`` (Step 9).
+
+    With a ``material`` (and ``thickness``, m, default ``Settings.structure_thickness``) the
+    members are strips of the panel (:func:`panel_section`); without, the paper's tubes.
 
     A step that does not converge is retried with half the increment up to
     ``deform_max_halvings`` times; then the analysis stops with status FAILED and the figures
@@ -243,6 +332,10 @@ def deform(
         support_face = default_support_face(pattern)
     lay = _layout(pattern)
     sec = TubeSection.from_settings(settings)
+    panel = None
+    if material is not None:
+        t = settings.structure_thickness if thickness is None else thickness
+        panel = panel_section(pattern, material, t)
     tag = lambda i: int(i) + 1  # noqa: E731 - OpenSees tags start at 1
 
     ops.wipe()
@@ -254,22 +347,23 @@ def deform(
     ops.uniaxialMaterial("Elastic", 1, float(settings.hinge_stiffness))
     for k, (a, b) in enumerate(lay.members):
         d = lay.coords[b] - lay.coords[a]
-        # any vector not parallel to the member defines its local x-z plane
-        ref = np.eye(3)[int(np.argmin(np.abs(d) / np.linalg.norm(d)))]
+        if panel is None:
+            # any vector not parallel to the member defines its local x-z plane
+            ref = np.eye(3)[int(np.argmin(np.abs(d) / np.linalg.norm(d)))]
+            props = (sec.A, sec.E, sec.G, sec.J, sec.I, sec.I)
+        else:
+            # local z along the panel's normal: Iy bends out of the plane, Iz in it
+            ref = panel.normal[k]
+            props = (
+                float(panel.A[k]),
+                panel.E,
+                panel.G,
+                float(panel.J[k]),
+                float(panel.I_out[k]),
+                float(panel.I_in[k]),
+            )
         ops.geomTransf("Corotational", k + 1, *map(float, ref))
-        ops.element(
-            "elasticBeamColumn",
-            k + 1,
-            tag(a),
-            tag(b),
-            sec.A,
-            sec.E,
-            sec.G,
-            sec.J,
-            sec.I,
-            sec.I,
-            k + 1,
-        )
+        ops.element("elasticBeamColumn", k + 1, tag(a), tag(b), *props, k + 1)
     n_el = len(lay.members)
     for k, (a, b) in enumerate(lay.springs):
         ops.element("zeroLength", n_el + k + 1, tag(a), tag(b), "-mat", 1, 1, 1, "-dir", 4, 5, 6)
@@ -279,7 +373,8 @@ def deform(
     ops.pattern("Plain", 1, 1)
     for node in np.unique(np.concatenate([lay.bary, lay.face_edge_node.ravel()])):
         ops.sp(tag(node), 3, float(plane_z - lay.coords[node, 2]))
-    penalty = settings.deform_penalty * sec.E * sec.A / float(np.mean(pattern.edge_lengths))
+    EA = sec.E * sec.A if panel is None else panel.E * float(np.mean(panel.A))
+    penalty = settings.deform_penalty * EA / float(np.mean(pattern.edge_lengths))
     ops.constraints("Penalty", penalty, penalty)
     ops.numberer("RCM")
     ops.system("UmfPack")

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.analysis import DeformResult, deform
@@ -25,6 +25,9 @@ from rigidfold.develop import Development, DevelopStatus, develop
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
+
+if TYPE_CHECKING:
+    from rigidfold.structure.material import Material
 
 
 class Agreement(Outcome):
@@ -180,12 +183,16 @@ def verify(
     support_face: int | None = None,
     dof: int | None = None,
     path: FoldingPath | None = None,
+    material: Material | None = None,
+    thickness: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> Verification:
     """Development (Step 8), large-deformation check (Step 9) and motion of one shape.
 
     ``dof``, ``path``: the shape's DOF and traced folding path where they are known
-    (:func:`rigidfold.deform.folding_motion` traces the path otherwise)."""
+    (:func:`rigidfold.deform.folding_motion` traces the path otherwise). ``material``,
+    ``thickness``: Step 9's frame as strips of the panels
+    (:func:`rigidfold.deform.analysis.panel_section`) instead of the paper's tubes."""
     times = {}
     t0 = time.perf_counter()
     development = develop(pattern, settings=settings)
@@ -193,7 +200,13 @@ def verify(
     deformation = None
     if run_deform:
         t0 = time.perf_counter()
-        deformation = deform(pattern, support_face=support_face, settings=settings)
+        deformation = deform(
+            pattern,
+            support_face=support_face,
+            material=material,
+            thickness=thickness,
+            settings=settings,
+        )
         times["deform"] = time.perf_counter() - t0
     motion = None
     if run_motion and development.status is DevelopStatus.CONVERGED:

@@ -3,10 +3,12 @@ under load in OpenSees (``rigidfold structure``).
 
 :mod:`~rigidfold.structure.material` (the panels' material, presets),
 :mod:`~rigidfold.structure.supports` (first-order rigidity of a design on its supports, and
-the fewest supports that give it), :mod:`~rigidfold.structure.model` (the shell model:
-panels as plates, free creases as hinges), :mod:`~rigidfold.structure.loads` (self-weight,
-snow, wind, point loads), :mod:`~rigidfold.structure.analysis` (static and eigen analysis
-in OpenSees), :mod:`~rigidfold.structure.check` (the check and its verdict),
+the fewest supports that give it), :mod:`~rigidfold.structure.stability` (second order where
+first order is not enough: prestress stability, or a finite mechanism),
+:mod:`~rigidfold.structure.model` (the shell model: panels as plates, free creases as
+hinges), :mod:`~rigidfold.structure.loads` (self-weight, snow, wind, point loads),
+:mod:`~rigidfold.structure.analysis` (static and eigen analysis in OpenSees),
+:mod:`~rigidfold.structure.check` (the check and its verdict),
 :mod:`~rigidfold.structure.design` (the check from the options as given, and its files) and
 :mod:`~rigidfold.structure.figure` (the deflected shape). OpenSees and matplotlib are
 imported only when an analysis runs or a figure is drawn.
@@ -27,6 +29,7 @@ from rigidfold.structure.design import (
 )
 from rigidfold.structure.loads import LOAD_KINDS, Load, parse_load
 from rigidfold.structure.material import MATERIALS, Material, parse_material, presets_help
+from rigidfold.structure.stability import SecondOrder, Stability, second_order
 from rigidfold.structure.supports import (
     CANDIDATE_FORMS,
     Rigidity,
@@ -46,6 +49,8 @@ __all__ = [
     "Load",
     "Material",
     "Rigidity",
+    "SecondOrder",
+    "Stability",
     "StructureCheck",
     "StructureStatus",
     "SupportModes",
@@ -61,6 +66,7 @@ __all__ = [
     "parse_load",
     "parse_material",
     "presets_help",
+    "second_order",
     "support_candidates",
     "write_structure",
 ]

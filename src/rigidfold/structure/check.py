@@ -26,6 +26,7 @@ from rigidfold.structure.analysis import ShellResponse, solve_shell
 from rigidfold.structure.loads import Load, check_loads, nodal_loads
 from rigidfold.structure.material import Material
 from rigidfold.structure.model import ShellMesh, shell_mesh
+from rigidfold.structure.stability import Stability
 from rigidfold.structure.supports import Rigidity
 
 
@@ -63,7 +64,9 @@ class StructureCheck:
     supports' first-order rigidity; loads : the load terms; self_weight : whether included;
     hinge_stiffness : N m/rad per m; nonlinear : geometrically nonlinear analysis; limit :
     the deflection limit's divisor (span / limit); mesh and response : the shell model and
-    its response (None when the supports leave a mechanism).
+    its response (None when the supports leave a mechanism); balance_tol : a static answer
+    whose reactions miss the loads by more than this share of them did not carry the load
+    (a singular stiffness: supports that are prestress stable only, with free hinges).
     """
 
     pattern: CreasePattern
@@ -78,13 +81,14 @@ class StructureCheck:
     mesh: ShellMesh | None
     response: ShellResponse | None
     auto: bool = False
+    balance_tol: float = DEFAULTS.structure_balance_tol
 
     # ------------------------------------------------------------------ verdict
     @property
     def status(self) -> StructureStatus:
-        if not self.rigidity.rigid or self.response is None:
+        if not self.rigidity.stable or self.response is None:
             return StructureStatus.MECHANISM
-        if not self.response.converged:
+        if not self.response.converged or not self.balance_error <= self.balance_tol:
             return StructureStatus.NOT_CONVERGED
         if self.max_displacement > self.allowed_displacement:
             return StructureStatus.DEFLECTION
@@ -99,15 +103,30 @@ class StructureCheck:
         """The status's message with this run's detail."""
         status = self.status
         if status is StructureStatus.MECHANISM:
-            return status.describe(self.rigidity.mode)
+            return status.describe(self.rigidity.detail)
         if status is StructureStatus.NOT_CONVERGED:
             assert self.response is not None
-            return status.describe(
-                f"load factor {self.response.load_factor:.3g}; {self.response.message}"
+            prestress = (
+                "; prestress stable supports carry a load across their flexes only by large "
+                "deflection"
+                if self.rigidity.stability is Stability.PRESTRESS
+                else ""
             )
+            why = self.response.message
+            if self.response.converged:
+                why = (
+                    f"the reactions miss the loads by {self.balance_error:.3g} of them: the "
+                    "stiffness is singular"
+                )
+            return status.describe(f"load factor {self.response.load_factor:.3g}; {why}{prestress}")
+        prestress = (
+            "; the supports are prestress stable, not first-order rigid"
+            if self.rigidity.stability is Stability.PRESTRESS
+            else ""
+        )
         return status.describe(
             f"{self.max_displacement * 1e3:.3g} mm, limit L/{self.limit:g} = "
-            f"{self.allowed_displacement * 1e3:.3g} mm on a span of {self.span:.3g} m"
+            f"{self.allowed_displacement * 1e3:.3g} mm on a span of {self.span:.3g} m{prestress}"
         )
 
     # ------------------------------------------------------------------ figures
@@ -283,8 +302,9 @@ def check_structure(
         nonlinear=nonlinear,
         limit=limit,
         auto=auto,
+        balance_tol=settings.structure_balance_tol,
     )
-    if not rigidity.rigid:
+    if not rigidity.stable:
         return StructureCheck(mesh=None, response=None, **common)  # type: ignore[arg-type]
     mesh = shell_mesh(held, settings.structure_subdivisions)
     weight = material.density * settings.structure_gravity * thickness if self_weight else 0.0

@@ -24,8 +24,15 @@ size the one of the largest smallest eigenvalue. Every set of one size is tried,
 size first (from ceil((d + 6) / 3), as each pin gives three rows), while the number of sets
 is at most ``Settings.structure_max_support_sets``; beyond, a greedy search adds the
 candidate that raises log det of K~ (eigenvalues floored) the most until rigid, then drops
-any support not needed. First-order rigidity is what is checked: a set that is rigid only at
-second order (prestress stability) is reported as a mechanism.
+any support not needed.
+
+Where first order is not enough (K~ has eigenvalues at most ``structure_rigidity_tol``: the
+supports leave first-order motions, the flexes, the eigenvectors of those eigenvalues), the
+flexes go to the second-order check of :mod:`rigidfold.structure.stability`: a set that is
+prestress stable (a self-stress of the constraints holds every flex) is accepted and says
+so; one that leaves a finite mechanism, or a flex that no self-stress holds, is refused with
+the motion named. ``auto`` prefers first-order rigid sets; it returns a prestress-stable one
+only when all candidates together are not first-order rigid.
 """
 
 from __future__ import annotations
@@ -45,6 +52,7 @@ from rigidfold.mechanism.kinematics import (
 )
 from rigidfold.mechanism.stiffness import PseudoStiffness
 from rigidfold.mesh import CreasePattern
+from rigidfold.structure.stability import SecondOrder, Stability, held_vertices, second_order
 
 CANDIDATE_FORMS = ("boundary", "ground", "V,V,...")
 
@@ -205,20 +213,31 @@ class SupportModes:
         free when they do not."""
         stiff = self.stiffness(supports)
         lam = stiff.eigenvalues
-        rigid = bool(lam[0] > self.settings.structure_rigidity_tol)
+        soft = lam <= self.settings.structure_rigidity_tol
+        rigid = not bool(soft.any())
         weakest = self.Q @ stiff.eigenvectors[:, 0]
+        second = None
+        if not rigid:
+            held = held_vertices(self.pattern, supports.pinned, supports.clamped)
+            flexes = self.Q @ stiff.eigenvectors[:, soft]
+            second = second_order(self.pattern, held, flexes, self.settings)
+            weakest = second.witness
+        noun = "a first-order motion"
+        if second is None or second.stability is Stability.MECHANISM:
+            noun = "a mechanism"
         return Rigidity(
             supports=supports,
             dof=self.dof,
             near_mechanisms=self.near,
             eigenvalues=lam,
             rigid=rigid,
-            mode=None if rigid else self.describe(weakest),
+            mode=None if rigid else self.describe(weakest, noun),
+            second_order=second,
         )
 
-    def describe(self, motion: np.ndarray) -> str:
-        """A motion (3V,) of the vertices in words: the creases it folds most, or the
-        rigid-body motion it is."""
+    def describe(self, motion: np.ndarray, noun: str = "a mechanism") -> str:
+        """A motion (3V,) of the vertices in words: ``noun`` that folds the creases it
+        folds most, or the rigid-body motion it is."""
         pat = self.pattern
         free = pat.free_creases
         rates = fold_angle_gradients(pat, free) @ motion if len(free) else np.zeros(0)
@@ -233,7 +252,7 @@ class SupportModes:
                 for j in order
                 if np.abs(rates[j]) > 0.1 * top
             ]
-            return "a mechanism that folds crease " + ", ".join(names)
+            return f"{noun} that folds crease " + ", ".join(names)
         t, w = coef[:3], coef[3:]
         if np.linalg.norm(w) * self.scale > 1e-6 * np.linalg.norm(t):
             return "a rigid-body rotation about the axis " + _vector(w / np.linalg.norm(w))
@@ -250,8 +269,9 @@ class Rigidity:
 
     supports : Supports; dof : the mechanism's DOF without supports; near_mechanisms : the
     motions of small stiffness counted with them; eigenvalues : (m,) ascending eigenvalues of
-    K~ (m = 6 + dof + near_mechanisms); rigid : bool; mode : the motion left free, in words
-    (None when rigid).
+    K~ (m = 6 + dof + near_mechanisms); rigid : first-order rigid; mode : the motion left
+    free at first order, in words (None when rigid); second_order : the second-order check
+    of the flexes when not first-order rigid (:mod:`rigidfold.structure.stability`).
     """
 
     supports: Supports
@@ -260,6 +280,37 @@ class Rigidity:
     eigenvalues: np.ndarray
     rigid: bool
     mode: str | None
+    second_order: SecondOrder | None = None
+
+    @property
+    def stability(self) -> Stability:
+        """First-order rigid, prestress stable, or the kind of motion left."""
+        if self.rigid or self.second_order is None:
+            return Stability.FIRST_ORDER if self.rigid else Stability.MECHANISM
+        return self.second_order.stability
+
+    @property
+    def stable(self) -> bool:
+        """The supports hold the design: first-order rigid or prestress stable."""
+        return self.stability in (Stability.FIRST_ORDER, Stability.PRESTRESS)
+
+    @property
+    def message(self) -> str:
+        """The stability's message with the motion concerned."""
+        return self.stability.describe(self.mode)
+
+    @property
+    def detail(self) -> str | None:
+        """The motion concerned, with the second order's word where it decided: ``a
+        mechanism that folds crease 3 (1-4)``, ``not prestress stable: ...``, ``prestress
+        stable: ...``; None when first-order rigid."""
+        kind = self.stability
+        if kind is Stability.FIRST_ORDER:
+            return None
+        if kind is Stability.MECHANISM:
+            return self.mode
+        word = "prestress stable" if kind is Stability.PRESTRESS else "not prestress stable"
+        return f"{word}: {self.mode}"
 
     @property
     def smallest(self) -> float:
@@ -271,8 +322,11 @@ class Rigidity:
             "mechanism_dof": self.dof,
             "near_mechanisms": self.near_mechanisms,
             "first_order_rigid": self.rigid,
+            "stability": self.stability.value,
+            "stable": self.stable,
             "smallest_eigenvalue": self.smallest,
             "mode": self.mode,
+            "second_order": None if self.second_order is None else self.second_order.to_dict(),
         }
 
 
@@ -294,7 +348,8 @@ def auto_supports(
     """The smallest set of pinned ``candidates`` (with the ``clamped`` vertices and the
     ``actuated`` creases) that makes ``pattern`` first-order rigid, of the largest smallest
     eigenvalue among the sets of that size tried (see the module's text). When even all
-    candidates leave a mechanism, the result for all of them (``rigid`` False)."""
+    candidates are not first-order rigid, the result for all of them (``rigid`` False), with
+    its second-order check (``stable`` when prestress stable)."""
     none = np.zeros(0, dtype=np.int64)
     base = Supports(
         none,
