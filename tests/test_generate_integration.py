@@ -189,3 +189,26 @@ def test_options_round_trip_and_studies_do_not_store_them():
 def test_bad_options_exit_2_before_the_run(tmp_path, extra):
     assert main_code([*FAST, *extra, "--out", str(tmp_path / "x")]) == 2
     assert not (tmp_path / "x" / "summary.json").exists()
+
+
+STEP9_RUN = ["generate", "--surface", "dome", "--pattern", "grid:3x3", "--quiet", "--no-report"]
+"""Three solutions, DOF 5 -> 3, with Step 9 on the final design (seconds)."""
+
+
+def test_step9_takes_the_users_material(tmp_path):
+    """Issue 32, item 1: with --material, Step 9's frame is of strips of the user's panels
+    (not the paper's steel tubes), so its figures differ; without, the paper's tubes."""
+    figures = {}
+    for name, extra in (("tubes", []), ("plywood", ["--material", "plywood"])):
+        out = tmp_path / name
+        assert main_code([*STEP9_RUN, *extra, "--out", str(out)]) == 1  # DOF 3: falls short
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["options"]["material"] == (None if name == "tubes" else "plywood")
+        (deformed,) = [r["deformation"] for r in summary["per_solution"] if r["deformation"]]
+        assert deformed["reached_plane"]
+        figures[name] = deformed["max_dl_mm"]
+    assert figures["tubes"] != pytest.approx(figures["plywood"], rel=1e-3)
+    from rigidfold.config import DEFAULTS
+
+    assert GenerateOptions().panel_material == DEFAULTS.structure_material
+    assert GenerateOptions(material="steel").panel_material == "steel"

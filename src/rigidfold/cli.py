@@ -267,8 +267,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--material",
         default=GENERATE_DEFAULTS.material,
         metavar="NAME|E,nu,density",
-        help=f"the panels' material for --structure and the thick panels' masses: a preset "
-        f"({', '.join(MATERIALS)}) or E,nu,density in SI units (default: %(default)s)",
+        help=f"the panels' material: a preset ({', '.join(MATERIALS)}) or E,nu,density in SI "
+        "units; Step 9's frame is then of strips of these panels (of --thickness, or "
+        f"{DEFAULTS.structure_thickness * 1e3:g} mm), and --structure and the thick panels' "
+        f"masses use it (default: the paper's steel tubes for Step 9, "
+        f"{DEFAULTS.structure_material} for the others)",
     )
     gen.add_argument(
         "--supports",

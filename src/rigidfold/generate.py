@@ -312,7 +312,11 @@ class GenerateOptions:
         ``supports`` (``"auto"`` or ``"V,V,..."`` pinned vertices) under self-weight and
         ``loads`` (``--load`` texts), its largest displacement within span / ``limit``.
     material : the panels' material (a preset name or ``"E,nu,density"``), for the
-        structure and for the masses of the thick panels.
+        structure, the masses of the thick panels and Step 9's frame (strips of the panels,
+        :func:`rigidfold.deform.analysis.panel_section`, of ``thickness`` or
+        ``Settings.structure_thickness``); None (the default): Step 9 with the paper's steel
+        tubes, and ``Settings.structure_material`` for the structure and the masses
+        (:attr:`panel_material`).
 
     Studies do not store the options of the thick panels and the structure
     (:meth:`rigidfold.study.StudyConfig.as_dict`): they run neither.
@@ -330,7 +334,7 @@ class GenerateOptions:
     thickness: float | None = None
     side: str = DEFAULTS.fabricate_side
     structure: bool = False
-    material: str = DEFAULTS.structure_material
+    material: str | None = None
     supports: str = "auto"
     loads: tuple[str, ...] = ()
     limit: float = DEFAULTS.structure_limit
@@ -371,7 +375,8 @@ class GenerateOptions:
             raise RigidfoldError(f"side must be one of {', '.join(SIDES)}, got {self.side!r}")
         if not isinstance(self.structure, bool):
             raise RigidfoldError(f"structure must be true or false, got {self.structure!r}")
-        parse_material(self.material)
+        if self.material is not None:
+            parse_material(self.material)
         supports = self.supports
         if not isinstance(supports, str) or not (
             supports.strip().lower() == "auto"
@@ -386,6 +391,11 @@ class GenerateOptions:
         for text in self.loads:
             parse_load(text)
         object.__setattr__(self, "limit", parse_limit(self.limit))
+
+    @property
+    def panel_material(self) -> str:
+        """The material of the structure check and of the thick panels' masses."""
+        return DEFAULTS.structure_material if self.material is None else self.material
 
     def replace(self, **changes) -> GenerateOptions:
         """These options with ``changes`` (field names), validated; unknown names are a

@@ -77,7 +77,7 @@ def thick_panels(
         panels,
         motion,
         options.thickness,
-        density=parse_material(options.material).density,
+        density=parse_material(options.panel_material).density,
         motion_message=message,
         settings=settings,
     )
@@ -164,7 +164,7 @@ def structure_check(
         pattern,
         supports=options.supports,
         thickness=thickness,
-        material=options.material,
+        material=options.panel_material,
         loads=options.loads,
         limit=options.limit,
         settings=settings,

@@ -39,6 +39,7 @@ from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_r
 from rigidfold.run.schema import SolutionRecord, aggregate
 from rigidfold.run.verdict import RunVerdict, run_verdict
 from rigidfold.structure import StructureCheck
+from rigidfold.structure.material import parse_material
 from rigidfold.surfaces import SplineSurface
 
 
@@ -199,6 +200,7 @@ class RunWriter:
             dof=dof,
             path=solution.path,
             support_face=self.options.support_face,
+            **self._frame_material(),
             settings=self.case.settings,
         )
         for stage, t in check.times.items():
@@ -233,6 +235,15 @@ class RunWriter:
             },
         )
         return path
+
+    def _frame_material(self) -> dict:
+        """Step 9's frame of strips of the user's panels (``options.material``, of
+        ``options.thickness`` or ``Settings.structure_thickness``); {} for the paper's tubes."""
+        if self.options.material is None:
+            return {}
+        settings = self.case.settings
+        thickness = self.options.thickness or settings.structure_thickness
+        return {"material": parse_material(self.options.material), "thickness": thickness}
 
     def finish(self, run: Generation) -> RunVerdict:
         """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
