@@ -9,18 +9,22 @@ import numpy as np
 import pytest
 
 from rigidfold.mesh import CreasePattern
-from rigidfold.numerics import restart_pinned
+from rigidfold.numerics import restart_pinned, restart_wanted
 
 
 def pytest_configure(config):
     """Run the tests, their xdist workers and the commands they start with the pinned
     numerics (rigidfold.numerics): tests that assert one generation path's counts or digits
     then hold on every x86-64 CPU. A pytest started without them restarts itself once, with
-    pytest's capture of the terminal suspended so that the new process writes to it."""
+    pytest's capture of the terminal suspended so that the new process writes to it. (The
+    capture is touched only then: resuming it here, where pytest has it suspended, would hand
+    the terminal reporter pytest's capture file, closed before the session's last lines.)"""
+    if not restart_wanted():
+        return
     capture = config.pluginmanager.getplugin("capturemanager")
     if capture is not None:
         capture.suspend_global_capture(in_=True)
-    restart_pinned()
+    restart_pinned()  # returns only when the restart failed
     if capture is not None:
         capture.resume_global_capture()
 

@@ -146,6 +146,21 @@ def pin_in_process() -> bool:
     return True
 
 
+def restart_wanted() -> bool:
+    """Whether :func:`restart_pinned` would replace this process (see there)."""
+    if not _supported() or _opted_out(os.environ) or os.environ.get(RESTARTED_ENV):
+        return False
+    initial = _initial_environ()
+    wanted = pinned_environ(initial)
+    if all(initial.get(k) == v for k, v in wanted.items() if k != "GLIBC_TUNABLES") and (
+        _libm_pinned(initial)
+    ):
+        return False
+    argv = list(getattr(sys, "orig_argv", [])) or [sys.executable, *sys.argv]
+    # a script read from standard input cannot be read twice
+    return "-" not in argv[1:2] and bool(sys.executable)
+
+
 def restart_pinned() -> None:
     """Replace this process by the same command started with the pinned numerics, unless it
     already runs with them, was asked not to (``RIGIDFOLD_NUMERICS=native``), was started
@@ -153,17 +168,9 @@ def restart_pinned() -> None:
     made. For entry points (the command line, the test runner): call it before anything
     that imports NumPy, so that the first process loads nothing in vain.
     """
-    if not _supported() or _opted_out(os.environ) or os.environ.get(RESTARTED_ENV):
-        return
-    initial = _initial_environ()
-    wanted = pinned_environ(initial)
-    if all(initial.get(k) == v for k, v in wanted.items() if k != "GLIBC_TUNABLES") and (
-        _libm_pinned(initial)
-    ):
+    if not restart_wanted():
         return
     argv = list(getattr(sys, "orig_argv", [])) or [sys.executable, *sys.argv]
-    if "-" in argv[1:2] or not sys.executable:
-        return  # a script read from standard input cannot be read twice
     env = pinned_environ(os.environ)
     env[RESTARTED_ENV] = "1"
     sys.stdout.flush()
