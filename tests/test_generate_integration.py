@@ -212,3 +212,24 @@ def test_step9_takes_the_users_material(tmp_path):
 
     assert GenerateOptions().panel_material == DEFAULTS.structure_material
     assert GenerateOptions(material="steel").panel_material == "steel"
+
+
+def test_a_check_that_cannot_run_is_a_failed_stage_not_a_lost_run(tmp_path, monkeypatch):
+    """A structure check that cannot run on the final design (a RigidfoldError from the
+    analysis) fails its stage with its message: the run still ends with its verdict,
+    summary.json and report (nothing computed is lost)."""
+    import rigidfold.run.writer as writer
+
+    def cannot(*args, **kwargs):
+        raise RigidfoldError("the shell model is singular\nat load step 1")
+
+    monkeypatch.setattr(writer, "structure_check", cannot)
+    out = tmp_path / "run"
+    assert main_code([*FAST, "--structure", "--out", str(out)]) == 1
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["verdict"]["outcome"] == "fell_short"
+    message = "the structure could not be checked: the shell model is singular at load step 1"
+    assert any(message in s for s in summary["verdict"]["shortfalls"])
+    assert summary["per_solution"][-1]["structure"]["status"] == "error"
+    assert message in (out / "report.html").read_text()
+    assert Stage.STRUCTURE in load_run(out).summary.per_solution[-1].failed_stages()

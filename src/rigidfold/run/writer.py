@@ -18,6 +18,7 @@ import numpy as np
 
 from rigidfold.case import Case
 from rigidfold.deform import MotionStatus, Verification, verify
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import Attempt, GenerateOptions, Generation, Solution, Stop
@@ -285,19 +286,27 @@ class RunWriter:
         pattern = final.result.pattern
         name = self.files[final.step].stem
         record = self.records[final.step]
+        # a check that cannot run on this design (RigidfoldError) is a failed stage with its
+        # message: the run still ends with its verdict, summary.json and report
         if opts.thickness is not None:
-            figures, self.fabrication = thick_panels(
-                self.out,
-                name,
-                pattern,
-                coords2d,
-                opts,
-                frames=self.motions.get(final.step),
-                path=final.path,
-            )
+            try:
+                figures, self.fabrication = thick_panels(
+                    self.out,
+                    name,
+                    pattern,
+                    coords2d,
+                    opts,
+                    frames=self.motions.get(final.step),
+                    path=final.path,
+                )
+            except RigidfoldError as exc:
+                figures = _not_checked("the thick panels", exc)
             record = replace(record, fabrication=figures)
         if opts.structure:
-            figures, self.structure = structure_check(self.out, name, pattern, opts)
+            try:
+                figures, self.structure = structure_check(self.out, name, pattern, opts)
+            except RigidfoldError as exc:
+                figures = _not_checked("the structure", exc)
             record = replace(record, structure=figures)
         self.records[final.step] = record
 
@@ -318,3 +327,12 @@ class RunWriter:
                 "target_surface": self.target_file,
             },
         )
+
+
+def _not_checked(what: str, exc: Exception) -> dict:
+    """The figures of a check of the final design that could not run: status "error" and
+    why (a failed :class:`~rigidfold.run.Stage` with this message)."""
+    return {
+        "status": "error",
+        "message": f"{what} could not be checked: {' '.join(str(exc).split())}",
+    }
