@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from conftest import folded_grid, main_code
+from fuzzing import byte_damage
 from rigidfold.io import write_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns import parse_pattern
@@ -315,21 +316,13 @@ MUTATIONS: list[Callable] = [
 
 
 def text_damage(text: str, rng: random.Random) -> tuple[bytes, str]:
-    """Damage to the file's bytes: cut short, a byte changed, not UTF-8, a BOM, empty."""
-    data = text.encode()
-    how = rng.choice(["cut", "byte", "latin-1", "bom", "empty", "duplicate key"])
-    k = rng.randrange(len(data))
-    if how == "cut":
-        return data[:k], f"cut at byte {k}"
-    if how == "byte":
-        return data[:k] + bytes([rng.randrange(256)]) + data[k + 1 :], f"byte {k} changed"
-    if how == "latin-1":
-        return data[:k] + b"\xe9\xff" + data[k:], f"bytes not UTF-8 at {k}"
-    if how == "bom":
-        return b"\xef\xbb\xbf" + data, "UTF-8 byte order mark"
-    if how == "empty":
-        return b"", "empty file"
-    return data.replace(b"{", b'{"vertices_coords": 7, ', 1), "a duplicated key first"
+    """Damage to the file's bytes: cut short, a byte changed, not UTF-8, a BOM, empty, a
+    key given twice."""
+    kinds = ("cut", "byte", "latin-1", "bom", "empty", "duplicate key")
+    data, what = byte_damage(text.encode(), rng, kinds)
+    if what == "duplicate key":
+        return data.replace(b"{", b'{"vertices_coords": 7, ', 1), "a duplicated key first"
+    return data, what
 
 
 def mutant(text: str, rng: random.Random) -> tuple[bytes, list[str]]:

@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 from conftest import dome_mesh, main_code
+from fuzzing import byte_damage
 from test_fuzz_svg import run_command
 
 NUMBERS = ["nan", "NaN", "inf", "-inf", "1e308", "-1e308", "1e400", "1e-300", "0", "-0", "",
@@ -210,17 +211,7 @@ def binary_ply(data: bytes, rng) -> tuple[bytes, str]:
 
 
 def text_damage(data: bytes, rng) -> tuple[bytes, str]:
-    how = rng.choice(["cut", "byte", "latin-1", "empty", "nul"])
-    k = rng.randrange(len(data))
-    if how == "cut":
-        return data[:k], f"cut at byte {k}"
-    if how == "byte":
-        return data[:k] + bytes([rng.randrange(256)]) + data[k + 1 :], f"byte {k} changed"
-    if how == "latin-1":
-        return data[:k] + b"\xe9\xff" + data[k:], f"bytes not UTF-8 at {k}"
-    if how == "nul":
-        return data[:k] + b"\0" + data[k:], f"a NUL byte at {k}"
-    return b"", "empty file"
+    return byte_damage(data, rng, ("cut", "byte", "latin-1", "empty", "nul"))
 
 
 def mutant(name: str, data: bytes, rng: random.Random) -> tuple[bytes, list[str]]:

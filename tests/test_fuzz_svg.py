@@ -30,6 +30,7 @@ from pathlib import Path
 import pytest
 
 from conftest import main_code
+from fuzzing import byte_damage
 from test_fuzz_fold import snapshot
 
 DATA = Path(__file__).parent / "data" / "origami_simulator"
@@ -266,20 +267,7 @@ MUTATIONS: list[Callable] = [
 
 def text_damage(text: str, rng: random.Random) -> tuple[bytes, str]:
     """Damage to the file's bytes: cut short, a byte changed, not UTF-8, a BOM, empty."""
-    data = text.encode()
-    how = rng.choice(["cut", "byte", "latin-1", "bom", "empty", "nul"])
-    k = rng.randrange(len(data))
-    if how == "cut":
-        return data[:k], f"cut at byte {k}"
-    if how == "byte":
-        return data[:k] + bytes([rng.randrange(256)]) + data[k + 1 :], f"byte {k} changed"
-    if how == "latin-1":
-        return data[:k] + b"\xe9\xff" + data[k:], f"bytes not UTF-8 at {k}"
-    if how == "bom":
-        return b"\xef\xbb\xbf" + data, "UTF-8 byte order mark"
-    if how == "nul":
-        return data[:k] + b"\0" + data[k:], f"a NUL byte at {k}"
-    return b"", "empty file"
+    return byte_damage(text.encode(), rng, ("cut", "byte", "latin-1", "bom", "empty", "nul"))
 
 
 def mutant(text: str, rng: random.Random) -> tuple[bytes, list[str]]:

@@ -63,13 +63,14 @@ from rigidfold.structure import (
     Material,
     StructureCheck,
     StructureStatus,
-    check_inputs,
-    check_structure,
-    parse_limit,
-    parse_load,
     parse_material,
 )
-from rigidfold.structure.design import STRUCTURE_FILES, design_supports, write_structure
+from rigidfold.structure.design import (
+    STRUCTURE_FILES,
+    check_options,
+    plan_design,
+    write_structure,
+)
 
 # ------------------------------------------------------------------------------ analyze
 FLAT_NOTE = (
@@ -534,39 +535,28 @@ def structure(
     texts (:func:`rigidfold.structure.parse_load`); limit : ``"L/250"``. Every input is
     checked before anything is written (ValueError, one line).
     """
-    mat = parse_material(material)
-    divisor = parse_limit(limit)
-    parsed = tuple(parse_load(text) for text in loads)
-    if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
-        raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
+    check_options(material=material, loads=loads, limit=limit, modes=modes)
     refuse_replacing_inputs([path], [Path(out) / name for name in STRUCTURE_FILES])
     data = read_fold(path, up=up, settings=settings)
-    pattern = data.pattern
-    check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=parsed)
-    rigidity, auto = design_supports(
-        pattern,
-        supports,
+    plan = plan_design(
+        data.pattern,
+        supports=supports,
         candidates=candidates,
         clamped=clamped,
         actuators=actuators,
+        thickness=thickness,
+        material=material,
+        hinge_stiffness=hinge_stiffness,
+        loads=loads,
+        self_weight=self_weight,
+        limit=limit,
+        nonlinear=nonlinear,
+        modes=modes,
         settings=settings,
     )
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
-    check = check_structure(
-        pattern,
-        rigidity,
-        material=mat,
-        thickness=thickness,
-        loads=parsed,
-        self_weight=self_weight,
-        hinge_stiffness=hinge_stiffness,
-        nonlinear=nonlinear,
-        limit=divisor,
-        modes=modes,
-        auto=auto,
-        settings=settings,
-    )
+    check = plan.check()
     written = write_structure(check, out_dir, str(path))
     return StructureRun(str(path), check, tuple(written))
 

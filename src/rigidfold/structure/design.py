@@ -1,14 +1,17 @@
 """The structure check of a design from its options as the user gives them, and its files.
 
-:func:`check_design` reads the supports (``"auto"`` or ``"V,V,..."``), the loads
+:func:`plan_design` reads the supports (``"auto"`` or ``"V,V,..."``), the loads
 (``--load`` texts) and the material (a preset or ``"E,nu,density"``), chooses or checks the
-supports and runs :func:`rigidfold.structure.check.check_structure`; :func:`write_structure`
-writes ``structure.json`` and ``structure.png`` (:data:`STRUCTURE_FILES`). ``rigidfold
-structure`` and ``rigidfold generate --structure`` both go through them.
+supports (a :class:`DesignPlan`), whose ``check`` runs
+:func:`rigidfold.structure.check.check_structure` (:func:`check_design` does both);
+:func:`write_structure` writes ``structure.json`` and ``structure.png``
+(:data:`STRUCTURE_FILES`). ``rigidfold structure`` and ``rigidfold generate --structure``
+both go through them.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from rigidfold.config import DEFAULTS, Settings
@@ -16,7 +19,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.io.files import atomic_write, write_json
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import StructureCheck, check_inputs, check_structure, parse_limit
-from rigidfold.structure.loads import parse_load
+from rigidfold.structure.loads import Load, parse_load
 from rigidfold.structure.material import Material, parse_material
 from rigidfold.structure.supports import (
     Rigidity,
@@ -58,7 +61,60 @@ def design_supports(
     return check_supports(pattern, Supports(pins, clamp, held), settings), False
 
 
-def check_design(
+@dataclass(frozen=True, eq=False)
+class DesignPlan:
+    """A structure check with every input read and checked and its supports chosen or
+    checked (:func:`plan_design`), not yet analysed: :meth:`check` runs it."""
+
+    pattern: CreasePattern
+    rigidity: Rigidity
+    auto: bool
+    material: Material
+    thickness: float
+    loads: tuple[Load, ...]
+    self_weight: bool
+    hinge_stiffness: float
+    nonlinear: bool
+    limit: float
+    modes: int
+    settings: Settings
+
+    def check(self) -> StructureCheck:
+        """The analysis and its verdict (:func:`rigidfold.structure.check.check_structure`)."""
+        return check_structure(
+            self.pattern,
+            self.rigidity,
+            material=self.material,
+            thickness=self.thickness,
+            loads=self.loads,
+            self_weight=self.self_weight,
+            hinge_stiffness=self.hinge_stiffness,
+            nonlinear=self.nonlinear,
+            limit=self.limit,
+            modes=self.modes,
+            auto=self.auto,
+            settings=self.settings,
+        )
+
+
+def check_options(
+    *,
+    material: str | Material = DEFAULTS.structure_material,
+    loads: tuple[str, ...] = (),
+    limit: str | float = DEFAULTS.structure_limit,
+    modes: int = DEFAULTS.structure_modes,
+) -> tuple[Material, tuple[Load, ...], float]:
+    """(material, loads, limit divisor) read from the options as given; ValueError (one
+    line) for any that is not valid, before the design is read."""
+    mat = parse_material(material)
+    divisor = parse_limit(limit)
+    parsed = tuple(parse_load(text) for text in loads)
+    if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
+        raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
+    return mat, parsed, divisor
+
+
+def plan_design(
     pattern: CreasePattern,
     *,
     supports: str = "auto",
@@ -74,14 +130,10 @@ def check_design(
     nonlinear: bool = False,
     modes: int = DEFAULTS.structure_modes,
     settings: Settings = DEFAULTS,
-) -> StructureCheck:
-    """The structure check of ``pattern`` (see the module's text and
-    :func:`design_supports`); every input is checked first (ValueError, one line)."""
-    mat = parse_material(material)
-    divisor = parse_limit(limit)
-    parsed = tuple(parse_load(text) for text in loads)
-    if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
-        raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
+) -> DesignPlan:
+    """The :class:`DesignPlan` of ``pattern`` (see the module's text and
+    :func:`design_supports`); every input is checked (ValueError, one line)."""
+    mat, parsed, divisor = check_options(material=material, loads=loads, limit=limit, modes=modes)
     check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=parsed)
     rigidity, auto = design_supports(
         pattern,
@@ -91,20 +143,26 @@ def check_design(
         actuators=actuators,
         settings=settings,
     )
-    return check_structure(
+    return DesignPlan(
         pattern,
         rigidity,
-        material=mat,
-        thickness=thickness,
-        loads=parsed,
-        self_weight=self_weight,
-        hinge_stiffness=hinge_stiffness,
-        nonlinear=nonlinear,
-        limit=divisor,
-        modes=modes,
-        auto=auto,
-        settings=settings,
+        auto,
+        mat,
+        thickness,
+        parsed,
+        self_weight,
+        hinge_stiffness,
+        nonlinear,
+        divisor,
+        modes,
+        settings,
     )
+
+
+def check_design(pattern: CreasePattern, **options) -> StructureCheck:
+    """The structure check of ``pattern`` with ``options`` (those of :func:`plan_design`):
+    every input checked first (ValueError, one line), then the analysis."""
+    return plan_design(pattern, **options).check()
 
 
 def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:
