@@ -296,8 +296,6 @@ def _bevels(panels: Panels, panel: int, bevel: np.ndarray) -> list[_Bevel]:
 def _prism(panels: Panels, panel: int, thickness: float):
     """The panel's untrimmed prism (manifold3d), exact: its triangles on the surface, the
     same moved ``thickness`` to the material side, and a quad along each outline edge."""
-    import manifold3d as mf
-
     p = panels.pattern
     verts = panels.vertices[panel]
     index = {v: i for i, v in enumerate(verts.tolist())}
@@ -311,13 +309,7 @@ def _prism(panels: Panels, panel: int, thickness: float):
         a = np.vectorize(index.__getitem__)(loop)
         b = np.roll(a, -1)
         faces += [np.column_stack([b, a, a + n]), np.column_stack([b, a + n, b + n])]
-    tri = np.vstack(faces)
-    x0, x1, x2 = (points[tri[:, k]] for k in range(3))
-    if np.einsum("ij,ij->i", x0, np.cross(x1, x2)).sum() < 0:
-        tri = tri[:, ::-1]
-    return mf.Manifold(
-        mf.Mesh64(vert_properties=np.ascontiguousarray(points), tri_verts=tri.astype(np.uint64))
-    )
+    return _closed_manifold(points, np.vstack(faces))
 
 
 def _wedge(b: _Bevel, d: np.ndarray, thickness: float):
@@ -376,7 +368,6 @@ def _relief_tool(panels: Panels, panel: int, w: int, reach: dict[int, float], th
     """The relief at vertex w of the panel as one solid: the fan of the chords between the
     panel's consecutive edges at w (at ``reach`` along each), closed through a point just
     outside the corner, through the thickness and a little past both faces."""
-    import manifold3d as mf
 
     p = panels.pattern
     coords = p.coords
@@ -408,13 +399,7 @@ def _relief_tool(panels: Panels, panel: int, w: int, reach: dict[int, float], th
     for i in range(n):
         a, b = 1 + i, 1 + (i + 1) % n
         faces += [(a, b + n + 1, b), (a, a + n + 1, b + n + 1)]
-    tri = np.asarray(faces)
-    x0, x1, x2 = (points[tri[:, k]] for k in range(3))
-    if np.einsum("ij,ij->i", x0, np.cross(x1, x2)).sum() < 0:
-        tri = tri[:, ::-1]
-    return mf.Manifold(
-        mf.Mesh64(vert_properties=np.ascontiguousarray(points), tri_verts=tri.astype(np.uint64))
-    )
+    return _closed_manifold(points, np.asarray(faces))
 
 
 def _chord_plane(w: np.ndarray, q1: np.ndarray, q2: np.ndarray, d: np.ndarray):
@@ -506,4 +491,17 @@ def thicken(
         volumes=volumes,
         depth=depth,
         empty_faces=np.asarray(sorted(empty), dtype=np.int64),
+    )
+
+
+def _closed_manifold(points: np.ndarray, tri: np.ndarray):
+    """The manifold3d solid of a closed triangle mesh: points (N, 3), tri (T, 3) of one
+    consistent winding, turned to face outwards (positive signed volume)."""
+    import manifold3d as mf
+
+    x0, x1, x2 = (points[tri[:, k]] for k in range(3))
+    if np.einsum("ij,ij->i", x0, np.cross(x1, x2)).sum() < 0:
+        tri = tri[:, ::-1]
+    return mf.Manifold(
+        mf.Mesh64(vert_properties=np.ascontiguousarray(points), tri_verts=tri.astype(np.uint64))
     )
