@@ -2,7 +2,7 @@
 
 Run with ``python benchmarks/bench_generate_scale.py [--grid 41] [--criterion s]
 [--lookahead] [--ipopt-alone]``; ``--ipopt-alone`` solves every step with IPOPT only
-(``Settings.projection_vertices`` above the grid's size: rigidfold before the projection).
+(``Settings.solver.projection_vertices`` above the grid's size: rigidfold before the projection).
 
 The case is the issue's: ``grid:NxN`` spanning 3 m with diagonals towards the centre, on the
 dome, criterion S, no Step 9 (``generate`` itself, as ``rigidfold generate --pattern

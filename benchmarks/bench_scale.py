@@ -16,7 +16,7 @@ Cases: ``grid:NxN`` with ``--size 3x3`` (a 3 m square, every diagonal towards th
   sparse method, each on a fresh copy of the shape (its topology caches rebuilt), median of
   ``--repeat``; the criterion S of the sparse analysis (``score_creases``); the DOF; where
   both ran, how far the sparse modes lie outside the span of the dense ones;
-  ``--sparse-iterations`` sets ``Settings.sparse_iterations`` for the analyses;
+  ``--sparse-iterations`` sets ``Settings.mechanism.sparse_iterations`` for the analyses;
 * memory: the peak resident set of a process that only reads the shape and runs the auto
   analysis (and of the build-and-solve process), from ``getrusage``, so that one method's
   peak does not hide another's.
@@ -185,8 +185,8 @@ def main() -> None:
     parser.add_argument(
         "--sparse-iterations",
         type=int,
-        default=DEFAULTS.sparse_iterations,
-        help="filterings of the sparse analysis's subspace (Settings.sparse_iterations)",
+        default=DEFAULTS.mechanism.sparse_iterations,
+        help="filterings of the sparse analysis's subspace (Settings.mechanism.sparse_iterations)",
     )
     parser.add_argument("--task", help=argparse.SUPPRESS)
     parser.add_argument("--task-grid", type=int, help=argparse.SUPPRESS)

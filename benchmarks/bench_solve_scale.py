@@ -13,7 +13,7 @@ machine it is the steadier figure), IPOPT iterations, the sizes of the Jacobian 
 handed to IPOPT, and the fitted log-log slope of build and solve time against V over the
 grids from 121 vertices on.
 
-From ``Settings.projection_vertices`` (200) on, the solver is IPOPT stopped at F <=
+From ``Settings.solver.projection_vertices`` (200) on, the solver is IPOPT stopped at F <=
 ``ipopt_stop_f`` and finished by the projection (``rigidfold.optimize.projection``). Each grid
 is also solved, in the same process, by IPOPT alone (``projection_vertices`` above the grid's
 size: the reference, as before the projection) and the ratio printed; and both solve a step

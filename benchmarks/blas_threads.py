@@ -24,8 +24,9 @@ import time
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from rigidfold import config
 from rigidfold.case import make_case
+from rigidfold.config import DEFAULTS
+from rigidfold.config import blas as config
 from rigidfold.generate import generate
 
 
@@ -41,7 +42,7 @@ def caller_threads(n: int | None):
 
 
 def first_solve(threads: int, hessian: str) -> tuple[np.ndarray, float, int]:
-    settings = config.DEFAULTS.with_(ipopt_hessian=hessian)
+    settings = DEFAULTS.with_(ipopt_hessian=hessian)
     with caller_threads(threads):
         case = make_case("hp", "11", symmetric=True, settings=settings)
         result = case.problem().solve()

@@ -7,7 +7,7 @@ Each case runs twice with S-hat and the look-ahead: with the paper's Step 5
 (``deploy_check=False``; the final design's folding path is traced afterwards, as delivered)
 and with the deployability check (rigidfold's default). A run *deploys* when it reaches its
 target DOF 1 and the final design's folding path reaches the flat state (every fold angle
-below ``Settings.path_flat_tol``, every length kept). Cases: the crease patterns of Origami
+below ``Settings.path.flat_tol``, every length kept). Cases: the crease patterns of Origami
 Simulator drawn by users (waterbomb, Resch's triangle tessellation, Miura-ori; tests/data)
 on the dome, the HP and a Bezier surface; the paper's patterns 1 and 2 on ten Bezier surfaces
 each; the paper's pattern 11 and a 9 x 9 grid on the dome and the HP: 33 cases. Prints one

@@ -2,7 +2,7 @@
 
 Run with ``python benchmarks/hessian_size.py [--patterns 1 2] [--seed 7] [--repeats 7]``.
 
-Per Bezier pattern, for both settings of ``Settings.ipopt_hessian`` in the same process: the
+Per Bezier pattern, for both settings of ``Settings.solver.ipopt_hessian`` in the same process: the
 nonzeros of the Hessian, the number of CasADi SX instructions of the symbolic one, the median
 wall time of one Hessian evaluation inside IPOPT, and the median wall time of the first solve
 of (6) from the target surface (``repeats`` solves each, interleaved), with the ratio

@@ -217,7 +217,7 @@ def _kernel(J: np.ndarray, settings: Settings) -> tuple[np.ndarray, int]:
     """(the last right singular vector of ``J``, its nullity): the columns of ``J`` minus its
     rank, counting singular values above ``mechanism_rank_tol`` times the largest."""
     _, sv, vt = np.linalg.svd(J)
-    return vt[-1], J.shape[1] - int(np.sum(sv > settings.mechanism_rank_tol * sv[0]))
+    return vt[-1], J.shape[1] - int(np.sum(sv > settings.mechanism.rank_tol * sv[0]))
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """MeshSurface on the built-in dome given as a triangle mesh: build time, fit_error and the
 largest |spline - analytic dome| ("max error") for several mesh resolutions and grid sizes
-(``Settings.surface_grid_nodes``), on the whole 3 m square and on a disc footprint (radius
+(``Settings.inputs.surface_grid_nodes``), on the whole 3 m square and on a disc footprint (radius
 1.4 m, where the grid's corners are continued outside the footprint).
 
     python benchmarks/mesh_surface.py [--vertices 61 121 241] [--nodes 33 65 129 257]

@@ -7,7 +7,7 @@ For each accepted solution of ``generate`` it prints the DOF, its change from th
 before (one more fixed crease), and the smallest singular values of the kinematic constraint
 matrix relative to the largest: the DOF counted ones plus the next two. Values near 1e-16
 are modes of the shape; values of 1e-12 to 1e-8 are near-singular directions that
-``Settings.mechanism_rank_tol`` decides about; the genuine non-zero values are 1e-5 and up.
+``Settings.mechanism.rank_tol`` decides about; the genuine non-zero values are 1e-5 and up.
 The shapes whose DOF stays or rises after a fix ("How fixing a crease changes the DOF" in
 the study report) are the ones to look at.
 """
@@ -39,7 +39,7 @@ def main() -> None:
     parser.add_argument("--pattern", default="2")
     parser.add_argument("--criterion", default="ss")
     parser.add_argument("--seed", type=int, default=7)
-    parser.add_argument("--rank-tol", type=float, default=DEFAULTS.mechanism_rank_tol)
+    parser.add_argument("--rank-tol", type=float, default=DEFAULTS.mechanism.rank_tol)
     parser.add_argument("--solver", default="ipopt", choices=["ipopt", "slsqp"])
     args = parser.parse_args()
     if not 0 < args.rank_tol < 1:

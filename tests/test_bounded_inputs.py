@@ -40,7 +40,7 @@ def test_deeply_nested_fold_file_is_refused(tmp_path, where):
         text = json.dumps(TRIANGLE)[:-1] + ', "rigidfold:x": ' + "[" * 600 + "]" * 600 + "}"
         path.write_text(text)
     proc = run_cli("analyze", str(path))
-    one_line_error(proc, f"nested deeper than {DEFAULTS.max_json_depth} levels")
+    one_line_error(proc, f"nested deeper than {DEFAULTS.limits.max_json_depth} levels")
     with pytest.raises(ValueError, match=r"deep\.fold: nested deeper"):
         read_fold(path)
 
@@ -99,7 +99,7 @@ def test_huge_study_is_refused_at_once(tmp_path):
     one_line_error(
         proc,
         f"--surfaces 1000000000 makes 8000000000 runs (1000000000 surfaces x 2 patterns x 4 "
-        f"criteria), more than the limit of {DEFAULTS.max_study_runs}",
+        f"criteria), more than the limit of {DEFAULTS.limits.max_study_runs}",
     )
     assert time.perf_counter() - t0 < 30
     assert list(tmp_path.iterdir()) == []
@@ -195,7 +195,6 @@ def test_full_disk_leaves_no_temporary_file(tmp_path, monkeypatch):
 def test_analysis_too_large_is_refused_before_allocating():
     import time
 
-    from rigidfold.config import Settings
     from rigidfold.mechanism import analysis_bytes, analyze, check_analysis_size
     from rigidfold.mesh import CreasePattern
     from rigidfold.patterns import parse_pattern
@@ -211,8 +210,8 @@ def test_analysis_too_large_is_refused_before_allocating():
     small = CreasePattern.from_faces(parse_pattern("1").xy, parse_pattern("1").faces)
     assert analysis_bytes(small.n_edges + 9, 3 * small.n_vertices) == 8 * (147**2 + 2 * 129 * 147)
     check_analysis_size(small)
-    with pytest.raises(ValueError, match=r"Settings\.max_analysis_bytes"):
-        check_analysis_size(small, Settings(max_analysis_bytes=1000))
+    with pytest.raises(ValueError, match=r"Settings\.limits\.max_analysis_bytes"):
+        check_analysis_size(small, DEFAULTS.with_(max_analysis_bytes=1000))
 
 
 def test_generate_of_a_pattern_too_large_to_analyse_stops_before_solving(tmp_path):
@@ -242,9 +241,11 @@ def test_generate_of_a_pattern_too_large_to_analyse_stops_before_solving(tmp_pat
         str(tmp_path / "o"),
     )
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
-    # refused on its triangle count (Settings.max_pattern_faces, checked on the file's real
+    # refused on its triangle count (Settings.limits.max_pattern_faces, checked on the file's real
     # faces since issue 30 item 5), before the estimate of the analysis's memory is needed
-    assert "has 104882 triangles, more than 20000 (Settings.max_pattern_faces)" in proc.stderr
+    assert (
+        "has 104882 triangles, more than 20000 (Settings.limits.max_pattern_faces)" in proc.stderr
+    )
     assert not (tmp_path / "o" / "summary.json").exists()
 
 
@@ -350,7 +351,7 @@ def test_pattern_plans_too_small_or_too_large_are_refused(tmp_path, capsys, patt
     code = main_code(["optimize", "--surface", "dome", "--pattern", *spec, "--out", str(out)])
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1, err
-    assert message in err and "Settings.max_coordinate" in err, err
+    assert message in err and "Settings.limits.max_coordinate" in err, err
     assert not out.exists()
 
 

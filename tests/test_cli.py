@@ -277,13 +277,17 @@ def test_defaults_come_from_the_library():
     parser = build_parser()
     gen = parser.parse_args(["generate", "--surface", "dome", "--pattern", "1", "--out", "x"])
     options = GenerateOptions()
-    assert (gen.seed, gen.target_dof, gen.dz) == (DEFAULT_SEED, options.target_dof, DEFAULTS.dz)
+    assert (gen.seed, gen.target_dof, gen.dz) == (
+        DEFAULT_SEED,
+        options.target_dof,
+        DEFAULTS.design.dz,
+    )
     assert (gen.criterion, gen.solver, gen.check) == (
         options.criterion,
         options.solver,
         options.check,
     )
-    assert gen.hessian == DEFAULTS.ipopt_hessian
+    assert gen.hessian == DEFAULTS.solver.ipopt_hessian
     study = parser.parse_args(["study", "--db", "x.db"])
     assert (study.surfaces, study.workers, study.first_seed) == (
         STUDY_DEFAULTS.surfaces,

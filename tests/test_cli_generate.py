@@ -81,7 +81,7 @@ def test_generate_writes_solutions_log_and_summary(generated):
     }
     for entry in summary["per_solution"]:
         fit = entry["fit"]
-        assert 0 <= fit["rms_dz_m"] <= fit["max_abs_dz_m"] <= DEFAULTS.dz + 1e-6
+        assert 0 <= fit["rms_dz_m"] <= fit["max_abs_dz_m"] <= DEFAULTS.design.dz + 1e-6
     log = json.loads((generated / "log.json").read_text())["attempts"]
     assert len(log) == summary["n_solves"]
     assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1])

@@ -155,7 +155,7 @@ def test_deform_fold_file_holds_the_support_panel_in_every_motion_frame(tmp_path
     raw = json.loads((tmp_path / "out" / "miura.fold").read_text())
     diagram = next(f for f in raw["file_frames"] if f["frame_classes"] == ["creasePattern"])
     motion = [f for f in raw["file_frames"] if "folding motion" in f["frame_title"]]
-    assert 3 <= len(motion) <= DEFAULTS.motion_frames
+    assert 3 <= len(motion) <= DEFAULTS.deformation.motion_frames
     support = raw["rigidfold:motion"]["support_faces"]
     assert (
         support

@@ -13,7 +13,7 @@ import pytest
 import rigidfold
 from rigidfold import RigidfoldError
 from rigidfold.case import make_case, parse_fixed
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS
 from rigidfold.exports import parse_formats
 from rigidfold.io import read_fold
 from rigidfold.patterns import parse_pattern
@@ -56,7 +56,7 @@ def test_rigidfold_error_is_a_value_error_exported_lightly():
         lambda tmp: read_fold(tmp / "none.fold"),
         lambda tmp: parse_fixed("a,b", make_case("dome", "grid:3x3").pattern),
         lambda tmp: parse_formats("obj,docx"),
-        lambda tmp: Settings(dz=-1.0),
+        lambda tmp: DEFAULTS.with_(dz=-1.0),
         lambda tmp: DEFAULTS.with_(theta_min=2.0, theta_max=1.0),
         lambda tmp: analyze_file(tmp / "none.fold"),
         lambda tmp: report_run(tmp / "no-run"),

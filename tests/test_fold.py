@@ -107,7 +107,7 @@ def test_assignment_and_fold_angle_sign(lift, letter):
 
 
 def test_flat_angle_threshold():
-    """A free crease folded by less than settings.flat_angle is flat ("F")."""
+    """A free crease folded by less than settings.geometry.flat_angle is flat ("F")."""
     tiny = hinge(1e-3)
     rho = tiny.fold_angles[0]
     assert fold_dict(tiny)["edges_assignment"][0] == "V"

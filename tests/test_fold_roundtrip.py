@@ -131,7 +131,7 @@ def test_deform_appends_the_motion_under_the_diagram(tmp_path):
     frames = output["file_frames"]
     assert frames[0]["frame_classes"] == ["creasePattern"]
     motion = frames[1:-1]
-    assert 3 <= len(motion) <= DEFAULTS.motion_frames
+    assert 3 <= len(motion) <= DEFAULTS.deformation.motion_frames
     assert all(f["frame_parent"] == 1 and f["frame_inherit"] for f in motion)
     assert all(f["frame_title"].startswith("rigidfold: folding motion") for f in motion)
     first = read_fold(tmp_path / "out" / "theirs.fold", frame=2)  # the motion's flat frame

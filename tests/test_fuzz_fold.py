@@ -290,7 +290,7 @@ def frames(doc, rng):
 
 
 def nest(doc, rng):
-    """A value nested deep (within or beyond Settings.max_json_depth)."""
+    """A value nested deep (within or beyond Settings.limits.max_json_depth)."""
     depth = rng.choice([20, 99, 150, 400])
     value: object = 1
     for _ in range(depth):

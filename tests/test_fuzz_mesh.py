@@ -284,9 +284,9 @@ def test_defects_found_by_the_mutants(tmp_path, capsys):
     footprint.write_text("0,0\n3,0\n3,1e-300\n1.5,3\n0,2\n")
     for case, message in (
         (obj, f"mesh {obj}: vertex 2 at [0.0, 3.0, 1e+308] lies farther than 1e+06 m from the "
-              "origin (Settings.max_coordinate)"),
+              "origin (Settings.limits.max_coordinate)"),
         (footprint, "has two points, or a point and a side, 0 m apart, less than 1e-09 of its "
-                    "size of 3 m (Settings.footprint_min_gap)"),  # GEOS's distance: 0
+                    "size of 3 m (Settings.inputs.footprint_min_gap)"),  # GEOS's distance: 0
     ):  # fmt: skip
         assert run(case, tmp_path / "out") == 2
         err = capsys.readouterr().err

@@ -221,7 +221,7 @@ def duplicate(text, rng):
 
 
 def nest(text, rng):
-    """The content inside many groups (within or beyond Settings.max_svg_depth)."""
+    """The content inside many groups (within or beyond Settings.limits.max_svg_depth)."""
     depth = rng.choice([10, 98, 101, 5000])
     start, end = body_start(text), text.rindex("</svg>")
     return text[:start] + "<g>" * depth + text[start:end] + "</g>" * depth + text[end:], (
@@ -415,7 +415,8 @@ DOUBLING = '<g id="u0"><line x1="0" y1="50" x2="100" y2="50" stroke="#f00"/></g>
     "body, message",
     [
         (DOUBLING, "its elements are larger than 8000000 characters of attributes and 100 per "
-                   "element, each <use> counted as what it refers to (Settings.max_svg_size)"),
+                   "element, each <use> counted as what it refers to "
+                   "(Settings.limits.max_svg_size)"),
         ('<g id="a"><use href="#b"/></g><g id="b"><use xlink:href="#a"/></g>',
          'its <use> elements refer to each other in a loop (through id="'),
         ('<path stroke="#f00"/>', "<path> has no d: path data is"),

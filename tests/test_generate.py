@@ -35,7 +35,7 @@ def test_generate_pattern1_reaches_one_dof_without_locks():
     assert run.n_reduce == 20
     assert [s.mechanism.dof for s in run.solutions] == list(range(21, 0, -1))
     for sol in run.solutions:
-        assert sol.result.F <= DEFAULTS.f_tol
+        assert sol.result.F <= DEFAULTS.design.f_tol
         assert not sol.mechanism.has_lock
         assert len(sol.result.pattern.fixed_creases) == 21 - sol.mechanism.dof
     # counters agree with the log
@@ -59,7 +59,7 @@ def test_generate_counts_locks_and_retries_the_next_candidate():
     for attempt in locks:
         assert attempt.locked  # the locked creases are logged
         assert attempt.dof >= 1
-        assert attempt.F <= DEFAULTS.f_tol  # a lock is not a tolerance miss
+        assert attempt.F <= DEFAULTS.design.f_tol  # a lock is not a tolerance miss
     assert run.n_reduce == 20
 
 

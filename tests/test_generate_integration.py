@@ -210,7 +210,7 @@ def test_step9_takes_the_users_material(tmp_path):
     assert figures["tubes"] != pytest.approx(figures["plywood"], rel=1e-3)
     from rigidfold.config import DEFAULTS
 
-    assert GenerateOptions().panel_material == DEFAULTS.structure_material
+    assert GenerateOptions().panel_material == DEFAULTS.structure.material
     assert GenerateOptions(material="steel").panel_material == "steel"
 
 

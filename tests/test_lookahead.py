@@ -239,8 +239,8 @@ def test_a_flat_group_is_fixed_at_once_and_locks_nothing(demo_dof5):
         assert locks_after_fixing(demo_dof5, (e,)) == (sorted(c.carried.tolist()), 4)
         assert locks_after_fixing(demo_dof5, (e, *c.carried.tolist())) == ([], 4)
         left = carried_angles(demo_dof5, (e,), c.carried)
-        assert np.abs(left).max() <= DEFAULTS.lookahead_carry_angle
-    strict = dataclasses.replace(DEFAULTS, lookahead_carry_angle=1e-6)
+        assert np.abs(left).max() <= DEFAULTS.generation.lookahead_carry_angle
+    strict = DEFAULTS.with_(lookahead_carry_angle=1e-6)
     assert flat_groups(demo_dof5, candidates, put_off, settings=strict) == []
     # a candidate whose fix locked another crease at an earlier shape forms no group
     other = dataclasses.replace(put_off[0], locked_before=np.array([0]))
@@ -324,7 +324,7 @@ def test_every_lock_logs_its_fold_angles_and_whether_it_was_predicted(demo_runs)
         assert set(a.locked) | set(a.fixed_added) in VERTICES
         assert a.locked_predicted == [True] * 3
         assert len(a.locked_fold_deg) == 3 and max(map(abs, a.locked_fold_deg)) < 1.0
-        assert max(a.locked_left) <= DEFAULTS.lookahead_tol
+        assert max(a.locked_left) <= DEFAULTS.generation.lookahead_tol
         assert a.predicted_locks is None  # no forecast of the attempts without a lock
         assert {"skipped", "locked_predicted", "locked_fold_deg"} <= a.to_dict().keys()
 

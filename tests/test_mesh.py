@@ -162,7 +162,7 @@ def test_error_messages_show_plain_numbers():
 
 
 def test_settings_decide_corners_of_a_case():
-    """Settings(corner_angle=...) reaches the pattern that make_case builds."""
+    """DEFAULTS.with_(corner_angle=...) reaches the pattern that make_case builds."""
     from rigidfold.case import make_case
 
     assert len(make_case("dome", "1").pattern.corners) == 4

@@ -19,7 +19,7 @@ import pytest
 
 from conftest import dome_mesh
 from rigidfold import patterns
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS
 from rigidfold.optimize import FormFindingProblem
 from rigidfold.surfaces import MESH_FORMATS, Dome, MeshSurface, mesh_surface, read_mesh
 
@@ -268,7 +268,7 @@ def test_check_finite_names_the_first_point_outside():
 
 
 def test_footprint_tolerance(fine_dome):
-    tol = DEFAULTS.surface_footprint_tol * 3.0
+    tol = DEFAULTS.inputs.surface_footprint_tol * 3.0
     fine_dome.check_finite(np.array([-0.9 * tol, 3.0 + 0.9 * tol]), np.array([1.0, 3.0]))
     with pytest.raises(ValueError, match=r"plan point 1 at"):
         fine_dome.check_finite(np.array([1.0, 3.0 + 1.1 * tol]), np.array([1.0, 2.0]))
@@ -277,9 +277,9 @@ def test_footprint_tolerance(fine_dome):
 def test_grid_settings_are_checked():
     for nodes in (3, 514, 10.0, True):
         with pytest.raises(ValueError, match="surface_grid_nodes must be an integer from 4 to 513"):
-            Settings(surface_grid_nodes=nodes)
+            DEFAULTS.with_(surface_grid_nodes=nodes)
     with pytest.raises(ValueError, match="surface_footprint_tol must be a finite number >= 0"):
-        Settings(surface_footprint_tol=-1.0)
+        DEFAULTS.with_(surface_footprint_tol=-1.0)
 
 
 def test_a_coarse_grid_still_has_four_nodes_a_side():
@@ -295,9 +295,9 @@ def test_form_finding_on_the_dome_mesh(fine_dome):
     pattern = patterns.build("11", fine_dome)
     result = FormFindingProblem(pattern, fine_dome).solve()
     assert result.converged
-    assert result.F <= DEFAULTS.f_tol  # measured 2e-17
+    assert result.F <= DEFAULTS.design.f_tol  # measured 2e-17
     c = result.pattern.coords
-    assert np.abs(c[:, 2] - DOME.height(c[:, 0], c[:, 1])).max() <= DEFAULTS.dz + 1e-3
+    assert np.abs(c[:, 2] - DOME.height(c[:, 0], c[:, 1])).max() <= DEFAULTS.design.dz + 1e-3
 
 
 # ----------------------------------------------- issue 30, item 4: the size of a target mesh
@@ -359,13 +359,13 @@ def test_candidates_are_a_superset_of_the_hits():
 
 
 def test_too_many_triangles_are_refused_in_one_line(tmp_path):
-    """Settings.max_mesh_triangles bounds a target mesh: MeshSurface and read_mesh refuse one
+    """Settings.limits.max_mesh_triangles bounds a target mesh: MeshSurface and read_mesh refuse one
     line; a binary STL file by its header, before trimesh loads it (a 2-million-face STL took
     8.9 GB before)."""
     small = DEFAULTS.with_(max_mesh_triangles=100)
     vertices, triangles = fan(200)
     message = (
-        "200 triangles, more than 100 (Settings.max_mesh_triangles): decimate the mesh; the "
+        "200 triangles, more than 100 (Settings.limits.max_mesh_triangles): decimate the mesh; the "
         "surface is sampled on at most 513 x 513 grid nodes"
     )
     with pytest.raises(ValueError, match=f"^mesh fan: {re.escape(message)}$"):
@@ -399,7 +399,8 @@ def test_too_many_triangles_are_refused_in_one_line(tmp_path):
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr == (
         f"rigidfold: error: mesh {stl}: 2000000 triangles, more than 500000 "
-        "(Settings.max_mesh_triangles): decimate the mesh; the surface is sampled on at most "
+        "(Settings.limits.max_mesh_triangles): decimate the mesh; the surface is sampled on at "
+        "most "
         "513 x 513 grid nodes\n"
     )
     with pytest.raises(ValueError, match="max_mesh_triangles must be an integer >= 1"):

@@ -177,12 +177,12 @@ def test_ipopt_solves_pattern1_and_result_is_consistent():
     case = make_case("bezier", "1", seed=4)
     result = case.problem().solve()
     assert result.status is Status.CONVERGED
-    assert result.F <= DEFAULTS.f_tol
-    assert result.max_violation <= DEFAULTS.constraint_tol
+    assert result.F <= DEFAULTS.design.f_tol
+    assert result.max_violation <= DEFAULTS.solver.constraint_tol
     shape = result.pattern
     assert np.sum(shape.angle_defects**2) == pytest.approx(result.F1, abs=1e-14)
     assert np.all(np.abs(shape.coords[:, 2] - case.surface.height(*shape.coords[:, :2].T)) <= 0.3)
-    assert shape.corner_angles.min() >= DEFAULTS.theta_min - 1e-8
+    assert shape.corner_angles.min() >= DEFAULTS.design.theta_min - 1e-8
 
 
 def test_fixed_creases_become_flat():
@@ -195,7 +195,7 @@ def test_fixed_creases_become_flat():
     second = problem.solve(fixed=flattest, start=first.coords)
     assert second.converged
     assert second.pattern.n_facets == second.pattern.n_faces - 3
-    assert np.all(second.pattern.flatness_residuals <= DEFAULTS.f_tol)
+    assert np.all(second.pattern.flatness_residuals <= DEFAULTS.design.f_tol)
 
 
 def test_fold_angle_bound():
@@ -208,10 +208,10 @@ def test_fold_angle_bound():
 
 def test_pattern2_infeasible_start_is_repaired():
     case = make_case("bezier", "2", seed=0)
-    assert case.pattern.corner_angles.min() < DEFAULTS.theta_min
+    assert case.pattern.corner_angles.min() < DEFAULTS.design.theta_min
     result = case.problem().solve()
     assert result.converged
-    assert result.pattern.corner_angles.min() >= DEFAULTS.theta_min - 1e-8
+    assert result.pattern.corner_angles.min() >= DEFAULTS.design.theta_min - 1e-8
 
 
 @pytest.mark.parametrize("solver", ["slsqp", "slsqp-fd"])

@@ -44,7 +44,7 @@ def test_obj_dome_works_like_the_built_in_dome(dome_obj, tmp_path, capsys):
     assert surface["fit_error_m"] <= 1e-3
     coords = np.array(json.loads((out / "solution.fold").read_text())["vertices_coords"])
     dz = coords[:, 2] - Dome().height(coords[:, 0], coords[:, 1])
-    assert np.abs(dz).max() <= DEFAULTS.dz + 1e-3
+    assert np.abs(dz).max() <= DEFAULTS.design.dz + 1e-3
     # the fitted surface against the analytic dome, on a grid finer than the fit's
     fitted = make_case(f"mesh:{dome_obj}", "11").surface
     x, y = np.meshgrid(np.linspace(0, 3, 201), np.linspace(0, 3, 201))

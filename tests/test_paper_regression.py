@@ -21,7 +21,10 @@ def test_ipopt_accepts_on_20_bezier_surfaces(pattern):
     accepted = []
     for seed in SEEDS:
         result = make_case("bezier", pattern, seed=seed).problem().solve()
-        ok = result.F <= DEFAULTS.f_tol and result.max_violation <= DEFAULTS.constraint_tol
+        ok = (
+            result.F <= DEFAULTS.design.f_tol
+            and result.max_violation <= DEFAULTS.solver.constraint_tol
+        )
         assert ok == result.converged
         accepted.append(ok)
     assert sum(accepted) >= 18, f"accepted {sum(accepted)} of 20"
@@ -35,7 +38,7 @@ def test_ipopt_accepts_dome_and_hp(surface, symmetric):
     result = case.problem().solve()
     assert result.converged, result.message
     assert result.n_variables == (83 if symmetric else 315)
-    assert result.max_violation <= DEFAULTS.constraint_tol
+    assert result.max_violation <= DEFAULTS.solver.constraint_tol
 
 
 @pytest.mark.slow
@@ -48,8 +51,8 @@ def test_generate_shat_reaches_one_dof_on_20_bezier_surfaces():
         run = generate(make_case("bezier", "1", seed=seed), criterion="shat", seed=seed)
         reached += run.final_dof == 1
         for sol in run.solutions:
-            assert sol.result.F <= DEFAULTS.f_tol
-            assert sol.result.max_violation <= DEFAULTS.constraint_tol
+            assert sol.result.F <= DEFAULTS.design.f_tol
+            assert sol.result.max_violation <= DEFAULTS.solver.constraint_tol
             assert not sol.mechanism.has_lock
             assert sol.mechanism.dof >= 1
     assert reached >= 18, f"DOF 1 reached on {reached} of 20"

@@ -55,7 +55,7 @@ def test_a_miura_ori_unfolds_to_flat_along_its_one_path(height):
     shape = miura(3, 3, height=height)
     path = trace_path(shape)
     assert path.status is PathStatus.FLAT and path.deploys and path.dof == 1
-    assert path.max_fold[-1] <= DEFAULTS.path_flat_tol
+    assert path.max_fold[-1] <= DEFAULTS.path.flat_tol
     assert np.all(np.diff(path.measure) < 0)  # a Miura-ori unfolds monotonically
     assert path.limit_points == () and path.bifurcations == ()
     assert np.allclose(path.points[0], shape.coords, rtol=0, atol=1e-12)
@@ -140,8 +140,8 @@ def test_motion_frames_are_equal_steps_of_the_path_and_keep_lengths():
 
     shape = miura(4, 3)
     motion = folding_motion(shape, develop(shape).coords2d)
-    assert motion.status == "ok" and len(motion.frames) == DEFAULTS.motion_frames
-    assert np.allclose(motion.parameter, np.linspace(0, 1, DEFAULTS.motion_frames))
+    assert motion.status == "ok" and len(motion.frames) == DEFAULTS.deformation.motion_frames
+    assert np.allclose(motion.parameter, np.linspace(0, 1, DEFAULTS.deformation.motion_frames))
     assert motion.max_length_error < 1e-8
     assert motion.path["deploys"] is True
 
@@ -175,9 +175,9 @@ def test_a_deployable_design_is_accepted_and_delivered(seed_103):
     _, _, checked = seed_103
     final = checked.final
     assert checked.final_dof == 1 and final is not None and final.path is not None
-    assert final.path.deploys and final.path.max_fold[-1] <= DEFAULTS.path_flat_tol
+    assert final.path.deploys and final.path.max_fold[-1] <= DEFAULTS.path.flat_tol
     assert_rigid(final.path, final.result.pattern)
-    assert final.result.F <= DEFAULTS.polish_tol * 10  # polished to F = 0
+    assert final.result.F <= DEFAULTS.solver.polish_tol * 10  # polished to F = 0
     record = checked.to_dict()
     assert record["N_path"] == checked.n_path and record["final_deploys"] is True
     assert record["time_s"]["path"] > 0
@@ -188,8 +188,8 @@ def test_polish_keeps_the_constraints_and_moves_the_shape_little():
     problem = case.problem()
     result = problem.solve()
     polished = problem.polish(result)
-    assert polished.F <= DEFAULTS.polish_tol < result.F
-    assert polished.max_violation <= DEFAULTS.constraint_tol
+    assert polished.F <= DEFAULTS.solver.polish_tol < result.F
+    assert polished.max_violation <= DEFAULTS.solver.constraint_tol
     assert np.abs(polished.coords - result.coords).max() < 1e-3
     assert np.abs(polished.pattern.angle_defects).max() < 1e-12
 
@@ -207,7 +207,7 @@ def test_the_counters_are_stored_and_reported(tmp_path, capsys):
     # the report's slider shows the traced path of the final design, flat to folded
     final = json.loads((out / summary["verdict"]["final_design"]).read_text())
     motion = [f for f in final["file_frames"] if "folding motion" in f.get("frame_title", "")]
-    assert len(motion) == DEFAULTS.motion_frames
+    assert len(motion) == DEFAULTS.deformation.motion_frames
     assert final["rigidfold:motion"]["path"]["deploys"] is True
     html = (out / "report.html").read_text()
     assert "N_path" in html

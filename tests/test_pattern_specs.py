@@ -96,7 +96,7 @@ def test_mesh_footprints_reach_theta_min(name):
     plan = patterns.parse_pattern(f"mesh:{FOOTPRINTS[name]}")
     shape = crease_pattern(plan)
     angles = np.degrees(shape.corner_angles)
-    assert angles.min() >= math.degrees(DEFAULTS.theta_min)
+    assert angles.min() >= math.degrees(DEFAULTS.design.theta_min)
     assert angles.min() == pytest.approx(MIN_ANGLE[name], abs=0.01)
     assert np.all(shape.face_normals[:, 2] > 0)
     # placed at (0, 0); the footprint's corners are the pattern's corners, first and in order
@@ -126,7 +126,7 @@ def test_mesh_edge_length_and_angle_cap():
     steep = DEFAULTS.with_(theta_min=math.radians(40), theta_max=math.radians(150))
     capped = patterns.parse_pattern(square, settings=steep)  # Triangle ends at the 33-degree cap
     angles = np.degrees(crease_pattern(capped).corner_angles)
-    assert angles.min() >= math.degrees(DEFAULTS.mesh_angle_cap)
+    assert angles.min() >= math.degrees(DEFAULTS.inputs.mesh_angle_cap)
 
 
 def test_mesh_keeps_sharp_input_angles():
@@ -296,7 +296,7 @@ def test_mesh_footprint_with_many_corners_is_refused_before_triangle(tmp_path, c
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1, err
     assert "has 30000 points on its outline: at least 29998 triangles, more than 20000 " in err
-    assert "(Settings.max_pattern_faces)" in err and not (tmp_path / "o").exists()
+    assert "(Settings.limits.max_pattern_faces)" in err and not (tmp_path / "o").exists()
 
 
 def test_mesh_pattern_is_checked_on_its_real_triangle_count():
@@ -309,7 +309,7 @@ def test_mesh_pattern_is_checked_on_its_real_triangle_count():
     with pytest.raises(ValueError) as info:
         patterns.parse_pattern(spec, edge_length=3.0, settings=settings)
     assert str(info.value) == (
-        f"pattern {spec!r} has 120 triangles, more than 100 (Settings.max_pattern_faces)"
+        f"pattern {spec!r} has 120 triangles, more than 100 (Settings.limits.max_pattern_faces)"
     )
 
 
@@ -331,7 +331,7 @@ def test_svg_and_fold_files_are_checked_on_their_triangles(tmp_path, capsys):
     )
     assert code == 2 and capsys.readouterr().err == (
         f"rigidfold: error: {svg}: its 12321 faces make 24642 triangles, more than 20000 "
-        "(Settings.max_pattern_faces)\n"
+        "(Settings.limits.max_pattern_faces)\n"
     )
     xy, faces = patterns.grid(9, 9, 3.0, 3.0)
     fold = tmp_path / "grid.fold"

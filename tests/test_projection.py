@@ -79,9 +79,9 @@ def solved_grid():
 
 def test_large_pattern_ipopt_hands_over_to_the_projection(solved_grid):
     case, _, result = solved_grid
-    assert case.pattern.n_vertices >= DEFAULTS.projection_vertices
+    assert case.pattern.n_vertices >= DEFAULTS.solver.projection_vertices
     assert result.status is Status.CONVERGED
-    assert result.F <= DEFAULTS.projection_tol
+    assert result.F <= DEFAULTS.solver.projection_tol
     assert result.max_violation == 0.0
     # the lifted dome breaks the sector-angle bounds: IPOPT first, stopped early, then polished
     assert "the start violates a constraint" in result.message
@@ -116,7 +116,7 @@ def test_fixing_one_more_crease_is_a_short_projection(solved_grid):
     assert again.message.startswith("projection: converged, F = ")
     assert abs(again.pattern.fold_angles[crease]) < 1e-7
     assert again.max_violation == 0.0
-    assert again.iterations < DEFAULTS.projection_max_iter
+    assert again.iterations < DEFAULTS.solver.projection_max_iter
 
 
 @pytest.fixture(scope="module")
@@ -140,7 +140,7 @@ def test_every_projected_iterate_stays_feasible(solved_grid, tight_grid):
     interior = np.flatnonzero(~result.pattern.is_boundary_edge)
     w[interior[np.argsort(-np.abs(result.pattern.fold_angles[interior]))[:3]]] = 1.0
     out = projection(tight.start_point(coords), w)
-    assert tight.violation(tight.map.expand(out.xi), w > 0) <= 0.1 * DEFAULTS.constraint_tol
+    assert tight.violation(tight.map.expand(out.xi), w > 0) <= 0.1 * DEFAULTS.solver.constraint_tol
     assert out.iterations >= 1
 
 
@@ -158,9 +158,9 @@ def test_a_step_blocked_by_a_bound_slides_along_it(solved_grid, tight_grid):
     assert out.converged and out.feasible
     assert out.held >= 1
     assert "constraint held" in out.reason
-    assert tight.violation(tight.map.expand(out.xi), w > 0) <= 0.1 * DEFAULTS.constraint_tol
+    assert tight.violation(tight.map.expand(out.xi), w > 0) <= 0.1 * DEFAULTS.solver.constraint_tol
     F, _, _ = (float(v) for v in tight.objective(out.xi, w))
-    assert F <= DEFAULTS.projection_tol
+    assert F <= DEFAULTS.solver.projection_tol
 
 
 def test_a_projection_stopped_near_a_zero_is_taken_without_ipopt(solved_grid):
@@ -190,7 +190,7 @@ def test_an_infeasible_start_is_not_projected():
 
 def test_generate_on_a_large_grid_projects_after_the_first_solve():
     case = make_case("dome", "grid:15x15", size="3x3")
-    assert case.pattern.n_vertices >= DEFAULTS.projection_vertices
+    assert case.pattern.n_vertices >= DEFAULTS.solver.projection_vertices
     messages = []
     run = generate(case, criterion="s", target_dof=GenerateOptions().target_dof)
     for sol in run.solutions:

@@ -18,7 +18,7 @@ import pytest
 from conftest import degree_n_vertex, folded_grid
 from conftest import paper_generate as generate
 from rigidfold.case import make_case
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism import (
     analysis_bytes,
@@ -141,7 +141,9 @@ def test_flat_sheet_grows_the_subspace():
     shape = _flat_grid(6)
     mech = analyze(shape, method="sparse")
     assert mech.dof == 3 * shape.n_vertices - shape.n_edges - 6 + len(shape.interior_vertices)
-    assert mech.dof > 3 * shape.n_vertices - shape.n_edges - 6 + DEFAULTS.sparse_oversampling
+    assert (
+        mech.dof > 3 * shape.n_vertices - shape.n_edges - 6 + DEFAULTS.mechanism.sparse_oversampling
+    )
     assert_same_analysis(shape)
 
 
@@ -167,8 +169,8 @@ def test_memory_estimate_follows_the_method():
     check_analysis_size(big)
     with pytest.raises(ValueError, match=r"needs about 20\.8 GiB, more than the limit of 8 GiB"):
         check_analysis_size(big, method="kinematic")
-    with pytest.raises(ValueError, match=r"Settings\.max_analysis_bytes"):
-        check_analysis_size(big, Settings(max_analysis_bytes=2**20))
+    with pytest.raises(ValueError, match=r"Settings\.limits\.max_analysis_bytes"):
+        check_analysis_size(big, DEFAULTS.with_(max_analysis_bytes=2**20))
 
 
 @pytest.mark.parametrize(

@@ -199,7 +199,7 @@ def test_self_weight_is_the_panels_weight(design, chosen):
     mat = MATERIALS["steel"]
     check = check_structure(design, chosen, material=mat, thickness=0.004, modes=0)
     area = float(face_areas(design.coords, design.faces).sum())
-    expected = mat.density * DEFAULTS.structure_gravity * 0.004 * area
+    expected = mat.density * DEFAULTS.structure.gravity * 0.004 * area
     assert check.total_load[2] == pytest.approx(-expected, rel=1e-9)
     assert check.balance_error < 1e-3
 
@@ -358,7 +358,7 @@ def test_roof_stands_on_auto_supports_under_self_weight(roof):
     mat = MATERIALS["plywood"]
     check = check_structure(roof, chosen, material=mat, thickness=0.018, modes=0)
     area = float(face_areas(roof.coords, roof.faces).sum())
-    weight = mat.density * DEFAULTS.structure_gravity * 0.018 * area
+    weight = mat.density * DEFAULTS.structure.gravity * 0.018 * area
     assert check.total_load[2] == pytest.approx(-weight, rel=1e-9)
     assert check.response.converged and check.balance_error < 1e-3
     assert check.status is not StructureStatus.MECHANISM

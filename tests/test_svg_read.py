@@ -277,7 +277,7 @@ ERRORS = {
     "dangling crease": (
         SQUARE + '<line x1="0" y1="50" x2="60" y2="50" stroke="red"/>',
         r"a crease ends inside a face at \(60, 50\): creases must end on another line \(an end "
-        r"within 1\.41 drawing units of a line is joined to it; Settings\.svg_snap_tol\)",
+        r"within 1\.41 drawing units of a line is joined to it; Settings\.inputs\.svg_snap_tol\)",
     ),
     "crease crossing out of the boundary": (
         SQUARE + '<line x1="50" y1="50" x2="150" y2="50" stroke="blue"/>',
@@ -401,7 +401,7 @@ SLIPS = {
 @pytest.mark.parametrize("slip", SLIPS)
 def test_slips_within_the_snap_tolerance_are_mended(tmp_path, slip):
     """Slips of under 1 % of the diagonal (1.41 units here) are mended by default
-    (Settings.svg_snap_tol) and refused with svg_snap_tol=0."""
+    (Settings.inputs.svg_snap_tol) and refused with svg_snap_tol=0."""
     body, sizes, letters = SLIPS[slip]
     path = write(tmp_path, SQUARE + body)
     drawing = read_svg(path)
@@ -458,7 +458,7 @@ def test_origami_simulator_files_with_slips(name, sizes, letters, triangles, ref
 
 
 def test_cli_svg_tolerance(tmp_path, capsys):
-    """--svg-tolerance sets Settings.svg_snap_tol; its default is the setting's."""
+    """--svg-tolerance sets Settings.inputs.svg_snap_tol; its default is the setting's."""
     path = write(tmp_path, SQUARE + '<line x1="0" y1="50" x2="98" y2="50" stroke="red"/>')
     args = ["optimize", "--surface", "dome", "--pattern", str(path), "--out"]
     assert main([*args, str(tmp_path / "a")]) == 2
@@ -495,7 +495,7 @@ def test_origami_simulator_files(name):
     np.testing.assert_array_equal(np.abs(drawing.fold_angles[crease]), 180)
     coords = np.column_stack([drawing.xy, np.zeros(len(drawing.xy))])
     triangles, diagonals = triangulate_polygons(
-        coords, drawing.polygons, area_tol=DEFAULTS.triangulation_area_tol
+        coords, drawing.polygons, area_tol=DEFAULTS.geometry.triangulation_area_tol
     )
     pattern = CreasePattern.from_faces(coords, orient_up(coords, triangles))
     assert len(pattern.faces) == sum(len(p) - 2 for p in drawing.polygons)
@@ -604,14 +604,14 @@ def test_good_transforms(tmp_path, transform):
 
 def test_nesting_depth_is_bounded(tmp_path, capsys):
     """5,000 nested groups (a RecursionError traceback from svgelements before) are refused in
-    one line; Settings.max_svg_depth is the limit."""
+    one line; Settings.limits.max_svg_depth is the limit."""
     deep = 5000
     path = write(tmp_path, "<g>" * deep + SQUARE + "</g>" * deep)
     code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and err == (
         f"rigidfold: error: {path}: its elements nest more than 100 levels deep (at <g>; "
-        "Settings.max_svg_depth)\n"
+        "Settings.limits.max_svg_depth)\n"
     )
     nested = write(tmp_path, "<g>" * 98 + SQUARE + "</g>" * 98)  # <svg>, 98 <g>, <rect>
     assert counts(read_svg(nested)) == (4, 4, 1)
@@ -641,7 +641,7 @@ def test_a_line_drawn_over_itself_many_times_is_one_line(tmp_path):
 
 def test_pieces_that_cannot_be_merged_are_bounded_by_max_svg_pairs(tmp_path):
     """Pieces drawn over each other that are not one crease (each of its own opacity) are
-    refused in one line once their pairs pass Settings.max_svg_pairs, before they are
+    refused in one line once their pairs pass Settings.limits.max_svg_pairs, before they are
     examined."""
     lines = "".join(
         f'<line x1="0" y1="50" x2="100" y2="50" stroke="red" stroke-opacity="{0.5 + k / 400}"/>'
@@ -651,7 +651,7 @@ def test_pieces_that_cannot_be_merged_are_bounded_by_max_svg_pairs(tmp_path):
     assert counts(read_svg(path)) == (6, 7, 2)  # 4,950 pairs and more: below the default
     message = (
         f"{path}: more than 1000 pairs of its 104 line pieces meet, cross or come within the "
-        "merge distance of each other (Settings.max_svg_pairs): too many lines cross or are "
+        "merge distance of each other (Settings.limits.max_svg_pairs): too many lines cross or are "
         "drawn over each other"
     )
     with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
@@ -670,7 +670,8 @@ def test_too_many_pairs_one_line_exit_2(tmp_path, capsys):
     code = main(["optimize", "--surface", "dome", "--pattern", str(path), "--out", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and err == (
-        f"rigidfold: error: {path}: more than {DEFAULTS.max_svg_pairs} pairs of its 1005 line "
+        f"rigidfold: error: {path}: more than {DEFAULTS.limits.max_svg_pairs} pairs of its "
+        "1005 line "
         "pieces meet, cross or come within the merge distance of each other "
-        "(Settings.max_svg_pairs): too many lines cross or are drawn over each other\n"
+        "(Settings.limits.max_svg_pairs): too many lines cross or are drawn over each other\n"
     )

@@ -43,12 +43,12 @@ class Case:
     @property
     def warnings(self) -> list[str]:
         """What looks like a slip, one sentence each (the case is built all the same): a plan
-        with a side of ``settings.unit_warning_size`` metres or more, or a ``dz`` larger than
+        with a side of ``settings.inputs.unit_warning_size`` metres or more, or a ``dz`` larger than
         the plan, given in millimetres rather than metres."""
         width, height = self.plan.box
-        size, dz = f"{width:g} m x {height:g} m", self.settings.dz
+        size, dz = f"{width:g} m x {height:g} m", self.settings.design.dz
         out = []
-        if max(width, height) >= self.settings.unit_warning_size:
+        if max(width, height) >= self.settings.inputs.unit_warning_size:
             out.append(
                 f"the plan is {size}: sizes are in metres; for millimetres divide by 1000 "
                 f"(--size {width / 1000:g}x{height / 1000:g})"
@@ -56,7 +56,7 @@ class Case:
         if dz > max(width, height):
             out.append(
                 f"--dz {dz:g} m is larger than the plan ({size}): it is in metres (the default "
-                f"{DEFAULTS.dz:g} m is {DEFAULTS.dz * 1000:g} mm)"
+                f"{DEFAULTS.design.dz:g} m is {DEFAULTS.design.dz * 1000:g} mm)"
             )
         return out
 
@@ -83,11 +83,11 @@ class Case:
             "surface": self.surface.metadata(),
             **self.plan.metadata(),
             "symmetry_planes": [str(p) for p in self.planes],
-            "dz_m": s.dz,
-            "theta_min_deg": math.degrees(s.theta_min),
-            "theta_max_deg": math.degrees(s.theta_max),
-            "rho_bar_deg": None if s.rho_bar is None else math.degrees(s.rho_bar),
-            "F_tol": s.f_tol,
+            "dz_m": s.design.dz,
+            "theta_min_deg": math.degrees(s.design.theta_min),
+            "theta_max_deg": math.degrees(s.design.theta_max),
+            "rho_bar_deg": None if s.design.rho_bar is None else math.degrees(s.design.rho_bar),
+            "F_tol": s.design.f_tol,
         }
 
 
@@ -152,15 +152,15 @@ def make_case(
 
 
 def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> None:
-    """Refuse an initial shape with more than ``settings.theta_far_share`` of its sector
+    """Refuse an initial shape with more than ``settings.inputs.theta_far_share`` of its sector
     angles far outside [theta_min, theta_max] (below theta_min / 2 or above
     (theta_max + pi) / 2), before any problem is built: one line saying how many angles lie
     below and above the bounds, the smallest and the largest, and which options move the
     bounds. Raises ValueError."""
     angles = shape.corner_angles
-    lo, hi = settings.theta_min, settings.theta_max
+    lo, hi = settings.design.theta_min, settings.design.theta_max
     far = (angles < lo / 2) | (angles > (hi + math.pi) / 2)
-    if far.sum() <= settings.theta_far_share * angles.size:
+    if far.sum() <= settings.inputs.theta_far_share * angles.size:
         return
     deg = np.degrees(angles)
     below, above = int((angles < lo).sum()), int((angles > hi).sum())
@@ -173,7 +173,8 @@ def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> 
         f"the crease pattern's initial shape has {below + above} of {angles.size} sector angles "
         f"outside the bounds [{math.degrees(lo):g}, {math.degrees(hi):g}] degrees: "
         f"{' and '.join(parts)}; {int(far.sum())} of them are far outside (more than "
-        f"{settings.theta_far_share:.0%} of the angles, Settings.theta_far_share), which problem "
+        f"{settings.inputs.theta_far_share:.0%} of the angles, "
+        "Settings.inputs.theta_far_share), which problem "
         "(6) cannot bring inside: allow them with --theta-min DEG / --theta-max DEG, or choose "
         "a pattern without such slivers"
     )

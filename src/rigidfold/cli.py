@@ -141,12 +141,12 @@ def _svg_tolerance(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--svg-tolerance",
         type=_fraction,
-        default=DEFAULTS.svg_snap_tol,
+        default=DEFAULTS.inputs.svg_snap_tol,
         metavar="FRACTION",
         help="slips of the pen in an SVG pattern mended, as a fraction of the drawing's "
         "diagonal: a crease overshooting the line it ends on, or ending short of one, by up "
         "to this much is cut or extended to it; 0 mends nothing (default: %(default)g, "
-        "Settings.svg_snap_tol)",
+        "Settings.inputs.svg_snap_tol)",
     )
 
 
@@ -228,7 +228,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="the paper's Step 5: accept a solution without tracing its folding path to the "
         "flat state (by default a solution of at most DOF max(target, "
-        f"{DEFAULTS.deploy_check_max_dof}) whose path does not reach the flat state is "
+        f"{DEFAULTS.generation.deploy_check_max_dof}) whose path does not reach the flat state is "
         "replaced like a lock and counted in N_path)",
     )
     gen.add_argument(
@@ -248,7 +248,7 @@ def build_parser() -> argparse.ArgumentParser:
         "1.8cm) as rigidfold fabricate does, from the motion the run traced: DIR/final/thick/; "
         "the run falls short when they collide over the deployment or are trimmed away. Also "
         "the panels' thickness of --structure (default: no thick panels; --structure alone: "
-        f"{DEFAULTS.structure_thickness:g})",
+        f"{DEFAULTS.structure.thickness:g})",
     )
     gen.add_argument(
         "--side",
@@ -269,9 +269,9 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME|E,nu,density",
         help=f"the panels' material: a preset ({', '.join(MATERIALS)}) or E,nu,density in SI "
         "units; Step 9's frame is then of strips of these panels (of --thickness, or "
-        f"{DEFAULTS.structure_thickness * 1e3:g} mm), and --structure and the thick panels' "
+        f"{DEFAULTS.structure.thickness * 1e3:g} mm), and --structure and the thick panels' "
         f"masses use it (default: the paper's steel tubes for Step 9, "
-        f"{DEFAULTS.structure_material} for the others)",
+        f"{DEFAULTS.structure.material} for the others)",
     )
     gen.add_argument(
         "--supports",
@@ -347,8 +347,10 @@ def build_parser() -> argparse.ArgumentParser:
         out=True,
         help="Step 9: large-deformation check of a FOLD shape (OpenSees) and its folding motion",
         description="Drive the frame model of a FOLD shape to the plane with OpenSees (tubes "
-        f"{DEFAULTS.tube_diameter * 1e3:g} mm x {DEFAULTS.tube_wall * 1e3:g} mm, E = "
-        f"{DEFAULTS.youngs_modulus / 1e9:g} GPa, {DEFAULTS.deform_steps} load steps) and trace "
+        f"{DEFAULTS.deformation.tube_diameter * 1e3:g} mm x "
+        f"{DEFAULTS.deformation.tube_wall * 1e3:g} mm, E = "
+        f"{DEFAULTS.deformation.youngs_modulus / 1e9:g} GPa, "
+        f"{DEFAULTS.deformation.steps} load steps) and trace "
         "its folding motion (a rigid-folding path from the plane, the support panel held "
         "still); a line says whether the two verdicts agree and, when not, why. Writes "
         "DIR/<name>.fold (the input plus the development diagram and the motion frames), "
@@ -363,7 +365,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="build the frame's members as strips of these panels instead of the paper's "
         "tubes (each triangle's area shared by its three members, the panel's thickness): a "
         f"preset ({', '.join(MATERIALS)}) or E,nu,density in SI units; with --thickness only, "
-        f"{DEFAULTS.structure_material} (default: the tubes)",
+        f"{DEFAULTS.structure.material} (default: the tubes)",
     )
     dfm.add_argument(
         "--thickness",
@@ -371,7 +373,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="T",
         help="panel thickness in metres for --material (default with --material: "
-        f"{DEFAULTS.structure_thickness:g})",
+        f"{DEFAULTS.structure.thickness:g})",
     )
 
     exp = _file_command(
@@ -425,13 +427,13 @@ def build_parser() -> argparse.ArgumentParser:
     stc.add_argument(
         "--thickness",
         type=_positive,
-        default=DEFAULTS.structure_thickness,
+        default=DEFAULTS.structure.thickness,
         metavar="T",
         help="panel thickness in metres (default: %(default)g)",
     )
     stc.add_argument(
         "--material",
-        default=DEFAULTS.structure_material,
+        default=DEFAULTS.structure.material,
         metavar="NAME|E,nu,density",
         help=f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units "
         "(Pa, -, kg/m^3), e.g. 10e9,0.3,700 (default: %(default)s)",
@@ -450,7 +452,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="boundary|ground|V,V,...",
         help="the vertices auto may choose: every boundary vertex, the boundary vertices at "
-        f"the lowest height (within {DEFAULTS.structure_ground_tol:g} m), or a list "
+        f"the lowest height (within {DEFAULTS.structure.ground_tol:g} m), or a list "
         "(default: boundary)",
     )
     stc.add_argument(
@@ -470,7 +472,7 @@ def build_parser() -> argparse.ArgumentParser:
     stc.add_argument(
         "--hinge-stiffness",
         type=float,
-        default=DEFAULTS.structure_hinge_stiffness,
+        default=DEFAULTS.structure.hinge_stiffness,
         metavar="K",
         help="rotational stiffness of every free crease, N m/rad per metre of crease "
         "(default: %(default)s, a free hinge)",
@@ -491,7 +493,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     stc.add_argument(
         "--limit",
-        default=f"L/{DEFAULTS.structure_limit:g}",
+        default=f"L/{DEFAULTS.structure.limit:g}",
         metavar="L/N",
         help="serviceability: the largest displacement may be at most the span over N; the "
         "span is the largest plan distance between supports (twice the reach of a "
@@ -501,12 +503,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--nonlinear",
         action="store_true",
         help="geometrically nonlinear analysis (corotational shells, "
-        f"{DEFAULTS.structure_steps} load steps) instead of a linear one",
+        f"{DEFAULTS.structure.steps} load steps) instead of a linear one",
     )
     stc.add_argument(
         "--modes",
         type=int,
-        default=DEFAULTS.structure_modes,
+        default=DEFAULTS.structure.modes,
         metavar="N",
         help="natural frequencies to compute, 0 for none (default: %(default)s)",
     )
@@ -547,7 +549,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     fab.add_argument(
         "--side",
-        default=DEFAULTS.fabricate_side,
+        default=DEFAULTS.fabricate.side,
         choices=SIDES,
         help="the side of the design surface the solids lie on: bottom (below it, the surface "
         "is their outer face) or top (default: %(default)s)",
@@ -555,7 +557,7 @@ def build_parser() -> argparse.ArgumentParser:
     fab.add_argument(
         "--clearance-angle",
         type=float,
-        default=round(math.degrees(DEFAULTS.fabricate_clearance_angle), 9),
+        default=round(math.degrees(DEFAULTS.fabricate.clearance_angle), 9),
         metavar="DEG",
         help="bevels leave this angle, degrees, to spare beyond each hinge's largest fold "
         "(default: %(default)s)",
@@ -563,7 +565,7 @@ def build_parser() -> argparse.ArgumentParser:
     fab.add_argument(
         "--density",
         type=_positive,
-        default=DEFAULTS.fabricate_density,
+        default=DEFAULTS.fabricate.density,
         metavar="KG/M3",
         help="density of the panel material for the masses, plywood by default (default: "
         "%(default)s)",
@@ -571,7 +573,7 @@ def build_parser() -> argparse.ArgumentParser:
     fab.add_argument(
         "--sheet",
         type=_sheet,
-        default=f"{DEFAULTS.fabricate_sheet_width:g}x{DEFAULTS.fabricate_sheet_height:g}",
+        default=f"{DEFAULTS.fabricate.sheet_width:g}x{DEFAULTS.fabricate.sheet_height:g}",
         metavar="WxH",
         help="stock sheet size in millimetres that the cut sheets are nested onto (default: "
         "%(default)s)",
@@ -582,7 +584,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="T",
         help="a panel whose solid is nowhere this deep once bevelled fails (default: "
-        f"{DEFAULTS.fabricate_min_depth:g} x the thickness)",
+        f"{DEFAULTS.fabricate.min_depth:g} x the thickness)",
     )
     fab.add_argument(
         "--overwrite",
@@ -667,7 +669,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     stu.add_argument(
         "--hessian",
-        default=DEFAULTS.ipopt_hessian,
+        default=DEFAULTS.solver.ipopt_hessian,
         choices=HESSIANS,
         help="IPOPT's Hessian of the Lagrangian: closed-form or casadi (the symbolic "
         "reference, used by studies made before the closed form; default: %(default)s)",
@@ -751,7 +753,8 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
         default=DEFAULT_SEED,
         help="random seed, 0 to 2**63 - 1: of the Bezier surface; generate also draws from it "
         "the fictitious hinge stiffnesses K_j (uniform in "
-        f"{DEFAULTS.hinge_stiffness:g} +/- {DEFAULTS.hinge_stiffness_spread:g} Nm, Section "
+        f"{DEFAULTS.generation.hinge_stiffness:g} +/- "
+        f"{DEFAULTS.generation.hinge_stiffness_spread:g} Nm, Section "
         "6.1) that the s and shat criteria rank by, and the order of the random criterion "
         "(default: %(default)s)",
     )
@@ -810,7 +813,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
         type=_positive,
         metavar="L",
         help="target edge length in metres of a mesh: pattern (default: sqrt(footprint area) "
-        f"/ {DEFAULTS.mesh_divisions:g})",
+        f"/ {DEFAULTS.inputs.mesh_divisions:g})",
     )
     p.add_argument(
         "--symmetric",
@@ -826,7 +829,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     )
     p.add_argument(
         "--hessian",
-        default=DEFAULTS.ipopt_hessian,
+        default=DEFAULTS.solver.ipopt_hessian,
         choices=HESSIANS,
         help="IPOPT's Hessian of the Lagrangian (both exact; they differ by round-off; "
         "default: %(default)s)",
@@ -834,12 +837,12 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     p.add_argument(
         "--dz",
         type=float,
-        default=DEFAULTS.dz,
+        default=DEFAULTS.design.dz,
         help="bound on |z - f(x, y)|: how far, in metres, each vertex may lie above or below "
         "the target surface (default: %(default)s)",
     )
     for bound, word in (("min", "smallest"), ("max", "largest")):
-        default = math.degrees(getattr(DEFAULTS, f"theta_{bound}"))
+        default = math.degrees(getattr(DEFAULTS.design, f"theta_{bound}"))
         p.add_argument(
             f"--theta-{bound}",
             type=float,

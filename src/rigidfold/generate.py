@@ -294,9 +294,9 @@ class GenerateOptions:
     deploy_check : polish every accepted solution to F = 0
         (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
         rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
-        on solutions of at most ``Settings.deploy_check_max_dof`` DOF, 0: all); one that does
-        not counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape (which
-        cannot deploy) is retried like a lock where the target is >= 1. False is the paper's
+        on solutions of at most ``Settings.generation.deploy_check_max_dof`` DOF, 0: all); one
+        that does not counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape
+        (which cannot deploy) is retried like a lock where the target is >= 1. False is the paper's
         method.
     support_face : the triangle whose frame node carries the s = 6 supports (default: the
         one nearest the centroid); it sets the metric of the mechanism modes and so the
@@ -307,15 +307,15 @@ class GenerateOptions:
     thickness : metres, or None (the default): thick panels of this thickness on ``side``
         (one of ``SIDES``) are made of the final design and checked over its folding motion
         (:func:`rigidfold.fabricate.fabricate_panels`); with ``structure``, also the panels'
-        thickness (None: ``Settings.structure_thickness``).
+        thickness (None: ``Settings.structure.thickness``).
     structure : check the final design as a structure (:mod:`rigidfold.structure`): on
         ``supports`` (``"auto"`` or ``"V,V,..."`` pinned vertices) under self-weight and
         ``loads`` (``--load`` texts), its largest displacement within span / ``limit``.
     material : the panels' material (a preset name or ``"E,nu,density"``), for the
         structure, the masses of the thick panels and Step 9's frame (strips of the panels,
         :func:`rigidfold.deform.analysis.panel_section`, of ``thickness`` or
-        ``Settings.structure_thickness``); None (the default): Step 9 with the paper's steel
-        tubes, and ``Settings.structure_material`` for the structure and the masses
+        ``Settings.structure.thickness``); None (the default): Step 9 with the paper's steel
+        tubes, and ``Settings.structure.material`` for the structure and the masses
         (:attr:`panel_material`).
 
     Studies do not store the options of the thick panels and the structure
@@ -332,12 +332,12 @@ class GenerateOptions:
     deform: bool = True
     check: str = CHECKS[0]
     thickness: float | None = None
-    side: str = DEFAULTS.fabricate_side
+    side: str = DEFAULTS.fabricate.side
     structure: bool = False
     material: str | None = None
     supports: str = "auto"
     loads: tuple[str, ...] = ()
-    limit: float = DEFAULTS.structure_limit
+    limit: float = DEFAULTS.structure.limit
 
     def __post_init__(self) -> None:
         if self.criterion not in CRITERIA:
@@ -395,7 +395,7 @@ class GenerateOptions:
     @property
     def panel_material(self) -> str:
         """The material of the structure check and of the thick panels' masses."""
-        return DEFAULTS.structure_material if self.material is None else self.material
+        return DEFAULTS.structure.material if self.material is None else self.material
 
     def replace(self, **changes) -> GenerateOptions:
         """These options with ``changes`` (field names), validated; unknown names are a
@@ -453,7 +453,7 @@ class _Steps:
         # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
         # over-reduction, retried like a lock (as with zero_dof_ends=False)
         self.zero_ends = (
-            self.settings.zero_dof_ends and not options.deploy_check
+            self.settings.generation.zero_dof_ends and not options.deploy_check
         ) or options.target_dof == 0
         self.locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
 
@@ -597,7 +597,7 @@ class _Steps:
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
             undeployable += rec.outcome is AttemptOutcome.PATH
-            if undeployable >= self.settings.deploy_max_candidates > 0:  # bounded cost
+            if undeployable >= self.settings.generation.deploy_max_candidates > 0:  # bounded cost
                 self.run.stop_detail = str(undeployable)
                 return Stop.NO_DEPLOYABLE
 
@@ -676,8 +676,8 @@ def _deployable_final(run: Generation, options: GenerateOptions, settings: Setti
 
 def _checked(mech: Mechanism | None, options: GenerateOptions, settings: Settings) -> bool:
     """Whether the deployability check runs on an accepted solution with this mechanism: at
-    most ``Settings.deploy_check_max_dof`` or the target DOF (0: every solution)."""
-    limit = settings.deploy_check_max_dof
+    most ``Settings.generation.deploy_check_max_dof`` or the target DOF (0: every solution)."""
+    limit = settings.generation.deploy_check_max_dof
     return mech is not None and (limit <= 0 or mech.dof <= max(limit, options.target_dof))
 
 

@@ -100,10 +100,10 @@ class ShapeAnalysis:
 
     @property
     def flat(self) -> bool:
-        """True for a flat sheet: every fold angle within ``settings.flat_angle`` of 0 (the
+        """True for a flat sheet: every fold angle within ``settings.geometry.flat_angle`` of 0 (the
         pattern's settings). Its DOF is first-order only (:data:`FLAT_NOTE`)."""
         pattern = self.data.pattern
-        return bool(np.all(np.abs(pattern.fold_angles) <= pattern.settings.flat_angle))
+        return bool(np.all(np.abs(pattern.fold_angles) <= pattern.settings.geometry.flat_angle))
 
     @property
     def notes(self) -> list[str]:
@@ -207,12 +207,12 @@ def deform_file(
 
     material, thickness : Step 9's frame as strips of these panels
     (:func:`rigidfold.deform.analysis.panel_section`; a preset's name or ``E,nu,density``,
-    metres); either given, the other defaults to ``Settings.structure_material`` /
+    metres); either given, the other defaults to ``Settings.structure.material`` /
     ``structure_thickness``; neither: the paper's tubes."""
     mat, t = None, None
     if material is not None or thickness is not None:
-        mat = parse_material(settings.structure_material if material is None else material)
-        t = settings.structure_thickness if thickness is None else thickness
+        mat = parse_material(settings.structure.material if material is None else material)
+        t = settings.structure.thickness if thickness is None else thickness
         if isinstance(t, bool) or not (isinstance(t, int | float) and np.isfinite(t) and t > 0):
             raise RigidfoldError(f"thickness must be a positive number of metres, got {t!r}")
     return _check_file(path, out, deform=True, up=up, settings=settings, material=mat, thickness=t)
@@ -261,10 +261,10 @@ def _check_file(
     if deform:
         section = {
             "kind": "tube",
-            "diameter_m": settings.tube_diameter,
-            "wall_m": settings.tube_wall,
-            "E_Pa": settings.youngs_modulus,
-            "nu": settings.poisson_ratio,
+            "diameter_m": settings.deformation.tube_diameter,
+            "wall_m": settings.deformation.tube_wall,
+            "E_Pa": settings.deformation.youngs_modulus,
+            "nu": settings.deformation.poisson_ratio,
         }
         if material is not None:
             section = {"kind": "panel", "material": material.to_dict(), "thickness_m": thickness}
@@ -510,18 +510,18 @@ def structure(
     path: str | os.PathLike,
     out: str | os.PathLike,
     *,
-    thickness: float = DEFAULTS.structure_thickness,
-    material: str | Material = DEFAULTS.structure_material,
+    thickness: float = DEFAULTS.structure.thickness,
+    material: str | Material = DEFAULTS.structure.material,
     supports: str = "auto",
     candidates: str | None = None,
     clamped: str = "",
     actuators: str = "",
-    hinge_stiffness: float = DEFAULTS.structure_hinge_stiffness,
+    hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness,
     loads: tuple[str, ...] = (),
     self_weight: bool = True,
-    limit: str | float = DEFAULTS.structure_limit,
+    limit: str | float = DEFAULTS.structure.limit,
     nonlinear: bool = False,
-    modes: int = DEFAULTS.structure_modes,
+    modes: int = DEFAULTS.structure.modes,
     up: str = "z",
     overwrite: bool = False,
     settings: Settings = DEFAULTS,
@@ -619,19 +619,19 @@ def fabricate_file(
     from rigidfold.fabricate.cutsheets import sheet_files
     from rigidfold.fabricate.files import FABRICATE_JSON, SOLID_FILES, write_fabrication
 
-    side = settings.fabricate_side if side is None else side
+    side = settings.fabricate.side if side is None else side
     if side not in ("bottom", "top"):
         raise RigidfoldError(f"side must be bottom or top, got {side!r}")
     if not (isinstance(thickness, float | int) and _math.isfinite(thickness) and thickness > 0):
         raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
-    angle = settings.fabricate_clearance_angle
+    angle = settings.fabricate.clearance_angle
     if clearance_angle_deg is not None:
         if not (_math.isfinite(clearance_angle_deg) and 0 <= clearance_angle_deg < 90):
             raise RigidfoldError(
                 f"clearance angle must be from 0 to below 90 degrees, got {clearance_angle_deg!r}"
             )
         angle = _math.radians(clearance_angle_deg)
-    width, height = sheet or (settings.fabricate_sheet_width, settings.fabricate_sheet_height)
+    width, height = sheet or (settings.fabricate.sheet_width, settings.fabricate.sheet_height)
     stem = Path(path).stem
     label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)] + sheet_files(out, stem)
@@ -660,6 +660,6 @@ def fabricate_file(
         title=title,
         label=label,
         sheet=(width, height),
-        gap=settings.fabricate_sheet_gap,
+        gap=settings.fabricate.sheet_gap,
     )
     return FabricateOutput(str(path), design, fab, summary, tuple(written))

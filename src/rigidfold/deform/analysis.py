@@ -70,10 +70,10 @@ class TubeSection:
     @classmethod
     def from_settings(cls, settings: Settings) -> TubeSection:
         return cls(
-            settings.tube_diameter,
-            settings.tube_wall,
-            settings.youngs_modulus,
-            settings.poisson_ratio,
+            settings.deformation.tube_diameter,
+            settings.deformation.tube_wall,
+            settings.deformation.youngs_modulus,
+            settings.deformation.poisson_ratio,
         )
 
     @property
@@ -316,7 +316,7 @@ def deform(
 ) -> DeformResult:
     """Drive the frame model of ``pattern`` to the plane z = ``plane_z`` (Step 9).
 
-    With a ``material`` (and ``thickness``, m, default ``Settings.structure_thickness``) the
+    With a ``material`` (and ``thickness``, m, default ``Settings.structure.thickness``) the
     members are strips of the panel (:func:`panel_section`); without, the paper's tubes.
 
     A step that does not converge is retried with half the increment up to
@@ -334,7 +334,7 @@ def deform(
     sec = TubeSection.from_settings(settings)
     panel = None
     if material is not None:
-        t = settings.structure_thickness if thickness is None else thickness
+        t = settings.structure.thickness if thickness is None else thickness
         panel = panel_section(pattern, material, t)
     tag = lambda i: int(i) + 1  # noqa: E731 - OpenSees tags start at 1
 
@@ -344,7 +344,7 @@ def deform(
         ops.node(tag(i), *map(float, c))
     sb = tag(lay.bary[support_face])
     ops.fix(sb, 1, 1, 0, 0, 0, 1)
-    ops.uniaxialMaterial("Elastic", 1, float(settings.hinge_stiffness))
+    ops.uniaxialMaterial("Elastic", 1, float(settings.generation.hinge_stiffness))
     for k, (a, b) in enumerate(lay.members):
         d = lay.coords[b] - lay.coords[a]
         if panel is None:
@@ -374,13 +374,13 @@ def deform(
     for node in np.unique(np.concatenate([lay.bary, lay.face_edge_node.ravel()])):
         ops.sp(tag(node), 3, float(plane_z - lay.coords[node, 2]))
     EA = sec.E * sec.A if panel is None else panel.E * float(np.mean(panel.A))
-    penalty = settings.deform_penalty * EA / float(np.mean(pattern.edge_lengths))
+    penalty = settings.deformation.penalty * EA / float(np.mean(pattern.edge_lengths))
     ops.constraints("Penalty", penalty, penalty)
     ops.numberer("RCM")
     ops.system("UmfPack")
-    ops.test("NormDispIncr", float(settings.deform_tol), int(settings.deform_max_iter), 0)
+    ops.test("NormDispIncr", float(settings.deformation.tol), int(settings.deformation.max_iter), 0)
     ops.algorithm("Newton")
-    ops.integrator("LoadControl", 1.0 / settings.deform_steps)
+    ops.integrator("LoadControl", 1.0 / settings.deformation.steps)
     ops.analysis("Static")
 
     l0 = _edge_lengths(lay.coords, lay.face_edge_node)
@@ -395,14 +395,14 @@ def deform(
     def nodes_now() -> np.ndarray:
         return lay.coords + np.array([ops.nodeDisp(t)[:3] for t in tags])
 
-    lam, step, halvings = 0.0, 1.0 / settings.deform_steps, 0
+    lam, step, halvings = 0.0, 1.0 / settings.deformation.steps, 0
     status, message = DeformStatus.REACHED_PLANE, ""
-    while lam < 1.0 - settings.deform_load_tol:
+    while lam < 1.0 - settings.deformation.load_tol:
         inc = min(step, 1.0 - lam)
         ops.integrator("LoadControl", inc)
         if ops.analyze(1) != 0:
             halvings += 1
-            if halvings > settings.deform_max_halvings:
+            if halvings > settings.deformation.max_halvings:
                 status = DeformStatus.FAILED
                 message = f"no convergence at load factor {lam:.4f} (step {inc:.2e})"
                 break
@@ -428,7 +428,7 @@ def deform(
         )
     if status is DeformStatus.REACHED_PLANE:
         z_off = float(np.max(np.abs(nodes_now()[:, 2] - plane_z)))
-        if z_off > settings.plane_tol:
+        if z_off > settings.deformation.plane_tol:
             status = DeformStatus.FAILED
             message = f"a frame node ends {z_off:.3g} m from the plane"
     ops.wipe()

@@ -111,7 +111,7 @@ def compare(
 def _not_traced(development: Development, motion: Motion, settings: Settings) -> tuple[str, str]:
     """(why the folding motion was not traced, how the OpenSees frame got to the plane
     instead: "" or " along another") for :func:`compare`."""
-    error, tol = development.max_length_error, settings.motion_length_tol
+    error, tol = development.max_length_error, settings.deformation.motion_length_tol
     if error > tol:
         return (
             "the shape is not developable within the motion's tolerance (its development's "

@@ -5,7 +5,7 @@ numerical continuation of the rigid-folding constraints (every edge length, ever
 crease's fold angle, a support triangle held still) from the design until every fold angle
 is within ``path_flat_tol`` of 0. For a 1-DOF mechanism it is the mechanism's own path, for
 more DOF the one closest to the straight line in fold angles. No single crease has to fold
-monotonically. The motion keeps ``settings.motion_frames`` shapes of the traced path at
+monotonically. The motion keeps ``settings.deformation.motion_frames`` shapes of the traced path at
 equal steps of arclength (:meth:`rigidfold.mechanism.path.FoldingPath.frames`), the
 development diagram (Step 8) at z = 0 as its flat end. The *support panel* (the panel,
 triangles joined by fixed creases, of the support triangle) holds still: every folded frame
@@ -99,15 +99,16 @@ def folding_motion(
     the deployability check), else it is traced here, with ``dof`` (the mechanism's, default
     the generic count) and ``support_face`` (default
     :func:`rigidfold.frame.model.default_support_face`). Returns up to
-    ``settings.motion_frames`` frames from the plane to the designed shape, the support panel
-    held still, when the path reaches the flat state; otherwise the part that was traced.
+    ``settings.deformation.motion_frames`` frames from the plane to the designed shape, the
+    support panel held still, when the path reaches the flat state; otherwise the part that was
+    traced.
     """
     if support_face is None:
         support_face = default_support_face(pattern)
     panel = np.flatnonzero(pattern.facets == pattern.facets[support_face])
     if path is None:
         path = trace_path(pattern, dof=dof, support_face=support_face, settings=settings)
-    n = max(int(settings.motion_frames), 2)
+    n = max(int(settings.deformation.motion_frames), 2)
     if path.deploys:
         folded, fraction = path.frames(pattern, n, support_face=support_face, settings=settings)
         folded, fraction = folded[1:], fraction[1:]  # the flat end: the development itself

@@ -149,7 +149,7 @@ def signed_areas(coords2d: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def count_flipped(
-    coords2d: np.ndarray, faces: np.ndarray, *, tol: float = DEFAULTS.degenerate_area
+    coords2d: np.ndarray, faces: np.ndarray, *, tol: float = DEFAULTS.geometry.degenerate_area
 ) -> int:
     """Number of triangles that are flipped or degenerate in a planar diagram.
 
@@ -161,7 +161,7 @@ def count_flipped(
         Triangles, counter-clockwise when not flipped.
     tol : float
         A triangle counts when its signed area is <= ``tol * (its longest edge)**2``
-        (default: ``Settings.degenerate_area``).
+        (default: ``Settings.geometry.degenerate_area``).
     """
     p = np.asarray(coords2d, dtype=np.float64)[np.asarray(faces)]
     longest2 = np.max(np.sum((p - np.roll(p, 1, axis=1)) ** 2, axis=2), axis=1)
@@ -169,7 +169,7 @@ def count_flipped(
 
 
 def count_overlaps(
-    coords2d: np.ndarray, faces: np.ndarray, *, tol: float = DEFAULTS.overlap_area_tol
+    coords2d: np.ndarray, faces: np.ndarray, *, tol: float = DEFAULTS.geometry.overlap_area_tol
 ) -> int:
     """Number of pairs of triangles (i < j) whose interiors overlap in a planar diagram.
 
@@ -342,7 +342,7 @@ def _solve(pattern: CreasePattern, layout: np.ndarray, start: str, settings: Set
     s = settings
     # a start with two vertices at one point (a crease folded 180 degrees) makes the gradient
     # of |dx| NaN there once; IPOPT steps away from it, so CasADi need not print a warning
-    opts = {**ipopt_options(s, tol=s.develop_tol), "show_eval_warnings": False}
+    opts = {**ipopt_options(s, tol=s.solver.develop_tol), "show_eval_warnings": False}
     x0 = _initial_guess(pattern, a, b, layout).T.ravel()[free]
     with native_quiet():
         solver = ca.nlpsol("development", "ipopt", {"x": xi, "f": D, "g": g}, opts)
@@ -360,8 +360,8 @@ def _solve(pattern: CreasePattern, layout: np.ndarray, start: str, settings: Set
         flipped = overlaps = -1
         status, verdict = DevelopStatus.FAILED, "non-finite coordinates"
     else:
-        flipped = count_flipped(coords2d, faces, tol=s.degenerate_area)
-        overlaps = count_overlaps(coords2d, faces, tol=s.overlap_area_tol)
+        flipped = count_flipped(coords2d, faces, tol=s.geometry.degenerate_area)
+        overlaps = count_overlaps(coords2d, faces, tol=s.geometry.overlap_area_tol)
         if ipopt_status not in _IPOPT_SUCCESS or not np.isfinite(D_val):
             status, verdict = DevelopStatus.FAILED, f"solver failure, D = {D_val:.3g}"
         elif flipped:

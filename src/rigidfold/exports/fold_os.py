@@ -24,7 +24,7 @@ FOLD file and nothing else (``js/importer.js``, ``openFile``; ``js/pattern.js``,
 :func:`origami_simulator_fold` writes the folded form in the top-level frame, no
 ``file_frames``: free creases ``M``/``V`` with their fold angles, flat free creases and fixed
 creases ``F`` at 0 (fixed creases are rigid panels; one folded more than
-``Settings.flat_angle``, a bent panel read from another tool's file, keeps its angle, which
+``Settings.geometry.flat_angle``, a bent panel read from another tool's file, keeps its angle, which
 Origami Simulator folds as a crease), the boundary ``B``. ``edges_rigidfold:fixed`` marks the
 fixed creases, so that rigidfold reads the file back (``--up y``) as the same design.
 """
@@ -61,7 +61,7 @@ def origami_simulator_fold(pattern: CreasePattern, *, title: str = "") -> dict:
             f"design has {pattern.n_vertices}"
         )
     rho = pattern.fold_angles
-    flat = np.abs(rho) <= pattern.settings.flat_angle
+    flat = np.abs(rho) <= pattern.settings.geometry.flat_angle
     letters = np.where(rho > 0, "V", "M")
     letters[flat | pattern.fixed] = "F"
     letters[pattern.is_boundary_edge] = "B"

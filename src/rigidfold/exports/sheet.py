@@ -138,7 +138,7 @@ def layout_sheet(
         height=float(size[1] + 2 * margin_mm),
         angle=angle,
         margin=float(margin_mm),
-        assignment=edge_assignments(pattern, pattern.settings.flat_angle),
+        assignment=edge_assignments(pattern, pattern.settings.geometry.flat_angle),
     )
 
 

@@ -4,9 +4,9 @@
 clearance angle (:mod:`rigidfold.fabricate.solids`), checks every pair of solids over the
 whole motion (:mod:`rigidfold.fabricate.collision`), doubles the relief at a vertex where
 two panels without a common hinge still come too close there (up to
-``settings.fabricate_relief_rounds`` times), and gives the verdict
+``settings.fabricate.relief_rounds`` times), and gives the verdict
 (:class:`FabricationStatus`). When the thickness fails, thinner ones are tried (halving,
-then bisection, ``settings.fabricate_thickness_tries`` in all) to name one that passes.
+then bisection, ``settings.fabricate.thickness_tries`` in all) to name one that passes.
 """
 
 from __future__ import annotations
@@ -173,15 +173,15 @@ def fabricate_panels(
     followed by thinner tries (see the module's text)."""
     if not (math.isfinite(thickness) and thickness > 0):
         raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
-    c = settings.fabricate_clearance_angle if clearance_angle is None else float(clearance_angle)
+    c = settings.fabricate.clearance_angle if clearance_angle is None else float(clearance_angle)
     if not 0 <= c < math.pi / 2:
         raise RigidfoldError(
             f"clearance angle must lie in [0, 90) degrees, got {math.degrees(c):g}"
         )
-    rho = density if density is not None else settings.fabricate_density
+    rho = density if density is not None else settings.fabricate.density
     if not (math.isfinite(rho) and rho > 0):
         raise RigidfoldError(f"density must be a positive number of kg/m^3, got {rho!r}")
-    least = settings.fabricate_min_depth * thickness if min_thickness is None else min_thickness
+    least = settings.fabricate.min_depth * thickness if min_thickness is None else min_thickness
     if not (math.isfinite(least) and 0 <= least <= thickness):
         raise RigidfoldError(
             f"the minimum thickness must lie from 0 to the thickness ({thickness * 1e3:g} mm), "
@@ -193,7 +193,7 @@ def fabricate_panels(
     tries: list[tuple[float, str]] = []
     good, bad = None, thickness
     share = least / thickness
-    for _ in range(settings.fabricate_thickness_tries):
+    for _ in range(settings.fabricate.thickness_tries):
         trial = bad / 2 if good is None else 0.5 * (good + bad)
         got = _evaluate(panels, motion, trial, c, share * trial, rho, "", settings)
         tries.append((trial, got.status.value))
@@ -227,13 +227,13 @@ def _evaluate(
         high = np.maximum(panels.closing(panels.pattern.fold_angles), 0.0)
     bevel = bevel_angles(high, clearance_angle)
     relief = np.zeros(panels.pattern.n_vertices)
-    relief[panels.relief_vertices] = settings.fabricate_vertex_relief * thickness
+    relief[panels.relief_vertices] = settings.fabricate.vertex_relief * thickness
     rounds = 0
     solids = thicken(panels, thickness, bevel, relief)
     around = [h for h, (a, b) in enumerate(solids.hinge_limits[1]) if a or b]
     if around:  # pieces reaching around a hinge's axis touch the neighbour at its ends
         ends = panels.hinge_vertices[around].ravel()
-        relief[ends] = np.maximum(relief[ends], settings.fabricate_vertex_relief * thickness)
+        relief[ends] = np.maximum(relief[ends], settings.fabricate.vertex_relief * thickness)
     while True:
         if rounds or around:
             solids = thicken(panels, thickness, bevel, relief)
@@ -242,10 +242,10 @@ def _evaluate(
             check = check_clearance(
                 solids,
                 motion,
-                clearance=settings.fabricate_clearance,
-                subdivisions=settings.fabricate_subdivisions,
+                clearance=settings.fabricate.clearance,
+                subdivisions=settings.fabricate.subdivisions,
             )
-        if check is None or check.collision_free or rounds >= settings.fabricate_relief_rounds:
+        if check is None or check.collision_free or rounds >= settings.fabricate.relief_rounds:
             break
         vertices = {m.vertex for m in check.meetings if m.kind == "gap" and m.vertex >= 0}
         if not vertices:
@@ -282,7 +282,7 @@ def _verdict(
     faces = solids.empty_faces
     gone = sorted(
         set(p.label[faces].tolist())
-        | set(np.flatnonzero(share < settings.fabricate_trimmed_away).tolist())
+        | set(np.flatnonzero(share < settings.fabricate.trimmed_away).tolist())
     )
     if gone:
         k = gone[0]

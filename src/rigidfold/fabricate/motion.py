@@ -6,7 +6,7 @@ The motion is a sequence of frames, vertex positions (K, V, 3) from the flat she
 they are fine enough, else the design's rigid-folding path
 (:func:`rigidfold.mechanism.path.trace_path`) sampled at equal arclength
 (:meth:`rigidfold.mechanism.path.FoldingPath.frames`) so finely that no hinge turns more
-than ``settings.fabricate_frame_step`` between two frames. Each panel moves rigidly: at
+than ``settings.fabricate.frame_step`` between two frames. Each panel moves rigidly: at
 frame i its points are ``R[i, k] @ x + t[i, k]`` for ``x`` in the design, ``R, t`` the
 least-squares fit (Kabsch) of the panel's vertices in the design onto theirs in the frame.
 """
@@ -160,7 +160,7 @@ def design_motion(
     again when the frames are too coarse."""
     from rigidfold.mechanism.path import trace_path
 
-    step = settings.fabricate_frame_step
+    step = settings.fabricate.frame_step
     carried = frames
     where = "the traced motion's"
     if carried is None and design is not None:

@@ -34,7 +34,7 @@ frame.
 **Relief at a vertex.** Panels that meet at a vertex without a common hinge would touch at
 that vertex all the way. At each such vertex (:attr:`Panels.relief_vertices`) every corner
 is cut off by the plane perpendicular to the surface and to the corner's bisector at the
-distance ``r`` from the vertex (:data:`rigidfold.config.Settings.fabricate_vertex_relief`
+distance ``r`` from the vertex (:data:`rigidfold.config.Settings.fabricate.vertex_relief`
 thicknesses; doubled where the check finds the solids too close), so no solid comes
 nearer than ``r`` to the vertex's normal line and the hinges end there.
 

@@ -122,8 +122,9 @@ def write_json(path: str | os.PathLike, data, *, indent: int | None = 2) -> Path
     return atomic_write(path, json.dumps(clean, indent=indent, allow_nan=False) + "\n")
 
 
-def parse_json(text: str | bytes, *, max_depth: int = DEFAULTS.max_json_depth):
-    """The JSON data of ``text``, nested at most ``max_depth`` levels (``Settings.max_json_depth``).
+def parse_json(text: str | bytes, *, max_depth: int = DEFAULTS.limits.max_json_depth):
+    """The JSON data of ``text``, nested at most ``max_depth`` levels
+    (``Settings.limits.max_json_depth``).
 
     Raises json.JSONDecodeError for text that is not JSON, and ValueError ``"nested deeper
     than N levels"`` for a deeper document (one nested too deep for Python's parser included).
@@ -136,7 +137,7 @@ def parse_json(text: str | bytes, *, max_depth: int = DEFAULTS.max_json_depth):
     return value
 
 
-def check_json_depth(value, *, max_depth: int = DEFAULTS.max_json_depth) -> None:
+def check_json_depth(value, *, max_depth: int = DEFAULTS.limits.max_json_depth) -> None:
     """ValueError ``"nested deeper than N levels"`` when lists, tuples and dicts nest in
     ``value`` deeper than ``max_depth``; measured without recursion, so any depth is safe."""
     stack = [(value, 1)]
@@ -154,7 +155,7 @@ def check_json_depth(value, *, max_depth: int = DEFAULTS.max_json_depth) -> None
 
 
 def _too_deep(max_depth: int) -> str:
-    return f"nested deeper than {max_depth} levels (Settings.max_json_depth)"
+    return f"nested deeper than {max_depth} levels (Settings.limits.max_json_depth)"
 
 
 def jsonable(value, *, where: str = "the value"):
@@ -168,7 +169,7 @@ def jsonable(value, *, where: str = "the value"):
 
     Raises ValueError ``"<where> holds a <type>, which is not JSON data"`` for anything else
     (sets, arbitrary objects), and ``"<where> is nested deeper than N levels"`` for lists and
-    dicts nested deeper than ``Settings.max_json_depth``.
+    dicts nested deeper than ``Settings.limits.max_json_depth``.
     """
     try:
         check_json_depth(value)

@@ -118,7 +118,7 @@ class FoldData:
         an unassigned crease (``"U"``, in the file or derived from the faces) gets what the
         shape's fold angle says (:func:`edge_assignments`); added diagonals are ``"J"``.
         """
-        measured = edge_assignments(self.pattern, self.pattern.settings.flat_angle)
+        measured = edge_assignments(self.pattern, self.pattern.settings.geometry.flat_angle)
         return [m if a == "U" else a for a, m in zip(self.assignment, measured, strict=True)]
 
 
@@ -150,7 +150,7 @@ def fold_dict(
     creator : str
         ``file_creator``.
     settings : Settings
-        ``settings.flat_angle`` decides which free creases are flat (``"F"``).
+        ``settings.geometry.flat_angle`` decides which free creases are flat (``"F"``).
     frames : list of dict, optional
         Further frames (``file_frames``), e.g. from :func:`crease_pattern_frame`.
 
@@ -168,7 +168,7 @@ def fold_dict(
         "file_classes": ["singleModel"],
         "frame_classes": [frame_class],
         "frame_title": title,
-        **_model_keys(pattern, edge_assignments(pattern, settings.flat_angle)),
+        **_model_keys(pattern, edge_assignments(pattern, settings.geometry.flat_angle)),
         **_prefixed(metadata),
     }
     if frames:
@@ -427,7 +427,9 @@ def write_document(path: str | os.PathLike, document: dict) -> Path:
     return atomic_write(path, _dumps(document))
 
 
-def edge_assignments(pattern: CreasePattern, flat_angle: float = DEFAULTS.flat_angle) -> list[str]:
+def edge_assignments(
+    pattern: CreasePattern, flat_angle: float = DEFAULTS.geometry.flat_angle
+) -> list[str]:
     """FOLD assignment letter of each edge.  -> list of E str"""
     rho = pattern.fold_angles
     letters = np.where(rho > flat_angle, "V", np.where(rho < -flat_angle, "M", "F"))
@@ -521,9 +523,9 @@ def read_fold(
     ------
     ValueError
         One line naming the file and the problem: unreadable file, invalid JSON, JSON nested
-        deeper than ``settings.max_json_depth`` (checked at its default), missing or
+        deeper than ``settings.limits.max_json_depth`` (checked at its default), missing or
         malformed keys, an unknown ``frame_unit``, non-finite coordinates, 2D and 3D vertices
-        mixed, a coordinate beyond ``settings.max_coordinate`` metres, indices out of
+        mixed, a coordinate beyond ``settings.limits.max_coordinate`` metres, indices out of
         range, cut edges (``"C"``), a boundary edge assigned ``"J"`` or marked fixed, faces
         whose projection onto the xy plane has zero area (a y-up file, a closed or
         flat-folded sheet), a surface that is not an oriented disc.
@@ -589,12 +591,12 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
             f"{', '.join(UNITS)}"
         )
     coords = _coords(data) * UNITS[unit]
-    far = np.abs(coords).max(axis=1, initial=0.0) > settings.max_coordinate
+    far = np.abs(coords).max(axis=1, initial=0.0) > settings.limits.max_coordinate
     if far.any():
         i = int(np.argmax(far))
         raise RigidfoldError(
             f"vertices_coords[{i}] = {_short(data['vertices_coords'][i])} lies farther than "
-            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+            f"{settings.limits.max_coordinate:g} m from the origin (Settings.limits.max_coordinate)"
         )
     if up == "y":
         coords = geometry.from_y_up(coords)
@@ -602,10 +604,10 @@ def _parse(raw: dict, frame: int, up: str, rigid_panels: bool, settings: Setting
     file_edges, file_assignment = _file_edges(data, len(coords))
     file_assignment = _mark_fixed(data, file_edges, file_assignment)
     triangles, diagonals = triangulate_polygons(
-        coords, polygons, area_tol=settings.triangulation_area_tol, name="faces_vertices"
+        coords, polygons, area_tol=settings.geometry.triangulation_area_tol, name="faces_vertices"
     )
     triangles = orient_up(coords, triangles)
-    _check_plan(coords, triangles, up, settings.plan_area_tol)
+    _check_plan(coords, triangles, up, settings.geometry.plan_area_tol)
     edges, assignment = _complete_edges(
         file_edges, file_assignment, diagonals, "J" if rigid_panels else "U", triangles, len(coords)
     )

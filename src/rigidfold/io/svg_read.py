@@ -8,7 +8,7 @@ faces, in the drawing's own coordinates (user units, y flipped to point up).
 
 What is read (svgelements parses the file: transforms, ``viewBox``, ``<use>``, styles), once
 the XML has been walked without recursion: elements nested deeper than
-``Settings.max_svg_depth``, an ``<svg>`` ``width`` or ``height`` that is not a positive
+``Settings.limits.max_svg_depth``, an ``<svg>`` ``width`` or ``height`` that is not a positive
 finite length, a ``viewBox`` that is not four finite numbers with a positive size, and a
 ``transform`` that is not transform functions of finite numbers are refused before
 svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or IndexError):
@@ -19,14 +19,14 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
 * colours by hue (:data:`COLOURS`), so ``#FF0000``, ``#f00``, ``rgb(255,0,0)`` and ``red``
   are all mountains; green cuts are refused;
 * lines are split where they cross or where one ends on another, points closer than
-  ``Settings.svg_merge_tol`` times the drawing's bounding-box diagonal are merged, and
+  ``Settings.inputs.svg_merge_tol`` times the drawing's bounding-box diagonal are merged, and
   pieces shorter than that are dropped. A piece drawn twice is kept once: if one drawing
   is black it stays boundary, other differing colours are refused. Where just two pieces
   of the same colour and opacity meet in a straight line, they become one line. Pieces of
   one colour and opacity drawn over each other along one line are made one before they are
   split (a line drawn back and forth many times costs no more than once), and a drawing
-  with more than ``Settings.max_svg_pairs`` pairs of pieces that meet or cross is refused;
-* slips of the pen up to ``Settings.svg_snap_tol`` times the diagonal are mended where a
+  with more than ``Settings.limits.max_svg_pairs`` pairs of pieces that meet or cross is refused;
+* slips of the pen up to ``Settings.inputs.svg_snap_tol`` times the diagonal are mended where a
   crease would otherwise end on nothing: an overshoot past the line a crease crosses (the
   boundary among them) is cut off, a piece drawn in two crease colours (one crease running
   on along another) is dropped, and a crease that ends short of a line is extended to it
@@ -151,9 +151,9 @@ def read_svg(path: str | os.PathLike, *, settings: Settings = DEFAULTS) -> SvgDr
     ------
     ValueError
         One line naming the file: unreadable, not an SVG, elements nested deeper than
-        ``settings.max_svg_depth``, a ``width``, ``height``, ``viewBox`` or ``transform``
+        ``settings.limits.max_svg_depth``, a ``width``, ``height``, ``viewBox`` or ``transform``
         that is not finite numbers (or scales the drawing to nothing), no lines, a curve, an
-        unknown or a cut (green) colour, more than ``settings.max_svg_pairs`` pairs of
+        unknown or a cut (green) colour, more than ``settings.limits.max_svg_pairs`` pairs of
         pieces that meet or cross, no boundary, a boundary that is not one closed
         outline (open, branching, several pieces, holes), creases outside the boundary, a
         crease ending inside a face, a face that is not a simple polygon.
@@ -187,12 +187,12 @@ def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     unit, scale, to_user = _units(svg)
     ends, letters, angles = _lines(svg, to_user)
     across = float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
-    tol, snap = settings.svg_merge_tol * across, settings.svg_snap_tol * across
+    tol, snap = settings.inputs.svg_merge_tol * across, settings.inputs.svg_snap_tol * across
     pieces: tuple[np.ndarray, list[str], list[float]] | None = (ends, letters, angles)
     for _ in range(_MENDS):
         if pieces is None:
             break
-        xy, edges, letters, angles = _node(*pieces, tol, snap, settings.max_svg_pairs)
+        xy, edges, letters, angles = _node(*pieces, tol, snap, settings.limits.max_svg_pairs)
         xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
         pieces = _mend(xy, edges, letters, angles, snap)
     boundary = _check_boundary(xy, edges, letters)
@@ -237,13 +237,14 @@ _TRANSFORM_NUMBERS = {
 
 def _check_xml(data: bytes, settings: Settings) -> None:
     """Walk the XML once before svgelements reads it, without recursion: ValueError for
-    elements nested deeper than ``settings.max_svg_depth``, for the attributes svgelements
+    elements nested deeper than ``settings.limits.max_svg_depth``, for the attributes svgelements
     would fail on with a ZeroDivisionError, IndexError or TypeError
-    (:func:`_check_attributes`), and for a drawing larger than ``settings.max_svg_size``
+    (:func:`_check_attributes`), and for a drawing larger than ``settings.limits.max_svg_size``
     once its ``<use>`` elements are expanded (:func:`_expanded_size`: a loop of them is
     named); ``ElementTree.ParseError`` for text that is not XML."""
     parser: ElementTree.XMLPullParser = ElementTree.XMLPullParser(events=("start", "end"))
-    # per open element: [its size and its children's, {id: <use>s of it}] (Settings.max_svg_size)
+    # per open element: [its size and its children's, {id: <use>s of it}]
+    # (Settings.limits.max_svg_size)
     stack: list[list] = [[0, {}]]
     found: dict[str, list[tuple[int, dict[str, int]]]] = {}
     step = 1 << 16
@@ -267,10 +268,10 @@ def _check_xml(data: bytes, settings: Settings) -> None:
                     parent[1][target] = parent[1].get(target, 0) + count
                 element.clear()
                 continue
-            if len(stack) > settings.max_svg_depth:
+            if len(stack) > settings.limits.max_svg_depth:
                 raise RigidfoldError(
-                    f"its elements nest more than {settings.max_svg_depth} levels deep (at "
-                    f"<{_local(element.tag)}>; Settings.max_svg_depth)"
+                    f"its elements nest more than {settings.limits.max_svg_depth} levels deep (at "
+                    f"<{_local(element.tag)}>; Settings.limits.max_svg_depth)"
                 )
             _check_attributes(element)
             size = ELEMENT_SIZE + sum(len(value) for value in element.attrib.values())
@@ -281,18 +282,18 @@ def _check_xml(data: bytes, settings: Settings) -> None:
                     used[target[1:]] = 1
             stack.append([size, used])
     size, uses = stack[0]
-    total = _expanded_size(size, uses, found, settings.max_svg_size)
-    if total > settings.max_svg_size:
+    total = _expanded_size(size, uses, found, settings.limits.max_svg_size)
+    if total > settings.limits.max_svg_size:
         raise RigidfoldError(
-            f"its elements are larger than {settings.max_svg_size} characters of attributes "
+            f"its elements are larger than {settings.limits.max_svg_size} characters of attributes "
             f"and {ELEMENT_SIZE} per element, each <use> counted as what it refers to "
-            "(Settings.max_svg_size)"
+            "(Settings.limits.max_svg_size)"
         )
 
 
 ELEMENT_SIZE = 100
 """What one element adds to the size of a drawing besides its attributes' characters
-(``Settings.max_svg_size``): svgelements takes about as long to read an element as to read
+(``Settings.limits.max_svg_size``): svgelements takes about as long to read an element as to read
 a hundred characters of path data."""
 _XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 
@@ -594,14 +595,14 @@ def _node(
     angles: list[float],
     tol: float,
     snap: float = 0.0,
-    max_pairs: int = DEFAULTS.max_svg_pairs,
+    max_pairs: int = DEFAULTS.limits.max_svg_pairs,
 ) -> tuple[np.ndarray, np.ndarray, list[str], list[float]]:
     """The drawn pieces split where they meet, close points merged, repeats dropped.
 
     ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance; snap : a piece
     no longer than this drawn in two crease colours (where a crease overshoots its end along
     another) is dropped, for :func:`_mend` to join the lines again, instead of refused;
-    max_pairs : ``Settings.max_svg_pairs`` (:func:`_splits`). Pieces of one colour and
+    max_pairs : ``Settings.limits.max_svg_pairs`` (:func:`_splits`). Pieces of one colour and
     angle drawn over each other along one line are first made one (:func:`_merge_overlaps`),
     so that a line drawn back and forth many times costs no more than once.
     Returns xy (V, 2), edges (E, 2) int64 (in drawing order), their letters and angles.
@@ -736,7 +737,7 @@ def _splits(
     b: np.ndarray,
     length: np.ndarray,
     tol: float,
-    max_pairs: int = DEFAULTS.max_svg_pairs,
+    max_pairs: int = DEFAULTS.limits.max_svg_pairs,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where pieces must be split: where an end of another piece lies within ``tol`` of
     their interior (a T-junction: split at the foot of the perpendicular from that end) and
@@ -745,7 +746,7 @@ def _splits(
     a, b : (n, 2) float, the pieces' ends; length : (n,) float, all > tol.
     Returns the piece index (k,), the parameter along it (k,) and the point (k, 2).
     ValueError when more than ``max_pairs`` pairs of pieces come within ``tol`` of each
-    other (``Settings.max_svg_pairs``), counted in batches before the pairs are examined.
+    other (``Settings.limits.max_svg_pairs``), counted in batches before the pairs are examined.
     """
     lines = shapely.linestrings(np.stack([a, b], axis=1))
     tree = shapely.STRtree(lines)
@@ -758,7 +759,7 @@ def _splits(
         if pairs > max_pairs:
             raise RigidfoldError(
                 f"more than {max_pairs} pairs of its {len(lines)} line pieces meet, cross or "
-                "come within the merge distance of each other (Settings.max_svg_pairs): too "
+                "come within the merge distance of each other (Settings.limits.max_svg_pairs): too "
                 "many lines cross or are drawn over each other"
             )
         found.append((i, j))
@@ -956,7 +957,7 @@ def _check_creases(
         raise RigidfoldError(
             f"a crease ends inside a face at {_at(xy[degree == 1][0])}: creases must end on "
             f"another line (an end within {tol:.3g} drawing units of a line is joined to it; "
-            "Settings.svg_snap_tol)"
+            "Settings.inputs.svg_snap_tol)"
         )
     n, component = connected_components(_graph(edges, len(xy)), directed=False)
     if n > 1:

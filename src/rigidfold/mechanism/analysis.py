@@ -11,7 +11,7 @@ Three methods give the same result:
 * ``"frame"``: the paper's way, the right singular vectors of the frame compatibility matrix
   S (6m x (6n - 6 + h)) for zero singular values. Slow for large patterns; a check.
 
-``"auto"`` (the default) takes ``"sparse"`` from ``Settings.sparse_analysis_vertices``
+``"auto"`` (the default) takes ``"sparse"`` from ``Settings.mechanism.sparse_analysis_vertices``
 vertices on and ``"kinematic"`` below. All return H with orthonormal columns spanning ker(S)
 in the frame's v-space, so the pseudo stiffness matrix and everything derived from it
 (Sections 4.2, 5) are the paper's.
@@ -110,7 +110,7 @@ def analyze(
 
     pattern : the shape, with its fixed creases; method : one of ``METHODS`` (see the
     module's text). A shape whose analysis would need more than
-    ``settings.max_analysis_bytes`` is refused (ValueError) before anything is built.
+    ``settings.limits.max_analysis_bytes`` is refused (ValueError) before anything is built.
     """
     method = chosen_method(pattern, method, settings)
     check_analysis_size(pattern, settings, method)
@@ -144,14 +144,19 @@ def analyze(
 
 def chosen_method(pattern: CreasePattern, method: str, settings: Settings = DEFAULTS) -> str:
     """The method :func:`analyze` runs for ``method`` (one of ``METHODS``): ``"auto"`` is
-    ``"sparse"`` from ``settings.sparse_analysis_vertices`` vertices on, else ``"kinematic"``."""
+    ``"sparse"`` from ``settings.mechanism.sparse_analysis_vertices`` vertices on, else
+    ``"kinematic"``."""
     if method not in METHODS:
         raise RigidfoldError(
             f"unknown mechanism method {method!r} (choose from {', '.join(METHODS)})"
         )
     if method != "auto":
         return method
-    return "sparse" if pattern.n_vertices >= settings.sparse_analysis_vertices else "kinematic"
+    return (
+        "sparse"
+        if pattern.n_vertices >= settings.mechanism.sparse_analysis_vertices
+        else "kinematic"
+    )
 
 
 def analysis_bytes(rows: int, cols: int) -> int:
@@ -180,14 +185,15 @@ def check_analysis_size(
     pattern: CreasePattern, settings: Settings = DEFAULTS, method: str = "auto"
 ) -> None:
     """One-line ValueError when :func:`analyze` of ``pattern`` with ``method`` (by default
-    the one ``generate`` uses) would need more than ``settings.max_analysis_bytes``
+    the one ``generate`` uses) would need more than ``settings.limits.max_analysis_bytes``
     (:func:`analysis_memory`); ``generate`` calls it before its first solve."""
     need = analysis_memory(pattern, method, settings)
-    if need > settings.max_analysis_bytes:
+    if need > settings.limits.max_analysis_bytes:
         raise RigidfoldError(
             f"the mechanism analysis of {pattern.n_vertices} vertices and {pattern.n_edges} "
             f"edges needs about {need / 2**30:.3g} GiB, more than the limit of "
-            f"{settings.max_analysis_bytes / 2**30:.3g} GiB (Settings.max_analysis_bytes): "
+            f"{settings.limits.max_analysis_bytes / 2**30:.3g} GiB "
+            "(Settings.limits.max_analysis_bytes): "
             "use a coarser pattern"
         )
 
@@ -195,7 +201,7 @@ def check_analysis_size(
 def _svd_kernel(A: np.ndarray, settings: Settings) -> tuple[np.ndarray, np.ndarray, int]:
     """Orthonormal kernel basis of A by SVD, with rank relative to the largest singular value."""
     _, sv, vt = scipy.linalg.svd(A, full_matrices=True, lapack_driver="gesdd")
-    rank = int(np.sum(sv > settings.mechanism_rank_tol * sv[0])) if len(sv) else 0
+    rank = int(np.sum(sv > settings.mechanism.rank_tol * sv[0])) if len(sv) else 0
     return vt[rank:].T.copy(), sv, rank
 
 
@@ -208,15 +214,15 @@ def _qr_kernel(A: np.ndarray, settings: Settings) -> tuple[np.ndarray, np.ndarra
     """
     q, r, _ = scipy.linalg.qr(A.T, pivoting=True, mode="full")
     diag = np.abs(np.diag(r))
-    rank = int(np.sum(diag > settings.mechanism_rank_tol * diag[0])) if len(diag) else 0
+    rank = int(np.sum(diag > settings.mechanism.rank_tol * diag[0])) if len(diag) else 0
     return q[:, rank:], diag, rank
 
 
 def _locked(frame: FrameModel, H_phi: np.ndarray, settings: Settings) -> np.ndarray:
     """Free creases that rotate in no mode while their two triangles are not coplanar."""
-    folded = np.abs(frame.pattern.fold_angles[frame.hinges]) > settings.flat_angle
+    folded = np.abs(frame.pattern.fold_angles[frame.hinges]) > settings.geometry.flat_angle
     if H_phi.shape[1] == 0:
         return folded
     norms = np.linalg.norm(H_phi, axis=1)
-    still = norms <= settings.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)
+    still = norms <= settings.mechanism.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)
     return still & folded

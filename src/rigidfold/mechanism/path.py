@@ -206,7 +206,7 @@ def _trace_direction(
     J, J_rho = cons.jacobian(x0)
     rho = cons.free_angles(x0)
     tr = _Trace([x0.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
-    flat_tol, limit = settings.path_flat_tol, settings.path_fold_limit
+    flat_tol, limit = settings.path.flat_tol, settings.path.fold_limit
     system = System(J, J_rho, mode, t0, settings)
     tr.factorizations += 1
     t = t0 if mode == "descent" else system.direction(t0, rho)
@@ -214,13 +214,13 @@ def _trace_direction(
     # step lengths are root-mean-square vertex displacements, in mean edge lengths
     rms = math.sqrt(cons.pattern.n_vertices)
     first, largest, least = (
-        rms * v for v in (settings.path_step, settings.path_max_step, settings.path_min_step)
+        rms * v for v in (settings.path.step, settings.path.max_step, settings.path.min_step)
     )
     x, h, travelled, slope_sign, slow = x0.copy(), first, 0.0, 0, 0
     best = 1.0  # the smallest measure so far
     lowest = np.inf  # DOF 1: the smallest measure since m first fell
     while True:
-        if tr.steps >= settings.path_max_steps:
+        if tr.steps >= settings.path.max_steps:
             return tr, PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps"
         if mode == "descent":
             d = system.direction(None, rho)
@@ -242,8 +242,8 @@ def _trace_direction(
         # the linear prediction of the closest approach to the flat state
         rate = system.J_rho @ unit
         fastest = float(np.abs(rate).max(initial=0.0))
-        if fastest * step > settings.path_max_fold_step:
-            step = settings.path_max_fold_step / fastest
+        if fastest * step > settings.path.max_fold_step:
+            step = settings.path.max_fold_step / fastest
         rr = float(rate @ rate)
         if rr > 0:
             s_star = -float(rho @ rate) / rr
@@ -253,7 +253,7 @@ def _trace_direction(
         tr.factorizations += nf
         if ok and mode != "descent":  # the tangent must not turn too far in one step
             chord = y - x
-            ok = float(chord @ unit) > np.cos(settings.path_max_turn) * np.linalg.norm(chord)
+            ok = float(chord @ unit) > np.cos(settings.path.max_turn) * np.linalg.norm(chord)
         if not ok:
             h = step / 2
             if h < least:
@@ -261,7 +261,7 @@ def _trace_direction(
                     tr,
                     PathStatus.STALLED,
                     (
-                        f"the step fell below {settings.path_min_step:g} mean edge lengths at "
+                        f"the step fell below {settings.path.min_step:g} mean edge lengths at "
                         f"m = {tr.measure[-1]:.3g} of the design's"
                     ),
                 )
@@ -294,7 +294,7 @@ def _trace_direction(
             if sign != det_sign:
                 tr.bifurcations.append(len(tr.points))
                 det_sign = sign
-        slow = slow + 1 if m > best * (1 - settings.path_stall_ratio) else 0
+        slow = slow + 1 if m > best * (1 - settings.path.stall_ratio) else 0
         best = min(best, m)
         tr.points.append(x.copy())
         tr.arclength.append(travelled)
@@ -310,7 +310,7 @@ def _trace_direction(
                     f"steps ({travelled * cons.scale:.3g} m of path)"
                 ),
             )
-        if slow >= (settings.path_stall_steps if mode == "descent" else settings.path_wander_steps):
+        if slow >= (settings.path.stall_steps if mode == "descent" else settings.path.wander_steps):
             return (
                 tr,
                 PathStatus.STOPS_SHORT,
@@ -322,7 +322,7 @@ def _trace_direction(
         if mode != "descent":
             if slope < 0:  # m falls: from here on a rise of path_turn_back is a turn back
                 lowest = min(lowest, m)
-            elif m > lowest + settings.path_turn_back:
+            elif m > lowest + settings.path.turn_back:
                 k = int(np.argmin(tr.measure))
                 return (
                     tr,
@@ -366,7 +366,7 @@ def trace_path(
             max(dof, 0),
             m0,
         )
-    if m0 == 0 or np.abs(rho).max() <= settings.path_flat_tol:
+    if m0 == 0 or np.abs(rho).max() <= settings.path.flat_tol:
         return _result(
             cons,
             [_single(cons, x0, rho)],

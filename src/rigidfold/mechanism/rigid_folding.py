@@ -205,8 +205,8 @@ class System:
         if mode == "projection":
             M = sp.identity(n, format="csc")
         else:
-            M = (J_rho.T @ J_rho) + settings.path_damping * sp.identity(n)
-        delta = settings.path_regularization
+            M = (J_rho.T @ J_rho) + settings.path.damping * sp.identity(n)
+        delta = settings.path.regularization
         self.factors = Factors(sp.bmat([[M, J.T], [J, -delta * sp.identity(m)]], format="csc"))
 
     def direction(self, t: np.ndarray | None, rho: np.ndarray) -> np.ndarray:
@@ -244,18 +244,18 @@ def correct(
     returns (y, converged, factorizations, the last system).
     """
     system, previous, factorizations = None, np.inf, 0
-    for _ in range(settings.path_corrector_iter + 1):
+    for _ in range(settings.path.corrector_iter + 1):
         c = cons.residual(y)
         norm = float(np.abs(c).max())
         if not np.isfinite(norm):
             return y, False, factorizations, system
-        if system is None or norm > settings.path_contraction * previous:
+        if system is None or norm > settings.path.contraction * previous:
             try:
                 system = System(*cons.jacobian(y), mode, t, settings)
             except RuntimeError:  # an exactly singular factor
                 return y, False, factorizations, system
             factorizations += 1
-        if norm <= settings.path_tol:
+        if norm <= settings.path.tol:
             return y, True, factorizations, system
         previous = norm
         y = y + system.correction(c)

@@ -11,14 +11,14 @@ dimensions, so this module finds it in a space of about that size:
    (symmetric mode, a minimum-degree order of the vertices). ``delta M^-1`` keeps a
    direction of singular value s of A with the factor ``delta / (s^2 + delta)``: 1 on the
    kernel and on every direction with s^2 << delta (all those near the rank threshold),
-   about ``delta / s^2`` on the others (``Settings.sparse_shift``).
-3. Subspace iteration: ``W <- M^-1 W`` (``Settings.sparse_iterations`` times) from m random
-   columns (a fixed seed: the same basis on every run), m = n - k plus
-   ``Settings.sparse_oversampling``.
+   about ``delta / s^2`` on the others (``Settings.mechanism.sparse_shift``).
+3. Subspace iteration: ``W <- M^-1 W`` (``Settings.mechanism.sparse_iterations`` times) from m
+   random columns (a fixed seed: the same basis on every run), m = n - k plus
+   ``Settings.mechanism.sparse_oversampling``.
 4. Rayleigh-Ritz: with Y a basis of the span of W (its left singular vectors, from a
    Householder R of W), the singular values of ``A Y`` are the Ritz values, each no smaller
    than the singular value of A it approximates; the right singular vectors of those at most
-   ``Settings.mechanism_rank_tol`` times the largest row norm of C (the ``|R_00|`` of the
+   ``Settings.mechanism.rank_tol`` times the largest row norm of C (the ``|R_00|`` of the
    dense pivoted QR) span the kernel.
 5. The subspace must have had room: at least half the oversampling columns are directions
    damped below 1e-12 of the kernel's share (and so is every direction outside the
@@ -62,23 +62,25 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
     A = C[:-9][:, free]
     A = A[np.diff(A.indptr) > 0]
     k, n = A.shape
-    limit = settings.mechanism_rank_tol * np.sqrt(C.multiply(C).sum(axis=1).max())
+    limit = settings.mechanism.rank_tol * np.sqrt(C.multiply(C).sum(axis=1).max())
     if n == 0:
         return np.zeros((C.shape[1], 0)), np.zeros(0), C.shape[1]
     order = _vertex_order(A, free // 3)
     free, A = free[order], A[:, order].tocsr()
     lu = spla.splu(
-        (A.T @ A + settings.sparse_shift * sp.identity(n)).tocsc(),
+        (A.T @ A + settings.mechanism.sparse_shift * sp.identity(n)).tocsc(),
         permc_spec="NATURAL",
         diag_pivot_thresh=0.0,
         options={"SymmetricMode": True},
     )
-    p = settings.sparse_oversampling
+    p = settings.mechanism.sparse_oversampling
     rng = np.random.default_rng(_SEED)
 
     def filtered(columns: int) -> np.ndarray:  # step 3, columns of unit norm
         W = rng.random((columns, n)).T - 0.5  # column-major, as SuperLU solves
-        for _ in range(settings.sparse_iterations):  # rescaled only: the span is what counts
+        for _ in range(
+            settings.mechanism.sparse_iterations
+        ):  # rescaled only: the span is what counts
             W = lu.solve(W / np.sqrt(np.einsum("ij,ij->j", W, W)))
         return W / np.sqrt(np.einsum("ij,ij->j", W, W))
 
@@ -150,5 +152,5 @@ def sparse_analysis_bytes(n_vertices: int, n_rows: int, dof: int, settings: Sett
     (``benchmarks/bench_scale.py`` prints it).
     """
     n = 3 * n_vertices
-    m = min(max(n - n_rows, dof, 0) + settings.sparse_oversampling, n)
+    m = min(max(n - n_rows, dof, 0) + settings.mechanism.sparse_oversampling, n)
     return int(8 * 10 * n * m + 12 * 12 * n * np.log2(max(n, 2)))

@@ -26,7 +26,7 @@ def hinge_stiffness(h: int, seed: int | None = 0, settings: Settings = DEFAULTS)
     The spread avoids repeated eigenvalues (Remark 3).  -> (h,) float64
     """
     rng = np.random.default_rng(seed)
-    k0, dk = settings.hinge_stiffness, settings.hinge_stiffness_spread
+    k0, dk = settings.generation.hinge_stiffness, settings.generation.hinge_stiffness_spread
     return rng.uniform(k0 - dk, k0 + dk, size=h)
 
 

@@ -85,13 +85,15 @@ class CreasePattern:
             raise RigidfoldError(f"edge {e} is on the boundary and cannot be a fixed crease")
         areas = geometry.face_areas(coords, faces)
         longest = geometry.edge_lengths(coords, edges).max()
-        small = areas <= self.settings.degenerate_area * longest**2
+        small = areas <= self.settings.geometry.degenerate_area * longest**2
         if small.any():
             f = int(np.flatnonzero(small)[0])
             raise RigidfoldError(
                 f"face {f} {tuple(faces[f].tolist())} is degenerate (area {areas[f]:.3g} m^2)"
             )
-        plan, surface, zero = geometry.plan_area(coords, faces, self.settings.plan_area_tol)
+        plan, surface, zero = geometry.plan_area(
+            coords, faces, self.settings.geometry.plan_area_tol
+        )
         if zero:
             raise RigidfoldError(
                 f"the faces' projection onto the xy plane has zero area ({plan:.3g} m^2 for "
@@ -234,9 +236,9 @@ class CreasePattern:
     @cached_property
     def corners(self) -> np.ndarray:
         """Boundary vertices where the plan boundary turns by more than
-        ``settings.corner_angle`` (the paper's V_c), in loop order."""
+        ``settings.geometry.corner_angle`` (the paper's V_c), in loop order."""
         turn = geometry.plan_turning_angles(self.coords, self.boundary_loop)
-        return self.boundary_loop[np.abs(turn) > self.settings.corner_angle]
+        return self.boundary_loop[np.abs(turn) > self.settings.geometry.corner_angle]
 
     @cached_property
     def boundary_sides(self) -> tuple[BoundarySide, ...]:

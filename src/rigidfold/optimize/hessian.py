@@ -225,7 +225,7 @@ class ClosedFormHessian:
         self.V, self.n, self.T, self.t = V, n, lin.T.tocsr(), lin.t
         faces = pat.faces
         F = len(faces)
-        self.rho = problem.settings.rho_bar
+        self.rho = problem.settings.design.rho_bar
         self.angle_vertices = angle_corners(faces)  # (3F, 3): a, b, c
         inner = pat.interior_vertices
         row_of = np.full(V, -1)

@@ -43,11 +43,11 @@ def ipopt_options(settings: Settings, tol: float | None = None) -> dict:
         "error_on_fail": False,
         "ipopt.print_level": 0,
         "ipopt.sb": "yes",
-        "ipopt.tol": settings.ipopt_tol if tol is None else tol,
-        "ipopt.max_iter": settings.ipopt_max_iter,
-        "ipopt.mu_strategy": settings.ipopt_mu_strategy,
-        "ipopt.constr_viol_tol": 0.1 * settings.constraint_tol,
-        "ipopt.bound_relax_factor": 0.01 * settings.constraint_tol,
+        "ipopt.tol": settings.solver.ipopt_tol if tol is None else tol,
+        "ipopt.max_iter": settings.solver.ipopt_max_iter,
+        "ipopt.mu_strategy": settings.solver.ipopt_mu_strategy,
+        "ipopt.constr_viol_tol": 0.1 * settings.solver.constraint_tol,
+        "ipopt.bound_relax_factor": 0.01 * settings.solver.constraint_tol,
         "ipopt.mumps_mem_percent": 100,
     }
 
@@ -55,7 +55,7 @@ def ipopt_options(settings: Settings, tol: float | None = None) -> dict:
 class IpoptSolver:
     """IPOPT on the NLP of a FormFindingProblem, built once (at construction) and kept.
 
-    The Hessian of the Lagrangian is ``settings.ipopt_hessian``: "closed-form"
+    The Hessian of the Lagrangian is ``settings.solver.ipopt_hessian``: "closed-form"
     (``rigidfold.optimize.hessian``, a callback this object keeps alive, as CasADi keeps no
     reference to it) or "casadi" (CasADi's symbolic Hessian).
 
@@ -89,7 +89,7 @@ class IpoptSolver:
         if self._stop is not None:
             options["iteration_callback"] = self._stop
         self._hess_lag = None
-        if problem.settings.ipopt_hessian == "closed-form":
+        if problem.settings.solver.ipopt_hessian == "closed-form":
             self._hess_lag = closed_form_hess_lag(problem)
             options["hess_lag"] = self._hess_lag
         with native_quiet():
@@ -121,7 +121,7 @@ class EarlyStop(ca.Callback):
         ca.Callback.__init__(self)
         self.stop_f = stop_f
         self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
-        self.tol = 0.1 * problem.settings.constraint_tol
+        self.tol = 0.1 * problem.settings.solver.constraint_tol
         self.sizes = {
             "x": problem.map.n_variables,
             "lam_x": problem.map.n_variables,

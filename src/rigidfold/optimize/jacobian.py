@@ -52,7 +52,7 @@ class ClosedFormJacobian:
         self.surface = problem.surface
         self.angle_vertices = angle_corners(pat.faces)  # (3F, 3): a, b, c
         self.dz_vertices = problem.nlp.dz_vertices
-        self.rho_bar = problem.settings.rho_bar
+        self.rho_bar = problem.settings.design.rho_bar
         self.interior = pat.interior_edges
         self.stencils = pat.crease_stencils(self.interior)  # (Ei, 4): u, v, a, b
         n_dz, n_theta = len(self.dz_vertices), len(self.angle_vertices)

@@ -1,11 +1,11 @@
 """The solver of problem (6) on large patterns: projection, IPOPT, projection.
 
-On patterns of at least ``Settings.projection_vertices`` vertices, ``--solver ipopt`` is
+On patterns of at least ``Settings.solver.projection_vertices`` vertices, ``--solver ipopt`` is
 this composite (:func:`ipopt_solver` chooses). IPOPT gets the gradient of F and the
 constraint Jacobian in closed form (:mod:`rigidfold.optimize.jacobian`; CasADi's cost most
 of a large build), and the solver does three things: the projection onto F = 0 from the
 start (:mod:`rigidfold.optimize.projection`), which is all that is needed after one more
-crease is fixed (a projection that stops, feasible, at F <= ``Settings.ipopt_stop_f`` is
+crease is fixed (a projection that stops, feasible, at F <= ``Settings.solver.ipopt_stop_f`` is
 taken too: IPOPT would stop there at once); otherwise IPOPT, stopped at its first feasible
 iterate with F <= ``ipopt_stop_f`` by an iteration callback; then the projection from
 there. IPOPT's last iterations on (6) creep along the family of zeros of F: on a 41 x 41
@@ -33,7 +33,7 @@ class ProjectedIpoptSolver:
     """
 
     def __init__(self, problem: SolverProblem) -> None:
-        self._stop_f = problem.settings.ipopt_stop_f
+        self._stop_f = problem.settings.solver.ipopt_stop_f
         residuals = Residuals(problem.pattern, problem.map)
         jacobian = ClosedFormJacobian(problem)
         self.projection = Projection(problem, residuals, jacobian)
@@ -67,8 +67,8 @@ class ProjectedIpoptSolver:
 
 
 def ipopt_solver(problem: SolverProblem) -> Solver:
-    """``--solver ipopt``: IPOPT on patterns of fewer than ``Settings.projection_vertices``
+    """``--solver ipopt``: IPOPT on patterns of fewer than ``Settings.solver.projection_vertices``
     vertices, :class:`ProjectedIpoptSolver` on larger ones."""
-    if problem.pattern.n_vertices >= problem.settings.projection_vertices:
+    if problem.pattern.n_vertices >= problem.settings.solver.projection_vertices:
         return ProjectedIpoptSolver(problem)
     return IpoptSolver(problem)

@@ -151,10 +151,10 @@ def build_nlp(
     mv = dz_vertices.tolist()
     height = surface.height(x[mv], y[mv], xp=ca)
     g = [z[mv] - height, theta]
-    lbg = [np.full(len(mv), -s.dz), np.full(theta.shape[0], s.theta_min)]
-    ubg = [np.full(len(mv), s.dz), np.full(theta.shape[0], s.theta_max)]
-    if s.rho_bar is not None:
-        g.append((1 - w_int) * (np.cos(s.rho_bar) - _dot(na, nb)))
+    lbg = [np.full(len(mv), -s.design.dz), np.full(theta.shape[0], s.design.theta_min)]
+    ubg = [np.full(len(mv), s.design.dz), np.full(theta.shape[0], s.design.theta_max)]
+    if s.design.rho_bar is not None:
+        g.append((1 - w_int) * (np.cos(s.design.rho_bar) - _dot(na, nb)))
         lbg.append(np.full(len(interior), -np.inf))
         ubg.append(np.zeros(len(interior)))
     return NLP(

@@ -178,14 +178,14 @@ class FormFindingProblem:
         dz = coords[:, 2] - np.asarray(self.surface.height(coords[:, 0], coords[:, 1]))
         theta = shape.corner_angles
         parts = [
-            np.abs(dz[self.nlp.dz_vertices]).max(initial=0.0) - s.dz,
-            s.theta_min - theta.min(),
-            theta.max() - s.theta_max,
+            np.abs(dz[self.nlp.dz_vertices]).max(initial=0.0) - s.design.dz,
+            s.design.theta_min - theta.min(),
+            theta.max() - s.design.theta_max,
             self.map.residual(coords),
         ]
-        if s.rho_bar is not None:
+        if s.design.rho_bar is not None:
             free = ~fixed & ~shape.is_boundary_edge
-            parts.append(np.abs(shape.fold_angles[free]).max(initial=0.0) - s.rho_bar)
+            parts.append(np.abs(shape.fold_angles[free]).max(initial=0.0) - s.design.rho_bar)
         return max(0.0, *parts)
 
     # ------------------------------------------------------------------ solve
@@ -244,7 +244,7 @@ class FormFindingProblem:
 
     # ------------------------------------------------------------------ polish
     def polish(self, result: OptimizeResult) -> OptimizeResult:
-        """An accepted ``result`` projected onto F = 0 to ``Settings.polish_tol``
+        """An accepted ``result`` projected onto F = 0 to ``Settings.solver.polish_tol``
         (:class:`rigidfold.optimize.projection.Projection`, every constraint of (6) kept).
 
         F_tol (1e-7) leaves angle defects of up to about 3e-4 rad, and a shape that is not
@@ -263,7 +263,7 @@ class FormFindingProblem:
         try:
             with one_blas_thread():
                 run = self._projection(
-                    self.start_point(result.coords), w, tol=self.settings.polish_tol
+                    self.start_point(result.coords), w, tol=self.settings.solver.polish_tol
                 )
         except RuntimeError:  # a singular factor (redundant rows at F ~ 0): keep the result
             return result
@@ -295,13 +295,13 @@ def classify(
     outcome : the solver's own flag (a ``SolverOutcome``, or its value).
     A point with F <= F_tol that meets every constraint is accepted whatever the solver said.
     """
-    feasible = violation <= settings.constraint_tol
-    if feasible and F <= settings.f_tol:
-        return Status.CONVERGED, f"accepted: F = {F:.3g} <= F_tol = {settings.f_tol:.3g}"
+    feasible = violation <= settings.solver.constraint_tol
+    if feasible and F <= settings.design.f_tol:
+        return Status.CONVERGED, f"accepted: F = {F:.3g} <= F_tol = {settings.design.f_tol:.3g}"
     if outcome == SolverOutcome.INFEASIBLE or (outcome == SolverOutcome.SOLVED and not feasible):
         return Status.INFEASIBLE, f"constraint violation {violation:.3g}"
     if outcome == SolverOutcome.ITERATION_LIMIT:
         return Status.ITERATION_LIMIT, f"stopped at F = {F:.3g}"
     if outcome == SolverOutcome.SOLVED:
-        return Status.TOLERANCE_NOT_MET, f"F = {F:.3g} > F_tol = {settings.f_tol:.3g}"
+        return Status.TOLERANCE_NOT_MET, f"F = {F:.3g} > F_tol = {settings.design.f_tol:.3g}"
     return Status.FAILED, f"F = {F:.3g}, constraint violation {violation:.3g}"

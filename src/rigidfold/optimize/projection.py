@@ -18,12 +18,12 @@ Every iterate meets the constraints of (6) (the dz, sector angle and fold angle 
 projection starts only from a feasible shape and refuses a step that leaves the feasible set,
 like one that does not decrease F. A constraint that a step would break joins the working
 set W and is held: its row of the constraint Jacobian C (``rigidfold.optimize.jacobian``)
-joins J, with the residual h that keeps it ``Settings.projection_margin`` inside its bound,
+joins J, with the residual h that keeps it ``Settings.solver.projection_margin`` inside its bound,
 so the next steps slide along the bound instead of being refused; a held constraint whose
 multiplier (its entry of (A A^T + mu I)^-1 (r, h)) pulls it away from its bound is released.
 This is what lets a step of ``generate`` move a shape whose sector angles or heights sit at
-their bounds. The projection ends converged at F <= ``Settings.projection_tol``; otherwise it
-stops after ``Settings.projection_max_iter`` factorisations and says so.
+their bounds. The projection ends converged at F <= ``Settings.solver.projection_tol``; otherwise it
+stops after ``Settings.solver.projection_max_iter`` factorisations and says so.
 
 IPOPT's interior-point path finds zeros of F far from the start (the lifted target surface
 is far from developable); the projection finds the near ones: after one more crease is
@@ -52,9 +52,9 @@ class Projected:
 
     xi : (n,) float64, the last iterate (feasible unless the start was not); F : its
     objective; iterations : the factorisations it took; converged : F <=
-    ``Settings.projection_tol``; feasible : whether xi meets the constraints of (6) (False only
-    for an infeasible start, which is not projected); held : how many constraints were held
-    at the end; reason : why it stopped, in words.
+    ``Settings.solver.projection_tol``; feasible : whether xi meets the constraints of (6)
+    (False only for an infeasible start, which is not projected); held : how many constraints
+    were held at the end; reason : why it stopped, in words.
     """
 
     xi: np.ndarray
@@ -99,13 +99,13 @@ class Projection:
     def feasible(self, xi: np.ndarray, w: np.ndarray) -> bool:
         """Whether a point meets every constraint of (6), well inside ``constraint_tol``."""
         coords = self.problem.map.expand(xi)
-        return self.problem.violation(coords, w > 0) <= 0.1 * self.settings.constraint_tol
+        return self.problem.violation(coords, w > 0) <= 0.1 * self.settings.solver.constraint_tol
 
     def __call__(self, xi0: np.ndarray, w: np.ndarray, *, tol: float | None = None) -> Projected:
         """Project from ``xi0`` (n,) with fixed-crease weights ``w`` (E,) to F <= ``tol``
-        (default ``Settings.projection_tol``)."""
+        (default ``Settings.solver.projection_tol``)."""
         s = self.settings
-        tol = s.projection_tol if tol is None else tol
+        tol = s.solver.projection_tol if tol is None else tol
         xi = np.asarray(xi0, dtype=float).copy()
         w = np.asarray(w, dtype=float)
         if not self.feasible(xi, w):
@@ -118,10 +118,10 @@ class Projection:
         A, ra = self._augment(point, held)
         F = float(r @ r)
         scale = -1.0  # the largest diagonal entry of A A^T at the start
-        lam, nu = s.projection_damping, 2.0
-        slack = 0.1 * s.constraint_tol
+        lam, nu = s.solver.projection_damping, 2.0
+        slack = 0.1 * s.solver.constraint_tol
         k = 0
-        for k in range(s.projection_max_iter):
+        for k in range(s.solver.projection_max_iter):
             if F <= tol:
                 return self._end(xi, F, k, held, "converged", tol)
             AA = (A @ A.T).tocsc()
@@ -175,7 +175,7 @@ class Projection:
         """A = (J; C_W) and (r, h) at a point, for the held constraints ``held``."""
         if not held.size:
             return point.J, point.r
-        margin = self.settings.projection_margin
+        margin = self.settings.solver.projection_margin
         g = point.g[held]
         lo, hi = self.lbg[held] + margin, self.ubg[held] - margin
         h = g - np.clip(g, lo, np.maximum(lo, hi))

@@ -65,7 +65,7 @@ class SlsqpSolver:
 
         s = self._settings
         constraint = {"type": "ineq", "fun": inequalities}
-        options = {"maxiter": s.slsqp_max_iter, "ftol": s.slsqp_ftol}
+        options = {"maxiter": s.solver.slsqp_max_iter, "ftol": s.solver.slsqp_ftol}
         if self.exact:
             constraint["jac"] = inequality_jacobian
             res = minimize(

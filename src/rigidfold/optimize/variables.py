@@ -104,7 +104,7 @@ def assemble_constraints(
     for plane in planes:  # (9)
         norm = np.hypot(plane.a, plane.b)
         a, b, c = plane.a / norm, plane.b / norm, plane.c / norm
-        mate = mirror_pairs(pattern.coords, plane, settings.symmetry_match_tol)
+        mate = mirror_pairs(pattern.coords, plane, settings.geometry.symmetry_match_tol)
         for i, j in enumerate(mate):
             # reflection of vertex i is vertex j: p_j = p_i - 2 (a x_i + b y_i + c) (a, b, 0)
             add([(X + j, 1.0), (X + i, -(1 - 2 * a * a)), (Y + i, 2 * a * b)], -2 * a * c)
@@ -209,9 +209,9 @@ def _eliminate_block(
     """
     q, r, piv = scipy.linalg.qr(block, pivoting=True)  # full q: all of rhs is checked
     diag = np.abs(np.diag(r))
-    rank = int(np.sum(diag > settings.linear_rank_tol * largest))
+    rank = int(np.sum(diag > settings.solver.linear_rank_tol * largest))
     qc = q.T @ rhs
-    if np.abs(qc[rank:]).max(initial=0.0) > settings.constraint_tol:
+    if np.abs(qc[rank:]).max(initial=0.0) > settings.solver.constraint_tol:
         raise RigidfoldError(
             "the boundary, corner and symmetry constraints (7)-(9) contradict each other for "
             "this shape (is the target surface symmetric about the chosen planes?)"
@@ -222,6 +222,6 @@ def _eliminate_block(
     solve = scipy.linalg.solve_triangular
     coef = -solve(r[:rank, :rank], r[:rank, col_of[ind]])
     const = solve(r[:rank, :rank], qc[:rank])
-    coef[np.abs(coef) < settings.map_prune_tol] = 0.0
-    const[np.abs(const) < settings.map_prune_tol] = 0.0
+    coef[np.abs(coef) < settings.solver.map_prune_tol] = 0.0
+    const[np.abs(const) < settings.solver.map_prune_tol] = 0.0
     return dep, const, ind, coef

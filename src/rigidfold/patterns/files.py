@@ -99,16 +99,16 @@ def read_pattern_file(
         # the extent is checked before the faces are triangulated (where it could overflow)
         plan, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
         count = sum(len(polygon) - 2 for polygon in drawing.polygons)  # n - 2 per polygon
-        if count > settings.max_pattern_faces:
+        if count > settings.limits.max_pattern_faces:
             raise RigidfoldError(
                 f"{path}: its {len(drawing.polygons)} faces make {count} triangles, more than "
-                f"{settings.max_pattern_faces} (Settings.max_pattern_faces)"
+                f"{settings.limits.max_pattern_faces} (Settings.limits.max_pattern_faces)"
             )
         coords = np.column_stack([xy, np.zeros(len(xy))])
         triangles, diagonals = triangulate_polygons(
             coords,
             drawing.polygons,
-            area_tol=settings.triangulation_area_tol,
+            area_tol=settings.geometry.triangulation_area_tol,
             name=f"{path}: face",
         )
         faces = orient_up(coords, triangles)
@@ -166,7 +166,7 @@ def _check_unfolded(xy: np.ndarray, faces: np.ndarray, path: Path, settings: Set
     faces overlap in plan, which cannot be lifted onto a surface z = f(x, y)."""
     area = geometry.plan_face_areas(xy, faces)
     longest = float(np.ptp(xy, axis=0).max())
-    bad = np.flatnonzero(area <= settings.degenerate_area * longest**2)
+    bad = np.flatnonzero(area <= settings.geometry.degenerate_area * longest**2)
     if bad.size:
         f = int(bad[0])
         how = "upside down (the sheet overlaps itself)" if area[f] < 0 else "vertical (edge-on)"

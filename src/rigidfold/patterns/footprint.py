@@ -72,9 +72,9 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
     Refused: fewer than 3 points, non-finite coordinates, a plan too small or too large
     (:func:`~rigidfold.patterns.grids.check_extent`), a repeated point, zero area, a
     self-intersecting outline (sides that cross or touch anywhere but at shared corners) and
-    two points, or a point and a side, closer than ``settings.footprint_min_gap`` times the
+    two points, or a point and a side, closer than ``settings.inputs.footprint_min_gap`` times the
     larger side of the bounding box (where Triangle's refinement runs away);
-    zero area is a convex hull smaller than ``settings.degenerate_area`` times the squared
+    zero area is a convex hull smaller than ``settings.geometry.degenerate_area`` times the squared
     larger side of the bounding box.
     """
     import shapely
@@ -85,12 +85,12 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
     if not np.isfinite(xy).all():
         bad = int(np.flatnonzero(~np.isfinite(xy).all(axis=1))[0])
         raise RigidfoldError(f"footprint point {bad + 1} is not finite: {_point(xy[bad])}")
-    far = np.abs(xy).max(axis=1) > settings.max_coordinate  # before any sum could overflow
+    far = np.abs(xy).max(axis=1) > settings.limits.max_coordinate  # before any sum could overflow
     if far.any():
         bad = int(np.argmax(far))
         raise RigidfoldError(
             f"footprint point {bad + 1} {_point(xy[bad])} lies farther than "
-            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+            f"{settings.limits.max_coordinate:g} m from the origin (Settings.limits.max_coordinate)"
         )
     width, height = (float(v) for v in np.ptp(xy, axis=0))
     check_extent(width, height, f"the footprint {_points(xy)}", settings)
@@ -102,7 +102,7 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
             f"footprint point {_point(again)} is repeated (points {', '.join(map(str, repeats))})"
         )
     hull = shapely.MultiPoint(xy).convex_hull.area
-    if hull <= settings.degenerate_area * np.ptp(xy, axis=0).max() ** 2:
+    if hull <= settings.geometry.degenerate_area * np.ptp(xy, axis=0).max() ** 2:
         raise RigidfoldError(
             f"the footprint {_points(xy)} has zero area (its points lie on a line)"
         )
@@ -115,18 +115,21 @@ def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray
         )
     polygon = shapely.Polygon(xy)
     gap, size = float(shapely.minimum_clearance(polygon)), float(np.ptp(xy, axis=0).max())
-    if gap < settings.footprint_min_gap * size:
+    if gap < settings.inputs.footprint_min_gap * size:
         raise RigidfoldError(
             f"the footprint {_points(xy)} has two points, or a point and a side, {gap:.3g} m "
-            f"apart, less than {settings.footprint_min_gap:g} of its size of {size:g} m "
-            "(Settings.footprint_min_gap): merge them or move them apart"
+            f"apart, less than {settings.inputs.footprint_min_gap:g} of its size of {size:g} m "
+            "(Settings.inputs.footprint_min_gap): merge them or move them apart"
         )
     return xy if _signed_area(xy) > 0 else np.concatenate([xy[:1], xy[:0:-1]])
 
 
 def default_edge_length(xy: np.ndarray, settings: Settings = DEFAULTS) -> float:
-    """sqrt(footprint area) / ``settings.mesh_divisions``: 0.5 m on the paper's 3 m square."""
-    return math.sqrt(abs(_signed_area(np.asarray(xy, dtype=float)))) / settings.mesh_divisions
+    """sqrt(footprint area) / ``settings.inputs.mesh_divisions``: 0.5 m on the paper's 3 m
+    square."""
+    return (
+        math.sqrt(abs(_signed_area(np.asarray(xy, dtype=float)))) / settings.inputs.mesh_divisions
+    )
 
 
 def footprint_mesh(
@@ -136,11 +139,11 @@ def footprint_mesh(
 
     Each side is first divided into ``round(length / edge_length)`` (at least 1) equal
     pieces; Triangle then adds points until no angle is below min(theta_min,
-    ``settings.mesh_angle_cap``) (except at the footprint's own corners sharper than that)
+    ``settings.inputs.mesh_angle_cap``) (except at the footprint's own corners sharper than that)
     and no triangle is larger than the equilateral triangle of side ``edge_length``. The
     footprint's corners come first, in order, then the points on its sides, then the inner
     points. Returns the plan vertices (V, 2) and counter-clockwise triangles (F, 3). An edge
-    length that is not a positive number up to ``settings.max_coordinate`` is a ValueError.
+    length that is not a positive number up to ``settings.limits.max_coordinate`` is a ValueError.
     """
     import triangle
 
@@ -148,34 +151,37 @@ def footprint_mesh(
         raise RigidfoldError(
             f"the edge length must be a positive number of metres, got {edge_length}"
         )
-    if edge_length > settings.max_coordinate:  # its square would overflow
+    if edge_length > settings.limits.max_coordinate:  # its square would overflow
         raise RigidfoldError(
-            f"the edge length must be at most {settings.max_coordinate:g} m, the largest plan "
-            f"(Settings.max_coordinate), got {edge_length:g} m"
+            f"the edge length must be at most {settings.limits.max_coordinate:g} m, "
+            "the largest plan "
+            f"(Settings.limits.max_coordinate), got {edge_length:g} m"
         )
     area = abs(_signed_area(xy))
     triangle_area = math.sqrt(3) / 4 * edge_length**2
-    if area / triangle_area > settings.max_pattern_faces:
+    if area / triangle_area > settings.limits.max_pattern_faces:
         raise RigidfoldError(
             f"edge length {edge_length:g} m makes about {area / triangle_area:.0f} triangles on "
-            f"a footprint of {area:g} m^2, more than {settings.max_pattern_faces} "
-            "(Settings.max_pattern_faces)"
+            f"a footprint of {area:g} m^2, more than {settings.limits.max_pattern_faces} "
+            "(Settings.limits.max_pattern_faces)"
         )
     ends = np.roll(xy, -1, axis=0)
     pieces = np.maximum(1, np.rint(np.hypot(*(ends - xy).T) / edge_length).astype(int))
-    if int(pieces.sum()) - 2 > settings.max_pattern_faces:  # n points on the outline: >= n - 2
+    if (
+        int(pieces.sum()) - 2 > settings.limits.max_pattern_faces
+    ):  # n points on the outline: >= n - 2
         raise RigidfoldError(
             f"the footprint of {len(xy)} corners, its sides divided at edge length "
             f"{edge_length:g} m, has {int(pieces.sum())} points on its outline: at least "
-            f"{int(pieces.sum()) - 2} triangles, more than {settings.max_pattern_faces} "
-            "(Settings.max_pattern_faces)"
+            f"{int(pieces.sum()) - 2} triangles, more than {settings.limits.max_pattern_faces} "
+            "(Settings.limits.max_pattern_faces)"
         )
     points, outline = [xy], []
     for k, n in enumerate(pieces):  # corner k, then the inner points of its side
         first = sum(len(q) for q in points)
         points.append(xy[k] + (ends[k] - xy[k]) * (np.arange(1, n)[:, None] / n))
         outline += [k, *range(first, first + n - 1)]
-    angle = min(settings.theta_min, settings.mesh_angle_cap)
+    angle = min(settings.design.theta_min, settings.inputs.mesh_angle_cap)
     out = triangle.triangulate(
         {
             "vertices": np.concatenate(points),

@@ -27,14 +27,15 @@ without units is fitted into: the paper's square."""
 
 def check_extent(width: float, height: float, what: str, settings: Settings = DEFAULTS) -> None:
     """A one-line ValueError naming ``what`` unless a plan of ``width`` x ``height`` metres
-    (its bounding box) is from ``settings.min_pattern_size`` to ``settings.max_coordinate``
-    across (its larger side)."""
+    (its bounding box) is from ``settings.limits.min_pattern_size`` to
+    ``settings.limits.max_coordinate`` across (its larger side)."""
     across = max(width, height)
-    if not settings.min_pattern_size <= across <= settings.max_coordinate:
+    if not settings.limits.min_pattern_size <= across <= settings.limits.max_coordinate:
         raise RigidfoldError(
             f"{what} is {width:.3g} m x {height:.3g} m: a crease pattern is "
-            f"{settings.min_pattern_size:g} m to {settings.max_coordinate:g} m across "
-            "(Settings.min_pattern_size, Settings.max_coordinate)"
+            f"{settings.limits.min_pattern_size:g} m to "
+            f"{settings.limits.max_coordinate:g} m across "
+            "(Settings.limits.min_pattern_size, Settings.limits.max_coordinate)"
         )
 
 

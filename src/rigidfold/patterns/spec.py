@@ -166,12 +166,12 @@ def parse_pattern(
 
 def check_faces(count: int, what: str, settings: Settings = DEFAULTS) -> None:
     """ValueError ``"<what> has <count> triangles, more than <limit>
-    (Settings.max_pattern_faces)"`` when a pattern's real triangle count passes the limit:
+    (Settings.limits.max_pattern_faces)"`` when a pattern's real triangle count passes the limit:
     checked after triangulation, before any problem is built on it."""
-    if count > settings.max_pattern_faces:
+    if count > settings.limits.max_pattern_faces:
         raise RigidfoldError(
-            f"{what} has {count} triangles, more than {settings.max_pattern_faces} "
-            "(Settings.max_pattern_faces)"
+            f"{what} has {count} triangles, more than {settings.limits.max_pattern_faces} "
+            "(Settings.limits.max_pattern_faces)"
         )
 
 

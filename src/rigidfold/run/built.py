@@ -90,8 +90,8 @@ def thick_panels(
         source=f"solutions/{name}.fold",
         title=title,
         label=name,
-        sheet=(settings.fabricate_sheet_width, settings.fabricate_sheet_height),
-        gap=settings.fabricate_sheet_gap,
+        sheet=(settings.fabricate.sheet_width, settings.fabricate.sheet_height),
+        gap=settings.fabricate.sheet_gap,
     )
     return _fabrication_figures(fab, run_dir, written, sheets, time.perf_counter() - t0), fab
 
@@ -154,12 +154,12 @@ def structure_check(
     run_dir: Path, name: str, pattern: CreasePattern, options: GenerateOptions
 ) -> tuple[dict, StructureCheck]:
     """The structure check of the design ``pattern`` with ``options`` (supports, loads,
-    material, limit; its thickness ``options.thickness`` or ``Settings.structure_thickness``)
+    material, limit; its thickness ``options.thickness`` or ``Settings.structure.thickness``)
     and its files (``structure.json``, ``structure.png``) in ``run_dir/final/structure/``.
     Returns (the record's figures, the check)."""
     settings = pattern.settings
     t0 = time.perf_counter()
-    thickness = settings.structure_thickness if options.thickness is None else options.thickness
+    thickness = settings.structure.thickness if options.thickness is None else options.thickness
     check = check_design(
         pattern,
         supports=options.supports,

@@ -230,13 +230,13 @@ class RunData:
     @property
     def at_dz_bound(self) -> float | None:
         """The final design's max |z - target| (metres, summary.json's ``fit``) where it is at
-        the dz bound (within ``Settings.dz_bound_tol`` of ``case.dz_m``), else None."""
+        the dz bound (within ``Settings.design.dz_bound_tol`` of ``case.dz_m``), else None."""
         final, dz = self.final, self.summary.case.get("dz_m")
         rows = self.summary.per_solution
         if final is None or dz is None or not 0 <= final.step < len(rows):
             return None
         reached = (rows[final.step].fit or {}).get("max_abs_dz_m")
-        if reached is None or reached < dz * (1 - DEFAULTS.dz_bound_tol):
+        if reached is None or reached < dz * (1 - DEFAULTS.design.dz_bound_tol):
             return None
         return float(reached)
 

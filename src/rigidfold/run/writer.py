@@ -239,11 +239,11 @@ class RunWriter:
 
     def _frame_material(self) -> dict:
         """Step 9's frame of strips of the user's panels (``options.material``, of
-        ``options.thickness`` or ``Settings.structure_thickness``); {} for the paper's tubes."""
+        ``options.thickness`` or ``Settings.structure.thickness``); {} for the paper's tubes."""
         if self.options.material is None:
             return {}
         settings = self.case.settings
-        thickness = self.options.thickness or settings.structure_thickness
+        thickness = self.options.thickness or settings.structure.thickness
         return {"material": parse_material(self.options.material), "thickness": thickness}
 
     def finish(self, run: Generation) -> RunVerdict:

@@ -103,7 +103,7 @@ def predicted_locks(
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = np.where(before > 0, after / before, 0.0)
     rel[j] = np.inf
-    return np.flatnonzero(rel < settings.lock_prediction_tol)
+    return np.flatnonzero(rel < settings.generation.lock_prediction_tol)
 
 
 def rank_candidates(

@@ -201,8 +201,8 @@ def lock_forecast(
     )
     members = _rows(groups, hinges, mechanism.pattern.n_edges)
     norms = mechanism.rotation_norms
-    still = norms <= settings.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)
-    basis, rank = group_bases(H_phi, members, still, settings.mechanism_rank_tol)
+    still = norms <= settings.mechanism.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)
+    basis, rank = group_bases(H_phi, members, still, settings.mechanism.rank_tol)
     r2 = squared_residuals(H_phi, basis)
     ci, slot = np.divmod(np.flatnonzero(members >= 0), members.shape[1])
     inside = (ci, members[ci, slot])
@@ -210,8 +210,10 @@ def lock_forecast(
     dof_after = mechanism.dof - rank
     top2 = r2.max(axis=1, initial=0.0)
     # no rotation left (DOF 0): the analysis calls every folded crease locked
-    bound2 = np.where((dof_after == 0) | (top2 <= 0.0), np.inf, settings.lookahead_tol**2 * top2)
-    folded = np.abs(mechanism.pattern.fold_angles[hinges]) > settings.flat_angle
+    bound2 = np.where(
+        (dof_after == 0) | (top2 <= 0.0), np.inf, settings.generation.lookahead_tol**2 * top2
+    )
+    folded = np.abs(mechanism.pattern.fold_angles[hinges]) > settings.geometry.flat_angle
     margin = 8 * np.finfo(float).eps * norms**2  # round-off of squared_residuals
     near = (r2 <= bound2[:, None] + margin) & folded
     near[inside] = False
@@ -219,7 +221,9 @@ def lock_forecast(
     if len(ci):  # decide these from the exact residuals
         r2[ci, pi] = exact_residuals(H_phi, basis, ci, pi)
         near[ci, pi] = r2[ci, pi] <= bound2[ci]
-    return LockForecast(hinges, groups, r2, folded, near, dof_after, settings.lookahead_tol)
+    return LockForecast(
+        hinges, groups, r2, folded, near, dof_after, settings.generation.lookahead_tol
+    )
 
 
 def _rows(groups: tuple[tuple[int, ...], ...], hinges: np.ndarray, n_edges: int) -> np.ndarray:
@@ -294,11 +298,13 @@ def carried_angles(
     rho = mechanism.pattern.fold_angles[mechanism.hinges]
     norms = mechanism.rotation_norms
     g = rows[0][rows[0] >= 0]
-    g = g[norms[g] > settings.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)]
+    g = g[
+        norms[g] > settings.mechanism.lock_tol * max(norms.max(initial=0.0), np.finfo(float).tiny)
+    ]
     c = rows[1:, 0]
     if not len(g):
         return rho[c]
-    a = np.linalg.lstsq(H_phi[g], -rho[g], rcond=settings.mechanism_rank_tol)[0]
+    a = np.linalg.lstsq(H_phi[g], -rho[g], rcond=settings.mechanism.rank_tol)[0]
     return rho[c] + H_phi[c] @ a
 
 
@@ -312,7 +318,7 @@ def flat_groups(
     """The put-off candidates to fix together with the creases they would lock.
 
     A candidate qualifies when its fix is forecast to lock creases, every one of them ends
-    within ``settings.lookahead_carry_angle`` of flat once the candidate is flat
+    within ``settings.generation.lookahead_carry_angle`` of flat once the candidate is flat
     (:func:`carried_angles`), and it locked no other crease at an earlier shape. Returned
     with ``carried`` = those creases: each set of creases once (from the candidate that
     carries it flattest), the smallest sets first, then the flattest.
@@ -328,7 +334,7 @@ def flat_groups(
         group = candidates[choice.index]
         left = float(np.abs(carried_angles(mechanism, group, locks, settings=settings)).max())
         key = frozenset(map(int, group)) | frozenset(locks.tolist())
-        if left <= settings.lookahead_carry_angle and left < best.get(key, (np.inf,))[0]:
+        if left <= settings.generation.lookahead_carry_angle and left < best.get(key, (np.inf,))[0]:
             best[key] = (left, dataclasses.replace(choice, carried=locks, passed=()))
     ranked = sorted(best.items(), key=lambda item: (len(item[0]), item[1][0]))
     return [choice for _, (_, choice) in ranked]
@@ -346,10 +352,10 @@ def lookahead_order(
     """The order to try ranked candidates with look-ahead: put off those predicted to lock.
 
     candidates : in the criterion's order (best first); dof0_ends : a fix that leaves DOF 0
-    ends generation (``Settings.zero_dof_ends``, or a target DOF 0), so such a candidate is
-    not put off although every crease locks at DOF 0. locked_before : {candidate (its edges,
-    as ranked): the creases its fix locked at an earlier shape of the run}; such a candidate
-    is put off too.
+    ends generation (``Settings.generation.zero_dof_ends``, or a target DOF 0), so such a
+    candidate is not put off although every crease locks at DOF 0. locked_before : {candidate
+    (its edges, as ranked): the creases its fix locked at an earlier shape of the run}; such a
+    candidate is put off too.
     yields : :class:`Choice`: first every candidate not put off, in the criterion's order,
         with ``passed``, the put-off ones ranked between it and the one before; then the
         groups of :func:`flat_groups` (a candidate with the nearly flat creases it would

@@ -27,7 +27,9 @@ def crease_groups(
     order = np.argsort(keys)
     a, b = [np.arange(E)], [np.arange(E)]
     for plane in planes:
-        image = mirror_pairs(pattern.coords, plane, settings.symmetry_match_tol)[pattern.edges]
+        image = mirror_pairs(pattern.coords, plane, settings.geometry.symmetry_match_tol)[
+            pattern.edges
+        ]
         pos = np.searchsorted(keys[order], edge_keys(image, V))
         a.append(np.arange(E))
         b.append(order[np.minimum(pos, E - 1)])

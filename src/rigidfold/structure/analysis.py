@@ -3,7 +3,7 @@ first natural frequencies.
 
 * **Linear static**: one load step, ``Linear`` algorithm, ``ShellDKGT`` elements.
 * **Geometrically nonlinear**: ``ShellNLDKGT`` elements (corotational kinematics),
-  ``Settings.structure_steps`` load steps with Newton iterations, a step that does not
+  ``Settings.structure.steps`` load steps with Newton iterations, a step that does not
   converge is halved up to ``structure_max_halvings`` times; the result is the last
   converged step and its load factor.
 * **Frequencies**: ``eigen`` of the linear model without load, mass from the section's
@@ -100,8 +100,8 @@ def solve_shell(
     ops.constraints("Transformation")
     ops.numberer("RCM")
     ops.system("UmfPack")
-    ops.test("NormDispIncr", float(settings.structure_tol), int(settings.structure_max_iter), 0)
-    steps = settings.structure_steps if nonlinear else 1
+    ops.test("NormDispIncr", float(settings.structure.tol), int(settings.structure.max_iter), 0)
+    steps = settings.structure.steps if nonlinear else 1
     ops.algorithm("Newton" if nonlinear else "Linear")
     ops.integrator("LoadControl", 1.0 / steps)
     ops.analysis("Static")
@@ -112,7 +112,7 @@ def solve_shell(
         ops.integrator("LoadControl", inc)
         if ops.analyze(1) != 0:
             halvings += 1
-            if not nonlinear or halvings > settings.structure_max_halvings:
+            if not nonlinear or halvings > settings.structure.max_halvings:
                 message = f"no convergence at load factor {lam:.4g}"
                 break
             step = inc / 2

@@ -81,7 +81,7 @@ class StructureCheck:
     mesh: ShellMesh | None
     response: ShellResponse | None
     auto: bool = False
-    balance_tol: float = DEFAULTS.structure_balance_tol
+    balance_tol: float = DEFAULTS.structure.balance_tol
 
     # ------------------------------------------------------------------ verdict
     @property
@@ -281,8 +281,8 @@ def check_structure(
     self_weight: bool = True,
     hinge_stiffness: float = 0.0,
     nonlinear: bool = False,
-    limit: float = DEFAULTS.structure_limit,
-    modes: int = DEFAULTS.structure_modes,
+    limit: float = DEFAULTS.structure.limit,
+    modes: int = DEFAULTS.structure.modes,
     auto: bool = False,
     settings: Settings = DEFAULTS,
 ) -> StructureCheck:
@@ -302,12 +302,12 @@ def check_structure(
         nonlinear=nonlinear,
         limit=limit,
         auto=auto,
-        balance_tol=settings.structure_balance_tol,
+        balance_tol=settings.structure.balance_tol,
     )
     if not rigidity.stable:
         return StructureCheck(mesh=None, response=None, **common)  # type: ignore[arg-type]
-    mesh = shell_mesh(held, settings.structure_subdivisions)
-    weight = material.density * settings.structure_gravity * thickness if self_weight else 0.0
+    mesh = shell_mesh(held, settings.structure.subdivisions)
+    weight = material.density * settings.structure.gravity * thickness if self_weight else 0.0
     forces = nodal_loads(mesh, tuple(loads), self_weight=weight)
     response = solve_shell(
         mesh,

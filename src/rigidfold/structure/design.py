@@ -99,10 +99,10 @@ class DesignPlan:
 
 def check_options(
     *,
-    material: str | Material = DEFAULTS.structure_material,
+    material: str | Material = DEFAULTS.structure.material,
     loads: tuple[str, ...] = (),
-    limit: str | float = DEFAULTS.structure_limit,
-    modes: int = DEFAULTS.structure_modes,
+    limit: str | float = DEFAULTS.structure.limit,
+    modes: int = DEFAULTS.structure.modes,
 ) -> tuple[Material, tuple[Load, ...], float]:
     """(material, loads, limit divisor) read from the options as given; ValueError (one
     line) for any that is not valid, before the design is read."""
@@ -121,14 +121,14 @@ def plan_design(
     candidates: str | None = None,
     clamped: str = "",
     actuators: str = "",
-    thickness: float = DEFAULTS.structure_thickness,
-    material: str | Material = DEFAULTS.structure_material,
-    hinge_stiffness: float = DEFAULTS.structure_hinge_stiffness,
+    thickness: float = DEFAULTS.structure.thickness,
+    material: str | Material = DEFAULTS.structure.material,
+    hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness,
     loads: tuple[str, ...] = (),
     self_weight: bool = True,
-    limit: str | float = DEFAULTS.structure_limit,
+    limit: str | float = DEFAULTS.structure.limit,
     nonlinear: bool = False,
-    modes: int = DEFAULTS.structure_modes,
+    modes: int = DEFAULTS.structure.modes,
     settings: Settings = DEFAULTS,
 ) -> DesignPlan:
     """The :class:`DesignPlan` of ``pattern`` (see the module's text and

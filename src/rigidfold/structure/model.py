@@ -1,7 +1,7 @@
 """The deployed structure as a shell model: panels as plates, free creases as hinges.
 
 Every triangle of the pattern is divided into ``n^2`` triangles (``n`` =
-``Settings.structure_subdivisions``, a lattice of ``n + 1`` points per side), which become
+``Settings.structure.subdivisions``, a lattice of ``n + 1`` points per side), which become
 ``ShellDKGT`` elements (``ShellNLDKGT`` for the geometrically nonlinear analysis: DKT
 bending, membrane with drilling DOF) of an ``ElasticMembranePlateSection`` of the material
 and thickness. Nodes are shared where the plate is continuous: inside a triangle, along a

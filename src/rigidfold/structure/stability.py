@@ -16,7 +16,7 @@ Discrete Math. 9(3), 1996):
   coordinates; a clamped vertex pins every vertex of the triangles at it, which holds their
   rotations exactly). A = dg/dx (n_c x 3V) is the first-order constraint matrix.
 * A **self-stress** is w with A^T w = 0 (the left singular vectors of A whose singular
-  value squared is at most ``Settings.structure_rigidity_tol``, the same threshold as the
+  value squared is at most ``Settings.structure.rigidity_tol``, the same threshold as the
   first-order test; forces in the edges and creases in equilibrium with the supports'
   reactions). Its **stress matrix** Omega(w) = sum_i w_i Hess g_i is the geometric
   stiffness that the self-stress gives the flexes: their energy at second order is
@@ -229,7 +229,7 @@ def second_order(
     U, sv, _ = np.linalg.svd(A, full_matrices=True)
     sigma = np.zeros(A.shape[0])
     sigma[: len(sv)] = sv
-    W = U[:, sigma**2 <= settings.structure_rigidity_tol]  # (n_c, s) self-stresses
+    W = U[:, sigma**2 <= settings.structure.rigidity_tol]  # (n_c, s) self-stresses
     forms = cons.stress_forms(Z)  # (n_c, k, k)
     N = np.einsum("is,ikl->skl", W, forms)  # one stress matrix on the flexes per stress
     flat = N.reshape(len(N), k * k).T  # (k^2, s)
@@ -238,14 +238,14 @@ def second_order(
     basis = np.zeros((0, k, k))
     if size > 0 and flat.size:
         u, s, _ = np.linalg.svd(flat / size, full_matrices=False)
-        keep = s > settings.structure_prestress_tol
+        keep = s > settings.structure.prestress_tol
         basis = (u[:, keep] * s[keep]).T.reshape(-1, k, k)
         basis = 0.5 * (basis + basis.transpose(0, 2, 1))
     margin, bound, coef = _best_stress(basis, k, settings)
     form = np.tensordot(coef, basis, axes=1) if len(basis) else np.zeros((k, k))
     lam, vec = np.linalg.eigh(form)
     direction = vec[:, 0]
-    if margin > settings.structure_prestress_tol:
+    if margin > settings.structure.prestress_tol:
         # near-mechanisms make near self-stresses: a finite motion along the weakest flex
         # (a rotation about two pins, say) is a mechanism whatever their stress matrices say
         moved = _finite_motion(cons, _unit(Z[:, 0]), settings)
@@ -290,7 +290,7 @@ def _best_stress(basis: np.ndarray, k: int, settings: Settings) -> tuple[float, 
         return 0.0, 0.0, np.zeros(0)
     cuts = [np.eye(k)[i] for i in range(k)]
     best, best_coef, bound = -np.inf, np.zeros(r), np.inf
-    for _ in range(settings.structure_prestress_cuts):
+    for _ in range(settings.structure.prestress_cuts):
         # maximise t s.t. t <= y^T (sum c_r B_r) y for every cut y; variables (c, t)
         G = np.array([[y @ B @ y for B in basis] for y in cuts])
         res = linprog(
@@ -306,9 +306,9 @@ def _best_stress(basis: np.ndarray, k: int, settings: Settings) -> tuple[float, 
         lam, vec = np.linalg.eigh(np.tensordot(coef, basis, axes=1))
         if lam[0] > best:
             best, best_coef = float(lam[0]), coef
-        if best > settings.structure_prestress_tol or bound <= settings.structure_prestress_tol:
+        if best > settings.structure.prestress_tol or bound <= settings.structure.prestress_tol:
             break
-        if bound - best <= settings.structure_prestress_tol:
+        if bound - best <= settings.structure.prestress_tol:
             break
         cuts.append(vec[:, 0])
     return best, bound, best_coef
@@ -320,13 +320,13 @@ def _finite_motion(cons: Constraints, z: np.ndarray, settings: Settings) -> np.n
     ``structure_flex_tol`` (of the mean edge length): that displacement (3V,) when it does
     within a correction smaller than the step, else None."""
     scale = float(np.mean(cons.lengths))
-    t = settings.structure_flex_step * scale
+    t = settings.structure.flex_step * scale
     zn = z / np.linalg.norm(z)
     x0 = cons.x0.ravel()
     x = x0 + t * z
-    for _ in range(settings.structure_max_iter):
+    for _ in range(settings.structure.max_iter):
         g = cons.values(x.reshape(-1, 3))
-        if np.linalg.norm(g) <= settings.structure_flex_tol * scale:
+        if np.linalg.norm(g) <= settings.structure.flex_tol * scale:
             moved = x - x0
             corr = moved - (moved @ zn) * zn
             return moved if np.linalg.norm(corr) < t else None

@@ -11,7 +11,7 @@ stiffness on the free motions is the pseudo stiffness matrix of Section 4 (Eq. 1
 ``K~ = (P Q)^T (P Q) = sum_v B_v^T B_v`` (:class:`rigidfold.mechanism.stiffness.PseudoStiffness`
 with the supports for the hinges). The supports make the mechanism **first-order rigid**
 when K~ is positive definite: its smallest eigenvalue exceeds
-``Settings.structure_rigidity_tol`` times its largest. Otherwise the eigenvector of the
+``Settings.structure.rigidity_tol`` times its largest. Otherwise the eigenvector of the
 smallest eigenvalue is the motion they leave free, named by its largest hinge rotations (a
 mechanism) or as a rigid-body motion.
 
@@ -22,7 +22,7 @@ Actuated creases (``--actuators``) are held at their angle: they count as fixed 
 the boundary vertices at ground level) that is first-order rigid, and among those of that
 size the one of the largest smallest eigenvalue. Every set of one size is tried, smallest
 size first (from ceil((d + 6) / 3), as each pin gives three rows), while the number of sets
-is at most ``Settings.structure_max_support_sets``; beyond, a greedy search adds the
+is at most ``Settings.structure.max_support_sets``; beyond, a greedy search adds the
 candidate that raises log det of K~ (eigenvalues floored) the most until rigid, then drops
 any support not needed.
 
@@ -77,14 +77,14 @@ def support_candidates(
     pattern: CreasePattern, spec: str | None = None, settings: Settings = DEFAULTS
 ) -> np.ndarray:
     """The vertices ``auto`` may choose (sorted, int64): ``None`` or ``"boundary"``: the
-    boundary vertices; ``"ground"``: those within ``settings.structure_ground_tol`` of the
+    boundary vertices; ``"ground"``: those within ``settings.structure.ground_tol`` of the
     lowest boundary vertex's height; ``"V,V,..."``: these vertices."""
     boundary = pattern.boundary_vertices
     if spec is None or spec.strip().lower() == "boundary":
         return boundary
     if spec.strip().lower() == "ground":
         z = pattern.coords[boundary, 2]
-        return boundary[z <= z.min() + settings.structure_ground_tol]
+        return boundary[z <= z.min() + settings.structure.ground_tol]
     return parse_indices(spec, pattern.n_vertices, "support candidates")
 
 
@@ -151,10 +151,10 @@ class SupportModes:
         sigma = np.zeros(3 * pattern.n_vertices)
         sigma[: len(sv)] = sv
         top = float(sv[0]) if len(sv) else 1.0
-        soft = sigma <= settings.structure_soft_modes * top
+        soft = sigma <= settings.structure.soft_modes * top
         self.sigma = sigma[soft]
         self.Q = vt[soft].T
-        self.dof = int(np.sum(sigma <= settings.mechanism_rank_tol * top)) - 6
+        self.dof = int(np.sum(sigma <= settings.mechanism.rank_tol * top)) - 6
         self.near = int(soft.sum()) - 6 - self.dof
         x = pattern.coords - pattern.coords.mean(axis=0)
         V = pattern.n_vertices
@@ -213,7 +213,7 @@ class SupportModes:
         free when they do not."""
         stiff = self.stiffness(supports)
         lam = stiff.eigenvalues
-        soft = lam <= self.settings.structure_rigidity_tol
+        soft = lam <= self.settings.structure.rigidity_tol
         rigid = not bool(soft.any())
         weakest = self.Q @ stiff.eigenvectors[:, 0]
         second = None
@@ -364,14 +364,14 @@ def auto_supports(
         (modes.gram(int(v), clamp=True) for v in base.clamped), np.zeros((modes.n_modes,) * 2)
     )
     G = np.stack([modes.gram(int(v)) for v in cand])
-    tol = settings.structure_rigidity_tol
+    tol = settings.structure.rigidity_tol
     everything = modes.rigidity(Supports(cand, base.clamped, base.actuated))
     if not everything.rigid:
         return everything
     need = int(np.sum(modes.sigma**2 <= tol))  # motions that only supports can hold
     k0 = max(1, math.ceil((need - 6 * len(base.clamped)) / 3))
     for k in range(k0, len(cand) + 1):
-        if math.comb(len(cand), k) > settings.structure_max_support_sets:
+        if math.comb(len(cand), k) > settings.structure.max_support_sets:
             chosen = _greedy(G0, G, tol)
             return modes.rigidity(Supports(cand[chosen], base.clamped, base.actuated))
         best, best_lam = None, 0.0

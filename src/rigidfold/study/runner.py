@@ -16,7 +16,7 @@ import os
 import socket
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
 from rigidfold.errors import RigidfoldError
@@ -61,7 +61,7 @@ class StudyConfig:
             "deform": o.deform,
             "target_dof": o.target_dof,
             "solver": o.solver,
-            "settings": asdict(self.settings),
+            "settings": self.settings.flat(),
             "lookahead": o.lookahead,
             "deploy_check": o.deploy_check,
             "check": o.check,
@@ -82,7 +82,7 @@ def plan(
     ``FILE.svg`` fitted into 3 m x 3 m) and criteria.
 
     Seed-major order (every pattern and criterion of a surface before the next surface), so
-    that a study stopped early holds complete surfaces. At most ``settings.max_study_runs``
+    that a study stopped early holds complete surfaces. At most ``settings.limits.max_study_runs``
     runs (checked before the list is built).
     """
     for p in patterns:
@@ -97,11 +97,11 @@ def plan(
     if not patterns or not criteria:
         raise RigidfoldError("at least one pattern and one criterion are needed")
     runs = surfaces * len(patterns) * len(criteria)
-    if runs > settings.max_study_runs:
+    if runs > settings.limits.max_study_runs:
         raise RigidfoldError(
             f"--surfaces {surfaces} makes {runs} runs ({surfaces} surfaces x {len(patterns)} "
             f"patterns x {len(criteria)} criteria), more than the limit of "
-            f"{settings.max_study_runs} (Settings.max_study_runs)"
+            f"{settings.limits.max_study_runs} (Settings.limits.max_study_runs)"
         )
     return [
         Key("bezier", seed, p, c)

@@ -310,11 +310,9 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     compared. So a study can be resumed by a newer version as long as nothing it
     measures has changed.
     """
-    from dataclasses import asdict
-
     from rigidfold.config import DEFAULTS
 
-    defaults = asdict(DEFAULTS)
+    defaults = DEFAULTS.flat()
     diff = []
     for key in sorted(set(stored) | set(current)):
         a, b = stored.get(key, LEGACY_CONFIG.get(key)), current.get(key)

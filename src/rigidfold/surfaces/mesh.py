@@ -10,15 +10,15 @@ twice continuously differentiable with exact derivatives in problem (6).
   smooth surface; ``fit_error`` shows how far the spline is from it. A closed mesh (a solid)
   projects onto zero area and is refused.
 * **Footprint.** The plan region the mesh covers; a plan point within
-  ``Settings.surface_footprint_tol`` times the longer side of the plan box of it counts as
+  ``Settings.inputs.surface_footprint_tol`` times the longer side of the plan box of it counts as
   inside. ``check_finite`` refuses plan points outside it. Grid nodes outside it get the
   smoothest continuation of the heights inside (least squares of third differences), so the
   spline continues the surface across the boundary; beyond the plan box the spline's end
   pieces continue for ``PAD`` cells.
-* **Resolution.** ``Settings.surface_grid_nodes`` nodes along the longer side of the plan box,
-  the same spacing along the other. A grid finer than the mesh's triangles makes the spline
-  follow their facets; a coarser one smooths them. ``fit_error`` is measured either way.
-* **Size.** A mesh of more than ``Settings.max_mesh_triangles`` triangles is refused (a
+* **Resolution.** ``Settings.inputs.surface_grid_nodes`` nodes along the longer side of the
+  plan box, the same spacing along the other. A grid finer than the mesh's triangles makes the
+  spline follow their facets; a coarser one smooths them. ``fit_error`` is measured either way.
+* **Size.** A mesh of more than ``Settings.limits.max_mesh_triangles`` triangles is refused (a
   binary STL file before it is loaded). The heights are found through buckets of the plan
   points and the columns of them each triangle crosses (:func:`_candidates`), in batches:
   the memory is linear in the mesh and the points, also for the long thin triangles of a
@@ -105,7 +105,7 @@ class SplineSurface(Surface):
 
 
 MAX_GRID_NODES = 513
-"""Most grid nodes along one side of a mesh fit (``Settings.surface_grid_nodes`` at most)."""
+"""Most grid nodes along one side of a mesh fit (``Settings.inputs.surface_grid_nodes`` at most)."""
 
 
 def _grid_problem(gx: Any, gy: Any, z: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -163,16 +163,16 @@ class MeshSurface(SplineSurface):
         plan = corners[:, :, :2]
         self.bounds = np.array([plan.min(axis=(0, 1)), plan.max(axis=(0, 1))])
         size = float((self.bounds[1] - self.bounds[0]).max())
-        self._tol = settings.surface_footprint_tol * size
+        self._tol = settings.inputs.surface_footprint_tol * size
         # triangles seen edge-on from above (zero plan area) give no height
         e1, e2 = plan[:, 1] - plan[:, 0], plan[:, 2] - plan[:, 0]
         det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
         longest = np.linalg.norm(plan - np.roll(plan, 1, axis=1), axis=2).max(axis=1)
-        seen = np.abs(det) / 2 > settings.degenerate_area * longest**2
+        seen = np.abs(det) / 2 > settings.geometry.degenerate_area * longest**2
         self._corners, self._det = corners[seen], det[seen]
 
         extent = self.bounds[1] - self.bounds[0]
-        cells = np.maximum(np.round(extent * (settings.surface_grid_nodes - 1) / size), 3)
+        cells = np.maximum(np.round(extent * (settings.inputs.surface_grid_nodes - 1) / size), 3)
         gx, gy = (
             np.linspace(self.bounds[0, k], self.bounds[1, k], int(cells[k]) + 1) for k in (0, 1)
         )
@@ -262,7 +262,7 @@ def _mesh_problem(
         return f"triangles must be an (M, 3) array of vertex indices, got shape {t.shape}"
     if len(t) == 0:
         return "no triangles"
-    if len(t) > settings.max_mesh_triangles:
+    if len(t) > settings.limits.max_mesh_triangles:
         return _too_many(len(t), settings)
     outside = t[(t < 0) | (t >= len(v))]
     if outside.size:
@@ -270,17 +270,17 @@ def _mesh_problem(
     bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
     if bad.size:
         return f"vertex {bad[0]} has non-finite coordinates {v[bad[0]].tolist()}"
-    far = np.flatnonzero(np.abs(v).max(axis=1) > settings.max_coordinate)
+    far = np.flatnonzero(np.abs(v).max(axis=1) > settings.limits.max_coordinate)
     if far.size:  # before the areas below overflow
         return (
             f"vertex {far[0]} at {v[far[0]].tolist()} lies farther than "
-            f"{settings.max_coordinate:g} m from the origin (Settings.max_coordinate)"
+            f"{settings.limits.max_coordinate:g} m from the origin (Settings.limits.max_coordinate)"
         )
     c = v[t].astype(float)
     e1, e2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
     plan = float((e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()) / 2
     surface = float(np.linalg.norm(np.cross(e1, e2), axis=1).sum()) / 2
-    if abs(plan) <= settings.plan_area_tol * surface:
+    if abs(plan) <= settings.geometry.plan_area_tol * surface:
         return (
             "the triangles' projection onto the xy plane has zero area (faces turned down "
             "count negative): a target surface needs z up and an open sheet, not a vertical "
@@ -292,8 +292,9 @@ def _mesh_problem(
 def _too_many(count: int, settings: Settings) -> str:
     """The message about a mesh of ``count`` triangles, more than the limit."""
     return (
-        f"{count} triangles, more than {settings.max_mesh_triangles} "
-        "(Settings.max_mesh_triangles): decimate the mesh; the surface is sampled on at most "
+        f"{count} triangles, more than {settings.limits.max_mesh_triangles} "
+        "(Settings.limits.max_mesh_triangles): decimate the mesh; the surface is sampled on at "
+        "most "
         "513 x 513 grid nodes"
     )
 
@@ -321,7 +322,7 @@ def read_mesh(
         raise RigidfoldError(f"cannot read mesh {path}: no such file")
     if kind == "stl":
         count = _check_stl(path)
-        if count is not None and count > settings.max_mesh_triangles:
+        if count is not None and count > settings.limits.max_mesh_triangles:
             raise RigidfoldError(f"mesh {path}: {_too_many(count, settings)}")
     import trimesh
 

@@ -1,0 +1,62 @@
+"""Tolerances and defaults, in one place.
+
+Every numerical threshold and every default design parameter of rigidfold lives in
+:class:`Settings`, a frozen record of groups (``settings.design.dz``,
+``settings.solver.ipopt_tol``, ``settings.path.tol``, ...), each field documented where it
+is defined. Library functions take a ``settings`` argument (default :data:`DEFAULTS`)
+instead of scattering literals through the code; ``DEFAULTS.with_(dz=0.1)`` changes a
+setting by its flat name (:meth:`Settings.flat` lists them all).
+
+Modules: ``base`` (a documented field, a group), ``core`` (Steps 2-8), ``checks`` (the
+checks of a design), ``inputs`` (reading, and bounds on any input), ``settings`` (the
+record), ``seeds``, ``blas`` (one BLAS thread).
+"""
+
+from rigidfold.config.blas import one_blas_thread
+from rigidfold.config.checks import (
+    SIDES,
+    DeformationSettings,
+    FabricateSettings,
+    PathSettings,
+    StructureSettings,
+)
+from rigidfold.config.core import (
+    HESSIANS,
+    DesignSettings,
+    GenerationSettings,
+    GeometrySettings,
+    MechanismSettings,
+    SolverSettings,
+)
+from rigidfold.config.inputs import InputSettings, LimitSettings
+from rigidfold.config.seeds import DEFAULT_SEED, SEED_LIMIT, check_seed
+from rigidfold.config.settings import DEFAULTS, FLAT_NAMES, GROUPS, Settings
+
+CHECKS = ("final", "all")
+"""Which solutions of a generation run get the folding motion and Step 9 (``generate
+--check``): the final design only (the default), or every solution."""
+
+__all__ = [
+    "CHECKS",
+    "DEFAULTS",
+    "DEFAULT_SEED",
+    "FLAT_NAMES",
+    "GROUPS",
+    "HESSIANS",
+    "SEED_LIMIT",
+    "SIDES",
+    "DeformationSettings",
+    "DesignSettings",
+    "FabricateSettings",
+    "GenerationSettings",
+    "GeometrySettings",
+    "InputSettings",
+    "LimitSettings",
+    "MechanismSettings",
+    "PathSettings",
+    "Settings",
+    "SolverSettings",
+    "StructureSettings",
+    "check_seed",
+    "one_blas_thread",
+]

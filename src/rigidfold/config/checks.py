@@ -1,0 +1,311 @@
+"""Settings of the checks of a design: its rigid-folding path, the large-deformation check
+(Step 9) and folding motion, the structure under load and the thick panels."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rigidfold.config.base import Group, setting
+from rigidfold.errors import RigidfoldError
+
+SIDES = ("bottom", "top")
+"""The sides of the design surface that thick panels can lie on (``fabricate --side``):
+below it (against the faces' normals, which point up) or above it."""
+
+
+@dataclass(frozen=True)
+class PathSettings(Group):
+    """The rigid-folding path of a design (``rigidfold.mechanism.path``, Step 5 beyond the
+    paper): a continuation from the design to the flat state."""
+
+    PREFIX = "path_"
+
+    flat_tol: float = setting(
+        math.radians(0.5),
+        "The path reaches the flat state when every free crease's fold angle is within this "
+        "of 0, radians (0.5 degrees).",
+    )
+    fold_limit: float = setting(
+        math.radians(179.0),
+        "The path ends where a crease folds to this, radians (179 degrees): its panels meet.",
+    )
+    tol: float = setting(
+        1e-10,
+        "Corrector tolerance: norm of the constraint residual (edge lengths in mean edge "
+        "lengths, fold angles in radians) at every traced point.",
+    )
+    step: float = setting(
+        0.05,
+        "First continuation step: the root-mean-square displacement of the vertices, in mean "
+        "edge lengths.",
+    )
+    max_step: float = setting(0.5, "Largest continuation step (as ``path_step``).")
+    min_step: float = setting(1e-7, "Smallest continuation step (as ``path_step``).")
+    max_fold_step: float = setting(
+        math.radians(5.0),
+        "Largest change of any fold angle in one continuation step, radians (5 degrees): the "
+        "traced points resolve the motion.",
+    )
+    max_steps: int = setting(
+        200, "Accepted steps of one direction of the trace before it gives up."
+    )
+    corrector_iter: int = setting(8, "Chord iterations of the corrector.")
+    contraction: float = setting(
+        0.5,
+        "Largest ratio of successive corrections the corrector accepts (a step that converges "
+        "more slowly is halved).",
+    )
+    turn_back: float = setting(
+        0.05,
+        "A 1-DOF path turns back (the shape does not deploy along it) when its folding "
+        "measure, having fallen, rises this much (a fraction of the design's) above its "
+        "lowest.",
+    )
+    max_turn: float = setting(
+        math.radians(30.0),
+        "Largest angle, radians, between the tangent and the chord of one step (DOF 1).",
+    )
+    regularization: float = setting(
+        1e-12,
+        "Diagonal added to the constraint block of the KKT systems (self-stressed rows).",
+    )
+    damping: float = setting(
+        1e-9, "Diagonal added to the fold-angle metric of the Gauss-Newton direction (DOF > 1)."
+    )
+    stall_steps: int = setting(
+        5,
+        "With DOF > 1 the path stops short when this many steps in a row each lower the "
+        "folding measure by less than ``path_stall_ratio`` (of its lowest so far).",
+    )
+    stall_ratio: float = setting(
+        1e-4,
+        "A step that lowers the folding measure by less than this fraction of its lowest so "
+        "far makes no progress (``path_stall_steps``, ``path_wander_steps``).",
+    )
+    wander_steps: int = setting(
+        40,
+        "With DOF 1 the path stops short when this many steps in a row bring the folding "
+        "measure no lower (by ``path_stall_ratio``) than its lowest so far.",
+    )
+
+
+@dataclass(frozen=True)
+class DeformationSettings(Group):
+    """The large-deformation check (Step 9, paper Section 6.1: the frame of tubes pushed to
+    the plane) and the folding motion."""
+
+    PREFIX = "deform_"
+
+    tube_diameter: float = setting(
+        0.020,
+        "Outside diameter of the frame's tubular beams, metres (20 mm).",
+        flat="tube_diameter",
+    )
+    tube_wall: float = setting(
+        0.001, "Wall thickness of the frame's tubular beams, metres (1 mm).", flat="tube_wall"
+    )
+    youngs_modulus: float = setting(
+        200e9, "Young's modulus of the beams' material, Pa (200 GPa).", flat="youngs_modulus"
+    )
+    poisson_ratio: float = setting(
+        0.3, "Poisson's ratio of the beams' material.", flat="poisson_ratio"
+    )
+    steps: int = setting(20, "Load steps from the folded shape to the plane.")
+    max_halvings: int = setting(
+        6, "A load step that does not converge is retried with half the increment this often."
+    )
+    tol: float = setting(1e-9, "Newton convergence: norm of the displacement increment (metres).")
+    max_iter: int = setting(30, "Newton iteration limit of a load step.")
+    penalty: float = setting(
+        1e6,
+        "Penalty factor of the pins of the frame model (OpenSees ``Penalty`` handler), times "
+        "E A / (mean edge length).",
+    )
+    load_tol: float = setting(
+        1e-12, "The analysis has reached the plane when the load factor is within this of 1."
+    )
+    plane_tol: float = setting(
+        1e-6,
+        "The plane is reached when every frame node ends within this distance (m) of z = 0.",
+        flat="plane_tol",
+    )
+    motion_frames: int = setting(
+        11,
+        "Frames of the folding motion from flat to the designed shape.",
+        flat="motion_frames",
+    )
+    motion_length_tol: float = setting(
+        1e-3,
+        "A shape whose development diagram misses its edge lengths by more than this "
+        "(relative) is not developable for the folding motion's verdict (``deform.compare``).",
+        flat="motion_length_tol",
+    )
+
+
+@dataclass(frozen=True)
+class StructureSettings(Group):
+    """The structure under load (``rigidfold structure``, :mod:`rigidfold.structure`)."""
+
+    PREFIX = "structure_"
+
+    thickness: float = setting(0.018, "Panel thickness, metres (18 mm: a common plywood sheet).")
+    material: str = setting(
+        "plywood", "The panels' material preset (``rigidfold.structure.MATERIALS``)."
+    )
+    hinge_stiffness: float = setting(
+        0.0,
+        "Rotational stiffness of a free crease's hinge, N m/rad per metre of crease (0: free).",
+    )
+    subdivisions: int = setting(
+        2, "Each triangle of the pattern is divided into this squared shell elements."
+    )
+    limit: float = setting(
+        250.0, "Serviceability: the largest displacement may be at most span / this (L/250)."
+    )
+    gravity: float = setting(9.81, "Acceleration of gravity for the self-weight, m/s^2.")
+    modes: int = setting(3, "Natural frequencies computed (0: none).")
+    steps: int = setting(10, "Load steps of the geometrically nonlinear analysis.")
+    max_halvings: int = setting(
+        4, "How often a nonlinear load step that does not converge is halved before it stops."
+    )
+    tol: float = setting(
+        1e-8,
+        "Newton convergence of the static analysis: norm of the displacement increment (m).",
+    )
+    max_iter: int = setting(
+        20, "Newton iteration limit of the static analysis (and of the flex correction)."
+    )
+    soft_modes: float = setting(
+        1e-2,
+        "Motions of the design whose singular value of the kinematic constraint matrix (rows "
+        "of unit norm) is at most this fraction of the largest are free motions that the "
+        "supports must hold (the rigid-body motions, the mechanisms, and the near-mechanisms "
+        "of nearly flat vertices), ``rigidfold.structure.supports``.",
+    )
+    rigidity_tol: float = setting(
+        1e-6,
+        "The supports make the design first-order rigid when the smallest eigenvalue of the "
+        "stiffness on those motions (their own, sigma^2, plus the supports', rows of unit "
+        "norm) exceeds this.",
+    )
+    max_support_sets: int = setting(
+        100_000,
+        "``--supports auto`` tries every set of this many candidate sets or fewer of one size "
+        "(the smallest that can be rigid first); more, and it searches greedily.",
+    )
+    ground_tol: float = setting(
+        1e-3,
+        "``--support-candidates ground``: boundary vertices within this (m) of the lowest "
+        "boundary vertex's height.",
+    )
+    balance_tol: float = setting(
+        1e-3,
+        "A static answer whose reactions miss the loads by more than this share of them did "
+        "not carry the load (0.1 %: a singular stiffness).",
+    )
+    prestress_tol: float = setting(
+        1e-8,
+        "Second order (``rigidfold.structure.stability``): the supports are prestress stable "
+        "when the smallest eigenvalue of the best self-stress's stress matrix on the flexes "
+        "exceeds this fraction of the stress matrices' largest entry; stress matrices below "
+        "this fraction of the largest are dropped.",
+    )
+    prestress_cuts: int = setting(
+        200, "Cutting planes (linear programs) of the search for that self-stress."
+    )
+    flex_step: float = setting(
+        0.05,
+        "A flex is a finite mechanism when the design moved this many mean edge lengths along "
+        "it is corrected (at right angles, Gauss-Newton, ``structure_max_iter`` iterations) "
+        "to meet every constraint within ``structure_flex_tol`` of the mean edge length.",
+    )
+    flex_tol: float = setting(
+        1e-10,
+        "A corrected flex meets every constraint within this fraction of the mean edge length "
+        "(``structure_flex_step``).",
+    )
+
+
+@dataclass(frozen=True)
+class FabricateSettings(Group):
+    """Thick panels (``rigidfold fabricate``, :mod:`rigidfold.fabricate`)."""
+
+    PREFIX = "fabricate_"
+
+    side: str = setting(
+        "bottom",
+        'Which side of the design surface the solids lie on: ``"bottom"`` (below it, against '
+        'the faces\' normals, which point up: the surface is the outer skin) or ``"top"``.',
+    )
+    clearance_angle: float = setting(
+        math.radians(2.0),
+        "Every solid is bevelled along each hinge so that the two solids stay apart up to the "
+        "crease's largest fold over the motion plus this angle, radians (2 degrees).",
+    )
+    clearance: float = setting(
+        1e-3,
+        "Smallest gap, metres, that solids of panels without a common hinge keep at every "
+        "point of the motion (1 mm).",
+    )
+    vertex_relief: float = setting(
+        1.0,
+        "Where panels without a common hinge meet at a vertex, every solid's corner there is "
+        "cut off at this many thicknesses from the vertex (a relief; the hinges end there).",
+    )
+    relief_rounds: int = setting(
+        4,
+        "Where two such panels still come closer than ``fabricate_clearance`` near a shared "
+        "vertex, the relief there is doubled and the check run again, this many times at "
+        "most.",
+    )
+    frame_step: float = setting(
+        math.radians(2.0),
+        "Largest change of a hinge's fold angle, radians, between two frames of the motion "
+        "that are checked (2 degrees): the design file's motion frames when they are that "
+        "fine, else the traced folding path sampled that finely.",
+    )
+    subdivisions: int = setting(
+        8,
+        "Between two frames, the motion is halved at most this many times where the bound on "
+        "the gap between two solids does not yet prove the clearance.",
+    )
+    min_depth: float = setting(
+        1.0,
+        "A panel is too thin when its solid is nowhere this share of the thickness deep (its "
+        "bevels meet above it); ``fabricate --min-thickness`` gives the length itself.",
+    )
+    trimmed_away: float = setting(
+        0.2,
+        "A panel is trimmed away when its solid keeps less than this share of its area times "
+        "the thickness, or one of its triangles keeps nothing.",
+    )
+    density: float = setting(
+        600.0, "Density of the panels' material, kg/m^3, for their masses (600: plywood)."
+    )
+    sheet_width: float = setting(
+        2440.0, "Width of the stock sheet the cut sheets are nested onto, millimetres."
+    )
+    sheet_height: float = setting(
+        1220.0, "Height of the stock sheet the cut sheets are nested onto, millimetres."
+    )
+    sheet_gap: float = setting(
+        10.0, "Gap between parts and from the stock sheet's edge, millimetres."
+    )
+    thickness_tries: int = setting(
+        8,
+        "When a thickness fails, thinner ones (halving, then bisection) are tried this many "
+        "times to name one that passes.",
+    )
+
+    def __post_init__(self) -> None:
+        self._choice("side", SIDES)
+        if not 0 <= self.clearance_angle < math.pi / 2:
+            raise RigidfoldError(
+                "fabricate_clearance_angle must lie in [0, 90) degrees, got "
+                f"{math.degrees(self.clearance_angle):g}"
+            )
+        self._non_negative("clearance", "vertex_relief", "sheet_gap")
+        self._positive("frame_step", "density", "sheet_width", "sheet_height")
+        self._fraction("min_depth", "trimmed_away")
+        self._integer(relief_rounds=0, subdivisions=0, thickness_tries=0)

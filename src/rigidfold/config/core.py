@@ -1,0 +1,269 @@
+"""Settings of form generation (Steps 2-8): the design parameters of problem (6), the
+generation procedure, the solvers, geometric tolerances and the mechanism analysis."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rigidfold.config.base import Group, setting
+from rigidfold.errors import RigidfoldError
+
+HESSIANS = ("closed-form", "casadi")
+"""The Hessians of the Lagrangian IPOPT can use (``SolverSettings.ipopt_hessian``)."""
+
+
+@dataclass(frozen=True)
+class DesignSettings(Group):
+    """Design parameters of problem (6) (paper, Section 6.1)."""
+
+    dz: float = setting(0.30, "Bound on |z_i - f(x_i, y_i)| in metres (paper: 0.30 m).")
+    theta_min: float = setting(
+        math.pi / 6, "Lower bound on every sector angle, radians (paper: pi/6)."
+    )
+    theta_max: float = setting(
+        2 * math.pi / 3, "Upper bound on every sector angle, radians (paper: 2 pi/3)."
+    )
+    rho_bar: float | None = setting(
+        None, "Optional bound on |rho_j| of free creases, constraint (12), radians."
+    )
+    f_tol: float = setting(1e-7, "A solution of (6) is accepted when F <= f_tol (paper: 1e-7).")
+    dz_bound_tol: float = setting(
+        1e-3,
+        "The report of a run flags a final design whose largest |z - target| is within this "
+        "fraction of ``dz`` of the bound (the constraint is active: the design is as far from "
+        "the target as ``dz`` allows).",
+    )
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.dz, float | int) and math.isfinite(self.dz) and self.dz > 0):
+            raise RigidfoldError(f"dz must be a positive number of metres, got {self.dz!r}")
+        if not (0 < self.theta_min < self.theta_max < math.pi):
+            raise RigidfoldError(
+                "sector-angle bounds must satisfy 0 < theta_min < theta_max < 180 degrees, got "
+                f"theta_min={math.degrees(self.theta_min):g}, "
+                f"theta_max={math.degrees(self.theta_max):g} degrees"
+            )
+        if self.rho_bar is not None and not (0 < self.rho_bar < math.pi):
+            raise RigidfoldError(
+                f"rho_bar must lie in (0, 180) degrees, got {math.degrees(self.rho_bar):g}"
+            )
+        if not self.f_tol > 0:
+            raise RigidfoldError(f"f_tol must be positive, got {self.f_tol!r}")
+
+
+@dataclass(frozen=True)
+class GenerationSettings(Group):
+    """The generation procedure (Steps 4-7): the fictitious hinge stiffnesses of the
+    criteria, lock prediction, the look-ahead and the deployability check."""
+
+    zero_dof_ends: bool = setting(
+        True,
+        "Step 5 of the paper: a solution of (6) whose mechanism has DOF 0 ends generation (it "
+        "goes to Step 8; not counted in N_reduce, N_lock or N_exceed). ``False``: while the "
+        "target DOF is >= 1, count it as a lock and try the next candidate (Step 7) instead, "
+        "which reaches the target more often at the price of more solves.",
+    )
+    hinge_stiffness: float = setting(
+        1e-3, "Mean of the fictitious hinge stiffnesses K_j, N m (Section 6.1)."
+    )
+    hinge_stiffness_spread: float = setting(
+        0.5e-6, "K_j are uniform in ``hinge_stiffness`` +/- this, N m (Section 6.1)."
+    )
+    lock_prediction_tol: float = setting(
+        1e-4,
+        "After multiplying K_j by 1e14, a hinge whose rotations outside the stiffest mode fall "
+        "below this fraction of its rotations before is predicted locked (Section 4.2).",
+    )
+    lookahead_tol: float = setting(
+        1e-7,
+        "Look-ahead (``generate(..., lookahead=True)``, :mod:`rigidfold.selection.lookahead`): "
+        "fixing a candidate is predicted to lock a folded free crease when the crease keeps, "
+        "in the first-order mechanisms left after the fix, rotations of norm at most this "
+        "times the largest any free crease keeps: the ``lock_tol`` test applied before the "
+        "solve. At ``lock_tol`` (the default) the forecast is the analysis of the fixed shape "
+        "at the same geometry; a larger value also skips candidates that leave a crease "
+        "nearly still.",
+    )
+    lookahead_carry_angle: float = setting(
+        math.radians(2.0),
+        "Look-ahead, once every candidate not forecast to lock has failed: a candidate whose "
+        "forecast locks only creases that its fix carries to within this angle of flat "
+        "(radians; first order: their fold angles plus their rotations along the smallest "
+        "mechanism motion that flattens the candidate) is fixed together with them, as one "
+        "group (a degree-4 vertex closing flat). Fixed creases are forced flat, so the group "
+        "asks only what fixing the candidate alone would do, less the lock.",
+    )
+    deploy_check_max_dof: int = setting(
+        1,
+        "The deployability check runs on accepted solutions of at most this DOF or the target "
+        "DOF, whichever is larger (0: on every solution). A run that does not reach the "
+        "target names the lowest-DOF solution that deploys as its final design.",
+    )
+    deploy_max_candidates: int = setting(
+        30,
+        "Step 7 gives up on a shape once this many of its candidates gave solutions whose "
+        "folding paths do not reach the flat state (``Stop.NO_DEPLOYABLE``; 0: it tries them "
+        "all): every candidate costs a solve and a trace, and a shape whose first candidates "
+        "all fail rarely has a deployable one further down the ranking.",
+    )
+
+
+@dataclass(frozen=True)
+class SolverSettings(Group):
+    """The solvers of problem (6) (IPOPT, the projection onto F = 0, SciPy SLSQP), of the
+    development diagram's problem (13), and the elimination of constraints (7)-(9)."""
+
+    constraint_tol: float = setting(
+        1e-8, "Largest accepted violation of any constraint of (6) (metres or radians)."
+    )
+    ipopt_tol: float = setting(1e-8, "IPOPT's convergence tolerance.")
+    ipopt_max_iter: int = setting(500, "IPOPT's iteration limit.")
+    ipopt_mu_strategy: str = setting("adaptive", "IPOPT's barrier-parameter strategy.")
+    ipopt_hessian: str = setting(
+        "closed-form",
+        'IPOPT\'s Hessian of the Lagrangian: "closed-form" (element Hessians assembled with '
+        'NumPy, ``rigidfold.optimize.hessian``) or "casadi" (CasADi\'s symbolic Hessian, the '
+        "reference it is tested against). Both are exact; they differ by round-off.",
+    )
+    ipopt_stop_f: float = setting(
+        1e-9,
+        "F at which IPOPT hands over to the projection on patterns of ``projection_vertices`` "
+        "or more (far below ``f_tol``, so that the projection starts near a zero of F); a "
+        "projection that stops at a feasible point this close to F = 0 is taken without IPOPT.",
+    )
+    projection_vertices: int = setting(
+        200,
+        "From this many vertices on, the IPOPT solver of (6) first tries the projection onto "
+        "F = 0 (:mod:`rigidfold.optimize.projection`) from the start; when that does not "
+        "converge, IPOPT runs and stops at the first feasible iterate with F <= "
+        "``ipopt_stop_f``, which the projection then finishes "
+        "(:mod:`rigidfold.optimize.large`). Smaller patterns (the paper's, up to 121 "
+        "vertices) run IPOPT alone.",
+    )
+    projection_tol: float = setting(1e-14, "The projection converges at F <= this.")
+    projection_max_iter: int = setting(60, "The projection stops after this many factorisations.")
+    projection_damping: float = setting(
+        1e-3,
+        "The projection starts with the damping this times |r| times the largest diagonal "
+        "entry of J J^T.",
+    )
+    projection_margin: float = setting(
+        1e-5,
+        "How far inside its bound the projection holds a constraint of (6) that blocked one "
+        "of its steps (radians for sector angles, metres for dz, the cosine for (12)).",
+    )
+    slsqp_ftol: float = setting(1e-12, "SciPy SLSQP's stopping tolerance.")
+    slsqp_max_iter: int = setting(1000, "SciPy SLSQP's iteration limit.")
+    polish_tol: float = setting(
+        1e-26,
+        "Before the deployability check, an accepted solution is projected onto F = 0 to this "
+        "F (:meth:`rigidfold.optimize.FormFindingProblem.polish`): developable to round-off.",
+    )
+    develop_tol: float = setting(
+        1e-12,
+        "IPOPT tolerance of problem (13) (the development diagram, Step 8); tighter than "
+        "``ipopt_tol`` so that a flat pattern develops onto itself to about 1e-10.",
+    )
+    linear_rank_tol: float = setting(
+        1e-10,
+        "Relative threshold of the rank-revealing QR that eliminates constraints (7)-(9).",
+    )
+    map_prune_tol: float = setting(
+        1e-13, "Entries of the variable map below this magnitude are dropped as round-off."
+    )
+
+    def __post_init__(self) -> None:
+        self._positive("projection_tol", "projection_damping", "projection_margin", "ipopt_stop_f")
+        self._integer(projection_vertices=3, projection_max_iter=1)
+        self._choice("ipopt_hessian", HESSIANS)
+
+
+@dataclass(frozen=True)
+class GeometrySettings(Group):
+    """Geometric tolerances of crease patterns, their symmetry and development diagrams."""
+
+    degenerate_area: float = setting(
+        1e-10,
+        "A triangle whose area is below this times (its longest edge)**2 is degenerate.",
+    )
+    corner_angle: float = setting(
+        math.radians(1.0),
+        "A boundary vertex is a corner when the boundary turns there by more than this (radians).",
+    )
+    flat_angle: float = setting(
+        1e-6, 'A free crease with |rho| below this (radians) is flat ("F" in FOLD files).'
+    )
+    symmetry_match_tol: float = setting(
+        1e-6, "Distance (metres) within which a mirrored vertex must land on another vertex."
+    )
+    overlap_area_tol: float = setting(
+        1e-9,
+        "Two facets of a development diagram overlap when their intersection is larger than "
+        "this fraction of the smaller one's area.",
+    )
+    triangulation_area_tol: float = setting(
+        1e-12,
+        "Triangulation of the polygon faces of FOLD and SVG files: a polygon is refused as "
+        "degenerate when a triangle of it has a doubled signed area below this times the "
+        "squared size of the polygon (the larger side of its bounding box, in its plane).",
+    )
+    plan_area_tol: float = setting(
+        1e-6,
+        "A sheet whose signed area in plan (its faces projected onto the xy plane) is within "
+        "this fraction of its surface area of zero has no plan (a y-up file, a vertical "
+        "sheet, a closed box, a flat-folded state): refused, since rigidfold needs z up. The "
+        "same test refuses the triangle mesh of a target surface (``MeshSurface``).",
+    )
+
+
+@dataclass(frozen=True)
+class MechanismSettings(Group):
+    """The mechanism analysis (Eq. 16, Section 4): ranks, the sparse method for large
+    patterns, and locks."""
+
+    rank_tol: float = setting(
+        1e-9,
+        "Singular values below this times the largest one count as zero (rank of S, Eq. 16); "
+        "in the kinematic and sparse analyses, the diagonal of the pivoted QR, and the Ritz "
+        "values, below this times the largest row norm of the constraint matrix (sqrt 2, the "
+        "row of an edge's length).",
+        flat="mechanism_rank_tol",
+    )
+    sparse_analysis_vertices: int = setting(
+        200,
+        "``analyze`` (and so ``generate``) takes the sparse method "
+        "(:mod:`rigidfold.mechanism.sparse`) for patterns with at least this many vertices "
+        "and the dense kinematic one below: the paper's patterns (up to 121 vertices) keep "
+        "the dense reference, and their results to the last digit.",
+    )
+    sparse_shift: float = setting(
+        1e-14,
+        "delta of the sparse analysis's filter ``(C^T C + delta I)^-1``: directions of "
+        "singular value s with s^2 << delta pass it like the kernel (all those within reach "
+        "of ``mechanism_rank_tol``), the others are damped by about delta / s^2 per solve. Ten "
+        "times the round-off of C^T C (about 1e-15); small enough that two solves damp every "
+        "direction with s > 1000 sqrt(delta) = 1e-4 below 1e-12 (a solved 31 x 31 grid has "
+        "some fifteen singular values between 1e-6 and 3e-4 beside its kernel).",
+    )
+    sparse_oversampling: int = setting(
+        12,
+        "Columns of the sparse analysis's subspace beyond the expected DOF; the subspace "
+        "doubles while fewer than half of them are damped below 1e-12 of the kernel's share.",
+    )
+    sparse_iterations: int = setting(
+        2,
+        "Solves with the filter per subspace: each multiplies the share of a direction of "
+        "singular value s by about delta / s^2; two leave the modes less than about 1e-12 of "
+        "every direction with s > 1000 sqrt(delta), far below ``lock_tol``.",
+    )
+    lock_tol: float = setting(
+        1e-7,
+        "A free crease is locked when the norm of its rotations over all modes is below this "
+        "times the largest such norm (and its triangles are not coplanar).",
+    )
+
+    def __post_init__(self) -> None:
+        if not 0 < self.sparse_shift < 1:
+            raise RigidfoldError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
+        self._integer(sparse_analysis_vertices=3, sparse_oversampling=2, sparse_iterations=1)
