@@ -8,7 +8,9 @@ metres where a roof may deflect centimetres (``docs/structure.md``). ``service``
 vertex that moves most (ties to the lower index, displacements compared to six
 significant digits so that round-off cannot choose), one at a time, with a linear analysis
 after each. Once the limit is met, each added pin is taken away again, in the order they
-were added, where the rest still meet it: the set is small, not necessarily the smallest.
+were added, where the rest still meet it, until every pin left has been tried against the
+final set: without any one of them the limit is missed. The set is small, not necessarily
+the smallest.
 A search that pins every candidate, or ``Settings.structure.service_max_pins`` of them,
 without meeting the limit says so: pins alone cannot carry the load within the limit
 (stiffer hinges, thicker panels, or supports elsewhere can).
@@ -97,14 +99,17 @@ def grow_supports(
         pins.append(v)
         added.append(v)
         check = run(pins, "add", v)
-    if check.passed:
-        for v in list(added):
+    kept: set[int] = set()  # tried without, against the current set: needed
+    while check.passed and (todo := [v for v in added if v not in kept]):
+        for v in todo:
             trial = [p for p in pins if p != v]
             fewer = run(trial, "drop", v)
             if fewer.passed:
                 pins, check = trial, fewer
                 added.remove(v)
+                kept.clear()  # a smaller set: the kept pins are tried again
             else:
+                kept.add(v)
                 _, vertex, n, largest, allowed = trail[-1]
                 trail[-1] = ("keep", vertex, n, largest, allowed)
     growth = SupportGrowth(
