@@ -14,6 +14,10 @@ Then the README's 12 m x 8 m roof (tests/data/roof_12x8_dof1.fold: ``rigidfold g
 --no-deform``, its final design, 54 vertices, DOF 1): the command with ``--supports auto``
 under self-weight alone (18 mm plywood, 3 frequencies), the reactions' balance, and each
 support removed in turn, reported as a mechanism (first- and second-order check).
+
+Last, ``--supports service`` (auto's pins, then more where the design deflects most until
+L/250 is met) on the roof and on the 11 x 11 design with free hinges under self-weight:
+the pins, the analyses of the search, the largest displacement, the wall time (once each).
 """
 
 from __future__ import annotations
@@ -82,6 +86,28 @@ def main() -> None:
     )
     print("target: the structure command on an 11 x 11 design under 10 s")
     roof(args.repeat)
+    service()
+
+
+def service() -> None:
+    """--supports service on the roof and the 11 x 11 design (free hinges, self-weight)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, path in (("roof", ROOF), ("11 x 11", DESIGN)):
+            t, run = timed(
+                1,
+                lambda path=path: structure(
+                    path, Path(tmp) / "s", supports="service", modes=0, overwrite=True
+                ),
+            )
+            c = run.check
+            g = c.growth
+            print(
+                f"{name}, --supports service: {c.status}, pins {len(g.rigid)} for rigidity + "
+                f"{len(g.added)} for the deflection of {g.candidates} candidates, "
+                f"{len(g.trail)} analyses; largest displacement {c.max_displacement * 1e3:.4g} "
+                f"mm (limit {c.allowed_displacement * 1e3:.3g} mm; auto's pins: "
+                f"{g.trail[0][3] * 1e3:.4g} mm); {t:.2f} s"
+            )
 
 
 def roof(repeat: int) -> None:

@@ -276,9 +276,10 @@ def build_parser() -> argparse.ArgumentParser:
     gen.add_argument(
         "--supports",
         default=GENERATE_DEFAULTS.supports,
-        metavar="V,V,...|auto",
-        help="--structure: pinned vertices, or auto: the fewest boundary vertices that make "
-        "the mechanism first-order rigid (default: %(default)s)",
+        metavar="V,V,...|auto|service",
+        help="--structure: pinned vertices; auto: the fewest boundary vertices that make "
+        "the mechanism first-order rigid; service: those, and more where the design deflects "
+        "most until the deflection limit is met (default: %(default)s)",
     )
     gen.add_argument(
         "--load",
@@ -441,11 +442,13 @@ def build_parser() -> argparse.ArgumentParser:
     stc.add_argument(
         "--supports",
         default="auto",
-        metavar="V,V,...|auto",
-        help="pinned vertices (indices of the FOLD file's vertices_coords), or auto: the "
+        metavar="V,V,...|auto|service",
+        help="pinned vertices (indices of the FOLD file's vertices_coords); auto: the "
         "fewest --support-candidates that make the mechanism first-order rigid, of the "
-        "largest smallest stiffness eigenvalue. A boundary edge whose ends are both supported "
-        "is supported along its length (default: %(default)s)",
+        "largest smallest stiffness eigenvalue; service: those, then one more at a time where "
+        "the design deflects most until the deflection limit is met (a linear analysis "
+        "each; added pins that are not needed are taken away again). A boundary edge whose "
+        "ends are both supported is supported along its length (default: %(default)s)",
     )
     stc.add_argument(
         "--support-candidates",
@@ -1132,9 +1135,15 @@ def _cmd_structure(args: argparse.Namespace) -> int:
         return code
     c = run.check
     sup = c.rigidity.supports
-    how = "chosen" if c.auto else "given"
+    how = {"given": "given", "auto": "chosen", "service": "chosen for the deflection"}[c.chosen]
+    grown = (
+        ""
+        if c.growth is None
+        else f" (rigid with {c.growth.rigid.tolist()}, {len(c.growth.added)} added for the "
+        f"deflection; {len(c.growth.trail)} analyses)"
+    )
     print(
-        f"supports ({how}): pinned {sup.pinned.tolist()}"
+        f"supports ({how}): pinned {sup.pinned.tolist()}{grown}"
         + (f", clamped {sup.clamped.tolist()}" if len(sup.clamped) else "")
         + f"; mechanism DOF {c.rigidity.dof} without them; smallest stiffness eigenvalue "
         f"{c.rigidity.smallest:.3g}"

@@ -67,6 +67,7 @@ from rigidfold.selection import (
 )
 from rigidfold.status import Outcome
 from rigidfold.structure import parse_limit, parse_load, parse_material
+from rigidfold.structure.design import CHOSEN_SUPPORTS
 
 
 class AttemptOutcome(Outcome):
@@ -379,11 +380,12 @@ class GenerateOptions:
             parse_material(self.material)
         supports = self.supports
         if not isinstance(supports, str) or not (
-            supports.strip().lower() == "auto"
+            supports.strip().lower() in CHOSEN_SUPPORTS
             or all(p.strip().isdigit() for p in supports.split(","))
         ):
             raise RigidfoldError(
-                f"supports must be auto or comma-separated vertex indices, got {supports!r}"
+                f"supports must be {' or '.join(CHOSEN_SUPPORTS)} or comma-separated vertex "
+                f"indices, got {supports!r}"
             )
         if isinstance(self.loads, str):
             raise RigidfoldError(f"loads must be a list of load texts, got {self.loads!r}")

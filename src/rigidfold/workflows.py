@@ -530,10 +530,11 @@ def structure(
     ``OUT/structure.json`` and ``OUT/structure.png`` (:mod:`rigidfold.structure`).
 
     supports : ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
-    ``"V,V,..."``) or ``"V,V,..."`` pinned vertices; clamped : ``"V,V,..."`` clamped
-    vertices; actuators : ``"I,J,..."`` free creases held at their angle; loads : ``--load``
-    texts (:func:`rigidfold.structure.parse_load`); limit : ``"L/250"``. Every input is
-    checked before anything is written (ValueError, one line).
+    ``"V,V,..."``), ``"service"`` (those, and more until the deflection limit is met:
+    :mod:`rigidfold.structure.service`) or ``"V,V,..."`` pinned vertices; clamped :
+    ``"V,V,..."`` clamped vertices; actuators : ``"I,J,..."`` free creases held at their
+    angle; loads : ``--load`` texts (:func:`rigidfold.structure.parse_load`); limit :
+    ``"L/250"``. Every input is checked before anything is written (ValueError, one line).
     """
     check_options(material=material, loads=loads, limit=limit, modes=modes)
     refuse_replacing_inputs([path], [Path(out) / name for name in STRUCTURE_FILES])

@@ -194,6 +194,12 @@ class StructureSettings(Group):
         "``--supports auto`` tries every set of this many candidate sets or fewer of one size "
         "(the smallest that can be rigid first); more, and it searches greedily.",
     )
+    service_max_pins: int = setting(
+        50,
+        "``--supports service`` adds at most this many pins to the rigid set of ``auto`` "
+        "while the deflection exceeds the limit, one linear analysis each "
+        "(:mod:`rigidfold.structure.service`).",
+    )
     ground_tol: float = setting(
         1e-3,
         "``--support-candidates ground``: boundary vertices within this (m) of the lowest "

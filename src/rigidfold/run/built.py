@@ -31,6 +31,7 @@ from rigidfold.structure import (
     parse_material,
     write_structure,
 )
+from rigidfold.structure.design import CHOSEN_SUPPORTS
 from rigidfold.structure.loads import check_loads
 
 THICK_DIR = Path("final") / "thick"
@@ -45,7 +46,7 @@ def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> Non
     run's crease pattern: every solution has its vertices) lacks, before the run starts."""
     if not options.structure:
         return
-    if options.supports.strip().lower() != "auto":
+    if options.supports.strip().lower() not in CHOSEN_SUPPORTS:
         parse_indices(options.supports, pattern.n_vertices, "supports")
     check_loads(tuple(parse_load(text) for text in options.loads), pattern.n_vertices)
 

@@ -27,7 +27,7 @@ from rigidfold.structure.loads import Load, check_loads, nodal_loads
 from rigidfold.structure.material import Material
 from rigidfold.structure.model import ShellMesh, shell_mesh
 from rigidfold.structure.stability import Stability
-from rigidfold.structure.supports import Rigidity
+from rigidfold.structure.supports import Rigidity, SupportGrowth
 
 
 class StructureStatus(Outcome):
@@ -64,7 +64,8 @@ class StructureCheck:
     supports' first-order rigidity; loads : the load terms; self_weight : whether included;
     hinge_stiffness : N m/rad per m; nonlinear : geometrically nonlinear analysis; limit :
     the deflection limit's divisor (span / limit); mesh and response : the shell model and
-    its response (None when the supports leave a mechanism); balance_tol : a static answer
+    its response (None when the supports leave a mechanism); growth : how ``--supports
+    service`` grew the supports for the deflection (None otherwise); balance_tol : a static answer
     whose reactions miss the loads by more than this share of them did not carry the load
     (a singular stiffness: supports that are prestress stable only, with free hinges).
     """
@@ -82,6 +83,7 @@ class StructureCheck:
     response: ShellResponse | None
     auto: bool = False
     balance_tol: float = DEFAULTS.structure.balance_tol
+    growth: SupportGrowth | None = None
 
     # ------------------------------------------------------------------ verdict
     @property
@@ -128,6 +130,12 @@ class StructureCheck:
             f"{self.max_displacement * 1e3:.3g} mm, limit L/{self.limit:g} = "
             f"{self.allowed_displacement * 1e3:.3g} mm on a span of {self.span:.3g} m{prestress}"
         )
+
+    @property
+    def chosen(self) -> str:
+        """How the supports came: ``"given"``, ``"auto"`` (the fewest pins that make the
+        design rigid) or ``"service"`` (those and more for the deflection)."""
+        return "service" if self.growth is not None else "auto" if self.auto else "given"
 
     # ------------------------------------------------------------------ figures
     @cached_property
@@ -196,7 +204,7 @@ class StructureCheck:
 
     def to_dict(self) -> dict:
         """What ``DIR/structure.json`` holds."""
-        out = {
+        out: dict = {
             "status": self.status.value,
             "message": self.message,
             "material": self.material.to_dict(),
@@ -205,10 +213,12 @@ class StructureCheck:
             "loads": [load.to_dict() for load in self.loads],
             "self_weight": self.self_weight,
             "analysis": "nonlinear" if self.nonlinear else "linear",
-            "supports": {**self.rigidity.to_dict(), "chosen": "auto" if self.auto else "given"},
+            "supports": {**self.rigidity.to_dict(), "chosen": self.chosen},
             "limit": f"L/{self.limit:g}",
             "span_m": self.span,
         }
+        if self.growth is not None:
+            out["supports"]["service"] = self.growth.to_dict()
         if self.response is None or self.mesh is None:
             return out
         r, mesh, coords = self.response, self.mesh, self.pattern.coords

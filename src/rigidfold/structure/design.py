@@ -1,6 +1,6 @@
 """The structure check of a design from its options as the user gives them, and its files.
 
-:func:`plan_design` reads the supports (``"auto"`` or ``"V,V,..."``), the loads
+:func:`plan_design` reads the supports (``"auto"``, ``"service"`` or ``"V,V,..."``), the loads
 (``--load`` texts) and the material (a preset or ``"E,nu,density"``), chooses or checks the
 supports (a :class:`DesignPlan`), whose ``check`` runs
 :func:`rigidfold.structure.check.check_structure` (:func:`check_design` does both);
@@ -11,8 +11,10 @@ both go through them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
+
+import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
@@ -30,6 +32,11 @@ from rigidfold.structure.supports import (
     support_candidates,
 )
 
+CHOSEN_SUPPORTS = ("auto", "service")
+"""The words ``--supports`` takes besides a list of vertices: ``auto``, the fewest pins that
+make the design first-order rigid; ``service``, those and more pins until the deflection
+limit is met (:mod:`rigidfold.structure.service`)."""
+
 STRUCTURE_FILES = ("structure.json", "structure.png")
 """The files :func:`write_structure` writes into its directory."""
 
@@ -45,19 +52,19 @@ def design_supports(
 ) -> tuple[Rigidity, bool]:
     """(the supports' first-order rigidity, whether they were chosen): ``supports``
     ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
-    ``"V,V,..."``) or ``"V,V,..."`` pinned vertices, with ``clamped`` vertices and
-    ``actuators`` (free creases held). ValueError (one line) for an index the design
-    lacks."""
+    ``"V,V,..."``; ``"service"`` starts from the same set) or ``"V,V,..."`` pinned
+    vertices, with ``clamped`` vertices and ``actuators`` (free creases held). ValueError
+    (one line) for an index the design lacks."""
     V = pattern.n_vertices
     clamp = parse_indices(clamped, V, "clamped vertices")
     held = parse_indices(actuators, pattern.n_edges, "actuators")
-    if supports.strip().lower() == "auto":
+    if supports.strip().lower() in CHOSEN_SUPPORTS:
         pool = support_candidates(pattern, candidates, settings)
         rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
         return rigidity, True
     pins = parse_indices(supports, V, "supports")
     if not len(pins) and not len(clamp):
-        raise RigidfoldError("give --supports V,V,... or auto, or --clamped vertices")
+        raise RigidfoldError("give --supports V,V,..., auto or service, or --clamped vertices")
     return check_supports(pattern, Supports(pins, clamp, held), settings), False
 
 
@@ -78,20 +85,41 @@ class DesignPlan:
     limit: float
     modes: int
     settings: Settings
+    service: np.ndarray | None = None
+    """(c,) int64 the candidates ``--supports service`` may pin, None for other supports."""
 
     def check(self) -> StructureCheck:
-        """The analysis and its verdict (:func:`rigidfold.structure.check.check_structure`)."""
-        return check_structure(
+        """The analysis and its verdict (:func:`rigidfold.structure.check.check_structure`);
+        with ``service``, after the supports have been grown for the deflection
+        (:func:`rigidfold.structure.service.grow_supports`)."""
+        if self.service is None:
+            return self._check(self.rigidity)
+        from rigidfold.structure.service import grow_supports
+
+        found, growth = grow_supports(
             self.pattern,
             self.rigidity,
+            self.service,
+            lambda rigidity: self._check(rigidity, nonlinear=False, modes=0),
+            self.settings,
+        )
+        final = found if not self.nonlinear and not self.modes else self._check(found.rigidity)
+        return replace(final, growth=growth)
+
+    def _check(
+        self, rigidity: Rigidity, *, nonlinear: bool | None = None, modes: int | None = None
+    ) -> StructureCheck:
+        return check_structure(
+            self.pattern,
+            rigidity,
             material=self.material,
             thickness=self.thickness,
             loads=self.loads,
             self_weight=self.self_weight,
             hinge_stiffness=self.hinge_stiffness,
-            nonlinear=self.nonlinear,
+            nonlinear=self.nonlinear if nonlinear is None else nonlinear,
             limit=self.limit,
-            modes=self.modes,
+            modes=self.modes if modes is None else modes,
             auto=self.auto,
             settings=self.settings,
         )
@@ -156,6 +184,9 @@ def plan_design(
         divisor,
         modes,
         settings,
+        support_candidates(pattern, candidates, settings)
+        if supports.strip().lower() == "service"
+        else None,
     )
 
 

@@ -420,3 +420,42 @@ def _greedy(G0: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
         chosen.remove(drop)
         current = current - G[drop]
     return np.array(sorted(chosen), dtype=np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class SupportGrowth:
+    """How ``--supports service`` grew the supports (:mod:`rigidfold.structure.service`).
+
+    rigid : (k,) int64 the pins ``auto`` chose for first-order rigidity; added : (a,) int64
+    the pins kept beside them for the deflection, in the order they were added; trail : one
+    ``(step, vertex, pins, largest displacement m, allowed displacement m)`` per analysis of
+    the search, in order: step ``"rigid"`` (auto's set; vertex -1), ``"add"`` (vertex
+    pinned), then ``"drop"`` (vertex taken away again: the rest meet the limit) or
+    ``"keep"`` (without it they do not); candidates : how many vertices it could pin;
+    passed : whether the last set met the deflection limit (in the search's linear
+    analysis).
+    """
+
+    rigid: np.ndarray
+    added: np.ndarray
+    trail: tuple[tuple[str, int, int, float, float], ...]
+    candidates: int
+    passed: bool
+
+    def to_dict(self) -> dict:
+        return {
+            "rigid": self.rigid.tolist(),
+            "added_for_deflection": self.added.tolist(),
+            "candidates": self.candidates,
+            "passed": self.passed,
+            "analyses": [
+                {
+                    "step": step,
+                    "vertex": v,
+                    "pins": n,
+                    "max_displacement_m": d,
+                    "allowed_displacement_m": a,
+                }
+                for step, v, n, d, a in self.trail
+            ],
+        }
