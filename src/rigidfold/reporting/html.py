@@ -293,6 +293,15 @@ def _structure(run: RunData) -> list[str]:
         "loads": ["self-weight"] * bool(f.get("self_weight"))
         + [_fmt(load) for load in f.get("loads") or []],
         "supports (pinned vertices)": f"{supports.get('pinned')} ({supports.get('chosen')})",
+        **(
+            {
+                "of which for the deflection": (supports.get("service") or {}).get(
+                    "added_for_deflection"
+                )
+            }
+            if isinstance(supports.get("service"), dict)
+            else {}
+        ),
         "first-order rigid on them": supports.get("first_order_rigid"),
         "mechanism left": supports.get("mode"),
         "total load (N)": f.get("total_load_N"),

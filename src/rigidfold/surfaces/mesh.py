@@ -113,7 +113,7 @@ def _grid_problem(gx: Any, gy: Any, z: Any) -> tuple[np.ndarray, np.ndarray, np.
     thing wrong (not numbers, sizes, order, non-finite)."""
     try:
         gx, gy, z = (np.asarray(a, dtype=float) for a in (gx, gy, z))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer like 10**400
         raise RigidfoldError("the grid of a mesh fit must hold numbers only") from None
     for axis, g in (("x", gx), ("y", gy)):
         if g.ndim != 1 or not 4 <= len(g) <= MAX_GRID_NODES:
