@@ -27,7 +27,13 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.io import read_fold
-from rigidfold.structure import Supports, auto_supports, check_supports, support_candidates
+from rigidfold.structure import (
+    StructureOptions,
+    Supports,
+    auto_supports,
+    check_supports,
+    support_candidates,
+)
 from rigidfold.workflows import structure
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
@@ -59,10 +65,12 @@ def main() -> None:
                 lambda k=k, nonlinear=nonlinear: structure(
                     DESIGN,
                     Path(tmp) / "out",
-                    loads=("uniform=0.5",),
-                    hinge_stiffness=k,
-                    nonlinear=nonlinear,
-                    modes=0 if nonlinear else 3,
+                    StructureOptions(
+                        loads=("uniform=0.5",),
+                        hinge_stiffness=k,
+                        nonlinear=nonlinear,
+                        modes=0 if nonlinear else 3,
+                    ),
                     overwrite=True,
                 ),
             )

@@ -163,7 +163,7 @@ class GenerateOptions:
             if thickness is None:
                 fab = None
             elif fab is None:
-                fab = FabricateOptions(thickness)  # type: ignore[arg-type]
+                fab = FabricateOptions(thickness)
             else:
                 fab = replace(fab, thickness=thickness)
         if side is not _UNSET:
