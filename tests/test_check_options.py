@@ -239,6 +239,7 @@ def test_support_candidates_and_actuators_reach_the_structure(built, tmp_path):
     [
         ["--clamped", "9999"],
         ["--actuators", "9999"],
+        ["--actuators", "0"],  # a boundary edge: never a free crease
         ["--support-candidates", "0,9999"],
         ["--support-candidates", "lowest"],
         ["--modes", "-1"],

@@ -19,13 +19,20 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication, FabricationStatus, Panels
 from rigidfold.fabricate.motion import design_motion
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
-from rigidfold.structure import StructureCheck, check_design, parse_material, write_structure
+from rigidfold.structure import (
+    StructureCheck,
+    check_design,
+    parse_indices,
+    parse_material,
+    write_structure,
+)
 
 THICK_DIR = Path("final") / "thick"
 """Where the thick panels' files go in the run's directory."""
@@ -37,9 +44,16 @@ STRUCTURE_DIR = Path("final") / "structure"
 def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> None:
     """ValueError (one line) for supports, support candidates, clamped vertices, actuators
     or point loads that ``pattern`` (the run's crease pattern: every solution has its
-    vertices and edges) lacks, before the run starts."""
-    if options.structure is not None:
-        options.structure.check_indices(pattern.n_vertices, pattern.n_edges)
+    vertices and edges) lacks, and for an actuator that is not one of its free creases (a
+    run only fixes more), before the run starts."""
+    st = options.structure
+    if st is None:
+        return
+    st.check_indices(pattern.n_vertices, pattern.n_edges)
+    free = set(pattern.free_creases.tolist())
+    fixed = [e for e in parse_indices(st.actuators, pattern.n_edges, "actuators") if e not in free]
+    if fixed:
+        raise RigidfoldError(f"actuator {fixed[0]} is not a free crease of the crease pattern")
 
 
 def thick_panels(
