@@ -68,6 +68,7 @@ def test_fabricate_options_refuse_bad_values_in_one_line(changes):
         {"thickness": "18mm"},
         {"material": "cheese"},
         {"supports": "a,b"},
+        {"supports": ""},  # no support and nothing clamped
         {"candidates": "lowest"},
         {"clamped": "0;1"},
         {"actuators": "x"},
@@ -92,6 +93,7 @@ def test_options_keep_what_the_user_gave():
     assert fab.thickness == pytest.approx(0.018) and fab.sheet == (3050.0, 1525.0)
     assert fab.min_thickness == pytest.approx(0.005)
     assert FabricateOptions.from_dict(json.loads(json.dumps(fab.to_dict()))) == fab
+    assert StructureOptions(supports="", clamped="0,6").clamped == "0,6"
     st = StructureOptions(supports="0, 4,9", loads=["uniform=0.5"], limit="L/300")
     assert st.loads == ("uniform=0.5",) and st.limit == 300.0 and st.supports == "0, 4,9"
     assert StructureOptions.from_dict(json.loads(json.dumps(st.to_dict()))) == st

@@ -180,15 +180,16 @@ class StructureOptions:
             raise RigidfoldError(
                 f"supports must be auto or comma-separated vertex indices, got {supports!r}"
             )
-        if supports.strip().lower() != "auto":
-            index_list(supports, "supports")
+        clamped = index_list(self.clamped, "clamped vertices")
+        if supports.strip().lower() != "auto" and not index_list(supports, "supports"):
+            if not clamped:
+                raise RigidfoldError("give --supports V,V,... or auto, or --clamped vertices")
         candidates = self.candidates
         if candidates is not None and (
             not isinstance(candidates, str)
             or candidates.strip().lower() not in ("boundary", "ground")
         ):
             index_list(candidates, "support candidates")
-        index_list(self.clamped, "clamped vertices")
         index_list(self.actuators, "actuators")
         for name in ("self_weight", "nonlinear"):
             if not isinstance(getattr(self, name), bool):
