@@ -31,7 +31,13 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.io import read_fold
-from rigidfold.structure import Supports, auto_supports, check_supports, support_candidates
+from rigidfold.structure import (
+    StructureOptions,
+    Supports,
+    auto_supports,
+    check_supports,
+    support_candidates,
+)
 from rigidfold.workflows import structure
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
@@ -63,10 +69,12 @@ def main() -> None:
                 lambda k=k, nonlinear=nonlinear: structure(
                     DESIGN,
                     Path(tmp) / "out",
-                    loads=("uniform=0.5",),
-                    hinge_stiffness=k,
-                    nonlinear=nonlinear,
-                    modes=0 if nonlinear else 3,
+                    StructureOptions(
+                        loads=("uniform=0.5",),
+                        hinge_stiffness=k,
+                        nonlinear=nonlinear,
+                        modes=0 if nonlinear else 3,
+                    ),
                     overwrite=True,
                 ),
             )

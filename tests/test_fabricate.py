@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import main_code
+from rigidfold.fabricate import FabricateOptions
 
 DESIGN_ARGS = [
     "generate",
@@ -53,7 +54,9 @@ def built(design, tmp_path_factory):
         )
         summary = json.loads((out / f"{design.stem}_fabricate.json").read_text())
         runs[t] = (code, out, summary)
-    runs["result"] = fabricate_file(design, tmp_path_factory.mktemp("lib"), thickness=0.02)
+    runs["result"] = fabricate_file(
+        design, tmp_path_factory.mktemp("lib"), FabricateOptions(thickness=0.02)
+    )
     return runs
 
 
@@ -143,7 +146,7 @@ def test_collision_reported_with_panels_and_fraction(design, tmp_path, capsys):
     settings = DEFAULTS.with_(
         fabricate_vertex_relief=0.0, fabricate_relief_rounds=0, fabricate_thickness_tries=2
     )
-    done = fabricate_file(design, tmp_path, thickness=0.05, settings=settings)
+    done = fabricate_file(design, tmp_path, FabricateOptions(thickness=0.05), settings=settings)
     fab = done.fabrication
     assert fab.status is FabricationStatus.COLLISION
     meeting = fab.clearance.meetings[0]

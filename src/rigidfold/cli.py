@@ -20,7 +20,14 @@ import unicodedata
 from collections.abc import Sequence
 
 from rigidfold import __version__
-from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, SIDES, check_seed
+from rigidfold.cli_checks import (
+    fabricate_arguments,
+    fabricate_options,
+    positive,
+    structure_arguments,
+    structure_options,
+)
+from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.generate import GenerateOptions
@@ -30,7 +37,7 @@ from rigidfold.optimize import SOLVERS
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.selection import CRITERIA
-from rigidfold.structure import MATERIALS, presets_help
+from rigidfold.structure import MATERIALS
 from rigidfold.study import STUDY_DEFAULTS
 from rigidfold.surfaces import SURFACE_FORMS
 
@@ -118,13 +125,6 @@ def one_line(text: str) -> str:
 def _error(message: str) -> None:
     """Print ``rigidfold: error: <message>`` on stderr, on one line (:func:`one_line`)."""
     print(f"rigidfold: error: {one_line(message)}", file=sys.stderr)
-
-
-def _positive(text: str) -> float:
-    value = float(text)
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
-    return value
 
 
 def _fraction(text: str) -> float:
@@ -239,63 +239,8 @@ def build_parser() -> argparse.ArgumentParser:
         "final design only, or all (default: %(default)s; the development diagram is drawn "
         "for every solution)",
     )
-    gen.add_argument(
-        "--thickness",
-        type=_length("thickness"),
-        default=GENERATE_DEFAULTS.thickness,
-        metavar="T",
-        help="make the final design's thick panels of this thickness (metres, or 18mm, "
-        "1.8cm) as rigidfold fabricate does, from the motion the run traced: DIR/final/thick/; "
-        "the run falls short when they collide over the deployment or are trimmed away. Also "
-        "the panels' thickness of --structure (default: no thick panels; --structure alone: "
-        f"{DEFAULTS.structure.thickness:g})",
-    )
-    gen.add_argument(
-        "--side",
-        default=GENERATE_DEFAULTS.side,
-        choices=SIDES,
-        help="the side of the design surface the thick panels lie on (default: %(default)s)",
-    )
-    gen.add_argument(
-        "--structure",
-        action="store_true",
-        help="check the final design as a structure as rigidfold structure does (supports, "
-        "self-weight and --load in OpenSees, the deflection limit): DIR/final/structure/; the "
-        "run falls short when the check fails",
-    )
-    gen.add_argument(
-        "--material",
-        default=GENERATE_DEFAULTS.material,
-        metavar="NAME|E,nu,density",
-        help=f"the panels' material: a preset ({', '.join(MATERIALS)}) or E,nu,density in SI "
-        "units; Step 9's frame is then of strips of these panels (of --thickness, or "
-        f"{DEFAULTS.structure.thickness * 1e3:g} mm), and --structure and the thick panels' "
-        f"masses use it (default: the paper's steel tubes for Step 9, "
-        f"{DEFAULTS.structure.material} for the others)",
-    )
-    gen.add_argument(
-        "--supports",
-        default=GENERATE_DEFAULTS.supports,
-        metavar="V,V,...|auto|service",
-        help="--structure: pinned vertices; auto: the fewest boundary vertices that make "
-        "the mechanism first-order rigid; service: those, and more where the design deflects "
-        "most until the deflection limit is met (default: %(default)s)",
-    )
-    gen.add_argument(
-        "--load",
-        action="append",
-        default=None,
-        metavar="KIND=VALUE",
-        help="--structure: a load besides self-weight, repeatable: uniform=KPA (snow), "
-        "pressure=KPA (wind), point=V:FX,FY,FZ (newtons)",
-    )
-    gen.add_argument(
-        "--limit",
-        default=f"L/{GENERATE_DEFAULTS.limit:g}",
-        metavar="L/N",
-        help="--structure: the largest displacement may be at most the span over N (default: "
-        "%(default)s)",
-    )
+    fabricate_arguments(gen, generate=True)
+    structure_arguments(gen, generate=True)
     gen.add_argument(
         "--quiet", action="store_true", help="no progress bar (the result lines are printed)"
     )
@@ -425,96 +370,7 @@ def build_parser() -> argparse.ArgumentParser:
         "displacement is within the limit, 1 when they leave a mechanism (named), the "
         "analysis does not converge or the limit is exceeded, 2 on bad input.",
     )
-    stc.add_argument(
-        "--thickness",
-        type=_positive,
-        default=DEFAULTS.structure.thickness,
-        metavar="T",
-        help="panel thickness in metres (default: %(default)g)",
-    )
-    stc.add_argument(
-        "--material",
-        default=DEFAULTS.structure.material,
-        metavar="NAME|E,nu,density",
-        help=f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units "
-        "(Pa, -, kg/m^3), e.g. 10e9,0.3,700 (default: %(default)s)",
-    )
-    stc.add_argument(
-        "--supports",
-        default="auto",
-        metavar="V,V,...|auto|service",
-        help="pinned vertices (indices of the FOLD file's vertices_coords); auto: the "
-        "fewest --support-candidates that make the mechanism first-order rigid, of the "
-        "largest smallest stiffness eigenvalue; service: those, then one more at a time where "
-        "the design deflects most until the deflection limit is met (a linear analysis "
-        "each; added pins that are not needed are taken away again). A boundary edge whose "
-        "ends are both supported is supported along its length (default: %(default)s)",
-    )
-    stc.add_argument(
-        "--support-candidates",
-        default=None,
-        metavar="boundary|ground|V,V,...",
-        help="the vertices auto may choose: every boundary vertex, the boundary vertices at "
-        f"the lowest height (within {DEFAULTS.structure.ground_tol:g} m), or a list "
-        "(default: boundary)",
-    )
-    stc.add_argument(
-        "--clamped",
-        default="",
-        metavar="V,V,...",
-        help="clamped vertices: translations and the rotations of the panels there held "
-        "(default: none)",
-    )
-    stc.add_argument(
-        "--actuators",
-        default="",
-        metavar="I,J,...",
-        help="free creases (indices into the FOLD file's edges_vertices) held at their angle "
-        "by actuators: supports of a hinge (default: none)",
-    )
-    stc.add_argument(
-        "--hinge-stiffness",
-        type=float,
-        default=DEFAULTS.structure.hinge_stiffness,
-        metavar="K",
-        help="rotational stiffness of every free crease, N m/rad per metre of crease "
-        "(default: %(default)s, a free hinge)",
-    )
-    stc.add_argument(
-        "--load",
-        action="append",
-        default=None,
-        metavar="KIND=VALUE",
-        help="a load, repeatable: uniform=KPA (kN/m^2 of plan, downwards: snow), "
-        "pressure=KPA (kN/m^2 normal to the panels, positive pressing on the upper face: "
-        "wind), point=V:FX,FY,FZ (newtons at vertex V)",
-    )
-    stc.add_argument(
-        "--no-self-weight",
-        action="store_true",
-        help="leave out the panels' weight (density x g x thickness)",
-    )
-    stc.add_argument(
-        "--limit",
-        default=f"L/{DEFAULTS.structure.limit:g}",
-        metavar="L/N",
-        help="serviceability: the largest displacement may be at most the span over N; the "
-        "span is the largest plan distance between supports (twice the reach of a "
-        "cantilever) (default: %(default)s)",
-    )
-    stc.add_argument(
-        "--nonlinear",
-        action="store_true",
-        help="geometrically nonlinear analysis (corotational shells, "
-        f"{DEFAULTS.structure.steps} load steps) instead of a linear one",
-    )
-    stc.add_argument(
-        "--modes",
-        type=int,
-        default=DEFAULTS.structure.modes,
-        metavar="N",
-        help="natural frequencies to compute, 0 for none (default: %(default)s)",
-    )
+    structure_arguments(stc, generate=False)
     stc.add_argument(
         "--overwrite",
         action="store_true",
@@ -543,52 +399,7 @@ def build_parser() -> argparse.ArgumentParser:
         "last line names the panels, the fraction folded where they meet and a thickness that "
         "would pass), 2 on bad input.",
     )
-    fab.add_argument(
-        "--thickness",
-        required=True,
-        type=_length("thickness"),
-        metavar="T",
-        help="panel thickness in metres, or with a unit: 18mm, 1.8cm",
-    )
-    fab.add_argument(
-        "--side",
-        default=DEFAULTS.fabricate.side,
-        choices=SIDES,
-        help="the side of the design surface the solids lie on: bottom (below it, the surface "
-        "is their outer face) or top (default: %(default)s)",
-    )
-    fab.add_argument(
-        "--clearance-angle",
-        type=float,
-        default=round(math.degrees(DEFAULTS.fabricate.clearance_angle), 9),
-        metavar="DEG",
-        help="bevels leave this angle, degrees, to spare beyond each hinge's largest fold "
-        "(default: %(default)s)",
-    )
-    fab.add_argument(
-        "--density",
-        type=_positive,
-        default=DEFAULTS.fabricate.density,
-        metavar="KG/M3",
-        help="density of the panel material for the masses, plywood by default (default: "
-        "%(default)s)",
-    )
-    fab.add_argument(
-        "--sheet",
-        type=_sheet,
-        default=f"{DEFAULTS.fabricate.sheet_width:g}x{DEFAULTS.fabricate.sheet_height:g}",
-        metavar="WxH",
-        help="stock sheet size in millimetres that the cut sheets are nested onto (default: "
-        "%(default)s)",
-    )
-    fab.add_argument(
-        "--min-thickness",
-        type=_length("min-thickness"),
-        default=None,
-        metavar="T",
-        help="a panel whose solid is nowhere this deep once bevelled fails (default: "
-        f"{DEFAULTS.fabricate.min_depth:g} x the thickness)",
-    )
+    fabricate_arguments(fab, generate=False)
     fab.add_argument(
         "--overwrite",
         action="store_true",
@@ -789,7 +600,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     )
     p.add_argument(
         "--scale",
-        type=_positive,
+        type=positive,
         metavar="M_PER_UNIT",
         help="metres per unit of a FOLD or SVG file drawn without units (instead of --size)",
     )
@@ -813,7 +624,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     )
     p.add_argument(
         "--edge-length",
-        type=_positive,
+        type=positive,
         metavar="L",
         help="target edge length in metres of a mesh: pattern (default: sqrt(footprint area) "
         f"/ {DEFAULTS.inputs.mesh_divisions:g})",
@@ -855,7 +666,7 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
         )
     p.add_argument(
         "--rho-max",
-        type=_positive,
+        type=positive,
         metavar="DEG",
         help="bound (12) on the fold angle of every free crease, |rho| <= this, degrees "
         "(default: no bound)",
@@ -926,6 +737,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
     if args.target_dof < 0:
         raise RigidfoldError(f"--target-dof must be >= 0, got {args.target_dof}")
+    structure = structure_options(args)  # checked even without --structure
     options = GenerateOptions(
         criterion=args.criterion,
         target_dof=args.target_dof,
@@ -935,13 +747,9 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         deploy_check=not args.no_deploy_check,
         deform=not args.no_deform,
         check=args.check,
-        thickness=args.thickness,
-        side=args.side,
-        structure=args.structure,
         material=args.material,
-        supports=args.supports,
-        loads=tuple(args.load or ()),
-        limit=args.limit,
+        fabricate=fabricate_options(args),
+        structure=structure if args.structure else None,
     )
     writer = RunWriter(args.out, _case(args), options, overwrite=args.overwrite)
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
@@ -1112,22 +920,7 @@ def _cmd_structure(args: argparse.Namespace) -> int:
     from rigidfold.workflows import structure
 
     run = structure(
-        args.file,
-        args.out,
-        thickness=args.thickness,
-        material=args.material,
-        supports=args.supports,
-        candidates=args.support_candidates,
-        clamped=args.clamped,
-        actuators=args.actuators,
-        hinge_stiffness=args.hinge_stiffness,
-        loads=tuple(args.load or ()),
-        self_weight=not args.no_self_weight,
-        limit=args.limit,
-        nonlinear=args.nonlinear,
-        modes=args.modes,
-        up=args.up,
-        overwrite=args.overwrite,
+        args.file, args.out, structure_options(args), up=args.up, overwrite=args.overwrite
     )
     code = 0 if run.status is StructureStatus.PASSED else EXIT_FAILED
     if args.json:
@@ -1170,18 +963,9 @@ def _cmd_structure(args: argparse.Namespace) -> int:
 def _cmd_fabricate(args: argparse.Namespace) -> int:
     from rigidfold.workflows import fabricate_file
 
-    done = fabricate_file(
-        args.file,
-        args.out,
-        thickness=args.thickness,
-        side=args.side,
-        clearance_angle_deg=args.clearance_angle,
-        density=args.density,
-        sheet=args.sheet,
-        min_thickness=args.min_thickness,
-        up=args.up,
-        overwrite=args.overwrite,
-    )
+    options = fabricate_options(args)
+    assert options is not None  # --thickness is required
+    done = fabricate_file(args.file, args.out, options, up=args.up, overwrite=args.overwrite)
     fab = done.fabrication
     if args.json:
         print(json.dumps(jsonable(done.to_dict())))
@@ -1195,27 +979,6 @@ def _cmd_fabricate(args: argparse.Namespace) -> int:
         print(f"wrote {len(done.written)} files to {args.out}")
         print(one_line(fab.last_line()))
     return 0 if done.ok else 1
-
-
-def _length(what: str):
-    def parse(text: str) -> float:
-        from rigidfold.fabricate.build import parse_length
-
-        try:
-            return parse_length(text, what)
-        except ValueError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-
-    return parse
-
-
-def _sheet(text: str) -> tuple[float, float]:
-    from rigidfold.fabricate.build import parse_sheet
-
-    try:
-        return parse_sheet(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _cmd_study(args: argparse.Namespace) -> int:

@@ -36,28 +36,22 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from rigidfold.case import Case
 from rigidfold.config import (
-    CHECKS,
-    DEFAULT_SEED,
-    DEFAULTS,
-    SIDES,
     Settings,
-    check_seed,
     one_blas_thread,
 )
-from rigidfold.errors import RigidfoldError
+from rigidfold.generate_options import GenerateOptions
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.numerics import numeric_environment
-from rigidfold.optimize import SOLVERS, OptimizeResult, Status
+from rigidfold.optimize import OptimizeResult, Status
 from rigidfold.selection import (
-    CRITERIA,
     Choice,
     crease_groups,
     lock_forecast,
@@ -66,8 +60,6 @@ from rigidfold.selection import (
     score_creases,
 )
 from rigidfold.status import Outcome
-from rigidfold.structure import parse_limit, parse_load, parse_material
-from rigidfold.structure.design import CHOSEN_SUPPORTS
 
 
 class AttemptOutcome(Outcome):
@@ -278,145 +270,6 @@ class Generation:
                 "path": sum(a.path_time for a in self.attempts),
             },
         }
-
-
-@dataclass(frozen=True)
-class GenerateOptions:
-    """How one generation run goes, in one place: Steps 2-7 (:func:`generate`) and the
-    checks that follow them (Steps 8-9, run by :class:`rigidfold.run.RunWriter`).
-
-    criterion : one of ``CRITERIA`` (default: the first, S-hat).
-    target_dof : int >= 0, the DOF at which generation ends (default 1: stabilised by one
-        support or actuator).
-    seed : the stream of the random criterion and of the hinge stiffnesses of S^F-hat.
-    solver : one of ``SOLVERS`` (default: the first, IPOPT).
-    lookahead : skip the candidates predicted to lock (see the module's text); the
-        forecast's cost is part of the selection time.
-    deploy_check : polish every accepted solution to F = 0
-        (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
-        rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
-        on solutions of at most ``Settings.generation.deploy_check_max_dof`` DOF, 0: all); one
-        that does not counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape
-        (which cannot deploy) is retried like a lock where the target is >= 1. False is the paper's
-        method.
-    support_face : the triangle whose frame node carries the s = 6 supports (default: the
-        one nearest the centroid); it sets the metric of the mechanism modes and so the
-        S^F-hat scores.
-    deform : run Step 9 (the large-deformation check) on the checked solutions.
-    check : one of ``CHECKS``: the folding motion and Step 9 on the final design only
-        ("final") or on every solution ("all").
-    thickness : metres, or None (the default): thick panels of this thickness on ``side``
-        (one of ``SIDES``) are made of the final design and checked over its folding motion
-        (:func:`rigidfold.fabricate.fabricate_panels`); with ``structure``, also the panels'
-        thickness (None: ``Settings.structure.thickness``).
-    structure : check the final design as a structure (:mod:`rigidfold.structure`): on
-        ``supports`` (``"auto"`` or ``"V,V,..."`` pinned vertices) under self-weight and
-        ``loads`` (``--load`` texts), its largest displacement within span / ``limit``.
-    material : the panels' material (a preset name or ``"E,nu,density"``), for the
-        structure, the masses of the thick panels and Step 9's frame (strips of the panels,
-        :func:`rigidfold.deform.analysis.panel_section`, of ``thickness`` or
-        ``Settings.structure.thickness``); None (the default): Step 9 with the paper's steel
-        tubes, and ``Settings.structure.material`` for the structure and the masses
-        (:attr:`panel_material`).
-
-    Studies do not store the options of the thick panels and the structure
-    (:meth:`rigidfold.study.StudyConfig.as_dict`): they run neither.
-    """
-
-    criterion: str = CRITERIA[0]
-    target_dof: int = 1
-    seed: int = DEFAULT_SEED
-    solver: str = SOLVERS[0]
-    lookahead: bool = False
-    deploy_check: bool = True
-    support_face: int | None = None
-    deform: bool = True
-    check: str = CHECKS[0]
-    thickness: float | None = None
-    side: str = DEFAULTS.fabricate.side
-    structure: bool = False
-    material: str | None = None
-    supports: str = "auto"
-    loads: tuple[str, ...] = ()
-    limit: float = DEFAULTS.structure.limit
-
-    def __post_init__(self) -> None:
-        if self.criterion not in CRITERIA:
-            raise RigidfoldError(
-                f"unknown criterion {self.criterion!r} (choose from {', '.join(CRITERIA)})"
-            )
-        if self.solver not in SOLVERS:
-            raise RigidfoldError(
-                f"unknown solver {self.solver!r} (choose from {', '.join(SOLVERS)})"
-            )
-        if self.check not in CHECKS:
-            raise RigidfoldError(f"unknown check {self.check!r} (choose from {', '.join(CHECKS)})")
-        target = self.target_dof
-        if isinstance(target, bool) or not isinstance(target, int | np.integer) or target < 0:
-            raise RigidfoldError(f"target DOF must be an integer >= 0, got {target!r}")
-        face = self.support_face
-        if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
-            raise RigidfoldError(f"support face must be a face index, got {face!r}")
-        check_seed(self.seed)
-        self._check_panels()
-
-    def _check_panels(self) -> None:
-        """Validate the options of the thick panels and the structure (ValueError naming
-        what was received); ``loads`` and ``limit`` kept as a tuple and a float."""
-        t = self.thickness
-        if t is not None and (
-            isinstance(t, bool)
-            or not isinstance(t, int | float | np.number)
-            or not (np.isfinite(t) and t > 0)
-        ):
-            raise RigidfoldError(f"thickness must be a positive number of metres, got {t!r}")
-        if t is not None:
-            object.__setattr__(self, "thickness", float(t))
-        if self.side not in SIDES:
-            raise RigidfoldError(f"side must be one of {', '.join(SIDES)}, got {self.side!r}")
-        if not isinstance(self.structure, bool):
-            raise RigidfoldError(f"structure must be true or false, got {self.structure!r}")
-        if self.material is not None:
-            parse_material(self.material)
-        supports = self.supports
-        if not isinstance(supports, str) or not (
-            supports.strip().lower() in CHOSEN_SUPPORTS
-            or all(p.strip().isdigit() for p in supports.split(","))
-        ):
-            raise RigidfoldError(
-                f"supports must be {' or '.join(CHOSEN_SUPPORTS)} or comma-separated vertex "
-                f"indices, got {supports!r}"
-            )
-        if isinstance(self.loads, str):
-            raise RigidfoldError(f"loads must be a list of load texts, got {self.loads!r}")
-        object.__setattr__(self, "loads", tuple(self.loads))
-        for text in self.loads:
-            parse_load(text)
-        object.__setattr__(self, "limit", parse_limit(self.limit))
-
-    @property
-    def panel_material(self) -> str:
-        """The material of the structure check and of the thick panels' masses."""
-        return DEFAULTS.structure.material if self.material is None else self.material
-
-    def replace(self, **changes) -> GenerateOptions:
-        """These options with ``changes`` (field names), validated; unknown names are a
-        ValueError naming them."""
-        unknown = sorted(set(changes) - {f.name for f in fields(self)})
-        if unknown:
-            raise RigidfoldError(f"unknown generate option {', '.join(map(repr, unknown))}")
-        return replace(self, **changes) if changes else self
-
-    def to_dict(self) -> dict:
-        """The options as JSON values (summary.json's ``options``)."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    @classmethod
-    def from_dict(cls, data: dict) -> GenerateOptions:
-        """The options of :meth:`to_dict`; keys of other versions (``symmetric``, kept in
-        the case) are ignored, missing ones take their defaults."""
-        names = {f.name for f in fields(cls)}
-        return cls(**{k: v for k, v in data.items() if k in names})
 
 
 @dataclass

@@ -44,7 +44,7 @@ from rigidfold.exports import (
     parse_formats,
     read_design,
 )
-from rigidfold.fabricate import Fabrication, Panels, design_motion, fabricate_panels
+from rigidfold.fabricate import FabricateOptions, Fabrication, Panels, design_motion
 from rigidfold.generate import Attempt, Generation, generate
 from rigidfold.io import (
     FoldData,
@@ -67,7 +67,7 @@ from rigidfold.structure import (
 )
 from rigidfold.structure.design import (
     STRUCTURE_FILES,
-    check_options,
+    StructureOptions,
     plan_design,
     write_structure,
 )
@@ -509,52 +509,21 @@ class StructureRun:
 def structure(
     path: str | os.PathLike,
     out: str | os.PathLike,
+    options: StructureOptions = StructureOptions(),  # noqa: B008 (frozen)
     *,
-    thickness: float = DEFAULTS.structure.thickness,
-    material: str | Material = DEFAULTS.structure.material,
-    supports: str = "auto",
-    candidates: str | None = None,
-    clamped: str = "",
-    actuators: str = "",
-    hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness,
-    loads: tuple[str, ...] = (),
-    self_weight: bool = True,
-    limit: str | float = DEFAULTS.structure.limit,
-    nonlinear: bool = False,
-    modes: int = DEFAULTS.structure.modes,
     up: str = "z",
     overwrite: bool = False,
     settings: Settings = DEFAULTS,
 ) -> StructureRun:
-    """Supports, loads and serviceability of the design in a FOLD file (read with ``up``):
-    ``OUT/structure.json`` and ``OUT/structure.png`` (:mod:`rigidfold.structure`).
-
-    supports : ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
-    ``"V,V,..."``), ``"service"`` (those, and more until the deflection limit is met:
-    :mod:`rigidfold.structure.service`) or ``"V,V,..."`` pinned vertices; clamped :
-    ``"V,V,..."`` clamped vertices; actuators : ``"I,J,..."`` free creases held at their
-    angle; loads : ``--load`` texts (:func:`rigidfold.structure.parse_load`); limit :
-    ``"L/250"``. Every input is checked before anything is written (ValueError, one line).
+    """Supports, loads and serviceability of the design in a FOLD file (read with ``up``)
+    as ``options`` ask (:class:`rigidfold.structure.StructureOptions`, checked when made):
+    ``OUT/structure.json`` and ``OUT/structure.png`` (:mod:`rigidfold.structure`). The
+    indices and point loads are checked against the design before anything is written
+    (ValueError, one line).
     """
-    check_options(material=material, loads=loads, limit=limit, modes=modes)
     refuse_replacing_inputs([path], [Path(out) / name for name in STRUCTURE_FILES])
     data = read_fold(path, up=up, settings=settings)
-    plan = plan_design(
-        data.pattern,
-        supports=supports,
-        candidates=candidates,
-        clamped=clamped,
-        actuators=actuators,
-        thickness=thickness,
-        material=material,
-        hinge_stiffness=hinge_stiffness,
-        loads=loads,
-        self_weight=self_weight,
-        limit=limit,
-        nonlinear=nonlinear,
-        modes=modes,
-        settings=settings,
-    )
+    plan = plan_design(data.pattern, options, settings=settings)
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
     check = plan.check()
@@ -593,46 +562,26 @@ class FabricateOutput:
 def fabricate_file(
     path: str | os.PathLike,
     out: str | os.PathLike,
+    options: FabricateOptions,
     *,
-    thickness: float,
-    side: str | None = None,
-    clearance_angle_deg: float | None = None,
-    density: float | None = None,
-    sheet: tuple[float, float] | None = None,
-    min_thickness: float | None = None,
     up: str = "z",
     overwrite: bool = False,
     settings: Settings = DEFAULTS,
 ) -> FabricateOutput:
-    """Thick panels of the FOLD design ``path`` (``rigidfold fabricate``): solids of
-    ``thickness`` metres on ``side``, bevelled and relieved so that they deploy from flat to
-    the design without collision, checked over its folding motion
+    """Thick panels of the FOLD design ``path`` (``rigidfold fabricate``) as ``options``
+    ask (:class:`rigidfold.fabricate.FabricateOptions`, checked when made): solids of
+    ``options.thickness`` metres on ``options.side``, bevelled and relieved so that they
+    deploy from flat to the design without collision, checked over its folding motion
     (:func:`rigidfold.fabricate.fabricate_panels`), and their files in OUT: the solids
     (GLB, STL, OBJ, 3DM), the hinge and vertex schedules, the cut sheets nested onto
-    ``sheet`` (mm) stock, and ``NAME_fabricate.json``. Defaults from ``settings``. The
-    files are written whatever the verdict. Refused (ValueError, before anything is
-    written) when one of them would replace ``path``, and when OUT holds an earlier
-    fabricate's files of the same NAME (every cut sheet included), unless ``overwrite``
-    (then they are removed first, like ``generate --overwrite``:
-    :func:`rigidfold.run.clear_earlier_run`)."""
-    import math as _math
-
+    ``options.sheet`` (mm) stock, and ``NAME_fabricate.json``. The files are written
+    whatever the verdict. Refused (ValueError, before anything is written) when one of them
+    would replace ``path``, and when OUT holds an earlier fabricate's files of the same NAME
+    (every cut sheet included), unless ``overwrite`` (then they are removed first, like
+    ``generate --overwrite``: :func:`rigidfold.run.clear_earlier_run`)."""
     from rigidfold.fabricate.cutsheets import sheet_files
     from rigidfold.fabricate.files import FABRICATE_JSON, SOLID_FILES, write_fabrication
 
-    side = settings.fabricate.side if side is None else side
-    if side not in ("bottom", "top"):
-        raise RigidfoldError(f"side must be bottom or top, got {side!r}")
-    if not (isinstance(thickness, float | int) and _math.isfinite(thickness) and thickness > 0):
-        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
-    angle = settings.fabricate.clearance_angle
-    if clearance_angle_deg is not None:
-        if not (_math.isfinite(clearance_angle_deg) and 0 <= clearance_angle_deg < 90):
-            raise RigidfoldError(
-                f"clearance angle must be from 0 to below 90 degrees, got {clearance_angle_deg!r}"
-            )
-        angle = _math.radians(clearance_angle_deg)
-    width, height = sheet or (settings.fabricate.sheet_width, settings.fabricate.sheet_height)
     stem = Path(path).stem
     label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)] + sheet_files(out, stem)
@@ -640,27 +589,17 @@ def fabricate_file(
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=tuple(names))
     design = read_design(path, up=up, settings=settings)
-    panels = Panels(design.pattern, design.coords2d, side)
+    panels = Panels(design.pattern, design.coords2d, options.side)
     motion, message = design_motion(panels, design, up=up, settings=settings)
-    fab = fabricate_panels(
-        panels,
-        motion,
-        float(thickness),
-        clearance_angle=angle,
-        min_thickness=min_thickness,
-        density=density,
-        motion_message=message,
-        settings=settings,
-    )
-    title = f"{label}: thick panels {thickness * 1e3:g} mm, {side} side"
+    fab = options.fabricate(panels, motion, motion_message=message, settings=settings)
     written, summary = write_fabrication(
         fab,
         out_dir,
         stem,
         source=str(path),
-        title=title,
+        title=options.title(label),
         label=label,
-        sheet=(width, height),
+        sheet=options.sheet,
         gap=settings.fabricate.sheet_gap,
     )
     return FabricateOutput(str(path), design, fab, summary, tuple(written))

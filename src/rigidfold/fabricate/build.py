@@ -171,22 +171,13 @@ def fabricate_panels(
     and ``density``: default from ``settings`` (``min_thickness``:
     ``fabricate_min_depth`` times the thickness). With ``search``, a failing thickness is
     followed by thinner tries (see the module's text)."""
-    if not (math.isfinite(thickness) and thickness > 0):
-        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
-    c = settings.fabricate.clearance_angle if clearance_angle is None else float(clearance_angle)
-    if not 0 <= c < math.pi / 2:
-        raise RigidfoldError(
-            f"clearance angle must lie in [0, 90) degrees, got {math.degrees(c):g}"
-        )
-    rho = density if density is not None else settings.fabricate.density
-    if not (math.isfinite(rho) and rho > 0):
-        raise RigidfoldError(f"density must be a positive number of kg/m^3, got {rho!r}")
-    least = settings.fabricate.min_depth * thickness if min_thickness is None else min_thickness
-    if not (math.isfinite(least) and 0 <= least <= thickness):
-        raise RigidfoldError(
-            f"the minimum thickness must lie from 0 to the thickness ({thickness * 1e3:g} mm), "
-            f"got {least!r} m"
-        )
+    c, least, rho = fabrication_values(
+        thickness,
+        clearance_angle=clearance_angle,
+        min_thickness=min_thickness,
+        density=density,
+        settings=settings,
+    )
     result = _evaluate(panels, motion, thickness, c, least, rho, motion_message, settings)
     if result.ok or not search or motion is None:
         return result
@@ -208,6 +199,50 @@ def fabricate_panels(
             "thickness_tries": tuple(tries),
         }
     )
+
+
+def fabrication_values(
+    thickness: float,
+    *,
+    clearance_angle: float | None = None,
+    min_thickness: float | None = None,
+    density: float | None = None,
+    settings: Settings = DEFAULTS,
+) -> tuple[float, float, float]:
+    """(clearance angle in radians, minimum thickness in metres, density in kg/m^3) of thick
+    panels ``thickness`` metres thick, each None taken from ``settings`` (the minimum
+    thickness: ``fabricate.min_depth`` times the thickness); ValueError (one line, naming
+    what was received) for a thickness that is not a positive number, an angle outside
+    [0, 90) degrees, a density that is not positive, a minimum thickness outside
+    [0, thickness]."""
+    if (
+        isinstance(thickness, bool)
+        or not isinstance(thickness, int | float | np.number)
+        or not (math.isfinite(thickness) and thickness > 0)
+    ):
+        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
+    c = settings.fabricate.clearance_angle if clearance_angle is None else clearance_angle
+    if isinstance(c, bool) or not (isinstance(c, int | float | np.number) and 0 <= c < math.pi / 2):
+        shown = f"{math.degrees(c):g}" if isinstance(c, int | float | np.number) else repr(c)
+        raise RigidfoldError(f"clearance angle must lie in [0, 90) degrees, got {shown}")
+    rho = density if density is not None else settings.fabricate.density
+    if (
+        isinstance(rho, bool)
+        or not isinstance(rho, int | float | np.number)
+        or not (math.isfinite(rho) and rho > 0)
+    ):
+        raise RigidfoldError(f"density must be a positive number of kg/m^3, got {rho!r}")
+    least = settings.fabricate.min_depth * thickness if min_thickness is None else min_thickness
+    if (
+        isinstance(least, bool)
+        or not isinstance(least, int | float | np.number)
+        or not (math.isfinite(least) and 0 <= least <= thickness)
+    ):
+        raise RigidfoldError(
+            f"the minimum thickness must lie from 0 to the thickness ({thickness * 1e3:g} mm), "
+            f"got {least!r} m"
+        )
+    return float(c), float(least), float(rho)
 
 
 def _evaluate(
@@ -341,12 +376,13 @@ def parse_length(text: str, what: str = "thickness") -> float:
     return value
 
 
-def parse_sheet(text: str) -> tuple[float, float]:
-    """(width, height) in mm from ``"2440x1220"``. Raises ValueError naming the text."""
-    parts = str(text).lower().replace(" ", "").split("x")
+def parse_sheet(text: str | tuple[float, float]) -> tuple[float, float]:
+    """(width, height) in mm from ``"2440x1220"`` or a (width, height) pair. Raises
+    ValueError naming what was received."""
+    parts = str(text).lower().replace(" ", "").split("x") if isinstance(text, str) else text
     try:
         w, h = (float(x) for x in parts)
-    except ValueError:
+    except (TypeError, ValueError):
         w = h = math.nan
     if not all(math.isfinite(x) and x > 0 for x in (w, h)):
         raise RigidfoldError(f"sheet must be WIDTHxHEIGHT in millimetres (2440x1220), got {text!r}")

@@ -1,10 +1,12 @@
 """The final design as built: its thick panels and its structure, run by the run writer.
 
-``rigidfold generate --thickness T`` makes the final design's thick panels
+``rigidfold generate --thickness T`` (``GenerateOptions.fabricate``, a
+:class:`~rigidfold.fabricate.FabricateOptions`) makes the final design's thick panels
 (:func:`rigidfold.fabricate.fabricate_panels`) from the motion the run traced, checks them
 over it and writes their files into ``DIR/final/thick/`` (:func:`thick_panels`);
-``--structure`` checks the final design on its supports under load
-(:func:`rigidfold.structure.check_design`) and writes ``DIR/final/structure/``
+``--structure`` (``GenerateOptions.structure``, a
+:class:`~rigidfold.structure.StructureOptions`) checks the final design on its supports
+under load (:func:`rigidfold.structure.check_design`) and writes ``DIR/final/structure/``
 (:func:`structure_check`). Each returns the figures that the final design's
 :class:`~rigidfold.run.SolutionRecord` keeps (``fabrication``, ``structure``), with the
 files named relative to the run's directory, and the result itself.
@@ -17,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.fabricate import Fabrication, FabricationStatus, Panels, fabricate_panels
+from rigidfold.errors import RigidfoldError
+from rigidfold.fabricate import Fabrication, FabricationStatus, Panels
 from rigidfold.fabricate.motion import design_motion
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
@@ -27,12 +30,9 @@ from rigidfold.structure import (
     StructureCheck,
     check_design,
     parse_indices,
-    parse_load,
     parse_material,
     write_structure,
 )
-from rigidfold.structure.design import CHOSEN_SUPPORTS
-from rigidfold.structure.loads import check_loads
 
 THICK_DIR = Path("final") / "thick"
 """Where the thick panels' files go in the run's directory."""
@@ -42,13 +42,18 @@ STRUCTURE_DIR = Path("final") / "structure"
 
 
 def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> None:
-    """ValueError (one line) for supports or point loads at vertices that ``pattern`` (the
-    run's crease pattern: every solution has its vertices) lacks, before the run starts."""
-    if not options.structure:
+    """ValueError (one line) for supports, support candidates, clamped vertices, actuators
+    or point loads that ``pattern`` (the run's crease pattern: every solution has its
+    vertices and edges) lacks, and for an actuator that is not one of its free creases (a
+    run only fixes more), before the run starts."""
+    st = options.structure
+    if st is None:
         return
-    if options.supports.strip().lower() not in CHOSEN_SUPPORTS:
-        parse_indices(options.supports, pattern.n_vertices, "supports")
-    check_loads(tuple(parse_load(text) for text in options.loads), pattern.n_vertices)
+    st.check_indices(pattern.n_vertices, pattern.n_edges)
+    free = set(pattern.free_creases.tolist())
+    fixed = [e for e in parse_indices(st.actuators, pattern.n_edges, "actuators") if e not in free]
+    if fixed:
+        raise RigidfoldError(f"actuator {fixed[0]} is not a free crease of the crease pattern")
 
 
 def thick_panels(
@@ -61,37 +66,37 @@ def thick_panels(
     frames: tuple[np.ndarray, np.ndarray] | None = None,
     path: FoldingPath | None = None,
 ) -> tuple[dict, Fabrication]:
-    """Thick panels of ``options.thickness`` on ``options.side`` of the design ``pattern``
-    (development ``coords2d`` (V, 2)), the panels' density that of ``options.material``,
-    checked over the run's traced motion (``frames``: (frames (K, V, 3), fraction (K,))) or
-    its folding ``path`` (traced again only when neither serves); their files
-    (:func:`rigidfold.fabricate.files.write_fabrication`) in ``run_dir/final/thick/``
-    named after ``name``. Returns (the record's figures, the result)."""
+    """Thick panels of the design ``pattern`` (development ``coords2d`` (V, 2)) as
+    ``options.fabricate`` asks (the density, unless it gives one, that of
+    ``options.panel_material``), checked over the run's traced motion (``frames``: (frames
+    (K, V, 3), fraction (K,))) or its folding ``path`` (traced again only when neither
+    serves); their files (:func:`rigidfold.fabricate.files.write_fabrication`) in
+    ``run_dir/final/thick/`` named after ``name``, the cut sheets nested onto its sheet.
+    Returns (the record's figures, the result)."""
     from rigidfold.fabricate.files import write_fabrication
 
-    assert options.thickness is not None
+    fabricate = options.fabricate
+    assert fabricate is not None
     settings = pattern.settings
     t0 = time.perf_counter()
-    panels = Panels(pattern, coords2d, options.side)
+    panels = Panels(pattern, coords2d, fabricate.side)
     motion, message = design_motion(panels, frames=frames, path=path, settings=settings)
-    fab = fabricate_panels(
+    fab = fabricate.fabricate(
         panels,
         motion,
-        options.thickness,
         density=parse_material(options.panel_material).density,
         motion_message=message,
         settings=settings,
     )
     out = prepare_output_dir(run_dir / THICK_DIR)
-    title = f"{name}: thick panels {options.thickness * 1e3:g} mm, {options.side} side"
     written, sheets = write_fabrication(
         fab,
         out,
         name,
         source=f"solutions/{name}.fold",
-        title=title,
+        title=fabricate.title(name),
         label=name,
-        sheet=(settings.fabricate.sheet_width, settings.fabricate.sheet_height),
+        sheet=fabricate.sheet,
         gap=settings.fabricate.sheet_gap,
     )
     return _fabrication_figures(fab, run_dir, written, sheets, time.perf_counter() - t0), fab
@@ -154,22 +159,13 @@ def _fabrication_figures(
 def structure_check(
     run_dir: Path, name: str, pattern: CreasePattern, options: GenerateOptions
 ) -> tuple[dict, StructureCheck]:
-    """The structure check of the design ``pattern`` with ``options`` (supports, loads,
-    material, limit; its thickness ``options.thickness`` or ``Settings.structure.thickness``)
-    and its files (``structure.json``, ``structure.png``) in ``run_dir/final/structure/``.
-    Returns (the record's figures, the check)."""
-    settings = pattern.settings
+    """The structure check of the design ``pattern`` as ``options.structure`` asks
+    (:func:`rigidfold.structure.check_design`) and its files (``structure.json``,
+    ``structure.png``) in ``run_dir/final/structure/``. Returns (the record's figures, the
+    check)."""
+    assert options.structure is not None
     t0 = time.perf_counter()
-    thickness = settings.structure.thickness if options.thickness is None else options.thickness
-    check = check_design(
-        pattern,
-        supports=options.supports,
-        thickness=thickness,
-        material=options.panel_material,
-        loads=options.loads,
-        limit=options.limit,
-        settings=settings,
-    )
+    check = check_design(pattern, options.structure, settings=pattern.settings)
     out = prepare_output_dir(run_dir / STRUCTURE_DIR)
     written = write_structure(check, out, f"solutions/{name}.fold")
     files = [str(p.relative_to(run_dir)) for p in written]

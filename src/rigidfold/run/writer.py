@@ -110,7 +110,7 @@ class RunWriter:
     the run has ended (its FOLD file is then written again with them), or every solution as
     it comes. ``overwrite``: replace the files of an earlier run in ``out``
     (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
-    target the verdict (:meth:`finish`) judges by. With ``options.thickness`` and
+    target the verdict (:meth:`finish`) judges by. With ``options.fabricate`` and
     ``options.structure`` the final design's thick panels and structure are checked too
     (:mod:`rigidfold.run.built`; ``DIR/final/thick/``, ``DIR/final/structure/``), their
     figures in its record; ``fabrication`` and ``structure`` hold the results.
@@ -239,11 +239,11 @@ class RunWriter:
 
     def _frame_material(self) -> dict:
         """Step 9's frame of strips of the user's panels (``options.material``, of
-        ``options.thickness`` or ``Settings.structure.thickness``); {} for the paper's tubes."""
+        ``options.panel_thickness`` or ``Settings.structure.thickness``); {} for the paper's
+        tubes."""
         if self.options.material is None:
             return {}
-        settings = self.case.settings
-        thickness = self.options.thickness or settings.structure.thickness
+        thickness = self.options.panel_thickness or self.case.settings.structure.thickness
         return {"material": parse_material(self.options.material), "thickness": thickness}
 
     def finish(self, run: Generation) -> RunVerdict:
@@ -281,14 +281,14 @@ class RunWriter:
         """The final design's thick panels and structure check, as the options ask, their
         figures written into its record."""
         opts = self.options
-        if opts.thickness is None and not opts.structure:
+        if opts.fabricate is None and opts.structure is None:
             return
         pattern = final.result.pattern
         name = self.files[final.step].stem
         record = self.records[final.step]
         # a check that cannot run on this design (RigidfoldError) is a failed stage with its
         # message: the run still ends with its verdict, summary.json and report
-        if opts.thickness is not None:
+        if opts.fabricate is not None:
             try:
                 figures, self.fabrication = thick_panels(
                     self.out,
@@ -302,7 +302,7 @@ class RunWriter:
             except RigidfoldError as exc:
                 figures = _not_checked("the thick panels", exc)
             record = replace(record, fabrication=figures)
-        if opts.structure:
+        if opts.structure is not None:
             try:
                 figures, self.structure = structure_check(self.out, name, pattern, opts)
             except RigidfoldError as exc:

@@ -9,7 +9,8 @@ first order is not enough: prestress stability, or a finite mechanism),
 hinges), :mod:`~rigidfold.structure.loads` (self-weight, snow, wind, point loads),
 :mod:`~rigidfold.structure.analysis` (static and eigen analysis in OpenSees),
 :mod:`~rigidfold.structure.check` (the check and its verdict),
-:mod:`~rigidfold.structure.design` (the check from the options as given, and its files) and
+:mod:`~rigidfold.structure.design` (the options as given, :class:`StructureOptions`, the check
+from them, and its files) and
 :mod:`~rigidfold.structure.figure` (the deflected shape). OpenSees and matplotlib are
 imported only when an analysis runs or a figure is drawn.
 """
@@ -23,6 +24,7 @@ from rigidfold.structure.check import (
 )
 from rigidfold.structure.design import (
     STRUCTURE_FILES,
+    StructureOptions,
     check_design,
     design_supports,
     write_structure,
@@ -52,6 +54,7 @@ __all__ = [
     "SecondOrder",
     "Stability",
     "StructureCheck",
+    "StructureOptions",
     "StructureStatus",
     "SupportModes",
     "Supports",

@@ -272,13 +272,21 @@ def check_inputs(
 ) -> None:
     """ValueError (one line, naming the value) for a thickness that is not a positive number
     of metres, a negative hinge stiffness, a point load at a vertex the design lacks."""
-    if isinstance(thickness, bool) or not (np.isfinite(thickness) and thickness > 0):
-        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
-    if isinstance(hinge_stiffness, bool) or not (
-        np.isfinite(hinge_stiffness) and hinge_stiffness >= 0
-    ):
-        raise RigidfoldError(f"hinge stiffness must be >= 0 N m/rad per m, got {hinge_stiffness!r}")
+    check_numbers(thickness=thickness, hinge_stiffness=hinge_stiffness)
     check_loads(tuple(loads), pattern.n_vertices)
+
+
+def check_numbers(*, thickness: float, hinge_stiffness: float) -> None:
+    """ValueError (one line, naming the value) for a thickness that is not a positive number
+    of metres, a hinge stiffness that is not a number >= 0."""
+
+    def number(x) -> bool:
+        return not isinstance(x, bool) and isinstance(x, int | float | np.number)
+
+    if not (number(thickness) and np.isfinite(thickness) and thickness > 0):
+        raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
+    if not (number(hinge_stiffness) and np.isfinite(hinge_stiffness) and hinge_stiffness >= 0):
+        raise RigidfoldError(f"hinge stiffness must be >= 0 N m/rad per m, got {hinge_stiffness!r}")
 
 
 def check_structure(

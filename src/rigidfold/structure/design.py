@@ -1,8 +1,10 @@
 """The structure check of a design from its options as the user gives them, and its files.
 
-:func:`plan_design` reads the supports (``"auto"``, ``"service"`` or ``"V,V,..."``), the loads
-(``--load`` texts) and the material (a preset or ``"E,nu,density"``), chooses or checks the
-supports (a :class:`DesignPlan`), whose ``check`` runs
+:class:`StructureOptions` holds the options of ``rigidfold structure`` (which ``rigidfold
+generate --structure`` shares), checked once when made. :func:`plan_design` reads them
+against a design: the supports (``"auto"``, ``"service"`` or ``"V,V,..."``), the loads
+(``--load`` texts) and the material (a preset or ``"E,nu,density"``); it chooses or checks
+the supports (a :class:`DesignPlan`), whose ``check`` runs
 :func:`rigidfold.structure.check.check_structure` (:func:`check_design` does both);
 :func:`write_structure` writes ``structure.json`` and ``structure.png``
 (:data:`STRUCTURE_FILES`). ``rigidfold structure`` and ``rigidfold generate --structure``
@@ -11,7 +13,7 @@ both go through them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -20,14 +22,21 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.io.files import atomic_write, write_json
 from rigidfold.mesh import CreasePattern
-from rigidfold.structure.check import StructureCheck, check_inputs, check_structure, parse_limit
-from rigidfold.structure.loads import Load, parse_load
+from rigidfold.structure.check import (
+    StructureCheck,
+    check_inputs,
+    check_numbers,
+    check_structure,
+    parse_limit,
+)
+from rigidfold.structure.loads import Load, check_loads, parse_load
 from rigidfold.structure.material import Material, parse_material
 from rigidfold.structure.supports import (
     Rigidity,
     Supports,
     auto_supports,
     check_supports,
+    index_list,
     parse_indices,
     support_candidates,
 )
@@ -142,33 +151,145 @@ def check_options(
     return mat, parsed, divisor
 
 
+@dataclass(frozen=True)
+class StructureOptions:
+    """The structure check of a design as ``rigidfold structure`` takes it, every option as
+    the user gives it (``rigidfold generate --structure`` builds the same).
+
+    thickness : the panels' thickness, metres.
+    material : a preset name (:data:`~rigidfold.structure.MATERIALS`) or ``"E,nu,density"``
+        in SI units.
+    supports : ``"auto"`` (the fewest pinned ``candidates`` that make the mechanism
+        first-order rigid), ``"service"`` (those, and more until the deflection limit is
+        met: :mod:`rigidfold.structure.service`) or ``"V,V,..."`` pinned vertices.
+    candidates : the vertices ``auto`` may choose: None or ``"boundary"``, ``"ground"``, or
+        ``"V,V,..."``.
+    clamped : ``"V,V,..."`` clamped vertices; actuators : ``"I,J,..."`` free creases held
+        at their angle (``""``: none).
+    hinge_stiffness : N m/rad per metre of every free crease (0: free hinges).
+    loads : ``--load`` texts (:func:`~rigidfold.structure.parse_load`), kept as a tuple.
+    self_weight : include the panels' weight.
+    limit : the deflection limit's divisor, or ``"L/250"``; kept as the divisor (a float).
+    nonlinear : geometrically nonlinear analysis; modes : natural frequencies computed.
+
+    Defaults from ``Settings.structure``. Every value is checked when the options are made
+    (ValueError, one line, naming what was received); the indices against a design by
+    :meth:`check_indices` and :func:`plan_design`.
+    """
+
+    thickness: float = DEFAULTS.structure.thickness
+    material: str = DEFAULTS.structure.material
+    supports: str = "auto"
+    candidates: str | None = None
+    clamped: str = ""
+    actuators: str = ""
+    hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness
+    loads: tuple[str, ...] = ()
+    self_weight: bool = True
+    limit: float = DEFAULTS.structure.limit
+    nonlinear: bool = False
+    modes: int = DEFAULTS.structure.modes
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.material, str):
+            raise RigidfoldError(
+                f"material must be a preset name or E,nu,density, got {self.material!r}"
+            )
+        if isinstance(self.loads, str) or not isinstance(self.loads, tuple | list):
+            raise RigidfoldError(f"loads must be a list of load texts, got {self.loads!r}")
+        object.__setattr__(self, "loads", tuple(self.loads))
+        _, _, divisor = check_options(
+            material=self.material, loads=self.loads, limit=self.limit, modes=self.modes
+        )
+        object.__setattr__(self, "limit", divisor)
+        check_numbers(thickness=self.thickness, hinge_stiffness=self.hinge_stiffness)
+        object.__setattr__(self, "thickness", float(self.thickness))
+        object.__setattr__(self, "hinge_stiffness", float(self.hinge_stiffness))
+        supports = self.supports
+        if not isinstance(supports, str):
+            raise RigidfoldError(
+                "supports must be auto, service or comma-separated vertex indices, got "
+                f"{supports!r}"
+            )
+        clamped = index_list(self.clamped, "clamped vertices")
+        if not self.auto and not index_list(supports, "supports"):
+            if not clamped:
+                raise RigidfoldError(
+                    "give --supports V,V,..., auto or service, or --clamped vertices"
+                )
+        candidates = self.candidates
+        if candidates is not None and (
+            not isinstance(candidates, str)
+            or candidates.strip().lower() not in ("boundary", "ground")
+        ):
+            index_list(candidates, "support candidates")
+        index_list(self.actuators, "actuators")
+        for name in ("self_weight", "nonlinear"):
+            if not isinstance(getattr(self, name), bool):
+                raise RigidfoldError(f"{name} must be true or false, got {getattr(self, name)!r}")
+
+    @property
+    def auto(self) -> bool:
+        """Whether the supports are chosen (``supports`` ``"auto"`` or ``"service"``)."""
+        return self.supports.strip().lower() in CHOSEN_SUPPORTS
+
+    @property
+    def service(self) -> bool:
+        """Whether the chosen supports are grown for the deflection (``"service"``)."""
+        return self.supports.strip().lower() == "service"
+
+    def check_indices(self, n_vertices: int, n_edges: int) -> None:
+        """ValueError (one line) for a support, candidate, clamped vertex, actuator or point
+        load that a design of ``n_vertices`` vertices and ``n_edges`` edges lacks."""
+        if not self.auto:
+            parse_indices(self.supports, n_vertices, "supports")
+        if self.candidates is not None and self.candidates.strip().lower() not in (
+            "boundary",
+            "ground",
+        ):
+            parse_indices(self.candidates, n_vertices, "support candidates")
+        parse_indices(self.clamped, n_vertices, "clamped vertices")
+        parse_indices(self.actuators, n_edges, "actuators")
+        check_loads(tuple(parse_load(text) for text in self.loads), n_vertices)
+
+    def replace(self, **changes) -> StructureOptions:
+        """These options with ``changes`` (field names), checked."""
+        return replace(self, **changes) if changes else self
+
+    def to_dict(self) -> dict:
+        """The options as JSON values; :meth:`from_dict` reads them."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> StructureOptions:
+        """The options of :meth:`to_dict` (``loads`` a list); unknown keys are ignored,
+        missing ones take their defaults."""
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in data.items() if k in names})
+
+
 def plan_design(
     pattern: CreasePattern,
+    options: StructureOptions = StructureOptions(),
     *,
-    supports: str = "auto",
-    candidates: str | None = None,
-    clamped: str = "",
-    actuators: str = "",
-    thickness: float = DEFAULTS.structure.thickness,
-    material: str | Material = DEFAULTS.structure.material,
-    hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness,
-    loads: tuple[str, ...] = (),
-    self_weight: bool = True,
-    limit: str | float = DEFAULTS.structure.limit,
-    nonlinear: bool = False,
-    modes: int = DEFAULTS.structure.modes,
     settings: Settings = DEFAULTS,
 ) -> DesignPlan:
-    """The :class:`DesignPlan` of ``pattern`` (see the module's text and
-    :func:`design_supports`); every input is checked (ValueError, one line)."""
-    mat, parsed, divisor = check_options(material=material, loads=loads, limit=limit, modes=modes)
-    check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=parsed)
+    """The :class:`DesignPlan` of ``pattern`` with ``options`` (see the module's text and
+    :func:`design_supports`); the indices and loads are checked against the design
+    (ValueError, one line)."""
+    mat, parsed, _ = check_options(material=options.material, loads=options.loads)
+    check_inputs(
+        pattern,
+        thickness=options.thickness,
+        hinge_stiffness=options.hinge_stiffness,
+        loads=parsed,
+    )
     rigidity, auto = design_supports(
         pattern,
-        supports,
-        candidates=candidates,
-        clamped=clamped,
-        actuators=actuators,
+        options.supports,
+        candidates=options.candidates,
+        clamped=options.clamped,
+        actuators=options.actuators,
         settings=settings,
     )
     return DesignPlan(
@@ -176,24 +297,27 @@ def plan_design(
         rigidity,
         auto,
         mat,
-        thickness,
+        options.thickness,
         parsed,
-        self_weight,
-        hinge_stiffness,
-        nonlinear,
-        divisor,
-        modes,
+        options.self_weight,
+        options.hinge_stiffness,
+        options.nonlinear,
+        options.limit,
+        options.modes,
         settings,
-        support_candidates(pattern, candidates, settings)
-        if supports.strip().lower() == "service"
-        else None,
+        support_candidates(pattern, options.candidates, settings) if options.service else None,
     )
 
 
-def check_design(pattern: CreasePattern, **options) -> StructureCheck:
-    """The structure check of ``pattern`` with ``options`` (those of :func:`plan_design`):
-    every input checked first (ValueError, one line), then the analysis."""
-    return plan_design(pattern, **options).check()
+def check_design(
+    pattern: CreasePattern,
+    options: StructureOptions = StructureOptions(),
+    *,
+    settings: Settings = DEFAULTS,
+) -> StructureCheck:
+    """The structure check of ``pattern`` with ``options``: every input checked first
+    (ValueError, one line), then the analysis."""
+    return plan_design(pattern, options, settings=settings).check()
 
 
 def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:

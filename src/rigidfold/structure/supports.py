@@ -57,16 +57,22 @@ from rigidfold.structure.stability import SecondOrder, Stability, held_vertices,
 CANDIDATE_FORMS = ("boundary", "ground", "V,V,...")
 
 
-def parse_indices(text: str, count: int, what: str) -> np.ndarray:
-    """``"3,7,12"`` as a sorted (k,) int64 array of distinct indices below ``count``;
-    ``""`` is none. ValueError naming ``what`` and the text for anything else."""
+def index_list(text: str, what: str) -> list[int]:
+    """The integers of ``"3,7,12"`` (``""``: none), not yet checked against a design;
+    ValueError naming ``what`` and the text for anything else."""
     if not isinstance(text, str):
         raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}")
     items = [t.strip() for t in text.split(",") if t.strip()]
     try:
-        values = [int(t) for t in items]
+        return [int(t) for t in items]
     except ValueError:
         raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}") from None
+
+
+def parse_indices(text: str, count: int, what: str) -> np.ndarray:
+    """``"3,7,12"`` as a sorted (k,) int64 array of distinct indices below ``count``;
+    ``""`` is none. ValueError naming ``what`` and the text for anything else."""
+    values = index_list(text, what)
     bad = [v for v in values if not 0 <= v < count]
     if bad:
         raise RigidfoldError(f"{what}: {bad[0]} is out of range 0..{count - 1} (got {text!r})")
