@@ -661,5 +661,6 @@ def fabricate_file(
         label=label,
         sheet=(width, height),
         gap=settings.fabricate.sheet_gap,
+        settings=settings,
     )
     return FabricateOutput(str(path), design, fab, summary, tuple(written))

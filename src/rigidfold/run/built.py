@@ -92,6 +92,7 @@ def thick_panels(
         label=name,
         sheet=(settings.fabricate.sheet_width, settings.fabricate.sheet_height),
         gap=settings.fabricate.sheet_gap,
+        settings=settings,
     )
     return _fabrication_figures(fab, run_dir, written, sheets, time.perf_counter() - t0), fab
 
