@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 import shapely
+import shapely.errors
 import shapely.geometry
 
 from rigidfold.config import DEFAULTS, Settings
@@ -273,7 +274,10 @@ def nest(
     on_stock = [p for p in items if p.panel in panels]  # each in its own frame, not its pair's
     if not on_stock or len(on_stock) > settings.fabricate.nest_parts:
         return boxes
-    outlines = nest_by_outlines(on_stock, width, height, gap, settings=settings)
+    try:
+        outlines = nest_by_outlines(on_stock, width, height, gap, settings=settings)
+    except shapely.errors.GEOSException:  # a degenerate outline: the boxes still hold
+        outlines = None
     if outlines is None or _usage(outlines) >= _usage(stock):
         return boxes
     return outlines + [s for s in boxes if s.oversize]
