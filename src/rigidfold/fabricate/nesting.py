@@ -10,11 +10,12 @@ The spots where a part keeps ``gap`` from every part already on a sheet are foun
 no-fit polygons: each outline is cut into convex pieces (a polygon that is nearly convex is
 taken as its convex hull, which only widens the gap; else it is cut into triangles), and the
 shift ``t`` of a piece ``B`` keeps the gap from a placed piece ``A`` when ``t`` lies outside
-the convex polygon ``A - B + K`` (``K``: a regular polygon whose inscribed circle has the
-gap as its radius, so ``A - B + K`` holds ``A - B`` grown by the gap: the gap is kept, at
-most ``1 / cos(pi / sides) - 1`` of it wider). The free spots are the rectangle of shifts
-that keep the gap from the sheet's edges less the union of those polygons; the lowest corner
-of its leftmost ones is taken. Every comparison is made on coordinates rounded to
+the convex polygon ``A - B + K`` (Minkowski sums, :func:`minkowski`; ``K``: a regular
+polygon of ``fabricate_nest_gap_sides`` sides whose inscribed circle has the gap plus
+``2 fabricate_nest_margin`` as its radius, so ``A - B + K`` holds ``A - B`` grown by the
+gap: the gap is kept, at most ``1 / cos(pi / sides) - 1`` of it wider). The free spots are
+the rectangle of shifts that keep the gap from the sheet's edges less those polygons; the
+lowest of its leftmost corners is taken. Every comparison is made on coordinates rounded to
 ``fabricate_nest_round`` mm, ties broken by the turn's and the sheet's order, so the result
 does not depend on floating-point noise.
 """
