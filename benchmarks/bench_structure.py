@@ -104,7 +104,10 @@ def service() -> None:
             t, run = timed(
                 1,
                 lambda path=path: structure(
-                    path, Path(tmp) / "s", supports="service", modes=0, overwrite=True
+                    path,
+                    Path(tmp) / "s",
+                    StructureOptions(supports="service", modes=0),
+                    overwrite=True,
                 ),
             )
             c = run.check

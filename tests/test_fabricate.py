@@ -225,19 +225,31 @@ def test_cut_sheets_every_panel_once_within_stock(built):
 
 
 def test_nesting_keeps_the_gap(built):
-    """Parts nested onto one sheet (joined in pairs or not) keep the gap between them, and
-    every panel is placed once."""
-    from rigidfold.fabricate.cutsheets import nest, parts
+    """Parts nested onto one sheet (by outlines, or by boxes joined in pairs or not) keep the
+    gap between them and from the sheet's edges, are turned and never mirrored, and every
+    panel is placed once; the sheets kept are no more than the boxes take, and the same
+    every time."""
+    from rigidfold.fabricate.cutsheets import nest, nest_boxes, nest_by_outlines, parts
+    from test_fabricate_nesting import check_nesting
 
     fab = built["result"].fabrication
-    sheets = nest(parts(fab), 2440, 1220, 10)
+    items = parts(fab)
+    sheets = nest(items, 2440, 1220, 10)
     placed = sorted(p.part.panel for s in sheets for p in s.parts)
     assert placed == list(range(fab.panels.n))
-    for sheet in sheets:
-        for i, a in enumerate(sheet.parts):
-            assert a.cut.bounds[0] >= 10 - 1e-6 and a.cut.bounds[2] <= sheet.width - 10 + 1e-6
-            for b in sheet.parts[i + 1 :]:
-                assert a.cut.distance(b.cut) >= 10 - 1e-6
+    check_nesting(sheets, items, 2440, 1220, 10)
+    boxes = nest_boxes(items, 2440, 1220, 10)
+    check_nesting(boxes, items, 2440, 1220, 10)
+    on_stock = {p.part.panel for s in boxes if not s.oversize for p in s.parts}
+    fitting = [p for p in items if p.panel in on_stock]  # not the oversize ones
+    outlines = nest_by_outlines(fitting, 2440, 1220, 10)
+    assert outlines is not None
+    check_nesting(outlines, fitting, 2440, 1220, 10)
+    assert sum(not s.oversize for s in sheets) <= sum(not s.oversize for s in boxes)
+    again = nest(items, 2440, 1220, 10)
+    assert [[(p.part.panel, p.cut.wkt) for p in s.parts] for s in again] == [
+        [(p.part.panel, p.cut.wkt) for p in s.parts] for s in sheets
+    ]
 
 
 def test_schedules(built):

@@ -14,7 +14,7 @@ from conftest import folded_grid, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.io import read_fold, write_fold
 from rigidfold.structure import StructureStatus, Supports, check_supports
-from rigidfold.structure.design import plan_design
+from rigidfold.structure.design import StructureOptions, plan_design
 from test_structure import independent_kernel
 
 DATA = Path(__file__).parent / "data"
@@ -29,9 +29,9 @@ def test_service_supports_meet_the_limit_that_auto_misses(roof):
     """The roof on free hinges: auto's pins hold the mechanism but let it sag far past
     L/250; service keeps them, adds boundary pins, meets the limit, and each added pin is
     needed (without any one of them the same analysis misses the limit)."""
-    auto = plan_design(roof, supports="auto", modes=0).check()
+    auto = plan_design(roof, StructureOptions(supports="auto", modes=0)).check()
     assert auto.rigidity.rigid and auto.status is StructureStatus.DEFLECTION
-    plan = plan_design(roof, supports="service", modes=0)
+    plan = plan_design(roof, StructureOptions(supports="service", modes=0))
     check = plan.check()
     assert check.status is StructureStatus.PASSED and check.chosen == "service"
     growth = check.growth
@@ -66,14 +66,18 @@ def test_a_search_that_cannot_meet_the_limit_says_how_far_it_went():
     service_max_pins), keeps them all (none can be taken away) and fails the limit."""
     design = folded_grid(4, 0.3)
     boundary = design.boundary_vertices
-    check = plan_design(design, supports="service", limit="L/1e9", modes=0).check()
+    check = plan_design(
+        design, StructureOptions(supports="service", limit="L/1e9", modes=0)
+    ).check()
     assert check.status is StructureStatus.DEFLECTION and not check.growth.passed
     np.testing.assert_array_equal(check.rigidity.supports.pinned, boundary)
     assert [t[0] for t in check.growth.trail] == ["rigid"] + ["add"] * (
         len(boundary) - len(check.growth.rigid)
     )
     capped = DEFAULTS.with_(structure_service_max_pins=2)
-    few = plan_design(design, supports="service", limit="L/1e9", modes=0, settings=capped).check()
+    few = plan_design(
+        design, StructureOptions(supports="service", limit="L/1e9", modes=0), settings=capped
+    ).check()
     assert len(few.growth.added) == 2 and len(few.growth.trail) == 3
     assert not few.growth.passed and few.status is StructureStatus.DEFLECTION
 

@@ -601,5 +601,6 @@ def fabricate_file(
         label=label,
         sheet=options.sheet,
         gap=settings.fabricate.sheet_gap,
+        settings=settings,
     )
     return FabricateOutput(str(path), design, fab, summary, tuple(written))

@@ -8,16 +8,21 @@ surface (``E12 64.2°``: tilt the saw blade by 90° minus it). Both outlines are
 the solid itself (its faces on the surface and at the full depth), so the sheets and the 3D
 files agree.
 
-Nesting: parts are first joined in pairs where that packs tighter (:func:`group`: two
-parts, most often triangles, whose convex hulls' longest sides are about as long, set side by
-side along them, the gap apart, the second turned half round, where the pair's smallest box
-is smaller than the two boxes alone), then each part or pair is turned to its smallest
-bounding rectangle (:func:`rigidfold.exports.sheet.min_area_angle`), its box rounded up to
-whole millimetres plus the gap, and the boxes are packed onto as many stock sheets as needed
-by ``rectpack`` (boxes may turn a quarter), the fewest sheets of a few of its heuristics
-(:func:`_pack`). Parts are never
-mirrored (their surface face stays up). A part larger than the stock in either direction is
-put on a sheet of its own size and reported (``oversize``).
+Nesting (:func:`nest`), two ways, the one on fewer stock sheets kept (then the one that
+uses less of the last sheet's width; the boxes where both are alike). By boxes
+(:func:`nest_boxes`): parts are first joined in pairs where that packs tighter
+(:func:`group`: two parts, most often triangles, whose convex hulls' longest sides are about
+as long, set side by side along them, the gap apart, the second turned half round, where the
+pair's smallest box is smaller than the two boxes alone), then each part or pair is turned
+to its smallest bounding rectangle (:func:`rigidfold.exports.sheet.min_area_angle`), its box
+rounded up to whole millimetres plus the gap, and the boxes are packed onto as many stock
+sheets as needed by ``rectpack`` (boxes may turn a quarter), the fewest sheets of a few of
+its heuristics (:func:`_pack`). By outlines (:func:`nest_by_outlines`, for at most
+``fabricate_nest_parts`` parts): each part's true outline is placed, largest first, at the
+leftmost-then-lowest spot where it keeps the gap, at a few turns
+(:mod:`rigidfold.fabricate.nesting`). Parts are never mirrored (their surface face stays
+up). A part larger than the stock in either direction is put on a sheet of its own size and
+reported (``oversize``) either way.
 """
 
 from __future__ import annotations
@@ -31,8 +36,10 @@ from pathlib import Path
 
 import numpy as np
 import shapely
+import shapely.errors
 import shapely.geometry
 
+from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import min_area_angle
 from rigidfold.fabricate.build import Fabrication
@@ -74,12 +81,14 @@ class Placed:
 
 @dataclass(frozen=True, eq=False)
 class StockSheet:
-    """One stock sheet: its size (mm), its parts, and whether it is an oversize one."""
+    """One stock sheet: its size (mm), its parts, whether it is an oversize one, and how
+    its parts were nested (``"boxes"`` or ``"outlines"``)."""
 
     width: float
     height: float
     parts: tuple[Placed, ...]
     oversize: bool = False
+    nesting: str = "boxes"
 
 
 def _frame(fab: Fabrication, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -246,9 +255,69 @@ def group(items: list[Part], width: float, height: float, gap: float) -> list[li
     return groups
 
 
-def nest(items: list[Part], width: float, height: float, gap: float) -> list[StockSheet]:
+def nest(
+    items: list[Part],
+    width: float,
+    height: float,
+    gap: float,
+    *,
+    settings: Settings = DEFAULTS,
+) -> list[StockSheet]:
     """Pack ``items`` onto stock sheets ``width`` x ``height`` mm with ``gap`` mm between
-    parts and from the edges (see the module's text)."""
+    parts and from the edges (see the module's text): by their boxes (:func:`nest_boxes`)
+    and by their outlines (:func:`nest_by_outlines`, up to ``fabricate_nest_parts`` parts),
+    the one on fewer stock sheets kept, then the one that uses less of the last sheet's
+    width, the boxes where both are alike. Parts with an empty outline are left out."""
+    boxes = nest_boxes(items, width, height, gap)
+    stock = [s for s in boxes if not s.oversize]
+    panels = {p.part.panel for s in stock for p in s.parts}
+    on_stock = [p for p in items if p.panel in panels]  # each in its own frame, not its pair's
+    if not on_stock or len(on_stock) > settings.fabricate.nest_parts:
+        return boxes
+    try:
+        outlines = nest_by_outlines(on_stock, width, height, gap, settings=settings)
+    except shapely.errors.GEOSException:  # a degenerate outline: the boxes still hold
+        outlines = None
+    if outlines is None or _usage(outlines) >= _usage(stock):
+        return boxes
+    return outlines + [s for s in boxes if s.oversize]
+
+
+def _usage(sheets: list[StockSheet]) -> tuple[int, float]:
+    """(how many sheets, how far the last one is used along its width, mm)."""
+    last = max((p.cut.bounds[2] for p in sheets[-1].parts), default=0.0) if sheets else 0.0
+    return len(sheets), round(last, 3)
+
+
+def nest_by_outlines(
+    items: list[Part],
+    width: float,
+    height: float,
+    gap: float,
+    *,
+    settings: Settings = DEFAULTS,
+) -> list[StockSheet] | None:
+    """``items`` placed by their true outlines on stock sheets ``width`` x ``height`` mm,
+    ``gap`` mm apart and from the edges (:func:`rigidfold.fabricate.nesting.nest_outlines`:
+    turned, never mirrored); ``None`` where one of them fits on no sheet."""
+    from rigidfold.fabricate.nesting import nest_outlines
+
+    spots = nest_outlines([p.cut for p in items], width, height, gap, settings=settings)
+    if spots is None:
+        return None
+    placed: dict[int, list[Placed]] = {}
+    for part, spot in zip(items, spots, strict=True):
+        c, s = math.cos(spot.angle), math.sin(spot.angle)
+        turn = np.array([[c, s], [-s, c]])  # row vectors: x @ turn turns x by the angle
+        placed.setdefault(spot.sheet, []).append(_placed(part, turn, (spot.x, spot.y)))
+    return [StockSheet(width, height, tuple(placed[b]), nesting="outlines") for b in sorted(placed)]
+
+
+def nest_boxes(items: list[Part], width: float, height: float, gap: float) -> list[StockSheet]:
+    """Pack ``items`` by their boxes (their pairs' boxes, :func:`group`) onto stock sheets
+    ``width`` x ``height`` mm with ``gap`` mm between parts and from the edges, by
+    ``rectpack`` (:func:`_pack`); a part larger than the stock on an oversize sheet of its
+    own after them."""
     inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
     boxes: dict[int, tuple[int, int, list[Part]]] = {}
     oversize = []
@@ -328,16 +397,24 @@ def _moved(geometry, matrix: np.ndarray | None = None, offset=(0.0, 0.0)):
 
 
 def _place(part: Part, x: float, y: float, turned: bool) -> Placed:
-    cut, far = part.cut, part.far
-    labels = [(np.array([lx, ly]), t) for lx, ly, t in part.labels]
-    if turned:  # a quarter turn, back into the box [0, height] x [0, width]
-        quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
-        cut = _moved(cut, quarter, (part.height, 0.0))
-        far = _moved(far, quarter, (part.height, 0.0))
-        labels = [(q @ quarter + [part.height, 0.0], t) for q, t in labels]
-    cut = _moved(cut, None, (x, y))
-    far = _moved(far, None, (x, y))
-    moved = tuple((float(q[0] + x), float(q[1] + y), t) for q, t in labels)
+    """``part`` at (x, y), a quarter turn back into its box ``[0, height] x [0, width]``
+    where ``turned``."""
+    if not turned:
+        return _placed(part, None, (x, y))
+    quarter = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    return _placed(part, quarter, (part.height + x, y))
+
+
+def _placed(part: Part, matrix: np.ndarray | None, offset: tuple[float, float]) -> Placed:
+    """``part`` with every point p (row) taken to ``p @ matrix + offset`` (a turn: never a
+    mirror), its labels with it."""
+    m = np.eye(2) if matrix is None else np.asarray(matrix, dtype=np.float64)
+    cut = _moved(part.cut, m, offset)
+    far = _moved(part.far, m, offset)
+    moved = tuple(
+        (float(q[0]), float(q[1]), t)
+        for q, t in ((np.array([lx, ly]) @ m + offset, t) for lx, ly, t in part.labels)
+    )
     c = cut.representative_point()
     return Placed(part, cut, far, moved, (float(c.x), float(c.y)))
 
@@ -451,11 +528,12 @@ def write_cut_sheets(
     height: float,
     gap: float,
     title: str = "",
+    settings: Settings = DEFAULTS,
 ) -> tuple[list[Path], list[StockSheet]]:
-    """Nest the panels onto ``width`` x ``height`` mm stock and write
+    """Nest the panels onto ``width`` x ``height`` mm stock (:func:`nest`) and write
     ``NAME_sheet_NN.dxf`` and ``.svg`` per sheet (``NAME_oversize_NN`` for a part larger than
     the stock); returns the files and the sheets."""
-    sheets = nest(parts(fab), width, height, gap)
+    sheets = nest(parts(fab), width, height, gap, settings=settings)
     written: list[Path] = []
     stock = oversize = 0
     for sheet in sheets:
@@ -486,9 +564,12 @@ def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:
 
 
 def sheets_summary(sheets: list[StockSheet]) -> dict:
-    """JSON-ready: the sheets and which panel is on which."""
+    """JSON-ready: the stock sheets, how they were nested (``"boxes"`` or ``"outlines"``,
+    :func:`nest`), and which panel is on which."""
+    stock = [s for s in sheets if not s.oversize]
     return {
-        "sheets": sum(not s.oversize for s in sheets),
+        "sheets": len(stock),
+        "nested_by": stock[0].nesting if stock else None,
         "oversize_panels": [p.part.panel for s in sheets if s.oversize for p in s.parts],
         "panels_on_sheet": [[p.part.panel for p in s.parts] for s in sheets if not s.oversize],
     }

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.mesh3d import Y_UP, panel_colours, panel_names
 from rigidfold.fabricate.build import Fabrication
@@ -267,6 +268,7 @@ def write_fabrication(
     label: str = "",
     sheet: tuple[float, float],
     gap: float,
+    settings: Settings = DEFAULTS,
 ) -> tuple[list[Path], dict]:
     """Every file of thick panels into ``out`` (which exists): the solids and schedules
     (:func:`write_solid_files`), the cut sheets nested onto ``sheet`` (width, height) mm stock
@@ -280,7 +282,7 @@ def write_fabrication(
     width, height = sheet
     written = write_solid_files(fab, out, name, title=title)
     more, sheets = write_cut_sheets(
-        fab, out, name, width=width, height=height, gap=gap, title=label
+        fab, out, name, width=width, height=height, gap=gap, title=label, settings=settings
     )
     written += more
     summary = sheets_summary(sheets) | {"stock_mm": [width, height]}

@@ -98,6 +98,7 @@ def thick_panels(
         label=name,
         sheet=fabricate.sheet,
         gap=settings.fabricate.sheet_gap,
+        settings=settings,
     )
     return _fabrication_figures(fab, run_dir, written, sheets, time.perf_counter() - t0), fab
 
