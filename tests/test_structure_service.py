@@ -104,3 +104,19 @@ def test_cli_service_reports_the_added_pins(tmp_path):
     assert saved["status"] == "deflection" and saved["supports"]["chosen"] == "service"
     assert saved["supports"]["service"]["passed"] is False
     assert saved["supports"]["pinned"] == design.boundary_vertices.tolist()
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("serv", "got 'serv' (did you mean service?)"),
+        ("x1", "got 'x1'"),
+        ("1,,a", "got '1,,a'"),
+    ],
+)
+def test_a_misspelt_support_word_is_one_line_naming_the_choices(text, words):
+    with pytest.raises(ValueError) as err:
+        StructureOptions(supports=text)
+    message = str(err.value)
+    assert message.startswith("supports must be auto, service or comma-separated vertex indices")
+    assert words in message and "\n" not in message

@@ -13,6 +13,7 @@ both go through them.
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -206,6 +207,12 @@ class StructureOptions:
         object.__setattr__(self, "thickness", float(self.thickness))
         object.__setattr__(self, "hinge_stiffness", float(self.hinge_stiffness))
         supports = self.supports
+        if isinstance(supports, str) and not self.auto and any(c.isalpha() for c in supports):
+            close = difflib.get_close_matches(supports.strip().lower(), CHOSEN_SUPPORTS, n=1)
+            raise RigidfoldError(
+                "supports must be auto, service or comma-separated vertex indices, got "
+                f"{supports!r}" + (f" (did you mean {close[0]}?)" if close else "")
+            )
         if not isinstance(supports, str):
             raise RigidfoldError(
                 "supports must be auto, service or comma-separated vertex indices, got "
