@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 from conftest import main_code
+from rigidfold.config import DEFAULTS
 from rigidfold.fabricate import FabricateOptions
+from rigidfold.structure import MATERIALS
 
 DESIGN_ARGS = [
     "generate",
@@ -267,7 +269,8 @@ def test_schedules(built):
     assert vertices and {"x_m", "flat_x_m", "relief_mm"} <= set(vertices[0])
     per_panel = summary["per_panel"]
     assert len(per_panel) == summary["panels"]
-    assert all(p["mass_kg"] == pytest.approx(600 * p["volume_m3"]) for p in per_panel)
+    rho = MATERIALS[DEFAULTS.structure.material].density  # the default panels' material
+    assert all(p["mass_kg"] == pytest.approx(rho * p["volume_m3"]) for p in per_panel)
 
 
 @pytest.mark.parametrize(

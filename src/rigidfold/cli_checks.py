@@ -21,7 +21,7 @@ import math
 
 from rigidfold.config import DEFAULTS, SIDES
 from rigidfold.fabricate.options import FabricateOptions
-from rigidfold.structure import StructureOptions, presets_help
+from rigidfold.structure import StructureOptions, parse_material, presets_help
 
 STRUCTURE = StructureOptions()
 """The structure check's defaults (``Settings.structure``)."""
@@ -103,14 +103,15 @@ def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     p.add_argument(
         "--density",
         type=positive,
-        default=None if generate else DEFAULTS.fabricate.density,
+        default=None,
         metavar="KG/M3",
         help=f"{pre}density of the panel material for the masses "
         + (
             "(default: that of --material, or of "
             f"{STRUCTURE.material}; it does not change the structure's self-weight)"
             if generate
-            else "(default: %(default)s, plywood)"
+            else f"(default: that of {STRUCTURE.material}, "
+            f"{parse_material(STRUCTURE.material).density:g})"
         ),
     )
     w, h = FabricateOptions.sheet

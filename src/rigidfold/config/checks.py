@@ -286,9 +286,6 @@ class FabricateSettings(Group):
         "A panel is trimmed away when its solid keeps less than this share of its area times "
         "the thickness, or one of its triangles keeps nothing.",
     )
-    density: float = setting(
-        600.0, "Density of the panels' material, kg/m^3, for their masses (600: plywood)."
-    )
     sheet_width: float = setting(
         2440.0, "Width of the stock sheet the cut sheets are nested onto, millimetres."
     )
@@ -342,7 +339,7 @@ class FabricateSettings(Group):
             )
         self._non_negative("clearance", "vertex_relief", "sheet_gap", "nest_margin")
         self._non_negative("nest_concavity")
-        self._positive("frame_step", "density", "sheet_width", "sheet_height", "nest_round")
+        self._positive("frame_step", "sheet_width", "sheet_height", "nest_round")
         self._fraction("min_depth", "trimmed_away")
         self._integer(relief_rounds=0, subdivisions=0, thickness_tries=0, nest_parts=0)
         self._integer(nest_gap_sides=4)

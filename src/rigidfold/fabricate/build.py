@@ -23,6 +23,7 @@ from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
 from rigidfold.fabricate.solids import Solids, bevel_angles, thicken
 from rigidfold.status import Outcome
+from rigidfold.structure.material import parse_material
 
 
 class FabricationStatus(Outcome):
@@ -225,7 +226,8 @@ def fabrication_values(
     if isinstance(c, bool) or not (isinstance(c, int | float | np.number) and 0 <= c < math.pi / 2):
         shown = f"{math.degrees(c):g}" if isinstance(c, int | float | np.number) else repr(c)
         raise RigidfoldError(f"clearance angle must lie in [0, 90) degrees, got {shown}")
-    rho = density if density is not None else settings.fabricate.density
+    # one density per material: the default is that of the default panels' material
+    rho = density if density is not None else parse_material(settings.structure.material).density
     if (
         isinstance(rho, bool)
         or not isinstance(rho, int | float | np.number)

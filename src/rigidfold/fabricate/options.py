@@ -37,8 +37,9 @@ class FabricateOptions:
         kept as a float.
     side : one of ``SIDES``: the side of the design surface the solids lie on.
     clearance_angle_deg : degrees the bevels leave beyond each hinge's largest fold.
-    density : kg/m^3 of the panels for their masses; None: ``Settings.fabricate.density``
-        (``rigidfold generate``: the density of its ``--material``).
+    density : kg/m^3 of the panels for their masses; None: the density of the panels'
+        material (``rigidfold generate``: its ``--material``; else
+        ``Settings.structure.material``, plywood's 700).
     sheet : (width, height) of the stock sheet in millimetres, or ``"2440x1220"``, kept as
         a pair.
     min_thickness : metres; a panel nowhere this deep once bevelled fails; None:
@@ -98,7 +99,7 @@ class FabricateOptions:
         """Thick panels of ``panels`` (made on :attr:`side`: ``Panels(pattern, coords2d,
         options.side)``) checked over ``motion``
         (:func:`rigidfold.fabricate.fabricate_panels`); ``density``: the one used where
-        :attr:`density` is None (else ``settings.fabricate.density``)."""
+        :attr:`density` is None (else the density of ``settings.structure.material``)."""
         return fabricate_panels(
             panels,
             motion,

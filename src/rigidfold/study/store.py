@@ -293,6 +293,9 @@ RETIRED_SETTINGS = frozenset(
         # configuration keeps target_dof and deploy_check at its top level
         "target_dof",
         "deploy_check",
+        # the thick panels' default density, now that of the default material (studies make
+        # no thick panels)
+        "fabricate_density",
     }
 )
 # configuration entries added later, at the value that reproduces the studies made before
