@@ -31,6 +31,7 @@ def test_service_supports_meet_the_limit_that_auto_misses(roof):
     needed (without any one of them the same analysis misses the limit)."""
     auto = plan_design(roof, StructureOptions(supports="auto", modes=0)).check()
     assert auto.rigidity.rigid and auto.status is StructureStatus.DEFLECTION
+    assert "--supports service pins more vertices" in auto.message  # what may meet it
     plan = plan_design(roof, StructureOptions(supports="service", modes=0))
     check = plan.check()
     assert check.status is StructureStatus.PASSED and check.chosen == "service"
@@ -70,6 +71,7 @@ def test_a_search_that_cannot_meet_the_limit_says_how_far_it_went():
         design, StructureOptions(supports="service", limit="L/1e9", modes=0)
     ).check()
     assert check.status is StructureStatus.DEFLECTION and not check.growth.passed
+    assert f"pins alone did not meet it ({len(boundary)} pinned of {len(boundary)}" in check.message
     np.testing.assert_array_equal(check.rigidity.supports.pinned, boundary)
     assert [t[0] for t in check.growth.trail] == ["rigid"] + ["add"] * (
         len(boundary) - len(check.growth.rigid)

@@ -129,7 +129,21 @@ class StructureCheck:
         return status.describe(
             f"{self.max_displacement * 1e3:.3g} mm, limit L/{self.limit:g} = "
             f"{self.allowed_displacement * 1e3:.3g} mm on a span of {self.span:.3g} m{prestress}"
+            + (self._hint if status is StructureStatus.DEFLECTION else "")
         )
+
+    @property
+    def _hint(self) -> str:
+        """What may meet a deflection limit that these supports miss."""
+        if self.chosen == "auto":
+            return "; --supports service pins more vertices where it deflects most"
+        if self.growth is not None:
+            pinned = len(self.rigidity.supports.pinned)
+            return (
+                f"; pins alone did not meet it ({pinned} pinned of {self.growth.candidates} "
+                "candidates): stiffer hinges, thicker panels or other supports may"
+            )
+        return ""
 
     @property
     def chosen(self) -> str:
