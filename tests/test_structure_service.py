@@ -122,3 +122,26 @@ def test_a_misspelt_support_word_is_one_line_naming_the_choices(text, words):
     message = str(err.value)
     assert message.startswith("supports must be auto, service or comma-separated vertex indices")
     assert words in message and "\n" not in message
+
+
+def test_where_pins_alone_miss_the_limit_the_hinge_stiffness_that_meets_it_is_named():
+    """Only auto's pins may be used and they miss L/1000: the verdict names a hinge
+    stiffness that meets it (checked again with the supports given), close to the least
+    (20 % less does not), and an unreachable limit is said to be out of reach of hinges."""
+    design = folded_grid(4, 0.3)
+    pins = ",".join(map(str, plan_design(design).rigidity.supports.pinned))
+    options = StructureOptions(supports="service", candidates=pins, limit="L/1000", modes=0)
+    check = plan_design(design, options).check()
+    assert check.status is StructureStatus.DEFLECTION and check.growth.searched_hinges
+    k, largest = check.growth.hinge_hint
+    assert largest <= check.allowed_displacement
+    assert "N m/rad per m would" in check.message
+    given = StructureOptions(supports=pins, limit="L/1000", modes=0)
+    assert plan_design(design, given.replace(hinge_stiffness=k)).check().passed
+    softer = plan_design(design, given.replace(hinge_stiffness=k / 1.2)).check()
+    assert softer.status is StructureStatus.DEFLECTION
+    data = check.to_dict()["supports"]["service"]["hinge_stiffness_that_meets_the_limit"]
+    assert data == {"Nm_per_rad_per_m": k, "max_displacement_m": largest}
+    never = StructureOptions(supports="service", candidates=pins, limit="L/1e9", modes=0)
+    out = plan_design(design, never).check()
+    assert out.growth.hinge_hint is None and "nor would stiffer hinges" in out.message

@@ -200,6 +200,18 @@ class StructureSettings(Group):
         "while the deflection exceeds the limit, one linear analysis each "
         "(:mod:`rigidfold.structure.service`).",
     )
+    hint_hinge_stiffness: float = setting(
+        1e6,
+        "Where ``--supports service`` pins every candidate it may and still misses the "
+        "deflection limit, the hinge stiffness (N m/rad per metre of crease) that would meet "
+        "it on those pins is searched up to this (beyond it a hinge is a rigid joint) and "
+        "named in the verdict.",
+    )
+    hint_iterations: int = setting(
+        8,
+        "Bisections, in log scale, of that search (8: the stiffness named within about 6 % "
+        "of the least that meets the limit between the design's own and the largest).",
+    )
     ground_tol: float = setting(
         1e-3,
         "``--support-candidates ground``: boundary vertices within this (m) of the lowest "

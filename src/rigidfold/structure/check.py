@@ -139,10 +139,19 @@ class StructureCheck:
             return "; --supports service pins more vertices where it deflects most"
         if self.growth is not None:
             pinned = len(self.rigidity.supports.pinned)
-            return (
+            alone = (
                 f"; pins alone did not meet it ({pinned} pinned of {self.growth.candidates} "
-                "candidates): stiffer hinges, thicker panels or other supports may"
+                "candidates)"
             )
+            hint = self.growth.hinge_hint
+            if hint is not None:
+                return (
+                    f"{alone}: hinges of {hint[0]:.2g} N m/rad per m would "
+                    f"({hint[1] * 1e3:.3g} mm), or thicker panels, or other supports"
+                )
+            if self.growth.searched_hinges:
+                return f"{alone}, nor would stiffer hinges: thicker panels or other supports may"
+            return f"{alone}: stiffer hinges, thicker panels or other supports may"
         return ""
 
     @property

@@ -110,14 +110,19 @@ class DesignPlan:
             self.pattern,
             self.rigidity,
             self.service,
-            lambda rigidity: self._check(rigidity, nonlinear=False, modes=0),
+            lambda rigidity, k: self._check(rigidity, nonlinear=False, modes=0, hinges=k),
             self.settings,
         )
         final = found if not self.nonlinear and not self.modes else self._check(found.rigidity)
         return replace(final, growth=growth)
 
     def _check(
-        self, rigidity: Rigidity, *, nonlinear: bool | None = None, modes: int | None = None
+        self,
+        rigidity: Rigidity,
+        *,
+        nonlinear: bool | None = None,
+        modes: int | None = None,
+        hinges: float | None = None,
     ) -> StructureCheck:
         return check_structure(
             self.pattern,
@@ -126,7 +131,7 @@ class DesignPlan:
             thickness=self.thickness,
             loads=self.loads,
             self_weight=self.self_weight,
-            hinge_stiffness=self.hinge_stiffness,
+            hinge_stiffness=self.hinge_stiffness if hinges is None else hinges,
             nonlinear=self.nonlinear if nonlinear is None else nonlinear,
             limit=self.limit,
             modes=self.modes if modes is None else modes,

@@ -21,6 +21,7 @@ checked as asked (``--nonlinear``, ``--modes``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -30,8 +31,9 @@ from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import StructureCheck, StructureStatus
 from rigidfold.structure.supports import Rigidity, SupportGrowth, Supports, check_supports
 
-Analyse = Callable[[Rigidity], StructureCheck]
-"""The linear structure check of the design on the supports of a :class:`Rigidity`."""
+Analyse = Callable[[Rigidity, float | None], StructureCheck]
+"""The linear structure check of the design on the supports of a :class:`Rigidity`, with
+hinges of the given stiffness (N m/rad per m; None: the design's own)."""
 
 
 def vertex_displacements(check: StructureCheck) -> np.ndarray:
@@ -81,7 +83,7 @@ def grow_supports(
                 settings,
             )
         )
-        check = analyse(rigidity)
+        check = analyse(rigidity, None)
         trail.append((step, vertex, len(pins), check.max_displacement, check.allowed_displacement))
         return check
 
@@ -112,11 +114,45 @@ def grow_supports(
                 kept.add(v)
                 _, vertex, n, largest, allowed = trail[-1]
                 trail[-1] = ("keep", vertex, n, largest, allowed)
+    searched = check.status is StructureStatus.DEFLECTION
     growth = SupportGrowth(
         rigid=rigid,
         added=np.array(added, dtype=np.int64),
         trail=tuple(trail),
         candidates=len(pool),
         passed=check.passed,
+        hinge_hint=hinge_hint(check, analyse, settings) if searched else None,
+        searched_hinges=searched,
     )
     return check, growth
+
+
+def hinge_hint(
+    check: StructureCheck, analyse: Analyse, settings: Settings = DEFAULTS
+) -> tuple[float, float] | None:
+    """(hinge stiffness N m/rad per m, its largest displacement m): about the least uniform
+    stiffness of the free creases' hinges that meets the deflection limit on the supports of
+    ``check`` (which misses it), two significant digits rounded up; None when even
+    ``Settings.structure.hint_hinge_stiffness`` does not (or the design's own is that
+    already). A bisection in log scale, ``hint_iterations`` steps, one linear analysis
+    each, assuming stiffer hinges deflect less."""
+    top = settings.structure.hint_hinge_stiffness
+    own = check.hinge_stiffness
+    if own >= top or not analyse(check.rigidity, top).passed:
+        return None
+    low, high = max(own, top * 1e-6), top
+    if own < low and analyse(check.rigidity, low).passed:
+        high = low
+    else:
+        for _ in range(settings.structure.hint_iterations):
+            mid = math.sqrt(low * high)
+            if analyse(check.rigidity, mid).passed:
+                high = mid
+            else:
+                low = mid
+    digit = 10.0 ** (math.floor(math.log10(high)) - 1)
+    rounded = min(math.ceil(high / digit - 1e-9) * digit, top)
+    named = analyse(check.rigidity, rounded)
+    if not named.passed:  # not monotone after all: name the stiffness bisected to
+        rounded, named = high, analyse(check.rigidity, high)
+    return rounded, named.max_displacement

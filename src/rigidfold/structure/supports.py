@@ -439,7 +439,9 @@ class SupportGrowth:
     pinned), then ``"drop"`` (vertex taken away again: the rest meet the limit) or
     ``"keep"`` (without it they do not); candidates : how many vertices it could pin;
     passed : whether the last set met the deflection limit (in the search's linear
-    analysis).
+    analysis). hinge_hint : (hinge stiffness N m/rad per m, its largest displacement m) that
+    meets the limit on the last set where pins alone did not, or None; searched_hinges :
+    whether that was searched (up to ``Settings.structure.hint_hinge_stiffness``).
     """
 
     rigid: np.ndarray
@@ -447,9 +449,15 @@ class SupportGrowth:
     trail: tuple[tuple[str, int, int, float, float], ...]
     candidates: int
     passed: bool
+    hinge_hint: tuple[float, float] | None = None
+    searched_hinges: bool = False
 
     def to_dict(self) -> dict:
         return {
+            "hinge_stiffness_that_meets_the_limit": None
+            if self.hinge_hint is None
+            else {"Nm_per_rad_per_m": self.hinge_hint[0], "max_displacement_m": self.hinge_hint[1]},
+            "hinge_stiffness_searched": self.searched_hinges,
             "rigid": self.rigid.tolist(),
             "added_for_deflection": self.added.tolist(),
             "candidates": self.candidates,
