@@ -166,6 +166,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             case,
             options.replace(criterion=key.criterion, seed=key.seed),
             on_solution=(lambda _run, solution: check(solution)) if every else None,
+            on_retract=(lambda _run, _solution: records.pop()) if every else None,
         )
         final = run.final
         if final is not None and final.path is None:  # the paper's method: trace it after
