@@ -60,6 +60,11 @@ def cases(which: str = "all") -> list[tuple[str, str, int]]:
     return out
 
 
+def _name(case: tuple[str, str, int]) -> str:
+    surface, pattern, seed = case
+    return f"{surface}:{Path(pattern).name}:{seed}"
+
+
 def run(case: tuple[str, str, int], deploy: bool, backtrack: int | None = None) -> dict:
     """One run of ``case``, with the check (``deploy``) and ``backtrack_max`` = ``backtrack``
     (None: the default) or with the paper's Step 5."""
@@ -110,12 +115,17 @@ def main() -> None:
         "Settings' default)",
     )
     parser.add_argument("--no-paper", action="store_true", help="only the runs with the check")
-    args = parser.parse_args()
-    backtracks = (
-        [None] if args.backtrack is None else [int(b) for b in args.backtrack.split(",")]
+    parser.add_argument(
+        "--only",
+        default=None,
+        metavar="TEXT",
+        help="only the cases whose 'surface:pattern:seed' holds TEXT (e.g. dome:miura)",
     )
+    args = parser.parse_args()
+    backtracks = [None] if args.backtrack is None else [int(b) for b in args.backtrack.split(",")]
     modes = ([] if args.no_paper else [(False, None)]) + [(True, b) for b in backtracks]
-    work = [(c, d, b) for c in cases(args.cases) for d, b in modes]
+    chosen = [c for c in cases(args.cases) if args.only is None or args.only in _name(c)]
+    work = [(c, d, b) for c in chosen for d, b in modes]
     rows = []
     with ProcessPoolExecutor(args.jobs) as pool:
         for row in pool.map(run, *zip(*work, strict=True)):

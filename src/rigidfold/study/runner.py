@@ -148,6 +148,9 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         c = verify(solution.result.pattern, run_motion=False, settings=settings)
         records.append(SolutionRecord.from_check(solution.step, solution.mechanism.dof, c))
 
+    def retract() -> None:  # backtracking retracted the last solution checked
+        records.pop()
+
     row: dict = {
         "version": __version__,
         "worker": f"{socket.gethostname()}:{os.getpid()}",
@@ -166,7 +169,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             case,
             options.replace(criterion=key.criterion, seed=key.seed),
             on_solution=(lambda _run, solution: check(solution)) if every else None,
-            on_retract=(lambda _run, _solution: records.pop()) if every else None,
+            on_retract=(lambda _run, _solution: retract()) if every else None,
         )
         final = run.final
         if final is not None and final.path is None:  # the paper's method: trace it after

@@ -273,7 +273,10 @@ class Key:
 
 
 # settings added with a default that differs from what rigidfold did before they existed
-LEGACY_SETTINGS = {"ipopt_hessian": "casadi"}
+LEGACY_SETTINGS = {"ipopt_hessian": "casadi", "backtrack_max": 0}
+# settings that change nothing without the deployability check: not compared between two
+# configurations without it (a study of the paper's Step 5 resumes whatever they are)
+CHECK_ONLY_SETTINGS = frozenset({"backtrack_max"})
 # settings that a later rigidfold removed, with what they set: a database that stored them
 # resumes, since no study ran what they tuned
 RETIRED_SETTINGS = frozenset(
@@ -310,12 +313,17 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes; so
     does an entry of the configuration itself at its value in ``LEGACY_CONFIG`` (e.g.
     ``lookahead`` false); a setting a later rigidfold removed (``RETIRED_SETTINGS``) is not
-    compared. So a study can be resumed by a newer version as long as nothing it
-    measures has changed.
+    compared, nor one that acts only with the deployability check
+    (``CHECK_ONLY_SETTINGS``) where neither configuration has it. So a study can be resumed
+    by a newer version as long as nothing it measures has changed.
     """
     from rigidfold.config import DEFAULTS
 
     defaults = DEFAULTS.flat()
+    checked = any(
+        config.get("deploy_check", LEGACY_CONFIG["deploy_check"]) for config in (stored, current)
+    )
+    inert = set() if checked else CHECK_ONLY_SETTINGS
     diff = []
     for key in sorted(set(stored) | set(current)):
         a, b = stored.get(key, LEGACY_CONFIG.get(key)), current.get(key)
@@ -324,6 +332,7 @@ def config_differences(stored: dict, current: dict) -> list[str]:
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
                 if k not in RETIRED_SETTINGS
+                and k not in inert
                 and (a.get(k, LEGACY_SETTINGS.get(k, defaults.get(k))) != b.get(k) or k not in b)
             ]
         elif a != b:
