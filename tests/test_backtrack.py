@@ -122,3 +122,26 @@ def test_studies_made_before_backtracking_resume_where_it_changes_nothing():
         assert config_differences(older, config(check, 0)) == []
         expected = ["settings.backtrack_max"] if check else []
         assert config_differences(older, config(check, None)) == expected
+
+
+def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_path):
+    """A 3 x 3 grid on the dome stops at DOF 3 (no candidate succeeds); backtracking finds no
+    lower chain, so the run ends with the one it had, and the chains it tried since leave no
+    file."""
+    case = make_case("dome", "grid:3x3")
+    plain = generate(make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0)))
+    run = generate_case(RunWriter(tmp_path, case, GenerateOptions(deform=False)), report=False)
+    assert plain.stop is run.stop is Stop.NO_CANDIDATE
+    dofs = [s.mechanism.dof for s in run.solutions]
+    assert dofs == [s.mechanism.dof for s in plain.solutions]
+    for a, b in zip(plain.solutions, run.solutions, strict=True):
+        assert a.result.F == b.result.F
+    assert len(run.attempts) > len(plain.attempts)  # it went back and tried more
+    outcomes = [a.outcome for a in run.attempts]
+    assert outcomes.count(AttemptOutcome.DEAD_END) == run.n_backtrack >= 1
+    assert outcomes.count(AttemptOutcome.ACCEPTED) == len(run.solutions)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    names = [f"step_{k:02d}_dof_{d:02d}" for k, d in enumerate(dofs)]
+    assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]
+    on_disk = sorted(p.name for p in (tmp_path / "solutions").iterdir())
+    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{n}.svg" for n in names])

@@ -83,8 +83,8 @@ class AttemptOutcome(Outcome):
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
         "dead_end",
-        "a solution retracted: no candidate of its shape gave a deployable solution (Step 7, "
-        "backtracking)",
+        "a solution retracted by backtracking: no candidate of its shape gave a deployable "
+        "solution, or a chain that reached a lower DOF was taken back (Step 7)",
     )
 
 
@@ -205,7 +205,8 @@ class Generation:
         How the run ended; ``stop_detail`` is the target DOF (TARGET_REACHED) or the outcome
         of the initial solve (INITIAL_FAILED), "" otherwise.
     n_backtrack : int
-        Solutions retracted by backtracking (their attempts' outcome DEAD_END).
+        Solutions retracted by backtracking (their attempts' outcome DEAD_END); where the
+        run ends with the chain it had before backtracking, its solutions are not counted.
     """
 
     initial_dof: int | None = None
@@ -312,6 +313,17 @@ class _Shape:
     t_sel: float = 0.0
 
 
+@dataclass
+class _Chain:
+    """The solutions of a run (and their attempts) when it stopped at their last shape, kept
+    in case backtracking ends at a higher DOF: the stop and its detail."""
+
+    solutions: list[Solution]
+    accepted: list[Attempt]
+    stop: Stop
+    detail: str
+
+
 class _Steps:
     """The steps of one generation run on its state: the problem (built once), the options,
     the run being recorded and the callbacks that see it."""
@@ -344,6 +356,7 @@ class _Steps:
         self.locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
         self.shapes: list[_Shape] = []  # Step 6 at each solution being reduced, the last on top
         self.accepted: list[Attempt] = []  # the attempt of each solution
+        self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
@@ -509,14 +522,48 @@ class _Steps:
             or run.n_backtrack >= self.settings.generation.backtrack_max
         ):
             return False
+        if self.deepest is None or _dof(run.solutions) < _dof(self.deepest.solutions):
+            self.deepest = _Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
         self.shapes.pop()
+        self.retract()
+        run.stop_detail = ""
+        return True
+
+    def retract(self) -> None:
+        """Take back the last solution: its attempt's outcome becomes DEAD_END."""
+        run = self.run
         solution = run.solutions.pop()
         self.accepted.pop().outcome = AttemptOutcome.DEAD_END
         run.n_backtrack += 1
-        run.stop_detail = ""
         if self.on_retract:
             self.on_retract(run, solution)
-        return True
+
+    def settle(self, stop: Stop) -> None:
+        """The run ends with ``stop`` at its last shape; where backtracking had left a chain
+        that reached a lower DOF (:attr:`deepest`), that chain is taken back instead (the
+        solutions found since are retracted, its own accepted again) with its stop."""
+        run, deepest = self.run, self.deepest
+        if deepest is None or _dof(deepest.solutions) >= _dof(run.solutions):
+            run.stop = stop
+            return
+        common = 0
+        for a, b in zip(deepest.solutions, run.solutions, strict=False):
+            if a is not b:
+                break
+            common += 1
+        while len(run.solutions) > common:
+            self.retract()
+        for solution, rec in zip(
+            deepest.solutions[common:], deepest.accepted[common:], strict=True
+        ):
+            rec.outcome = AttemptOutcome.ACCEPTED
+            run.n_backtrack -= 1  # no longer retracted
+            assert solution.step == len(run.solutions)  # the chains share what is before
+            run.solutions.append(solution)
+            self.accepted.append(rec)
+            if self.on_solution:
+                self.on_solution(run, solution)
+        run.stop, run.stop_detail = deepest.stop, deepest.detail
 
 
 @one_blas_thread()  # the same path on every machine (see one_blas_thread)
@@ -558,10 +605,15 @@ def generate(
     while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
         stop = steps.reduce(run.solutions[-1])
         if stop is not None and not steps.backtrack(stop):
-            run.stop = stop
+            steps.settle(stop)
             return _deployable_final(run, opts, case.settings)
     run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
     return run
+
+
+def _dof(solutions: list[Solution]) -> int:
+    """The DOF of a chain's last solution."""
+    return solutions[-1].mechanism.dof
 
 
 def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
