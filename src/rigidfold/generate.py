@@ -23,7 +23,9 @@ times a run): when every candidate of a shape after the first fails, its solutio
 retracted (its attempt's outcome becomes DEAD_END, and it leaves ``Generation.solutions``)
 and Step 7 resumes at the shape before it with that shape's remaining candidates, in the
 order ranked there (each shape's ranking is kept on a stack; nothing is ranked or tried
-again). Without the check, or with ``backtrack_max = 0``, Step 7 is the paper's.
+again). A run whose backtracking ends at a higher DOF than the chain it retracted ends with
+that chain instead (the solutions found since are retracted). Without the check, or with
+``backtrack_max = 0``, Step 7 is the paper's.
 
 With ``lookahead=True`` (any criterion), Step 6 forecasts, at the last accepted shape, the
 creases each candidate would lock at first order (:func:`rigidfold.selection.lock_forecast`,
