@@ -155,6 +155,7 @@ def _attempts(plt, run: RunData):
     top.set_title(
         f"DOF and F per attempt: N_lock = {run.summary.n_lock}, "
         f"N_exceed = {run.summary.n_exceed}, N_path = {run.summary.n_path or 0}"
+        + (f", retracted {run.summary.n_backtrack}" if run.summary.n_backtrack else "")
     )
     bottom.legend(fontsize=7, loc="best")
     return (
