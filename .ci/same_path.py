@@ -21,8 +21,8 @@ COMMAND = [
     "generate", "--surface", "bezier", "--seed", "1", "--pattern", "1", "--criterion", "shat",
     "--no-deform",
 ]  # fmt: skip
-COMPARED = ("N_reduce", "N_lock", "N_exceed", "N_path", "n_solves", "final_dof",
-            "mean_F_accepted", "mean_F_all_solves", "final_deploys")  # fmt: skip
+COMPARED = ("N_reduce", "N_lock", "N_exceed", "N_path", "N_backtrack", "n_solves",
+            "final_dof", "mean_F_accepted", "mean_F_all_solves", "final_deploys")  # fmt: skip
 PINS = ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "NPY_ENABLE_CPU_FEATURES",
         "NPY_DISABLE_CPU_FEATURES", "GLIBC_TUNABLES", "RIGIDFOLD_NUMERICS",
         "RIGIDFOLD_NUMERICS_RESTARTED")  # fmt: skip

@@ -19,7 +19,15 @@ from rigidfold.study import legacy_stop
 # the values that JSON files and study databases of every version hold
 VALUES = {
     Status: ["converged", "tolerance_not_met", "infeasible", "iteration_limit", "failed"],
-    AttemptOutcome: ["accepted", "exceed", "lock", "zero_dof", "path", "initial_failed"],
+    AttemptOutcome: [
+        "accepted",
+        "exceed",
+        "lock",
+        "zero_dof",
+        "path",
+        "initial_failed",
+        "dead_end",
+    ],
     PathStatus: [
         "flat",
         "turned_back",

@@ -45,6 +45,13 @@ GENERATE_DEFAULTS = GenerateOptions()
 """The defaults of ``generate``'s options (criterion, target DOF, solver, check)."""
 
 EXIT_USAGE = 2
+BACKTRACK_HELP = (
+    "with the deployability check: how many times a run may retract a solution whose shape "
+    "had no deployable candidate and resume at the shape before, with its next candidates "
+    f"(default: {DEFAULTS.generation.backtrack_max}; 0: never, as in the paper's Step 7)"
+)
+
+
 LOOKAHEAD_HELP = (
     "skip the candidate creases whose fix would lock another crease at first order, or "
     "locked one at an earlier shape (tried only once every other candidate failed, first "
@@ -231,6 +238,7 @@ def build_parser() -> argparse.ArgumentParser:
         f"{DEFAULTS.generation.deploy_check_max_dof}) whose path does not reach the flat state is "
         "replaced like a lock and counted in N_path)",
     )
+    gen.add_argument("--backtrack", type=int, metavar="N", help=BACKTRACK_HELP)
     gen.add_argument(
         "--check",
         choices=CHECKS,
@@ -481,6 +489,7 @@ def build_parser() -> argparse.ArgumentParser:
         "does by default (N_path); without it the study runs the paper's Step 5 and traces "
         "only each final design's path (whether it deploys)",
     )
+    stu.add_argument("--backtrack", type=int, metavar="N", help=BACKTRACK_HELP)
     stu.add_argument(
         "--hessian",
         default=DEFAULTS.solver.ipopt_hessian,
@@ -674,6 +683,12 @@ def _case_options(p: argparse.ArgumentParser, *, out: str) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help=out)
 
 
+def _backtrack(args: argparse.Namespace) -> dict:
+    """``backtrack_max`` of ``--backtrack`` where given (checked by Settings), else {}."""
+    value = getattr(args, "backtrack", None)
+    return {} if value is None else {"backtrack_max": value}
+
+
 def _case(args: argparse.Namespace):
     from rigidfold.case import make_case
     from rigidfold.config import Settings
@@ -688,6 +703,7 @@ def _case(args: argparse.Namespace):
         theta_max_deg=args.theta_max,
         rho_bar_deg=args.rho_max,
         zero_dof_ends=not getattr(args, "retry_zero_dof", False),
+        **_backtrack(args),
         ipopt_hessian=args.hessian,
         svg_snap_tol=args.svg_tolerance,
     )
@@ -993,7 +1009,9 @@ def _cmd_study(args: argparse.Namespace) -> int:
         run_study_command,
     )
 
-    settings = DEFAULTS.with_(ipopt_hessian=args.hessian, svg_snap_tol=args.svg_tolerance)
+    settings = DEFAULTS.with_(
+        ipopt_hessian=args.hessian, svg_snap_tol=args.svg_tolerance, **_backtrack(args)
+    )
     if args.preset is not None:
         keys = preset(args.preset)
     else:

@@ -18,6 +18,15 @@
 Generation ends when the target DOF is reached, at DOF 0, or when no candidate succeeds.
 The NLP is built once; every solve starts from the last accepted shape.
 
+With the deployability check, Step 7 may backtrack (``Settings.generation.backtrack_max``
+times a run): when every candidate of a shape after the first fails, its solution is
+retracted (its attempt's outcome becomes DEAD_END, and it leaves ``Generation.solutions``)
+and Step 7 resumes at the shape before it with that shape's remaining candidates, in the
+order ranked there (each shape's ranking is kept on a stack; nothing is ranked or tried
+again). A run whose backtracking ends at a higher DOF than the chain it retracted ends with
+that chain instead (the solutions found since are retracted). Without the check, or with
+``backtrack_max = 0``, Step 7 is the paper's.
+
 With ``lookahead=True`` (any criterion), Step 6 forecasts, at the last accepted shape, the
 creases each candidate would lock at first order (:func:`rigidfold.selection.lock_forecast`,
 block by block of the ranking as the candidates are reached); candidates predicted to lock,
@@ -74,6 +83,11 @@ class AttemptOutcome(Outcome):
         "the shape's rigid-folding path does not reach the flat state (Step 5, N_path)",
     )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
+    DEAD_END = (
+        "dead_end",
+        "a solution retracted by backtracking: no candidate of its shape gave a deployable "
+        "solution, or a chain that reached a lower DOF was taken back (Step 7)",
+    )
 
 
 class Stop(Outcome):
@@ -192,6 +206,9 @@ class Generation:
     stop : Stop
         How the run ended; ``stop_detail`` is the target DOF (TARGET_REACHED) or the outcome
         of the initial solve (INITIAL_FAILED), "" otherwise.
+    n_backtrack : int
+        Solutions retracted by backtracking (their attempts' outcome DEAD_END); where the
+        run ends with the chain it had before backtracking, its solutions are not counted.
     """
 
     initial_dof: int | None = None
@@ -200,6 +217,7 @@ class Generation:
     n_lock: int = 0
     n_exceed: int = 0
     n_path: int = 0
+    n_backtrack: int = 0
     deploy_check: bool = False
     final_step: int | None = None
     stop: Stop = Stop.RUNNING
@@ -251,6 +269,7 @@ class Generation:
             "N_lock": self.n_lock,
             "N_exceed": self.n_exceed,
             "N_path": self.n_path,
+            "N_backtrack": self.n_backtrack,
             "deploy_check": self.deploy_check,
             "final_step": None if self.final is None else self.final.step,
             "final_deploys": (
@@ -282,6 +301,31 @@ class _Trial:
     path: FoldingPath | None
 
 
+@dataclass
+class _Shape:
+    """Step 6 at one accepted shape, kept while the shape may be reduced again: the ranked
+    crease groups with their scores, the candidates not yet tried (an iterator, lazy with
+    look-ahead), the candidates whose paths did not reach the flat state, and the seconds of
+    selection not yet charged to an attempt."""
+
+    solution: Solution
+    ranked: list
+    order: Iterator[Choice]
+    undeployable: int = 0
+    t_sel: float = 0.0
+
+
+@dataclass
+class _Chain:
+    """The solutions of a run (and their attempts) when it stopped at their last shape, kept
+    in case backtracking ends at a higher DOF: the stop and its detail."""
+
+    solutions: list[Solution]
+    accepted: list[Attempt]
+    stop: Stop
+    detail: str
+
+
 class _Steps:
     """The steps of one generation run on its state: the problem (built once), the options,
     the run being recorded and the callbacks that see it."""
@@ -292,9 +336,10 @@ class _Steps:
         options: GenerateOptions,
         on_attempt: Callable[[Generation, Attempt], None] | None,
         on_solution: Callable[[Generation, Solution], None] | None,
+        on_retract: Callable[[Generation, Solution], None] | None = None,
     ) -> None:
         self.case, self.options, self.settings = case, options, case.settings
-        self.on_attempt, self.on_solution = on_attempt, on_solution
+        self.on_attempt, self.on_solution, self.on_retract = on_attempt, on_solution, on_retract
         self.rng = np.random.default_rng(options.seed)
         self.run = Generation(
             numerics=numeric_environment().to_dict(), deploy_check=options.deploy_check
@@ -311,6 +356,9 @@ class _Steps:
             self.settings.generation.zero_dof_ends and not options.deploy_check
         ) or options.target_dof == 0
         self.locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
+        self.shapes: list[_Shape] = []  # Step 6 at each solution being reduced, the last on top
+        self.accepted: list[Attempt] = []  # the attempt of each solution
+        self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
@@ -379,6 +427,7 @@ class _Steps:
             assert trial.mechanism is not None  # a solution was analysed
             sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
             run.solutions.append(sol)
+            self.accepted.append(rec)
             if self.on_solution:
                 self.on_solution(run, sol)
 
@@ -430,13 +479,17 @@ class _Steps:
 
     def reduce(self, current: Solution) -> Stop | None:
         """Steps 6-7 at the shape ``current``: fix the best candidate, replacing it with the
-        next on failure, until one is accepted (None) or the run ends (its Stop)."""
-        ranked, order, t_sel = self.rank(current)
-        undeployable = 0  # candidates of this shape whose paths do not reach the flat state
+        next on failure, until one is accepted (None) or the run ends (its Stop). At a shape
+        reduced before (backtracking returned to it), the candidates not yet tried."""
+        if not self.shapes or self.shapes[-1].solution is not current:
+            ranked, order, t_sel = self.rank(current)
+            self.shapes.append(_Shape(current, ranked, order, t_sel=t_sel))
+        shape = self.shapes[-1]
+        ranked, order = shape.ranked, shape.order
         while True:
             t1 = time.perf_counter()
             choice = next(order, None)  # look-ahead: lazy forecast
-            t_sel += time.perf_counter() - t1
+            shape.t_sel += time.perf_counter() - t1
             if choice is None:
                 return Stop.NO_CANDIDATE
             group, score = ranked[choice.index]
@@ -444,17 +497,75 @@ class _Steps:
             trial_fixed = current.result.pattern.fixed.copy()
             trial_fixed[list(fix)] = True
             rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
-            rec.selection_time, t_sel = t_sel, 0.0
+            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
             self.annotate(rec, choice, ranked, current)
             self.record(rec, trial)
             if self.is_solution(rec):
                 return None
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
-            undeployable += rec.outcome is AttemptOutcome.PATH
-            if undeployable >= self.settings.generation.deploy_max_candidates > 0:  # bounded cost
-                self.run.stop_detail = str(undeployable)
+            shape.undeployable += rec.outcome is AttemptOutcome.PATH
+            limit = self.settings.generation.deploy_max_candidates
+            if shape.undeployable >= limit > 0:  # bounded cost
+                self.run.stop_detail = str(shape.undeployable)
                 return Stop.NO_DEPLOYABLE
+
+    def backtrack(self, stop: Stop) -> bool:
+        """Step 7 beyond the last fix: after ``stop`` at the last solution's shape, retract
+        that solution (not the initial shape's) while the run's budget
+        (``Settings.generation.backtrack_max``) lasts and the deployability check runs; its
+        attempt's outcome becomes DEAD_END. Returns whether it did (then the shape before it
+        is reduced again)."""
+        run = self.run
+        if (
+            not self.options.deploy_check
+            or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
+            or len(run.solutions) < 2
+            or run.n_backtrack >= self.settings.generation.backtrack_max
+        ):
+            return False
+        if self.deepest is None or _dof(run.solutions) < _dof(self.deepest.solutions):
+            self.deepest = _Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
+        self.shapes.pop()
+        self.retract()
+        run.stop_detail = ""
+        return True
+
+    def retract(self) -> None:
+        """Take back the last solution: its attempt's outcome becomes DEAD_END."""
+        run = self.run
+        solution = run.solutions.pop()
+        self.accepted.pop().outcome = AttemptOutcome.DEAD_END
+        run.n_backtrack += 1
+        if self.on_retract:
+            self.on_retract(run, solution)
+
+    def settle(self, stop: Stop) -> None:
+        """The run ends with ``stop`` at its last shape; where backtracking had left a chain
+        that reached a lower DOF (:attr:`deepest`), that chain is taken back instead (the
+        solutions found since are retracted, its own accepted again) with its stop."""
+        run, deepest = self.run, self.deepest
+        if deepest is None or _dof(deepest.solutions) >= _dof(run.solutions):
+            run.stop = stop
+            return
+        common = 0
+        for a, b in zip(deepest.solutions, run.solutions, strict=False):
+            if a is not b:
+                break
+            common += 1
+        while len(run.solutions) > common:
+            self.retract()
+        for solution, rec in zip(
+            deepest.solutions[common:], deepest.accepted[common:], strict=True
+        ):
+            rec.outcome = AttemptOutcome.ACCEPTED
+            run.n_backtrack -= 1  # no longer retracted
+            assert solution.step == len(run.solutions)  # the chains share what is before
+            run.solutions.append(solution)
+            self.accepted.append(rec)
+            if self.on_solution:
+                self.on_solution(run, solution)
+        run.stop, run.stop_detail = deepest.stop, deepest.detail
 
 
 @one_blas_thread()  # the same path on every machine (see one_blas_thread)
@@ -464,9 +575,13 @@ def generate(
     *,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
+    on_retract: Callable[[Generation, Solution], None] | None = None,
     **changes,
 ) -> Generation:
-    """Run Steps 2-7 on a case; callbacks see every attempt and every accepted solution.
+    """Run Steps 2-7 on a case; callbacks see every attempt, every accepted solution and
+    every solution retracted by backtracking (``on_retract``, after it has left
+    ``run.solutions`` and its attempt's outcome became DEAD_END: the last solution seen by
+    ``on_solution``; the next solution takes its step).
 
     ``options`` (default :class:`GenerateOptions`'s defaults) with ``changes`` to its fields
     given as keywords, e.g. ``generate(case, criterion="s", target_dof=2)``. With mirror
@@ -477,7 +592,7 @@ def generate(
     """
     opts = (options or GenerateOptions()).replace(**changes)
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
-    steps = _Steps(case, opts, on_attempt, on_solution)
+    steps = _Steps(case, opts, on_attempt, on_solution, on_retract)
     run = steps.run
     # Steps 2-5 for the triangulated target surface
     rec, trial = steps.solve(case.pattern.fixed.copy(), None, (), None)
@@ -491,11 +606,16 @@ def generate(
     steps.record(rec, trial)
     while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
         stop = steps.reduce(run.solutions[-1])
-        if stop is not None:
-            run.stop = stop
+        if stop is not None and not steps.backtrack(stop):
+            steps.settle(stop)
             return _deployable_final(run, opts, case.settings)
     run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
     return run
+
+
+def _dof(solutions: list[Solution]) -> int:
+    """The DOF of a chain's last solution."""
+    return solutions[-1].mechanism.dof
 
 
 def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:

@@ -48,7 +48,8 @@ class GenerateProgress:
     at most every ``log_every`` seconds and at the end.
 
     run : rigidfold.generate.Generation (``initial_dof``, ``n_reduce``, ``final_dof``,
-    ``n_lock``, ``n_exceed``, ``n_path`` are read); attempt : rigidfold.generate.Attempt or
+    ``n_lock``, ``n_exceed``, ``n_path``, ``n_backtrack`` are read; the DOF removed falls
+    back when backtracking retracts a solution); attempt : rigidfold.generate.Attempt or
     None (``solve_time``, ``analysis_time``, ``path_time``: the folding path traced for the
     deployability check).
     """
@@ -64,13 +65,15 @@ class GenerateProgress:
         self.costs: tuple[float, float, float] | None = None
 
     def counts(self, run) -> tuple[int, int, str]:
-        """(DOF removed, DOF to remove, "DOF d  lock l  exceed e") of a run."""
+        """(DOF removed, DOF to remove, "DOF d  lock l  exceed e  path p [back b]") of a
+        run."""
         total = max(run.initial_dof - self.target, 0)
         dof = run.initial_dof if run.final_dof is None else run.final_dof  # before a solution
         return (
             min(run.n_reduce, total),
             total,
-            (f"DOF {dof}  lock {run.n_lock}  exceed {run.n_exceed}  path {run.n_path}"),
+            f"DOF {dof}  lock {run.n_lock}  exceed {run.n_exceed}  path {run.n_path}"
+            + (f"  back {run.n_backtrack}" if getattr(run, "n_backtrack", 0) else ""),
         )
 
     def describe(self, run, elapsed: float) -> tuple[int, int, str]:

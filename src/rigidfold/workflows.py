@@ -333,7 +333,8 @@ def generate_case(
     report: bool = True,
 ) -> Generation:
     """Steps 2-9 on ``writer.case`` with ``writer.options``, every attempt and solution
-    written by ``writer`` as it comes (so an interrupt loses nothing); ``progress(run,
+    written by ``writer`` as it comes (so an interrupt loses nothing), a solution retracted
+    by backtracking removed (:meth:`rigidfold.run.RunWriter.on_retract`); ``progress(run,
     attempt)`` after each of them. ``summary.json`` is written once more at the end, with
     the run's verdict (``writer.verdict``, :func:`rigidfold.run.run_verdict`); then, with
     ``report``, ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is
@@ -353,8 +354,19 @@ def generate_case(
         if progress:
             progress(run, None)
 
+    def on_retract(run: Generation, solution) -> None:
+        writer.on_retract(run, solution)
+        if progress:
+            progress(run, None)
+
     try:
-        run = generate(writer.case, writer.options, on_attempt=on_attempt, on_solution=on_solution)
+        run = generate(
+            writer.case,
+            writer.options,
+            on_attempt=on_attempt,
+            on_solution=on_solution,
+            on_retract=on_retract,
+        )
         writer.finish(run)
         if report:
             report_run(writer.out)

@@ -107,6 +107,21 @@ class GenerationSettings(Group):
         "all): every candidate costs a solve and a trace, and a shape whose first candidates "
         "all fail rarely has a deployable one further down the ranking.",
     )
+    backtrack_max: int = setting(
+        3,
+        "With the deployability check: retractions a run may make (0: none, the paper's Step "
+        "7). When every candidate of a shape after the first fails (``Stop.NO_DEPLOYABLE`` or "
+        "``Stop.NO_CANDIDATE``), the solution of that shape is retracted (its attempt's "
+        "outcome becomes ``dead_end``) and generation resumes at the shape before it with that "
+        "shape's remaining candidates, in their ranked order. Without the check it does "
+        "nothing.",
+    )
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.backtrack_max, int) and self.backtrack_max >= 0):
+            raise RigidfoldError(
+                f"backtrack_max must be a whole number >= 0, got {self.backtrack_max!r}"
+            )
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ OUTCOME_STYLE = {
     "zero_dof": ("s", "#9467bd", "DOF 0"),
     "path": ("P", "#8c564b", "folding path does not reach flat (N_path)"),
     "initial_failed": ("D", "#7f7f7f", "initial solve failed"),
+    "dead_end": ("*", "#e377c2", "retracted: no deployable candidate at its shape"),
 }
 """Attempt outcome -> (marker, colour, legend label)."""
 
@@ -154,6 +155,7 @@ def _attempts(plt, run: RunData):
     top.set_title(
         f"DOF and F per attempt: N_lock = {run.summary.n_lock}, "
         f"N_exceed = {run.summary.n_exceed}, N_path = {run.summary.n_path or 0}"
+        + (f", retracted {run.summary.n_backtrack}" if run.summary.n_backtrack else "")
     )
     bottom.legend(fontsize=7, loc="best")
     return (
@@ -161,7 +163,8 @@ def _attempts(plt, run: RunData):
         "DOF and F per attempt",
         "Every solve of problem (6) in the order made (log.json): the DOF of the shape found "
         "and its objective F. Red crosses and lines mark the lock events (a crease locked, the "
-        "fix replaced, Step 7).",
+        "fix replaced, Step 7); pink stars, solutions retracted by backtracking (no candidate "
+        "of their shape gave a deployable solution).",
     )
 
 

@@ -131,6 +131,7 @@ def _answer(run: RunData) -> list[str]:
         ("target DOF", "–" if target is None else str(target)),
         ("N_lock", str(s.n_lock)),
         *((("N_path", str(s.n_path)),) if s.deploy_check else ()),
+        *((("retracted (backtracking)", str(s.n_backtrack)),) if s.n_backtrack else ()),
         (
             "deploys",
             "–"
@@ -363,7 +364,8 @@ def _figure(figure: Figure) -> str:
 def _tables(run: RunData) -> list[str]:
     s = run.summary.document
     run_keys = (
-        "stop_reason initial_dof final_dof N_reduce N_lock N_exceed N_path deploy_check "
+        "stop_reason initial_dof final_dof N_reduce N_lock N_exceed N_path N_backtrack "
+        "deploy_check "
         "final_deploys n_solutions n_solves n_skipped mean_F_accepted mean_F_all_solves"
     ).split()
     blocks = [("Run", _pairs({k: s.get(k) for k in run_keys if k in s}))]

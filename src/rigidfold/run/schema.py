@@ -55,6 +55,7 @@ SUMMARY_SHAPE = Record(
         "N_lock": Nullable(int),
         "N_exceed": Nullable(int),
         "N_path": Nullable(int),
+        "N_backtrack": Nullable(int),
         "deploy_check": Nullable(bool),
         "final_step": Nullable(int),
         "final_deploys": Nullable(bool),
@@ -469,7 +470,8 @@ class RunSummary:
 
     stop, stop_reason : how the run ended (:class:`rigidfold.generate.Stop` value and words);
     initial_dof, final_dof, n_reduce, n_lock, n_exceed, n_path : the paper's counters and
-    N_path (None in a file without them); deploy_check : whether the deployability check
+    N_path (None in a file without them); n_backtrack : the solutions retracted by
+    backtracking (None in a file written before it); deploy_check : whether the deployability check
     ran; final_step, final_deploys : the final design's step and whether its path reaches
     the flat state; solutions : the solution files, relative to the run's directory;
     per_solution : their records; case, options : the case's metadata and the generate
@@ -487,6 +489,7 @@ class RunSummary:
     n_lock: int | None
     n_exceed: int | None
     n_path: int | None
+    n_backtrack: int | None
     deploy_check: bool
     final_step: int | None
     final_deploys: bool | None
@@ -517,6 +520,7 @@ class RunSummary:
             n_lock=data["N_lock"],
             n_exceed=data.get("N_exceed"),
             n_path=data.get("N_path"),
+            n_backtrack=data.get("N_backtrack"),
             deploy_check=bool(data.get("deploy_check")),
             final_step=data.get("final_step"),
             final_deploys=data.get("final_deploys"),

@@ -189,6 +189,21 @@ class RunWriter:
         self.files.append(self._write_solution(solution, deform=deform, motion=full))
         self.write_summary(run)
 
+    def on_retract(self, run: Generation, solution: Solution) -> None:
+        """Backtracking retracted the last solution: its FOLD and SVG files leave
+        ``solutions/`` and its record summary.json (the run stays a chain, and the next
+        solution takes its step); log.json keeps its attempt, with the outcome DEAD_END."""
+        assert self.solutions and self.solutions[-1] is solution, "not the last solution"
+        self.solutions.pop()
+        self.records.pop()
+        self.developments.pop(solution.step, None)
+        self.motions.pop(solution.step, None)
+        fold = self.files.pop()
+        for path in (fold, fold.with_suffix(".svg")):
+            path.unlink(missing_ok=True)
+        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
+        self.write_summary(run)
+
     def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
         """Check one solution (Step 8; the motion and Step 9 as asked) and write its FOLD and
         SVG files; its record replaces ``records[solution.step]``. Returns the FOLD path."""

@@ -148,6 +148,9 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         c = verify(solution.result.pattern, run_motion=False, settings=settings)
         records.append(SolutionRecord.from_check(solution.step, solution.mechanism.dof, c))
 
+    def retract() -> None:  # backtracking retracted the last solution checked
+        records.pop()
+
     row: dict = {
         "version": __version__,
         "worker": f"{socket.gethostname()}:{os.getpid()}",
@@ -166,6 +169,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             case,
             options.replace(criterion=key.criterion, seed=key.seed),
             on_solution=(lambda _run, solution: check(solution)) if every else None,
+            on_retract=(lambda _run, _solution: retract()) if every else None,
         )
         final = run.final
         if final is not None and final.path is None:  # the paper's method: trace it after
@@ -198,6 +202,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         time_analysis=s["time_s"]["analysis"],
         time_selection=s["time_s"]["selection"],
         n_path=s["N_path"],
+        n_backtrack=s["N_backtrack"],
         final_deploys=None if final is None or final.path is None else int(final.path.deploys),
         time_path=s["time_s"]["path"] + row.pop("time_path_final", 0.0),
     )

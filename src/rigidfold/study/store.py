@@ -91,6 +91,7 @@ ADDED_RUN_COLUMNS = {
     "final_deploys": "INTEGER",
     "time_path": "REAL",
     "stop": "TEXT",
+    "n_backtrack": "INTEGER",
 }
 """Columns of ``runs`` added later, as :data:`ADDED_ATTEMPT_COLUMNS`: ``numerics`` is the
 key of the numeric environment of the worker that computed the run
@@ -99,7 +100,9 @@ because their folding path does not reach the flat state (N_path, 0 without the
 deployability check), ``final_deploys`` whether the final design's folding path reaches the
 flat state (1 or 0), ``time_path`` the seconds of tracing; NULL for runs of older
 versions. ``stop`` is the :class:`~rigidfold.generate.Stop` value (NULL for an error),
-filled for the runs of older versions when the database is opened for writing."""
+filled for the runs of older versions when the database is opened for writing.
+``n_backtrack`` the solutions retracted by backtracking (``generate.Generation.n_backtrack``;
+NULL for runs of older versions, which did not backtrack)."""
 ADDED_COLUMNS = {"attempts": ADDED_ATTEMPT_COLUMNS, "runs": ADDED_RUN_COLUMNS}
 JSON_ATTEMPT_FIELDS = (
     "fixed_added",
@@ -182,10 +185,10 @@ class RunRow:
 
     study, seed, pattern, criterion, symmetric : its :class:`Key`; stop : how it ended
     (None: it could not run, ``status`` then "error: <message>"); status : the words; the
-    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, the final
-    design's ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9
-    figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the
-    times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
+    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_backtrack``,
+    the final design's ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the
+    Step 8-9 figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``),
+    the times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
     ``numerics``); a figure the run (or its version) did not record is None.
     """
 
@@ -221,6 +224,7 @@ class RunRow:
     n_path: int | None = None
     final_deploys: int | None = None
     time_path: float | None = None
+    n_backtrack: int | None = None
 
     @property
     def key(self) -> Key:
@@ -273,7 +277,10 @@ class Key:
 
 
 # settings added with a default that differs from what rigidfold did before they existed
-LEGACY_SETTINGS = {"ipopt_hessian": "casadi"}
+LEGACY_SETTINGS = {"ipopt_hessian": "casadi", "backtrack_max": 0}
+# settings that change nothing without the deployability check: not compared between two
+# configurations without it (a study of the paper's Step 5 resumes whatever they are)
+CHECK_ONLY_SETTINGS = frozenset({"backtrack_max"})
 # settings that a later rigidfold removed, with what they set: a database that stored them
 # resumes, since no study ran what they tuned
 RETIRED_SETTINGS = frozenset(
@@ -310,12 +317,17 @@ def config_differences(stored: dict, current: dict) -> list[str]:
     or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes; so
     does an entry of the configuration itself at its value in ``LEGACY_CONFIG`` (e.g.
     ``lookahead`` false); a setting a later rigidfold removed (``RETIRED_SETTINGS``) is not
-    compared. So a study can be resumed by a newer version as long as nothing it
-    measures has changed.
+    compared, nor one that acts only with the deployability check
+    (``CHECK_ONLY_SETTINGS``) where neither configuration has it. So a study can be resumed
+    by a newer version as long as nothing it measures has changed.
     """
     from rigidfold.config import DEFAULTS
 
     defaults = DEFAULTS.flat()
+    checked = any(
+        config.get("deploy_check", LEGACY_CONFIG["deploy_check"]) for config in (stored, current)
+    )
+    inert = set() if checked else CHECK_ONLY_SETTINGS
     diff = []
     for key in sorted(set(stored) | set(current)):
         a, b = stored.get(key, LEGACY_CONFIG.get(key)), current.get(key)
@@ -324,6 +336,7 @@ def config_differences(stored: dict, current: dict) -> list[str]:
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
                 if k not in RETIRED_SETTINGS
+                and k not in inert
                 and (a.get(k, LEGACY_SETTINGS.get(k, defaults.get(k))) != b.get(k) or k not in b)
             ]
         elif a != b:

@@ -144,7 +144,8 @@ def locks_by_stage(store: Store) -> list[dict]:
         c["seeds"].add(seed)
         stage = None  # the DOF of the last accepted shape of this run
         for dof, outcome in attempts:
-            if outcome == AttemptOutcome.ACCEPTED:
+            # a solution retracted later (DEAD_END) was the shape reduced until then
+            if outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END):
                 stage = dof
             elif outcome == AttemptOutcome.LOCK and stage is not None:
                 for k, (lo, hi) in enumerate(STAGES):

@@ -1,0 +1,147 @@
+"""Backtracking in Step 7 (``Settings.generation.backtrack_max``): a shape after the first
+whose candidates give no deployable solution retracts its solution, and generation resumes at
+the shape before with that shape's remaining candidates; the run stays a chain, on disk too.
+
+The case: pattern 1 on Bezier seed 102 (S-hat, look-ahead) with ``deploy_max_candidates = 1``,
+so that one folding path that does not reach the flat state gives a shape up (seconds).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from conftest import main_code, paper_generate
+from rigidfold.case import make_case
+from rigidfold.config import DEFAULTS
+from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop, generate
+from rigidfold.run import RunWriter, load_run
+from rigidfold.workflows import generate_case
+
+SEED = 102
+OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False)
+
+
+def _case(backtrack_max: int):
+    settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max)
+    return make_case("bezier", "1", seed=SEED, settings=settings)
+
+
+@pytest.fixture(scope="module")
+def backtracked(tmp_path_factory):
+    out = tmp_path_factory.mktemp("backtrack")
+    writer = RunWriter(out, _case(DEFAULTS.generation.backtrack_max), OPTIONS)
+    run = generate_case(writer, report=True)
+    return out, run
+
+
+def test_a_backtracking_run_ends_with_a_chain(backtracked):
+    _, run = backtracked
+    assert run.n_backtrack >= 1
+    assert run.n_backtrack <= DEFAULTS.generation.backtrack_max
+    outcomes = [a.outcome for a in run.attempts]
+    assert outcomes.count(AttemptOutcome.DEAD_END) == run.n_backtrack
+    assert outcomes.count(AttemptOutcome.ACCEPTED) == len(run.solutions)
+    assert [s.step for s in run.solutions] == list(range(len(run.solutions)))
+    for before, after in zip(run.solutions, run.solutions[1:], strict=False):
+        fixed_before = before.result.pattern.fixed
+        fixed_after = after.result.pattern.fixed
+        assert np.all(fixed_after[fixed_before])  # every fix of the chain is kept
+        assert fixed_after.sum() > fixed_before.sum()
+        assert after.mechanism.dof <= before.mechanism.dof
+    # the retracted solutions were accepted shapes of the run
+    for attempt in run.attempts:
+        if attempt.outcome is AttemptOutcome.DEAD_END:
+            assert attempt.dof is not None and attempt.dof >= 1
+    assert run.to_dict()["N_backtrack"] == run.n_backtrack
+
+
+def test_the_run_directory_holds_only_the_chain(backtracked):
+    out, run = backtracked
+    summary = json.loads((out / "summary.json").read_text())
+    log = json.loads((out / "log.json").read_text())["attempts"]
+    assert summary["N_backtrack"] == run.n_backtrack
+    assert sum(a["outcome"] == "dead_end" for a in log) == run.n_backtrack
+    assert len(log) == len(run.attempts)
+    names = [f"step_{s.step:02d}_dof_{s.mechanism.dof:02d}" for s in run.solutions]
+    assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]
+    assert [r["step"] for r in summary["per_solution"]] == list(range(len(run.solutions)))
+    on_disk = sorted(p.name for p in (out / "solutions").iterdir())
+    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{n}.svg" for n in names])
+    assert summary["n_solutions"] == len(run.solutions)
+    # it reads back, and the report (written by the run) is made again from it
+    data = load_run(out)
+    assert data.summary.n_backtrack == run.n_backtrack
+    assert (out / "report.html").is_file()
+    assert main_code(["report", str(out)]) == 0
+
+
+def test_no_backtracking_is_the_run_without_it(backtracked):
+    """backtrack_max = 0: the run ends where the backtracking run first retracted, with the
+    same attempts up to there (the same F, to the last digit)."""
+    _, run = backtracked
+    plain = generate(_case(0), OPTIONS)
+    assert plain.n_backtrack == 0 and plain.stop is Stop.NO_DEPLOYABLE
+    assert AttemptOutcome.DEAD_END not in [a.outcome for a in plain.attempts]
+    first = next(i for i, a in enumerate(run.attempts) if a.outcome is AttemptOutcome.DEAD_END)
+    assert len(plain.attempts) > first
+    for a, b in zip(plain.attempts, run.attempts, strict=False):
+        assert a.F == b.F and a.fixed_added == b.fixed_added
+        assert a.outcome == b.outcome or b.outcome is AttemptOutcome.DEAD_END
+
+
+def test_without_the_check_nothing_is_retracted():
+    run = paper_generate(_case(DEFAULTS.generation.backtrack_max), criterion="shat", seed=SEED)
+    assert run.n_backtrack == 0 and run.final_dof == 1
+    assert AttemptOutcome.DEAD_END not in [a.outcome for a in run.attempts]
+
+
+def test_backtrack_max_is_checked():
+    with pytest.raises(ValueError, match="backtrack_max"):
+        DEFAULTS.with_(backtrack_max=-1)
+
+
+def test_studies_made_before_backtracking_resume_where_it_changes_nothing():
+    """A study stored before ``backtrack_max`` existed ran without backtracking: with the
+    deployability check it resumes at 0 only; without the check, at any value."""
+    from rigidfold.study import STUDY_OPTIONS, StudyConfig
+    from rigidfold.study.store import config_differences
+
+    def config(deploy_check: bool, backtrack_max: int | None) -> dict:
+        settings = (
+            DEFAULTS if backtrack_max is None else DEFAULTS.with_(backtrack_max=backtrack_max)
+        )
+        stored = StudyConfig(STUDY_OPTIONS.replace(deploy_check=deploy_check), settings)
+        return stored.as_dict()
+
+    for check in (False, True):
+        older = config(check, None)
+        del older["settings"]["backtrack_max"]
+        assert config_differences(older, config(check, 0)) == []
+        expected = ["settings.backtrack_max"] if check else []
+        assert config_differences(older, config(check, None)) == expected
+
+
+def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_path):
+    """A 3 x 3 grid on the dome stops at DOF 3 (no candidate succeeds); backtracking finds no
+    lower chain, so the run ends with the one it had, and the chains it tried since leave no
+    file."""
+    case = make_case("dome", "grid:3x3")
+    plain = generate(make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0)))
+    run = generate_case(RunWriter(tmp_path, case, GenerateOptions(deform=False)), report=False)
+    assert plain.stop is run.stop is Stop.NO_CANDIDATE
+    dofs = [s.mechanism.dof for s in run.solutions]
+    assert dofs == [s.mechanism.dof for s in plain.solutions]
+    for a, b in zip(plain.solutions, run.solutions, strict=True):
+        assert a.result.F == b.result.F
+    assert len(run.attempts) > len(plain.attempts)  # it went back and tried more
+    outcomes = [a.outcome for a in run.attempts]
+    assert outcomes.count(AttemptOutcome.DEAD_END) == run.n_backtrack >= 1
+    assert outcomes.count(AttemptOutcome.ACCEPTED) == len(run.solutions)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    names = [f"step_{k:02d}_dof_{d:02d}" for k, d in enumerate(dofs)]
+    assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]
+    on_disk = sorted(p.name for p in (tmp_path / "solutions").iterdir())
+    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{n}.svg" for n in names])
