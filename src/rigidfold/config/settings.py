@@ -112,7 +112,8 @@ class Settings:
     @classmethod
     def docs(cls) -> dict[str, str]:
         """What every setting means, by its flat name."""
-        return {name: GROUPS[g].docs()[a] for name, (g, a) in FLAT_NAMES.items()}
+        docs = {g: group.docs() for g, group in GROUPS.items()}
+        return {name: docs[g][a] for name, (g, a) in FLAT_NAMES.items()}
 
     @classmethod
     def from_degrees(

@@ -280,6 +280,12 @@ def _structure(run: RunData) -> list[str]:
     if f is None:
         return []
     supports = f.get("supports") or {}
+    service = supports.get("service")
+    added = (
+        {"of which for the deflection": service.get("added_for_deflection")}
+        if isinstance(service, dict)
+        else {}
+    )
     at = f.get("max_displacement_at") or {}
     material = f.get("material") or {}
     rows = {
@@ -294,15 +300,7 @@ def _structure(run: RunData) -> list[str]:
         "loads": ["self-weight"] * bool(f.get("self_weight"))
         + [_fmt(load) for load in f.get("loads") or []],
         "supports (pinned vertices)": f"{supports.get('pinned')} ({supports.get('chosen')})",
-        **(
-            {
-                "of which for the deflection": (supports.get("service") or {}).get(
-                    "added_for_deflection"
-                )
-            }
-            if isinstance(supports.get("service"), dict)
-            else {}
-        ),
+        **added,
         "first-order rigid on them": supports.get("first_order_rigid"),
         "mechanism left": supports.get("mode"),
         "total load (N)": f.get("total_load_N"),

@@ -181,14 +181,15 @@ class StructureCheck:
         return self.span / self.limit
 
     @cached_property
-    def _magnitudes(self) -> np.ndarray:
+    def magnitudes(self) -> np.ndarray:
+        """(N,) float64 displacement magnitude of every shell node, m."""
         assert self.response is not None
         return np.linalg.norm(self.response.displacements[:, :3], axis=1)
 
     @property
     def max_displacement(self) -> float:
         """Largest displacement magnitude of any node, m (0 without a response)."""
-        return float(self._magnitudes.max(initial=0.0)) if self.response is not None else 0.0
+        return float(self.magnitudes.max(initial=0.0)) if self.response is not None else 0.0
 
     @property
     def total_load(self) -> np.ndarray:
@@ -245,7 +246,7 @@ class StructureCheck:
         if self.response is None or self.mesh is None:
             return out
         r, mesh, coords = self.response, self.mesh, self.pattern.coords
-        worst = int(np.argmax(self._magnitudes))
+        worst = int(np.argmax(self.magnitudes))
         at = mesh.coords[worst]
         nearest = int(np.argmin(np.linalg.norm(coords - at, axis=1)))
         hot = int(np.argmax(r.von_mises)) if len(r.von_mises) else 0

@@ -44,8 +44,7 @@ def vertex_displacements(check: StructureCheck) -> np.ndarray:
     if check.response is None or check.mesh is None:
         return out
     nodes = check.mesh.node_vertex >= 0
-    mag = np.linalg.norm(check.response.displacements[nodes, :3], axis=1)
-    np.maximum.at(out, check.mesh.node_vertex[nodes], mag)
+    np.maximum.at(out, check.mesh.node_vertex[nodes], check.magnitudes[nodes])
     return out
 
 
