@@ -59,8 +59,9 @@ def design_supports(
     clamped: str = "",
     actuators: str = "",
     settings: Settings = DEFAULTS,
-) -> tuple[Rigidity, bool]:
-    """(the supports' first-order rigidity, whether they were chosen): ``supports``
+) -> tuple[Rigidity, np.ndarray | None]:
+    """(the supports' first-order rigidity, the candidates they were chosen from or None
+    where they were given): ``supports``
     ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
     ``"V,V,..."``; ``"service"`` starts from the same set) or ``"V,V,..."`` pinned
     vertices, with ``clamped`` vertices and ``actuators`` (free creases held). ValueError
@@ -71,11 +72,11 @@ def design_supports(
     if supports.strip().lower() in CHOSEN_SUPPORTS:
         pool = support_candidates(pattern, candidates, settings)
         rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
-        return rigidity, True
+        return rigidity, pool
     pins = parse_indices(supports, V, "supports")
     if not len(pins) and not len(clamp):
         raise RigidfoldError("give --supports V,V,..., auto or service, or --clamped vertices")
-    return check_supports(pattern, Supports(pins, clamp, held), settings), False
+    return check_supports(pattern, Supports(pins, clamp, held), settings), None
 
 
 @dataclass(frozen=True, eq=False)
@@ -296,7 +297,7 @@ def plan_design(
         hinge_stiffness=options.hinge_stiffness,
         loads=parsed,
     )
-    rigidity, auto = design_supports(
+    rigidity, pool = design_supports(
         pattern,
         options.supports,
         candidates=options.candidates,
@@ -307,7 +308,7 @@ def plan_design(
     return DesignPlan(
         pattern,
         rigidity,
-        auto,
+        pool is not None,
         mat,
         options.thickness,
         parsed,
@@ -317,7 +318,7 @@ def plan_design(
         options.limit,
         options.modes,
         settings,
-        support_candidates(pattern, options.candidates, settings) if options.service else None,
+        pool if options.service else None,
     )
 
 
