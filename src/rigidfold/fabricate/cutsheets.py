@@ -27,7 +27,6 @@ reported (``oversize``) either way.
 
 from __future__ import annotations
 
-import itertools
 import math
 import os
 import re
@@ -114,7 +113,35 @@ def _faces_at(fab: Fabrication, k: int, depth: float, origin, a1, a2) -> shapely
         return shapely.Polygon()
     xy = np.column_stack([(verts - origin) @ a1, (verts - origin) @ a2]) * MM
     polys = shapely.polygons(xy[tris[on]])
-    return shapely.union_all(polys, grid_size=1e-6).buffer(0)
+    return outline(shapely.union_all(polys, grid_size=OUTLINE_GRID), OUTLINE_CLOSE)
+
+
+OUTLINE_GRID = 1e-4
+"""The grid (mm) the triangles of a face are snapped to before their union."""
+
+OUTLINE_CLOSE = 1e-2
+"""Cracks narrower than twice this (mm) between a face's triangles are closed: the solid's
+mesh has vertices on its triangles' edges (T-junctions), which leave slits of about 1e-6 mm
+between the triangles' union that a cutter would follow into the panel."""
+
+
+def outline(face: shapely.Geometry, close: float = OUTLINE_CLOSE) -> shapely.Geometry:
+    """One face of a solid drawn flat as one simple polygon without holes (mm): ``face``
+    closed morphologically by ``close`` mm (grown, then shrunk by it with mitred corners,
+    so that the slits between its triangles close and its corners stay sharp), and of what
+    is left the largest polygon's outer ring (the pieces and holes left are slivers of the
+    mesh's rounding: a panel is one piece without holes); empty for an empty face."""
+    if face.is_empty:
+        return shapely.Polygon()
+    closed = face.buffer(close, join_style="mitre", mitre_limit=10.0).buffer(
+        -close, join_style="mitre", mitre_limit=10.0
+    )
+    pieces = [g for g in getattr(closed, "geoms", [closed]) if g.geom_type == "Polygon"]
+    if not pieces:
+        return shapely.Polygon()
+    largest = max(pieces, key=lambda g: g.area)
+    ring = shapely.Polygon(largest.exterior).simplify(OUTLINE_GRID)
+    return shapely.geometry.polygon.orient(ring, 1.0)
 
 
 def parts(fab: Fabrication) -> list[Part]:
@@ -215,11 +242,23 @@ def _joined(
     return out
 
 
-def group(items: list[Part], width: float, height: float, gap: float) -> list[list[Part]]:
+def group(
+    items: list[Part],
+    width: float,
+    height: float,
+    gap: float,
+    *,
+    window: int = DEFAULTS.fabricate.nest_pair_window,
+) -> list[list[Part]]:
     """The parts in groups of one or two to be packed as one box each: two parts whose
     hulls' longest sides are within a fifth of each other's length are joined along them
     (:func:`_joined`) where that saves box area (with the gap) and still fits the stock,
-    the largest savings first; the rest alone."""
+    the largest savings first; the rest alone.
+
+    Only the ``window`` parts that follow a part in the order of those sides are offered
+    to it (parts of about one length lie next to each other there), and an offer keeps its
+    saving alone, the pair built again when it is taken: time and memory grow as the
+    parts times ``window``, not as the parts squared."""
 
     def box(w: float, h: float) -> float:
         return (w + gap) * (h + gap)
@@ -231,26 +270,31 @@ def group(items: list[Part], width: float, height: float, gap: float) -> list[li
 
     live = [p for p in items if not p.cut.is_empty]
     longest = [_longest_side(p.cut) for p in live]
-    sides = [x[2] for x in longest]
+    sides = np.array([x[2] for x in longest], dtype=np.float64)
     alone_fits = [fits(p.width, p.height) for p in live]
-    offers = []
-    for i, j in itertools.combinations(range(len(live)), 2):
-        if abs(sides[i] - sides[j]) > 0.2 * max(sides[i], sides[j]) or not (
-            alone_fits[i] and alone_fits[j]
-        ):
+    order = np.argsort(sides, kind="stable")
+    offers: list[tuple[float, int, int, int]] = []
+    for at, i in enumerate(order.tolist()):
+        if not alone_fits[i]:
             continue
-        alone = box(live[i].width, live[i].height) + box(live[j].width, live[j].height)
-        for pair in _joined(live[i], live[j], gap, (longest[i], longest[j])):
-            w, h = pair[0].width, pair[0].height
-            if fits(w, h) and box(w, h) < alone:
-                offers.append((box(w, h) - alone, i, j, pair))
-    offers.sort(key=lambda o: (o[0], o[1], o[2]))
+        for j in order[at + 1 : at + 1 + window].tolist():
+            if sides[j] - sides[i] > 0.2 * max(sides[i], sides[j]):
+                break
+            if not alone_fits[j]:
+                continue
+            a, b = min(i, j), max(i, j)
+            alone = box(live[a].width, live[a].height) + box(live[b].width, live[b].height)
+            for way, pair in enumerate(_joined(live[a], live[b], gap, (longest[a], longest[b]))):
+                w, h = pair[0].width, pair[0].height
+                if fits(w, h) and box(w, h) < alone:
+                    offers.append((box(w, h) - alone, a, b, way))
+    offers.sort()
     used: set[int] = set()
     groups = []
-    for _, i, j, pair in offers:
+    for _, i, j, way in offers:
         if i not in used and j not in used:
             used |= {i, j}
-            groups.append(pair)
+            groups.append(_joined(live[i], live[j], gap, (longest[i], longest[j]))[way])
     groups += [[p] for k, p in enumerate(live) if k not in used]
     return groups
 
@@ -268,7 +312,7 @@ def nest(
     and by their outlines (:func:`nest_by_outlines`, up to ``fabricate_nest_parts`` parts),
     the one on fewer stock sheets kept, then the one that uses less of the last sheet's
     width, the boxes where both are alike. Parts with an empty outline are left out."""
-    boxes = nest_boxes(items, width, height, gap)
+    boxes = nest_boxes(items, width, height, gap, settings=settings)
     stock = [s for s in boxes if not s.oversize]
     panels = {p.part.panel for s in stock for p in s.parts}
     on_stock = [p for p in items if p.panel in panels]  # each in its own frame, not its pair's
@@ -313,7 +357,14 @@ def nest_by_outlines(
     return [StockSheet(width, height, tuple(placed[b]), nesting="outlines") for b in sorted(placed)]
 
 
-def nest_boxes(items: list[Part], width: float, height: float, gap: float) -> list[StockSheet]:
+def nest_boxes(
+    items: list[Part],
+    width: float,
+    height: float,
+    gap: float,
+    *,
+    settings: Settings = DEFAULTS,
+) -> list[StockSheet]:
     """Pack ``items`` by their boxes (their pairs' boxes, :func:`group`) onto stock sheets
     ``width`` x ``height`` mm with ``gap`` mm between parts and from the edges, by
     ``rectpack`` (:func:`_pack`); a part larger than the stock on an oversize sheet of its
@@ -321,7 +372,9 @@ def nest_boxes(items: list[Part], width: float, height: float, gap: float) -> li
     inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
     boxes: dict[int, tuple[int, int, list[Part]]] = {}
     oversize = []
-    for g, members in enumerate(group(items, width, height, gap)):
+    for g, members in enumerate(
+        group(items, width, height, gap, window=settings.fabricate.nest_pair_window)
+    ):
         first = members[0]
         w = math.ceil(first.width + gap)
         h = math.ceil(first.height + gap)
