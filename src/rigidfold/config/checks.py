@@ -328,6 +328,12 @@ class FabricateSettings(Group):
         "costs the parts times this, not the parts squared (before: every pair, 34 s and "
         "343 MB for 242 triangles).",
     )
+    progress_panels: int = setting(
+        200,
+        "``rigidfold fabricate`` (and ``generate --thickness``) prints a line on stderr as "
+        "each step that can take long begins (the path traced, the solids and their check, "
+        "a thinner try, the nesting, the files) for designs of at least this many panels.",
+    )
     nest_gap_sides: int = setting(
         8,
         "The true-outline nesting keeps the gap around a part by a regular polygon of this "
@@ -368,7 +374,7 @@ class FabricateSettings(Group):
         self._positive("frame_step", "frame_tol", "sheet_width", "sheet_height", "nest_round")
         self._fraction("min_depth", "trimmed_away")
         self._integer(relief_rounds=0, subdivisions=0, thickness_tries=0, nest_parts=0)
-        self._integer(nest_pair_window=1)
+        self._integer(nest_pair_window=1, progress_panels=0)
         self._integer(nest_gap_sides=4)
         if self.nest_gap_sides % 2:
             raise RigidfoldError(

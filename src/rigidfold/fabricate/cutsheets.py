@@ -42,7 +42,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import min_area_angle
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import atomic_write
+from rigidfold.io.files import write_together
 
 MM = 1000.0
 
@@ -572,6 +572,39 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
     return "\n".join(items) + "\n"
 
 
+def cut_sheet_data(
+    fab: Fabrication,
+    out: Path,
+    name: str,
+    *,
+    width: float,
+    height: float,
+    gap: float,
+    title: str = "",
+    settings: Settings = DEFAULTS,
+) -> tuple[list[tuple[Path, str | bytes]], list[StockSheet]]:
+    """Nest the panels onto ``width`` x ``height`` mm stock (:func:`nest`): the files
+    ``NAME_sheet_NN.dxf`` and ``.svg`` per sheet (``NAME_oversize_NN`` for a part larger
+    than the stock) as (path in ``out``, data), and the sheets."""
+    from rigidfold.fabricate.progress import step
+
+    step(f"nesting the cut sheets of {fab.panels.n} panels", fab.panels.n, settings=settings)
+    sheets = nest(parts(fab), width, height, gap, settings=settings)
+    files: list[tuple[Path, str | bytes]] = []
+    stock = oversize = 0
+    for sheet in sheets:
+        if sheet.oversize:
+            oversize += 1
+            stem = f"{name}_oversize_{oversize:02d}"
+        else:
+            stock += 1
+            stem = f"{name}_sheet_{stock:02d}"
+        label = f"{title} {stem} ({sheet.width:.0f} x {sheet.height:.0f} mm)".strip()
+        files.append((out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
+        files.append((out / f"{stem}.svg", svg_text(sheet, title=label)))
+    return files, sheets
+
+
 def write_cut_sheets(
     fab: Fabrication,
     out: Path,
@@ -583,23 +616,12 @@ def write_cut_sheets(
     title: str = "",
     settings: Settings = DEFAULTS,
 ) -> tuple[list[Path], list[StockSheet]]:
-    """Nest the panels onto ``width`` x ``height`` mm stock (:func:`nest`) and write
-    ``NAME_sheet_NN.dxf`` and ``.svg`` per sheet (``NAME_oversize_NN`` for a part larger than
-    the stock); returns the files and the sheets."""
-    sheets = nest(parts(fab), width, height, gap, settings=settings)
-    written: list[Path] = []
-    stock = oversize = 0
-    for sheet in sheets:
-        if sheet.oversize:
-            oversize += 1
-            stem = f"{name}_oversize_{oversize:02d}"
-        else:
-            stock += 1
-            stem = f"{name}_sheet_{stock:02d}"
-        label = f"{title} {stem} ({sheet.width:.0f} x {sheet.height:.0f} mm)".strip()
-        written.append(atomic_write(out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
-        written.append(atomic_write(out / f"{stem}.svg", svg_text(sheet, title=label)))
-    return written, sheets
+    """Nest the panels and write their sheets together (:func:`cut_sheet_data`,
+    :func:`rigidfold.io.files.write_together`); returns the files and the sheets."""
+    files, sheets = cut_sheet_data(
+        fab, out, name, width=width, height=height, gap=gap, title=title, settings=settings
+    )
+    return write_together(files), sheets
 
 
 def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:

@@ -21,6 +21,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.exports import Design
+from rigidfold.fabricate import progress
 from rigidfold.fabricate.panels import Panels
 from rigidfold.io import read_frames
 from rigidfold.mesh.geometry import rigid_motions
@@ -182,6 +183,7 @@ def design_motion(
     again when the frames are too coarse."""
     from rigidfold.mechanism.path import trace_path
 
+    progress.check_size(panels.n, settings=settings)
     step = settings.fabricate.frame_step
     carried = frames
     where = "the traced motion's"
@@ -201,6 +203,8 @@ def design_motion(
             return motion, motion.source
     pattern = panels.pattern
     if path is None:
+        text = f"tracing the folding path of {panels.n} panels{rejected}"
+        progress.step(text, panels.n, settings=settings)
         path = trace_path(pattern, settings=settings)
     if not path.deploys:
         if carried is not None:
