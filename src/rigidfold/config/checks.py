@@ -286,9 +286,9 @@ class FabricateSettings(Group):
     frame_tol: float = setting(
         1e-6,
         "A design file's motion frames are used only as a rigid motion of the design from "
-        "flat: every panel's vertices, the first frame's distance from a plane and the last "
-        "frame's from the design within this share of the design's size (the diagonal of its "
-        "box); else the folding path is traced.",
+        "flat: every panel's vertices within this share of the design's size (the diagonal "
+        "of its box) of their rigid motion, the last frame as close to the design, and the "
+        "first flat (``path_flat_tol``); else the folding path is traced.",
     )
     subdivisions: int = setting(
         8,

@@ -135,8 +135,9 @@ def motion_evidence(
     design from flat, in words; ``""`` when they are: each panel moves rigidly (its
     vertices within ``settings.fabricate.frame_tol`` times the design's size of its
     least-squares rigid motion, so lengths are kept and panels stay flat), the first frame
-    is flat (every vertex that close to one plane), the last one is the design (so moved
-    rigidly onto it), and the fraction rises from 0 to 1."""
+    is flat (every hinge within ``settings.path.flat_tol`` of flat, as the traced path's
+    flat end), the last one is the design (so moved rigidly onto it), and the fraction rises
+    from 0 to 1."""
     pattern = panels.pattern
     size = float(np.linalg.norm(np.ptp(pattern.coords, axis=0))) or 1.0
     tol = settings.fabricate.frame_tol * size
@@ -152,10 +153,9 @@ def motion_evidence(
             worst, at = float(off.max()), k
     if worst > tol:
         return f"panel {at} does not move rigidly (off by {worst * 1e3:.3g} mm)"
-    flat = frames[0] - frames[0].mean(axis=0)
-    out = float(np.abs(flat @ np.linalg.svd(flat, full_matrices=False)[2][-1]).max())
-    if out > tol:
-        return f"the first frame is not flat (a vertex {out * 1e3:.3g} mm off its plane)"
+    first = np.abs(closing_angles(panels, rotations[0])).max(initial=0.0)
+    if first > settings.path.flat_tol:
+        return f"the first frame is not flat (a hinge folded {math.degrees(first):.3g} degrees)"
     whole = [np.arange(pattern.n_vertices)]
     r, t = rigid_motions(frames[-1], pattern.coords[None], whole)
     off = np.linalg.norm(frames[-1] @ r[0, 0].T + t[0, 0] - pattern.coords, axis=1).max()
