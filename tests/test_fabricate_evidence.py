@@ -295,3 +295,27 @@ def test_progress_on_stderr(tmp_path, capsys):
         assert step in err
     fabricate_file(AFRAME, tmp_path / "b", FabricateOptions(thickness=0.018))
     assert capsys.readouterr().err == ""
+
+
+def test_sheets_have_a_legend_and_labels_apart(large):
+    """Item 14: every nested sheet explains its lines and labels (a legend with the red
+    dashed far face) and has a scale bar, below the stock; the labels of a part (its edges'
+    and its number) do not overlap, each edge's along its edge."""
+    import shapely
+
+    from rigidfold.fabricate.cutsheets import _label_box, nest, parts
+
+    fab, files = large
+    for path in files:
+        if path.suffix == ".svg":
+            text = path.read_text()
+            assert 'id="LEGEND"' in text and "far face" in text and " mm</text>" in text
+    for sheet in nest(parts(fab), 2440, 1220, 10):
+        for placed in sheet.parts:
+            boxes = [_label_box(lab) for lab in placed.labels]
+            mark = placed.part.mark
+            assert mark is not None and placed.cut.contains(shapely.Point(placed.centre))
+            number = shapely.Point(placed.centre).buffer(0.31 * mark.size * len(mark.text))
+            for i, box in enumerate(boxes):
+                assert not box.intersects(number), placed.part.panel
+                assert not any(box.intersects(other) for other in boxes[i + 1 :])
