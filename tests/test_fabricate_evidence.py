@@ -319,3 +319,25 @@ def test_sheets_have_a_legend_and_labels_apart(large):
             for i, box in enumerate(boxes):
                 assert not box.intersects(number), placed.part.panel
                 assert not any(box.intersects(other) for other in boxes[i + 1 :])
+
+
+def test_whole_pattern_labels_fill_their_creases():
+    """Item 14: the whole-pattern cut sheet's crease labels are as large as their creases
+    allow (never below the sheet's text height, larger where the crease is long), and
+    none of the enlarged ones overlaps another label."""
+    import shapely
+
+    from rigidfold.exports.cutsheet import _box, crease_labels
+    from rigidfold.exports.sheet import layout_sheet
+
+    pattern, flat = curved_grid(9)
+    sheet = layout_sheet(pattern, flat)
+    labels = crease_labels(sheet)
+    least = sheet.text_height
+    assert all(label.size >= least * (1 - 1e-9) for label in labels)
+    assert np.mean([label.size for label in labels]) > 1.2 * least
+    boxes = [_box(label) for label in labels]
+    first, second = shapely.STRtree(boxes).query(boxes, predicate="intersects")
+    for i, j in zip(first, second, strict=True):
+        if i != j:
+            assert labels[i].size <= least * (1 + 1e-9), labels[i].text
