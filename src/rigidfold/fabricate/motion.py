@@ -2,8 +2,10 @@
 
 The motion is a sequence of frames, vertex positions (K, V, 3) from the flat sheet
 (fraction 0) to the design (fraction 1): the design file's own motion frames
-(``foldedForm`` frames, as ``rigidfold generate`` writes them for a checked design) when
-they are fine enough, else the design's rigid-folding path
+(``foldedForm`` frames, as ``rigidfold generate`` writes them for a checked design, read
+by :func:`rigidfold.io.read_frames`) when they are a rigid motion of the design from flat
+(:func:`motion_evidence`: motion frames are evidence, checked, never trusted) and fine
+enough, else the design's rigid-folding path
 (:func:`rigidfold.mechanism.path.trace_path`) sampled at equal arclength
 (:meth:`rigidfold.mechanism.path.FoldingPath.frames`) so finely that no hinge turns more
 than ``settings.fabricate.frame_step`` between two frames. Each panel moves rigidly: at
@@ -180,7 +182,11 @@ def design_motion(
     frames : (frames (K, V, 3), fraction (K,)) of a motion already at hand (a run's traced
     motion), used instead of the design file's; path : the design's folding path already
     traced (:func:`rigidfold.mechanism.path.trace_path`), sampled instead of tracing it
-    again when the frames are too coarse."""
+    again when the frames are too coarse; up : how the design was read (its frames are read
+    z up, as rigidfold writes them: frames of another up axis are not the design's motion,
+    and the path is traced). Raises ValueError for a design of more than
+    ``settings.limits.max_fabricate_panels`` panels."""
+    del up  # the frames are evidence, checked against the design as read
     from rigidfold.mechanism.path import trace_path
 
     progress.check_size(panels.n, settings=settings)
