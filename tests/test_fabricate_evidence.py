@@ -75,27 +75,31 @@ def test_every_cut_outline_is_one_simple_polygon(large):
 
 
 def test_pairing_costs_the_parts_times_the_window(large, monkeypatch):
-    """Item 5: the pairing by boxes joins a part only with the window of parts next to it
-    in the order of their longest sides (before: every pair, n (n - 1) / 2), and still
-    pairs most of the triangles."""
+    """Item 5: the pairing by boxes offers a part only to the window of parts next to it
+    in the order of their longest sides (before: every pair, n (n - 1) / 2, each pair
+    built and kept), and still pairs most of the triangles, each pair keeping the gap."""
     from rigidfold.fabricate import cutsheets
 
     fab, _ = large
     items = cutsheets.parts(fab)
     calls = []
-    joined = cutsheets._joined
+    offered = cutsheets._joined_boxes
 
     def counted(*args, **kwargs):
         calls.append(1)
-        return joined(*args, **kwargs)
+        return offered(*args, **kwargs)
 
-    monkeypatch.setattr(cutsheets, "_joined", counted)
+    monkeypatch.setattr(cutsheets, "_joined_boxes", counted)
     window = 4
     groups = cutsheets.group(items, 2440, 1220, 10, window=window)
     pairs = sum(len(g) == 2 for g in groups)
-    assert len(calls) <= len(items) * window + pairs
+    assert len(calls) <= len(items) * window
     assert sorted(p.panel for g in groups for p in g) == list(range(len(items)))
     assert pairs >= len(items) // 4
+    for g in groups:
+        if len(g) == 2:
+            assert g[0].cut.distance(g[1].cut) >= 10 - 1e-6
+            assert g[0].width == pytest.approx(g[1].width) and g[0].width >= g[0].height
 
 
 def _with_motion(source: Path, target: Path, frames: np.ndarray) -> Path:

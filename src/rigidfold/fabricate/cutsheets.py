@@ -353,6 +353,37 @@ def _joined(
     return out
 
 
+def _box_of(ring: np.ndarray) -> tuple[float, float]:
+    """(longer, shorter) side of the smallest bounding rectangle of the points ``ring``
+    (n, 2), as :func:`_fit` turns a part to it."""
+    angle = min_area_angle(ring)
+    c, sn = math.cos(angle), math.sin(angle)
+    xy = ring @ np.array([[c, sn], [-sn, c]])
+    w, h = np.ptp(xy, axis=0)
+    return float(max(w, h)), float(min(w, h))
+
+
+def _joined_boxes(
+    first: np.ndarray,
+    second: np.ndarray,
+    gap: float,
+    sides: tuple[tuple[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray, float]],
+) -> list[tuple[float, float]]:
+    """The boxes of the two pairs :func:`_joined` makes of parts of hull points ``first``
+    and ``second`` (n, 2), computed on those points alone (the same turns and shifts)."""
+    (a, b, _), (c, d, _) = sides
+    e = (b - a) / np.linalg.norm(b - a)
+    normal = np.array([e[1], -e[0]])
+    angle = math.atan2(*(a - b)[::-1]) - math.atan2(*(d - c)[::-1])
+    co, si = math.cos(angle), math.sin(angle)
+    turn = np.array([[co, si], [-si, co]])
+    out = []
+    for anchor, point in ((b, c), (a, d)):
+        shift = anchor + gap * normal - point @ turn
+        out.append(_box_of(np.vstack([first, second @ turn + shift])))
+    return out
+
+
 def group(
     items: list[Part],
     width: float,
@@ -381,6 +412,7 @@ def group(
 
     live = [p for p in items if not p.cut.is_empty]
     longest = [_longest_side(p.cut) for p in live]
+    hulls = [np.asarray(shapely.get_coordinates(shapely.convex_hull(p.cut))) for p in live]
     sides = np.array([x[2] for x in longest], dtype=np.float64)
     alone_fits = [fits(p.width, p.height) for p in live]
     order = np.argsort(sides, kind="stable")
@@ -395,8 +427,8 @@ def group(
                 continue
             a, b = min(i, j), max(i, j)
             alone = box(live[a].width, live[a].height) + box(live[b].width, live[b].height)
-            for way, pair in enumerate(_joined(live[a], live[b], gap, (longest[a], longest[b]))):
-                w, h = pair[0].width, pair[0].height
+            both = _joined_boxes(hulls[a], hulls[b], gap, (longest[a], longest[b]))
+            for way, (w, h) in enumerate(both):
                 if fits(w, h) and box(w, h) < alone:
                     offers.append((box(w, h) - alone, a, b, way))
     offers.sort()
