@@ -25,6 +25,7 @@ VALUES = {
         "lock",
         "zero_dof",
         "path",
+        "second_order_rigid",
         "initial_failed",
         "dead_end",
     ],
@@ -45,6 +46,7 @@ VALUES = {
         "no_deployable",
         "initial_failed",
         "interrupted",
+        "time_limit",
     ],
     DevelopStatus: ["converged", "flipped", "overlap", "failed"],
     DeformStatus: ["reached_plane", "failed"],
@@ -72,6 +74,7 @@ def test_stop_reasons_are_the_texts_of_every_version():
         (Stop.INITIAL_FAILED, "lock"): "no developable polyhedron from the initial shape (lock)",
         (Stop.RUNNING, ""): "running",
         (Stop.INTERRUPTED, ""): "interrupted",
+        (Stop.TIME_LIMIT, "60"): "time limit of 60 s reached",
     }
     assert set(STOP_REASONS) == set(Stop)
     for (stop, detail), text in texts.items():

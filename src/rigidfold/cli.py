@@ -240,6 +240,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     gen.add_argument("--backtrack", type=int, metavar="N", help=BACKTRACK_HELP)
     gen.add_argument(
+        "--time-limit",
+        type=float,
+        metavar="SECONDS",
+        help="solve no further candidate after this many seconds: the run ends with the "
+        "lowest-DOF design that deploys as its final design, checked as usual, and exits 1 "
+        "(default: no limit)",
+    )
+    gen.add_argument(
         "--check",
         choices=CHECKS,
         default=GENERATE_DEFAULTS.check,
@@ -766,6 +774,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         material=args.material,
         fabricate=fabricate_options(args),
         structure=structure if args.structure else None,
+        time_limit=args.time_limit,
     )
     writer = RunWriter(args.out, _case(args), options, overwrite=args.overwrite)
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
@@ -773,10 +782,12 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         run = generate_case(writer, progress=progress.update, report=not args.no_report)
     except KeyboardInterrupt:
         progress.close()
+        best = writer.verdict.final_design if writer.verdict is not None else None
         print(
             one_line(
                 f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json "
                 f"and summary.json are in {writer.out}"
+                + ("" if best is None else f"; best design so far: {writer.out / best}")
             ),
             file=sys.stderr,
         )
@@ -784,10 +795,16 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     progress.close()
     summary = run.to_dict()
     print(
-        f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['final_dof']}, "
+        f"{run.stop_reason}: DOF {summary['initial_dof']} -> {summary['lowest_dof']}, "
         f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
-        f"N_exceed={summary['N_exceed']} N_path={summary['N_path']}, "
-        f"{summary['n_solves']} solves"
+        f"N_exceed={summary['N_exceed']} N_path={summary['N_path']}"
+        + (f" N_rigid={summary['N_rigid']}" if summary["N_rigid"] else "")
+        + f", {summary['n_solves']} solves"
+        + (
+            f"; final design DOF {summary['final_dof']}"
+            if summary["final_dof"] != summary["lowest_dof"]
+            else ""
+        )
     )
     print(
         f"wrote {_count(len(writer.files), 'solution')}, log.json and summary.json to {writer.out}"

@@ -78,6 +78,9 @@ class GenerateOptions:
     structure : the final design's structure check (:class:`~rigidfold.structure.
         StructureOptions`, as ``rigidfold structure`` takes them; with ``fabricate``, of its
         thickness); None (the default): none.
+    time_limit : seconds of Steps 2-7 after which no further candidate is solved: the run
+        ends (``Stop.TIME_LIMIT``) with the lowest-DOF solution that deploys as its final
+        design, checked as usual, and falls short; None (the default): no limit.
 
     The keywords of earlier versions are still taken: ``thickness`` (metres, None: no thick
     panels; else the thick panels' and, with a structure check, its thickness), ``side``,
@@ -102,6 +105,7 @@ class GenerateOptions:
     material: str | None = None
     fabricate: FabricateOptions | None = None
     structure: StructureOptions | None = None
+    time_limit: float | None = None
 
     def __init__(
         self,
@@ -117,6 +121,7 @@ class GenerateOptions:
         material: str | None = None,
         fabricate: FabricateOptions | None = None,
         structure: StructureOptions | bool | None = None,
+        time_limit: float | None = None,
         *,
         thickness: float | str | _Unset | None = _UNSET,
         side: str | _Unset = _UNSET,
@@ -151,6 +156,13 @@ class GenerateOptions:
         if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
             raise RigidfoldError(f"support face must be a face index, got {face!r}")
         check_seed(self.seed)
+        limit = self.time_limit
+        if limit is not None and (
+            isinstance(limit, bool)
+            or not isinstance(limit, int | float | np.integer | np.floating)
+            or not 0 < limit < float("inf")
+        ):
+            raise RigidfoldError(f"time limit must be a number of seconds > 0, got {limit!r}")
         if self.material is not None:
             parse_material(self.material)
 

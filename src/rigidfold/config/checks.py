@@ -224,7 +224,7 @@ class StructureSettings(Group):
     )
     prestress_tol: float = setting(
         1e-8,
-        "Second order (``rigidfold.structure.stability``): the supports are prestress stable "
+        "Second order (``rigidfold.mechanism.second_order``): the supports are prestress stable "
         "when the smallest eigenvalue of the best self-stress's stress matrix on the flexes "
         "exceeds this fraction of the stress matrices' largest entry; stress matrices below "
         "this fraction of the largest are dropped.",
