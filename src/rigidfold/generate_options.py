@@ -10,7 +10,7 @@ commands' records: the thick panels in a :class:`rigidfold.fabricate.FabricateOp
 
 Each field is made by :func:`rigidfold.flags.option` with what it means, which is also the
 help of its command-line flag (``rigidfold generate --target-dof``): a new option is a new
-field here, and :mod:`rigidfold.cli_fields` gives it its flag.
+field here, and :mod:`rigidfold.cli_parser` gives it its flag.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
-from rigidfold.flags import option
+from rigidfold.flags import count, option
 from rigidfold.optimize import SOLVERS
 from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
@@ -47,7 +47,7 @@ class GenerateOptions:
         1,
         "stop at a shape with this many degrees of freedom (DOF: independent rigid folding "
         "motions; 1 = folds along one path, stabilised by one support or actuator)",
-        parse=int,
+        parse=count,
     )
     seed: int = option(
         DEFAULT_SEED,
