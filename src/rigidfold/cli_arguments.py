@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 from rigidfold.case_options import CaseOptions, SettingsOptions
 from rigidfold.cli_checks import fabricate_arguments, structure_arguments
-from rigidfold.cli_parser import Parser, add_options, directory
+from rigidfold.cli_parser import Parser, add_options, argument_type, directory
 from rigidfold.config import DEFAULTS
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.flags import seed
@@ -174,7 +174,7 @@ def _study(p: Parser) -> None:
     )
     p.add_argument(
         "--first-seed",
-        type=seed,
+        type=argument_type(seed),
         default=plan.first_seed,
         help="seed of the first Bezier surface, 0 to 2**63 - 1 (default: %(default)s)",
     )

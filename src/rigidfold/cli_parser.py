@@ -56,7 +56,7 @@ def add_options(
         shown = "" if required or default is None else " (default: %(default)s)"
         how: dict[str, Any] = {"required": True} if required else {"default": default}
         if flag.parse is not None:
-            how["type"] = _argument_type(flag.parse)
+            how["type"] = argument_type(flag.parse)
         parser.add_argument(
             flag.name or "--" + dashed,
             dest=f.name,
@@ -78,7 +78,7 @@ def options_of(record: type, args: argparse.Namespace, **given: Any) -> Any:
     return record(**flagged | given)
 
 
-def _argument_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
+def argument_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
     """``parse`` as an argparse type: its RigidfoldError is argparse's one-line error
     ("argument --seed: must be ...")."""
     if parse in (int, float, str):
