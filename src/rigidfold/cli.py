@@ -23,17 +23,8 @@ from collections.abc import Sequence
 from rigidfold import __version__
 from rigidfold.case_options import CaseOptions, SettingsOptions
 from rigidfold.cli_arguments import add_arguments
-from rigidfold.cli_checks import (
-    fabricate_options,
-    structure_options,
-)
-from rigidfold.cli_parser import (
-    EXIT_USAGE,
-    Parser,
-    attached_values,
-    one_line,
-    options_of,
-)
+from rigidfold.cli_checks import fabricate_options, structure_options
+from rigidfold.cli_parser import EXIT_USAGE, Parser, attached_values, one_line, options_of
 from rigidfold.cli_text import COMMANDS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions

@@ -16,7 +16,6 @@ for a run that could not run), and ``status`` the words (``Generation.stop_reaso
 
 from __future__ import annotations
 
-import functools
 import itertools
 import json
 import os
@@ -88,59 +87,25 @@ JSON_ATTEMPT_FIELDS = (
 )
 """Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
 
-RUN_FIELDS = (
-    "status",
-    "n_reduce",
-    "n_lock",
-    "n_exceed",
-    "mean_f",
-    "initial_dof",
-    "final_dof",
-    "n_solutions",
-    "n_solves",
-    "mean_d",
-    "mean_dl_mm",
-    "mean_drho_fix_deg",
-    "reached_plane",
-    "time_build",
-    "time_solve",
-    "time_analysis",
-    "time_selection",
-    "time_develop",
-    "time_deform",
-    "time_total",
-    "version",
-    "worker",
-    "numerics",
-    "n_path",
-    "final_deploys",
-    "time_path",
-    "stop",
-    "n_backtrack",
-)
-ATTEMPT_FIELDS = (
-    "idx",
-    "fixed_added",
-    "score",
-    "status",
-    "f",
-    "iterations",
-    "dof",
-    "locked",
-    "outcome",
-    "solve_time",
-    "analysis_time",
-    "selection_time",
-    "skipped",
-    "skipped_locks",
-    "predicted_locks",
-    "locked_predicted",
-    "locked_left",
-    "locked_fold_deg",
-    "carried",
-    "path",
-    "path_time",
-)
+KEY_COLUMNS = ("study", "seed", "pattern", "criterion", "symmetric")
+"""The columns of a run's :class:`Key`, first in ``runs`` and ``attempts``."""
+
+
+def schema_columns() -> dict[str, dict[str, str]]:
+    """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
+    con = sqlite3.connect(":memory:")
+    con.executescript(SCHEMA)
+    tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")]
+    columns = {t: {r[1]: r[2] for r in con.execute(f"PRAGMA table_info({t})")} for t in tables}
+    con.close()
+    return columns
+
+
+SCHEMA_COLUMNS = schema_columns()
+RUN_FIELDS = tuple(c for c in SCHEMA_COLUMNS["runs"] if c not in KEY_COLUMNS)
+"""The columns of ``runs`` besides the key, in the order of :data:`SCHEMA`."""
+ATTEMPT_FIELDS = tuple(c for c in SCHEMA_COLUMNS["attempts"] if c not in KEY_COLUMNS)
+"""The columns of ``attempts`` besides the key, in the order of :data:`SCHEMA`."""
 
 
 ERROR_PREFIX = "error: "
@@ -283,17 +248,6 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
 READONLY_COPY_TRIES = 3
 """Times a database opened read-only is copied into memory before it is read in place
 instead (:meth:`Store._connect_readonly`): a copy is kept only if nothing wrote meanwhile."""
-
-
-@functools.cache
-def schema_columns() -> dict[str, dict[str, str]]:
-    """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
-    con = sqlite3.connect(":memory:")
-    con.executescript(SCHEMA)
-    tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")]
-    columns = {t: {r[1]: r[2] for r in con.execute(f"PRAGMA table_info({t})")} for t in tables}
-    con.close()
-    return columns
 
 
 class Store:
@@ -456,7 +410,7 @@ class Store:
             if verdict != "ok":
                 first = [line for line in verdict.splitlines() if not line.startswith("***")]
                 raise RigidfoldError(f"{name!r}: damaged SQLite file: {(first or [verdict])[0]}")
-            for table, columns in schema_columns().items():
+            for table, columns in SCHEMA_COLUMNS.items():
                 have = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
                 if not have:
                     raise RigidfoldError(
@@ -557,8 +511,7 @@ class Store:
 
     def _add(self, key: Key, run: dict, attempts: list[dict]) -> None:
         with self.db:
-            names: tuple[str, ...] = ("study", "seed", "pattern", "criterion", "symmetric")
-            names += RUN_FIELDS
+            names = KEY_COLUMNS + RUN_FIELDS
             added = self.db.execute(
                 f"INSERT OR IGNORE INTO runs ({', '.join(names)}) "
                 f"VALUES ({', '.join('?' * len(names))})",
@@ -567,7 +520,7 @@ class Store:
             ).rowcount
             if not added:
                 raise RigidfoldError(f"{str(self.path)!r} already holds the run {key.row()}")
-            names = ("study", "seed", "pattern", "criterion", "symmetric", *ATTEMPT_FIELDS)
+            names = KEY_COLUMNS + ATTEMPT_FIELDS
             self.db.executemany(
                 f"INSERT INTO attempts ({', '.join(names)}) VALUES ({', '.join('?' * len(names))})",
                 [
