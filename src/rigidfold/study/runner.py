@@ -180,7 +180,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             row["time_path_final"] = time.perf_counter() - t_path
         if final is not None and options.deform and not every:
             check(final)
-    except ValueError as exc:  # a configuration that cannot run: recorded, not retried
+    except RigidfoldError as exc:  # a configuration that cannot run: recorded, not retried
         row.update(
             status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
         )
