@@ -49,6 +49,8 @@ CREATE TABLE IF NOT EXISTS runs (
     time_path REAL,               -- seconds of tracing
     stop TEXT,                    -- the generate.Stop value (NULL: an error)
     n_backtrack INTEGER,          -- generate.Generation.n_backtrack
+    n_rigid INTEGER,              -- N_rigid: solutions rejected as second-order rigid
+    lowest_dof INTEGER,           -- the lowest DOF reached (final_dof: the final design's)
     PRIMARY KEY (study, seed, pattern, criterion, symmetric)
 );
 CREATE TABLE IF NOT EXISTS invocations (  -- one row per `rigidfold study` command that ended
@@ -70,6 +72,8 @@ CREATE TABLE IF NOT EXISTS attempts (
     locked_predicted TEXT, locked_left TEXT, locked_fold_deg TEXT,  -- JSON, per locked crease
     carried TEXT,                 -- JSON: creases the look-ahead fixed with the candidate
     path TEXT, path_time REAL,    -- JSON: generate.Attempt.path, and its seconds
+    second_order TEXT,            -- JSON: generate.Attempt.second_order
+    rigid_forecast INTEGER,       -- forecast second-order rigid (NULL: no forecast)
     PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
 );
 """
@@ -84,6 +88,7 @@ JSON_ATTEMPT_FIELDS = (
     "locked_fold_deg",
     "carried",
     "path",
+    "second_order",
 )
 """Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
 
@@ -118,9 +123,9 @@ class RunRow:
 
     study, seed, pattern, criterion, symmetric : its :class:`Key`; stop : how it ended
     (None: it could not run, ``status`` then "error: <message>"); status : the words; the
-    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_backtrack``,
-    the final design's ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the
-    Step 8-9 figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``),
+    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_rigid``,
+    ``n_backtrack``, the lowest DOF reached (``lowest_dof``), the final design's
+    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9 figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``),
     the times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
     ``numerics``); a figure the run (or its version) did not record is None.
     """
@@ -158,6 +163,8 @@ class RunRow:
     final_deploys: int | None = None
     time_path: float | None = None
     n_backtrack: int | None = None
+    n_rigid: int | None = None
+    lowest_dof: int | None = None
 
     @property
     def key(self) -> Key:
