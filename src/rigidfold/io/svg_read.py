@@ -1001,9 +1001,16 @@ def _check_boundary(
     black = edges[np.array(letters) == "B"]
     degree = np.bincount(black.ravel(), minlength=len(xy))
     if (degree == 1).any():
+        ends = np.flatnonzero(degree == 1)
+        gap = np.linalg.norm(xy[ends[1:]] - xy[ends[0]], axis=1)
+        other = (
+            f", {gap.min():.3g} drawing units from its end at {_at(xy[ends[1 + np.argmin(gap)]])}"
+            if len(gap)
+            else ""
+        )
         raise RigidfoldError(
-            f"the boundary (black) is not closed: it ends at {_at(xy[degree == 1][0])} (a "
-            f"gap of up to {snap:.3g} drawing units between two ends is closed; "
+            f"the boundary (black) is not closed: it ends at {_at(xy[ends[0]])}{other} (a gap "
+            f"of up to {snap:.3g} drawing units between two ends is closed; "
             "Settings.inputs.svg_snap_tol)"
         )
     if (degree > 2).any():
