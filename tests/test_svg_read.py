@@ -684,6 +684,29 @@ def test_origami_simulator_files(name):
     assert len(pattern.edges) == len(drawing.edges) + len(diagonals)
 
 
+MORE_OS_FILES = {
+    # file: ((V, E, faces), assignment counts, triangles)
+    "waterbomb.svg": ((195, 524, 330), {"B": 58, "M": 246, "V": 220}, 330),
+    "reschTriTessellation.svg": ((243, 664, 422), {"B": 60, "M": 451, "V": 153}, 424),
+    "polygamiCross.svg": ((144, 278, 135), {"B": 44, "M": 122, "V": 112}, 242),
+    "langWedgeDoubleFaced.svg": ((264, 560, 297), {"B": 64, "M": 250, "V": 246}, 462),
+    "miura_sharpangle.svg": ((325, 612, 288), {"B": 72, "M": 282, "V": 258}, 576),
+    "test.svg": ((25, 54, 30), {"B": 18, "M": 16, "V": 20}, 30),
+}
+
+
+@pytest.mark.parametrize("name", MORE_OS_FILES)
+def test_more_origami_simulator_files(name):
+    """Origami Simulator's tessellations of tests/data/origami_simulator/README.md (the last
+    four for the deployability benchmark) read and triangulate."""
+    sizes, letters, triangles = MORE_OS_FILES[name]
+    drawing = read_svg(DATA / name)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    check_pattern_file(DATA / name, triangles)
+
+
 def test_origami_simulator_curved_file():
     with pytest.raises(
         ValueError,
