@@ -19,18 +19,22 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
 * colours by hue (:data:`COLOURS`), so ``#FF0000``, ``#f00``, ``rgb(255,0,0)`` and ``red``
   are all mountains; green cuts are refused;
 * lines are split where they cross or where one ends on another, points closer than
-  ``Settings.inputs.svg_merge_tol`` times the drawing's bounding-box diagonal are merged, and
-  pieces shorter than that are dropped. A piece drawn twice is kept once: if one drawing
+  ``Settings.inputs.svg_merge_tol`` times the drawing's bounding-box diagonal are merged (the
+  ends of the lines drawn before the crossings are found, as Origami Simulator does, so that
+  lines drawn to one point from ends that miss it slightly meet there), and pieces shorter
+  than that are dropped. A piece drawn twice is kept once: if one drawing
   is black it stays boundary, other differing colours are refused. Where just two pieces
   of the same colour and opacity meet in a straight line, they become one line. Pieces of
   one colour and opacity drawn over each other along one line are made one before they are
   split (a line drawn back and forth many times costs no more than once), and a drawing
   with more than ``Settings.limits.max_svg_pairs`` pairs of pieces that meet or cross is refused;
 * slips of the pen up to ``Settings.inputs.svg_snap_tol`` times the diagonal are mended where a
-  crease would otherwise end on nothing: an overshoot past the line a crease crosses (the
-  boundary among them) is cut off, a piece drawn in two crease colours (one crease running
-  on along another) is dropped, and a crease that ends short of a line is extended to it
-  (:func:`_mend`);
+  line would otherwise end on nothing. The boundary first (:func:`_close_boundary`): a black
+  piece past a corner, or drawn over a crease inside the sheet, is dropped (the crease
+  stays), and a gap between two ends of the boundary is closed halfway. Then the creases
+  (:func:`_mend`): an overshoot past the line a crease crosses (the boundary among them) is
+  cut off, a piece drawn in two crease colours (one crease running on along another) is
+  dropped, and a crease that ends short of a line is extended to it;
 * the black lines must form one closed outline, every crease must lie inside it and end
   on another line, and every face must be a simple polygon (no holes, no crease loop
   hanging at one point). Each problem is a one-line ``ValueError`` naming the file.
