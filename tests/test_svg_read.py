@@ -423,11 +423,10 @@ def test_slips_beyond_the_snap_tolerance_are_refused(tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("name", "merge", "sizes", "letters", "triangles", "refusal"),
+    ("name", "sizes", "letters", "triangles", "refusal"),
     [
         (
             "huffmanWaterbomb.svg",
-            1e-4,
             (448, 1165, 718),
             {"B": 88, "M": 758, "V": 319},
             806,
@@ -436,29 +435,26 @@ def test_slips_beyond_the_snap_tolerance_are_refused(tmp_path):
         ),
         (
             "hypar.svg",
-            DEFAULTS.inputs.svg_merge_tol,
-            (97, 284, 188),
-            {"B": 4, "M": 96, "V": 88, "U": 96},
-            188,
+            (98, 285, 188),
+            {"B": 4, "M": 96, "V": 89, "U": 96},
+            190,
             r"a crease ends inside a face at \(629\.168, 524\.834\)",
         ),
     ],
 )
-def test_origami_simulator_files_with_slips(name, merge, sizes, letters, triangles, refusal):
+def test_origami_simulator_files_with_slips(name, sizes, letters, triangles, refusal):
     """Origami Simulator's examples with slips of under 1e-3 of their diagonals (creases
-    0.58 units, 4e-4 of the diagonal, past the boundary, which the default svg_merge_tol of
-    5e-4 merges already; a crease ending 0.83 units, 7e-4, short of a line) read once the
+    0.58 units past the boundary; a crease ending 0.83 units short of a line) read once the
     slips are mended; without mending they are refused as before."""
     from rigidfold.patterns.files import read_pattern_file
 
-    settings = DEFAULTS.with_(svg_merge_tol=merge)
-    drawing = read_svg(DATA / name, settings=settings)
+    drawing = read_svg(DATA / name)
     check_planar(drawing)
     assert counts(drawing) == sizes
     assert Counter(drawing.assignment) == letters
-    assert len(read_pattern_file(DATA / name, settings=settings).faces) == triangles
+    assert len(read_pattern_file(DATA / name).faces) == triangles
     with pytest.raises(ValueError, match=refusal):
-        read_svg(DATA / name, settings=settings.with_(svg_snap_tol=0))
+        read_svg(DATA / name, settings=DEFAULTS.with_(svg_snap_tol=0))
 
 
 # a square drawn as four lines, the last of them ending short of the first one's start
@@ -558,12 +554,20 @@ def check_pattern_file(
     return pattern
 
 
+# Origami Simulator merges points within 3 px before it looks for crossings; whirlpool's
+# lines miss the points they are drawn to by up to 0.25 units (3e-4 of its diagonal), the
+# weave's by 0.85 units (2.3e-4): svg_merge_tol 5e-4 joins them where the default 1e-4 does not
+MERGED = {"svg_merge_tol": 5e-4}
+
+
 def test_whirlpool_reads():
-    """Origami Simulator's whirlpool.svg: its boundary misses itself by up to 0.25 units (3e-4
-    of the diagonal), its lines miss the points they are drawn to as much, and a black
-    stroke 4.2 units long lies over a valley inside the sheet. It reads as drawn: 150
-    vertices, 240 triangles, the stroke's valley a valley."""
-    drawing = read_svg(WHIRLPOOL)
+    """Origami Simulator's whirlpool.svg: its boundary is separate lines whose ends miss each
+    other by up to 0.25 units, and a black stroke 4.2 units long lies over a valley inside
+    the sheet (Origami Simulator takes it for a boundary edge there). Within svg_snap_tol
+    the boundary is closed and the stroke dropped, its valley kept; with svg_merge_tol 5e-4
+    it reads as drawn: 150 vertices, 240 triangles."""
+    settings = DEFAULTS.with_(**MERGED)
+    drawing = read_svg(WHIRLPOOL, settings=settings)
     check_planar(drawing)
     assert counts(drawing) == (150, 389, 240)
     assert Counter(drawing.assignment) == {"B": 58, "M": 120, "V": 211}
@@ -575,20 +579,30 @@ def test_whirlpool_reads():
         == {(126.6, -175.5), (130.6, -176.8)}
     ]
     assert stroke == ["V"]
-    check_pattern_file(WHIRLPOOL, 240)
+    check_pattern_file(WHIRLPOOL, 240, **MERGED)
     with pytest.raises(ValueError, match=r"not closed: it ends at \(130\.57, 176\.781\)"):
-        read_svg(WHIRLPOOL, settings=DEFAULTS.with_(svg_snap_tol=0))
+        read_svg(WHIRLPOOL, settings=settings.with_(svg_snap_tol=0))
 
 
-def test_whirlpool_with_a_fine_merge_tolerance_names_the_face_it_cannot_cut():
-    """With svg_merge_tol 1e-4 (0.08 units) the points that whirlpool's lines miss are
-    several: a face is left with corners 0.1 apart that cannot be cut into triangles. The
-    refusal is one line naming its corners and its shortest side in the file's
-    coordinates, and the setting that joins them."""
+def test_whirlpool_boundary_is_closed_within_the_snap_tolerance():
+    """With the default svg_merge_tol (1e-4, 0.08 units) the nine gaps of whirlpool's
+    boundary (0.08 to 0.25 units) are not merged: svg_snap_tol closes each halfway."""
+    drawing = read_svg(WHIRLPOOL)
+    check_planar(drawing)
+    assert Counter(drawing.assignment)["B"] == 61
+    closed = np.array([517.172 + 517.345, -549.847 - 549.781]) / 2  # the first gap's middle
+    assert np.linalg.norm(drawing.xy - closed, axis=1).min() < 1e-9
+
+
+def test_whirlpool_with_the_default_merge_tolerance_names_the_face_it_cannot_cut():
+    """With the default svg_merge_tol (1e-4, 0.08 units) the points that whirlpool's lines
+    miss are several: a face is left with corners 0.1 apart that cannot be cut into
+    triangles. The refusal is one line naming its corners and its shortest side in the
+    file's coordinates, and the setting that joins them."""
     from rigidfold.patterns.files import read_pattern_file
 
     with pytest.raises(ValueError) as info:
-        read_pattern_file(WHIRLPOOL, settings=DEFAULTS.with_(svg_merge_tol=1e-4))
+        read_pattern_file(WHIRLPOOL)
     message = str(info.value)
     assert "\n" not in message
     assert re.fullmatch(
@@ -602,22 +616,24 @@ def test_whirlpool_with_a_fine_merge_tolerance_names_the_face_it_cannot_cut():
 
 
 def test_huffman_rectangular_weave_reads():
-    """Origami Simulator's huffmanRectangularWeave.svg: creases drawn at half opacity, lines
-    that miss the points they are drawn to by 0.85 units (2.3e-4 of the diagonal). It
-    reads as drawn: 512 vertices, 353 rectangles and 224 triangles, folds of 90 and 180
-    degrees."""
+    """Origami Simulator's huffmanRectangularWeave.svg: creases drawn at half opacity and
+    full, lines that miss the points they are drawn to by 0.85 units (2.3e-4 of the
+    diagonal), rectangles with a vertex on a side (refused as degenerate before). With the
+    default svg_merge_tol the near misses stay: 1025 vertices, slivers of 5e-8 of the sheet
+    among the triangles; with 5e-4 it reads as drawn: 512 vertices, 353 rectangles and 224
+    triangles, folds of 90 and 180 degrees."""
     drawing = read_svg(WEAVE)
+    check_planar(drawing)
+    assert counts(drawing) == (1025, 1705, 681)
+    check_pattern_file(WEAVE, 1943, smallest=1e-8)
+    drawing = read_svg(WEAVE, settings=DEFAULTS.with_(**MERGED))
     check_planar(drawing)
     assert counts(drawing) == (512, 1088, 577)
     assert Counter(drawing.assignment) == {"B": 92, "M": 464, "V": 532}
     assert Counter(len(p) for p in drawing.polygons) == {3: 224, 4: 353}
     folds = Counter(zip(drawing.assignment, np.abs(drawing.fold_angles).tolist(), strict=True))
     assert folds == {("V", 90): 420, ("M", 90): 240, ("M", 180): 224, ("V", 180): 112, ("B", 0): 92}
-    check_pattern_file(WEAVE, 930)
-    # with the merge tolerance of before, the near misses stay: many more faces, slivers
-    # of 5e-8 of the sheet among them, which still triangulate (rectangles with a vertex
-    # on a side among them)
-    check_pattern_file(WEAVE, 1943, smallest=1e-8, svg_merge_tol=1e-4)
+    check_pattern_file(WEAVE, 930, **MERGED)
 
 
 def test_a_polygon_with_a_vertex_on_a_straight_side_triangulates():

@@ -16,17 +16,14 @@ class InputSettings(Group):
     meshes (``rigidfold.surfaces.MeshSurface``)."""
 
     svg_merge_tol: float = setting(
-        5e-4,
+        1e-4,
         "Crease patterns drawn in SVG (:func:`rigidfold.io.read_svg`): points closer than "
         "this times the diagonal of the drawing's bounding box are one vertex, a line that "
         "ends within it of another line ends on it, and a line shorter than it is dropped. "
         "Round-off of drawing programs (about 1e-3 px) lies far below the default; Origami "
-        "Simulator merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals. Lines "
-        "of some of them miss the points they are drawn to by up to 3e-4 of the diagonal "
-        "(whirlpool.svg, huffmanRectangularWeave.svg in tests/data/origami_simulator: 1e-4 "
-        "leaves edges and faces a few tenths of a unit across there), while the shortest edge "
-        "of those drawings is 5e-3 of it. A carelessly drawn pattern may need 1e-3, which "
-        "would also merge real features of some designs.",
+        "Simulator merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals, and a "
+        "carelessly drawn pattern may need 1e-3, which would also merge real features of some "
+        "designs.",
     )
     svg_snap_tol: float = setting(
         1e-2,
