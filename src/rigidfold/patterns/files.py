@@ -141,12 +141,15 @@ def _triangulate_drawing(
         return triangulate_polygons(coords, polygons, area_tol=tol)
     except RigidfoldError:
         pass
-    for polygon in polygons:  # the first face refused
+
+    def refused(polygon: list[int]) -> bool:
         try:
             triangulate_polygons(coords, [polygon], area_tol=tol)
         except RigidfoldError:
-            break
-    xy = drawing.xy[polygon]
+            return True
+        return False
+
+    xy = drawing.xy[next(p for p in polygons if refused(p))]
     side = np.linalg.norm(np.roll(xy, -1, axis=0) - xy, axis=1)
     k = int(np.argmin(side))
     shown = ", ".join(_at(p) for p in xy[:_SHOWN])
