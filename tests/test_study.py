@@ -386,9 +386,7 @@ def test_generate_progress_shows_the_last_step_and_an_eta(capsys):
 
     bar = GenerateProgress(enabled=True, target=1, log_every=3600.0)
     bar.plain = True
-    run = SimpleNamespace(
-        initial_dof=11, n_reduce=0, lowest_dof=11, n_lock=0, n_exceed=0, n_path=0
-    )
+    run = SimpleNamespace(initial_dof=11, n_reduce=0, lowest_dof=11, n_lock=0, n_exceed=0, n_path=0)
     step = SimpleNamespace(solve_time=0.25, analysis_time=0.125, path_time=0.5)
     bar.update(run, step)  # the first line prints
     run.n_reduce, run.lowest_dof, run.n_lock = 4, 7, 1

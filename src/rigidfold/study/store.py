@@ -125,8 +125,9 @@ class RunRow:
     (None: it could not run, ``status`` then "error: <message>"); status : the words; the
     paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_rigid``,
     ``n_backtrack``, the lowest DOF reached (``lowest_dof``), the final design's
-    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9 figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``),
-    the times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
+    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9 figures
+    (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the times in
+    seconds (``time_*``), and where it was computed (``version``, ``worker``,
     ``numerics``); a figure the run (or its version) did not record is None.
     """
 
