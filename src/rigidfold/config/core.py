@@ -128,11 +128,11 @@ class GenerationSettings(Group):
     )
     rigid_confirmations: int = setting(
         3,
-        "With the look-ahead and ``generation_second_order``: a shape whose own stress form "
+        "With the look-ahead and ``second_order``: a shape whose own stress form "
         "is definite on its flexes (every child forecast second-order rigid) is given up "
         "(``Stop.NO_DEPLOYABLE``, then backtracking) once this many of its candidates in a "
         "row were solved and found second-order rigid, instead of after "
-        "``generation_deploy_max_candidates`` (0: only that bound).",
+        "``deploy_max_candidates`` (0: only that bound).",
     )
 
     def __post_init__(self) -> None:
