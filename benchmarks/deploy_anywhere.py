@@ -53,6 +53,17 @@ ROOF = {
 MODES = {"after": True, "before": False}
 
 
+def paper_cases(surfaces: int) -> list[dict]:
+    """The paper's study (Tables 5-6): patterns 1 and 2, S-hat and S, Bezier seeds 0 to
+    ``surfaces - 1``, as ``rigidfold study --lookahead --deploy-check`` runs it."""
+    return [
+        {"surface": "bezier", "pattern": p, "seed": seed, "criterion": c, "limit": 600.0}
+        for p in ("1", "2")
+        for c in ("shat", "s")
+        for seed in range(surfaces)
+    ]
+
+
 def cases() -> list[dict]:
     """Every case: a drawn pattern on the dome, the HP and Bezier seed 7; the roof."""
     out = [
@@ -65,7 +76,12 @@ def cases() -> list[dict]:
 
 
 def name(case: dict) -> str:
-    return f"{case['surface']}:{Path(case['pattern']).name}"
+    text = f"{case['surface']}:{Path(case['pattern']).name}"
+    return (
+        text
+        if case["surface"] != "bezier" or case["seed"] == 7
+        else (f"{text}:{case['criterion']}:{case['seed']}")
+    )
 
 
 def cause(attempt) -> str | None:
@@ -136,9 +152,17 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=None)
     parser.add_argument("--only", default=None, metavar="TEXT", help="cases whose name holds it")
     parser.add_argument("--modes", default="after,before", help="after, before or both")
+    parser.add_argument(
+        "--paper",
+        type=int,
+        default=0,
+        metavar="N",
+        help="instead: the paper's study on N Bezier surfaces (patterns 1 and 2, S-hat and S)",
+    )
     args = parser.parse_args()
     modes = [m for m in args.modes.split(",") if m]
-    chosen = [c for c in cases() if args.only is None or args.only in name(c)]
+    every = paper_cases(args.paper) if args.paper else cases()
+    chosen = [c for c in every if args.only is None or args.only in name(c)]
     work = [(c, m) for c in chosen for m in modes]
     rows = []
     with ProcessPoolExecutor(args.jobs) as pool:
