@@ -39,6 +39,17 @@ def counts(drawing: SvgDrawing) -> tuple[int, int, int]:
     return len(drawing.xy), len(drawing.edges), len(drawing.polygons)
 
 
+def shortest_edge(drawing: SvgDrawing) -> float:
+    """The length of the drawing's shortest edge, in drawing units."""
+    xy, edges = drawing.xy, drawing.edges
+    return float(np.linalg.norm(xy[edges[:, 0]] - xy[edges[:, 1]], axis=1).min())
+
+
+OLD_MERGE = {"svg_merge_tol": 1e-4}
+"""The default svg_merge_tol before issue 39 item 19 (5e-4 since): near misses of 2e-4 to 4e-4
+of the diagonal, as in Origami Simulator's examples drawn in Illustrator, stay apart."""
+
+
 def check_planar(drawing: SvgDrawing) -> None:
     """What every drawing read must satisfy: faces counter-clockwise and simple, their
     sides edges, every edge a side of one face (boundary) or two (creases), a disc."""
@@ -422,39 +433,82 @@ def test_slips_beyond_the_snap_tolerance_are_refused(tmp_path):
         DEFAULTS.with_(svg_snap_tol=-0.1)
 
 
+WATERBOMB_UNMENDED = (
+    r"the crease from \(135\.014, 1074\.92\) to \(135\.014, 1075\.5\) lies outside the boundary"
+)
+HYPAR_UNMENDED = r"a crease ends inside a face at \(629\.168, 524\.834\)"
+
+
 @pytest.mark.parametrize(
-    ("name", "sizes", "letters", "triangles", "refusal"),
+    ("name", "merge", "sizes", "letters", "triangles", "shortest", "unmended"),
     [
-        (
+        pytest.param(
             "huffmanWaterbomb.svg",
+            {},
+            (440, 1157, 718),
+            {"B": 80, "M": 758, "V": 319},
+            798,
+            53.975,
+            None,
+            id="huffmanWaterbomb-default",
+        ),
+        pytest.param(
+            "huffmanWaterbomb.svg",
+            OLD_MERGE,
             (448, 1165, 718),
             {"B": 88, "M": 758, "V": 319},
             806,
-            r"the crease from \(135\.014, 1074\.92\) to \(135\.014, 1075\.5\) lies outside "
-            r"the boundary",
+            0.58,
+            WATERBOMB_UNMENDED,
+            id="huffmanWaterbomb-1e-4",
         ),
-        (
+        pytest.param(
             "hypar.svg",
+            {},
+            (97, 284, 188),
+            {"B": 4, "M": 96, "V": 88, "U": 96},
+            188,
+            25.456,
+            HYPAR_UNMENDED,
+            id="hypar-default",
+        ),
+        pytest.param(
+            "hypar.svg",
+            OLD_MERGE,
             (98, 285, 188),
             {"B": 4, "M": 96, "V": 89, "U": 96},
             190,
-            r"a crease ends inside a face at \(629\.168, 524\.834\)",
+            0.482,
+            HYPAR_UNMENDED,
+            id="hypar-1e-4",
         ),
     ],
 )
-def test_origami_simulator_files_with_slips(name, sizes, letters, triangles, refusal):
-    """Origami Simulator's examples with slips of under 1e-3 of their diagonals (creases
-    0.58 units past the boundary; a crease ending 0.83 units short of a line) read once the
-    slips are mended; without mending they are refused as before."""
+def test_origami_simulator_files_with_slips(
+    name, merge, sizes, letters, triangles, shortest, unmended
+):
+    """Origami Simulator's examples with slips of under 1e-3 of their diagonals: in
+    huffmanWaterbomb.svg creases are drawn to points 0.59 units (3.8e-4) past the boundary,
+    in hypar.svg a crease ends 0.83 units (6.8e-4) short of a line, near a vertex. With the
+    default svg_merge_tol (5e-4: 0.76 and 0.61 units) they read as drawn: the waterbomb's
+    creases meet at their drawn ends, which the boundary passes through, and it reads even
+    unmended; hypar's crease, extended, ends at the vertex. Their shortest edges are then 54
+    and 25 units. With 1e-4 (the default before) the mended ends stay 0.58 and 0.48 units
+    from those points: edges that short, and unmended both are refused."""
     from rigidfold.patterns.files import read_pattern_file
 
-    drawing = read_svg(DATA / name)
+    settings = DEFAULTS.with_(**merge)
+    drawing = read_svg(DATA / name, settings=settings)
     check_planar(drawing)
     assert counts(drawing) == sizes
     assert Counter(drawing.assignment) == letters
-    assert len(read_pattern_file(DATA / name).faces) == triangles
-    with pytest.raises(ValueError, match=refusal):
-        read_svg(DATA / name, settings=DEFAULTS.with_(svg_snap_tol=0))
+    assert shortest_edge(drawing) == pytest.approx(shortest, abs=1e-3)
+    assert len(read_pattern_file(DATA / name, settings=settings).faces) == triangles
+    if unmended is None:
+        assert counts(read_svg(DATA / name, settings=settings.with_(svg_snap_tol=0))) == sizes
+    else:
+        with pytest.raises(ValueError, match=unmended):
+            read_svg(DATA / name, settings=settings.with_(svg_snap_tol=0))
 
 
 # a square drawn as four lines, the last of them ending short of the first one's start
@@ -556,18 +610,19 @@ def check_pattern_file(
 
 # Origami Simulator merges points within 3 px before it looks for crossings; whirlpool's
 # lines miss the points they are drawn to by up to 0.25 units (3e-4 of its diagonal), the
-# weave's by 0.85 units (2.3e-4): svg_merge_tol 5e-4 joins them where the default 1e-4 does not
-MERGED = {"svg_merge_tol": 5e-4}
+# weave's by 0.85 units (2.3e-4): the default svg_merge_tol, 5e-4, joins them where 1e-4 (the
+# default before) does not
 
 
 def test_whirlpool_reads():
     """Origami Simulator's whirlpool.svg: its boundary is separate lines whose ends miss each
     other by up to 0.25 units, and a black stroke 4.2 units long lies over a valley inside
     the sheet (Origami Simulator takes it for a boundary edge there). Within svg_snap_tol
-    the boundary is closed and the stroke dropped, its valley kept; with svg_merge_tol 5e-4
-    it reads as drawn: 150 vertices, 240 triangles."""
-    settings = DEFAULTS.with_(**MERGED)
-    drawing = read_svg(WHIRLPOOL, settings=settings)
+    the boundary is closed and the stroke dropped, its valley kept; with the default
+    svg_merge_tol (5e-4, 0.41 units) it reads as drawn: 150 vertices, 240 triangles, its
+    shortest edge 4.15 units."""
+    assert DEFAULTS.inputs.svg_merge_tol == 5e-4
+    drawing = read_svg(WHIRLPOOL)
     check_planar(drawing)
     assert counts(drawing) == (150, 389, 240)
     assert Counter(drawing.assignment) == {"B": 58, "M": 120, "V": 211}
@@ -579,30 +634,32 @@ def test_whirlpool_reads():
         == {(126.6, -175.5), (130.6, -176.8)}
     ]
     assert stroke == ["V"]
-    check_pattern_file(WHIRLPOOL, 240, **MERGED)
+    assert shortest_edge(drawing) == pytest.approx(4.153, abs=1e-3)
+    check_pattern_file(WHIRLPOOL, 240)
     with pytest.raises(ValueError, match=r"not closed: it ends at \(130\.57, 176\.781\)"):
-        read_svg(WHIRLPOOL, settings=settings.with_(svg_snap_tol=0))
+        read_svg(WHIRLPOOL, settings=DEFAULTS.with_(svg_snap_tol=0))
 
 
 def test_whirlpool_boundary_is_closed_within_the_snap_tolerance():
-    """With the default svg_merge_tol (1e-4, 0.08 units) the nine gaps of whirlpool's
+    """With svg_merge_tol=1e-4 (0.08 units, the default before) the nine gaps of whirlpool's
     boundary (0.08 to 0.25 units) are not merged: svg_snap_tol closes each halfway."""
-    drawing = read_svg(WHIRLPOOL)
+    drawing = read_svg(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
     check_planar(drawing)
+    assert counts(drawing) == (201, 450, 250)
     assert Counter(drawing.assignment)["B"] == 61
     closed = np.array([517.172 + 517.345, -549.847 - 549.781]) / 2  # the first gap's middle
     assert np.linalg.norm(drawing.xy - closed, axis=1).min() < 1e-9
 
 
-def test_whirlpool_with_the_default_merge_tolerance_names_the_face_it_cannot_cut():
-    """With the default svg_merge_tol (1e-4, 0.08 units) the points that whirlpool's lines
-    miss are several: a face is left with corners 0.1 apart that cannot be cut into
+def test_whirlpool_with_a_small_merge_tolerance_names_the_face_it_cannot_cut():
+    """With svg_merge_tol=1e-4 (0.08 units, the default before) the points that whirlpool's
+    lines miss are several: a face is left with corners 0.1 apart that cannot be cut into
     triangles. The refusal is one line naming its corners and its shortest side in the
     file's coordinates, and the setting that joins them."""
     from rigidfold.patterns.files import read_pattern_file
 
     with pytest.raises(ValueError) as info:
-        read_pattern_file(WHIRLPOOL)
+        read_pattern_file(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
     message = str(info.value)
     assert "\n" not in message
     assert re.fullmatch(
@@ -618,22 +675,25 @@ def test_whirlpool_with_the_default_merge_tolerance_names_the_face_it_cannot_cut
 def test_huffman_rectangular_weave_reads():
     """Origami Simulator's huffmanRectangularWeave.svg: creases drawn at half opacity and
     full, lines that miss the points they are drawn to by 0.85 units (2.3e-4 of the
-    diagonal), rectangles with a vertex on a side (refused as degenerate before). With the
-    default svg_merge_tol the near misses stay: 1025 vertices, slivers of 5e-8 of the sheet
-    among the triangles; with 5e-4 it reads as drawn: 512 vertices, 353 rectangles and 224
-    triangles, folds of 90 and 180 degrees."""
-    drawing = read_svg(WEAVE)
+    diagonal), rectangles with a vertex on a side (refused as degenerate before). With
+    svg_merge_tol=1e-4 (the default before) the near misses stay: 1025 vertices, edges of
+    0.84 units, slivers of 5e-8 of the sheet among the triangles; with the default (5e-4) it
+    reads as drawn: 512 vertices, 353 rectangles and 224 triangles, folds of 90 and 180
+    degrees, its shortest edge 83 units."""
+    drawing = read_svg(WEAVE, settings=DEFAULTS.with_(**OLD_MERGE))
     check_planar(drawing)
     assert counts(drawing) == (1025, 1705, 681)
-    check_pattern_file(WEAVE, 1943, smallest=1e-8)
-    drawing = read_svg(WEAVE, settings=DEFAULTS.with_(**MERGED))
+    assert shortest_edge(drawing) == pytest.approx(0.841, abs=1e-3)
+    check_pattern_file(WEAVE, 1943, smallest=1e-8, **OLD_MERGE)
+    drawing = read_svg(WEAVE)
     check_planar(drawing)
     assert counts(drawing) == (512, 1088, 577)
+    assert shortest_edge(drawing) == pytest.approx(83.135, abs=1e-3)
     assert Counter(drawing.assignment) == {"B": 92, "M": 464, "V": 532}
     assert Counter(len(p) for p in drawing.polygons) == {3: 224, 4: 353}
     folds = Counter(zip(drawing.assignment, np.abs(drawing.fold_angles).tolist(), strict=True))
     assert folds == {("V", 90): 420, ("M", 90): 240, ("M", 180): 224, ("V", 180): 112, ("B", 0): 92}
-    check_pattern_file(WEAVE, 930, **MERGED)
+    check_pattern_file(WEAVE, 930)
 
 
 def test_a_polygon_with_a_vertex_on_a_straight_side_triangulates():
