@@ -53,15 +53,7 @@ def test_the_stress_form_is_the_second_derivative_of_the_constraints():
 
 @pytest.mark.parametrize("fold", [0.3, 0.8])
 def test_a_folded_degree_4_vertex_is_not_second_order_rigid_and_deploys(fold):
-    # fold the straight vertex about the line 0-2 (its one finite motion)
-    c = np.column_stack([STRAIGHT4, np.zeros(5)])
-    axis = (c[2] - c[0]) / np.linalg.norm(c[2] - c[0])
-    p = c[3] - c[0]
-    rot = (
-        p * np.cos(fold) + np.cross(axis, p) * np.sin(fold) + axis * (axis @ p) * (1 - np.cos(fold))
-    )
-    c[3] = c[0] + rot
-    shape = CreasePattern.from_faces(c, FACES4)
+    shape = _folded_vertex(fold)
     dof = analyze(shape, support_face=0).dof
     assert dof == 1
     assert not obstruction(shape, 0, dof).rigid
@@ -121,3 +113,54 @@ def test_final_dof_is_the_final_designs_and_the_lowest_is_its_own_field():
     d = run.to_dict()
     assert (d["final_dof"], d["lowest_dof"], d["final_step"]) == (5, 2, 0)
     assert AttemptOutcome.RIGID.value == "second_order_rigid"
+
+
+def _folded_vertex(fold: float) -> CreasePattern:
+    """The straight degree-4 vertex folded by ``fold`` about its diagonal 0-2."""
+    c = np.column_stack([STRAIGHT4, np.zeros(5)])
+    axis = (c[2] - c[0]) / np.linalg.norm(c[2] - c[0])
+    p = c[3] - c[0]
+    c[3] = c[0] + (
+        p * np.cos(fold) + np.cross(axis, p) * np.sin(fold) + axis * (axis @ p) * (1 - np.cos(fold))
+    )
+    return CreasePattern.from_faces(c, FACES4)
+
+
+def test_a_dense_step_passes_the_bifurcation_point_of_a_flat_vertex_on_its_branch():
+    """The flat state of a degree-4 vertex is a bifurcation point (two flexes: a fold about
+    either diagonal). Arriving along the fold about 0-2, the dense step continues on that
+    branch, onto the constraints to the tracer's tolerance."""
+    from rigidfold.mechanism.path import _escape
+    from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints
+
+    flat = CreasePattern.from_faces(STRAIGHT4, FACES4)
+    cons = RigidFoldingConstraints(flat, 0)
+    t = np.zeros(cons.n)
+    t[3 * 3 + 2] = 1.0  # vertex 3 leaves the plane: the fold about 0-2
+    x0 = cons.x0
+    out = _escape(cons, x0, t, cons.free_angles(x0), 0.05, "projection", DEFAULTS)
+    assert out is not None
+    y, d, _, _ = out
+    assert np.abs(cons.residual(y)).max() <= DEFAULTS.path.tol
+    moved = (y - x0).reshape(-1, 3) * cons.scale
+    assert abs(moved[3, 2]) > 1e-3  # along the branch it came on
+    assert np.abs(moved[[0, 1, 2, 4]]).max() < 1e-9  # the other branch is not taken
+
+
+def test_a_trace_whose_sparse_corrector_fails_goes_on_by_dense_steps(monkeypatch):
+    """A stall of the sparse continuation (forced here: its corrector fails on the first
+    30 calls) is passed by a dense step, and the path still reaches the flat state."""
+    from rigidfold.mechanism import path as path_module
+
+    real, calls = path_module.correct, [0]
+
+    def failing(*args, **kwargs):
+        calls[0] += 1
+        y, ok, nf, system = real(*args, **kwargs)
+        return (y, False, nf, system) if calls[0] <= 30 else (y, ok, nf, system)
+
+    monkeypatch.setattr(path_module, "correct", failing)
+    shape = _folded_vertex(0.8)
+    path = trace_path(shape, dof=1, support_face=0)
+    assert path.deploys and path.escapes >= 1
+    assert path.max_length_error < 1e-8
