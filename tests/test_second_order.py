@@ -140,7 +140,7 @@ def test_a_dense_step_passes_the_bifurcation_point_of_a_flat_vertex_on_its_branc
     x0 = cons.x0
     out = _escape(cons, x0, t, cons.free_angles(x0), 0.05, "projection", DEFAULTS)
     assert out is not None
-    y, d, _, _ = out
+    y, _, _, _ = out
     assert np.abs(cons.residual(y)).max() <= DEFAULTS.path.tol
     moved = (y - x0).reshape(-1, 3) * cons.scale
     assert abs(moved[3, 2]) > 1e-3  # along the branch it came on
