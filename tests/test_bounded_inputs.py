@@ -111,7 +111,7 @@ def test_huge_study_is_refused_at_once(tmp_path):
 
 # ------------------------------------------------------------------- defect 12: small ones
 def test_expression_starting_with_minus_is_accepted(tmp_path):
-    from rigidfold.cli import _attached_values
+    from rigidfold.cli_parser import attached_values as _attached_values
 
     out = str(tmp_path / "o")
     proc = run_cli(

@@ -90,25 +90,17 @@ def test_options_keep_what_the_user_gave():
         StructureOptions(actuators="20").check_indices(n_vertices=9, n_edges=20)
 
 
-def test_generate_options_hold_the_checks_and_read_old_summaries():
+def test_generate_options_hold_the_checks():
     fab = FabricateOptions(0.02, clearance_angle_deg=3.0)
     st = StructureOptions(thickness=0.02, nonlinear=True, clamped="0")
     opts = GenerateOptions(fabricate=fab, structure=st, material="plywood")
-    assert opts.thickness == 0.02 and opts.panel_thickness == 0.02 and opts.supports == "auto"
+    assert opts.panel_thickness == 0.02
     data = json.loads(json.dumps(opts.to_dict()))
-    # the flat keys of earlier versions are still written, with their meaning
-    assert data["thickness"] == 0.02 and data["structure"] is True and data["limit"] == 250.0
+    assert data["fabricate"]["thickness"] == 0.02 and data["structure"]["nonlinear"] is True
     assert GenerateOptions.from_dict(data) == opts
     assert pickle.loads(pickle.dumps(opts)) == opts  # a study hands it to its workers
-    # an earlier summary.json: the flat keys only
-    old = {"thickness": 0.018, "side": "top", "structure": True, "supports": "0,6"}
-    read = GenerateOptions.from_dict(old | {"material": None, "loads": [], "limit": 300.0})
-    assert read.fabricate == FabricateOptions(0.018, side="top")
-    assert read.structure == StructureOptions(thickness=0.018, supports="0,6", limit=300.0)
-    assert GenerateOptions.from_dict({"structure": False, "thickness": None}) == GenerateOptions()
-    # the thickness keyword moves both checks; a new material is the structure's too
-    moved = opts.replace(thickness=0.03, material="steel")
-    assert moved.fabricate.thickness == moved.structure.thickness == 0.03
+    assert GenerateOptions.from_dict({"structure": None, "fabricate": None}) == GenerateOptions()
+    moved = opts.replace(material="steel")  # a new material is the structure's too
     assert moved.structure.material == "steel" and moved.structure.nonlinear
 
 
@@ -192,7 +184,7 @@ def test_new_fabricate_flags_reach_the_thick_panels(built):
     sheets = sorted((out / "final" / "thick").glob("*_sheet_*.svg"))
     stock = '<rect x="0" y="0" width="3050.000" height="1525.000"'  # the legend goes below
     assert sheets and all(stock in p.read_text() for p in sheets)
-    assert summary["options"]["fabricate_options"]["sheet"] == [3050.0, 1525.0]
+    assert summary["options"]["fabricate"]["sheet"] == [3050.0, 1525.0]
 
 
 def test_new_structure_flags_reach_the_structure(built):
@@ -206,8 +198,7 @@ def test_new_structure_flags_reach_the_structure(built):
     if "frequencies_Hz" in saved:  # analysed: no natural frequencies with --modes 0
         assert saved["frequencies_Hz"] == []
     assert record["structure"]["analysis"] == "nonlinear"
-    assert summary["options"]["structure_options"]["nonlinear"] is True
-    assert summary["options"]["structure"] is True  # the flat key of earlier versions
+    assert summary["options"]["structure"]["nonlinear"] is True
 
 
 def test_support_candidates_and_actuators_reach_the_structure(built, tmp_path):

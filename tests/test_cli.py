@@ -396,3 +396,77 @@ def test_native_quiet_drops_what_the_quiet_thread_prints_only(capsys, monkeypatc
     with native_quiet():
         print("verbose")
     assert capsys.readouterr().out == "verbose\n"
+
+
+# ----------------------------------------- bad input or a bug; flags made from the records
+@pytest.mark.parametrize(
+    "argv",
+    [
+        [*OPTIMIZE_RUN, "--out", ""],
+        ["generate", "--surface", "dome", "--pattern", "1", "--out", ""],
+        ["develop", "x.fold", "--out", ""],
+        ["study-report", "x.sqlite", "--out", ""],
+    ],
+)
+def test_an_empty_output_directory_is_refused(tmp_path, monkeypatch, capsys, argv):
+    """``--out ""`` would write into the current directory: refused, one line, exit 2."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    assert exit_.value.code == 2
+    assert "argument --out: an empty directory name" in _one_line_error(capsys)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_bug_is_not_called_bad_input(tmp_path, monkeypatch, capsys):
+    """An exception that is not a RigidfoldError (here a ValueError of a library below) is a
+    bug: one line saying so and where its traceback is, exit code 1."""
+    import rigidfold.workflows
+
+    def broken(*args, **kwargs):
+        raise ValueError("operands could not be broadcast together")
+
+    monkeypatch.setattr(rigidfold.workflows, "optimize_case", broken)
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
+    assert main([*OPTIMIZE_RUN, "--out", str(tmp_path / "o")]) == 1
+    line = _one_line_error(capsys)
+    assert line.startswith("rigidfold: error: a bug in rigidfold, not in the input: ValueError")
+    (written,) = tmp_path.glob("rigidfold-bug-*.txt")
+    assert f"the traceback is in {written}" in line
+    assert "Traceback" in written.read_text() and "broken" in written.read_text()
+
+
+def test_a_documented_field_is_a_flag():
+    """A field of an options record made by flags.option is a flag, its help the field's
+    documentation, its default the record's, its value checked by its parse."""
+    import argparse
+    from dataclasses import dataclass
+
+    from rigidfold.cli_parser import Parser, add_options, options_of
+    from rigidfold.flags import count, option, positive
+
+    @dataclass(frozen=True)
+    class Options:
+        time_limit: float | None = option(
+            None, "stop after this many seconds", parse=positive, metavar="S"
+        )
+        retries: int = option(2, "tries of each solve", parse=count)
+        fast: bool = option(False, "the fast path")
+        check: bool = option(True, "the final check")
+        hidden: str = option("x", "not on the command line", flag=False)
+
+    parser = Parser(prog="t")
+    add_options(parser, Options)
+    assert parser.long_options == ["--help", "--time-limit", "--retries", "--fast", "--no-check"]
+    help_text = " ".join(parser.format_help().split())
+    assert "--time-limit S stop after this many seconds" in help_text
+    assert (
+        "tries of each solve (default: 2)" in help_text and "turn off the final check" in help_text
+    )
+    args = parser.parse_args(["--time-limit", "60", "--fast", "--no-check"])
+    assert options_of(Options, args) == Options(60.0, 2, True, False)
+    assert (
+        isinstance(args, argparse.Namespace) and options_of(Options, args, hidden="y").hidden == "y"
+    )
+    with pytest.raises(SystemExit):
+        parser.parse_args(["--retries", "-1"])

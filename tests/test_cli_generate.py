@@ -198,7 +198,10 @@ def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     assert "interrupted" in capsys.readouterr().err
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["n_solutions"] == 2
-    assert summary["stop"] == "interrupted" and summary["verdict"] is None  # never "running"
+    assert summary["stop"] == "interrupted"  # never "running"
+    # the best design so far is named: the last solution (no path of it is known to deploy)
+    assert summary["verdict"]["outcome"] == "fell_short"
+    assert summary["verdict"]["final_design"] == summary["solutions"][-1]
     assert len(json.loads((tmp_path / "log.json").read_text())["attempts"]) == 2
     for path in (tmp_path / "solutions").glob("*.fold"):
         read_fold(path)
@@ -449,7 +452,7 @@ def test_a_signal_during_an_ipopt_solve_is_an_interrupt(tmp_path, name):
     ]
     summary = json.loads((out / "summary.json").read_text())
     assert summary["stop"] == "interrupted" and summary["stop_reason"] == "interrupted"
-    assert summary["n_solutions"] == 0 and summary["verdict"] is None
+    assert summary["n_solutions"] == 0 and summary["verdict"]["final_design"] is None
     assert not (out / ".rigidfold-run.lock").exists()
 
 

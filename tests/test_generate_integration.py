@@ -13,11 +13,11 @@ import pytest
 
 from conftest import main_code
 from rigidfold.errors import RigidfoldError
+from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.generate import GenerateOptions
 from rigidfold.run import Stage, load_run
+from rigidfold.structure import StructureOptions
 from rigidfold.study import STUDY_OPTIONS, StudyConfig
-
-LEGACY_RUN = Path(__file__).parent / "data" / "legacy_run"
 
 FAST = [
     "generate",
@@ -132,27 +132,14 @@ def test_failing_thick_panels_and_limit_fall_short(failing):
     assert words["thick panels"] == words["structure"] == "FAILED"
 
 
-def test_legacy_run_reads_without_them():
-    run = load_run(LEGACY_RUN)
-    assert run.final_record.fabrication is None and run.final_record.structure is None
-    assert [c.name for c in run.checks()] == ["development", "folding motion", "large deformation"]
-    thick, note = run.thick_panels()
-    assert thick is None and "--thickness" in note
-    assert run.structure_figure() is None
-
-
 @pytest.mark.parametrize(
     "changes",
     [
-        {"thickness": -0.02},
-        {"thickness": float("nan")},
-        {"thickness": True},
-        {"side": "left"},
+        {"target_dof": -1},
+        {"seed": -1},
         {"material": "unobtainium"},
-        {"supports": "a,b"},
-        {"loads": ("snow=1",)},
-        {"loads": "uniform=1"},
-        {"limit": "L/0"},
+        {"fabricate": 0.02},
+        {"structure": True},
     ],
 )
 def test_options_are_validated(changes):
@@ -161,8 +148,9 @@ def test_options_are_validated(changes):
 
 
 def test_options_round_trip_and_studies_do_not_store_them():
-    opts = GenerateOptions(thickness=0.018, structure=True, loads=["uniform=0.5"], limit="L/300")
-    assert opts.loads == ("uniform=0.5",) and opts.limit == 300.0
+    structure = StructureOptions(thickness=0.018, loads=("uniform=0.5",), limit="L/300")
+    opts = GenerateOptions(fabricate=FabricateOptions(0.018), structure=structure)
+    assert opts.structure.loads == ("uniform=0.5",) and opts.structure.limit == 300.0
     assert GenerateOptions.from_dict(json.loads(json.dumps(opts.to_dict()))) == opts
     stored = StudyConfig(STUDY_OPTIONS).as_dict()
     assert set(stored) == {

@@ -14,6 +14,7 @@ import sys
 
 import pytest
 
+import rigidfold
 from rigidfold import numerics
 from rigidfold.numerics import (
     BLAS_KERNEL_NAMES,
@@ -213,3 +214,57 @@ def test_workers_of_other_numerics_are_named():
     check_worker_numerics({"tcp://a:1": "k", "tcp://b:2": "k"}, "k")
     with pytest.raises(ValueError, match=r"tcp://b:2 computes with numerics 'other'"):
         check_worker_numerics({"tcp://a:1": "k", "tcp://b:2": "other"}, "k")
+
+
+# ------------------------------------------------------ the pin measured; restarts that fail
+@needs_x86
+def test_the_libm_pin_is_measured():
+    """This process (started pinned) computes the pinned libm's bits; one started with the
+    machine's own libm is found unpinned where the CPU has the FMA variants."""
+    assert numerics.libm_pinned()
+    if not {"fma", "avx2"} <= FLAGS:
+        pytest.skip("this CPU has no FMA variants: its libm is the pinned one")
+    env = pinned_environ(unpinned_env())
+    env.pop("GLIBC_TUNABLES")
+    env[OPT_OUT_ENV] = "native"
+    code = "from rigidfold.numerics import libm_pinned; print(libm_pinned())"
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert proc.stdout.strip() == "False", proc.stderr
+
+
+def test_a_restart_that_fails_says_so(monkeypatch, capsys):
+    def refused(*args):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(numerics, "restart_wanted", lambda: True)
+    monkeypatch.setattr(numerics.os, "execve", refused)
+    numerics.restart_pinned()  # carries on
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "could not restart with the pinned numerics (Permission denied)" in line
+
+
+def test_pinned_refuses_a_file_it_cannot_run_in_one_line(tmp_path):
+    script = tmp_path / "script"
+    script.write_text("print('hi')\n")  # no #! line
+    script.chmod(0o755)
+    proc = subprocess.run(
+        [sys.executable, "-m", "rigidfold.pinned", str(script)], capture_output=True, text=True
+    )
+    assert proc.returncode == 126 and "Traceback" not in proc.stderr
+    (line,) = proc.stderr.splitlines()
+    assert line.startswith(f"rigidfold.pinned: cannot run {str(script)!r}: ")
+
+
+def test_a_program_that_calls_the_entry_point_runs_once(tmp_path):
+    """rigidfold.launch.main() called from a program does not restart the process (which
+    would run the program again from the top); the rigidfold command does."""
+    script = tmp_path / "program.py"
+    script.write_text(
+        "import sys\nprint('top')\nsys.argv[1:] = ['--version']\n"
+        "import rigidfold.launch\nraise SystemExit(rigidfold.launch.main())\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, str(script)], env=unpinned_env(), capture_output=True, text=True
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines() == ["top", f"rigidfold {rigidfold.__version__}"]

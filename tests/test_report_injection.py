@@ -74,7 +74,12 @@ def test_study_report_writes_pattern_names_as_text(tmp_path):
     )
     for name in NAMES:
         for seed in range(2):
-            row = numbers | {"status": "target DOF 1 reached", "n_lock": seed, "version": "t"}
+            row = numbers | {
+                "stop": "target_reached",
+                "status": "target DOF 1 reached",
+                "n_lock": seed,
+                "version": "t",
+            }
             store.add(Key("bezier", seed, name, "s"), row, [])
     store.add(
         Key("bezier", 5, NAMES[0], "s"),

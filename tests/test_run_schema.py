@@ -1,11 +1,9 @@
 """The run artifact (issue 28): one schema for summary.json, log.json and the solution files,
-one set of generate options, the FOLD frame contract, and runs of the previous version."""
+one set of generate options and the FOLD frame contract."""
 
 from __future__ import annotations
 
 import json
-import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,13 +12,7 @@ from rigidfold.generate import GenerateOptions
 from rigidfold.io import FRACTION_KEY, motion_frames, read_frames
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns import pattern1
-from rigidfold.run import RunSummary, SolutionRecord, Stage, aggregate, load_run
-from rigidfold.workflows import report_run
-
-LEGACY_RUN = Path(__file__).parent / "data" / "legacy_run"
-"""A generate run written by rigidfold before the run artifact (commit 7b0ce6b): ``rigidfold
-generate --surface bezier --seed 1 --pattern 1 --criterion shat --target-dof 17
---no-report`` (summary.json, log.json and the solution FOLD files; final/ left out)."""
+from rigidfold.run import SolutionRecord, Stage, aggregate
 
 
 def _record(development="converged", motion=None, deformation=None) -> SolutionRecord:
@@ -116,49 +108,3 @@ def test_motion_frames_carry_their_fraction():
         f["frame_title"] = "a motion frame"
     other = read_frames({"file_frames": frames}, pattern.n_vertices, "test")
     np.testing.assert_array_equal(other.fraction, [0.0, 0.5, 1.0])
-
-
-def test_a_run_of_the_previous_version_still_reads(tmp_path):
-    """summary.json, log.json and solution files written before the run artifact: the same
-    counters, checks, final design and motion (fractions from the frames' titles), and a
-    report."""
-    run_dir = shutil.copytree(LEGACY_RUN, tmp_path / "run")
-    run = load_run(run_dir)
-    summary = json.loads((LEGACY_RUN / "summary.json").read_text())
-    assert isinstance(run.summary, RunSummary)
-    assert (run.summary.final_dof, run.summary.n_lock) == (summary["final_dof"], summary["N_lock"])
-    assert run.summary.options["symmetric"] is False and run.target_dof == 17
-    assert [d.name for d in run.designs] == summary["solutions"]
-    assert run.final is not None and run.final.name == summary["solutions"][-1]
-    assert [c.word for c in run.checks()] == ["passed", "passed", "passed"]
-    fraction = run.final.fraction
-    assert len(fraction) == len(run.final.motion) > 2
-    assert fraction[0] == 0.0 and fraction[-1] == 1.0 and np.all(np.diff(fraction) > 0)
-    assert GenerateOptions.from_dict(run.summary.options).target_dof == 17
-    report = report_run(run_dir)
-    assert report.html.is_file() and report.to_dict()["checks"]["development"] == "passed"
-
-
-LEGACY_STUDY = Path(__file__).parent / "data" / "legacy_study.sqlite"
-"""A study database written by rigidfold before the run artifact (commit 7b0ce6b): ``rigidfold
-study --patterns 1 --criteria s --surfaces 1 --no-deform --workers 1``."""
-
-
-def test_a_study_of_the_previous_version_resumes(tmp_path):
-    """Its configuration (target_dof and deploy_check still among the settings, no
-    ``check``) is the one the same command makes now: the study resumes, its run is done."""
-    from rigidfold.config import DEFAULTS
-    from rigidfold.study import STUDY_OPTIONS, Key, Store, StudyConfig
-
-    db = shutil.copy(LEGACY_STUDY, tmp_path / "study.sqlite")
-    config = StudyConfig(STUDY_OPTIONS.replace(deform=False), DEFAULTS)
-    store = Store(db, config.as_dict(), allow_mixed_numerics=True)
-    try:
-        assert store.done() == {Key("bezier", 0, "1", "s")}
-        (row,) = store.runs()
-        assert row.n_lock is not None and row.final_dof is not None
-        assert row.stop is not None  # filled from the old status words when opened
-    finally:
-        store.close()
-    with pytest.raises(ValueError, match="lookahead"):
-        Store(db, StudyConfig(STUDY_OPTIONS.replace(lookahead=True), DEFAULTS).as_dict())

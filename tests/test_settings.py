@@ -1,19 +1,16 @@
 """Settings: frozen groups whose fields are documented where they are defined, one flat name
 per setting (``with_``, error messages, a study's stored configuration), and the flat view
-that older study databases are compared with."""
+a study stores."""
 
 import dataclasses
-import json
 import math
 import pickle
-import sqlite3
 from pathlib import Path
 
 import pytest
 
 from rigidfold.config import DEFAULTS, FLAT_NAMES, GROUPS, DesignSettings, Settings
 from rigidfold.errors import RigidfoldError
-from rigidfold.study.store import RETIRED_SETTINGS, config_differences
 
 DATA = Path(__file__).parent / "data"
 
@@ -99,20 +96,8 @@ def test_from_degrees_keeps_the_defaults_exactly():
     assert s.inputs.svg_snap_tol == 0.0
 
 
-def test_a_study_stores_the_flat_view_and_older_databases_compare_with_it():
-    """The configuration a study stores is the flat view (the names every version wrote),
-    so a database written before the groups compares equal to the current defaults."""
+def test_a_study_stores_the_flat_view():
+    """The configuration a study stores is the flat view (the names every version wrote)."""
     from rigidfold.study.runner import StudyConfig
 
-    stored = StudyConfig().as_dict()
-    assert stored["settings"] == DEFAULTS.flat()
-    con = sqlite3.connect(f"file:{DATA / 'legacy_study.sqlite'}?mode=ro", uri=True)
-    try:
-        (text,) = con.execute("SELECT value FROM meta WHERE key = 'config'").fetchone()
-    finally:
-        con.close()
-    legacy = json.loads(text)
-    assert set(legacy["settings"]) - RETIRED_SETTINGS <= set(FLAT_NAMES)
-    assert config_differences(legacy, {**legacy, "settings": stored["settings"]}) == []
-    changed = StudyConfig(settings=DEFAULTS.with_(path_tol=1e-12)).as_dict()["settings"]
-    assert config_differences(legacy, {**legacy, "settings": changed}) == ["settings.path_tol"]
+    assert StudyConfig().as_dict()["settings"] == DEFAULTS.flat()

@@ -1,4 +1,4 @@
-"""Second order where first order is not enough (rigidfold.structure.stability): a flat or
+"""Second order where first order is not enough (rigidfold.mechanism.second_order): a flat or
 nearly flat vertex held around its boundary is prestress stable and accepted; a hinge with
 one side held is a finite mechanism and refused with its crease named."""
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 import os
 import signal
 import sqlite3
@@ -164,10 +163,12 @@ def test_plan_and_store_units(tmp_path):
         plan(["grid:5"], ["s"], 1)
     store = Store(tmp_path / "u.sqlite", StudyConfig().as_dict())
     key = Key("bezier", 5, "1", "shat")
-    store.add(key, {"status": "DOF 0 reached", "version": "v"}, [])
+    store.add(key, {"stop": "zero_dof", "status": "DOF 0 reached", "version": "v"}, [])
     assert store.done() == {key}
     with pytest.raises(ValueError, match="already holds the run"):
-        store.add(key, {"status": "DOF 0 reached", "version": "v"}, [])  # never counted twice
+        store.add(
+            key, {"stop": "zero_dof", "status": "DOF 0 reached", "version": "v"}, []
+        )  # never counted twice
     assert len(store.runs()) == 1
 
 
@@ -284,25 +285,10 @@ def test_settings_added_later_at_their_default_are_compatible():
     changed = StudyConfig(settings=DEFAULTS.with_(path_step=0.5)).as_dict()
     assert config_differences(older, changed) == ["settings.path_step"]
     assert config_differences(current, older) == ["settings.path_step"]  # one removed
-    # the settings of the tracer before issue 29, removed since: a database that has them
-    # resumes
-    retired = {**current, "settings": {**current["settings"], "motion_arc_step": 0.2}}
-    assert config_differences(retired, current) == []
     deform = StudyConfig(STUDY_OPTIONS.replace(deform=True)).as_dict()
     assert config_differences(current, deform) == ["deform"]
     tighter = StudyConfig(settings=DEFAULTS.with_(f_tol=1e-9)).as_dict()
     assert config_differences(current, tighter) == ["settings.f_tol"]
-
-
-def test_databases_from_before_the_closed_form_hessian_are_not_resumed_with_it():
-    from rigidfold.config import DEFAULTS
-    from rigidfold.study.store import config_differences
-
-    current = StudyConfig().as_dict()
-    older = _without_setting(current, "ipopt_hessian")  # when CasADi's was the only Hessian
-    assert config_differences(older, current) == ["settings.ipopt_hessian"]
-    casadi = StudyConfig(settings=DEFAULTS.with_(ipopt_hessian="casadi")).as_dict()
-    assert config_differences(older, casadi) == []
 
 
 def test_locks_by_stage_adds_up_to_n_lock(uninterrupted):
@@ -327,103 +313,6 @@ def test_dof_steps_add_up_to_the_dof_reduced(uninterrupted):
         assert sum(st["per_kind"].values()) == pytest.approx(accepted_fixes)
         assert st["per_kind"]["-1"] >= 0
     assert "### How fixing a crease changes the DOF" in markdown(store)
-
-
-# the schema of the study databases written before the outcome enums (rigidfold 3cb7e52)
-OLD_SCHEMA = """
-CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE IF NOT EXISTS runs (
-    study TEXT NOT NULL,          -- "bezier", or a preset ("dome", "hp")
-    seed INTEGER NOT NULL,        -- surface seed (0 for presets)
-    pattern TEXT NOT NULL,
-    criterion TEXT NOT NULL,
-    symmetric INTEGER NOT NULL,
-    status TEXT NOT NULL,         -- the generator's stop reason, or "error: ..."
-    n_reduce INTEGER, n_lock INTEGER, n_exceed INTEGER,
-    mean_f REAL, initial_dof INTEGER, final_dof INTEGER, n_solutions INTEGER, n_solves INTEGER,
-    mean_d REAL, mean_dl_mm REAL, mean_drho_fix_deg REAL, reached_plane INTEGER,
-    time_build REAL, time_solve REAL, time_analysis REAL, time_selection REAL,
-    time_develop REAL, time_deform REAL, time_total REAL,
-    version TEXT NOT NULL, worker TEXT,
-    PRIMARY KEY (study, seed, pattern, criterion, symmetric)
-);
-CREATE TABLE IF NOT EXISTS invocations (  -- one row per `rigidfold study` command that ended
-    started TEXT NOT NULL,        -- UTC, ISO 8601
-    argv TEXT NOT NULL,           -- the command line (JSON list)
-    workers INTEGER, scheduler TEXT,
-    ran INTEGER NOT NULL, skipped INTEGER NOT NULL, total INTEGER NOT NULL,
-    wall_s REAL NOT NULL, outcome TEXT NOT NULL, version TEXT NOT NULL
-);
-CREATE TABLE IF NOT EXISTS attempts (
-    study TEXT NOT NULL, seed INTEGER NOT NULL, pattern TEXT NOT NULL,
-    criterion TEXT NOT NULL, symmetric INTEGER NOT NULL,
-    idx INTEGER NOT NULL,
-    fixed_added TEXT NOT NULL, score REAL, status TEXT NOT NULL, f REAL, iterations INTEGER,
-    dof INTEGER, locked TEXT NOT NULL, outcome TEXT NOT NULL,
-    solve_time REAL, analysis_time REAL, selection_time REAL,
-    PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
-);
-"""
-
-
-OLD_STATUSES = {  # the status texts that every earlier version wrote, and how they read
-    0: ("target DOF 1 reached", Stop.TARGET_REACHED),
-    1: ("DOF 0 reached", Stop.ZERO_DOF),
-    2: ("no candidate crease succeeds", Stop.NO_CANDIDATE),
-    3: ("no developable polyhedron from the initial shape (exceed)", Stop.INITIAL_FAILED),
-    4: ("error: unknown pattern '7'", None),
-}
-
-
-def old_database(path) -> None:
-    """A study database as an earlier rigidfold wrote it: its schema, rows by plain SQL."""
-    import json
-
-    con = sqlite3.connect(path)
-    con.executescript(OLD_SCHEMA)
-    con.execute(
-        "INSERT INTO meta VALUES ('config', ?)",
-        (json.dumps(StudyConfig().as_dict(), sort_keys=True),),
-    )
-    for seed, (status, _) in OLD_STATUSES.items():
-        figures = (20, seed, 0, 1e-9, 21, 1, 21, 22) if status[0] != "e" else (None,) * 8
-        con.execute(
-            f"INSERT INTO runs VALUES ({', '.join('?' * 27)})",
-            ("bezier", seed, "1", "s", 0, status, *figures, *(None,) * 10, 10.0 + seed, "0", "w"),
-        )
-        attempts = [(0, "accepted", 3), (1, "lock", 2), (2, "accepted", 2)] if seed < 4 else []
-        for idx, outcome, dof in attempts:
-            solve = (idx, "[]", None, "converged", 1e-9, 7, dof, "[]", outcome, 0.1, 0.01, 0.0)
-            con.execute(
-                f"INSERT INTO attempts VALUES ({', '.join('?' * 17)})",
-                ("bezier", seed, "1", "s", 0, *solve),
-            )
-    con.commit()
-    con.close()
-
-
-def test_databases_of_earlier_versions_read_and_resume_the_same(tmp_path):
-    from rigidfold.study import legacy_stop
-
-    db = tmp_path / "old.sqlite"
-    old_database(db)
-    store = Store(db, readonly=True)
-    assert [r.stop for r in store.runs()] == [s for _, s in OLD_STATUSES.values()]
-    (row,) = tables_5_6(store)
-    assert (row["n"], row["reached_target"], row["n_lock"]) == (4, 1, 1.5)
-    (stage,) = locks_by_stage(store)
-    assert stage["no_candidate"] == 1 and sum(stage["per_stage"]) == pytest.approx(1.0)
-    assert "| S | 4 | 20.00 ± 0.00 |" in markdown(store)
-    store.close()
-    # a newer rigidfold resumes it: its runs go into the old table
-    store = Store(db, StudyConfig().as_dict())
-    new = {"status": Stop.TARGET_REACHED.reason("1"), "n_reduce": 20, "time_total": 5.0}
-    store.add(Key("bezier", 5, "1", "s"), new | {"version": "new"}, [])
-    store.close()
-    (row,) = tables_5_6(Store(db, readonly=True))
-    assert (row["n"], row["reached_target"]) == (5, 2)
-    with pytest.raises(ValueError, match="not the stop reason"):
-        legacy_stop("stopped somehow")
 
 
 def test_readonly_store_takes_no_configuration(uninterrupted, tmp_path):
@@ -478,50 +367,6 @@ def test_lookahead_study_has_its_own_database(uninterrupted, tmp_path):
     assert "look-ahead on" in markdown(store)
 
 
-def test_old_databases_resume_with_the_new_attempt_columns(tmp_path):
-    """A database from before the look-ahead (no lookahead in its config, no new columns):
-    read as it is, refused with --lookahead, resumed without it (columns added)."""
-    db = tmp_path / "old.sqlite"
-    old_database(db)
-    con = sqlite3.connect(db)
-    config = StudyConfig().as_dict()
-    del config["lookahead"]  # as written before the option existed
-    con.execute("UPDATE meta SET value = ? WHERE key = 'config'", (json.dumps(config),))
-    con.commit()
-    con.close()
-    store = Store(db, readonly=True)
-    (angles,) = locked_fold_angles(store)
-    assert (angles["locks"], angles["creases"]) == (4, 0)
-    (causes,) = lock_causes(store)
-    assert causes["causes"]["unknown"] == 4
-    assert criterion_summary(store)[0]["skipped_per_run"] is None
-    assert criterion_summary(store)[0]["groups_per_run"] is None
-    assert "look-ahead off" in markdown(store)
-    store.close()
-    digest = hashlib.sha256(db.read_bytes()).hexdigest()
-    with pytest.raises(ValueError, match="differs in: lookahead"):
-        Store(db, StudyConfig(STUDY_OPTIONS.replace(lookahead=True)).as_dict())
-    assert hashlib.sha256(db.read_bytes()).hexdigest() == digest
-    store = Store(db, StudyConfig().as_dict())
-    attempt = {
-        "idx": 0, "fixed_added": [], "status": "converged", "locked": [3, 4],
-        "outcome": "lock", "skipped": 2, "skipped_locks": [{"fixed": [1], "locks": [2]}],
-        "predicted_locks": [], "locked_predicted": [False, False], "locked_left": [None, 0.5],
-        "locked_fold_deg": [0.05, -7.0],
-    }  # fmt: skip
-    new = {"status": Stop.TARGET_REACHED.reason("1"), "n_reduce": 20, "version": "new"}
-    store.add(Key("bezier", 5, "1", "s"), new, [attempt])
-    store.close()
-    store = Store(db, readonly=True)
-    (angles,) = locked_fold_angles(store)
-    assert (angles["locks"], angles["creases"], angles["bins"]) == (5, 2, [1, 0, 0, 1])
-    (causes,) = lock_causes(store)
-    assert causes["causes"] == {"predicted": 0, "flat before": 0, "missed": 1, "unknown": 4}
-    assert causes["missed_left_median"] == 0.5
-    runs = {seed: rows for _, seed, rows in store.attempt_runs("bezier", ("skipped_locks",))}
-    assert runs[5] == [([{"fixed": [1], "locks": [2]}],)] and runs[0][0] == (None,)
-
-
 def test_report_figures_never_follow_a_link(uninterrupted, tmp_path):
     outside = tmp_path / "outside.png"
     outside.write_bytes(b"keep")
@@ -541,15 +386,15 @@ def test_generate_progress_shows_the_last_step_and_an_eta(capsys):
 
     bar = GenerateProgress(enabled=True, target=1, log_every=3600.0)
     bar.plain = True
-    run = SimpleNamespace(initial_dof=11, n_reduce=0, final_dof=11, n_lock=0, n_exceed=0, n_path=0)
+    run = SimpleNamespace(initial_dof=11, n_reduce=0, lowest_dof=11, n_lock=0, n_exceed=0, n_path=0)
     step = SimpleNamespace(solve_time=0.25, analysis_time=0.125, path_time=0.5)
     bar.update(run, step)  # the first line prints
-    run.n_reduce, run.final_dof, run.n_lock = 4, 7, 1
+    run.n_reduce, run.lowest_dof, run.n_lock = 4, 7, 1
     bar.update(run, step)  # within log_every: silent
     done, total, text = bar.describe(run, 120.0)
     assert (done, total) == (4, 10)
     assert "ETA 3.0 min" in text  # 6 DOF to go at 0.5 min each
-    run.n_reduce, run.final_dof = 10, 1
+    run.n_reduce, run.lowest_dof = 10, 1
     bar.update(run, step)  # the last line always prints
     lines = capsys.readouterr().err.splitlines()
     assert len(lines) == 2

@@ -25,7 +25,12 @@ def fake_run(key, config):
     row = {f: 1 for f in RUN_FIELDS if f not in ("status", "stop", "version", "worker", "numerics")}
     from rigidfold.numerics import numeric_environment
 
-    row |= {"status": "target DOF 1 reached", "version": "t", "numerics": numeric_environment().key}
+    row |= {
+        "stop": "target_reached",
+        "status": "target DOF 1 reached",
+        "version": "t",
+        "numerics": numeric_environment().key,
+    }
     attempt = {"fixed_added": list(range(100)), "status": "converged", "locked": list(range(100))}
     return key, row, [attempt | {"idx": i, "outcome": "accepted", "dof": 40 - i} for i in range(40)]
 

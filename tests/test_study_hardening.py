@@ -26,7 +26,12 @@ def valid_database(path) -> None:
     store = Store(path, StudyConfig().as_dict())
     attempt = {"fixed_added": [1, 2], "status": "converged", "locked": [], "outcome": "accepted"}
     for seed in range(60):
-        run = {"status": "target DOF 1 reached", "n_lock": 1, "version": "v"}
+        run = {
+            "stop": "target_reached",
+            "status": "target DOF 1 reached",
+            "n_lock": 1,
+            "version": "v",
+        }
         store.add(Key("bezier", seed, "1", "s"), run, [attempt | {"idx": i} for i in range(5)])
     store.close()
 
@@ -120,9 +125,17 @@ def test_a_second_client_is_refused_and_a_dead_ones_lock_taken_over(tmp_path):
         holder.stdout.close()
     assert (tmp_path / "s.sqlite.lock").exists()  # left by the killed client, taken over:
     store = Store(db, config)
-    store.add(Key("bezier", 0, "1", "s"), {"status": "DOF 0 reached", "version": "v"}, [])
+    store.add(
+        Key("bezier", 0, "1", "s"),
+        {"stop": "zero_dof", "status": "DOF 0 reached", "version": "v"},
+        [],
+    )
     with pytest.raises(ValueError, match="already holds the run"):
-        store.add(Key("bezier", 0, "1", "s"), {"status": "DOF 0 reached", "version": "v"}, [])
+        store.add(
+            Key("bezier", 0, "1", "s"),
+            {"stop": "zero_dof", "status": "DOF 0 reached", "version": "v"},
+            [],
+        )
     store.close()
     assert not (tmp_path / "s.sqlite.lock").exists()
 
@@ -357,7 +370,11 @@ def test_a_database_named_with_uri_characters_resumes_without_stray_files(tmp_pa
     key = Key("bezier", 0, "1", "s")
     config = StudyConfig().as_dict()
     store = Store(db, config)
-    store.add(key, {"status": "target DOF 1 reached", "n_lock": 2, "version": "t"}, [])
+    store.add(
+        key,
+        {"stop": "target_reached", "status": "target DOF 1 reached", "n_lock": 2, "version": "t"},
+        [],
+    )
     store.close()
     store = Store(db, config)  # resumed: the existing file is checked read-only first
     assert store.done() == {key}
@@ -385,7 +402,13 @@ def test_report_figures_of_patterns_with_directories_are_written(tmp_path, capsy
         for seed in range(2):
             store.add(
                 Key("bezier", seed, pattern, "s"),
-                numbers | {"status": "target DOF 1 reached", "n_lock": seed + i, "version": "t"},
+                numbers
+                | {
+                    "stop": "target_reached",
+                    "status": "target DOF 1 reached",
+                    "n_lock": seed + i,
+                    "version": "t",
+                },
                 [],
             )
     store.close()

@@ -39,6 +39,17 @@ def counts(drawing: SvgDrawing) -> tuple[int, int, int]:
     return len(drawing.xy), len(drawing.edges), len(drawing.polygons)
 
 
+def shortest_edge(drawing: SvgDrawing) -> float:
+    """The length of the drawing's shortest edge, in drawing units."""
+    xy, edges = drawing.xy, drawing.edges
+    return float(np.linalg.norm(xy[edges[:, 0]] - xy[edges[:, 1]], axis=1).min())
+
+
+OLD_MERGE = {"svg_merge_tol": 1e-4}
+"""The default svg_merge_tol before issue 39 item 19 (5e-4 since): near misses of 2e-4 to 4e-4
+of the diagonal, as in Origami Simulator's examples drawn in Illustrator, stay apart."""
+
+
 def check_planar(drawing: SvgDrawing) -> None:
     """What every drawing read must satisfy: faces counter-clockwise and simple, their
     sides edges, every edge a side of one face (boundary) or two (creases), a disc."""
@@ -422,39 +433,286 @@ def test_slips_beyond_the_snap_tolerance_are_refused(tmp_path):
         DEFAULTS.with_(svg_snap_tol=-0.1)
 
 
+WATERBOMB_UNMENDED = (
+    r"the crease from \(135\.014, 1074\.92\) to \(135\.014, 1075\.5\) lies outside the boundary"
+)
+HYPAR_UNMENDED = r"a crease ends inside a face at \(629\.168, 524\.834\)"
+
+
 @pytest.mark.parametrize(
-    ("name", "sizes", "letters", "triangles", "refusal"),
+    ("name", "merge", "sizes", "letters", "triangles", "shortest", "unmended"),
     [
-        (
+        pytest.param(
             "huffmanWaterbomb.svg",
+            {},
+            (440, 1157, 718),
+            {"B": 80, "M": 758, "V": 319},
+            798,
+            53.975,
+            None,
+            id="huffmanWaterbomb-default",
+        ),
+        pytest.param(
+            "huffmanWaterbomb.svg",
+            OLD_MERGE,
             (448, 1165, 718),
             {"B": 88, "M": 758, "V": 319},
             806,
-            r"the crease from \(135\.014, 1074\.92\) to \(135\.014, 1075\.5\) lies outside "
-            r"the boundary",
+            0.58,
+            WATERBOMB_UNMENDED,
+            id="huffmanWaterbomb-1e-4",
         ),
-        (
+        pytest.param(
             "hypar.svg",
+            {},
+            (97, 284, 188),
+            {"B": 4, "M": 96, "V": 88, "U": 96},
+            188,
+            25.456,
+            HYPAR_UNMENDED,
+            id="hypar-default",
+        ),
+        pytest.param(
+            "hypar.svg",
+            OLD_MERGE,
             (98, 285, 188),
             {"B": 4, "M": 96, "V": 89, "U": 96},
             190,
-            r"a crease ends inside a face at \(629\.168, 524\.834\)",
+            0.482,
+            HYPAR_UNMENDED,
+            id="hypar-1e-4",
         ),
     ],
 )
-def test_origami_simulator_files_with_slips(name, sizes, letters, triangles, refusal):
-    """Origami Simulator's examples with slips of under 1e-3 of their diagonals (creases
-    0.58 units past the boundary; a crease ending 0.83 units short of a line) read once the
-    slips are mended; without mending they are refused as before."""
+def test_origami_simulator_files_with_slips(
+    name, merge, sizes, letters, triangles, shortest, unmended
+):
+    """Origami Simulator's examples with slips of under 1e-3 of their diagonals: in
+    huffmanWaterbomb.svg creases are drawn to points 0.59 units (3.8e-4) past the boundary,
+    in hypar.svg a crease ends 0.83 units (6.8e-4) short of a line, near a vertex. With the
+    default svg_merge_tol (5e-4: 0.76 and 0.61 units) they read as drawn: the waterbomb's
+    creases meet at their drawn ends, which the boundary passes through, and it reads even
+    unmended; hypar's crease, extended, ends at the vertex. Their shortest edges are then 54
+    and 25 units. With 1e-4 (the default before) the mended ends stay 0.58 and 0.48 units
+    from those points: edges that short, and unmended both are refused."""
     from rigidfold.patterns.files import read_pattern_file
 
-    drawing = read_svg(DATA / name)
+    settings = DEFAULTS.with_(**merge)
+    drawing = read_svg(DATA / name, settings=settings)
     check_planar(drawing)
     assert counts(drawing) == sizes
     assert Counter(drawing.assignment) == letters
-    assert len(read_pattern_file(DATA / name).faces) == triangles
-    with pytest.raises(ValueError, match=refusal):
-        read_svg(DATA / name, settings=DEFAULTS.with_(svg_snap_tol=0))
+    assert shortest_edge(drawing) == pytest.approx(shortest, abs=1e-3)
+    assert len(read_pattern_file(DATA / name, settings=settings).faces) == triangles
+    if unmended is None:
+        assert counts(read_svg(DATA / name, settings=settings.with_(svg_snap_tol=0))) == sizes
+    else:
+        with pytest.raises(ValueError, match=unmended):
+            read_svg(DATA / name, settings=settings.with_(svg_snap_tol=0))
+
+
+# a square drawn as four lines, the last of them ending short of the first one's start
+GAP = (
+    '<line x1="0" y1="0" x2="100" y2="0" stroke="#000"/>'
+    '<line x1="100" y1="0" x2="100" y2="100" stroke="#000"/>'
+    '<line x1="100" y1="100" x2="0" y2="100" stroke="#000"/>'
+    '<line x1="0" y1="100" x2="{x}" y2="{y}" stroke="#000"/>'
+    '<line x1="0" y1="0" x2="100" y2="100" stroke="#f00"/>'
+)
+
+
+@pytest.mark.parametrize(("x", "y"), [(0, 1), (0.6, 0.8), (-0.5, 0.5)])
+def test_a_boundary_gap_within_the_snap_tolerance_is_closed(tmp_path, x, y):
+    """A gap of at most 1 unit (0.7 % of the diagonal, under svg_snap_tol's 1 %) between the
+    boundary's two loose ends is closed at the point halfway between them; with
+    svg_snap_tol=0 it is refused, the loose end named."""
+    path = write(tmp_path, GAP.format(x=x, y=y))
+    drawing = read_svg(path)
+    check_planar(drawing)
+    assert counts(drawing) == (4, 5, 2)
+    assert Counter(drawing.assignment) == {"B": 4, "M": 1}
+    assert points(drawing.xy) == sorted([(x / 2, -y / 2), (0, -100), (100, -100), (100, 0)])
+    gap = math.hypot(x, y)
+    with pytest.raises(
+        ValueError,
+        match=rf"not closed: it ends at \(0, 0\), {gap:.3g} drawing units from its end "
+        rf"at \({x:g}, {y:g}\) \(a gap of up to 0 drawing units",
+    ):
+        read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_a_boundary_gap_beyond_the_snap_tolerance_is_refused(tmp_path):
+    path = write(tmp_path, GAP.format(x=0, y=2))
+    with pytest.raises(
+        ValueError,
+        match=r"pattern\.svg: the boundary \(black\) is not closed: it ends at \(0, 0\), 2 drawing "
+        r"units from its end at \(0, 2\) \(a gap of up to 1\.41 drawing units between two ends is "
+        r"closed; Settings\.inputs\.svg_snap_tol\)$",
+    ):
+        read_svg(path)
+    assert counts(read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0.015))) == (4, 5, 2)
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        # both lines of a corner drawn 0.8 past it: the stubs cross at the corner
+        '<line x1="0" y1="0" x2="100.8" y2="0" stroke="#000"/>'
+        '<line x1="100" y1="-0.8" x2="100" y2="100" stroke="#000"/>'
+        '<line x1="100" y1="100" x2="0" y2="100" stroke="#000"/>'
+        '<line x1="0" y1="100" x2="0" y2="0" stroke="#000"/>'
+        '<line x1="0" y1="0" x2="100" y2="100" stroke="#f00"/>',
+        # a black stroke 1 unit long over the crease, from a corner
+        SQUARE
+        + '<line x1="0" y1="0" x2="100" y2="100" stroke="#f00"/>'
+        + '<line x1="0" y1="0" x2="0.7" y2="0.7" stroke="#000"/>',
+    ],
+)
+def test_black_stubs_within_the_snap_tolerance_are_dropped(tmp_path, body):
+    """A black piece of up to svg_snap_tol from a loose end to where three black lines meet
+    (an overshoot past a corner, a black stroke over a crease) is dropped; a crease drawn
+    along it stays."""
+    path = write(tmp_path, body)
+    drawing = read_svg(path)
+    check_planar(drawing)
+    assert counts(drawing) == (4, 5, 2)
+    assert Counter(drawing.assignment) == {"B": 4, "M": 1}
+    assert points(drawing.xy) == [(0, -100), (0, 0), (100, -100), (100, 0)]
+    with pytest.raises(ValueError, match=r"not closed: it ends at \((100\.8, 0|0\.7, 0\.7)\)"):
+        read_svg(path, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+# --------------------------------------------------------------------------- issue 39 item 19
+WHIRLPOOL, WEAVE = DATA / "whirlpool.svg", DATA / "huffmanRectangularWeave.svg"
+
+
+def check_pattern_file(
+    path: Path, triangles: int, smallest: float = 1e-5, **settings
+) -> CreasePattern:
+    """The crease pattern of an SVG file (read_pattern_file): ``triangles`` triangles, up,
+    tiling the sheet, none smaller than ``smallest`` of it."""
+    from rigidfold.patterns.files import read_pattern_file
+
+    plan = read_pattern_file(path, settings=DEFAULTS.with_(**settings))
+    coords = np.column_stack([plan.xy, np.zeros(len(plan.xy))])
+    pattern = CreasePattern.from_faces(coords, plan.faces)
+    assert pattern.n_faces == triangles
+    assert (pattern.face_normals[:, 2] > 0).all()
+    a, b = (
+        plan.xy[plan.faces[:, 1]] - plan.xy[plan.faces[:, 0]],
+        (plan.xy[plan.faces[:, 2]] - plan.xy[plan.faces[:, 0]]),
+    )
+    area = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / 2
+    assert area.sum() == pytest.approx(shapely.MultiPoint(plan.xy).convex_hull.area, rel=0.2)
+    assert (area > smallest * area.sum()).all()
+    return pattern
+
+
+# Origami Simulator merges points within 3 px before it looks for crossings; whirlpool's
+# lines miss the points they are drawn to by up to 0.25 units (3e-4 of its diagonal), the
+# weave's by 0.85 units (2.3e-4): the default svg_merge_tol, 5e-4, joins them where 1e-4 (the
+# default before) does not
+
+
+def test_whirlpool_reads():
+    """Origami Simulator's whirlpool.svg: its boundary is separate lines whose ends miss each
+    other by up to 0.25 units, and a black stroke 4.2 units long lies over a valley inside
+    the sheet (Origami Simulator takes it for a boundary edge there). Within svg_snap_tol
+    the boundary is closed and the stroke dropped, its valley kept; with the default
+    svg_merge_tol (5e-4, 0.41 units) it reads as drawn: 150 vertices, 240 triangles, its
+    shortest edge 4.15 units."""
+    assert DEFAULTS.inputs.svg_merge_tol == 5e-4
+    drawing = read_svg(WHIRLPOOL)
+    check_planar(drawing)
+    assert counts(drawing) == (150, 389, 240)
+    assert Counter(drawing.assignment) == {"B": 58, "M": 120, "V": 211}
+    assert {len(p) for p in drawing.polygons} == {3}
+    stroke = [
+        letter
+        for (u, v), letter in zip(drawing.edges, drawing.assignment, strict=True)
+        if {(round(x, 1), round(y, 1)) for x, y in drawing.xy[[u, v]]}
+        == {(126.6, -175.5), (130.6, -176.8)}
+    ]
+    assert stroke == ["V"]
+    assert shortest_edge(drawing) == pytest.approx(4.153, abs=1e-3)
+    check_pattern_file(WHIRLPOOL, 240)
+    with pytest.raises(ValueError, match=r"not closed: it ends at \(130\.57, 176\.781\)"):
+        read_svg(WHIRLPOOL, settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_whirlpool_boundary_is_closed_within_the_snap_tolerance():
+    """With svg_merge_tol=1e-4 (0.08 units, the default before) the nine gaps of whirlpool's
+    boundary (0.08 to 0.25 units) are not merged: svg_snap_tol closes each halfway."""
+    drawing = read_svg(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
+    check_planar(drawing)
+    assert counts(drawing) == (201, 450, 250)
+    assert Counter(drawing.assignment)["B"] == 61
+    closed = np.array([517.172 + 517.345, -549.847 - 549.781]) / 2  # the first gap's middle
+    assert np.linalg.norm(drawing.xy - closed, axis=1).min() < 1e-9
+
+
+def test_whirlpool_with_a_small_merge_tolerance_names_the_face_it_cannot_cut():
+    """With svg_merge_tol=1e-4 (0.08 units, the default before) the points that whirlpool's
+    lines miss are several: a face is left with corners 0.1 apart that cannot be cut into
+    triangles. The refusal is one line naming its corners and its shortest side in the
+    file's coordinates, and the setting that joins them."""
+    from rigidfold.patterns.files import read_pattern_file
+
+    with pytest.raises(ValueError) as info:
+        read_pattern_file(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
+    message = str(info.value)
+    assert "\n" not in message
+    assert re.fullmatch(
+        r".*whirlpool\.svg: the face with corners (\(\d+\.?\d*, \d+\.?\d*\)(, | and |)){3,}.*"
+        r"\(drawing units, y down\) cannot be cut into triangles: it is degenerate or nearly "
+        r"so, its shortest side, from \(\S+, \S+\) to \(\S+, \S+\), 0\.\d+ long; lines drawn "
+        r"to one point that miss each other by that much are joined with a larger "
+        r"Settings\.inputs\.svg_merge_tol",
+        message,
+    ), message
+
+
+def test_huffman_rectangular_weave_reads():
+    """Origami Simulator's huffmanRectangularWeave.svg: creases drawn at half opacity and
+    full, lines that miss the points they are drawn to by 0.85 units (2.3e-4 of the
+    diagonal), rectangles with a vertex on a side (refused as degenerate before). With
+    svg_merge_tol=1e-4 (the default before) the near misses stay: 1025 vertices, edges of
+    0.84 units, slivers of 5e-8 of the sheet among the triangles; with the default (5e-4) it
+    reads as drawn: 512 vertices, 353 rectangles and 224 triangles, folds of 90 and 180
+    degrees, its shortest edge 83 units."""
+    drawing = read_svg(WEAVE, settings=DEFAULTS.with_(**OLD_MERGE))
+    check_planar(drawing)
+    assert counts(drawing) == (1025, 1705, 681)
+    assert shortest_edge(drawing) == pytest.approx(0.841, abs=1e-3)
+    check_pattern_file(WEAVE, 1943, smallest=1e-8, **OLD_MERGE)
+    drawing = read_svg(WEAVE)
+    check_planar(drawing)
+    assert counts(drawing) == (512, 1088, 577)
+    assert shortest_edge(drawing) == pytest.approx(83.135, abs=1e-3)
+    assert Counter(drawing.assignment) == {"B": 92, "M": 464, "V": 532}
+    assert Counter(len(p) for p in drawing.polygons) == {3: 224, 4: 353}
+    folds = Counter(zip(drawing.assignment, np.abs(drawing.fold_angles).tolist(), strict=True))
+    assert folds == {("V", 90): 420, ("M", 90): 240, ("M", 180): 224, ("V", 180): 112, ("B", 0): 92}
+    check_pattern_file(WEAVE, 930)
+
+
+def test_a_polygon_with_a_vertex_on_a_straight_side_triangulates():
+    """A face of huffmanRectangularWeave.svg read with svg_merge_tol=1e-4: a rectangle with
+    a vertex on its right side, 0.85 units from a corner, its x the corners' to round-off.
+    Earcut cuts an ear of three points on that side (no area); the polygon is cut without
+    its straight vertex, and the triangle on that side cut again with it."""
+    from rigidfold.mesh.triangulate import triangulate_polygon
+
+    x = 482.76599999999996  # as svgelements computes 482.766 from the path's relative moves
+    xy = [[231.661, -489.955], [x, -489.955], [482.766, -406.82]]
+    xy += [[x, -405.972], [231.661, -405.972]]
+    tri, diagonals = triangulate_polygon(xy, area_tol=DEFAULTS.geometry.triangulation_area_tol)
+    assert len(tri) == 3 and len(diagonals) == 2
+    p = np.array(xy)[np.array(tri)]
+    a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    area = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / 2
+    assert (area > 100).all()
+    assert area.sum() == pytest.approx(shapely.Polygon(xy).area)
 
 
 def test_cli_svg_tolerance(tmp_path, capsys):
@@ -500,6 +758,29 @@ def test_origami_simulator_files(name):
     pattern = CreasePattern.from_faces(coords, orient_up(coords, triangles))
     assert len(pattern.faces) == sum(len(p) - 2 for p in drawing.polygons)
     assert len(pattern.edges) == len(drawing.edges) + len(diagonals)
+
+
+MORE_OS_FILES = {
+    # file: ((V, E, faces), assignment counts, triangles)
+    "waterbomb.svg": ((195, 524, 330), {"B": 58, "M": 246, "V": 220}, 330),
+    "reschTriTessellation.svg": ((243, 664, 422), {"B": 60, "M": 451, "V": 153}, 424),
+    "polygamiCross.svg": ((144, 278, 135), {"B": 44, "M": 122, "V": 112}, 242),
+    "langWedgeDoubleFaced.svg": ((264, 560, 297), {"B": 64, "M": 250, "V": 246}, 462),
+    "miura_sharpangle.svg": ((325, 612, 288), {"B": 72, "M": 282, "V": 258}, 576),
+    "test.svg": ((25, 54, 30), {"B": 18, "M": 16, "V": 20}, 30),
+}
+
+
+@pytest.mark.parametrize("name", MORE_OS_FILES)
+def test_more_origami_simulator_files(name):
+    """Origami Simulator's tessellations of tests/data/origami_simulator/README.md (the last
+    four for the deployability benchmark) read and triangulate."""
+    sizes, letters, triangles = MORE_OS_FILES[name]
+    drawing = read_svg(DATA / name)
+    check_planar(drawing)
+    assert counts(drawing) == sizes
+    assert Counter(drawing.assignment) == letters
+    check_pattern_file(DATA / name, triangles)
 
 
 def test_origami_simulator_curved_file():

@@ -54,10 +54,14 @@ from rigidfold.config import (
     Settings,
     one_blas_thread,
 )
+from rigidfold.frame.model import default_support_face
 from rigidfold.generate_options import GenerateOptions
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
+from rigidfold.mechanism.margin import dof_margin
 from rigidfold.mechanism.path import FoldingPath, trace_path
+from rigidfold.mechanism.second_order import ChildForecast, Obstruction, obstruction
 from rigidfold.mechanism.stiffness import hinge_stiffness
+from rigidfold.mesh import CreasePattern
 from rigidfold.numerics import numeric_environment
 from rigidfold.optimize import OptimizeResult, Status
 from rigidfold.selection import (
@@ -82,6 +86,11 @@ class AttemptOutcome(Outcome):
         "path",
         "the shape's rigid-folding path does not reach the flat state (Step 5, N_path)",
     )
+    RIGID = (
+        "second_order_rigid",
+        "the shape is mobile at first order only: a self-stress holds its flexes at second "
+        "order, so it cannot fold (Step 5, N_rigid)",
+    )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
         "dead_end",
@@ -103,6 +112,7 @@ class Stop(Outcome):
     )
     INITIAL_FAILED = "initial_failed", "no developable polyhedron from the initial shape"
     INTERRUPTED = "interrupted", "the run was interrupted (Ctrl-C or SIGTERM)"
+    TIME_LIMIT = "time_limit", "the run's time limit was reached (Step 7)"
 
     def reason(self, detail: str = "") -> str:
         """The stop reason's words with the run's ``detail`` (see :data:`STOP_REASONS`)."""
@@ -117,6 +127,7 @@ STOP_REASONS = {
     Stop.NO_DEPLOYABLE: "no deployable solution in {} candidates",
     Stop.INITIAL_FAILED: "no developable polyhedron from the initial shape ({})",
     Stop.INTERRUPTED: "interrupted",
+    Stop.TIME_LIMIT: "time limit of {} s reached",
 }
 """The words of each :class:`Stop`, ``{}`` standing for the detail (the target DOF, or the
 outcome of the initial solve). Every rigidfold version has written these texts to
@@ -158,6 +169,15 @@ class Attempt:
         where it did not run.
     path_time : float
         Seconds of the check.
+    second_order : dict or None
+        For a checked solution whose path does not reach the flat state: the second-order
+        test of its flexes (:meth:`rigidfold.mechanism.second_order.Obstruction.to_dict`):
+        whether it is second-order rigid (outcome RIGID) and how strongly; None where it did
+        not run.
+    rigid_forecast : bool or None
+        With the look-ahead at a shape whose children are checked: whether this fix was
+        forecast to leave a second-order rigid shape (:class:`rigidfold.mechanism.
+        second_order.ChildForecast`); None where no forecast was made.
     """
 
     index: int
@@ -181,6 +201,8 @@ class Attempt:
     locked_fold_deg: list[float] = field(default_factory=list)
     path: dict | None = None
     path_time: float = 0.0
+    second_order: dict | None = None
+    rigid_forecast: bool | None = None
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""
@@ -209,6 +231,9 @@ class Generation:
     n_backtrack : int
         Solutions retracted by backtracking (their attempts' outcome DEAD_END); where the
         run ends with the chain it had before backtracking, its solutions are not counted.
+    n_rigid : int
+        Solutions rejected as second-order rigid (outcome RIGID): mobile at first order
+        only; beside N_path, the paths that do not reach the flat state for other reasons.
     """
 
     initial_dof: int | None = None
@@ -218,10 +243,12 @@ class Generation:
     n_exceed: int = 0
     n_path: int = 0
     n_backtrack: int = 0
+    n_rigid: int = 0
     deploy_check: bool = False
     final_step: int | None = None
     stop: Stop = Stop.RUNNING
     stop_detail: str = ""
+    dof_margin: dict | None = None  # rigidfold.mechanism.margin.DofMargin.to_dict()
     build_time: float = 0.0
     numerics: dict | None = None  # rigidfold.numerics.NumericEnvironment.to_dict()
 
@@ -241,6 +268,14 @@ class Generation:
 
     @property
     def final_dof(self) -> int | None:
+        """The DOF of the final design (:attr:`final`), which may be above
+        :attr:`lowest_dof` where the run fell short with the deployability check."""
+        final = self.final
+        return None if final is None else final.mechanism.dof
+
+    @property
+    def lowest_dof(self) -> int | None:
+        """The lowest DOF a solution reached (the last solution's)."""
         return self.solutions[-1].mechanism.dof if self.solutions else None
 
     @property
@@ -265,16 +300,19 @@ class Generation:
             "stop_reason": self.stop_reason,
             "initial_dof": self.initial_dof,
             "final_dof": self.final_dof,
+            "lowest_dof": self.lowest_dof,
             "N_reduce": self.n_reduce,
             "N_lock": self.n_lock,
             "N_exceed": self.n_exceed,
             "N_path": self.n_path,
             "N_backtrack": self.n_backtrack,
+            "N_rigid": self.n_rigid,
             "deploy_check": self.deploy_check,
             "final_step": None if self.final is None else self.final.step,
             "final_deploys": (
                 None if self.final is None or self.final.path is None else self.final.path.deploys
             ),
+            "dof_margin": self.dof_margin,
             "n_solutions": len(self.solutions),
             "n_solves": len(self.attempts),
             "n_skipped": self.n_skipped,
@@ -311,7 +349,9 @@ class _Shape:
     solution: Solution
     ranked: list
     order: Iterator[Choice]
+    forecast: ChildForecast | None = None
     undeployable: int = 0
+    rigid_in_row: int = 0
     t_sel: float = 0.0
 
 
@@ -345,6 +385,7 @@ class _Steps:
             numerics=numeric_environment().to_dict(), deploy_check=options.deploy_check
         )
         t0 = time.perf_counter()
+        self.started = time.monotonic()
         self.problem = case.problem(build_ipopt=options.solver == "ipopt")
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
@@ -375,7 +416,7 @@ class _Steps:
         )
         t_an = time.perf_counter() - t1
         outcome = _classify(mech, self.zero_ends)
-        path, t_path = None, 0.0
+        path, t_path, second = None, 0.0, None
         if (
             outcome is AttemptOutcome.ACCEPTED
             and opts.deploy_check
@@ -386,9 +427,12 @@ class _Steps:
             path = trace_path(
                 result.pattern, dof=mech.dof, support_face=opts.support_face, settings=settings
             )
-            t_path = time.perf_counter() - t2
             if not path.deploys:
                 outcome = AttemptOutcome.PATH
+                second = self.obstruction(result.pattern, mech.dof)
+                if second is not None and second.rigid:
+                    outcome = AttemptOutcome.RIGID
+            t_path = time.perf_counter() - t2
         locked = [] if mech is None else mech.locked_creases.tolist()
         rec = Attempt(
             index=len(self.run.attempts),
@@ -405,9 +449,48 @@ class _Steps:
             locked_fold_deg=np.degrees(result.pattern.fold_angles[locked]).tolist(),
             path=None if path is None else path.to_dict(),
             path_time=t_path,
+            second_order=None if second is None else second.to_dict(),
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
+
+    def support_face(self, pattern: CreasePattern) -> int:
+        """The gauge triangle of the path and the second-order test (the options', or the
+        one nearest the centroid)."""
+        face = self.options.support_face
+        return default_support_face(pattern) if face is None else int(face)
+
+    def obstruction(self, pattern: CreasePattern, dof: int) -> Obstruction | None:
+        """The second-order test of a checked solution whose path does not reach the flat
+        state (``Settings.generation.second_order``); None where it is not made."""
+        settings = self.settings
+        if (
+            not settings.generation.second_order
+            or pattern.n_vertices > settings.mechanism.second_order_vertices
+        ):
+            return None
+        return obstruction(pattern, self.support_face(pattern), dof, settings)
+
+    def child_forecast(self, current: Solution) -> ChildForecast | None:
+        """With the look-ahead, at a shape whose children get the deployability check: the
+        second-order forecast of its candidates (None where it is not made)."""
+        opts, settings = self.options, self.settings
+        dof = current.mechanism.dof
+        limit = settings.generation.deploy_check_max_dof
+        pattern = current.result.pattern
+        if (
+            not (opts.lookahead and opts.deploy_check and settings.generation.second_order)
+            or dof < 2
+            or (limit > 0 and dof - 1 > max(limit, opts.target_dof))
+            or pattern.n_vertices > settings.mechanism.second_order_vertices
+        ):
+            return None
+        return ChildForecast.at(pattern, self.support_face(pattern), dof, settings)
+
+    def out_of_time(self) -> bool:
+        """The run's time limit (``GenerateOptions.time_limit``) has passed."""
+        limit = self.options.time_limit
+        return limit is not None and time.monotonic() - self.started > limit
 
     def is_solution(self, rec: Attempt) -> bool:
         """Whether an attempt gives a solution: accepted, or the DOF-0 shape of a target 0."""
@@ -421,6 +504,7 @@ class _Steps:
         run.n_exceed += rec.outcome is AttemptOutcome.EXCEED
         run.n_lock += rec.outcome is AttemptOutcome.LOCK
         run.n_path += rec.outcome is AttemptOutcome.PATH
+        run.n_rigid += rec.outcome is AttemptOutcome.RIGID
         if self.on_attempt:
             self.on_attempt(run, rec)
         if self.is_solution(rec):
@@ -431,9 +515,10 @@ class _Steps:
             if self.on_solution:
                 self.on_solution(run, sol)
 
-    def rank(self, current: Solution) -> tuple[list, Iterator[Choice], float]:
+    def rank(self, current: Solution) -> tuple[list, Iterator[Choice], ChildForecast | None, float]:
         """Step 6 at the shape ``current``: the ranked crease groups with their scores, the
-        order to try them in (look-ahead: lazy, forecast block by block) and the seconds."""
+        order to try them in (look-ahead: lazy, forecast block by block), the second-order
+        forecast of its children and the seconds."""
         t1 = time.perf_counter()
         settings = self.settings
         K = hinge_stiffness(
@@ -441,6 +526,7 @@ class _Steps:
         )
         scores = score_creases(current.mechanism, K=K, settings=settings)
         ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
+        forecast = self.child_forecast(current)
         order: Iterator[Choice] = (
             lookahead_order(
                 current.mechanism,
@@ -448,16 +534,21 @@ class _Steps:
                 settings=settings,
                 dof0_ends=self.zero_ends,
                 locked_before=self.locked_before,
+                rigid=None if forecast is None else forecast.rigid,
             )
             if self.options.lookahead
             else (Choice(k) for k in range(len(ranked)))
         )
-        return ranked, order, time.perf_counter() - t1
+        return ranked, order, forecast, time.perf_counter() - t1
 
-    def annotate(self, rec: Attempt, choice: Choice, ranked: list, current: Solution) -> None:
+    def annotate(self, rec: Attempt, choice: Choice, shape: _Shape, current: Solution) -> None:
         """The look-ahead's record of a candidate's attempt (what it skipped, what it was
-        predicted to lock, what it carried) and the forecast's view of the creases it locked."""
+        predicted to lock, what it carried, whether it was forecast second-order rigid) and
+        the forecast's view of the creases it locked."""
+        ranked = shape.ranked
         group = ranked[choice.index][0]
+        if shape.forecast is not None:
+            rec.rigid_forecast = choice.rigid
         if self.options.lookahead:
             rec.predicted_locks = [] if len(choice.carried) else choice.locks.tolist()
             rec.carried = choice.carried.tolist()
@@ -467,6 +558,7 @@ class _Steps:
                     "fixed": list(ranked[c.index][0]),
                     "locks": c.locks.tolist(),
                     "locked_before": c.locked_before.tolist(),
+                    "rigid": c.rigid,
                 }
                 for c in choice.passed
             ]
@@ -482,11 +574,14 @@ class _Steps:
         next on failure, until one is accepted (None) or the run ends (its Stop). At a shape
         reduced before (backtracking returned to it), the candidates not yet tried."""
         if not self.shapes or self.shapes[-1].solution is not current:
-            ranked, order, t_sel = self.rank(current)
-            self.shapes.append(_Shape(current, ranked, order, t_sel=t_sel))
+            ranked, order, forecast, t_sel = self.rank(current)
+            self.shapes.append(_Shape(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
         while True:
+            if self.out_of_time():
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
             t1 = time.perf_counter()
             choice = next(order, None)  # look-ahead: lazy forecast
             shape.t_sel += time.perf_counter() - t1
@@ -498,15 +593,22 @@ class _Steps:
             trial_fixed[list(fix)] = True
             rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
             rec.selection_time, shape.t_sel = shape.t_sel, 0.0
-            self.annotate(rec, choice, ranked, current)
+            self.annotate(rec, choice, shape, current)
             self.record(rec, trial)
             if self.is_solution(rec):
                 return None
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
-            shape.undeployable += rec.outcome is AttemptOutcome.PATH
+            rigid = rec.outcome is AttemptOutcome.RIGID
+            shape.undeployable += rigid or rec.outcome is AttemptOutcome.PATH
+            shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             limit = self.settings.generation.deploy_max_candidates
-            if shape.undeployable >= limit > 0:  # bounded cost
+            confirm = self.settings.generation.rigid_confirmations
+            if shape.undeployable >= limit > 0 or (  # bounded cost
+                shape.forecast is not None
+                and shape.forecast.dead_end
+                and shape.rigid_in_row >= confirm > 0
+            ):
                 self.run.stop_detail = str(shape.undeployable)
                 return Stop.NO_DEPLOYABLE
 
@@ -608,9 +710,25 @@ def generate(
         stop = steps.reduce(run.solutions[-1])
         if stop is not None and not steps.backtrack(stop):
             steps.settle(stop)
-            return _deployable_final(run, opts, case.settings)
-    run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
+            _deployable_final(run, opts, case.settings)
+            break
+    else:
+        run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
+    final = run.final
+    if final is not None:
+        pattern = final.result.pattern
+        run.dof_margin = dof_margin(pattern, steps.support_face(pattern), case.settings).to_dict()
     return run
+
+
+def best_so_far(run: Generation) -> None:
+    """Name the final design of a run that stops before its end (interrupted): the
+    lowest-DOF solution whose folding path is known to reach the flat state, else the last
+    (no path is traced)."""
+    for solution in reversed(run.solutions):
+        if solution.path is not None and solution.path.deploys:
+            run.final_step = solution.step
+            return
 
 
 def _dof(solutions: list[Solution]) -> int:
@@ -629,12 +747,12 @@ def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
     return AttemptOutcome.LOCK if mech.has_lock else AttemptOutcome.ACCEPTED
 
 
-def _deployable_final(run: Generation, options: GenerateOptions, settings: Settings) -> Generation:
+def _deployable_final(run: Generation, options: GenerateOptions, settings: Settings) -> None:
     """With the deployability check, a run that ends short of its target names as its final
     design the lowest-DOF solution whose folding path reaches the flat state (tracing the
     paths not yet traced, from the last solution back); none: the last solution."""
     if not options.deploy_check:
-        return run
+        return
     for solution in reversed(run.solutions):
         if solution.path is None:
             solution.path = trace_path(
@@ -645,8 +763,7 @@ def _deployable_final(run: Generation, options: GenerateOptions, settings: Setti
             )
         if solution.path.deploys:
             run.final_step = solution.step
-            return run
-    return run
+            return
 
 
 def _checked(mech: Mechanism | None, options: GenerateOptions, settings: Settings) -> bool:

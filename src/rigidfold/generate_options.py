@@ -6,9 +6,11 @@ it. The checks of the final design that have their own commands keep their optio
 commands' records: the thick panels in a :class:`rigidfold.fabricate.FabricateOptions`
 (``rigidfold fabricate``), the structure in a :class:`rigidfold.structure.StructureOptions`
 (``rigidfold structure``); None: the check does not run. summary.json records them under
-``fabricate_options`` and ``structure_options``, besides the flat keys every earlier version
-wrote (``thickness``, ``side``, ``structure``, ``supports``, ``loads``, ``limit``), which
-:meth:`GenerateOptions.from_dict` still reads.
+``fabricate`` and ``structure``.
+
+Each field is made by :func:`rigidfold.flags.option` with what it means, which is also the
+help of its command-line flag (``rigidfold generate --target-dof``): a new option is a new
+field here, and :mod:`rigidfold.cli_parser` gives it its flag.
 """
 
 from __future__ import annotations
@@ -17,133 +19,113 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, SIDES, check_seed
+from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
+from rigidfold.flags import count, option, positive
 from rigidfold.optimize import SOLVERS
 from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
 from rigidfold.structure.material import parse_material
 
 
-class _Unset:
-    """A keyword not given (None has a meaning: ``thickness=None`` is no thick panels)."""
-
-    def __repr__(self) -> str:
-        return "<unset>"
-
-
-_UNSET = _Unset()
-
-FLAT_KEYS = ("thickness", "side", "structure", "supports", "loads", "limit")
-"""The options of the thick panels and the structure as summary.json has held them since
-they were added (flat, the structure a bool); still written and read."""
-
-
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class GenerateOptions:
     """How one generation run goes, in one place: Steps 2-7 (:func:`rigidfold.generate.
     generate`) and the checks that follow them (Steps 8-9 and the final design as built, run
-    by :class:`rigidfold.run.RunWriter`).
+    by :class:`rigidfold.run.RunWriter`). Checked when made (:class:`RigidfoldError` naming
+    what was received). What each field means: :func:`rigidfold.flags.docs`."""
 
-    criterion : one of ``CRITERIA`` (default: the first, S-hat).
-    target_dof : int >= 0, the DOF at which generation ends (default 1: stabilised by one
-        support or actuator).
-    seed : the stream of the random criterion and of the hinge stiffnesses of S^F-hat.
-    solver : one of ``SOLVERS`` (default: the first, IPOPT).
-    lookahead : skip the candidates predicted to lock (see :mod:`rigidfold.generate`); the
-        forecast's cost is part of the selection time.
-    deploy_check : polish every accepted solution to F = 0
-        (:meth:`rigidfold.optimize.FormFindingProblem.polish`) and accept it only if its
-        rigid-folding path reaches the flat state (:func:`rigidfold.mechanism.path.trace_path`,
-        on solutions of at most ``Settings.generation.deploy_check_max_dof`` DOF, 0: all); one
-        that does not counts in N_path and is replaced like a lock (Step 7), and a DOF-0 shape
-        (which cannot deploy) is retried like a lock where the target is >= 1. False is the
-        paper's method.
-    support_face : the triangle whose frame node carries the s = 6 supports (default: the
-        one nearest the centroid); it sets the metric of the mechanism modes and so the
-        S^F-hat scores.
-    deform : run Step 9 (the large-deformation check) on the checked solutions.
-    check : one of ``CHECKS``: the folding motion and Step 9 on the final design only
-        ("final") or on every solution ("all").
-    material : the panels' material (a preset name or ``"E,nu,density"``): Step 9's frame
-        of strips of the panels (:func:`rigidfold.deform.analysis.panel_section`, of
-        :attr:`panel_thickness`), the structure's material (``structure.material`` must be
-        it) and the thick panels' density unless ``fabricate.density``; None (the default):
-        Step 9 with the paper's steel tubes, the structure's own material, and
-        :attr:`panel_material` for the masses.
-    fabricate : the final design's thick panels (:class:`~rigidfold.fabricate.
-        FabricateOptions`, as ``rigidfold fabricate`` takes them), made from the motion the
-        run traced and checked over it; None (the default): none.
-    structure : the final design's structure check (:class:`~rigidfold.structure.
-        StructureOptions`, as ``rigidfold structure`` takes them; with ``fabricate``, of its
-        thickness); None (the default): none.
+    criterion: str = option(
+        CRITERIA[0],
+        "how the next crease line to fix is chosen, lowest score first (Section 5): shat = "
+        "S-hat and s = S, the shape score S^S over the mechanism score (from normalised or "
+        "plain mechanism modes), ss = S^S alone, random",
+        choices=CRITERIA,
+    )
+    target_dof: int = option(
+        1,
+        "stop at a shape with this many degrees of freedom (DOF: independent rigid folding "
+        "motions; 1 = folds along one path, stabilised by one support or actuator)",
+        parse=count,
+    )
+    seed: int = option(
+        DEFAULT_SEED,
+        "the stream of the random criterion and of the hinge stiffnesses of S-hat (the "
+        "command line's --seed, which also draws the Bezier surface)",
+        flag=False,
+    )
+    solver: str = option(SOLVERS[0], "solver of problem (6)", choices=SOLVERS)
+    lookahead: bool = option(
+        False,
+        "the look-ahead: skip the candidate creases whose fix would lock another crease at "
+        "first order, or locked one at an earlier shape (tried only once every other "
+        "candidate failed, first together with the nearly flat creases they would lock); the "
+        "forecast's cost is part of the selection time",
+    )
+    deploy_check: bool = option(
+        True,
+        "the deployability check of Step 5 (each accepted solution of at most DOF max(target, "
+        f"{DEFAULTS.generation.deploy_check_max_dof}) is polished to F = 0 and accepted only "
+        "if its folding path reaches the flat state, else replaced like a lock and counted in "
+        "N_path; a 0-DOF solution, which cannot deploy, is retried like a lock); without it, "
+        "the paper's Step 5",
+    )
+    support_face: int | None = option(
+        None,
+        "the triangle whose frame node carries the s = 6 supports (None: the one nearest the "
+        "centroid); it sets the metric of the mechanism modes and so the S-hat scores",
+        flag=False,
+    )
+    deform: bool = option(
+        True,
+        "Step 9, the large-deformation check (OpenSees), on the solutions that --check names "
+        "(the development diagram, Step 8, and the folding motion run without it)",
+    )
+    check: str = option(
+        CHECKS[0],
+        "which solutions get the folding motion and the large-deformation check: the final "
+        "design only, or all (the development diagram is drawn for every solution)",
+        choices=CHECKS,
+    )
+    material: str | None = option(
+        None,
+        "the panels' material (a preset or 'E,nu,density'): Step 9's frame of strips of the "
+        "panels, the structure's material and the thick panels' density unless theirs is "
+        "given (None: Step 9 with the paper's steel tubes; the command line's --material)",
+        flag=False,
+    )
+    fabricate: FabricateOptions | None = option(  # noqa: RUF009 (a field, as dataclasses.field)
+        None,
+        "the final design's thick panels as rigidfold fabricate takes them, made from the "
+        "motion the run traced (None: none)",
+        flag=False,
+    )
+    structure: StructureOptions | None = option(  # noqa: RUF009
+        None,
+        "the final design's structure check as rigidfold structure takes it, of the thick "
+        "panels' thickness (None: none)",
+        flag=False,
+    )
+    time_limit: float | None = option(
+        None,
+        "solve no further candidate after this many seconds: the run ends with the lowest-DOF "
+        "design that deploys as its final design, checked as usual, and exits 1 (None: no "
+        "limit)",
+        parse=positive,
+        metavar="SECONDS",
+    )
 
-    The keywords of earlier versions are still taken: ``thickness`` (metres, None: no thick
-    panels; else the thick panels' and, with a structure check, its thickness), ``side``,
-    ``structure=True`` (a structure check of ``material`` or the default, of ``thickness``
-    or the default) and ``supports``, ``loads``, ``limit`` (the structure check's); and read
-    back as properties (:attr:`thickness`, :attr:`side`, :attr:`supports`, :attr:`loads`,
-    :attr:`limit`: a check's value, or its default where the check does not run).
-
-    Studies do not store the options of the thick panels and the structure
-    (:meth:`rigidfold.study.StudyConfig.as_dict`): they run neither.
-    """
-
-    criterion: str = CRITERIA[0]
-    target_dof: int = 1
-    seed: int = DEFAULT_SEED
-    solver: str = SOLVERS[0]
-    lookahead: bool = False
-    deploy_check: bool = True
-    support_face: int | None = None
-    deform: bool = True
-    check: str = CHECKS[0]
-    material: str | None = None
-    fabricate: FabricateOptions | None = None
-    structure: StructureOptions | None = None
-
-    def __init__(
-        self,
-        criterion: str = CRITERIA[0],
-        target_dof: int = 1,
-        seed: int = DEFAULT_SEED,
-        solver: str = SOLVERS[0],
-        lookahead: bool = False,
-        deploy_check: bool = True,
-        support_face: int | None = None,
-        deform: bool = True,
-        check: str = CHECKS[0],
-        material: str | None = None,
-        fabricate: FabricateOptions | None = None,
-        structure: StructureOptions | bool | None = None,
-        *,
-        thickness: float | str | _Unset | None = _UNSET,
-        side: str | _Unset = _UNSET,
-        supports: str | _Unset = _UNSET,
-        loads: tuple[str, ...] | list[str] | _Unset = _UNSET,
-        limit: float | str | _Unset = _UNSET,
-    ) -> None:
-        given = dict(locals())
-        for f in fields(self):
-            object.__setattr__(self, f.name, given[f.name])
+    def __post_init__(self) -> None:
         self._check_run()
-        keywords = {"supports": supports, "loads": loads, "limit": limit}
-        self._legacy(thickness, side, structure, keywords)
         self._check_checks()
 
     def _check_run(self) -> None:
-        """Validate the options of Steps 2-9 (ValueError naming what was received)."""
-        if self.criterion not in CRITERIA:
-            raise RigidfoldError(
-                f"unknown criterion {self.criterion!r} (choose from {', '.join(CRITERIA)})"
-            )
-        if self.solver not in SOLVERS:
-            raise RigidfoldError(
-                f"unknown solver {self.solver!r} (choose from {', '.join(SOLVERS)})"
-            )
-        if self.check not in CHECKS:
-            raise RigidfoldError(f"unknown check {self.check!r} (choose from {', '.join(CHECKS)})")
+        """Validate the options of Steps 2-9."""
+        for name, choices in (("criterion", CRITERIA), ("solver", SOLVERS), ("check", CHECKS)):
+            value = getattr(self, name)
+            if value not in choices:
+                raise RigidfoldError(f"unknown {name} {value!r} (choose from {', '.join(choices)})")
         target = self.target_dof
         if isinstance(target, bool) or not isinstance(target, int | np.integer) or target < 0:
             raise RigidfoldError(f"target DOF must be an integer >= 0, got {target!r}")
@@ -151,43 +133,15 @@ class GenerateOptions:
         if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
             raise RigidfoldError(f"support face must be a face index, got {face!r}")
         check_seed(self.seed)
+        limit = self.time_limit
+        if limit is not None and (
+            isinstance(limit, bool)
+            or not isinstance(limit, int | float | np.integer | np.floating)
+            or not 0 < limit < float("inf")
+        ):
+            raise RigidfoldError(f"time limit must be a number of seconds > 0, got {limit!r}")
         if self.material is not None:
             parse_material(self.material)
-
-    def _legacy(self, thickness, side, structure, keywords: dict) -> None:
-        """Fold the keywords of earlier versions into ``fabricate`` and ``structure``, on top
-        of those given (so that :meth:`replace` takes them too); each is checked even where
-        its check does not run."""
-        fab = self.fabricate
-        if thickness is not _UNSET:
-            if thickness is None:
-                fab = None
-            elif fab is None:
-                fab = FabricateOptions(thickness)
-            else:
-                fab = replace(fab, thickness=thickness)
-        if side is not _UNSET:
-            if fab is None:
-                if side not in SIDES:
-                    raise RigidfoldError(f"side must be one of {', '.join(SIDES)}, got {side!r}")
-            else:
-                fab = replace(fab, side=side)
-        changes = {k: v for k, v in keywords.items() if v is not _UNSET}
-        if fab is not None and thickness is not _UNSET:
-            changes["thickness"] = fab.thickness
-        if isinstance(structure, bool):  # structure=True: a check of the keywords
-            base = StructureOptions(
-                thickness=DEFAULTS.structure.thickness if fab is None else fab.thickness,
-                material=DEFAULTS.structure.material if self.material is None else self.material,
-            )
-            st = base.replace(**changes)
-            structure = st if structure else None
-        elif structure is not None and changes:
-            structure = structure.replace(**changes)
-        elif changes:
-            StructureOptions().replace(**changes)  # checked, not used
-        object.__setattr__(self, "fabricate", fab)
-        object.__setattr__(self, "structure", structure)
 
     def _check_checks(self) -> None:
         """The thick panels and the structure: of their types, one material and one
@@ -225,37 +179,10 @@ class GenerateOptions:
             return self.fabricate.thickness
         return None if self.structure is None else self.structure.thickness
 
-    @property
-    def thickness(self) -> float | None:
-        """The thick panels' thickness, metres; None: no thick panels."""
-        return None if self.fabricate is None else self.fabricate.thickness
-
-    @property
-    def side(self) -> str:
-        """The side of the thick panels (the default where there are none)."""
-        return DEFAULTS.fabricate.side if self.fabricate is None else self.fabricate.side
-
-    @property
-    def supports(self) -> str:
-        """The structure check's supports (its default where it does not run)."""
-        return (self.structure or StructureOptions()).supports
-
-    @property
-    def loads(self) -> tuple[str, ...]:
-        """The structure check's loads (none where it does not run)."""
-        return (self.structure or StructureOptions()).loads
-
-    @property
-    def limit(self) -> float:
-        """The structure check's deflection limit (its default where it does not run)."""
-        return (self.structure or StructureOptions()).limit
-
     def replace(self, **changes) -> GenerateOptions:
-        """These options with ``changes`` (field names, or the keywords of earlier versions),
-        validated; unknown names are a ValueError naming them. A new ``material`` is the
-        structure check's too."""
-        known = {f.name for f in fields(self)} | {"thickness", "side", "supports", "loads", "limit"}
-        unknown = sorted(set(changes) - known)
+        """These options with ``changes`` (field names), validated; unknown names are a
+        RigidfoldError naming them. A new ``material`` is the structure check's too."""
+        unknown = sorted(set(changes) - {f.name for f in fields(self)})
         if unknown:
             raise RigidfoldError(f"unknown generate option {', '.join(map(repr, unknown))}")
         material = changes.get("material")
@@ -265,35 +192,22 @@ class GenerateOptions:
 
     def to_dict(self) -> dict:
         """The options as JSON values (summary.json's ``options``): the fields, the checks'
-        options under ``fabricate_options`` and ``structure_options`` (None: not run), and
-        the flat keys of earlier versions (:data:`FLAT_KEYS`)."""
+        options as theirs (None: not run)."""
         data = {f.name: getattr(self, f.name) for f in fields(self)}
         fab, st = data.pop("fabricate"), data.pop("structure")
         return data | {
-            "thickness": self.thickness,
-            "side": self.side,
-            "structure": st is not None,
-            "supports": self.supports,
-            "loads": self.loads,
-            "limit": self.limit,
-            "fabricate_options": None if fab is None else fab.to_dict(),
-            "structure_options": None if st is None else st.to_dict(),
+            "fabricate": None if fab is None else fab.to_dict(),
+            "structure": None if st is None else st.to_dict(),
         }
 
     @classmethod
     def from_dict(cls, data: dict) -> GenerateOptions:
-        """The options of :meth:`to_dict`, or of an earlier version's summary.json (the flat
-        keys); keys of other versions (``symmetric``, kept in the case) are ignored, missing
-        ones take their defaults."""
-        names = {f.name for f in fields(cls)} - {"fabricate", "structure"}
-        given = {k: v for k, v in data.items() if k in names}
-        if "fabricate_options" in data or "structure_options" in data:
-            fab, st = data.get("fabricate_options"), data.get("structure_options")
-            return cls(
-                **given,
-                fabricate=None if fab is None else FabricateOptions.from_dict(fab),
-                structure=None if st is None else StructureOptions.from_dict(st),
-            )
-        flat = {k: data[k] for k in FLAT_KEYS if k in data}
-        flat["structure"] = bool(flat.get("structure", False))
-        return cls(**given, **flat)
+        """The options of :meth:`to_dict`; other keys (``symmetric``, kept in the case) are
+        ignored, missing ones take their defaults."""
+        given = {f.name: data[f.name] for f in fields(cls) if f.name in data}
+        fab, st = given.pop("fabricate", None), given.pop("structure", None)
+        return cls(
+            **given,
+            fabricate=None if fab is None else FabricateOptions.from_dict(fab),
+            structure=None if st is None else StructureOptions.from_dict(st),
+        )

@@ -7,19 +7,25 @@ Kept apart from :mod:`rigidfold.cli` so that the restart with the pinned numeric
 from __future__ import annotations
 
 import sys
+import sysconfig
 from collections.abc import Sequence
+from pathlib import Path
 
 from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; Ctrl-C at any time, while the libraries load too, exits 130
-    with one line ``rigidfold: interrupted``, not a traceback; SIGTERM too."""
+    with one line ``rigidfold: interrupted``, not a traceback; SIGTERM too. Started as the
+    ``rigidfold`` command (or ``python -m rigidfold``), the process first restarts itself
+    with the pinned numerics; called from another program, it does not (restarting would
+    run that program again from the top: ``python -m rigidfold.pinned python script.py``
+    pins one)."""
     terminate_interrupts()
     try:
         from rigidfold.numerics import restart_pinned
 
-        if argv is None:  # the process's own command line: it can be started again
+        if argv is None and _started_as_rigidfold():
             restart_pinned()
         from rigidfold.cli import main as cli_main
 
@@ -27,3 +33,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("rigidfold: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def _started_as_rigidfold() -> bool:
+    """Whether this process is the ``rigidfold`` command: its main module is rigidfold's
+    (``python -m rigidfold``) or an installed script (the console script of the package,
+    in the environment's scripts directory), not a program of the user's."""
+    main = sys.modules.get("__main__")
+    spec = getattr(main, "__spec__", None)
+    if spec is not None and spec.name.split(".")[0] == "rigidfold":
+        return True
+    file = getattr(main, "__file__", None)
+    if file is None:
+        return False
+    scripts = sysconfig.get_path("scripts")
+    return Path(file).resolve().parent == Path(scripts).resolve()

@@ -41,11 +41,12 @@ import functools
 import hashlib
 import os
 import platform
-import struct
+import subprocess
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from rigidfold import libm_probe
 from rigidfold.status import Outcome
 
 OPT_OUT_ENV = "RIGIDFOLD_NUMERICS"
@@ -105,7 +106,9 @@ def pinned_environ(environ: Mapping[str, str]) -> dict[str, str]:
     return env
 
 
-def _libm_pinned(environ: Mapping[str, str]) -> bool:
+def _libm_masked(environ: Mapping[str, str]) -> bool:
+    """Whether ``environ`` asks the dynamic loader for the pinned libm (what a process
+    started with it runs with: :func:`libm_pinned` measures it)."""
     masks = {
         m
         for p in environ.get("GLIBC_TUNABLES", "").split(":")
@@ -153,7 +156,7 @@ def restart_wanted() -> bool:
     initial = _initial_environ()
     wanted = pinned_environ(initial)
     if all(initial.get(k) == v for k, v in wanted.items() if k != "GLIBC_TUNABLES") and (
-        _libm_pinned(initial)
+        _libm_masked(initial)
     ):
         return False
     argv = list(getattr(sys, "orig_argv", [])) or [sys.executable, *sys.argv]
@@ -177,48 +180,27 @@ def restart_pinned() -> None:
     sys.stderr.flush()
     try:
         os.execve(sys.executable, argv, env)
-    except OSError:
-        return  # carry on unpinned; numeric_environment() says so
+    except OSError as exc:  # carry on unpinned, and say so
+        print(
+            f"rigidfold: warning: could not restart with the pinned numerics "
+            f"({exc.strerror or exc}); this process computes with this machine's libm",
+            file=sys.stderr,
+        )
 
 
 # --- what a process runs with ------------------------------------------------------------
-
-
-def _canary_inputs(n: int = 4096) -> tuple[list[float], list[float]]:
-    """Fixed inputs (no RNG of NumPy's: it must not depend on its version either)."""
-    xs, ps = [], []
-    state = 0x2545F4914F6CDD1D
-    for _ in range(n):
-        state = (state * 6364136223846793005 + 1442695040888963407) % (1 << 64)
-        u = (state >> 11) / float(1 << 53)
-        xs.append(20.0 * u - 10.0)
-        ps.append((state >> 20) / float(1 << 44))
-    return xs, ps
 
 
 def canary() -> str:
     """Hash of a fixed set of results from every floating-point path that follows the CPU:
     libm through Python's ``math`` (as CasADi's expressions use it), NumPy's ufuncs (SIMD
     dispatch), a matrix product (NumPy's OpenBLAS) and an SVD (SciPy's LAPACK and BLAS)."""
-    import math
-
     import numpy as np
     import scipy.linalg
 
-    xs, ps = _canary_inputs()
+    xs, ps = libm_probe.canary_inputs()
     h = hashlib.sha256()
-    pairs = list(zip(xs, xs[1:] + xs[:1], strict=True))
-    for f, data in (
-        (math.sin, xs),
-        (math.cos, xs),
-        (math.exp, xs),
-        (math.atan, xs),
-        (math.acos, ps),
-        (math.log, ps),
-    ):
-        h.update(struct.pack(f"{len(data)}d", *map(f, data)))
-    h.update(struct.pack(f"{len(pairs)}d", *(math.atan2(a, b) for a, b in pairs)))
-    h.update(struct.pack(f"{len(xs)}d", *(math.pow(p, x) for p, x in zip(ps, xs, strict=True))))
+    libm_probe.update(h, xs, ps)
     x, p = np.array(xs), np.array(ps)
     for arr in (np.sin(x), np.cos(x), np.arccos(p), np.arctan2(x, x[::-1]), np.exp(x), np.log(p)):
         h.update(arr.tobytes())
@@ -332,13 +314,39 @@ class NumericEnvironment:
         }
 
 
+LIBM_PROBE_TIMEOUT_S = 60
+
+
+@functools.cache
+def libm_pinned() -> bool:
+    """Whether this process's libm computes the bits of the pinned one: the libm canary
+    (:func:`rigidfold.libm_probe.digest`) here and in a process started with the pinned
+    hwcaps are the same (measured, so a CPU without FMA and AVX2 is pinned whatever the
+    environment says, and a loader that ignored the mask is not). False when that process
+    could not run."""
+    env = dict(os.environ)  # this environment, with the hwcaps mask even where opted out
+    env["GLIBC_TUNABLES"] = _hwcaps_tunables(env.get("GLIBC_TUNABLES", ""))
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-I", "-S", libm_probe.__file__],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=LIBM_PROBE_TIMEOUT_S,
+            check=False,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return proc.returncode == 0 and proc.stdout.strip() == libm_probe.digest()
+
+
 @functools.cache
 def numeric_environment() -> NumericEnvironment:
     """What this process computes with (cached: it cannot change once the libraries load)."""
     initial = _initial_environ()
     blas = _blas()
     simd = _simd()
-    libm_mask = ",".join(f"-{c}" for c in LIBM_HWCAPS) if _libm_pinned(initial) else "native"
+    libm_mask = ",".join(f"-{c}" for c in LIBM_HWCAPS) if _libm_masked(initial) else "native"
     versions = _versions()
     libm = f"{versions['libc']}, hwcaps {libm_mask}"
     unpinned: list[str] = []
@@ -349,8 +357,11 @@ def numeric_environment() -> NumericEnvironment:
             unpinned.append("OpenBLAS blocking from this CPU's L2 size")
         if simd != "baseline":
             unpinned.append(f"NumPy SIMD dispatch of this CPU ({simd})")
-        if libm_mask == "native":
-            unpinned.append("libm variants of this CPU (the process was not started pinned)")
+        if not libm_pinned():
+            unpinned.append(
+                "libm variants of this CPU (its results differ from the pinned libm's: the "
+                "process was not started pinned)"
+            )
     if not _supported():
         status = NumericsStatus.UNSUPPORTED
     elif not unpinned:

@@ -17,6 +17,9 @@ import sys
 
 from rigidfold.numerics import RESTARTED_ENV, numeric_environment, pinned_environ, restart_pinned
 
+EXIT_NOT_FOUND = 127  # as a shell reports a command it cannot find
+EXIT_CANNOT_RUN = 126  # as a shell reports one it found but cannot run
+
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
@@ -24,10 +27,15 @@ def main(argv: list[str] | None = None) -> int:
         program = shutil.which(args[0])
         if program is None:
             print(f"rigidfold.pinned: no command {args[0]!r}", file=sys.stderr)
-            return 127
+            return EXIT_NOT_FOUND
         env = pinned_environ(os.environ)
         env[RESTARTED_ENV] = "1"
-        os.execve(program, args, env)
+        try:
+            os.execve(program, args, env)
+        except OSError as exc:  # not a program: a script without #!, a directory, ...
+            reason = exc.strerror or str(exc)
+            print(f"rigidfold.pinned: cannot run {args[0]!r}: {reason}", file=sys.stderr)
+            return EXIT_CANNOT_RUN
     restart_pinned()
     print(json.dumps(numeric_environment().to_dict(), indent=1))
     return 0

@@ -47,11 +47,15 @@ class GenerateProgress:
     it is a rich bar; otherwise (a batch job, a log file) a plain line with the same figures,
     at most every ``log_every`` seconds and at the end.
 
-    run : rigidfold.generate.Generation (``initial_dof``, ``n_reduce``, ``final_dof``,
-    ``n_lock``, ``n_exceed``, ``n_path``, ``n_backtrack`` are read; the DOF removed falls
-    back when backtracking retracts a solution); attempt : rigidfold.generate.Attempt or
-    None (``solve_time``, ``analysis_time``, ``path_time``: the folding path traced for the
-    deployability check).
+    The ETA is the mean time per DOF removed times the DOF left, unless the run has spent
+    longer than that at its current shape (its candidates keep failing): then it says how
+    many candidates that shape has cost and gives no ETA rather than a wrong one.
+
+    run : rigidfold.generate.Generation (``initial_dof``, ``n_reduce``, ``lowest_dof``,
+    ``n_lock``, ``n_exceed``, ``n_path``, ``n_rigid``, ``n_backtrack`` are read; the DOF
+    removed falls back when backtracking retracts a solution); attempt :
+    rigidfold.generate.Attempt or None (``solve_time``, ``analysis_time``, ``path_time``:
+    the folding path traced for the deployability check).
     """
 
     def __init__(self, *, enabled: bool, target: int, log_every: float = 30.0) -> None:
@@ -63,16 +67,20 @@ class GenerateProgress:
         self.last = -math.inf
         # solve, analysis and path tracing of the last attempt
         self.costs: tuple[float, float, float] | None = None
+        self.shape_since = self.t0  # when the current shape was reached
+        self.tried = 0  # candidates tried at it
+        self.removed = 0
 
     def counts(self, run) -> tuple[int, int, str]:
         """(DOF removed, DOF to remove, "DOF d  lock l  exceed e  path p [back b]") of a
         run."""
         total = max(run.initial_dof - self.target, 0)
-        dof = run.initial_dof if run.final_dof is None else run.final_dof  # before a solution
+        dof = run.initial_dof if run.lowest_dof is None else run.lowest_dof  # before a solution
         return (
             min(run.n_reduce, total),
             total,
             f"DOF {dof}  lock {run.n_lock}  exceed {run.n_exceed}  path {run.n_path}"
+            + (f"  rigid {run.n_rigid}" if getattr(run, "n_rigid", 0) else "")
             + (f"  back {run.n_backtrack}" if getattr(run, "n_backtrack", 0) else ""),
         )
 
@@ -85,6 +93,9 @@ class GenerateProgress:
                 f"path {self.costs[2]:.2f} s"
             )
         eta = f"{(total - done) * elapsed / done / 60:.1f} min" if done else "?"
+        stuck = time.monotonic() - self.shape_since
+        if done and stuck > elapsed / done:  # longer at this shape than a DOF takes
+            eta = f"? ({self.tried} candidates tried at this DOF in {stuck / 60:.1f} min)"
         return done, total, f"{text}  elapsed {elapsed / 60:.1f} min  ETA {eta}"
 
     def update(self, run, attempt=None) -> None:
@@ -92,6 +103,9 @@ class GenerateProgress:
             return
         if attempt is not None:
             self.costs = (attempt.solve_time, attempt.analysis_time, attempt.path_time)
+            self.tried += 1
+        elif run.n_reduce != self.removed:  # a new shape (or one taken back)
+            self.removed, self.tried, self.shape_since = run.n_reduce, 0, time.monotonic()
         if self.plain:
             now = time.monotonic()
             done, total, text = self.describe(run, now - self.t0)
@@ -102,6 +116,8 @@ class GenerateProgress:
         done, total, text = self.counts(run)  # elapsed and ETA in rich's columns: it fits
         if self.costs is not None:
             text += f"  step {self.costs[0]:.2f}+{self.costs[1]:.2f}+{self.costs[2]:.2f} s"
+        if self.tried > 1:  # rich's ETA knows only the DOF removed
+            text += f"  {self.tried} candidates tried at this DOF"
         if self.bar is None:
             self.bar = _rich_bar("generate", eta=True)
             self.task = self.bar.add_task("", total=total)

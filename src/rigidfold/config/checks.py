@@ -88,6 +88,20 @@ class PathSettings(Group):
         "With DOF 1 the path stops short when this many steps in a row bring the folding "
         "measure no lower (by ``path_stall_ratio``) than its lowest so far.",
     )
+    escape_tol: float = setting(
+        1e-6,
+        "Where the sparse continuation stalls (the step halved below ``path_min_step``: a "
+        "singular or bifurcation point, where the regularised systems lose the corrections), "
+        "the null space of the constraint Jacobian there is taken from a dense SVD: the "
+        "singular values below this times the largest. The path continues along it (the last "
+        "tangent's part in it, else the part of the steepest descent of the folding measure), "
+        "corrected by Gauss-Newton with the pseudo-inverse truncated at "
+        "``mechanism_rank_tol`` to ``path_tol``; up to ``mechanism_second_order_vertices`` "
+        "vertices.",
+    )
+    max_escapes: int = setting(
+        20, "Dense steps past stalls (``path_escape_tol``) one direction of a trace may take."
+    )
 
 
 @dataclass(frozen=True)
@@ -224,7 +238,7 @@ class StructureSettings(Group):
     )
     prestress_tol: float = setting(
         1e-8,
-        "Second order (``rigidfold.structure.stability``): the supports are prestress stable "
+        "Second order (``rigidfold.mechanism.second_order``): the supports are prestress stable "
         "when the smallest eigenvalue of the best self-stress's stress matrix on the flexes "
         "exceeds this fraction of the stress matrices' largest entry; stress matrices below "
         "this fraction of the largest are dropped.",

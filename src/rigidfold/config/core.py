@@ -117,6 +117,24 @@ class GenerationSettings(Group):
         "nothing.",
     )
 
+    second_order: bool = setting(
+        True,
+        "With the deployability check: a solution whose folding path does not reach the flat "
+        "state is tested at second order (:func:`rigidfold.mechanism.second_order."
+        "obstruction`); a second-order rigid one is counted in N_rigid, not N_path. With the "
+        "look-ahead, at a shape whose children are checked, candidates forecast to leave a "
+        "second-order rigid child (:class:`~rigidfold.mechanism.second_order.ChildForecast`) "
+        "are put off like those forecast to lock.",
+    )
+    rigid_confirmations: int = setting(
+        3,
+        "With the look-ahead and ``second_order``: a shape whose own stress form "
+        "is definite on its flexes (every child forecast second-order rigid) is given up "
+        "(``Stop.NO_DEPLOYABLE``, then backtracking) once this many of its candidates in a "
+        "row were solved and found second-order rigid, instead of after "
+        "``deploy_max_candidates`` (0: only that bound).",
+    )
+
     def __post_init__(self) -> None:
         if not (isinstance(self.backtrack_max, int) and self.backtrack_max >= 0):
             raise RigidfoldError(
@@ -276,6 +294,20 @@ class MechanismSettings(Group):
         1e-7,
         "A free crease is locked when the norm of its rotations over all modes is below this "
         "times the largest such norm (and its triangles are not coplanar).",
+    )
+    second_order_vertices: int = setting(
+        800,
+        "The second-order test of a shape in generation (:mod:`rigidfold.mechanism."
+        "second_order`) factorises the constraint matrix densely (one SVD of about 3V x 3V): "
+        "above this many vertices it is not made (the failed path stays in N_path).",
+    )
+    dof_gap: float = setting(
+        1e3,
+        "The DOF of a design is *clear* when the smallest singular value counted as non-zero "
+        "is at least this many times the rank threshold (``mechanism_rank_tol``) and the "
+        "largest counted as zero at most 1/this of it; otherwise the verdict and the report "
+        "say how many singular values lie near the threshold (near-mechanisms: very soft "
+        "modes of the built design).",
     )
 
     def __post_init__(self) -> None:

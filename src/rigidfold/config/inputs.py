@@ -16,14 +16,18 @@ class InputSettings(Group):
     meshes (``rigidfold.surfaces.MeshSurface``)."""
 
     svg_merge_tol: float = setting(
-        1e-4,
+        5e-4,
         "Crease patterns drawn in SVG (:func:`rigidfold.io.read_svg`): points closer than "
         "this times the diagonal of the drawing's bounding box are one vertex, a line that "
         "ends within it of another line ends on it, and a line shorter than it is dropped. "
-        "Round-off of drawing programs (about 1e-3 px) lies far below the default; Origami "
-        "Simulator merges within 3 px, 2e-4 to 1e-2 of its example drawings' diagonals, and a "
-        "carelessly drawn pattern may need 1e-3, which would also merge real features of some "
-        "designs.",
+        "Origami Simulator merges within 3 px, 2e-4 to 1e-2 of its example drawings' "
+        "diagonals; the default joins the near misses of those drawn in Illustrator (lines "
+        "that miss the points they are drawn to by 2.3e-4 to 3.8e-4: whirlpool.svg, "
+        "huffmanRectangularWeave.svg, huffmanWaterbomb.svg), which 1e-4 (the default before) "
+        "kept as slivers or as faces that cannot be triangulated, and lies far above "
+        "round-off of drawing programs (about 1e-3 px). Features of a design closer than it "
+        "(2 mm on a 3 m x 3 m sheet) are merged; a carelessly drawn pattern may need 1e-3, "
+        "which would also merge real features of some designs.",
     )
     svg_snap_tol: float = setting(
         1e-2,
@@ -58,8 +62,9 @@ class InputSettings(Group):
         "/ 2 or above (theta_max + 180 degrees) / 2) is refused before any problem is built: "
         "the solver cannot bring that many slivers inside the bounds, and a solve from there "
         "ends at collapsed triangles (Origami Simulator's hypar.svg: a third of its angles "
-        "under 15 degrees). A few are brought inside (huffmanWaterbomb.svg: 8 of 2418 under 1 "
-        "degree, converged); 1 checks nothing.",
+        "under 15 degrees). A few are brought inside (huffmanWaterbomb.svg read with "
+        "svg_merge_tol 1e-4: 8 of 2418 under 1 degree, converged; with the default none under "
+        "21 degrees); 1 checks nothing.",
     )
     unit_warning_size: float = setting(
         1000.0,

@@ -19,18 +19,22 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
 * colours by hue (:data:`COLOURS`), so ``#FF0000``, ``#f00``, ``rgb(255,0,0)`` and ``red``
   are all mountains; green cuts are refused;
 * lines are split where they cross or where one ends on another, points closer than
-  ``Settings.inputs.svg_merge_tol`` times the drawing's bounding-box diagonal are merged, and
-  pieces shorter than that are dropped. A piece drawn twice is kept once: if one drawing
+  ``Settings.inputs.svg_merge_tol`` times the drawing's bounding-box diagonal are merged (the
+  ends of the lines drawn before the crossings are found, as Origami Simulator does, so that
+  lines drawn to one point from ends that miss it slightly meet there), and pieces shorter
+  than that are dropped. A piece drawn twice is kept once: if one drawing
   is black it stays boundary, other differing colours are refused. Where just two pieces
   of the same colour and opacity meet in a straight line, they become one line. Pieces of
   one colour and opacity drawn over each other along one line are made one before they are
   split (a line drawn back and forth many times costs no more than once), and a drawing
   with more than ``Settings.limits.max_svg_pairs`` pairs of pieces that meet or cross is refused;
 * slips of the pen up to ``Settings.inputs.svg_snap_tol`` times the diagonal are mended where a
-  crease would otherwise end on nothing: an overshoot past the line a crease crosses (the
-  boundary among them) is cut off, a piece drawn in two crease colours (one crease running
-  on along another) is dropped, and a crease that ends short of a line is extended to it
-  (:func:`_mend`);
+  line would otherwise end on nothing. The boundary first (:func:`_close_boundary`): a black
+  piece past a corner, or drawn over a crease inside the sheet, is dropped (the crease
+  stays), and a gap between two ends of the boundary is closed halfway. Then the creases
+  (:func:`_mend`): an overshoot past the line a crease crosses (the boundary among them) is
+  cut off, a piece drawn in two crease colours (one crease running on along another) is
+  dropped, and a crease that ends short of a line is extended to it;
 * the black lines must form one closed outline, every crease must lie inside it and end
   on another line, and every face must be a simple polygon (no holes, no crease loop
   hanging at one point). Each problem is a one-line ``ValueError`` naming the file.
@@ -85,9 +89,10 @@ magenta (300) is that colour; any other stroke is refused."""
 HUE_TOLERANCE = 30.0
 """Largest hue difference (degrees) of a stroke from its colour in :data:`COLOURS`."""
 
-_MENDS = 3
+_MENDS = 4
 """How many times the slips of a drawing are mended (:func:`_mend`) and the drawing noded
-again, at most: cutting off an overshoot can leave another loose end."""
+again, at most: the boundary is closed first, and cutting off an overshoot can leave another
+loose end."""
 
 _LARGEST = 1e150
 """Largest extent of a drawing in its own units: squares of its lengths stay finite."""
@@ -188,21 +193,22 @@ def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
     ends, letters, angles = _lines(svg, to_user)
     across = float(np.linalg.norm(np.ptp(ends.reshape(-1, 2), axis=0)))
     tol, snap = settings.inputs.svg_merge_tol * across, settings.inputs.svg_snap_tol * across
-    pieces: tuple[np.ndarray, list[str], list[float]] | None = (ends, letters, angles)
+    drawn = (ends, letters, angles)
+    pieces: tuple[np.ndarray, list[str], list[float]] | None = drawn
     for _ in range(_MENDS):
         if pieces is None:
             break
         xy, edges, letters, angles = _node(*pieces, tol, snap, settings.limits.max_svg_pairs)
         xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
-        pieces = _mend(xy, edges, letters, angles, snap)
-    boundary = _check_boundary(xy, edges, letters)
+        pieces = _mend(xy, edges, letters, angles, snap, tol, drawn)
+    boundary = _check_boundary(xy, edges, letters, snap)
     inside = _inside(xy, edges, boundary, letters, snap)
     if not inside.all():
         xy, edges = _compact(xy, edges[inside])
         letters = [a for a, k in zip(letters, inside, strict=True) if k]
         angles = [a for a, k in zip(angles, inside, strict=True) if k]
         xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
-        boundary = _check_boundary(xy, edges, letters)
+        boundary = _check_boundary(xy, edges, letters, snap)
     _check_creases(xy, edges, letters, boundary, max(tol, snap))
     return SvgDrawing(
         xy=xy,
@@ -608,6 +614,7 @@ def _node(
     Returns xy (V, 2), edges (E, 2) int64 (in drawing order), their letters and angles.
     """
     ends, letters, angles = _merge_overlaps(ends, letters, angles, tol)
+    ends = _merge_ends(ends, tol)
     a, b = ends[:, 0], ends[:, 1]
     length = np.linalg.norm(b - a, axis=1)
     drawn = np.flatnonzero(length > tol)
@@ -659,6 +666,24 @@ def _node(
         [out_letters[e] for e in keep],
         [out_angles[e] for e in keep],
     )
+
+
+def _merge_ends(ends: np.ndarray, tol: float) -> np.ndarray:
+    """The pieces' ends closer than ``tol`` to each other (or linked by such ends) moved onto
+    one point, the first of them drawn, before the pieces are split where they cross: lines
+    drawn to one point from ends that miss each other by less than ``tol`` then meet there,
+    and do not cross each other near it, as Origami Simulator merges points before it looks
+    for intersections. ends (n, 2, 2) -> the same, with the ends moved."""
+    points = ends.reshape(-1, 2)
+    distinct, same = np.unique(points, axis=0, return_inverse=True)
+    pairs = cKDTree(distinct).query_pairs(tol, output_type="ndarray")
+    if not len(pairs):
+        return ends
+    label = connected_components(_graph(pairs, len(distinct)), directed=False)[1]
+    label = label[same.reshape(-1)]
+    first = np.full(label.max() + 1, len(points))
+    np.minimum.at(first, label, np.arange(len(points)))
+    return points[first[label]].reshape(ends.shape)
 
 
 def _merge_overlaps(
@@ -831,15 +856,27 @@ def _join_straight(
 
 
 def _mend(
-    xy: np.ndarray, edges: np.ndarray, letters: list[str], angles: list[float], snap: float
+    xy: np.ndarray,
+    edges: np.ndarray,
+    letters: list[str],
+    angles: list[float],
+    snap: float,
+    tol: float = 0.0,
+    drawn: tuple[np.ndarray, list[str], list[float]] | None = None,
 ) -> tuple[np.ndarray, list[str], list[float]] | None:
     """The drawing with its slips within ``snap`` mended, as pieces to node again (ends
-    (n, 2, 2), letters, angles), or None when it has none. A loose crease end (one that
-    touches no other line) is mended: the piece no longer than ``snap`` that ends there (an
-    overshoot past the line it crosses) is dropped; a longer crease is extended from there to
-    the first line that it points at within ``snap``, or else to the nearest point within
-    ``snap`` of a line that does not touch it. Boundary (black) lines are left as drawn.
+    (n, 2, 2), letters, angles), or None when it has none. Gaps in the boundary are closed
+    first (:func:`_close_boundary`, which needs the pieces as ``drawn`` and the merge
+    distance ``tol``); when it closes any, the creases are mended on the next call. A loose
+    crease end (one that touches no other line) is mended: the piece no longer than ``snap``
+    that ends there (an overshoot past the line it crosses) is dropped; a longer crease is
+    extended from there to the first line that it points at within ``snap``, or else to the
+    nearest point within ``snap`` of a line that does not touch it.
     xy (V, 2), edges (E, 2) -> see above."""
+    if drawn is not None:
+        closed = _close_boundary(xy, edges, letters, angles, snap, tol, drawn)
+        if closed is not None:
+            return closed
     crease = np.array(letters) != "B"
     degree = np.bincount(edges.ravel(), minlength=len(xy))
     loose = (degree[edges] == 1) & crease[:, None]  # (E, 2): a crease's loose ends
@@ -882,6 +919,72 @@ def _mend(
     return np.concatenate(pieces), letters, angles
 
 
+def _close_boundary(
+    xy: np.ndarray,
+    edges: np.ndarray,
+    letters: list[str],
+    angles: list[float],
+    snap: float,
+    tol: float,
+    drawn: tuple[np.ndarray, list[str], list[float]],
+) -> tuple[np.ndarray, list[str], list[float]] | None:
+    """The drawing with the gaps of its boundary within ``snap`` closed, as pieces to node
+    again (ends (n, 2, 2), letters, angles), or None when the boundary has no loose end (a
+    vertex where just one black line ends).
+
+    A black piece no longer than ``snap`` from a loose end to a vertex where three or more
+    black lines meet (an overshoot past a corner, or a black stroke drawn over a crease
+    inside the sheet) is dropped; where a crease was drawn along all of it (within ``tol``,
+    ``drawn``: the pieces as drawn, ends (n, 2, 2), letters, angles), that crease stays.
+    Then two loose ends within ``snap`` of each other, each the other's nearest, become one
+    vertex halfway between them (the lines that end there, creases among them, move with
+    it), as Origami Simulator merges points within 3 px. Other loose ends are left for
+    :func:`_check_boundary` to refuse. xy (V, 2), edges (E, 2) -> see above."""
+    black = np.array(letters) == "B"
+    degree = np.bincount(edges[black].ravel(), minlength=len(xy))
+    loose = (degree[edges] == 1) & black[:, None]  # (E, 2): the boundary's loose ends
+    if not loose.any():
+        return None
+    length = np.linalg.norm(xy[edges[:, 1]] - xy[edges[:, 0]], axis=1)
+    stub = loose.any(axis=1) & (degree[edges].max(axis=1) >= 3) & (length <= snap)
+    pieces, out_letters, out_angles = [], [], []
+    ends, kinds, folds = drawn
+    crease = np.flatnonzero(np.array(kinds) != "B")
+    lines = shapely.linestrings(ends[crease])
+    for e in np.flatnonzero(stub):
+        gap = shapely.distance(lines[:, None], shapely.points(xy[edges[e]])[None, :])
+        along = np.flatnonzero((gap <= tol).all(axis=1))
+        if len(along):
+            k = int(crease[along[0]])
+            pieces.append(xy[edges[e]])
+            out_letters.append(kinds[k])
+            out_angles.append(folds[k])
+    keep = ~stub
+    degree = np.bincount(edges[black & keep].ravel(), minlength=len(xy))
+    free = np.flatnonzero(degree == 1)
+    moved = xy.copy()
+    if len(free) > 1:
+        distance, nearest = cKDTree(xy[free]).query(xy[free], k=2)
+        partner = nearest[:, 1]
+        pair = np.flatnonzero(
+            (partner[partner] == np.arange(len(free)))
+            & (distance[:, 1] <= snap)
+            & (np.arange(len(free)) < partner)
+        )
+        joined = {frozenset(e) for e in edges[black & keep].tolist()}
+        for i in pair:
+            u, v = int(free[i]), int(free[partner[i]])
+            if frozenset((u, v)) not in joined:  # not both ends of one short black line
+                moved[u] = moved[v] = (xy[u] + xy[v]) / 2
+    if not stub.any() and np.array_equal(moved, xy):
+        return None
+    return (
+        np.concatenate([moved[edges[keep]], np.reshape(pieces, (-1, 2, 2))]),
+        [a for a, k in zip(letters, keep, strict=True) if k] + out_letters,
+        [a for a, k in zip(angles, keep, strict=True) if k] + out_angles,
+    )
+
+
 def _compact(xy: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Only the vertices that edges use, numbered in order of first use.
     xy (V, 2), edges (E, 2) -> xy (V', 2), edges (E, 2)."""
@@ -893,14 +996,26 @@ def _compact(xy: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 # ------------------------------------------------------------------------- the faces
-def _check_boundary(xy: np.ndarray, edges: np.ndarray, letters: list[str]) -> list[int]:
+def _check_boundary(
+    xy: np.ndarray, edges: np.ndarray, letters: list[str], snap: float = 0.0
+) -> list[int]:
     """The black edges' one closed outline (counter-clockwise vertex indices); ValueError
-    when it is open, branches, or is several outlines (a hole among them)."""
+    when it is open (naming ``snap``, the gap closed: :func:`_close_boundary`), branches,
+    or is several outlines (a hole among them)."""
     black = edges[np.array(letters) == "B"]
     degree = np.bincount(black.ravel(), minlength=len(xy))
     if (degree == 1).any():
+        ends = np.flatnonzero(degree == 1)
+        gap = np.linalg.norm(xy[ends[1:]] - xy[ends[0]], axis=1)
+        other = (
+            f", {gap.min():.3g} drawing units from its end at {_at(xy[ends[1 + np.argmin(gap)]])}"
+            if len(gap)
+            else ""
+        )
         raise RigidfoldError(
-            f"the boundary (black) is not closed: it ends at {_at(xy[degree == 1][0])}"
+            f"the boundary (black) is not closed: it ends at {_at(xy[ends[0]])}{other} (a gap "
+            f"of up to {snap:.3g} drawing units between two ends is closed; "
+            "Settings.inputs.svg_snap_tol)"
         )
     if (degree > 2).any():
         w = int(np.argmax(degree))

@@ -87,6 +87,8 @@ class FoldingPath:
         det [J; t^T] changed sign (DOF 1)
     steps : accepted continuation steps; factorizations : sparse LU factorisations
     max_length_error : largest |l - l0| / l0 over all points and edges
+    escapes : dense steps past points where the sparse continuation stalled
+        (``Settings.path.escape_tol``: singular and bifurcation points)
     """
 
     points: np.ndarray
@@ -103,6 +105,7 @@ class FoldingPath:
     steps: int
     factorizations: int
     max_length_error: float
+    escapes: int = 0
 
     @property
     def deploys(self) -> bool:
@@ -175,6 +178,7 @@ class FoldingPath:
             "limit_points": len(self.limit_points),
             "bifurcations": len(self.bifurcations),
             "max_length_error": self.max_length_error,
+            "escapes": self.escapes,
         }
 
 
@@ -191,6 +195,7 @@ class _Trace:
     bifurcations: list
     steps: int = 0
     factorizations: int = 0
+    escapes: int = 0
 
 
 def _trace_direction(
@@ -216,7 +221,7 @@ def _trace_direction(
     first, largest, least = (
         rms * v for v in (settings.path.step, settings.path.max_step, settings.path.min_step)
     )
-    x, h, travelled, slope_sign, slow = x0.copy(), first, 0.0, 0, 0
+    x, h, travelled, slope_sign, slow, escapes = x0.copy(), first, 0.0, 0, 0, 0
     best = 1.0  # the smallest measure so far
     lowest = np.inf  # DOF 1: the smallest measure since m first fell
     while True:
@@ -256,16 +261,26 @@ def _trace_direction(
             ok = float(chord @ unit) > np.cos(settings.path.max_turn) * np.linalg.norm(chord)
         if not ok:
             h = step / 2
-            if h < least:
+            if h >= least:
+                continue
+            escaped = (
+                _escape(cons, x, t, rho, first, mode, settings)
+                if escapes < settings.path.max_escapes
+                else None
+            )
+            if escaped is None:
                 return (
                     tr,
                     PathStatus.STALLED,
                     (
                         f"the step fell below {settings.path.min_step:g} mean edge lengths at "
                         f"m = {tr.measure[-1]:.3g} of the design's"
+                        + (f" ({escapes} dense steps past stalls)" if escapes else "")
                     ),
                 )
-            continue
+            y, t, new, mode = escaped
+            escapes, step, nf = escapes + 1, first, 1
+            tr.escapes += 1
         assert new is not None
         rho_y = cons.free_angles(y)
         fold_max = float(np.abs(rho_y).max(initial=0.0))
@@ -333,6 +348,63 @@ def _trace_direction(
                     ),
                 )
         h = min(2 * step, largest) if nf == 1 else step
+
+
+def _escape(
+    cons: RigidFoldingConstraints,
+    x: np.ndarray,
+    t: np.ndarray | None,
+    rho: np.ndarray,
+    first: float,
+    mode: str,
+    settings: Settings,
+) -> tuple[np.ndarray, np.ndarray, System, str] | None:
+    """One step past the point x where the sparse continuation stalled (see
+    ``Settings.path.escape_tol``): the null space N of J at x from a dense SVD; the
+    directions tried are the last tangent's part in N (the branch continued) and the part of
+    the steepest descent of the folding measure (a branch towards flat); each step of
+    ``first``, a quarter, a sixteenth, corrected by Gauss-Newton in the plane normal to it
+    with the pseudo-inverse truncated at ``mechanism_rank_tol``, until every constraint holds
+    to ``path_tol``. Returns (the point, its direction, the factored system there, the mode:
+    "projection" where the augmented matrix is singular), or None (no step converged, or more
+    than ``mechanism_second_order_vertices`` vertices)."""
+    if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
+        return None
+    J, J_rho = cons.jacobian(x)
+    _, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
+    values = np.zeros(cons.n)
+    values[: len(s)] = s
+    N = vt[values <= settings.path.escape_tol * values[0]].T
+    if not N.shape[1]:
+        return None
+    tries = [] if t is None else [N @ (N.T @ t)]
+    tries.append(N @ (N.T @ -(J_rho.T @ rho)))
+    for d in tries:
+        size = float(np.linalg.norm(d))
+        if not size > 0:
+            continue
+        d = d / size
+        for h in (first, first / 4, first / 16):
+            y = x + h * d
+            for _ in range(3 * settings.path.corrector_iter):
+                c = cons.residual(y)
+                if not np.isfinite(c).all():
+                    break
+                if float(np.abs(c).max()) <= settings.path.tol:
+                    chord = y - x
+                    if float(chord @ d) <= 0.5 * h:  # slid back towards x
+                        break
+                    Jy, Jy_rho = cons.jacobian(y)
+                    for kind in (mode, "projection"):
+                        try:
+                            return y, d, System(Jy, Jy_rho, kind, d, settings), kind
+                        except RuntimeError:  # an exactly singular augmented matrix
+                            continue
+                    return None
+                A = np.vstack([cons.jacobian(y)[0].toarray(), d])
+                dy = np.linalg.lstsq(A, np.r_[-c, 0.0], rcond=settings.mechanism.rank_tol)[0]
+                y = y + dy
+    return None
 
 
 def trace_path(
@@ -454,4 +526,5 @@ def _result(
             sum(t.factorizations for t in traces) if factorizations is None else factorizations
         ),
         max_length_error=error,
+        escapes=sum(t.escapes for t in traces),
     )

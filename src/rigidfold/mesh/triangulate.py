@@ -112,29 +112,113 @@ def triangulate_polygon(
         used once (in its direction) and each other edge twice (once each way).
     """
     n = len(xy)
+    size = max(max(p[d] for p in xy) - min(p[d] for p in xy) for d in (0, 1))
+    area_floor = area_tol * size**2
+    tri: list[list[int]] | None = _earcut(xy)
+    half = None if tri is None else _tiling(xy, tri, area_floor)
+    if half is None:
+        # earcut may cut an ear of three points on a line (a vertex on a straight side):
+        # cut the polygon without its straight vertices, then the triangles with them
+        tri = _earcut_without_straight(xy, area_floor)
+        half = None if tri is None else _tiling(xy, tri, area_floor)
+    if tri is None or half is None:
+        raise RigidfoldError("the polygon is degenerate or self-intersecting")
+    tri = delaunay_flips(xy, tri, half, area_floor=area_floor, circle_floor=area_tol * size**4)
+    return tri, [(a, b) for a, b in half if a < b and (b - a) % n not in (1, n - 1)]
+
+
+def _earcut(xy: list[list[float]]) -> list[list[int]]:
+    """Earcut's triangles of the polygon ``xy`` (n, 2), counter-clockwise when their total
+    area is positive."""
+    n = len(xy)
     found = mapbox_earcut.triangulate_float64(
         np.asarray(xy, dtype=np.float64).reshape(n, 2), np.array([n], dtype=np.uint32)
     )
     tri = found.reshape(-1, 3).tolist()
-    size = max(max(p[d] for p in xy) - min(p[d] for p in xy) for d in (0, 1))
-    area_floor = area_tol * size**2
-    doubled = [cross2d(xy[a], xy[b], xy[c]) for a, b, c in tri]
-    if sum(doubled) < 0:  # earcut's own orientation
-        tri, doubled = [t[::-1] for t in tri], [-d for d in doubled]
+    if sum(cross2d(xy[a], xy[b], xy[c]) for a, b, c in tri) < 0:  # earcut's own orientation
+        tri = [t[::-1] for t in tri]
+    return tri
+
+
+def _tiling(
+    xy: list[list[float]], tri: list[list[int]], area_floor: float
+) -> dict[tuple[int, int], int] | None:
+    """The triangle of each directed edge of ``tri`` when the triangles tile the polygon
+    ``xy``: n - 2 triangles of twice their area above ``area_floor``, each side of the polygon
+    used once (in its direction) and each other edge twice (once each way); else None."""
+    n = len(xy)
     half = {(t[i], t[(i + 1) % 3]): k for k, t in enumerate(tri) for i in range(3)}
     turns = [(b - a) % n for a, b in half]
     tiles = (
         len(tri) == n - 2
-        and min(doubled, default=0.0) > area_floor
+        and min((cross2d(xy[a], xy[b], xy[c]) for a, b, c in tri), default=0.0) > area_floor
         and len(half) == 3 * len(tri)  # no half-edge twice
         and turns.count(1) == n  # every side once, in its direction
         and n - 1 not in turns  # no side the wrong way
         and all((b, a) in half for (a, b), turn in zip(half, turns, strict=True) if turn != 1)
     )
-    if not tiles:
-        raise RigidfoldError("the polygon is degenerate or self-intersecting")
-    tri = delaunay_flips(xy, tri, half, area_floor=area_floor, circle_floor=area_tol * size**4)
-    return tri, [(a, b) for a, b in half if a < b and (b - a) % n not in (1, n - 1)]
+    return half if tiles else None
+
+
+def _earcut_without_straight(xy: list[list[float]], area_floor: float) -> list[list[int]] | None:
+    """Triangles of the polygon ``xy`` (n, 2) cut by earcut without its straight vertices
+    (each between its neighbours, on their line within ``area_floor``), each of whose
+    triangles is then cut again with the straight vertices on its sides
+    (:func:`_clip_convex`); None when fewer than three vertices are left or what earcut
+    gives does not tile (:func:`_tiling`)."""
+    n = len(xy)
+    straight = [
+        abs(cross2d(xy[k - 1], xy[k], xy[(k + 1) % n])) <= area_floor
+        and (xy[k - 1][0] - xy[k][0]) * (xy[(k + 1) % n][0] - xy[k][0])
+        + (xy[k - 1][1] - xy[k][1]) * (xy[(k + 1) % n][1] - xy[k][1])
+        < 0
+        for k in range(n)
+    ]
+    kept = [k for k in range(n) if not straight[k]]
+    if not any(straight) or len(kept) < 3:
+        return None
+    reduced = _earcut([xy[k] for k in kept])
+    if _tiling([xy[k] for k in kept], reduced, area_floor) is None:
+        return None
+    tri: list[list[int]] = []
+    for t in reduced:
+        outline = []
+        for i in range(3):  # the triangle's corners and the straight vertices between them
+            a, b = kept[t[i]], kept[t[(i + 1) % 3]]
+            run = [(a + j) % n for j in range(1, (b - a) % n)]
+            outline += [a, *run] if run and all(straight[k] for k in run) else [a]
+        clipped = _clip_convex(xy, outline, area_floor)
+        if clipped is None:
+            return None
+        tri += clipped
+    return tri
+
+
+def _clip_convex(
+    xy: list[list[float]], outline: list[int], area_floor: float
+) -> list[list[int]] | None:
+    """Triangles of a convex polygon (``outline``: indices into ``xy``, counter-clockwise)
+    with straight vertices on its sides, by cutting off ears of twice their area above
+    ``area_floor``, those next to a straight vertex first (so that three corners stay);
+    None when no such ear is left."""
+    outline, tri = list(outline), []
+
+    def doubled(i: int) -> float:
+        m = len(outline)
+        return cross2d(xy[outline[i - 1]], xy[outline[i]], xy[outline[(i + 1) % m]])
+
+    while len(outline) > 3:
+        m = len(outline)
+        ears = [i for i in range(m) if doubled(i) > area_floor]
+        near = [i for i in ears if min(doubled(i - 1), doubled((i + 1) % m)) <= area_floor]
+        if not ears:
+            return None
+        i = (near or ears)[0]
+        tri.append([outline[i - 1], outline[i], outline[(i + 1) % m]])
+        del outline[i]
+    if doubled(1) <= area_floor:
+        return None
+    return [*tri, outline]
 
 
 def delaunay_flips(

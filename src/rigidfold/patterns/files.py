@@ -19,6 +19,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,6 +29,9 @@ from rigidfold.io.fold import read_fold
 from rigidfold.mesh import geometry
 from rigidfold.mesh.triangulate import orient_up, triangulate_polygons
 from rigidfold.patterns.grids import DEFAULT_SIZE, check_extent
+
+if TYPE_CHECKING:
+    from rigidfold.io.svg_read import SvgDrawing
 
 FILE_FORMATS = {".fold": "FOLD", ".svg": "SVG"}
 """File name suffixes read as crease patterns, and their formats."""
@@ -105,12 +109,7 @@ def read_pattern_file(
                 f"{settings.limits.max_pattern_faces} (Settings.limits.max_pattern_faces)"
             )
         coords = np.column_stack([xy, np.zeros(len(xy))])
-        triangles, diagonals = triangulate_polygons(
-            coords,
-            drawing.polygons,
-            area_tol=settings.geometry.triangulation_area_tol,
-            name=f"{path}: face",
-        )
+        triangles, diagonals = _triangulate_drawing(path, drawing, coords, settings)
         faces = orient_up(coords, triangles)
         fixed = np.asarray(diagonals if rigid_panels else [], dtype=np.int64).reshape(-1, 2)
     xy = plan
@@ -125,6 +124,47 @@ def read_pattern_file(
         "fitted_into_m": fitted,
     }
     return PatternFile(xy - xy.min(axis=0), np.asarray(faces, dtype=np.int64), fixed, source)
+
+
+def _triangulate_drawing(
+    path: Path, drawing: SvgDrawing, coords: np.ndarray, settings: Settings
+) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """:func:`triangulate_polygons` of the faces of an SVG drawing; a face that cannot be
+    cut into triangles (degenerate: points of it nearly on one line or nearly one point) is
+    refused in one line naming its corners in the file's coordinates and its shortest side,
+    the lines that make it degenerate."""
+    from rigidfold.io.svg_read import _at
+
+    polygons = drawing.polygons
+    tol = settings.geometry.triangulation_area_tol
+    try:
+        return triangulate_polygons(coords, polygons, area_tol=tol)
+    except RigidfoldError:
+        pass
+
+    def refused(polygon: list[int]) -> bool:
+        try:
+            triangulate_polygons(coords, [polygon], area_tol=tol)
+        except RigidfoldError:
+            return True
+        return False
+
+    xy = drawing.xy[next(p for p in polygons if refused(p))]
+    side = np.linalg.norm(np.roll(xy, -1, axis=0) - xy, axis=1)
+    k = int(np.argmin(side))
+    shown = ", ".join(_at(p) for p in xy[:_SHOWN])
+    more = f" and {len(xy) - _SHOWN} more" if len(xy) > _SHOWN else ""
+    raise RigidfoldError(
+        f"{path}: the face with corners {shown}{more} (drawing units, y down) cannot be cut "
+        "into triangles: it is degenerate or nearly so, its shortest side, from "
+        f"{_at(xy[k])} to {_at(xy[(k + 1) % len(xy)])}, {side[k]:.3g} long; lines drawn to "
+        "one point that miss each other by that much are joined with a larger "
+        "Settings.inputs.svg_merge_tol"
+    )
+
+
+_SHOWN = 8
+"""How many corners of a degenerate face a message names."""
 
 
 def _scaled(

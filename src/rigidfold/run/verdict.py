@@ -85,11 +85,13 @@ def run_verdict(
         short.append(
             f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"
         )
-        if run.deploy_check and run.n_path:
+        failed = run.n_path + run.n_rigid
+        if run.deploy_check and failed and run.stop is not Stop.INTERRUPTED:
+            counts = f"N_path {run.n_path}, N_rigid {run.n_rigid}" if run.n_rigid else "N_path"
             short.append(
                 f"no deployable design below DOF {final.mechanism.dof}: the folding paths of "
-                f"{run.n_path} solution{'s' if run.n_path > 1 else ''} did not reach the flat "
-                "state (N_path)"
+                f"{failed} solution{'s' if failed > 1 else ''} did not reach the flat "
+                f"state ({counts})"
             )
     if records:
         final_record = records[k]
@@ -109,6 +111,9 @@ def run_verdict(
             f"the initial DOF {run.initial_dof} is already at or below the target DOF "
             f"{target}: no crease was fixed",
         )
+    margin = run.dof_margin
+    if final is not None and margin is not None and not margin.get("clear", True):
+        warnings += (str(margin["message"]),)
     if final is not None and final.mechanism.dof == 0 and reached:
         warnings += (
             "a DOF-0 design has no mechanism: it does not fold (no folding motion or "

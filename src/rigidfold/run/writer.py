@@ -21,7 +21,14 @@ from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
-from rigidfold.generate import Attempt, GenerateOptions, Generation, Solution, Stop
+from rigidfold.generate import (
+    Attempt,
+    GenerateOptions,
+    Generation,
+    Solution,
+    Stop,
+    best_so_far,
+)
 from rigidfold.io import (
     FoldData,
     crease_pattern_frame,
@@ -165,11 +172,22 @@ class RunWriter:
 
     def interrupted(self, run: Generation | None) -> None:
         """Write summary.json of a run stopped by Ctrl-C or SIGTERM: ``run`` (None when it
-        was stopped before its first attempt ended) with the stop INTERRUPTED and no
-        verdict."""
+        was stopped before its first attempt ended) with the stop INTERRUPTED, its best
+        design so far named (:func:`rigidfold.generate.best_so_far`: no path is traced, no
+        check is run and nothing is exported) and its verdict (fell short)."""
         if run is None:
             run = Generation()
         run.stop, run.stop_detail = Stop.INTERRUPTED, ""
+        best_so_far(run)
+        final = run.final
+        if final is not None and final.step < len(self.files):
+            self.final_step = final.step
+        self.verdict = run_verdict(
+            run,
+            self.records,
+            [p.relative_to(self.out) for p in self.files],
+            self.options.target_dof,
+        )
         write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
         self.write_summary(run)
 

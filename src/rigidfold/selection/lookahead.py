@@ -53,7 +53,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -260,6 +260,8 @@ class Choice:
     carried : (c,) int64 creases fixed together with the candidate (:func:`flat_groups`):
         the nearly flat ones it would lock; empty for the candidate alone
     passed : the put-off candidates ranked between this one and the one before it
+    rigid : its fix is forecast to leave a shape that is mobile at first order only
+        (second-order rigid; :class:`rigidfold.mechanism.second_order.ChildForecast`)
     """
 
     index: int
@@ -267,11 +269,13 @@ class Choice:
     locked_before: np.ndarray = field(default_factory=_no_edges)
     carried: np.ndarray = field(default_factory=_no_edges)
     passed: tuple[Choice, ...] = ()
+    rigid: bool = False
 
     @property
     def put_off(self) -> bool:
-        """Forecast to lock, or locked at an earlier shape: tried once all others failed."""
-        return bool(len(self.locks) or len(self.locked_before))
+        """Forecast to lock or to be second-order rigid, or locked at an earlier shape:
+        tried once all others failed."""
+        return bool(len(self.locks) or len(self.locked_before) or self.rigid)
 
 
 def carried_angles(
@@ -348,6 +352,7 @@ def lookahead_order(
     dof0_ends: bool = True,
     block: int = 8,
     locked_before: Mapping[tuple[int, ...], Sequence[int]] | None = None,
+    rigid: Callable[[tuple[int, ...]], bool] | None = None,
 ) -> Iterator[Choice]:
     """The order to try ranked candidates with look-ahead: put off those predicted to lock.
 
@@ -355,7 +360,9 @@ def lookahead_order(
     ends generation (``Settings.generation.zero_dof_ends``, or a target DOF 0), so such a
     candidate is not put off although every crease locks at DOF 0. locked_before : {candidate
     (its edges, as ranked): the creases its fix locked at an earlier shape of the run}; such a
-    candidate is put off too.
+    candidate is put off too. rigid : whether a candidate's fix (its edges) is forecast to
+    leave a second-order rigid shape (that shape cannot fold); such a candidate that leaves
+    DOF >= 1 is put off too.
     yields : :class:`Choice`: first every candidate not put off, in the criterion's order,
         with ``passed``, the put-off ones ranked between it and the one before; then the
         groups of :func:`flat_groups` (a candidate with the nearly flat creases it would
@@ -378,7 +385,9 @@ def lookahead_order(
         ends = dof0_ends & (forecast.dof_after == 0)
         for i, group in enumerate(forecast.candidates):
             before = np.asarray(known.get(tuple(map(int, group)), ()), dtype=np.int64)
-            choice = Choice(start + i, forecast.locks(i), before)
+            moves = bool(forecast.dof_after[i] > 0)
+            stiff = rigid is not None and moves and rigid(tuple(map(int, group)))
+            choice = Choice(start + i, forecast.locks(i), before, rigid=stiff)
             if choice.put_off and not ends[i]:
                 passed.append(choice)
                 put_off.append(choice)

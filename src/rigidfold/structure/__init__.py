@@ -3,7 +3,7 @@ under load in OpenSees (``rigidfold structure``).
 
 :mod:`~rigidfold.structure.material` (the panels' material, presets),
 :mod:`~rigidfold.structure.supports` (first-order rigidity of a design on its supports, and
-the fewest supports that give it), :mod:`~rigidfold.structure.stability` (second order where
+the fewest supports that give it), :mod:`~rigidfold.mechanism.second_order` (second order where
 first order is not enough: prestress stability, or a finite mechanism),
 :mod:`~rigidfold.structure.model` (the shell model: panels as plates, free creases as
 hinges), :mod:`~rigidfold.structure.loads` (self-weight, snow, wind, point loads),
@@ -15,6 +15,7 @@ from them, and its files) and
 imported only when an analysis runs or a figure is drawn.
 """
 
+from rigidfold.mechanism.second_order import SecondOrder, Stability, second_order
 from rigidfold.structure.check import (
     StructureCheck,
     StructureStatus,
@@ -31,7 +32,6 @@ from rigidfold.structure.design import (
 )
 from rigidfold.structure.loads import LOAD_KINDS, Load, parse_load
 from rigidfold.structure.material import MATERIALS, Material, parse_material, presets_help
-from rigidfold.structure.stability import SecondOrder, Stability, second_order
 from rigidfold.structure.supports import (
     CANDIDATE_FORMS,
     Rigidity,

@@ -20,13 +20,13 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
+from rigidfold.mechanism.second_order import Stability
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
 from rigidfold.structure.analysis import ShellResponse, solve_shell
 from rigidfold.structure.loads import Load, check_loads, nodal_loads
 from rigidfold.structure.material import Material
 from rigidfold.structure.model import ShellMesh, shell_mesh
-from rigidfold.structure.stability import Stability
 from rigidfold.structure.supports import Rigidity, SupportGrowth
 
 

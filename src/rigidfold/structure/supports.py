@@ -28,7 +28,7 @@ any support not needed.
 
 Where first order is not enough (K~ has eigenvalues at most ``structure_rigidity_tol``: the
 supports leave first-order motions, the flexes, the eigenvectors of those eigenvalues), the
-flexes go to the second-order check of :mod:`rigidfold.structure.stability`: a set that is
+flexes go to the second-order check of :mod:`rigidfold.mechanism.second_order`: a set that is
 prestress stable (a self-stress of the constraints holds every flex) is accepted and says
 so; one that leaves a finite mechanism, or a flex that no self-stress holds, is refused with
 the motion named. ``auto`` prefers first-order rigid sets; it returns a prestress-stable one
@@ -50,9 +50,9 @@ from rigidfold.mechanism.kinematics import (
     constraint_matrix,
     fold_angle_gradients,
 )
+from rigidfold.mechanism.second_order import SecondOrder, Stability, held_vertices, second_order
 from rigidfold.mechanism.stiffness import PseudoStiffness
 from rigidfold.mesh import CreasePattern
-from rigidfold.structure.stability import SecondOrder, Stability, held_vertices, second_order
 
 CANDIDATE_FORMS = ("boundary", "ground", "V,V,...")
 
@@ -277,7 +277,7 @@ class Rigidity:
     motions of small stiffness counted with them; eigenvalues : (m,) ascending eigenvalues of
     K~ (m = 6 + dof + near_mechanisms); rigid : first-order rigid; mode : the motion left
     free at first order, in words (None when rigid); second_order : the second-order check
-    of the flexes when not first-order rigid (:mod:`rigidfold.structure.stability`).
+    of the flexes when not first-order rigid (:mod:`rigidfold.mechanism.second_order`).
     """
 
     supports: Supports

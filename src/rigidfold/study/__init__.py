@@ -16,7 +16,7 @@ from rigidfold.study.session import (
     failure_summary,
     run_study_command,
 )
-from rigidfold.study.store import Key, RunRow, Store, StoreWriteError, legacy_stop
+from rigidfold.study.store import Key, RunRow, Store, StoreWriteError
 
 __all__ = [
     "PRESETS",
@@ -30,7 +30,6 @@ __all__ = [
     "StudyInterrupted",
     "StudyPlan",
     "failure_summary",
-    "legacy_stop",
     "plan",
     "preset",
     "run_one",

@@ -110,14 +110,11 @@ def _configuration_lines(store: Store) -> list[str]:
     versions = sorted({r.version for r in store.runs()})
     if not config:
         return []
-    from rigidfold.study.store import LEGACY_CONFIG, LEGACY_SETTINGS
-
     settings = config.get("settings") or {}
-    hessian = settings.get("ipopt_hessian", LEGACY_SETTINGS["ipopt_hessian"])
     solver = config.get("solver")
     if solver == "ipopt":
-        solver = f"ipopt ({hessian} Hessian)"
-    lookahead = config.get("lookahead", LEGACY_CONFIG["lookahead"])
+        solver = f"ipopt ({settings.get('ipopt_hessian')} Hessian)"
+    lookahead = config.get("lookahead")
     return [
         f"Configuration: solver {md_text(solver)}, target DOF {md_text(config.get('target_dof'))}, "
         f"Steps 8-9 {'on' if config.get('deform') else 'off'}, "

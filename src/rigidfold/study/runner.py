@@ -180,7 +180,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             row["time_path_final"] = time.perf_counter() - t_path
         if final is not None and options.deform and not every:
             check(final)
-    except ValueError as exc:  # a configuration that cannot run: recorded, not retried
+    except RigidfoldError as exc:  # a configuration that cannot run: recorded, not retried
         row.update(
             status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
         )
@@ -203,6 +203,8 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         time_selection=s["time_s"]["selection"],
         n_path=s["N_path"],
         n_backtrack=s["N_backtrack"],
+        n_rigid=s["N_rigid"],
+        lowest_dof=s["lowest_dof"],
         final_deploys=None if final is None or final.path is None else int(final.path.deploys),
         time_path=s["time_s"]["path"] + row.pop("time_path_final", 0.0),
     )

@@ -11,14 +11,11 @@ written: its numbers would not be comparable.
 
 A run's ``stop`` column holds how it ended, the :class:`~rigidfold.generate.Stop` value (NULL
 for a run that could not run), and ``status`` the words (``Generation.stop_reason``) or
-"error: <message>". Databases written before the ``stop`` column get it filled from the
-words once, when opened for writing (:func:`legacy_stop`); :meth:`Store.runs` returns typed
-rows (:class:`RunRow`).
+"error: <message>"; :meth:`Store.runs` returns typed rows (:class:`RunRow`).
 """
 
 from __future__ import annotations
 
-import functools
 import itertools
 import json
 import os
@@ -28,7 +25,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 
 from rigidfold.errors import RigidfoldError
-from rigidfold.generate import STOP_REASONS, Stop
+from rigidfold.generate import Stop
 from rigidfold.study.lock import StudyLock
 
 SCHEMA = """
@@ -46,6 +43,14 @@ CREATE TABLE IF NOT EXISTS runs (
     time_build REAL, time_solve REAL, time_analysis REAL, time_selection REAL,
     time_develop REAL, time_deform REAL, time_total REAL,
     version TEXT NOT NULL, worker TEXT,
+    numerics TEXT,                -- rigidfold.numerics.NumericEnvironment.key of its worker
+    n_path INTEGER,               -- N_path (0 without the deployability check)
+    final_deploys INTEGER,        -- whether the final design's folding path reaches flat
+    time_path REAL,               -- seconds of tracing
+    stop TEXT,                    -- the generate.Stop value (NULL: an error)
+    n_backtrack INTEGER,          -- generate.Generation.n_backtrack
+    n_rigid INTEGER,              -- N_rigid: solutions rejected as second-order rigid
+    lowest_dof INTEGER,           -- the lowest DOF reached (final_dof: the final design's)
     PRIMARY KEY (study, seed, pattern, criterion, symmetric)
 );
 CREATE TABLE IF NOT EXISTS invocations (  -- one row per `rigidfold study` command that ended
@@ -62,48 +67,17 @@ CREATE TABLE IF NOT EXISTS attempts (
     fixed_added TEXT NOT NULL, score REAL, status TEXT NOT NULL, f REAL, iterations INTEGER,
     dof INTEGER, locked TEXT NOT NULL, outcome TEXT NOT NULL,
     solve_time REAL, analysis_time REAL, selection_time REAL,
-    skipped INTEGER,              -- candidates skipped by the look-ahead just before (NULL: older)
+    skipped INTEGER,              -- candidates skipped by the look-ahead just before
     skipped_locks TEXT, predicted_locks TEXT,  -- JSON, see generate.Attempt
     locked_predicted TEXT, locked_left TEXT, locked_fold_deg TEXT,  -- JSON, per locked crease
     carried TEXT,                 -- JSON: creases the look-ahead fixed with the candidate
+    path TEXT, path_time REAL,    -- JSON: generate.Attempt.path, and its seconds
+    second_order TEXT,            -- JSON: generate.Attempt.second_order
+    rigid_forecast INTEGER,       -- forecast second-order rigid (NULL: no forecast)
     PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
 );
 """
 
-ADDED_ATTEMPT_COLUMNS = {
-    "skipped": "INTEGER",
-    "skipped_locks": "TEXT",
-    "predicted_locks": "TEXT",
-    "locked_predicted": "TEXT",
-    "locked_left": "TEXT",
-    "locked_fold_deg": "TEXT",
-    "carried": "TEXT",
-    "path": "TEXT",
-    "path_time": "REAL",
-}
-"""Columns of ``attempts`` added after the first databases (the look-ahead, issue 18; the
-deployability check, issue 29: ``path`` is JSON, ``generate.Attempt.path``): added
-by ALTER TABLE when such a database is opened for writing, read as NULL from one opened
-read-only."""
-ADDED_RUN_COLUMNS = {
-    "numerics": "TEXT",
-    "n_path": "INTEGER",
-    "final_deploys": "INTEGER",
-    "time_path": "REAL",
-    "stop": "TEXT",
-    "n_backtrack": "INTEGER",
-}
-"""Columns of ``runs`` added later, as :data:`ADDED_ATTEMPT_COLUMNS`: ``numerics`` is the
-key of the numeric environment of the worker that computed the run
-(:attr:`rigidfold.numerics.NumericEnvironment.key`); ``n_path`` the solutions replaced
-because their folding path does not reach the flat state (N_path, 0 without the
-deployability check), ``final_deploys`` whether the final design's folding path reaches the
-flat state (1 or 0), ``time_path`` the seconds of tracing; NULL for runs of older
-versions. ``stop`` is the :class:`~rigidfold.generate.Stop` value (NULL for an error),
-filled for the runs of older versions when the database is opened for writing.
-``n_backtrack`` the solutions retracted by backtracking (``generate.Generation.n_backtrack``;
-NULL for runs of older versions, which did not backtrack)."""
-ADDED_COLUMNS = {"attempts": ADDED_ATTEMPT_COLUMNS, "runs": ADDED_RUN_COLUMNS}
 JSON_ATTEMPT_FIELDS = (
     "fixed_added",
     "locked",
@@ -114,69 +88,33 @@ JSON_ATTEMPT_FIELDS = (
     "locked_fold_deg",
     "carried",
     "path",
+    "second_order",
 )
 """Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
 
-RUN_FIELDS = (
-    "status",
-    "n_reduce",
-    "n_lock",
-    "n_exceed",
-    "mean_f",
-    "initial_dof",
-    "final_dof",
-    "n_solutions",
-    "n_solves",
-    "mean_d",
-    "mean_dl_mm",
-    "mean_drho_fix_deg",
-    "reached_plane",
-    "time_build",
-    "time_solve",
-    "time_analysis",
-    "time_selection",
-    "time_develop",
-    "time_deform",
-    "time_total",
-    "version",
-    "worker",
-    *ADDED_RUN_COLUMNS,
-)
-ATTEMPT_FIELDS = (
-    "idx",
-    "fixed_added",
-    "score",
-    "status",
-    "f",
-    "iterations",
-    "dof",
-    "locked",
-    "outcome",
-    "solve_time",
-    "analysis_time",
-    "selection_time",
-    *ADDED_ATTEMPT_COLUMNS,
-)
+KEY_COLUMNS = ("study", "seed", "pattern", "criterion", "symmetric")
+"""The columns of a run's :class:`Key`, first in ``runs`` and ``attempts``."""
+
+
+def schema_columns() -> dict[str, dict[str, str]]:
+    """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
+    con = sqlite3.connect(":memory:")
+    con.executescript(SCHEMA)
+    tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")]
+    columns = {t: {r[1]: r[2] for r in con.execute(f"PRAGMA table_info({t})")} for t in tables}
+    con.close()
+    return columns
+
+
+SCHEMA_COLUMNS = schema_columns()
+RUN_FIELDS = tuple(c for c in SCHEMA_COLUMNS["runs"] if c not in KEY_COLUMNS)
+"""The columns of ``runs`` besides the key, in the order of :data:`SCHEMA`."""
+ATTEMPT_FIELDS = tuple(c for c in SCHEMA_COLUMNS["attempts"] if c not in KEY_COLUMNS)
+"""The columns of ``attempts`` besides the key, in the order of :data:`SCHEMA`."""
 
 
 ERROR_PREFIX = "error: "
 """Start of the ``status`` of a run that could not run (a configuration error)."""
-
-
-def legacy_stop(status: str) -> Stop | None:
-    """How a run of a database written before the ``stop`` column ended, from its
-    ``status``: a Stop, or None for "error: <message>". Every rigidfold version has written
-    there the generator's ``stop_reason`` (:data:`rigidfold.generate.STOP_REASONS`, the
-    same words since the first) or "error: <message>". Raises RigidfoldError for any other
-    text."""
-    if status.startswith(ERROR_PREFIX):
-        return None
-    for stop, template in STOP_REASONS.items():
-        head, slot, tail = template.partition("{}")
-        fits = status.startswith(head) and status.endswith(tail)
-        if fits and (len(status) >= len(head) + len(tail) if slot else status == template):
-            return stop
-    raise RigidfoldError(f"{status!r} is not the stop reason of a generation run")
 
 
 @dataclass(frozen=True)
@@ -185,10 +123,11 @@ class RunRow:
 
     study, seed, pattern, criterion, symmetric : its :class:`Key`; stop : how it ended
     (None: it could not run, ``status`` then "error: <message>"); status : the words; the
-    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_backtrack``,
-    the final design's ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the
-    Step 8-9 figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``),
-    the times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
+    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_rigid``,
+    ``n_backtrack``, the lowest DOF reached (``lowest_dof``), the final design's
+    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9 figures
+    (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the times in
+    seconds (``time_*``), and where it was computed (``version``, ``worker``,
     ``numerics``); a figure the run (or its version) did not record is None.
     """
 
@@ -225,6 +164,8 @@ class RunRow:
     final_deploys: int | None = None
     time_path: float | None = None
     n_backtrack: int | None = None
+    n_rigid: int | None = None
+    lowest_dof: int | None = None
 
     @property
     def key(self) -> Key:
@@ -237,24 +178,18 @@ class RunRow:
 
     @classmethod
     def from_columns(cls, values: dict) -> RunRow:
-        """The row of the ``runs`` columns ``values`` (a column of a later version that the
-        database lacks: None; ``stop`` NULL in a database opened read-only that has not been
-        migrated: :func:`legacy_stop` of the status)."""
+        """The row of the ``runs`` columns ``values``."""
         names = {f.name for f in fields(cls)}
         known = {k: v for k, v in values.items() if k in names}
         stop = known.pop("stop", None)
         known["symmetric"] = bool(known["symmetric"])
-        return cls(stop=legacy_stop(known["status"]) if stop is None else Stop(stop), **known)
+        return cls(stop=None if stop is None else Stop(stop), **known)
 
 
 def _stop_value(run: dict) -> str | None:
-    """The ``stop`` column of a run to add: its ``stop`` (a Stop value), or, for a row that
-    gives only the words of ``status``, the Stop they say (:func:`legacy_stop`)."""
+    """The ``stop`` column of a run to add: its ``stop`` as a Stop value (None: an error)."""
     stop = run.get("stop")
-    if stop is None:
-        legacy = legacy_stop(run["status"])
-        return None if legacy is None else legacy.value
-    return Stop(stop).value
+    return None if stop is None else Stop(stop).value
 
 
 class StoreWriteError(RigidfoldError):
@@ -276,68 +211,32 @@ class Key:
         return (self.study, self.seed, self.pattern, self.criterion, int(self.symmetric))
 
 
-# settings added with a default that differs from what rigidfold did before they existed
-LEGACY_SETTINGS = {"ipopt_hessian": "casadi", "backtrack_max": 0}
 # settings that change nothing without the deployability check: not compared between two
 # configurations without it (a study of the paper's Step 5 resumes whatever they are)
 CHECK_ONLY_SETTINGS = frozenset({"backtrack_max"})
-# settings that a later rigidfold removed, with what they set: a database that stored them
-# resumes, since no study ran what they tuned
-RETIRED_SETTINGS = frozenset(
-    {  # the folding-motion tracer before issue 29 (studies trace no motion)
-        "motion_tol",
-        "motion_max_iter",
-        "motion_arc_step",
-        "motion_arc_max_steps",
-        "motion_max_halvings",
-        "motion_level_tol",
-        "motion_stall_iter",
-        "motion_stall_ratio",
-        "motion_probe",
-        "motion_arc_min_step",
-        "motion_turn_back",
-        # the options of a run, moved to rigidfold.generate.GenerateOptions (issue 28): the
-        # configuration keeps target_dof and deploy_check at its top level
-        "target_dof",
-        "deploy_check",
-        # the thick panels' default density, now that of the default material (studies make
-        # no thick panels)
-        "fabricate_density",
-    }
-)
-# configuration entries added later, at the value that reproduces the studies made before
-LEGACY_CONFIG = {"lookahead": False, "deploy_check": False, "check": "all"}
 
 
 def config_differences(stored: dict, current: dict) -> list[str]:
     """Names of the configuration entries in which ``current`` differs from ``stored``.
 
     A setting that a later rigidfold added (absent from ``stored["settings"]``) counts as
-    equal when ``current`` has it at the value that reproduces the older code: its default,
-    or its entry in ``LEGACY_SETTINGS`` where the default changed what the code computes; so
-    does an entry of the configuration itself at its value in ``LEGACY_CONFIG`` (e.g.
-    ``lookahead`` false); a setting a later rigidfold removed (``RETIRED_SETTINGS``) is not
-    compared, nor one that acts only with the deployability check
-    (``CHECK_ONLY_SETTINGS``) where neither configuration has it. So a study can be resumed
-    by a newer version as long as nothing it measures has changed.
+    equal when ``current`` has it at its default; one that acts only with the deployability
+    check (``CHECK_ONLY_SETTINGS``) is not compared where neither configuration has it. So
+    a study can be resumed by a newer version as long as nothing it measures has changed.
     """
     from rigidfold.config import DEFAULTS
 
     defaults = DEFAULTS.flat()
-    checked = any(
-        config.get("deploy_check", LEGACY_CONFIG["deploy_check"]) for config in (stored, current)
-    )
+    checked = any(config.get("deploy_check") for config in (stored, current))
     inert = set() if checked else CHECK_ONLY_SETTINGS
     diff = []
     for key in sorted(set(stored) | set(current)):
-        a, b = stored.get(key, LEGACY_CONFIG.get(key)), current.get(key)
+        a, b = stored.get(key), current.get(key)
         if key == "settings" and isinstance(a, dict) and isinstance(b, dict):
             diff += [
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
-                if k not in RETIRED_SETTINGS
-                and k not in inert
-                and (a.get(k, LEGACY_SETTINGS.get(k, defaults.get(k))) != b.get(k) or k not in b)
+                if k not in inert and (a.get(k, defaults.get(k)) != b.get(k) or k not in b)
             ]
         elif a != b:
             diff.append(key)
@@ -357,17 +256,6 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
 READONLY_COPY_TRIES = 3
 """Times a database opened read-only is copied into memory before it is read in place
 instead (:meth:`Store._connect_readonly`): a copy is kept only if nothing wrote meanwhile."""
-
-
-@functools.cache
-def schema_columns() -> dict[str, dict[str, str]]:
-    """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
-    con = sqlite3.connect(":memory:")
-    con.executescript(SCHEMA)
-    tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")]
-    columns = {t: {r[1]: r[2] for r in con.execute(f"PRAGMA table_info({t})")} for t in tables}
-    con.close()
-    return columns
 
 
 class Store:
@@ -407,7 +295,6 @@ class Store:
                 raise RigidfoldError(f"no study database at {str(self.path)!r}")
             self.db = self._connect_readonly()
             self._check(self.db)
-            self._attempt_columns = self._columns("attempts")
             return
         if self.path.is_dir():
             raise RigidfoldError(f"database path {str(self.path)!r} is a directory")
@@ -505,13 +392,6 @@ class Store:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")
             self.db.executescript(SCHEMA)
-            for table, added in ADDED_COLUMNS.items():
-                have = self._columns(table)
-                for name, kind in added.items():
-                    if name not in have:  # a database of an earlier version: new columns
-                        self.db.execute(f"ALTER TABLE {table} ADD COLUMN {name} {kind}")
-            self._fill_stops()
-            self._attempt_columns = self._columns("attempts")
             if config is not None:
                 self.db.execute(
                     "INSERT OR IGNORE INTO meta VALUES ('config', ?)",
@@ -528,22 +408,9 @@ class Store:
         except sqlite3.Error as exc:
             raise RigidfoldError(f"cannot open study database {str(self.path)!r}: {exc}") from None
 
-    def _fill_stops(self) -> None:
-        """The ``stop`` of the runs stored before the column existed, from their words
-        (:func:`legacy_stop`); errors keep NULL."""
-        statuses = self.db.execute("SELECT DISTINCT status FROM runs WHERE stop IS NULL").fetchall()
-        for (status,) in statuses:
-            stop = legacy_stop(status)
-            if stop is not None:
-                self.db.execute(
-                    "UPDATE runs SET stop = ? WHERE stop IS NULL AND status = ?",
-                    (stop.value, status),
-                )
-
     def _check(self, con: sqlite3.Connection, config: dict | None = None) -> None:
         """Refuse, reading ``con`` only, a damaged SQLite file, one without the tables and
-        columns of :data:`SCHEMA` (the columns added later may be absent, and the
-        ``invocations`` table), one with text in a number column or a ``meta`` config that
+        columns of :data:`SCHEMA`, one with text in a number column or a ``meta`` config that
         is not a JSON object; and, given ``config``, one with no or another configuration."""
         name = str(self.path)
         try:
@@ -551,16 +418,14 @@ class Store:
             if verdict != "ok":
                 first = [line for line in verdict.splitlines() if not line.startswith("***")]
                 raise RigidfoldError(f"{name!r}: damaged SQLite file: {(first or [verdict])[0]}")
-            for table, columns in schema_columns().items():
+            for table, columns in SCHEMA_COLUMNS.items():
                 have = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
-                if not have and table == "invocations":  # older databases lack it
-                    continue
                 if not have:
                     raise RigidfoldError(
                         f"{name!r}: not a rigidfold study database: no table {table!r}"
                     )
                 for column, kind in columns.items():
-                    if column not in have and column not in ADDED_COLUMNS.get(table, {}):
+                    if column not in have:
                         raise RigidfoldError(
                             f"{name!r}: not a rigidfold study database: table {table!r} "
                             f"lacks column {column!r}"
@@ -633,10 +498,6 @@ class Store:
         except (TypeError, json.JSONDecodeError):
             return None
 
-    def _columns(self, table: str) -> set[str]:
-        """Names of the columns of ``table`` in this file."""
-        return {row[1] for row in self.db.execute(f"PRAGMA table_info({table})")}
-
     def config(self) -> dict | None:
         row = self.db.execute("SELECT value FROM meta WHERE key='config'").fetchone()
         return None if row is None else json.loads(row[0])
@@ -658,7 +519,7 @@ class Store:
 
     def _add(self, key: Key, run: dict, attempts: list[dict]) -> None:
         with self.db:
-            names = ("study", "seed", "pattern", "criterion", "symmetric", *RUN_FIELDS)
+            names = KEY_COLUMNS + RUN_FIELDS
             added = self.db.execute(
                 f"INSERT OR IGNORE INTO runs ({', '.join(names)}) "
                 f"VALUES ({', '.join('?' * len(names))})",
@@ -667,7 +528,7 @@ class Store:
             ).rowcount
             if not added:
                 raise RigidfoldError(f"{str(self.path)!r} already holds the run {key.row()}")
-            names = ("study", "seed", "pattern", "criterion", "symmetric", *ATTEMPT_FIELDS)
+            names = KEY_COLUMNS + ATTEMPT_FIELDS
             self.db.executemany(
                 f"INSERT INTO attempts ({', '.join(names)}) VALUES ({', '.join('?' * len(names))})",
                 [
@@ -714,11 +575,8 @@ class Store:
         )
 
     def invocations(self) -> list[dict]:
-        """Every recorded command, oldest first (none in a database from before the table)."""
-        try:
-            cur = self.db.execute("SELECT * FROM invocations ORDER BY started")
-        except sqlite3.OperationalError:
-            return []
+        """Every recorded command, oldest first."""
+        cur = self.db.execute("SELECT * FROM invocations ORDER BY started")
         names = [d[0] for d in cur.description]
         rows = [dict(zip(names, row, strict=True)) for row in cur]
         for r in rows:
@@ -758,18 +616,16 @@ class Store:
         Yields ``((pattern, criterion), seed, rows)`` per run, ``rows`` holding ``columns``
         (names of :data:`ATTEMPT_FIELDS`) of each attempt, only those with ``outcome`` (an
         :class:`~rigidfold.generate.AttemptOutcome` value) when given. JSON columns
-        (:data:`JSON_ATTEMPT_FIELDS`) come decoded; a column that a database of an earlier
-        version lacks (opened read-only) reads as None.
+        (:data:`JSON_ATTEMPT_FIELDS`) come decoded.
         """
         unknown = [c for c in columns if c not in ATTEMPT_FIELDS]
         if unknown:
             raise RigidfoldError(
                 f"unknown attempt columns {unknown} (choose from {ATTEMPT_FIELDS})"
             )
-        selected = [c if c in self._attempt_columns else f"NULL AS {c}" for c in columns]
         decode = [c in JSON_ATTEMPT_FIELDS for c in columns]
         cur = self.db.execute(
-            f"SELECT pattern, criterion, seed, {', '.join(selected)} FROM attempts "
+            f"SELECT pattern, criterion, seed, {', '.join(columns)} FROM attempts "
             "WHERE study = ?"
             + (" AND outcome = ?" if outcome is not None else "")
             + " ORDER BY pattern, criterion, seed, idx",

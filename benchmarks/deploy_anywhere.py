@@ -1,0 +1,198 @@
+"""Deployable anywhere, in minutes (issue 40): the share of runs on drawn patterns and a roof
+grid that end at DOF 1 with a design that deploys, the time and the solves per run, and why
+every rejected candidate was rejected; with the second-order test and forecast
+(``Settings.generation.second_order``, rigidfold's default) and without it (the search before
+it), in the same process.
+
+Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only TEXT]
+[--modes after,before]``. Every run uses S-hat with the look-ahead and the deployability
+check, as the README recommends, and ``--time-limit`` (180 s for a drawn pattern, 420 s for
+the roof): a run that hits it ends with its best design, counted as not reaching DOF 1.
+
+Cases: Origami Simulator's patterns in tests/data/origami_simulator (waterbomb, Huffman's
+waterbomb, Resch's triangles, Miura-ori, Lang's wedge, the polygami cross, the sharp-angle
+Miura-ori, the strip of squares) on the dome, the HP and the Bezier surface of seed 7; and a
+15 x 9 grid on a 12 m x 8 m roof (a barrel vault with a cross fall) with the criterion S.
+
+Each line: the case, whether it reached DOF 1 and deploys, the final design's DOF, the
+solves, the solves per DOF removed, the seconds, and the rejected candidates by cause
+(``lock``, ``exceed``, ``second_order_rigid``, and for paths that do not reach the flat state
+their status: ``turned_back``, ``stops_short``, ``collision``, ``max_steps``, ``stalled`` (the
+tracer's failure), ``zero_dof``; ``dead_end``: retracted by backtracking). At the end, per
+mode: the share, the median time and the median solves per DOF removed, and the causes
+summed; where the forecast ran, how its calls matched what the solve and trace found.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from collections import Counter
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+DATA = Path(__file__).resolve().parents[1] / "tests" / "data" / "origami_simulator"
+DRAWN = (
+    "waterbomb.svg",
+    "huffmanWaterbomb.svg",
+    "reschTriTessellation.svg",
+    "miura-ori.svg",
+    "langWedgeDoubleFaced.svg",
+    "polygamiCross.svg",
+    "miura_sharpangle.svg",
+    "test.svg",
+)
+ROOF = {
+    "surface": "expr",
+    "pattern": "grid:15x9",
+    "size": "12x8",
+    "expr": "0.08*x*(12-x)/6 + 0.02*(y-4)**2 - 0.05*y",
+}
+MODES = {"after": True, "before": False}
+
+
+def paper_cases(surfaces: int) -> list[dict]:
+    """The paper's study (Tables 5-6): patterns 1 and 2, S-hat and S, Bezier seeds 0 to
+    ``surfaces - 1``, as ``rigidfold study --lookahead --deploy-check`` runs it."""
+    return [
+        {"surface": "bezier", "pattern": p, "seed": seed, "criterion": c, "limit": 600.0}
+        for p in ("1", "2")
+        for c in ("shat", "s")
+        for seed in range(surfaces)
+    ]
+
+
+def cases() -> list[dict]:
+    """Every case: a drawn pattern on the dome, the HP and Bezier seed 7; the roof."""
+    out = [
+        {"surface": s, "pattern": str(DATA / f), "seed": 7, "criterion": "shat", "limit": 180.0}
+        for f in DRAWN
+        for s in ("dome", "hp", "bezier")
+    ]
+    out.append({**ROOF, "seed": 0, "criterion": "s", "limit": 420.0})
+    return out
+
+
+def name(case: dict) -> str:
+    text = f"{case['surface']}:{Path(case['pattern']).name}"
+    return (
+        text
+        if case["surface"] != "bezier" or case["seed"] == 7
+        else (f"{text}:{case['criterion']}:{case['seed']}")
+    )
+
+
+def cause(attempt) -> str | None:
+    """Why an attempt was rejected (None: accepted, or the initial solve)."""
+    outcome = attempt.outcome.value
+    if outcome == "accepted":
+        return None
+    if outcome == "path":
+        return attempt.path["status"] if attempt.path else "path"
+    return outcome
+
+
+def run(case: dict, mode: str) -> dict:
+    """One run of ``case`` with the second-order test and forecast (``after``) or without."""
+    from rigidfold.case import make_case
+    from rigidfold.config import DEFAULTS
+    from rigidfold.generate import Stop, generate
+
+    settings = DEFAULTS.with_(second_order=MODES[mode])
+    t0 = time.perf_counter()
+    built = make_case(
+        case["surface"],
+        case["pattern"],
+        seed=case["seed"],
+        size=case.get("size"),
+        expr=case.get("expr"),
+        settings=settings,
+    )
+    gen = generate(
+        built,
+        criterion=case["criterion"],
+        seed=case["seed"],
+        lookahead=True,
+        deform=False,
+        time_limit=case["limit"],
+    )
+    final = gen.final
+    deploys = final is not None and final.path is not None and final.path.deploys
+    removed = (gen.initial_dof or 0) - (gen.lowest_dof or gen.initial_dof or 0)
+    forecast = Counter(
+        f"{'rigid' if a.rigid_forecast else 'free'}->{cause(a) or 'accepted'}"
+        for a in gen.attempts
+        if a.rigid_forecast is not None
+    )
+    return {
+        "case": name(case),
+        "mode": mode,
+        "stop": gen.stop_reason,
+        "initial_dof": gen.initial_dof,
+        "final_dof": gen.final_dof,
+        "lowest_dof": gen.lowest_dof,
+        "dof1_deploys": bool(gen.stop is Stop.TARGET_REACHED and deploys),
+        "solves": len(gen.attempts),
+        "solves_per_dof": len(gen.attempts) / removed if removed else None,
+        "time_s": time.perf_counter() - t0,
+        "N_lock": gen.n_lock,
+        "N_path": gen.n_path,
+        "N_rigid": gen.n_rigid,
+        "N_backtrack": gen.n_backtrack,
+        "causes": dict(Counter(c for a in gen.attempts if (c := cause(a)) is not None)),
+        "forecast": dict(forecast),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--only", default=None, metavar="TEXT", help="cases whose name holds it")
+    parser.add_argument("--modes", default="after,before", help="after, before or both")
+    parser.add_argument(
+        "--paper",
+        type=int,
+        default=0,
+        metavar="N",
+        help="instead: the paper's study on N Bezier surfaces (patterns 1 and 2, S-hat and S)",
+    )
+    args = parser.parse_args()
+    modes = [m for m in args.modes.split(",") if m]
+    every = paper_cases(args.paper) if args.paper else cases()
+    chosen = [c for c in every if args.only is None or args.only in name(c)]
+    work = [(c, m) for c in chosen for m in modes]
+    rows = []
+    with ProcessPoolExecutor(args.jobs) as pool:
+        for row in pool.map(run, *zip(*work, strict=True)):
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+            if args.out:
+                with args.out.open("a") as f:
+                    f.write(json.dumps(row) + "\n")
+    for mode in modes:
+        sel = [r for r in rows if r["mode"] == mode]
+        if not sel:
+            continue
+        share = sum(r["dof1_deploys"] for r in sel)
+        per_dof = [r["solves_per_dof"] for r in sel if r["solves_per_dof"] is not None]
+        causes: Counter = Counter()
+        forecast: Counter = Counter()
+        for r in sel:
+            causes.update(r["causes"])
+            forecast.update(r["forecast"])
+        print(
+            f"{mode}: {share}/{len(sel)} reach DOF 1 and deploy; median run "
+            f"{statistics.median(r['time_s'] for r in sel):.1f} s, longest "
+            f"{max(r['time_s'] for r in sel):.1f} s; median solves per DOF removed "
+            f"{statistics.median(per_dof) if per_dof else float('nan'):.2f}"
+        )
+        print(f"{mode}: rejected candidates by cause {dict(causes.most_common())}")
+        if forecast:
+            print(f"{mode}: forecast -> found {dict(forecast.most_common())}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,96 @@
+"""A field of an options record, with its documentation and how the command line gives it.
+
+An options record (:class:`rigidfold.generate.GenerateOptions`,
+:class:`rigidfold.case_options.CaseOptions`) is a frozen dataclass whose fields are made by
+:func:`option`: the default, what the value means (``field.metadata["doc"]``, which is also
+the command-line help) and, unless ``flag=False``, a :class:`Flag` (``field.metadata
+["flag"]``) from which :mod:`rigidfold.cli_parser` makes the argument: so a documented field
+is all it takes to add an option to the library and a flag to the commands that take the
+record.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from typing import Any
+
+from rigidfold.config import check_seed
+from rigidfold.errors import RigidfoldError
+
+
+@dataclasses.dataclass(frozen=True)
+class Flag:
+    """How the command line gives a field.
+
+    name : the flag (default: ``--`` and the field's name with dashes; a bool whose default
+        is True is turned off by ``--no-`` and that name).
+    parse : the text to the value (an argparse ``type``; default: the text).
+    metavar, choices : as argparse's.
+    """
+
+    name: str | None = None
+    parse: Callable[[str], Any] | None = None
+    metavar: str | None = None
+    choices: tuple[str, ...] | None = None
+
+
+def option(default: Any, doc: str, *, flag: bool = True, **how: Any) -> Any:
+    """A field of an options record: its default, what it means (a phrase that reads as the
+    command-line help too: a bool's says what it turns on) and, unless ``flag=False``, how the
+    command line gives it (:class:`Flag`'s ``name``, ``parse``, ``metavar``, ``choices``)."""
+    return dataclasses.field(
+        default=default, metadata={"doc": doc, "flag": Flag(**how) if flag else None}
+    )
+
+
+def docs(record: type) -> dict[str, str]:
+    """What every field of an options record means, by field name."""
+    return {f.name: f.metadata.get("doc", "") for f in dataclasses.fields(record)}
+
+
+# ---- the text of a flag to its value: a RigidfoldError names what was received ----------
+
+
+def count(text: str) -> int:
+    """An integer >= 0."""
+    value = _integer(text)
+    if value < 0:
+        raise RigidfoldError(f"must be an integer >= 0, got {text!r}")
+    return value
+
+
+def seed(text: str) -> int:
+    """A seed: an integer from 0 to below 2**63."""
+    return check_seed(_integer(text))
+
+
+def positive(text: str) -> float:
+    """A finite number > 0."""
+    value = _number(text)
+    if not (math.isfinite(value) and value > 0):
+        raise RigidfoldError(f"must be a positive number, got {text!r}")
+    return value
+
+
+def fraction(text: str) -> float:
+    """A number from 0 to below 1."""
+    value = _number(text)
+    if not 0 <= value < 1:
+        raise RigidfoldError(f"must be a number from 0 to below 1, got {text!r}")
+    return value
+
+
+def _integer(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise RigidfoldError(f"invalid int value: {text!r}") from None
+
+
+def _number(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
