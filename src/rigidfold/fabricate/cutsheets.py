@@ -656,6 +656,14 @@ def _nice_length(limit: float) -> float:
     return max(m * power for m in (1, 2, 5) if m * power <= limit)
 
 
+def _scale_bar(sheet: StockSheet) -> tuple[float, float]:
+    """(length, left end) of a sheet's scale bar, mm: a round length near a quarter of the
+    sheet's width, right of the legend and at least 60 % of the way across."""
+    f = text_height(sheet)
+    legend = 7 * f + CHAR_WIDTH * 0.8 * f * max(len(text) for _, text in LEGEND)
+    return _nice_length(sheet.width / 4), max(0.6 * sheet.width, legend)
+
+
 def _degrees(lab: Label) -> float:
     """A label's direction as an angle, degrees counter-clockwise (y up)."""
     return math.degrees(math.atan2(lab.uy, lab.ux))
@@ -707,8 +715,8 @@ def dxf_bytes(sheet: StockSheet, *, title: str = "") -> bytes:
         msp.add_text(text, height=f * 0.8, dxfattribs={"layer": "LEGEND"}).set_placement(
             (f, -1.6 * f * (i + 1))
         )
-    bar = _nice_length(sheet.width / 4)
-    x0, y0 = 0.6 * sheet.width, -1.6 * f
+    bar, x0 = _scale_bar(sheet)
+    y0 = -1.6 * f
     msp.add_lwpolyline(
         [(x0, y0 + f / 2), (x0, y0), (x0 + bar, y0), (x0 + bar, y0 + f / 2)],
         dxfattribs={"layer": "LEGEND"},
@@ -734,6 +742,8 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
     w, h = sheet.width, sheet.height
     f = text_height(sheet)
     total = h + legend_height(sheet)
+    bar, x0 = _scale_bar(sheet)
+    wide = max(w, x0 + max(bar, 45 * CHAR_WIDTH * 0.8 * f))
 
     def path(ring: np.ndarray) -> str:
         pts = " L ".join(f"{x:.3f} {h - y:.3f}" for x, y in ring.tolist())
@@ -741,8 +751,8 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
 
     items = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.3f}mm" height="{total:.3f}mm" '
-        f'viewBox="0 0 {w:.3f} {total:.3f}">',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{wide:.3f}mm" height="{total:.3f}mm" '
+        f'viewBox="0 0 {wide:.3f} {total:.3f}">',
         f"<title>{escape(title)}</title>",
         f'<rect x="0" y="0" width="{w:.3f}" height="{h:.3f}" fill="none" stroke="#999" '
         'stroke-width="1"/>',
@@ -792,8 +802,7 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
         items.append(
             f'<text x="{5 * f:.2f}" y="{y:.2f}" dominant-baseline="middle">{escape(rest)}</text>'
         )
-    bar = _nice_length(w / 4)
-    x0, y0 = 0.6 * w, h + 1.6 * f * 2
+    y0 = h + 1.6 * f * 2
     items += [
         f'<path d="M {x0:.2f} {y0 - f / 2:.2f} V {y0:.2f} H {x0 + bar:.2f} V {y0 - f / 2:.2f}" '
         'fill="none" stroke="#333" stroke-width="1"/>',
