@@ -182,7 +182,8 @@ def test_new_fabricate_flags_reach_the_thick_panels(built):
     assert fab["mass_kg"] == pytest.approx(450.0 * fab["volume_m3"])
     assert fab["min_thickness_m"] == pytest.approx(0.005)
     sheets = sorted((out / "final" / "thick").glob("*_sheet_*.svg"))
-    assert sheets and all('width="3050.000mm" height="1525.000mm"' in p.read_text() for p in sheets)
+    stock = '<rect x="0" y="0" width="3050.000" height="1525.000"'  # the legend goes below
+    assert sheets and all(stock in p.read_text() for p in sheets)
     assert summary["options"]["fabricate"]["sheet"] == [3050.0, 1525.0]
 
 

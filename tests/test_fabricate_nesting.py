@@ -13,6 +13,7 @@ import shapely
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.cutsheets import (
+    Label,
     Part,
     _fit,
     nest,
@@ -30,7 +31,9 @@ def _part(k: int, ring) -> Part:
     smallest box like the panels' parts."""
     cut = shapely.Polygon(ring)
     c = cut.centroid
-    return _fit([Part(k, cut, shapely.Polygon(), ((c.x, c.y, f"E{k}"),), 0.0, 0.0)])[0]
+    return _fit(
+        [Part(k, cut, shapely.Polygon(), (Label(c.x, c.y, f"E{k}", 1.0, 0.0, 10.0),), 0.0, 0.0)]
+    )[0]
 
 
 def _signed(geometry) -> float:
@@ -60,7 +63,7 @@ def check_nesting(sheets, items, width=W, height=H, gap=GAP):
             assert a.cut.area == pytest.approx(a.part.cut.area, rel=1e-9)
             assert _signed(a.cut) == pytest.approx(_signed(a.part.cut), rel=1e-9)
             assert len(a.labels) == len(a.part.labels)
-            for (x, y, t), (u, v, s) in zip(a.labels, a.part.labels, strict=True):
+            for (x, y, t, *_), (u, v, s, *_) in zip(a.labels, a.part.labels, strict=True):
                 assert t == s
                 assert a.cut.distance(shapely.Point(x, y)) == pytest.approx(
                     a.part.cut.distance(shapely.Point(u, v)), abs=1e-6

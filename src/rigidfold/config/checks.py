@@ -297,6 +297,13 @@ class FabricateSettings(Group):
         "that are checked (2 degrees): the design file's motion frames when they are that "
         "fine, else the traced folding path sampled that finely.",
     )
+    frame_tol: float = setting(
+        1e-6,
+        "A design file's motion frames are used only as a rigid motion of the design from "
+        "flat: every panel's vertices within this share of the design's size (the diagonal "
+        "of its box) of their rigid motion, the last frame as close to the design, and the "
+        "first flat (``path_flat_tol``); else the folding path is traced.",
+    )
     subdivisions: int = setting(
         8,
         "Between two frames, the motion is halved at most this many times where the bound on "
@@ -327,6 +334,19 @@ class FabricateSettings(Group):
         "fewer sheets kept) where at most this many parts go on stock sheets: a bound on "
         "the time, which grows about as the parts times the sheets (each part is tried on "
         "every sheet so far; 163 parts on 5 sheets: 2-3 s).",
+    )
+    nest_pair_window: int = setting(
+        16,
+        "The cut sheets' pairing by boxes offers each part only to the parts that follow it "
+        "in the order of their convex hulls' longest sides, this many at most: the pairing "
+        "costs the parts times this, not the parts squared (before: every pair, 34 s and "
+        "343 MB for 242 triangles).",
+    )
+    progress_panels: int = setting(
+        200,
+        "``rigidfold fabricate`` (and ``generate --thickness``) prints a line on stderr as "
+        "each step that can take long begins (the path traced, the solids and their check, "
+        "a thinner try, the nesting, the files) for designs of at least this many panels.",
     )
     nest_gap_sides: int = setting(
         8,
@@ -365,9 +385,10 @@ class FabricateSettings(Group):
             )
         self._non_negative("clearance", "vertex_relief", "sheet_gap", "nest_margin")
         self._non_negative("nest_concavity")
-        self._positive("frame_step", "sheet_width", "sheet_height", "nest_round")
+        self._positive("frame_step", "frame_tol", "sheet_width", "sheet_height", "nest_round")
         self._fraction("min_depth", "trimmed_away")
         self._integer(relief_rounds=0, subdivisions=0, thickness_tries=0, nest_parts=0)
+        self._integer(nest_pair_window=1, progress_panels=0)
         self._integer(nest_gap_sides=4)
         if self.nest_gap_sides % 2:
             raise RigidfoldError(

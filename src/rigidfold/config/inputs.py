@@ -191,5 +191,21 @@ class LimitSettings(Group):
         "minutes and gigabytes listing runs that could never finish.",
     )
 
+    max_sheet_size: float = setting(
+        100_000.0,
+        "Largest width or height of a stock sheet for the cut sheets (``fabricate --sheet``), "
+        "millimetres (100 m): a larger one is refused in one line before the nesting, whose "
+        "coordinates would overflow (``--sheet 1e308x1e308``).",
+    )
+    max_fabricate_panels: int = setting(
+        5000,
+        "Largest number of panels ``rigidfold fabricate`` (and ``generate --thickness``) "
+        "builds thick: a larger design is refused in one line before its solids are built. "
+        "The solids, the check and the nesting grow about linearly with the panels (722 "
+        "panels: under a minute, ``benchmarks/bench_fabricate_scale.py``).",
+    )
+
     def __post_init__(self) -> None:
         self._integer(max_svg_depth=1, max_svg_pairs=1, max_svg_size=1, max_mesh_triangles=1)
+        self._integer(max_fabricate_panels=1)
+        self._positive("max_sheet_size")

@@ -81,35 +81,78 @@ undriven one (magenta)."""
 _LAYER = {layer.name: layer for layer in LAYERS}
 
 
+LABEL_FILL = 0.7
+"""Share of its crease's length a crease label may take on the whole-pattern sheet."""
+
+
 @dataclass(frozen=True)
 class Label:
     """A crease label: ``text`` centred at (x, y) mm, turned ``rotation`` degrees
-    counter-clockwise (y up), so that it reads along its crease, beside it."""
+    counter-clockwise (y up), so that it reads along its crease, beside it, ``size`` mm
+    high (0: the sheet's :attr:`~rigidfold.exports.sheet.Sheet.text_height`)."""
 
     text: str
     x: float
     y: float
     rotation: float
+    size: float = 0.0
 
 
 def crease_labels(sheet: Sheet) -> list[Label]:
     """One label per free crease (mountain, valley or flat): ``"E: +A°"`` with E the edge
-    index and A the fold angle in degrees, beside the crease's midpoint."""
-    h = sheet.text_height
-    labels = []
+    index and A the fold angle in degrees, beside the crease's midpoint, as large as
+    :data:`LABEL_FILL` of the crease's length allows (at least the sheet's text height, at
+    most twice it); labels that would overlap another are made smaller again (down to the
+    sheet's text height; overlaps are found with shapely's STRtree)."""
+    import shapely
+
+    least = sheet.text_height
+    rows = []
     for e in sheet.pattern.free_creases.tolist():
         u, v = sheet.pattern.edges[e]
         a, b = sheet.xy[u], sheet.xy[v]
+        text = f"{e}: {sheet.fold_angles_deg[e]:+.1f}°"
+        # as large as fits along the crease (0.6 em a character), never below the sheet's
+        h = max(least, min(LABEL_FILL * float(np.hypot(*(b - a))) / (0.6 * len(text)), 2 * least))
         rotation = math.degrees(math.atan2(b[1] - a[1], b[0] - a[0]))
         if rotation > 90:
             rotation -= 180
         elif rotation <= -90:
             rotation += 180
-        normal = np.array([-math.sin(math.radians(rotation)), math.cos(math.radians(rotation))])
-        x, y = (a + b) / 2 + 0.7 * h * normal
-        text = f"{e}: {sheet.fold_angles_deg[e]:+.1f}°"
-        labels.append(Label(text, float(x), float(y), rotation))
+        rows.append([text, (a + b) / 2, rotation, h])
+
+    def made() -> list[Label]:
+        out = []
+        for text, mid, rotation, h in rows:
+            turn = math.radians(rotation)
+            x, y = mid + 0.7 * h * np.array([-math.sin(turn), math.cos(turn)])
+            out.append(Label(text, float(x), float(y), rotation, h))
+        return out
+
+    labels = made()
+    for _ in range(6):
+        boxes = [_box(label) for label in labels]
+        first, second = shapely.STRtree(boxes).query(boxes, predicate="intersects")
+        crowded = {int(i) for i, j in zip(first, second, strict=True) if i != j}
+        crowded = {i for i in crowded if rows[i][3] > least}
+        if not crowded:
+            break
+        for i in crowded:
+            rows[i][3] = max(0.8 * rows[i][3], least)
+        labels = made()
     return labels
+
+
+def _box(label: Label):
+    """The rectangle a crease label covers (0.6 em a character), mm."""
+    import shapely
+
+    half = 0.3 * label.size * len(label.text)
+    turn = math.radians(label.rotation)
+    d = np.array([math.cos(turn), math.sin(turn)])
+    n = np.array([-d[1], d[0]]) * 0.5 * label.size
+    c = np.array([label.x, label.y])
+    return shapely.Polygon([c - half * d - n, c + half * d - n, c + half * d + n, c - half * d + n])
 
 
 # ------------------------------------------------------------------------------ DXF
@@ -134,7 +177,7 @@ def dxf_text(sheet: Sheet) -> str:
     for label in crease_labels(sheet):
         text = msp.add_text(
             label.text,
-            height=sheet.text_height,
+            height=label.size or sheet.text_height,
             rotation=label.rotation,
             dxfattribs={"layer": "LABELS"},
         )
@@ -215,8 +258,8 @@ def _drawing(sheet: Sheet, lw: float) -> list[str]:
     for label in crease_labels(sheet):
         x, y = _n(label.x), _n(sheet.height - label.y)
         out.append(
-            f'<text x="{x}" y="{y}" dy="0.35em" transform="rotate({-label.rotation:.3f} {x} {y})"'
-            f">{html.escape(label.text)}</text>"
+            f'<text x="{x}" y="{y}" dy="0.35em" font-size="{_n(label.size or sheet.text_height)}"'
+            f' transform="rotate({-label.rotation:.3f} {x} {y})">{html.escape(label.text)}</text>'
         )
     return [*out, "</g>", *_legend(sheet, lw)]
 

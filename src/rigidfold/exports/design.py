@@ -37,7 +37,7 @@ from rigidfold.exports.fold_os import write_origami_simulator_fold
 from rigidfold.exports.mesh3d import MESH_FORMATS, write_mesh
 from rigidfold.exports.schedule import write_schedule
 from rigidfold.exports.sheet import MARGIN_MM, layout_sheet
-from rigidfold.io import FoldData, crease_pattern_frames, prepare_output_dir, read_fold
+from rigidfold.io import DesignFrames, FoldData, prepare_output_dir, read_fold, read_frames
 from rigidfold.mesh import CreasePattern
 
 EXPORT_FORMATS = (*MESH_FORMATS, "dxf", "svg", "csv", "fold-os")
@@ -163,12 +163,16 @@ class Design:
         as rigidfold writes it) or ``"computed"`` (Step 8 run on reading).
     development : Development or None
         Step 8's result when the diagram was computed, else None.
+    frames : DesignFrames
+        The file's frames (:func:`rigidfold.io.read_frames`: its diagram and motion), read
+        once with the file.
     """
 
     data: FoldData
     coords2d: np.ndarray
     diagram: str
     development: Development | None
+    frames: DesignFrames | None = None
 
     @property
     def pattern(self) -> CreasePattern:
@@ -186,24 +190,12 @@ def read_design(path: str | os.PathLike, *, up: str = "z", settings: Settings = 
     computed diagram with non-finite coordinates.
     """
     data = read_fold(path, up=up, settings=settings)
-    for k in crease_pattern_frames(data.raw):
-        try:
-            flat = read_fold(data.raw, k, settings=settings).pattern
-        except ValueError:
-            continue
-        if _same_model(flat, data.pattern) and not flat.coords[:, 2].any():
-            return Design(data, flat.coords[:, :2].copy(), f"frame {k}", None)
+    frames = read_frames(data.raw, data.pattern.n_vertices, str(path))
+    if frames.diagram is not None:
+        return Design(data, frames.diagram.copy(), f"frame {frames.diagram_frame}", None, frames)
     development = develop(data.pattern, settings=settings)
     if not np.isfinite(development.coords2d).all():
         raise RigidfoldError(
             f"{path}: the development diagram could not be computed ({development.message})"
         )
-    return Design(data, development.coords2d, "computed", development)
-
-
-def _same_model(a: CreasePattern, b: CreasePattern) -> bool:
-    return (
-        a.n_vertices == b.n_vertices
-        and np.array_equal(a.edges, b.edges)
-        and np.array_equal(a.faces, b.faces)
-    )
+    return Design(data, development.coords2d, "computed", development, frames)

@@ -21,6 +21,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.collision import Clearance, check_clearance
 from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
+from rigidfold.fabricate.progress import check_size, step
 from rigidfold.fabricate.solids import Solids, bevel_angles, thicken
 from rigidfold.status import Outcome
 from rigidfold.structure.material import parse_material
@@ -172,6 +173,7 @@ def fabricate_panels(
     and ``density``: default from ``settings`` (``min_thickness``:
     ``fabricate_min_depth`` times the thickness). With ``search``, a failing thickness is
     followed by thinner tries (see the module's text)."""
+    check_size(panels.n, settings=settings)
     c, least, rho = fabrication_values(
         thickness,
         clearance_angle=clearance_angle,
@@ -185,8 +187,14 @@ def fabricate_panels(
     tries: list[tuple[float, str]] = []
     good, bad = None, thickness
     share = least / thickness
-    for _ in range(settings.fabricate.thickness_tries):
+    for k in range(settings.fabricate.thickness_tries):
         trial = bad / 2 if good is None else 0.5 * (good + bad)
+        step(
+            f"a thinner try, {trial * 1e3:.3g} mm ({k + 1} of "
+            f"{settings.fabricate.thickness_tries})",
+            panels.n,
+            settings=settings,
+        )
         got = _evaluate(panels, motion, trial, c, share * trial, rho, "", settings)
         tries.append((trial, got.status.value))
         if got.ok:
@@ -266,6 +274,13 @@ def _evaluate(
     relief = np.zeros(panels.pattern.n_vertices)
     relief[panels.relief_vertices] = settings.fabricate.vertex_relief * thickness
     rounds = 0
+    frames = 0 if motion is None else motion.n_frames
+    step(
+        f"solids of {panels.n} panels {thickness * 1e3:.3g} mm thick and their check over "
+        f"{frames} frames",
+        panels.n,
+        settings=settings,
+    )
     solids = thicken(panels, thickness, bevel, relief)
     around = [h for h, (a, b) in enumerate(solids.hinge_limits[1]) if a or b]
     if around:  # pieces reaching around a hinge's axis touch the neighbour at its ends
@@ -378,9 +393,11 @@ def parse_length(text: str, what: str = "thickness") -> float:
     return value
 
 
-def parse_sheet(text: str | tuple[float, float]) -> tuple[float, float]:
-    """(width, height) in mm from ``"2440x1220"`` or a (width, height) pair. Raises
-    ValueError naming what was received."""
+def parse_sheet(
+    text: str | tuple[float, float], *, settings: Settings = DEFAULTS
+) -> tuple[float, float]:
+    """(width, height) in mm from ``"2440x1220"`` or a (width, height) pair, each at most
+    ``settings.limits.max_sheet_size``. Raises ValueError naming what was received."""
     parts = str(text).lower().replace(" ", "").split("x") if isinstance(text, str) else text
     try:
         w, h = (float(x) for x in parts)
@@ -388,4 +405,10 @@ def parse_sheet(text: str | tuple[float, float]) -> tuple[float, float]:
         w = h = math.nan
     if not all(math.isfinite(x) and x > 0 for x in (w, h)):
         raise RigidfoldError(f"sheet must be WIDTHxHEIGHT in millimetres (2440x1220), got {text!r}")
+    most = settings.limits.max_sheet_size
+    if max(w, h) > most:
+        raise RigidfoldError(
+            f"sheet must be at most {most:g} mm each way (Settings.limits.max_sheet_size), "
+            f"got {text!r}"
+        )
     return w, h

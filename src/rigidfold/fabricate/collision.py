@@ -205,6 +205,37 @@ class _Pair:
         return np.asarray(out, dtype=np.int64).reshape(-1, 2)
 
 
+def _near_pairs(solids: Solids, motion: PanelMotion, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """(a (n,), b (n,)), a < b: the pairs of solids whose bounding spheres come within
+    ``reach`` of each other over some interval of the motion, by the bound of
+    :meth:`_GapCheck._prefilter` made the same for every pair (the largest radius and
+    move), found at each frame with a k-d tree (``scipy.spatial.cKDTree.query_pairs``):
+    about the solids times the frames times log the solids, never every pair. Every pair
+    it leaves out is proven at least ``reach`` apart over the whole motion."""
+    from scipy.spatial import cKDTree
+
+    n, k = solids.panels.n, motion.n_frames
+    if n < 2 or k == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    centres = np.einsum("kpij,pj->kpi", motion.rotations, solids.centres) + motion.translations
+    r = float(solids.radii.max(initial=0.0))
+    if k > 1:
+        turn = np.linalg.norm(_turn(motion.rotations[:-1], motion.rotations[1:]), axis=-1)
+        moved = np.linalg.norm(np.diff(centres, axis=0), axis=2)
+        eps = _move_bound(moved, turn, solids.radii[None]).max(axis=1)  # (K - 1,)
+        around = np.maximum(np.concatenate([eps, eps[-1:]]), np.concatenate([eps[:1], eps]))
+    else:
+        around = np.zeros(1)
+    found = set()
+    for i in range(k):
+        tree = cKDTree(centres[i])
+        found |= tree.query_pairs(2 * r + 2 * float(around[i]) + reach)
+    if not found:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    pairs = np.array(sorted(found), dtype=np.int64)
+    return pairs[:, 0], pairs[:, 1]
+
+
 def _relative(motion: PanelMotion, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(rot (K, n, 3, 3), shift (K, n, 3)): solid b seen from solid a (in a's design place) at
     every frame, for pairs a, b (n,)."""
@@ -309,11 +340,15 @@ class _GapCheck:
         self.min_gap, self.min_panels, self.min_fraction = math.inf, (-1, -1), math.nan
         panels = solids.panels
         n = panels.n
-        joined = np.zeros((n, n), dtype=bool)
+        ia, ib = _near_pairs(solids, motion, clearance + solids.thickness)
+        keys = ia * n + ib
         if len(panels.neighbours):
-            joined[panels.neighbours[:, 0], panels.neighbours[:, 1]] = True
-        ia, ib = np.triu_indices(n, 1)
-        keep = ~joined[ia, ib] & (solids.radii[ia] > 0) & (solids.radii[ib] > 0)
+            a, b = np.sort(panels.neighbours, axis=1).T
+            keys_joined = a.astype(np.int64) * n + b
+        else:
+            keys_joined = np.zeros(0, dtype=np.int64)
+        self.left_out = len(ia) < n * (n - 1) // 2
+        keep = ~np.isin(keys, keys_joined) & (solids.radii[ia] > 0) & (solids.radii[ib] > 0)
         pairs = [_Pair(int(a), int(b)) for a, b in zip(ia[keep], ib[keep], strict=True)]
         for h, (wrap_a, wrap_b) in enumerate(solids.hinge_limits[1]):
             if wrap_a or wrap_b:
@@ -322,7 +357,8 @@ class _GapCheck:
         self.pairs = pairs
         self.ia = np.asarray([q.a for q in pairs], dtype=np.int64)
         self.ib = np.asarray([q.b for q in pairs], dtype=np.int64)
-        self.bound = math.inf
+        # the pairs never near (:func:`_near_pairs`) are at least this far apart
+        self.bound = clearance + solids.thickness if self.left_out else math.inf
         if len(self.ia):
             self._run()
 
@@ -356,7 +392,7 @@ class _GapCheck:
             proven = lower
         near = (proven < self.clearance + solids.thickness).any(axis=0)
         far = proven[:, ~near]
-        self.bound = float(far.min()) if far.size else math.inf
+        self.bound = min(self.bound, float(far.min()) if far.size else math.inf)
         self.pairs = [q for q, keep in zip(self.pairs, near, strict=True) if keep]
         self.ia, self.ib = ia[near], ib[near]
 

@@ -27,23 +27,24 @@ reported (``oversize``) either way.
 
 from __future__ import annotations
 
-import itertools
 import math
 import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import shapely
 import shapely.errors
 import shapely.geometry
+import shapely.ops
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import min_area_angle
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import atomic_write
+from rigidfold.io.files import write_together
 
 MM = 1000.0
 
@@ -52,20 +53,111 @@ SHEET_FILE = r"{}_(?:sheet|oversize)_[0-9]{{2,}}\.(?:dxf|svg)"
 name, escaped): ``NAME_sheet_NN`` and ``NAME_oversize_NN``, ``.dxf`` and ``.svg``."""
 
 
+class Label(NamedTuple):
+    """A bevelled edge's label on a part, mm: ``text`` centred at (x, y), reading along the
+    unit direction (ux, uy) (the edge's, turned so that it never reads upside down),
+    ``size`` high (fitted to the edge's length and kept off the other labels)."""
+
+    x: float
+    y: float
+    text: str
+    ux: float
+    uy: float
+    size: float
+
+
+LABEL_SIZE = 10.0
+"""Largest height of an edge label on a nested sheet, mm (the panel numbers: twice it)."""
+
+LABEL_LEAST = 2.0
+"""Smallest height of an edge label, mm: a label on a shorter edge overhangs it."""
+
+CHAR_WIDTH = 0.62
+"""Width of a character of the labels' sans-serif font, in text heights (an estimate that
+errs wide, used to keep labels apart)."""
+
+
+def _labels_moved(labels, matrix: np.ndarray, offset) -> tuple[Label, ...]:
+    """``labels`` with every point p (row) taken to ``p @ matrix + offset`` and every
+    direction to ``d @ matrix`` (turned back where it would read upside down)."""
+    out = []
+    for lab in labels:
+        q = np.array([lab.x, lab.y]) @ matrix + offset
+        d = np.array([lab.ux, lab.uy]) @ matrix
+        if d[0] < -1e-9 or (abs(d[0]) <= 1e-9 and d[1] < 0):
+            d = -d
+        out.append(Label(float(q[0]), float(q[1]), lab.text, float(d[0]), float(d[1]), lab.size))
+    return tuple(out)
+
+
+def _label_box(lab: Label) -> shapely.Geometry:
+    """The rectangle a label covers (its estimated width x its height), mm."""
+    half = 0.5 * CHAR_WIDTH * lab.size * len(lab.text)
+    d = np.array([lab.ux, lab.uy])
+    n = np.array([-d[1], d[0]]) * 0.5 * lab.size
+    c = np.array([lab.x, lab.y])
+    return shapely.Polygon([c - half * d - n, c + half * d - n, c + half * d + n, c - half * d + n])
+
+
+def _edge_labels(centre: np.ndarray, edges, texts, keep_off: shapely.Geometry) -> tuple[Label, ...]:
+    """The labels ``texts`` of the edges ``edges`` ((a, b) points, mm, in a part's own
+    frame; ``centre``: a point inside it), each along its edge, inside the part, as high as
+    :data:`LABEL_SIZE` and the edge's length allow; labels that would overlap each other or
+    ``keep_off`` (the panel's number) are made smaller together (down to
+    :data:`LABEL_LEAST`) and then, where they still do, moved further inside."""
+    labels = []
+    for (a, b), text in zip(edges, texts, strict=True):
+        d = b - a
+        length = float(np.hypot(*d))
+        if length <= 0:
+            continue
+        d = d / length
+        n = np.array([-d[1], d[0]])
+        if (centre - a) @ n < 0:
+            n = -n
+        size = min(LABEL_SIZE, 0.8 * length / (CHAR_WIDTH * len(text)))
+        size = max(size, LABEL_LEAST)
+        labels.append([a, b, d, n, text, size, 0.9])
+    for _ in range(8):
+        made = []
+        for a, b, d, n, text, size, depth in labels:
+            at = 0.5 * (a + b) + depth * size * n
+            made.append(Label(float(at[0]), float(at[1]), text, float(d[0]), float(d[1]), size))
+        made = list(_labels_moved(made, np.eye(2), (0.0, 0.0)))
+        boxes = [_label_box(lab) for lab in made]
+        crowded = {
+            i
+            for i in range(len(boxes))
+            for j in range(len(boxes))
+            if i != j and boxes[i].intersects(boxes[j])
+        } | {i for i, box in enumerate(boxes) if box.intersects(keep_off)}
+        if not crowded:
+            break
+        for i in crowded:
+            if labels[i][5] > LABEL_LEAST:
+                labels[i][5] = max(0.8 * labels[i][5], LABEL_LEAST)
+            else:
+                labels[i][6] += 1.2
+    return tuple(made) if labels else ()
+
+
 @dataclass(frozen=True, eq=False)
 class Part:
     """One panel drawn flat, millimetres, its bounding box starting at (0, 0).
 
     panel : int; cut : shapely geometry of the surface face; far : of the far face (may be
-    empty); labels : ((x, y, text), ...) of the bevelled edges; width, height : its box.
+    empty); labels : a :class:`Label` of each bevelled edge; width, height : its box;
+    mark : the panel's number ``P K`` (drawn level on the sheet, at its point, its size),
+    None for an empty part.
     """
 
     panel: int
     cut: shapely.Geometry
     far: shapely.Geometry
-    labels: tuple[tuple[float, float, str], ...]
+    labels: tuple[Label, ...]
     width: float
     height: float
+    mark: Label | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,7 +167,7 @@ class Placed:
     part: Part
     cut: shapely.Geometry
     far: shapely.Geometry
-    labels: tuple[tuple[float, float, str], ...]
+    labels: tuple[Label, ...]
     centre: tuple[float, float]
 
 
@@ -114,7 +206,35 @@ def _faces_at(fab: Fabrication, k: int, depth: float, origin, a1, a2) -> shapely
         return shapely.Polygon()
     xy = np.column_stack([(verts - origin) @ a1, (verts - origin) @ a2]) * MM
     polys = shapely.polygons(xy[tris[on]])
-    return shapely.union_all(polys, grid_size=1e-6).buffer(0)
+    return outline(shapely.union_all(polys, grid_size=OUTLINE_GRID), OUTLINE_CLOSE)
+
+
+OUTLINE_GRID = 1e-4
+"""The grid (mm) the triangles of a face are snapped to before their union."""
+
+OUTLINE_CLOSE = 1e-2
+"""Cracks narrower than twice this (mm) between a face's triangles are closed: the solid's
+mesh has vertices on its triangles' edges (T-junctions), which leave slits of about 1e-6 mm
+between the triangles' union that a cutter would follow into the panel."""
+
+
+def outline(face: shapely.Geometry, close: float = OUTLINE_CLOSE) -> shapely.Geometry:
+    """One face of a solid drawn flat as one simple polygon without holes (mm): ``face``
+    closed morphologically by ``close`` mm (grown, then shrunk by it with mitred corners,
+    so that the slits between its triangles close and its corners stay sharp), and of what
+    is left the largest polygon's outer ring (the pieces and holes left are slivers of the
+    mesh's rounding: a panel is one piece without holes); empty for an empty face."""
+    if face.is_empty:
+        return shapely.Polygon()
+    closed = face.buffer(close, join_style="mitre", mitre_limit=10.0).buffer(
+        -close, join_style="mitre", mitre_limit=10.0
+    )
+    pieces = [g for g in getattr(closed, "geoms", [closed]) if g.geom_type == "Polygon"]
+    if not pieces:
+        return shapely.Polygon()
+    largest = max(pieces, key=lambda g: g.area)
+    ring = shapely.Polygon(largest.exterior).simplify(OUTLINE_GRID)
+    return shapely.geometry.polygon.orient(ring, 1.0)
 
 
 def parts(fab: Fabrication) -> list[Part]:
@@ -125,17 +245,39 @@ def parts(fab: Fabrication) -> list[Part]:
         origin, a1, a2 = _frame(fab, k)
         cut = _faces_at(fab, k, 0.0, origin, a1, a2)
         far = _faces_at(fab, k, s.thickness, origin, a1, a2)
-        labels = []
+        flat = (p.pattern.coords - origin) @ np.column_stack([a1, a2]) * MM
+        edges, texts = [], []
         for h in p.hinges_of[k].tolist():
             u, v = p.hinge_vertices[h].tolist()
-            mid = 0.5 * (p.pattern.coords[u] + p.pattern.coords[v]) - origin
-            inward = p.pattern.coords[p.vertices[k]].mean(axis=0) - origin - mid
-            at = mid + 0.15 * inward
-            text = f"E{int(p.hinge_edges[h])} {math.degrees(s.bevel[h]):.1f}°"
-            labels.append((float(at @ a1) * MM, float(at @ a2) * MM, text))
-        part = Part(k, cut, far, tuple(labels), 0.0, 0.0)
+            edges.append((flat[u], flat[v]))
+            texts.append(f"E{int(p.hinge_edges[h])} {math.degrees(s.bevel[h]):.1f}°")
+        mark = _mark(cut, f"P{k}")
+        keep_off = (
+            shapely.Point(mark.x, mark.y).buffer(0.5 * CHAR_WIDTH * mark.size * len(mark.text))
+            if mark is not None
+            else shapely.Polygon()
+        )
+        inside = np.array([mark.x, mark.y]) if mark is not None else np.zeros(2)
+        labels = _edge_labels(inside, edges, texts, keep_off)
+        part = Part(k, cut, far, labels, 0.0, 0.0, mark)
         out.append(part if cut.is_empty else _fit([part])[0])
     return out
+
+
+def _mark(cut: shapely.Geometry, text: str) -> Label | None:
+    """A part's number ``text`` at the point of ``cut`` farthest from its outline (shapely's
+    ``polylabel``), as high as :data:`LABEL_SIZE` twice, less where the part is small; None
+    for an empty part."""
+    if cut.is_empty or cut.geom_type != "Polygon":
+        return None
+    at = shapely.ops.polylabel(cut, tolerance=max(1e-3, 0.01 * math.sqrt(cut.area)))
+    room = cut.exterior.distance(at)
+    size = min(2 * LABEL_SIZE, 0.25 * math.sqrt(cut.area), 1.6 * room / (CHAR_WIDTH * len(text)))
+    return Label(float(at.x), float(at.y), text, 1.0, 0.0, max(size, LABEL_LEAST))
+
+
+def _mark_moved(mark: Label | None, matrix: np.ndarray, offset) -> Label | None:
+    return None if mark is None else _labels_moved((mark,), matrix, offset)[0]
 
 
 def _fit(members: list[Part]) -> list[Part]:
@@ -154,10 +296,7 @@ def _fit(members: list[Part]) -> list[Part]:
     shift = -np.array([x0, y0])
     out = []
     for m in members:
-        labels = tuple(
-            (float(q[0]), float(q[1]), t)
-            for q, t in ((np.array([x, y]) @ turn + shift, t) for x, y, t in m.labels)
-        )
+        labels = _labels_moved(m.labels, turn, shift)
         out.append(
             Part(
                 m.panel,
@@ -166,6 +305,7 @@ def _fit(members: list[Part]) -> list[Part]:
                 labels,
                 float(x1 - x0),
                 float(y1 - y0),
+                _mark_moved(m.mark, turn, shift),
             )
         )
     return out
@@ -204,22 +344,63 @@ def _joined(
             second.panel,
             _moved(second.cut, turn, shift),
             _moved(second.far, turn, shift),
-            tuple(
-                (float(q[0]), float(q[1]), t)
-                for q, t in ((np.array([x, y]) @ turn + shift, t) for x, y, t in second.labels)
-            ),
+            _labels_moved(second.labels, turn, shift),
             0.0,
             0.0,
+            _mark_moved(second.mark, turn, shift),
         )
         out.append(_fit([first, moved]))
     return out
 
 
-def group(items: list[Part], width: float, height: float, gap: float) -> list[list[Part]]:
+def _box_of(ring: np.ndarray) -> tuple[float, float]:
+    """(longer, shorter) side of the smallest bounding rectangle of the points ``ring``
+    (n, 2), as :func:`_fit` turns a part to it."""
+    angle = min_area_angle(ring)
+    c, sn = math.cos(angle), math.sin(angle)
+    xy = ring @ np.array([[c, sn], [-sn, c]])
+    w, h = np.ptp(xy, axis=0)
+    return float(max(w, h)), float(min(w, h))
+
+
+def _joined_boxes(
+    first: np.ndarray,
+    second: np.ndarray,
+    gap: float,
+    sides: tuple[tuple[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray, float]],
+) -> list[tuple[float, float]]:
+    """The boxes of the two pairs :func:`_joined` makes of parts of hull points ``first``
+    and ``second`` (n, 2), computed on those points alone (the same turns and shifts)."""
+    (a, b, _), (c, d, _) = sides
+    e = (b - a) / np.linalg.norm(b - a)
+    normal = np.array([e[1], -e[0]])
+    angle = math.atan2(*(a - b)[::-1]) - math.atan2(*(d - c)[::-1])
+    co, si = math.cos(angle), math.sin(angle)
+    turn = np.array([[co, si], [-si, co]])
+    out = []
+    for anchor, point in ((b, c), (a, d)):
+        shift = anchor + gap * normal - point @ turn
+        out.append(_box_of(np.vstack([first, second @ turn + shift])))
+    return out
+
+
+def group(
+    items: list[Part],
+    width: float,
+    height: float,
+    gap: float,
+    *,
+    window: int = DEFAULTS.fabricate.nest_pair_window,
+) -> list[list[Part]]:
     """The parts in groups of one or two to be packed as one box each: two parts whose
     hulls' longest sides are within a fifth of each other's length are joined along them
     (:func:`_joined`) where that saves box area (with the gap) and still fits the stock,
-    the largest savings first; the rest alone."""
+    the largest savings first; the rest alone.
+
+    Only the ``window`` parts that follow a part in the order of those sides are offered
+    to it (parts of about one length lie next to each other there), and an offer keeps its
+    saving alone, the pair built again when it is taken: time and memory grow as the
+    parts times ``window``, not as the parts squared."""
 
     def box(w: float, h: float) -> float:
         return (w + gap) * (h + gap)
@@ -231,26 +412,32 @@ def group(items: list[Part], width: float, height: float, gap: float) -> list[li
 
     live = [p for p in items if not p.cut.is_empty]
     longest = [_longest_side(p.cut) for p in live]
-    sides = [x[2] for x in longest]
+    hulls = [np.asarray(shapely.get_coordinates(shapely.convex_hull(p.cut))) for p in live]
+    sides = np.array([x[2] for x in longest], dtype=np.float64)
     alone_fits = [fits(p.width, p.height) for p in live]
-    offers = []
-    for i, j in itertools.combinations(range(len(live)), 2):
-        if abs(sides[i] - sides[j]) > 0.2 * max(sides[i], sides[j]) or not (
-            alone_fits[i] and alone_fits[j]
-        ):
+    order = np.argsort(sides, kind="stable")
+    offers: list[tuple[float, int, int, int]] = []
+    for at, i in enumerate(order.tolist()):
+        if not alone_fits[i]:
             continue
-        alone = box(live[i].width, live[i].height) + box(live[j].width, live[j].height)
-        for pair in _joined(live[i], live[j], gap, (longest[i], longest[j])):
-            w, h = pair[0].width, pair[0].height
-            if fits(w, h) and box(w, h) < alone:
-                offers.append((box(w, h) - alone, i, j, pair))
-    offers.sort(key=lambda o: (o[0], o[1], o[2]))
+        for j in order[at + 1 : at + 1 + window].tolist():
+            if sides[j] - sides[i] > 0.2 * max(sides[i], sides[j]):
+                break
+            if not alone_fits[j]:
+                continue
+            a, b = min(i, j), max(i, j)
+            alone = box(live[a].width, live[a].height) + box(live[b].width, live[b].height)
+            both = _joined_boxes(hulls[a], hulls[b], gap, (longest[a], longest[b]))
+            for way, (w, h) in enumerate(both):
+                if fits(w, h) and box(w, h) < alone:
+                    offers.append((box(w, h) - alone, a, b, way))
+    offers.sort()
     used: set[int] = set()
     groups = []
-    for _, i, j, pair in offers:
+    for _, i, j, way in offers:
         if i not in used and j not in used:
             used |= {i, j}
-            groups.append(pair)
+            groups.append(_joined(live[i], live[j], gap, (longest[i], longest[j]))[way])
     groups += [[p] for k, p in enumerate(live) if k not in used]
     return groups
 
@@ -268,7 +455,7 @@ def nest(
     and by their outlines (:func:`nest_by_outlines`, up to ``fabricate_nest_parts`` parts),
     the one on fewer stock sheets kept, then the one that uses less of the last sheet's
     width, the boxes where both are alike. Parts with an empty outline are left out."""
-    boxes = nest_boxes(items, width, height, gap)
+    boxes = nest_boxes(items, width, height, gap, settings=settings)
     stock = [s for s in boxes if not s.oversize]
     panels = {p.part.panel for s in stock for p in s.parts}
     on_stock = [p for p in items if p.panel in panels]  # each in its own frame, not its pair's
@@ -313,7 +500,14 @@ def nest_by_outlines(
     return [StockSheet(width, height, tuple(placed[b]), nesting="outlines") for b in sorted(placed)]
 
 
-def nest_boxes(items: list[Part], width: float, height: float, gap: float) -> list[StockSheet]:
+def nest_boxes(
+    items: list[Part],
+    width: float,
+    height: float,
+    gap: float,
+    *,
+    settings: Settings = DEFAULTS,
+) -> list[StockSheet]:
     """Pack ``items`` by their boxes (their pairs' boxes, :func:`group`) onto stock sheets
     ``width`` x ``height`` mm with ``gap`` mm between parts and from the edges, by
     ``rectpack`` (:func:`_pack`); a part larger than the stock on an oversize sheet of its
@@ -321,7 +515,9 @@ def nest_boxes(items: list[Part], width: float, height: float, gap: float) -> li
     inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
     boxes: dict[int, tuple[int, int, list[Part]]] = {}
     oversize = []
-    for g, members in enumerate(group(items, width, height, gap)):
+    for g, members in enumerate(
+        group(items, width, height, gap, window=settings.fabricate.nest_pair_window)
+    ):
         first = members[0]
         w = math.ceil(first.width + gap)
         h = math.ceil(first.height + gap)
@@ -411,11 +607,9 @@ def _placed(part: Part, matrix: np.ndarray | None, offset: tuple[float, float]) 
     m = np.eye(2) if matrix is None else np.asarray(matrix, dtype=np.float64)
     cut = _moved(part.cut, m, offset)
     far = _moved(part.far, m, offset)
-    moved = tuple(
-        (float(q[0]), float(q[1]), t)
-        for q, t in ((np.array([lx, ly]) @ m + offset, t) for lx, ly, t in part.labels)
-    )
-    c = cut.representative_point()
+    moved = _labels_moved(part.labels, m, offset)
+    mark = _mark_moved(part.mark, m, offset)
+    c = cut.representative_point() if mark is None else shapely.Point(mark.x, mark.y)
     return Placed(part, cut, far, moved, (float(c.x), float(c.y)))
 
 
@@ -431,43 +625,108 @@ def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
 
 
 def text_height(sheet: StockSheet) -> float:
+    """Height of the legend's text below a sheet, mm."""
     return max(min(sheet.width, sheet.height) / 60.0, 5.0)
 
 
+def panel_text_height(placed: Placed) -> float:
+    """Height of a part's number ``P K`` (:func:`_mark`), mm."""
+    mark = placed.part.mark
+    return 2 * LABEL_SIZE if mark is None else mark.size
+
+
+LEGEND = (
+    ("cut", "cut line: the panel's face on the design surface, cut through the sheet"),
+    ("far", "far face: where the bevels and reliefs end (bevel from the cut line to it)"),
+    ("panel", "P12: panel 12 (panel_12 of the 3D files, the schedules)"),
+    ("edge", "E34 64.2°: hinge of crease 34, bevel 64.2° between bevel and surface"),
+    ("", "(tilt the saw blade by 90° minus the bevel); all lengths in mm at 1:1"),
+)
+"""The rows of the legend below a nested sheet: (sample, text)."""
+
+
+def legend_height(sheet: StockSheet) -> float:
+    """Height of the band below a sheet that holds its legend and scale bar, mm."""
+    return (1.6 * (len(LEGEND) + 1)) * text_height(sheet)
+
+
+def _nice_length(limit: float) -> float:
+    """The largest 1, 2 or 5 times a power of ten that is at most ``limit`` (> 0), mm."""
+    power = 10.0 ** math.floor(math.log10(limit))
+    return max(m * power for m in (1, 2, 5) if m * power <= limit)
+
+
+def _scale_bar(sheet: StockSheet) -> tuple[float, float]:
+    """(length, left end) of a sheet's scale bar, mm: a round length near a quarter of the
+    sheet's width, right of the legend and at least 60 % of the way across."""
+    f = text_height(sheet)
+    legend = 7 * f + CHAR_WIDTH * 0.8 * f * max(len(text) for _, text in LEGEND)
+    return _nice_length(sheet.width / 4), max(0.6 * sheet.width, legend)
+
+
+def _degrees(lab: Label) -> float:
+    """A label's direction as an angle, degrees counter-clockwise (y up)."""
+    return math.degrees(math.atan2(lab.uy, lab.ux))
+
+
 def dxf_bytes(sheet: StockSheet, *, title: str = "") -> bytes:
-    """One stock sheet as DXF (R2010, mm): layers SHEET, CUT, BEVEL, LABELS."""
+    """One stock sheet as DXF (R2010, mm): layers SHEET, CUT, BEVEL, LABELS, and LEGEND (the
+    legend and a scale bar below the sheet)."""
     import io
 
     import ezdxf
     from ezdxf import units
+    from ezdxf.enums import TextEntityAlignment
 
     doc = ezdxf.new("R2010", setup=True)
     doc.units = units.MM
     doc.header["$INSUNITS"] = units.MM
-    for name, colour in (("SHEET", 8), ("CUT", 7), ("BEVEL", 1), ("LABELS", 5)):
+    for name, colour in (("SHEET", 8), ("CUT", 7), ("BEVEL", 1), ("LABELS", 5), ("LEGEND", 8)):
         doc.layers.add(name, color=colour)
+    doc.linetypes.add("DASHED2", pattern=[6.0, 4.0, -2.0], description="- - -")
     msp = doc.modelspace()
     msp.add_lwpolyline(
         [(0, 0), (sheet.width, 0), (sheet.width, sheet.height), (0, sheet.height)],
         close=True,
         dxfattribs={"layer": "SHEET"},
     )
-    size = text_height(sheet)
+    centre = TextEntityAlignment.MIDDLE_CENTER
     for placed in sheet.parts:
         for ring in _rings(placed.cut):
             msp.add_lwpolyline(ring.tolist(), close=True, dxfattribs={"layer": "CUT"})
         for ring in _rings(placed.far):
-            msp.add_lwpolyline(ring.tolist(), close=True, dxfattribs={"layer": "BEVEL"})
-        msp.add_text(
-            f"P{placed.part.panel}", height=size, dxfattribs={"layer": "LABELS"}
-        ).set_placement(placed.centre, align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
-        for x, y, text in placed.labels:
-            msp.add_text(text, height=size * 0.5, dxfattribs={"layer": "LABELS"}).set_placement(
-                (x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER
+            msp.add_lwpolyline(
+                ring.tolist(), close=True, dxfattribs={"layer": "BEVEL", "linetype": "DASHED2"}
             )
+        msp.add_text(
+            f"P{placed.part.panel}",
+            height=panel_text_height(placed),
+            dxfattribs={"layer": "LABELS"},
+        ).set_placement(placed.centre, align=centre)
+        for lab in placed.labels:
+            msp.add_text(
+                lab.text,
+                height=lab.size,
+                rotation=_degrees(lab),
+                dxfattribs={"layer": "LABELS"},
+            ).set_placement((lab.x, lab.y), align=centre)
+    f = text_height(sheet)
+    for i, (_, text) in enumerate(LEGEND):
+        msp.add_text(text, height=f * 0.8, dxfattribs={"layer": "LEGEND"}).set_placement(
+            (f, -1.6 * f * (i + 1))
+        )
+    bar, x0 = _scale_bar(sheet)
+    y0 = -1.6 * f
+    msp.add_lwpolyline(
+        [(x0, y0 + f / 2), (x0, y0), (x0 + bar, y0), (x0 + bar, y0 + f / 2)],
+        dxfattribs={"layer": "LEGEND"},
+    )
+    msp.add_text(f"{bar:g} mm", height=f * 0.8, dxfattribs={"layer": "LEGEND"}).set_placement(
+        (x0 + bar / 2, y0 - f), align=centre
+    )
     if title:
-        msp.add_text(title, height=size * 0.5, dxfattribs={"layer": "LABELS"}).set_placement(
-            (size, sheet.height - size)
+        msp.add_text(title, height=f * 0.5, dxfattribs={"layer": "LABELS"}).set_placement(
+            (f, sheet.height - f)
         )
     out = io.StringIO()
     doc.write(out)
@@ -476,11 +735,15 @@ def dxf_bytes(sheet: StockSheet, *, title: str = "") -> bytes:
 
 def svg_text(sheet: StockSheet, *, title: str = "") -> str:
     """One stock sheet as SVG at 1:1 in mm (y up in the drawing's numbers, flipped for
-    SVG): the sheet in grey, cut lines black, far-face lines red, labels blue."""
+    SVG): the sheet in grey, cut lines black, far-face lines red and dashed, labels blue
+    (each edge's along its edge), and below the sheet a legend and a scale bar."""
     from xml.sax.saxutils import escape
 
     w, h = sheet.width, sheet.height
-    size = text_height(sheet)
+    f = text_height(sheet)
+    total = h + legend_height(sheet)
+    bar, x0 = _scale_bar(sheet)
+    wide = max(w, x0 + max(bar, 45 * CHAR_WIDTH * 0.8 * f))
 
     def path(ring: np.ndarray) -> str:
         pts = " L ".join(f"{x:.3f} {h - y:.3f}" for x, y in ring.tolist())
@@ -488,12 +751,13 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
 
     items = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.3f}mm" height="{h:.3f}mm" '
-        f'viewBox="0 0 {w:.3f} {h:.3f}">',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{wide:.3f}mm" height="{total:.3f}mm" '
+        f'viewBox="0 0 {wide:.3f} {total:.3f}">',
         f"<title>{escape(title)}</title>",
         f'<rect x="0" y="0" width="{w:.3f}" height="{h:.3f}" fill="none" stroke="#999" '
         'stroke-width="1"/>',
     ]
+    font = 'font-family="sans-serif" fill="#1f3fbf" text-anchor="middle"'
     for placed in sheet.parts:
         cut = " ".join(path(r) for r in _rings(placed.cut))
         far = " ".join(path(r) for r in _rings(placed.far))
@@ -507,16 +771,82 @@ def svg_text(sheet: StockSheet, *, title: str = "") -> str:
             )
         cx, cy = placed.centre
         items.append(
-            f'<text x="{cx:.2f}" y="{h - cy:.2f}" font-size="{size:.2f}" fill="#1f3fbf" '
-            f'text-anchor="middle" dominant-baseline="middle">P{placed.part.panel}</text>'
+            f'<text x="{cx:.2f}" y="{h - cy:.2f}" font-size="{panel_text_height(placed):.2f}" '
+            f'{font} dominant-baseline="middle">P{placed.part.panel}</text>'
         )
-        for x, y, text in placed.labels:
+        for lab in placed.labels:
+            x, y = lab.x, h - lab.y
             items.append(
-                f'<text x="{x:.2f}" y="{h - y:.2f}" font-size="{size * 0.5:.2f}" '
-                f'fill="#1f3fbf" text-anchor="middle">{escape(text)}</text>'
+                f'<text x="{x:.2f}" y="{y:.2f}" font-size="{lab.size:.2f}" {font} '
+                f'dominant-baseline="middle" transform="rotate({-_degrees(lab):.2f} {x:.2f} '
+                f'{y:.2f})">{escape(lab.text)}</text>'
             )
+    samples = {
+        "cut": 'stroke="#000" stroke-width="0.5"',
+        "far": 'stroke="#d62728" stroke-width="0.4" stroke-dasharray="4 2"',
+    }
+    items.append(f'<g id="LEGEND" font-family="sans-serif" font-size="{0.8 * f:.2f}">')
+    for i, (sample, text) in enumerate(LEGEND):
+        y = h + 1.6 * f * (i + 1)
+        if sample in samples:
+            items.append(
+                f'<line x1="{f:.2f}" y1="{y:.2f}" x2="{4 * f:.2f}" y2="{y:.2f}" {samples[sample]}/>'
+            )
+        label = escape(text.split(": ", 1)[0]) if sample in ("panel", "edge") else ""
+        if label:
+            items.append(
+                f'<text x="{2.5 * f:.2f}" y="{y:.2f}" fill="#1f3fbf" text-anchor="middle" '
+                f'dominant-baseline="middle">{label}</text>'
+            )
+        rest = text.split(": ", 1)[1] if label else text
+        items.append(
+            f'<text x="{5 * f:.2f}" y="{y:.2f}" dominant-baseline="middle">{escape(rest)}</text>'
+        )
+    y0 = h + 1.6 * f * 2
+    items += [
+        f'<path d="M {x0:.2f} {y0 - f / 2:.2f} V {y0:.2f} H {x0 + bar:.2f} V {y0 - f / 2:.2f}" '
+        'fill="none" stroke="#333" stroke-width="1"/>',
+        f'<text x="{x0 + bar / 2:.2f}" y="{y0 + 1.2 * f:.2f}" text-anchor="middle" '
+        f'dominant-baseline="middle">{bar:g} mm</text>',
+        f'<text x="{x0:.2f}" y="{y0 + 2.8 * f:.2f}" dominant-baseline="middle">'
+        f"stock sheet {w:.0f} x {h:.0f} mm, scale 1:1</text>",
+        "</g>",
+    ]
     items.append("</svg>")
     return "\n".join(items) + "\n"
+
+
+def cut_sheet_data(
+    fab: Fabrication,
+    out: Path,
+    name: str,
+    *,
+    width: float,
+    height: float,
+    gap: float,
+    title: str = "",
+    settings: Settings = DEFAULTS,
+) -> tuple[list[tuple[Path, str | bytes]], list[StockSheet]]:
+    """Nest the panels onto ``width`` x ``height`` mm stock (:func:`nest`): the files
+    ``NAME_sheet_NN.dxf`` and ``.svg`` per sheet (``NAME_oversize_NN`` for a part larger
+    than the stock) as (path in ``out``, data), and the sheets."""
+    from rigidfold.fabricate.progress import step
+
+    step(f"nesting the cut sheets of {fab.panels.n} panels", fab.panels.n, settings=settings)
+    sheets = nest(parts(fab), width, height, gap, settings=settings)
+    files: list[tuple[Path, str | bytes]] = []
+    stock = oversize = 0
+    for sheet in sheets:
+        if sheet.oversize:
+            oversize += 1
+            stem = f"{name}_oversize_{oversize:02d}"
+        else:
+            stock += 1
+            stem = f"{name}_sheet_{stock:02d}"
+        label = f"{title} {stem} ({sheet.width:.0f} x {sheet.height:.0f} mm)".strip()
+        files.append((out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
+        files.append((out / f"{stem}.svg", svg_text(sheet, title=label)))
+    return files, sheets
 
 
 def write_cut_sheets(
@@ -530,23 +860,12 @@ def write_cut_sheets(
     title: str = "",
     settings: Settings = DEFAULTS,
 ) -> tuple[list[Path], list[StockSheet]]:
-    """Nest the panels onto ``width`` x ``height`` mm stock (:func:`nest`) and write
-    ``NAME_sheet_NN.dxf`` and ``.svg`` per sheet (``NAME_oversize_NN`` for a part larger than
-    the stock); returns the files and the sheets."""
-    sheets = nest(parts(fab), width, height, gap, settings=settings)
-    written: list[Path] = []
-    stock = oversize = 0
-    for sheet in sheets:
-        if sheet.oversize:
-            oversize += 1
-            stem = f"{name}_oversize_{oversize:02d}"
-        else:
-            stock += 1
-            stem = f"{name}_sheet_{stock:02d}"
-        label = f"{title} {stem} ({sheet.width:.0f} x {sheet.height:.0f} mm)".strip()
-        written.append(atomic_write(out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
-        written.append(atomic_write(out / f"{stem}.svg", svg_text(sheet, title=label)))
-    return written, sheets
+    """Nest the panels and write their sheets together (:func:`cut_sheet_data`,
+    :func:`rigidfold.io.files.write_together`); returns the files and the sheets."""
+    files, sheets = cut_sheet_data(
+        fab, out, name, width=width, height=height, gap=gap, title=title, settings=settings
+    )
+    return write_together(files), sheets
 
 
 def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:

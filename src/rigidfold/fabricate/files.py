@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 import tempfile
@@ -30,7 +31,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.mesh3d import Y_UP, panel_colours, panel_names
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import atomic_write
+from rigidfold.io.files import write_together
 
 HINGE_COLUMNS = (
     "hinge",
@@ -89,7 +90,26 @@ def glb_bytes(fab: Fabrication) -> bytes:
             process=False,
         )
         scene.add_geometry(mesh, node_name=name, geom_name=name, parent_node_name="rigidfold")
+    if not scene.geometry:  # every panel trimmed away: a valid file with no mesh
+        return _empty_glb()
     return scene.export(file_type="glb")
+
+
+def _empty_glb() -> bytes:
+    """A glTF binary of one scene with the y-up node ``rigidfold`` and no mesh (trimesh
+    exports no empty scene)."""
+    import struct
+
+    document = {
+        "asset": {"version": "2.0", "generator": "rigidfold"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"name": "rigidfold", "matrix": np.asarray(Y_UP).T.ravel().tolist()}],
+    }
+    body = json.dumps(document).encode("utf-8")
+    body += b" " * (-len(body) % 4)
+    chunk = struct.pack("<II", len(body), 0x4E4F534A) + body
+    return struct.pack("<4sII", b"glTF", 2, 12 + len(chunk)) + chunk
 
 
 def stl_bytes(fab: Fabrication) -> bytes:
@@ -98,6 +118,8 @@ def stl_bytes(fab: Fabrication) -> bytes:
     from trimesh.exchange.stl import export_stl
 
     parts = [(v, f) for _, v, f in _meshes(fab) if len(f)]
+    if not parts:  # every panel trimmed away: a binary STL of no triangle
+        return b"rigidfold: no solid".ljust(80, b" ") + b"\x00\x00\x00\x00"
     offsets = np.cumsum([0] + [len(v) for v, _ in parts])
     verts = np.vstack([v for v, _ in parts])
     faces = np.vstack([f + o for (_, f), o in zip(parts, offsets, strict=False)])
@@ -244,18 +266,25 @@ def csv_text(columns: tuple[str, ...], rows: list[dict]) -> str:
     return out.getvalue()
 
 
-def write_solid_files(fab: Fabrication, out: Path, name: str, *, title: str = "") -> list[Path]:
-    """Write the 3D files and the schedules of ``fab`` into ``out`` (which exists) as
-    ``NAME_solids.glb/.stl/.obj/.3dm``, ``NAME_hinges.csv`` and ``NAME_vertices.csv``;
-    returns them."""
+def solid_file_data(
+    fab: Fabrication, out: Path, name: str, *, title: str = ""
+) -> list[tuple[Path, str | bytes]]:
+    """The 3D files and the schedules of ``fab`` as (path in ``out``, data):
+    ``NAME_solids.glb/.stl/.obj/.3dm``, ``NAME_hinges.csv`` and ``NAME_vertices.csv``."""
     return [
-        atomic_write(out / f"{name}_solids.glb", glb_bytes(fab)),
-        atomic_write(out / f"{name}_solids.stl", stl_bytes(fab)),
-        atomic_write(out / f"{name}_solids.obj", obj_text(fab, title=title)),
-        atomic_write(out / f"{name}_solids.3dm", rhino_bytes(fab, out)),
-        atomic_write(out / f"{name}_hinges.csv", csv_text(HINGE_COLUMNS, hinge_rows(fab))),
-        atomic_write(out / f"{name}_vertices.csv", csv_text(VERTEX_COLUMNS, vertex_rows(fab))),
+        (out / f"{name}_solids.glb", glb_bytes(fab)),
+        (out / f"{name}_solids.stl", stl_bytes(fab)),
+        (out / f"{name}_solids.obj", obj_text(fab, title=title)),
+        (out / f"{name}_solids.3dm", rhino_bytes(fab, out)),
+        (out / f"{name}_hinges.csv", csv_text(HINGE_COLUMNS, hinge_rows(fab))),
+        (out / f"{name}_vertices.csv", csv_text(VERTEX_COLUMNS, vertex_rows(fab))),
     ]
+
+
+def write_solid_files(fab: Fabrication, out: Path, name: str, *, title: str = "") -> list[Path]:
+    """Write the 3D files and the schedules of ``fab`` into ``out`` (which exists), together
+    (:func:`rigidfold.io.files.write_together`, :func:`solid_file_data`); returns them."""
+    return write_together(solid_file_data(fab, out, name, title=title))
 
 
 def write_fabrication(
@@ -271,29 +300,35 @@ def write_fabrication(
     settings: Settings = DEFAULTS,
 ) -> tuple[list[Path], dict]:
     """Every file of thick panels into ``out`` (which exists): the solids and schedules
-    (:func:`write_solid_files`), the cut sheets nested onto ``sheet`` (width, height) mm stock
-    ``gap`` mm apart (:func:`rigidfold.fabricate.cutsheets.write_cut_sheets`, titled
+    (:func:`solid_file_data`), the cut sheets nested onto ``sheet`` (width, height) mm stock
+    ``gap`` mm apart (:func:`rigidfold.fabricate.cutsheets.cut_sheet_data`, titled
     ``label``), and ``NAME_fabricate.json``: ``{"file": source, **fab.to_dict(),
-    "cut_sheets": ..., "written": [the other files]}``. Returns (the files in the order
+    "cut_sheets": ..., "written": [the other files]}``. Every file is made in memory first
+    and all are written together (:func:`rigidfold.io.files.write_together`: on a full disk
+    none appears, and the error says so in one line). Returns (the files in the order
     written, the cut sheets' summary)."""
-    from rigidfold.fabricate.cutsheets import sheets_summary, write_cut_sheets
-    from rigidfold.io import write_json
+    from rigidfold.fabricate.cutsheets import cut_sheet_data, sheets_summary
+    from rigidfold.fabricate.progress import step
+    from rigidfold.io.files import jsonable
 
     width, height = sheet
-    written = write_solid_files(fab, out, name, title=title)
-    more, sheets = write_cut_sheets(
+    step(f"writing the solids of {fab.panels.n} panels", fab.panels.n, settings=settings)
+    files = solid_file_data(fab, out, name, title=title)
+    more, sheets = cut_sheet_data(
         fab, out, name, width=width, height=height, gap=gap, title=label, settings=settings
     )
-    written += more
+    files += more
     summary = sheets_summary(sheets) | {"stock_mm": [width, height]}
+    path = out / FABRICATE_JSON.format(name)
     report = {
         "file": source,
         **fab.to_dict(),
         "cut_sheets": summary,
-        "written": [str(p) for p in written],
+        "written": [str(p) for p, _ in files],
     }
-    written.append(write_json(out / FABRICATE_JSON.format(name), report))
-    return written, summary
+    text = json.dumps(jsonable(report, where=f"the JSON data of '{path}'"), indent=2)
+    files.append((path, text + "\n"))
+    return write_together(files), summary
 
 
 FABRICATE_JSON = "{}_fabricate.json"

@@ -2,8 +2,10 @@
 
 The motion is a sequence of frames, vertex positions (K, V, 3) from the flat sheet
 (fraction 0) to the design (fraction 1): the design file's own motion frames
-(``foldedForm`` frames, as ``rigidfold generate`` writes them for a checked design) when
-they are fine enough, else the design's rigid-folding path
+(``foldedForm`` frames, as ``rigidfold generate`` writes them for a checked design, read
+by :func:`rigidfold.io.read_frames`) when they are a rigid motion of the design from flat
+(:func:`motion_evidence`: motion frames are evidence, checked, never trusted) and fine
+enough, else the design's rigid-folding path
 (:func:`rigidfold.mechanism.path.trace_path`) sampled at equal arclength
 (:meth:`rigidfold.mechanism.path.FoldingPath.frames`) so finely that no hinge turns more
 than ``settings.fabricate.frame_step`` between two frames. Each panel moves rigidly: at
@@ -21,8 +23,9 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.exports import Design
+from rigidfold.fabricate import progress
 from rigidfold.fabricate.panels import Panels
-from rigidfold.io import motion_fraction, read_fold
+from rigidfold.io import read_frames
 from rigidfold.mesh.geometry import rigid_motions
 
 if TYPE_CHECKING:
@@ -114,31 +117,53 @@ def panel_motion(
     )
 
 
-def file_frames(design: Design, *, up: str = "z", settings: Settings = DEFAULTS):
-    """(frames (K, V, 3), fraction (K,)) of the folding motion the design file carries
-    (its ``foldedForm`` frames of the same model, flat first), or None when it has fewer
-    than two."""
-    raw = design.data.raw
-    frames, fraction = [], []
-    pattern = design.pattern
-    for k, frame in enumerate(raw.get("file_frames") or [], start=1):
-        classes = frame.get("frame_classes")
-        if not (isinstance(classes, list) and "foldedForm" in classes):
-            continue
-        try:
-            shape = read_fold(raw, k, up=up, settings=settings).pattern
-        except ValueError:
-            continue
-        if shape.n_vertices != pattern.n_vertices or not np.array_equal(shape.faces, pattern.faces):
-            continue
-        frames.append(shape.coords)
-        fraction.append(motion_fraction(frame))
-    if len(frames) < 2:
+def file_frames(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
+    """(frames (K, V, 3), fraction (K,)) of the folding motion the design file carries (its
+    motion frames, :func:`rigidfold.io.read_frames`, read once with the file), or None when
+    it has fewer than two. Not yet checked: :func:`motion_evidence` says whether they are
+    a rigid motion of the design from flat."""
+    frames = design.frames
+    if frames is None:
+        frames = read_frames(design.data.raw, design.pattern.n_vertices, "the design file")
+    if len(frames.motion) < 2:
         return None
-    s = np.asarray(fraction)
-    if np.isnan(s).any() or np.any(np.diff(s) < 0):
-        s = np.linspace(0.0, 1.0, len(frames))
-    return np.asarray(frames), s
+    return frames.motion, frames.fraction
+
+
+def motion_evidence(
+    panels: Panels, frames: np.ndarray, fraction: np.ndarray, *, settings: Settings = DEFAULTS
+) -> str:
+    """Why ``frames`` (K, V, 3), at ``fraction`` (K,), are not a rigid motion of ``panels``'
+    design from flat, in words; ``""`` when they are: each panel moves rigidly (its
+    vertices within ``settings.fabricate.frame_tol`` times the design's size of its
+    least-squares rigid motion, so lengths are kept and panels stay flat), the first frame
+    is flat (every hinge within ``settings.path.flat_tol`` of flat, as the traced path's
+    flat end), the last one is the design (so moved rigidly onto it), and the fraction rises
+    from 0 to 1."""
+    pattern = panels.pattern
+    size = float(np.linalg.norm(np.ptp(pattern.coords, axis=0))) or 1.0
+    tol = settings.fabricate.frame_tol * size
+    s = np.asarray(fraction, dtype=np.float64)
+    if not (np.isclose(s[0], 0.0) and np.isclose(s[-1], 1.0) and np.all(np.diff(s) >= 0)):
+        return "their fraction folded does not rise from 0 to 1"
+    rotations, translations = fit_panels(panels, frames)
+    worst, at = 0.0, 0
+    for k, verts in enumerate(panels.vertices):
+        moved = np.einsum("kij,vj->kvi", rotations[:, k], pattern.coords[verts])
+        off = np.linalg.norm(moved + translations[:, k, None] - frames[:, verts], axis=2)
+        if off.max() > worst:
+            worst, at = float(off.max()), k
+    if worst > tol:
+        return f"panel {at} does not move rigidly (off by {worst * 1e3:.3g} mm)"
+    first = np.abs(closing_angles(panels, rotations[0])).max(initial=0.0)
+    if first > settings.path.flat_tol:
+        return f"the first frame is not flat (a hinge folded {math.degrees(first):.3g} degrees)"
+    whole = [np.arange(pattern.n_vertices)]
+    r, t = rigid_motions(frames[-1], pattern.coords[None], whole)
+    off = np.linalg.norm(frames[-1] @ r[0, 0].T + t[0, 0] - pattern.coords, axis=1).max()
+    if off > tol:
+        return f"the last frame is not the design (a vertex {off * 1e3:.3g} mm off)"
+    return ""
 
 
 def design_motion(
@@ -157,14 +182,26 @@ def design_motion(
     frames : (frames (K, V, 3), fraction (K,)) of a motion already at hand (a run's traced
     motion), used instead of the design file's; path : the design's folding path already
     traced (:func:`rigidfold.mechanism.path.trace_path`), sampled instead of tracing it
-    again when the frames are too coarse."""
+    again when the frames are too coarse; up : how the design was read (its frames are read
+    z up, as rigidfold writes them: frames of another up axis are not the design's motion,
+    and the path is traced). Raises ValueError for a design of more than
+    ``settings.limits.max_fabricate_panels`` panels."""
+    del up  # the frames are evidence, checked against the design as read
     from rigidfold.mechanism.path import trace_path
 
+    progress.check_size(panels.n, settings=settings)
     step = settings.fabricate.frame_step
     carried = frames
     where = "the traced motion's"
+    rejected = ""
     if carried is None and design is not None:
-        carried, where = file_frames(design, up=up, settings=settings), "the design file's"
+        carried, where = file_frames(design), "the design file's"
+        if carried is not None:
+            why = motion_evidence(panels, *carried, settings=settings)
+            if why:
+                n = len(carried[0])
+                rejected = f" (the design file's {n} frames are not its motion: {why})"
+                carried = None
     if carried is not None:
         shapes, fraction = carried
         motion = panel_motion(panels, shapes, fraction, f"{where} {len(shapes)} frames")
@@ -172,16 +209,20 @@ def design_motion(
             return motion, motion.source
     pattern = panels.pattern
     if path is None:
+        text = f"tracing the folding path of {panels.n} panels{rejected}"
+        progress.step(text, panels.n, settings=settings)
         path = trace_path(pattern, settings=settings)
     if not path.deploys:
         if carried is not None:
             return motion, f"{motion.source} (the path could not be traced finer: {path.message})"
-        return None, f"{path.status.message}: {path.message}"
+        return None, f"{path.status.message}: {path.message}{rejected}"
     largest = float(np.abs(panels.closing(pattern.fold_angles)).max(initial=0.0))
     n = min(max(math.ceil(largest / step) + 1, 3), MAX_FRAMES)
     for _ in range(3):
         sampled, fraction = path.frames(pattern, n, settings=settings)
-        motion = panel_motion(panels, sampled, fraction, f"the traced folding path at {n} frames")
+        motion = panel_motion(
+            panels, sampled, fraction, f"the traced folding path at {n} frames{rejected}"
+        )
         if motion.largest_step <= step or n >= MAX_FRAMES:
             break
         n = min(math.ceil((n - 1) * motion.largest_step / step) + 1, MAX_FRAMES)

@@ -73,7 +73,7 @@ class FabricateOptions:
         for name in ("density", "min_thickness"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, float(getattr(self, name)))
-        object.__setattr__(self, "sheet", parse_sheet(self.sheet))
+        object.__setattr__(self, "sheet", parse_sheet(self.sheet))  # within the limits
 
     def values(self, settings: Settings = DEFAULTS) -> tuple[float, float, float]:
         """(clearance angle in radians, minimum thickness in metres, density in kg/m^3),

@@ -112,6 +112,52 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
     return path
 
 
+def write_together(files: list[tuple[Path, str | bytes]]) -> list[Path]:
+    """Write every ``(path, data)`` of ``files`` so that they appear together: each to a new
+    temporary file beside its path (as :func:`atomic_write`: exclusive, no symbolic link
+    followed, synced), and only when all of them are written are they renamed onto their
+    paths. On an error while writing (a full disk) every temporary file is removed and no
+    path is touched: ValueError ``"cannot write the N files of 'DIR' (reason): none
+    written"``. A rename that fails after some succeeded (rare: renames take no space)
+    raises ValueError naming the files that are missing. Returns the paths, in order."""
+    staged: list[tuple[Path, Path]] = []
+    try:
+        for path, data in files:
+            path = Path(path)
+            raw = data.encode("utf-8") if isinstance(data, str) else data
+            fd, tmp = _create_temp(path.parent, path.name)
+            staged.append((tmp, path))
+            with os.fdopen(fd, "wb") as file:
+                file.write(raw)
+                file.flush()
+                os.fsync(file.fileno())
+    except BaseException as exc:
+        for tmp, _ in staged:
+            with contextlib.suppress(OSError):
+                tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            where = Path(files[0][0]).parent if files else Path(".")
+            raise RigidfoldError(
+                f"cannot write the {len(files)} files of '{where}' ({_reason(exc)}): none written"
+            ) from None
+        raise
+    done: list[Path] = []
+    for k, (tmp, path) in enumerate(staged):
+        try:
+            os.replace(tmp, path)
+        except OSError as exc:
+            for left, _ in staged[k:]:
+                with contextlib.suppress(OSError):
+                    left.unlink(missing_ok=True)
+            missing = ", ".join(p.name for _, p in staged[k:])
+            raise RigidfoldError(
+                f"cannot write '{path}' ({_reason(exc)}): {len(done)} of {len(staged)} files "
+                f"written, missing: {missing}"
+            ) from None
+        done.append(path)
+    return done
+
+
 def write_json(path: str | os.PathLike, data, *, indent: int | None = 2) -> Path:
     """Write ``jsonable(data)`` as strict JSON text atomically (see :func:`atomic_write`).
 

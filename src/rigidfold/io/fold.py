@@ -25,7 +25,6 @@ import json
 import math
 import numbers
 import os
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -311,9 +310,6 @@ FRACTION_KEY = "rigidfold:fraction"
 """The key of a motion frame (:func:`motion_frames`) that holds its fraction folded, 0 (flat)
 to 1 (the design)."""
 
-_LEGACY_FRACTION = re.compile(r"folding motion: ([0-9.]+)% folded")
-"""The fraction in the title of a motion frame written before :data:`FRACTION_KEY`."""
-
 
 @dataclass(frozen=True, eq=False)
 class DesignFrames:
@@ -321,14 +317,17 @@ class DesignFrames:
     :func:`crease_pattern_frame` and :func:`motion_frames`).
 
     diagram : (V, 2) float64 development diagram of the last ``creasePattern`` frame, or
-    None; motion : (K, V, 3) float64 ``foldedForm`` frames from flat to the design;
-    fraction : (K,) float64 fraction folded of each (:data:`FRACTION_KEY`; files written
-    before it: the fraction in the frame's title; frames of another writer: evenly spaced).
+    None; diagram_frame : its frame number (``k >= 1`` is ``file_frames[k - 1]``), or None;
+    motion : (K, V, 3) float64 ``foldedForm`` frames from flat to the design (those that
+    carry :data:`FRACTION_KEY`, after the last ``creasePattern`` frame; frames of another
+    writer, without it: every ``foldedForm`` frame), metres; fraction : (K,) float64
+    fraction folded of each (:data:`FRACTION_KEY`; frames of another writer: evenly spaced).
     """
 
     diagram: np.ndarray | None
     motion: np.ndarray
     fraction: np.ndarray
+    diagram_frame: int | None = None
 
 
 def crease_pattern_frames(raw: dict) -> list[int]:
@@ -345,33 +344,60 @@ def crease_pattern_frames(raw: dict) -> list[int]:
 
 
 def read_frames(raw: dict, n_vertices: int, where: str) -> DesignFrames:
-    """The :class:`DesignFrames` of a FOLD document ``raw`` whose model has ``n_vertices``;
-    ValueError naming ``where`` and the frame for coordinates of another shape."""
-    diagram, motion, fraction = None, [], []
-    for k, frame in enumerate(raw.get("file_frames") or []):
+    """The :class:`DesignFrames` of a FOLD document ``raw`` (parsed once: every frame is
+    read from it, none re-parsed) whose model has ``n_vertices``: the one reader of a
+    design's frames. Each frame's coordinates are converted from its ``frame_unit`` (its
+    own or inherited, :data:`UNITS`) to metres and read z up, as rigidfold writes them.
+    ValueError naming ``where`` and the frame for a frame of another vertex count, a unit
+    rigidfold does not know, coordinates that are not finite numbers, or a
+    ``creasePattern`` frame that is not flat."""
+    frames = raw.get("file_frames") or []
+    if not isinstance(frames, list) or not all(isinstance(f, dict) for f in frames):
+        raise RigidfoldError(f"{where}: file_frames must be a list of objects")
+    every = [raw, *frames]
+    diagram, diagram_frame = None, None
+    motion: list[tuple[int, np.ndarray, float]] = []
+    for k, frame in enumerate(frames, start=1):
         classes = frame.get("frame_classes") or []
-        if "creasePattern" in classes:
-            diagram = _frame_coords(frame, n_vertices, 2, f"{where}: file_frames[{k}]")
-        elif "foldedForm" in classes:
-            motion.append(_frame_coords(frame, n_vertices, 3, f"{where}: file_frames[{k}]"))
-            fraction.append(motion_fraction(frame))
-    if np.isnan(fraction).any():  # frames of another writer: evenly spaced
+        if not isinstance(classes, list):
+            continue
+        kind = "creasePattern" if "creasePattern" in classes else None
+        kind = kind or ("foldedForm" if "foldedForm" in classes else None)
+        if kind is None:
+            continue
+        at = f"{where}: file_frames[{k - 1}]"
+        data = _inherited(every, k)
+        unit = data.get("frame_unit", "unit")
+        if not isinstance(unit, str) or unit not in UNITS:
+            raise RigidfoldError(f"{at}: frame_unit {_short(unit)} is not a unit rigidfold knows")
+        coords = _frame_coords(data, n_vertices, 3, at) * UNITS[unit]
+        if kind == "creasePattern":
+            if np.abs(coords[:, 2]).max(initial=0.0) > 0:
+                raise RigidfoldError(f"{at}: a creasePattern frame that is not flat (z != 0)")
+            diagram, diagram_frame = coords[:, :2], k
+            motion = []  # the motion follows the last diagram
+        else:
+            motion.append((k, coords, motion_fraction(frame)))
+    keyed = [m for m in motion if not math.isnan(m[2])]
+    if keyed:
+        motion = keyed
+    fraction = [m[2] for m in motion]
+    if not keyed:  # frames of another writer: evenly spaced
         fraction = np.linspace(0.0, 1.0, len(motion)).tolist()
     return DesignFrames(
         diagram,
-        np.asarray(motion, dtype=float).reshape(-1, n_vertices, 3),
+        np.asarray([m[1] for m in motion], dtype=float).reshape(-1, n_vertices, 3),
         np.asarray(fraction, dtype=float),
+        diagram_frame,
     )
 
 
 def motion_fraction(frame: dict) -> float:
-    """A motion frame's fraction folded (:data:`FRACTION_KEY`; files written before it: the
-    fraction in its title); NaN when it has none."""
+    """A motion frame's fraction folded (:data:`FRACTION_KEY`); NaN when it has none."""
     value = frame.get(FRACTION_KEY)
     if isinstance(value, int | float) and not isinstance(value, bool) and 0 <= value <= 1:
         return float(value)
-    legacy = _LEGACY_FRACTION.search(str(frame.get("frame_title", "")))
-    return float(legacy.group(1)) / 100 if legacy else math.nan
+    return math.nan
 
 
 def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndarray:
@@ -379,7 +405,7 @@ def _frame_coords(frame: dict, n_vertices: int, dim: int, where: str) -> np.ndar
     when ``dim`` is 3)."""
     try:
         xy = np.asarray(frame["vertices_coords"], dtype=float)
-    except (KeyError, TypeError, ValueError):
+    except (KeyError, TypeError, ValueError, OverflowError):
         raise RigidfoldError(f"{where} has no numeric vertices_coords") from None
     if xy.ndim != 2 or xy.shape[0] != n_vertices or xy.shape[1] not in (2, 3):
         raise RigidfoldError(
@@ -664,6 +690,11 @@ def _frame(raw: dict, index: int) -> dict:
     frames = [raw, *frames]
     if index >= len(frames):
         raise RigidfoldError(f"frame {index} does not exist (frames 0..{len(frames) - 1})")
+    return _inherited(frames, index)
+
+
+def _inherited(frames: list[dict], index: int) -> dict:
+    """The keys of ``frames[index]`` (``frames[0]``: the top level) with those it inherits."""
     chain = [index]
     data = dict(frames[index])
     while chain[-1] != 0 and frames[chain[-1]].get("frame_inherit") is True:

@@ -102,29 +102,44 @@ def clear_earlier_run(
     *,
     overwrite: bool,
     inputs: tuple[Path, ...] = (),
-    names: tuple[str, ...] = (*RUN_FILES, *RUN_DIRS),
+    names: tuple[str, ...] | None = None,
+    dirs: tuple[str, ...] = (),
 ) -> Path:
     """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
 
-    Only the run's own files and directories, ``names`` (a generation run's by default:
-    :data:`RUN_FILES`, :data:`RUN_DIRS`), count and are removed; other files in ``out``
-    stay. With ``overwrite`` the temporary files of those names that a killed run left
-    (``.report.html.<random>.tmp``: :func:`rigidfold.io.files.temp_files`) are removed too.
-    A symbolic link among them is removed itself, never followed. Removing one of the
-    run's ``inputs`` (e.g. an earlier solution used as the pattern) is refused. Returns
-    ``out`` as a Path. Raises ValueError naming what was found.
+    The one rule of ``--overwrite``: it replaces only what the command writes. ``names`` are
+    the files the command writes (a generation run's by default, :data:`RUN_FILES`, with
+    its directories :data:`RUN_DIRS` as ``dirs``); only they count and are removed, other
+    files in ``out`` stay. A directory where the command writes a file is never removed:
+    it is refused, with or without ``overwrite`` (a file cannot be written there). Only the
+    command's own directories, ``dirs``, are removed whole. With ``overwrite`` the
+    temporary files of those names that a killed run left (``.report.html.<random>.tmp``:
+    :func:`rigidfold.io.files.temp_files`) are removed too. A symbolic link among them is
+    removed itself, never followed. Removing one of the run's ``inputs`` (e.g. an earlier
+    solution used as the pattern) is refused. Returns ``out`` as a Path. Raises ValueError
+    naming what was found.
     """
     from rigidfold.io.files import temp_files
 
+    if names is None:
+        names, dirs = RUN_FILES, (*RUN_DIRS, *dirs)
     out = Path(out)
-    found = [out / n for n in names if (out / n).is_symlink() or (out / n).exists()]
+    for n in names:
+        if n not in dirs and (out / n).is_dir() and not (out / n).is_symlink():
+            raise RigidfoldError(
+                f"output directory '{out}' holds a directory '{n}' where this command writes "
+                "a file (--overwrite replaces only files the command writes): move it, or use "
+                "another --out"
+            )
+    every = (*names, *(d for d in dirs if d not in names))
+    found = [out / n for n in every if (out / n).is_symlink() or (out / n).exists()]
     if found and not overwrite:
         raise RigidfoldError(
             f"output directory '{out}' holds an earlier run ({', '.join(p.name for p in found)}): "
             "give --overwrite to replace it, or another --out"
         )
     if overwrite:
-        found += temp_files(out, names)
+        found += temp_files(out, every)
     if not found:
         return out
     for path in found:
@@ -143,9 +158,9 @@ def clear_earlier_run(
                 )
     try:
         for path in found:
-            if path.is_dir() and not path.is_symlink():
+            if path.name in dirs and path.is_dir() and not path.is_symlink():
                 shutil.rmtree(path)
-            else:
+            elif not path.is_dir() or path.is_symlink():
                 path.unlink(missing_ok=True)
     except OSError as exc:
         raise RigidfoldError(
