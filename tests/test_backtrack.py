@@ -103,27 +103,6 @@ def test_backtrack_max_is_checked():
         DEFAULTS.with_(backtrack_max=-1)
 
 
-def test_studies_made_before_backtracking_resume_where_it_changes_nothing():
-    """A study stored before ``backtrack_max`` existed ran without backtracking: with the
-    deployability check it resumes at 0 only; without the check, at any value."""
-    from rigidfold.study import STUDY_OPTIONS, StudyConfig
-    from rigidfold.study.store import config_differences
-
-    def config(deploy_check: bool, backtrack_max: int | None) -> dict:
-        settings = (
-            DEFAULTS if backtrack_max is None else DEFAULTS.with_(backtrack_max=backtrack_max)
-        )
-        stored = StudyConfig(STUDY_OPTIONS.replace(deploy_check=deploy_check), settings)
-        return stored.as_dict()
-
-    for check in (False, True):
-        older = config(check, None)
-        del older["settings"]["backtrack_max"]
-        assert config_differences(older, config(check, 0)) == []
-        expected = ["settings.backtrack_max"] if check else []
-        assert config_differences(older, config(check, None)) == expected
-
-
 def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_path):
     """A 3 x 3 grid on the dome stops at DOF 3 (no candidate succeeds); backtracking finds no
     lower chain, so the run ends with the one it had, and the chains it tried since leave no
