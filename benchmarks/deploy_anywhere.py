@@ -114,7 +114,7 @@ def run(case: dict, mode: str) -> dict:
         built,
         criterion=case["criterion"],
         seed=case["seed"],
-        lookahead=True,
+        lookahead=case.get("lookahead", True),
         deform=False,
         time_limit=case["limit"],
     )
@@ -159,9 +159,26 @@ def main() -> None:
         metavar="N",
         help="instead: the paper's study on N Bezier surfaces (patterns 1 and 2, S-hat and S)",
     )
+    parser.add_argument(
+        "--no-lookahead", action="store_true", help="the runs without the look-ahead"
+    )
+    parser.add_argument(
+        "--seeds", default=None, help="with --paper: only these comma-separated seeds"
+    )
+    parser.add_argument(
+        "--criteria", default=None, help="with --paper: only these comma-separated criteria"
+    )
+    parser.add_argument("--limit", type=float, default=None, help="each run's time limit, s")
     args = parser.parse_args()
     modes = [m for m in args.modes.split(",") if m]
     every = paper_cases(args.paper) if args.paper else cases()
+    if args.seeds:
+        every = [c for c in every if c["seed"] in {int(v) for v in args.seeds.split(",")}]
+    if args.criteria:
+        every = [c for c in every if c["criterion"] in args.criteria.split(",")]
+    for c in every:
+        c["lookahead"] = not args.no_lookahead
+        c["limit"] = args.limit or c["limit"]
     chosen = [c for c in every if args.only is None or args.only in name(c)]
     work = [(c, m) for c in chosen for m in modes]
     rows = []

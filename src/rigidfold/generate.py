@@ -472,14 +472,14 @@ class _Steps:
         return obstruction(pattern, self.support_face(pattern), dof, settings)
 
     def child_forecast(self, current: Solution) -> ChildForecast | None:
-        """With the look-ahead, at a shape whose children get the deployability check: the
-        second-order forecast of its candidates (None where it is not made)."""
+        """At a shape whose children get the deployability check: the second-order forecast
+        of its candidates (None where it is not made)."""
         opts, settings = self.options, self.settings
         dof = current.mechanism.dof
         limit = settings.generation.deploy_check_max_dof
         pattern = current.result.pattern
         if (
-            not (opts.lookahead and opts.deploy_check and settings.generation.second_order)
+            not (opts.deploy_check and settings.generation.second_order)
             or dof < 2
             or (limit > 0 and dof - 1 > max(limit, opts.target_dof))
             or pattern.n_vertices > settings.mechanism.second_order_vertices
@@ -537,7 +537,7 @@ class _Steps:
                 rigid=None if forecast is None else forecast.rigid,
             )
             if self.options.lookahead
-            else (Choice(k) for k in range(len(ranked)))
+            else _forecast_order([g for g, _ in ranked], forecast)
         )
         return ranked, order, forecast, time.perf_counter() - t1
 
@@ -729,6 +729,22 @@ def best_so_far(run: Generation) -> None:
         if solution.path is not None and solution.path.deploys:
             run.final_step = solution.step
             return
+
+
+def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterator[Choice]:
+    """Without the look-ahead: the criterion's order, except that the candidates forecast to
+    leave a second-order rigid shape come last (in the criterion's order); with no forecast,
+    the criterion's order."""
+    if forecast is None:
+        yield from (Choice(k) for k in range(len(candidates)))
+        return
+    rigid = []
+    for k, group in enumerate(candidates):
+        if forecast.rigid(tuple(map(int, group))):
+            rigid.append(Choice(k, rigid=True))
+        else:
+            yield Choice(k)
+    yield from rigid
 
 
 def _dof(solutions: list[Solution]) -> int:

@@ -121,14 +121,14 @@ class GenerationSettings(Group):
         True,
         "With the deployability check: a solution whose folding path does not reach the flat "
         "state is tested at second order (:func:`rigidfold.mechanism.second_order."
-        "obstruction`); a second-order rigid one is counted in N_rigid, not N_path. With the "
-        "look-ahead, at a shape whose children are checked, candidates forecast to leave a "
-        "second-order rigid child (:class:`~rigidfold.mechanism.second_order.ChildForecast`) "
-        "are put off like those forecast to lock.",
+        "obstruction`); a second-order rigid one is counted in N_rigid, not N_path. At a "
+        "shape whose children are checked, candidates forecast to leave a second-order rigid "
+        "child (:class:`~rigidfold.mechanism.second_order.ChildForecast`) are tried last "
+        "(with the look-ahead, put off like those forecast to lock).",
     )
     rigid_confirmations: int = setting(
         3,
-        "With the look-ahead and ``second_order``: a shape whose own stress form "
+        "With ``second_order``: a shape whose own stress form "
         "is definite on its flexes (every child forecast second-order rigid) is given up "
         "(``Stop.NO_DEPLOYABLE``, then backtracking) once this many of its candidates in a "
         "row were solved and found second-order rigid, instead of after "
