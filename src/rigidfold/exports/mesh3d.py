@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.errors import RigidfoldError
-from rigidfold.io.files import atomic_write
+from rigidfold.io.files import atomic_write, text_bytes
 from rigidfold.mesh import CreasePattern
 
 MESH_FORMATS = ("obj", "stl", "ply", "glb")
@@ -124,7 +124,7 @@ def mesh_bytes(pattern: CreasePattern, fmt: str, *, title: str = "") -> bytes:
     """The file content of the folded form in ``fmt`` (:data:`MESH_FORMATS`); ``title`` goes
     into the OBJ header. Raises ValueError for an unknown format."""
     if fmt == "obj":
-        return obj_text(pattern, title=title).encode("utf-8")
+        return text_bytes(obj_text(pattern, title=title))
     writers = {"stl": stl_bytes, "ply": ply_bytes, "glb": glb_bytes}
     if fmt not in writers:
         raise RigidfoldError(f"3D format must be one of {', '.join(MESH_FORMATS)}, got {fmt!r}")

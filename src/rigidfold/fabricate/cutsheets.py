@@ -44,7 +44,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import min_area_angle
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import write_together
+from rigidfold.io.files import text_bytes, write_together
 
 MM = 1000.0
 
@@ -730,7 +730,7 @@ def dxf_bytes(sheet: StockSheet, *, title: str = "") -> bytes:
         )
     out = io.StringIO()
     doc.write(out)
-    return out.getvalue().encode("utf-8")
+    return text_bytes(out.getvalue())
 
 
 def svg_text(sheet: StockSheet, *, title: str = "") -> str:

@@ -21,7 +21,6 @@ import csv
 import io
 import json
 import math
-import os
 import tempfile
 from pathlib import Path
 
@@ -31,7 +30,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.mesh3d import Y_UP, panel_colours, panel_names
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import write_together
+from rigidfold.io.files import text_bytes, write_together
 
 HINGE_COLUMNS = (
     "hinge",
@@ -106,7 +105,7 @@ def _empty_glb() -> bytes:
         "scenes": [{"nodes": [0]}],
         "nodes": [{"name": "rigidfold", "matrix": np.asarray(Y_UP).T.ravel().tolist()}],
     }
-    body = json.dumps(document).encode("utf-8")
+    body = text_bytes(json.dumps(document))
     body += b" " * (-len(body) % 4)
     chunk = struct.pack("<II", len(body), 0x4E4F534A) + body
     return struct.pack("<4sII", b"glTF", 2, 12 + len(chunk)) + chunk
@@ -143,9 +142,10 @@ def obj_text(fab: Fabrication, *, title: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def rhino_bytes(fab: Fabrication, directory: Path) -> bytes:
-    """The Rhino model (see the module's text), written through a temporary file in
-    ``directory`` (rhino3dm writes files only)."""
+def rhino_bytes(fab: Fabrication) -> bytes:
+    """The Rhino model (see the module's text), written through a file in a private
+    temporary directory (rhino3dm writes files only, and takes only paths it can encode in
+    UTF-8: the output directory's name need not be)."""
     import rhino3dm  # its stubs do not know the setters and the attribute arguments
 
     p = fab.panels
@@ -194,14 +194,11 @@ def rhino_bytes(fab: Fabrication, directory: Path) -> bytes:
         centre = coords[p.vertices[k]].mean(axis=0)
         point = rhino3dm.Point3d(*centre)
         model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))  # type: ignore[call-arg]
-    fd, tmp = tempfile.mkstemp(prefix=".rigidfold-", suffix=".3dm", dir=directory)
-    os.close(fd)
-    try:
-        if not model.Write(tmp, 7):
-            raise RigidfoldError(f"cannot write the Rhino model in '{directory}'")
-        return Path(tmp).read_bytes()
-    finally:
-        Path(tmp).unlink(missing_ok=True)
+    with tempfile.TemporaryDirectory(prefix="rigidfold-") as private:
+        tmp = Path(private) / "model.3dm"
+        if not model.Write(str(tmp), 7):
+            raise RigidfoldError("cannot write the Rhino model (rhino3dm refused it)")
+        return tmp.read_bytes()
 
 
 def hinge_rows(fab: Fabrication) -> list[dict]:
@@ -275,7 +272,7 @@ def solid_file_data(
         (out / f"{name}_solids.glb", glb_bytes(fab)),
         (out / f"{name}_solids.stl", stl_bytes(fab)),
         (out / f"{name}_solids.obj", obj_text(fab, title=title)),
-        (out / f"{name}_solids.3dm", rhino_bytes(fab, out)),
+        (out / f"{name}_solids.3dm", rhino_bytes(fab)),
         (out / f"{name}_hinges.csv", csv_text(HINGE_COLUMNS, hinge_rows(fab))),
         (out / f"{name}_vertices.csv", csv_text(VERTEX_COLUMNS, vertex_rows(fab))),
     ]

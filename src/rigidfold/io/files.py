@@ -77,6 +77,16 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def text_bytes(text: str) -> bytes:
+    """``text`` as UTF-8 for a file's contents. A file name whose bytes are not UTF-8 reaches
+    Python as lone surrogates (``surrogateescape``); inside a document (a title, a label)
+    each such character becomes U+FFFD, so the document stays valid UTF-8 (the name on disk
+    keeps its bytes)."""
+    if not any("\udc80" <= ch <= "\udcff" for ch in text):
+        return text.encode("utf-8")
+    return os.fsencode(text).decode("utf-8", "replace").encode("utf-8")
+
+
 def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
     """Write ``data`` (str: as UTF-8) to ``path`` atomically; returns ``path`` as a Path.
 
@@ -89,7 +99,7 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
     """
     path = Path(path)
     if isinstance(data, str):
-        data = data.encode("utf-8")
+        data = text_bytes(data)
     elif not isinstance(data, bytes):
         raise RigidfoldError(
             f"cannot write '{path}': data must be str or bytes, got {type(data).__name__}"
@@ -124,7 +134,7 @@ def write_together(files: list[tuple[Path, str | bytes]]) -> list[Path]:
     try:
         for path, data in files:
             path = Path(path)
-            raw = data.encode("utf-8") if isinstance(data, str) else data
+            raw = text_bytes(data) if isinstance(data, str) else data
             fd, tmp = _create_temp(path.parent, path.name)
             staged.append((tmp, path))
             with os.fdopen(fd, "wb") as file:

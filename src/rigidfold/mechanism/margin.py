@@ -69,7 +69,8 @@ class DofMargin:
             )
         return (
             f"DOF {self.dof} has no clear margin: {self.near} singular value"
-            f"{'s' if self.near != 1 else ''} of the constraints lie within a factor "
+            f"{'s' if self.near != 1 else ''} of the constraints "
+            f"{'lie' if self.near != 1 else 'lies'} within a factor "
             f"{self.gap:g} of the rank threshold {self.threshold:g} (smallest non-zero "
             f"{self.nonzero_min:.2g}, largest zero {self.zero_max:.2g} of the largest): "
             "near-mechanisms, very soft modes of the built design"
