@@ -16,8 +16,12 @@ TARGET_FILE = "target_surface.json"
 """The fitted spline of a mesh target (:meth:`rigidfold.surfaces.SplineSurface.grid`), which
 summary.json names under ``target_surface`` so that the report can show the fit."""
 
-RUN_FILES = ("summary.json", "log.json", "report.html", TARGET_FILE)
+RUN_FILES = ("summary.json", "log.jsonl", "report.html", TARGET_FILE)
 """The files a generation run writes at the top of its directory."""
+
+OLD_RUN_FILES = ("log.json",)
+"""Files that runs of earlier rigidfold versions wrote at the top of their directory: an
+earlier run all the same (refused, or removed with ``--overwrite``)."""
 
 RUN_DIRS = ("solutions", "figures", "final")
 """The directories a generation run writes (solution files, figures, exports)."""
@@ -102,14 +106,15 @@ def clear_earlier_run(
     *,
     overwrite: bool,
     inputs: tuple[Path, ...] = (),
-    names: tuple[str, ...] = (*RUN_FILES, *RUN_DIRS),
+    names: tuple[str, ...] = (*RUN_FILES, *OLD_RUN_FILES, *RUN_DIRS),
 ) -> Path:
     """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
 
     Only the run's own files and directories, ``names`` (a generation run's by default:
-    :data:`RUN_FILES`, :data:`RUN_DIRS`), count and are removed; other files in ``out``
-    stay. With ``overwrite`` the temporary files of those names that a killed run left
-    (``.report.html.<random>.tmp``: :func:`rigidfold.io.files.temp_files`) are removed too.
+    :data:`RUN_FILES`, :data:`OLD_RUN_FILES`, :data:`RUN_DIRS`), count and are removed;
+    other files in ``out`` stay. With ``overwrite`` the temporary files of those names that
+    a killed run left (``.report.html.<random>.tmp``: :func:`rigidfold.io.files.temp_files`)
+    are removed too.
     A symbolic link among them is removed itself, never followed. Removing one of the
     run's ``inputs`` (e.g. an earlier solution used as the pattern) is refused. Returns
     ``out`` as a Path. Raises ValueError naming what was found.
