@@ -437,7 +437,17 @@ def load_run(directory: str | os.PathLike) -> RunData:
     surface, note = target_surface(summary.case.get("surface") or {})
     if surface is None and summary.target_surface is not None:
         surface, note = _stored_surface(root, summary.target_surface)
+    if surface is not None and not all(_measurable(d, surface) for d in designs):
+        surface, note = None, "the target surface could not be rebuilt: its heights are too large"
     return RunData(root, summary, attempts, tuple(designs), surface, note)
+
+
+def _measurable(design: SolutionFile, surface: TargetSurface) -> bool:
+    """Whether the distances of ``design`` to ``surface`` are numbers, their squares in mm
+    too (a surface rebuilt from damaged heights may give distances beyond the floats)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        dz = design.dz(surface)
+        return bool(np.all(np.isfinite((dz * 1e3) ** 2)))
 
 
 def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:

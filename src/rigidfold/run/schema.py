@@ -218,6 +218,7 @@ def check_shape(
     not have ``shape`` (:data:`SUMMARY_SHAPE` says how shapes are written), and what it
     holds instead."""
     label = f"'{file}'" + ("" if line is None else f", line {line}")
+    whole = "the document" if line is None else "the line"
     stack = [(value, shape, where)]
     while stack:
         value, given, where = stack.pop()
@@ -225,14 +226,14 @@ def check_shape(
         if value is None and shape is not given:
             continue
         if not _has_shape(value, shape):
-            key = f"{where!r}" if where else "the document"
+            key = f"{where!r}" if where else whole
             raise RigidfoldError(
                 f"{label}: {key} is {received(value)}, expected {_expected(given)}"
             )
         if isinstance(shape, Record):
             missing = [k for k in shape.required if k not in value]
             if missing:
-                key = f"{where!r}" if where else "the document"
+                key = f"{where!r}" if where else whole
                 raise RigidfoldError(f"{label}: {key} has no {', '.join(map(repr, missing))}")
             stack += [
                 (value[k], s, f"{where}.{k}" if where else k)
@@ -423,7 +424,8 @@ class AttemptRecord:
     index : int; outcome : the :class:`rigidfold.generate.AttemptOutcome` value; dof : None
     when the solve was not analysed; F, iterations : the solve's; fixed_added, locked : the
     creases fixed by it and locked at the shape found; path : the deployability check's
-    figures or None.
+    figures or None; document : the whole line (every field of
+    :meth:`rigidfold.generate.Attempt.to_dict`).
     """
 
     index: int
@@ -434,11 +436,13 @@ class AttemptRecord:
     fixed_added: list | None = None
     locked: list | None = None
     path: dict | None = None
+    document: dict = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def from_dict(cls, data: dict, k: int = 0) -> AttemptRecord:
-        names = {f.name for f in fields(cls)}
-        return cls(**{"index": k, **{n: v for n, v in data.items() if n in names}})
+        names = {f.name for f in fields(cls)} - {"document"}
+        known = {n: v for n, v in data.items() if n in names}
+        return cls(**{"index": k, **known, "document": data})
 
 
 def aggregate(records: list[SolutionRecord]) -> dict:
