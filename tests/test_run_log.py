@@ -118,14 +118,29 @@ def test_the_reader_takes_the_last_line_of_each_index(logged, tmp_path):
 
 def test_summary_json_is_written_when_it_changes_and_exact_at_the_end(logged):
     out, run, _, writes = logged
-    # once at the first attempt, then at each solution and retraction, and at the end
-    assert writes["summary"] == 1 + writes["solution"] + writes["retract"] + 1
+    # at each solution and retraction, and at the end (the first attempt is a solution)
+    assert writes["summary"] == writes["solution"] + writes["retract"] + 1
     assert writes["summary"] < len(run.attempts) + writes["solution"]  # not every attempt
     summary = json.loads((out / "summary.json").read_text())
     assert summary["schema_version"] == SCHEMA_VERSION
     exact = run.to_dict()
     for key in ("n_solves", "N_lock", "N_exceed", "N_path", "N_backtrack", "N_rigid", "stop"):
         assert summary[key] == exact[key], key
+
+
+def test_summary_interval_0_writes_summary_json_after_every_attempt(tmp_path):
+    settings = DEFAULTS.with_(deploy_max_candidates=1, summary_interval=0)
+    writer = RunWriter(tmp_path, make_case("bezier", "1", seed=SEED, settings=settings), OPTIONS)
+    seen = []
+
+    def progress(run, attempt) -> None:
+        if attempt is not None and attempt.outcome is not AttemptOutcome.ACCEPTED:
+            summary = json.loads((tmp_path / "summary.json").read_text())
+            seen.append(summary["n_solves"] == len(run.attempts))
+
+    run = generate_case(writer, progress=progress, report=False)
+    assert len(seen) > 3 and all(seen)  # exact after every rejected attempt
+    assert run.n_backtrack >= 1
 
 
 def test_summary_interval_is_checked():

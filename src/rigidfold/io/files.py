@@ -152,8 +152,12 @@ def append_json_line(path: str | os.PathLike, data, *, create: bool = False) -> 
             if not stat.S_ISREG(os.fstat(fd).st_mode):
                 raise RigidfoldError(f"cannot write '{path}': not a regular file")
             view = memoryview(line)
-            while view:
-                view = view[os.write(fd, view) :]
+            try:
+                while view:
+                    view = view[os.write(fd, view) :]
+            finally:  # a Ctrl-C between two writes of one line: the line is ended first
+                while view:
+                    view = view[os.write(fd, view) :]
             os.fsync(fd)
         finally:
             os.close(fd)

@@ -259,6 +259,8 @@ class RunWriter:
         ``Settings.generation.summary_interval`` seconds have passed since it last was (a
         solution, a retraction and the end write it every time)."""
         self.log.sync(run.attempts)
+        if attempt.outcome is AttemptOutcome.ACCEPTED:
+            return  # its solution (:meth:`on_solution`) writes summary.json next
         interval = self.case.settings.generation.summary_interval
         if time.monotonic() - self.summary_written >= interval:
             self.write_summary(run)
