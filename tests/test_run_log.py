@@ -263,3 +263,15 @@ def test_a_study_database_of_another_version_is_refused_in_one_line(tmp_path, ca
         (line,) = capsys.readouterr().err.strip().splitlines()
         assert line == f"rigidfold: error: {words}"
         assert db.read_bytes() == before  # refused untouched
+
+
+def test_a_target_rebuilt_beyond_the_floats_is_not_used(logged, tmp_path):
+    """Found by the seeded fuzz of summary.json once the log's lines changed its draws: a
+    control height of 1e308 overflowed in the report (a RuntimeWarning, exit 1)."""
+    copy = shutil.copytree(logged[0], tmp_path / "run")
+    summary = json.loads((copy / "summary.json").read_text())
+    summary["case"]["surface"]["control_heights"][0][0] = 1e308
+    (copy / "summary.json").write_text(json.dumps(summary))
+    run = load_run(copy)
+    assert run.surface is None
+    assert run.surface_note == "the target surface could not be rebuilt: its heights are too large"
