@@ -14,7 +14,6 @@ Targets (issue 20): under 5 s and under 10 MB for an 11 x 11 run.
 from __future__ import annotations
 
 import argparse
-import json
 import resource
 import statistics
 import subprocess
@@ -22,6 +21,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from rigidfold.run import load_run
 
 
 def generate_run(out: Path) -> None:
@@ -52,7 +53,7 @@ def bench(run: Path, repeat: int) -> None:
         )
         times.append(time.perf_counter() - t0)
         cpu.append(_cpu() - c0)
-    summary = json.loads((run / "summary.json").read_text())
+    summary = load_run(run).summary.document  # run files are read through rigidfold.run
     case = summary["case"]
     fields = [
         f"report of {case['pattern']} on {case['surface']['name']}: "

@@ -17,7 +17,7 @@ from conftest import main_code, paper_generate
 from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop, generate
-from rigidfold.run import RunWriter, load_run
+from rigidfold.run import RunWriter, load_run, read_log
 from rigidfold.workflows import generate_case
 
 SEED = 102
@@ -61,10 +61,10 @@ def test_a_backtracking_run_ends_with_a_chain(backtracked):
 def test_the_run_directory_holds_only_the_chain(backtracked):
     out, run = backtracked
     summary = json.loads((out / "summary.json").read_text())
-    log = json.loads((out / "log.json").read_text())["attempts"]
+    log = read_log(out / "log.jsonl")  # the last line of each attempt
     assert summary["N_backtrack"] == run.n_backtrack
-    assert sum(a["outcome"] == "dead_end" for a in log) == run.n_backtrack
-    assert len(log) == len(run.attempts)
+    assert sum(a.outcome == "dead_end" for a in log) == run.n_backtrack
+    assert [a.outcome for a in log] == [a.outcome.value for a in run.attempts]
     names = [f"step_{s.step:02d}_dof_{s.mechanism.dof:02d}" for s in run.solutions]
     assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]
     assert [r["step"] for r in summary["per_solution"]] == list(range(len(run.solutions)))

@@ -19,6 +19,7 @@ from rigidfold.config import DEFAULTS
 from rigidfold.io import fold_dict, read_fold, write_fold
 from rigidfold.mesh.geometry import best_fit
 from rigidfold.patterns import miura
+from rigidfold.run import read_log
 
 
 @pytest.fixture(scope="module")
@@ -82,9 +83,9 @@ def test_generate_writes_solutions_log_and_summary(generated):
     for entry in summary["per_solution"]:
         fit = entry["fit"]
         assert 0 <= fit["rms_dz_m"] <= fit["max_abs_dz_m"] <= DEFAULTS.design.dz + 1e-6
-    log = json.loads((generated / "log.json").read_text())["attempts"]
-    assert len(log) == summary["n_solves"]
-    assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1])
+    log = read_log(generated / "log.jsonl")
+    assert len(log) == summary["n_solves"] and [a.index for a in log] == list(range(len(log)))
+    assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1].document)
     last = read_fold(generated / "solutions" / names[-1])
     assert len(last.pattern.fixed_creases) == 3
     assert last.metadata["dof"] == 18
@@ -202,7 +203,7 @@ def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     # the best design so far is named: the last solution (no path of it is known to deploy)
     assert summary["verdict"]["outcome"] == "fell_short"
     assert summary["verdict"]["final_design"] == summary["solutions"][-1]
-    assert len(json.loads((tmp_path / "log.json").read_text())["attempts"]) == 2
+    assert len(read_log(tmp_path / "log.jsonl")) == 2
     for path in (tmp_path / "solutions").glob("*.fold"):
         read_fold(path)
     assert not list(tmp_path.rglob("*.tmp"))
@@ -270,7 +271,7 @@ def test_an_earlier_run_is_refused_unless_overwrite(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert (
         len(err) == 1
-        and "holds an earlier run (summary.json, log.json, report.html, solutions, figures, final)"
+        and "holds an earlier run (summary.json, log.jsonl, report.html, solutions, figures, final)"
         in err[0]
     )
     assert stale.exists()  # refused: nothing touched
@@ -448,7 +449,7 @@ def test_a_signal_during_an_ipopt_solve_is_an_interrupt(tmp_path, name):
     )
     assert proc.returncode == 130, proc.stderr
     assert proc.stderr.strip().splitlines() == [
-        f"rigidfold: interrupted; 0 solutions, log.json and summary.json are in {out}"
+        f"rigidfold: interrupted; 0 solutions, log.jsonl and summary.json are in {out}"
     ]
     summary = json.loads((out / "summary.json").read_text())
     assert summary["stop"] == "interrupted" and summary["stop_reason"] == "interrupted"

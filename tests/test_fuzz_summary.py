@@ -1,5 +1,5 @@
 """Fuzz test of what ``rigidfold report`` reads (issue 30, item 14): a generate run's
-``summary.json`` and ``log.json`` (and the rigidfold keys of its solution files) damaged, by
+``summary.json`` and ``log.jsonl`` (and the rigidfold keys of its solution files) damaged, by
 hand (the mutations that gave a traceback) and by a seeded mutator. Every case must end with
 exit code 0, or 2 with one line ``rigidfold: error: ...`` that names the damaged file (and,
 for a value of the wrong shape, its key), raise nothing else (warnings are errors in the
@@ -19,6 +19,22 @@ from conftest import main_code
 from test_fuzz_fold import JUNK, nodes, put
 
 FINAL = "solutions/step_03_dof_06.fold"
+LOG = "log.jsonl"
+
+
+def read_doc(path: Path):
+    """The JSON of ``path``; of the log (JSON lines), the list of its lines."""
+    if path.name == LOG:
+        return [json.loads(line) for line in path.read_text().splitlines()]
+    return json.loads(path.read_text())
+
+
+def write_doc(path: Path, doc) -> None:
+    """Write ``doc`` as :func:`read_doc` reads it."""
+    if path.name == LOG:
+        path.write_text("".join(json.dumps(line, allow_nan=True) + "\n" for line in doc))
+    else:
+        path.write_text(json.dumps(doc, allow_nan=True))
 
 
 @pytest.fixture(scope="module")
@@ -83,17 +99,23 @@ MUTATIONS = [
     ("summary.json", ("solutions", 0), "../run/" + FINAL, "expected a file in the run's direc"),
     ("summary.json", ("solutions", 0), "", "'solutions[0]' is \"\", expected a file in the"),
     ("summary.json", ("per_solution",), DELETE, "not the summary of rigidfold generate (no per"),
-    ("log.json", ("attempts",), [1], "'attempts[0]' is 1, expected an object"),
-    ("log.json", ("attempts",), {}, "has no list of attempts"),
-    ("log.json", ("attempts", 0, "outcome"), DELETE, "'attempts[0]' has no 'outcome'"),
-    ("log.json", ("attempts", 0, "dof"), DELETE, "'attempts[0]' has no 'dof'"),
-    ("log.json", ("attempts", 0, "dof"), "9", "'attempts[0].dof' is \"9\", expected a whole"),
-    ("log.json", ("attempts", 0, "dof"), None, "'attempts[0].dof' is null, expected a whole nu"),
-    ("log.json", ("attempts", 1, "F"), "small", "'attempts[1].F' is \"small\", expected a fin"),
-    ("log.json", ("attempts", 1, "F"), 1e400, "'attempts[1].F' is Infinity, expected a finite"),
-    ("log.json", ("attempts", 0, "index"), "0", "'attempts[0].index' is \"0\", expected a who"),
-    ("log.json", ("attempts", 0, "index"), 2**64, "'attempts[0].index' is 18446744073709551616"),
-    ("log.json", ("attempts", 1, "F"), 10**400, "'attempts[1].F' is 10000000000000000000000"),
+    ("summary.json", ("schema_version",), 2, "summary.json' was written by run schema version 2"),
+    ("summary.json", ("schema_version",), DELETE, "run schema version 0 (none recorded); this"),
+    ("summary.json", ("schema_version",), "1", 'run schema version "1"; this rigidfold reads'),
+    # log.jsonl as its list of lines: 0 the header, then one per attempt
+    (LOG, (0,), {}, "line 1: {} is not the header of a run log (no 'schema_version')"),
+    (LOG, (0, "schema_version"), 0, "log.jsonl' was written by run schema version 0; this"),
+    (LOG, (1,), 1, "line 2: 1 is not a JSON object"),
+    (LOG, (1, "outcome"), DELETE, "line 2: the line has no 'outcome'"),
+    (LOG, (1, "dof"), DELETE, "line 2: the line has no 'dof'"),
+    (LOG, (1, "index"), DELETE, "line 2: the line has no 'index'"),
+    (LOG, (1, "dof"), "9", "line 2: 'dof' is \"9\", expected a whole"),
+    (LOG, (1, "dof"), None, "line 2: 'dof' is null, expected a whole nu"),
+    (LOG, (2, "F"), "small", "line 3: 'F' is \"small\", expected a fin"),
+    (LOG, (2, "F"), 1e400, "line 3: 'F' is Infinity, expected a finite"),
+    (LOG, (1, "index"), "0", "line 2: 'index' is \"0\", expected a who"),
+    (LOG, (1, "index"), 2**64, "line 2: 'index' is 18446744073709551616"),
+    (LOG, (2, "F"), 10**400, "line 3: 'F' is 10000000000000000000000"),
     ("summary.json", ("per_solution", 0, "dof"), -(2**63), "'per_solution[0].dof' is -9223"),
     (FINAL, ("rigidfold:deformation", "history"), "x", "'rigidfold:deformation.history' is \"x"),
     (FINAL, ("rigidfold:deformation", "history", 0), {}, "history[0]' has no 'load_factor'"),
@@ -140,8 +162,8 @@ def test_a_damaged_summary_or_log_is_one_line_naming_the_file_and_key(
     run_dir, tmp_path, capsys, file, path, value, words
 ):
     case = shutil.copytree(run_dir, tmp_path / "run")
-    doc = json.loads((case / file).read_text())
-    (case / file).write_text(json.dumps(mutate(doc, path, value)))
+    doc = read_doc(case / file)
+    write_doc(case / file, mutate(doc, path, value))
     code, err = report(case, capsys)
     assert code == 2, f"{file} {path} = {value!r}: exit {code}"
     line = one_line(err)
@@ -154,12 +176,12 @@ def test_a_damaged_summary_or_log_is_one_line_naming_the_file_and_key(
 MUTANTS = 40
 
 
-def random_mutant(summary: dict, log: dict, rng: random.Random) -> tuple[dict, dict, list[str]]:
+def random_mutant(summary: dict, log: list, rng: random.Random) -> tuple[dict, list, list[str]]:
     """A copy of (summary, log) with 1 to 3 random values replaced by junk or keys deleted."""
     summary, log = copy.deepcopy(summary), copy.deepcopy(log)
     done = []
     for _ in range(rng.choice([1, 1, 2, 3])):
-        name, doc = rng.choice([("summary.json", summary), ("log.json", log)])
+        name, doc = rng.choice([("summary.json", summary), (LOG, log)])
         places = [(p, v) for p, v in nodes(doc) if p]
         path, _ = rng.choice(places)
         if rng.random() < 0.25 and isinstance(path[-1], str):
@@ -174,20 +196,20 @@ def random_mutant(summary: dict, log: dict, rng: random.Random) -> tuple[dict, d
 
 def test_random_damage_to_summary_and_log_ends_in_an_exit_code(run_dir, tmp_path, capsys):
     summary = json.loads((run_dir / "summary.json").read_text())
-    log = json.loads((run_dir / "log.json").read_text())
+    log = read_doc(run_dir / LOG)
     rng = random.Random("fuzz-summary")
     codes = []
     for k in range(MUTANTS):
         new_summary, new_log, done = random_mutant(summary, log, rng)
         case = shutil.copytree(run_dir, tmp_path / f"case{k}")
-        (case / "summary.json").write_text(json.dumps(new_summary, allow_nan=True))
-        (case / "log.json").write_text(json.dumps(new_log, allow_nan=True))
+        write_doc(case / "summary.json", new_summary)
+        write_doc(case / LOG, new_log)
         label = f"mutant {k} ({'; '.join(done)})"
         code, err = report(case, capsys)
         assert code in (0, 2), f"{label}: exit {code}"
         if code == 2:
             line = one_line(err)
-            assert "summary.json" in line or "log.json" in line or ".fold" in line, label
+            assert "summary.json" in line or LOG in line or ".fold" in line, label
         codes.append(code)
         shutil.rmtree(case)
     assert sorted(p.name for p in tmp_path.iterdir()) == []

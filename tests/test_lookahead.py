@@ -17,6 +17,7 @@ from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.mechanism import analyze
 from rigidfold.mesh import CreasePattern
+from rigidfold.run import read_log
 from rigidfold.selection import carried_angles, flat_groups, lock_forecast, lookahead_order
 
 PARALLEL = {87, 89, 103, 108}  # the demo's four creases with parallel rows at DOF 5 (issue 18)
@@ -353,6 +354,6 @@ def test_generate_command_passes_lookahead_to_the_log(tmp_path):
     )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["options"]["lookahead"] is True and summary["n_skipped"] == 0
-    (first, second) = json.loads((out / "log.json").read_text())["attempts"]
+    (first, second) = [a.document for a in read_log(out / "log.jsonl")]
     assert first["predicted_locks"] is None and second["predicted_locks"] == []
     assert second["skipped"] == 0 and second["skipped_locks"] == []

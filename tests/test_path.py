@@ -22,6 +22,7 @@ from rigidfold.mechanism.path import PathStatus, trace_path
 from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
+from rigidfold.run import read_log
 
 DATA = Path(__file__).parent / "data"
 
@@ -202,8 +203,8 @@ def test_the_counters_are_stored_and_reported(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text())
     assert f"N_path={summary['N_path']}" in printed and summary["N_path"] >= 1
     assert summary["final_deploys"] is True and summary["options"]["deploy_check"] is True
-    log = json.loads((out / "log.json").read_text())["attempts"]
-    assert sum(a["outcome"] == "path" for a in log) == summary["N_path"]
+    log = read_log(out / "log.jsonl")
+    assert sum(a.outcome == "path" for a in log) == summary["N_path"]
     # the report's slider shows the traced path of the final design, flat to folded
     final = json.loads((out / summary["verdict"]["final_design"]).read_text())
     motion = [f for f in final["file_frames"] if "folding motion" in f.get("frame_title", "")]

@@ -16,7 +16,7 @@ from rigidfold.case import make_case
 from rigidfold.cli import main
 from rigidfold.reporting import page, render_figures, view_figure
 from rigidfold.reporting.view3d import best_fit
-from rigidfold.run import load_run, target_surface
+from rigidfold.run import SCHEMA_VERSION, load_run, read_log, target_surface
 from rigidfold.workflows import report_run
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -135,8 +135,8 @@ def test_missing_solution_file_and_malformed_log(run_dir, copy):
     with pytest.raises(ValueError, match=r"step_02_dof_07\.fold' listed in summary\.json"):
         report_run(copy)
     shutil.copy(run_dir / "solutions" / "step_02_dof_07.fold", copy / "solutions")
-    (copy / "log.json").write_text('{"attempts": 3}')
-    with pytest.raises(ValueError, match=r"log\.json' has no list of attempts"):
+    (copy / "log.jsonl").write_text('{"schema_version": 1}\n3\n')
+    with pytest.raises(ValueError, match=r"log\.jsonl', line 2: 3 is not a JSON object"):
         report_run(copy)
     assert not (copy / "report.html").exists()
 
@@ -222,18 +222,18 @@ def test_unknown_surface_reports_without_the_fit(copy):
 
 
 def test_lock_and_exceed_attempts_are_drawn(copy):
-    log = json.loads((copy / "log.json").read_text())
-    last = log["attempts"][-1]
-    log["attempts"] += [
-        {**last, "index": 4, "outcome": "lock", "dof": 5, "locked": [7]},
-        {**last, "index": 5, "outcome": "exceed", "dof": None, "F": None, "locked": []},
-    ]
-    (copy / "log.json").write_text(json.dumps(log))
+    last = read_log(copy / "log.jsonl")[-1].document
+    with (copy / "log.jsonl").open("a") as log:  # appended, as the run writer does
+        for line in (
+            {**last, "index": 4, "outcome": "lock", "dof": 5, "locked": [7]},
+            {**last, "index": 5, "outcome": "exceed", "dof": None, "F": None, "locked": []},
+        ):
+            log.write(json.dumps(line) + "\n")
     run = load_run(copy)
     figures = render_figures(run)
     assert [f.name for f in figures] == [f"{n}.png" for n in FIGURES]
     text = page(run, figures, view_figure(run.final, run.surface))
-    assert "Attempts (6, log.json)" in text
+    assert "Attempts (6, log.jsonl)" in text
 
 
 def test_run_without_step_9_says_not_run(tmp_path):
@@ -250,9 +250,9 @@ def test_run_without_step_9_says_not_run(tmp_path):
 
 def test_run_without_solution_and_unfinished_run(copy):
     summary = json.loads((copy / "summary.json").read_text())
-    log = json.loads((copy / "log.json").read_text())
-    first = {**log["attempts"][0], "outcome": "initial_failed", "dof": None}
-    (copy / "log.json").write_text(json.dumps({"attempts": [first]}))
+    first = {**read_log(copy / "log.jsonl")[0].document, "outcome": "initial_failed", "dof": None}
+    header = json.dumps({"schema_version": SCHEMA_VERSION})
+    (copy / "log.jsonl").write_text(f"{header}\n{json.dumps(first)}\n")
     failed = {
         **summary,
         "stop": "initial_failed",

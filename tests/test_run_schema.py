@@ -1,4 +1,4 @@
-"""The run artifact (issue 28): one schema for summary.json, log.json and the solution files,
+"""The run artifact (issue 28): one schema for summary.json, log.jsonl and the solution files,
 one set of generate options and the FOLD frame contract."""
 
 from __future__ import annotations

@@ -125,7 +125,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         best = None if writer.verdict is None else writer.verdict.final_design
         print(
             one_line(
-                f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.json "
+                f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.jsonl "
                 f"and summary.json are in {writer.out}"
                 + ("" if best is None else f"; best design so far: {writer.out / best}")
             ),
@@ -135,7 +135,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     progress.close()
     print(_counters(run.to_dict(), run.stop_reason))
     print(
-        f"wrote {_count(len(writer.files), 'solution')}, log.json and summary.json to {writer.out}"
+        f"wrote {_count(len(writer.files), 'solution')}, log.jsonl and summary.json to {writer.out}"
     )
     if writer.exports:
         names = ", ".join(p.name for p in writer.exports)

@@ -41,7 +41,7 @@ OVERWRITE_HELP = {
 def _generate(p: Parser) -> None:
     _case(
         p,
-        out="output directory: solutions/, log.json, summary.json, final/ (the final design "
+        out="output directory: solutions/, log.jsonl, summary.json, final/ (the final design "
         "exported in every format of rigidfold export) and report.html",
     )
     add_options(p, GenerateOptions)

@@ -10,7 +10,7 @@ COMMANDS: dict[str, dict[str, str]] = {
         "help": "Steps 2-7: fix crease lines one by one down to the target DOF",
         "description": (
             "Generate developable, rigid-foldable shapes of decreasing DOF. Writes "
-            "DIR/solutions/step_XX_dof_YY.fold, DIR/log.json and DIR/summary.json as it goes; the "
+            "DIR/solutions/step_XX_dof_YY.fold, DIR/log.jsonl and DIR/summary.json as it goes; the "
             "last line names the final design (the last solution). Exit code 0 when the target DOF "
             "was reached and every check that ran on the final design (development diagram, "
             "folding motion, large deformation; thick panels and structure with --thickness and "

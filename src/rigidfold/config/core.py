@@ -134,12 +134,20 @@ class GenerationSettings(Group):
         "row were solved and found second-order rigid, instead of after "
         "``deploy_max_candidates`` (0: only that bound).",
     )
+    summary_interval: float = setting(
+        2.0,
+        "Seconds between writes of a run's summary.json after attempts that are rejected "
+        "(its log, ``log.jsonl``, gets every attempt as it ends): each solution, each "
+        "retraction by backtracking, the end and an interrupt write it every time, so its "
+        "counters are exact once the run has ended. 0: after every attempt.",
+    )
 
     def __post_init__(self) -> None:
         if not (isinstance(self.backtrack_max, int) and self.backtrack_max >= 0):
             raise RigidfoldError(
                 f"backtrack_max must be a whole number >= 0, got {self.backtrack_max!r}"
             )
+        self._non_negative("summary_interval")
 
 
 @dataclass(frozen=True)

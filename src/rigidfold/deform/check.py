@@ -161,7 +161,7 @@ class Verification:
         return compare(self.development, self.deformation, self.motion, self.settings)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready figures of every stage (for log.json, summary.json and the CLI)."""
+        """JSON-ready figures of every stage (for log.jsonl, summary.json and the CLI)."""
         verdicts = self.verdicts
         out: dict[str, Any] = {
             "development": self.development.to_dict(),

@@ -2,6 +2,7 @@
 atomic output files."""
 
 from rigidfold.io.files import (
+    append_json_line,
     atomic_write,
     check_json_depth,
     jsonable,
@@ -38,6 +39,7 @@ __all__ = [
     "DesignFrames",
     "FoldData",
     "SvgDrawing",
+    "append_json_line",
     "atomic_write",
     "check_json_depth",
     "crease_pattern_frame",

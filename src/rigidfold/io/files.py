@@ -3,7 +3,8 @@
 Every file rigidfold writes goes through :func:`atomic_write`: the content goes to a new,
 uniquely named temporary file beside the target, is flushed to disk and then renamed onto
 the target, so an interrupted run never leaves a half-written file and a reader never sees
-one.
+one. A file that grows as a run goes (a run's attempt log) is appended to instead, a line
+at a time (:func:`append_json_line`): a crash can tear only its last line.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import math
 import os
 import re
 import secrets
+import stat
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -176,6 +178,48 @@ def write_json(path: str | os.PathLike, data, *, indent: int | None = 2) -> Path
     path = Path(path)
     clean = jsonable(data, where=f"the JSON data of '{path}'")
     return atomic_write(path, json.dumps(clean, indent=indent, allow_nan=False) + "\n")
+
+
+_APPEND_FLAGS = (
+    os.O_WRONLY | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+)
+
+
+def append_json_line(path: str | os.PathLike, data, *, create: bool = False) -> Path:
+    """Append ``jsonable(data)`` to ``path`` as one line of JSON text (JSON Lines), flushed
+    and synced to disk before it returns; returns ``path`` as a Path.
+
+    The line goes in one write to the end of the file (``O_APPEND``), so earlier lines are
+    never touched and a crash can leave at most the last line torn (a reader skips a last
+    line that does not parse). ``create``: the file is new, created exclusively (an
+    existing file or symbolic link of that name is an error); otherwise it must exist. A
+    symbolic link is never followed, and anything but a regular file is refused.
+
+    Raises ValueError ``"cannot write 'PATH': reason"`` when the line cannot be appended, and
+    for data that is not JSON data.
+    """
+    path = Path(path)
+    clean = jsonable(data, where=f"the JSON data of '{path}'")
+    line = (json.dumps(clean, allow_nan=False, separators=(",", ":")) + "\n").encode("utf-8")
+    flags = _APPEND_FLAGS | (os.O_CREAT | os.O_EXCL if create else 0)
+    try:
+        fd = os.open(path, flags, 0o666)
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise RigidfoldError(f"cannot write '{path}': not a regular file")
+            view = memoryview(line)
+            try:
+                while view:
+                    view = view[os.write(fd, view) :]
+            finally:  # a Ctrl-C between two writes of one line: the line is ended first
+                while view:
+                    view = view[os.write(fd, view) :]
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        raise RigidfoldError(f"cannot write '{path}': {_reason(exc)}") from None
+    return path
 
 
 def parse_json(text: str | bytes, *, max_depth: int = DEFAULTS.limits.max_json_depth):

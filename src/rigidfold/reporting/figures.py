@@ -161,7 +161,7 @@ def _attempts(plt, run: RunData):
     return (
         fig,
         "DOF and F per attempt",
-        "Every solve of problem (6) in the order made (log.json): the DOF of the shape found "
+        "Every solve of problem (6) in the order made (log.jsonl): the DOF of the shape found "
         "and its objective F. Red crosses and lines mark the lock events (a crease locked, the "
         "fix replaced, Step 7); pink stars, solutions retracted by backtracking (no candidate "
         "of their shape gave a deployable solution).",

@@ -5,7 +5,7 @@ the final design's file), then the interactive 3D view (plotly, its JavaScript e
 the final design's thick panels (``generate --thickness``: a table and their 3D view along
 the folding slider) and structure (``--structure``: a table and the deflected shape) where
 they were made, the figures (PNG as ``data:`` URIs) and the tables of ``summary.json`` and
-``log.json``.
+``log.jsonl``.
 Nothing in the page is fetched: no CDN, no web font, no external image.
 """
 
@@ -86,7 +86,7 @@ def page(
         *(_figure(f) for f in figures),
         '<h2 id="tables">Tables</h2>',
         *_tables(run),
-        f'<p class="sub">Written by rigidfold {_e(_version())} from summary.json, log.json '
+        f'<p class="sub">Written by rigidfold {_e(_version())} from summary.json, log.jsonl '
         "and the solution files; the figures are also in figures/.</p>",
         "</body>\n</html>\n",
     ]
@@ -463,7 +463,7 @@ def _attempts(run: RunData) -> list[str]:
         for a in run.attempts
     ]
     return [
-        f"<details><summary>Attempts ({len(rows)}, log.json)</summary>",
+        f"<details><summary>Attempts ({len(rows)}, log.jsonl)</summary>",
         _grid(head, rows),
         "</details>",
     ]

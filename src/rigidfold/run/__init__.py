@@ -4,8 +4,9 @@
 ``--overwrite`` handled (:mod:`.lock`); :func:`run_verdict` judges the finished run
 (:mod:`.verdict`); :func:`load_run` reads it back (:mod:`.reader`) for the report. Every
 file's content is a type of :mod:`.schema`: :class:`RunSummary` (summary.json),
-:class:`AttemptRecord` (log.json), :class:`SolutionRecord` (a solution's checks; which
-failed: :meth:`SolutionRecord.failed_stages`).
+:class:`AttemptRecord` (a line of log.jsonl, read by :func:`read_log`),
+:class:`SolutionRecord` (a solution's checks; which failed:
+:meth:`SolutionRecord.failed_stages`).
 """
 
 from rigidfold.run.lock import LOCK_NAME, RUN_DIRS, RUN_FILES, clear_earlier_run, lock_run_dir
@@ -15,11 +16,14 @@ from rigidfold.run.reader import (
     SolutionFile,
     ThickPanels,
     load_run,
+    read_log,
     read_solids,
     read_solution,
     target_surface,
 )
 from rigidfold.run.schema import (
+    LOG_FILE,
+    SCHEMA_VERSION,
     AttemptRecord,
     RunSummary,
     SolutionRecord,
@@ -32,8 +36,10 @@ from rigidfold.run.writer import RunWriter, verification_frames, write_checked_s
 
 __all__ = [
     "LOCK_NAME",
+    "LOG_FILE",
     "RUN_DIRS",
     "RUN_FILES",
+    "SCHEMA_VERSION",
     "AttemptRecord",
     "Check",
     "RunData",
@@ -50,6 +56,7 @@ __all__ = [
     "clear_earlier_run",
     "load_run",
     "lock_run_dir",
+    "read_log",
     "read_solids",
     "read_solution",
     "run_verdict",

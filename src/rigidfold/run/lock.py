@@ -16,8 +16,12 @@ TARGET_FILE = "target_surface.json"
 """The fitted spline of a mesh target (:meth:`rigidfold.surfaces.SplineSurface.grid`), which
 summary.json names under ``target_surface`` so that the report can show the fit."""
 
-RUN_FILES = ("summary.json", "log.json", "report.html", TARGET_FILE)
+RUN_FILES = ("summary.json", "log.jsonl", "report.html", TARGET_FILE)
 """The files a generation run writes at the top of its directory."""
+
+OLD_RUN_FILES = ("log.json",)
+"""Files that runs of earlier rigidfold versions wrote at the top of their directory: an
+earlier run all the same (refused, or removed with ``--overwrite``)."""
 
 RUN_DIRS = ("solutions", "figures", "final")
 """The directories a generation run writes (solution files, figures, exports)."""
@@ -108,8 +112,9 @@ def clear_earlier_run(
     """Refuse, or with ``overwrite`` remove, the files of an earlier run in ``out``.
 
     The one rule of ``--overwrite``: it replaces only what the command writes. ``names`` are
-    the files the command writes (a generation run's by default, :data:`RUN_FILES`, with
-    its directories :data:`RUN_DIRS` as ``dirs``); only they count and are removed, other
+    the files the command writes (a generation run's by default, :data:`RUN_FILES` and the
+    file of earlier versions :data:`OLD_RUN_FILES`, with its directories :data:`RUN_DIRS`
+    as ``dirs``); only they count and are removed, other
     files in ``out`` stay. A directory where the command writes a file is never removed:
     it is refused, with or without ``overwrite`` (a file cannot be written there). Only the
     command's own directories, ``dirs``, are removed whole. With ``overwrite`` the
@@ -122,7 +127,7 @@ def clear_earlier_run(
     from rigidfold.io.files import temp_files
 
     if names is None:
-        names, dirs = RUN_FILES, (*RUN_DIRS, *dirs)
+        names, dirs = (*RUN_FILES, *OLD_RUN_FILES), (*RUN_DIRS, *dirs)
     out = Path(out)
     for n in names:
         if n not in dirs and (out / n).is_dir() and not (out / n).is_symlink():

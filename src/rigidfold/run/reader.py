@@ -1,11 +1,12 @@
 """A finished (or running) ``rigidfold generate`` directory, read back.
 
 :func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.run.RunSummary`),
-``DIR/log.json`` (:class:`~rigidfold.run.AttemptRecord`) and every solution's FOLD file
-(``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its development diagram and folding
-motion as frames (:func:`rigidfold.io.read_frames`), and the figures of Steps 8-9 with the
-large-deformation history under ``rigidfold:deformation``), and rebuilds the target surface
-from the case's metadata where it can. Anything that is not a generate run is a one-line
+``DIR/log.jsonl`` (:class:`~rigidfold.run.AttemptRecord`, :func:`read_log`) and every
+solution's FOLD file (``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its
+development diagram and folding motion as frames (:func:`rigidfold.io.read_frames`), and
+the figures of Steps 8-9 with the large-deformation history under
+``rigidfold:deformation``), and rebuilds the target surface from the case's metadata where
+it can. Anything that is not a generate run is a one-line
 ``ValueError``.
 """
 
@@ -23,12 +24,14 @@ from rigidfold.io import parse_json, read_fold, read_frames
 from rigidfold.protocols import TargetSurface
 from rigidfold.run.schema import (
     DESIGN_SHAPE,
+    LOG_FILE,
     LOG_SHAPE,
     AttemptRecord,
     RunSummary,
     SolutionRecord,
     Stage,
     check_shape,
+    check_version,
     received,
 )
 from rigidfold.surfaces import Bezier, SplineSurface, get_surface
@@ -203,7 +206,7 @@ class Check:
 class RunData:
     """Everything the report shows of one generate run.
 
-    directory : Path; summary : ``summary.json``; attempts : ``log.json``'s attempts;
+    directory : Path; summary : ``summary.json``; attempts : ``log.jsonl``'s attempts, by index;
     designs : every solution in order (the last is the final design); surface : the target
     surface, or None with ``surface_note`` saying why.
     """
@@ -405,10 +408,11 @@ def load_run(directory: str | os.PathLike) -> RunData:
     """Read the generate run in ``directory`` (see the module's text).
 
     Raises ValueError (one line) when ``directory`` is not a generate run: no directory, no
-    or malformed ``summary.json`` / ``log.json`` (what the report reads of them not of the
+    or malformed ``summary.json`` / ``log.jsonl`` (what the report reads of them not of the
     shape it must have, :data:`SUMMARY_SHAPE` and :data:`LOG_SHAPE`: the error names the
-    file and the key), or a listed solution file that is not in the directory, is missing or
-    is not a FOLD file of a generate run.
+    file and the key; :func:`read_log`), either of another run schema version
+    (:data:`~rigidfold.run.schema.SCHEMA_VERSION`), or a listed solution file that is not in
+    the directory, is missing or is not a FOLD file of a generate run.
     """
     root = Path(directory)
     if not root.is_dir():
@@ -416,17 +420,7 @@ def load_run(directory: str | os.PathLike) -> RunData:
             f"{str(root)!r} is not a directory (give the --out of rigidfold generate)"
         )
     summary = RunSummary.from_dict(_json_object(root, "summary.json"), root / "summary.json")
-    log = _json_object(root, "log.json")
-    if not isinstance(log.get("attempts"), list):
-        raise RigidfoldError(f"{str(root / 'log.json')!r} has no list of attempts")
-    check_shape(log, LOG_SHAPE, root / "log.json")
-    attempts = tuple(AttemptRecord.from_dict(a, k) for k, a in enumerate(log["attempts"]))
-    for k, attempt in enumerate(attempts):
-        if attempt.outcome == "accepted" and attempt.dof is None:
-            raise RigidfoldError(
-                f"'{root / 'log.json'}': 'attempts[{k}].dof' is null, expected a whole number "
-                "(an accepted shape has a DOF)"
-            )
+    attempts = read_log(root / LOG_FILE)
     names = summary.solutions
     designs = []
     for k, name in enumerate(names):
@@ -443,7 +437,80 @@ def load_run(directory: str | os.PathLike) -> RunData:
     surface, note = target_surface(summary.case.get("surface") or {})
     if surface is None and summary.target_surface is not None:
         surface, note = _stored_surface(root, summary.target_surface)
+    if surface is not None and not all(_measurable(d, surface) for d in designs):
+        surface, note = None, "the target surface could not be rebuilt: its heights are too large"
     return RunData(root, summary, attempts, tuple(designs), surface, note)
+
+
+def _measurable(design: SolutionFile, surface: TargetSurface) -> bool:
+    """Whether the distances of ``design`` to ``surface`` are numbers, their squares in mm
+    too (a surface rebuilt from damaged heights may give distances beyond the floats)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        dz = design.dz(surface)
+        return bool(np.all(np.isfinite((dz * 1e3) ** 2)))
+
+
+def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
+    """The attempts of a run's log (``DIR/log.jsonl``, :data:`~rigidfold.run.schema.LOG_FILE`),
+    by index: the last line of each index is its record (an attempt whose outcome
+    backtracking changed was appended again).
+
+    The first line is the header, ``{"schema_version": N}``; a log of another version is
+    refused (:func:`~rigidfold.run.schema.check_version`). A last line that does not end the
+    file and does not parse (torn by a crash mid-write) is skipped, the lines before it
+    kept. Raises ValueError (one line, naming the file and the line) for a missing or
+    unreadable file, a line that is not JSON or an attempt of the wrong shape
+    (:data:`~rigidfold.run.schema.LOG_SHAPE`), and an accepted attempt without a DOF.
+    """
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise RigidfoldError(
+            f"{str(path.parent)!r} is not a rigidfold generate run: it has no {path.name}"
+        ) from None
+    except OSError as exc:
+        raise RigidfoldError(f"cannot read {str(path)!r}: {exc.strerror}") from None
+    lines = data.split(b"\n")
+    last = lines.pop()  # b"" after the final newline; else a line the writer did not end
+    records = [_log_line(path, n, line) for n, line in enumerate(lines, start=1)]
+    if last.strip():
+        try:
+            records.append(_log_line(path, len(lines) + 1, last))
+        except ValueError:
+            pass  # torn by a crash mid-write
+    if not records:
+        return ()
+    header, *rows = records
+    if "schema_version" not in header:
+        raise RigidfoldError(
+            f"{str(path)!r}, line 1: {received(header)} is not the header of a run log "
+            "(no 'schema_version')"
+        )
+    check_version(header["schema_version"], path)
+    attempts: dict[int, AttemptRecord] = {}
+    for n, row in enumerate(rows, start=2):
+        check_shape(row, LOG_SHAPE, path, line=n)
+        if row["outcome"] == "accepted" and row["dof"] is None:
+            raise RigidfoldError(
+                f"{str(path)!r}, line {n}: 'dof' is null, expected a whole number (an accepted "
+                "shape has a DOF)"
+            )
+        attempts[row["index"]] = AttemptRecord.from_dict(row)
+    return tuple(attempts[k] for k in sorted(attempts))
+
+
+def _log_line(path: Path, n: int, line: bytes) -> dict:
+    """The JSON object on line ``n`` of the log ``path``: ValueError (one line) otherwise."""
+    try:
+        value = parse_json(line)
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise RigidfoldError(
+            f"{str(path)!r}, line {n}: not JSON ({' '.join(str(exc).split())})"
+        ) from None
+    if not isinstance(value, dict):
+        raise RigidfoldError(f"{str(path)!r}, line {n}: {received(value)} is not a JSON object")
+    return value
 
 
 def _stored_surface(root: Path, name: str) -> tuple[TargetSurface | None, str]:

@@ -1,11 +1,13 @@
-"""The schema of a run directory: summary.json, log.json and the solution files, read and
+"""The schema of a run directory: summary.json, log.jsonl and the solution files, read and
 written through one set of types.
 
 :class:`SolutionRecord` is one solution's checks (``summary.json``'s ``per_solution``; the
-figures in its FOLD file), :class:`AttemptRecord` one solve (``log.json``),
+figures in its FOLD file), :class:`AttemptRecord` one solve (a line of ``log.jsonl``),
 :class:`RunSummary` the whole of ``summary.json``. What the readers rely on is checked
 against a shape first (:data:`SUMMARY_SHAPE`, :data:`LOG_SHAPE`, :func:`check_shape`), so a
-damaged file is a one-line ValueError naming the file and the key. :class:`Stage` and
+damaged file is a one-line ValueError naming the file and the key. Both files carry
+:data:`SCHEMA_VERSION` (summary.json's ``schema_version``, log.jsonl's first line), and a
+run of another version is refused in one line (:func:`check_version`). :class:`Stage` and
 :meth:`SolutionRecord.failed_stages` say, once for the writer, the report and the study,
 which check of a solution failed.
 """
@@ -26,6 +28,30 @@ from rigidfold.fabricate import FabricationStatus
 from rigidfold.generate import Stop
 from rigidfold.status import Outcome
 from rigidfold.structure import StructureStatus
+
+SCHEMA_VERSION = 1
+"""The version of the files of a run directory this rigidfold writes and reads: summary.json's
+``schema_version`` and the header line of log.jsonl (``{"schema_version": 1}``). A run of
+another version (0: written before rigidfold recorded one) is refused
+(:func:`check_version`), not read through layers of old formats."""
+
+LOG_FILE = "log.jsonl"
+"""The attempt log of a run: JSON Lines, a header (``{"schema_version": N}``), then one line
+per attempt (:meth:`rigidfold.generate.Attempt.to_dict`) appended as the run goes; an attempt
+whose outcome changed later (backtracking) is appended again with the same ``index``, and
+the last line of an index is its record."""
+
+
+def check_version(version, file: str | os.PathLike) -> None:
+    """RigidfoldError (one line naming ``file`` and both versions) unless ``version`` (None:
+    the file has none, written before rigidfold recorded one) is :data:`SCHEMA_VERSION`."""
+    if version == SCHEMA_VERSION and not isinstance(version, bool):
+        return
+    given = "0 (none recorded)" if version is None else received(version)
+    raise RigidfoldError(
+        f"'{file}' was written by run schema version {given}; this rigidfold reads version "
+        f"{SCHEMA_VERSION}"
+    )
 
 
 @dataclass(frozen=True)
@@ -164,23 +190,16 @@ list ``[S]`` a list of S, a tuple a list of that many items of those shapes, a
 
 LOG_SHAPE = Record(
     {
-        "attempts": [
-            Record(
-                {
-                    "index": int,
-                    "outcome": str,
-                    "dof": Nullable(int),
-                    "F": _NUMBERS,
-                    "iterations": Nullable(int),
-                    "path": Nullable(Record({"status": Nullable(str), "deploys": Nullable(bool)})),
-                },
-                ("outcome", "dof"),
-            )
-        ]
+        "index": int,
+        "outcome": str,
+        "dof": Nullable(int),
+        "F": _NUMBERS,
+        "iterations": Nullable(int),
+        "path": Nullable(Record({"status": Nullable(str), "deploys": Nullable(bool)})),
     },
-    ("attempts",),
+    ("index", "outcome", "dof"),
 )
-"""What the report reads of ``log.json`` (see :data:`SUMMARY_SHAPE`)."""
+"""What the report reads of each attempt line of ``log.jsonl`` (see :data:`SUMMARY_SHAPE`)."""
 
 HISTORY_SHAPE = [
     Record(
@@ -191,10 +210,15 @@ HISTORY_SHAPE = [
 """The large-deformation history of a solution file (``deformation.history``)."""
 
 
-def check_shape(value, shape, file: str | os.PathLike, where: str = "") -> None:
-    """ValueError naming ``file`` and the key (``per_solution[0].development.D``) of the
-    first part of ``value`` (JSON data) that does not have ``shape`` (:data:`SUMMARY_SHAPE`
-    says how shapes are written), and what it holds instead."""
+def check_shape(
+    value, shape, file: str | os.PathLike, where: str = "", *, line: int | None = None
+) -> None:
+    """ValueError naming ``file`` (and its ``line``, for a file of JSON lines) and the key
+    (``per_solution[0].development.D``) of the first part of ``value`` (JSON data) that does
+    not have ``shape`` (:data:`SUMMARY_SHAPE` says how shapes are written), and what it
+    holds instead."""
+    label = f"'{file}'" + ("" if line is None else f", line {line}")
+    whole = "the document" if line is None else "the line"
     stack = [(value, shape, where)]
     while stack:
         value, given, where = stack.pop()
@@ -202,15 +226,15 @@ def check_shape(value, shape, file: str | os.PathLike, where: str = "") -> None:
         if value is None and shape is not given:
             continue
         if not _has_shape(value, shape):
-            key = f"{where!r}" if where else "the document"
+            key = f"{where!r}" if where else whole
             raise RigidfoldError(
-                f"'{file}': {key} is {received(value)}, expected {_expected(given)}"
+                f"{label}: {key} is {received(value)}, expected {_expected(given)}"
             )
         if isinstance(shape, Record):
             missing = [k for k in shape.required if k not in value]
             if missing:
-                key = f"{where!r}" if where else "the document"
-                raise RigidfoldError(f"'{file}': {key} has no {', '.join(map(repr, missing))}")
+                key = f"{where!r}" if where else whole
+                raise RigidfoldError(f"{label}: {key} has no {', '.join(map(repr, missing))}")
             stack += [
                 (value[k], s, f"{where}.{k}" if where else k)
                 for k, s in reversed(shape.keys.items())
@@ -394,12 +418,14 @@ class SolutionRecord:
 
 @dataclass(frozen=True)
 class AttemptRecord:
-    """What the report reads of one solve in ``log.json`` (checked with :data:`LOG_SHAPE`).
+    """What the report reads of one solve in ``log.jsonl`` (a line, checked with
+    :data:`LOG_SHAPE`).
 
     index : int; outcome : the :class:`rigidfold.generate.AttemptOutcome` value; dof : None
     when the solve was not analysed; F, iterations : the solve's; fixed_added, locked : the
     creases fixed by it and locked at the shape found; path : the deployability check's
-    figures or None.
+    figures or None; document : the whole line (every field of
+    :meth:`rigidfold.generate.Attempt.to_dict`).
     """
 
     index: int
@@ -410,11 +436,13 @@ class AttemptRecord:
     fixed_added: list | None = None
     locked: list | None = None
     path: dict | None = None
+    document: dict = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def from_dict(cls, data: dict, k: int = 0) -> AttemptRecord:
-        names = {f.name for f in fields(cls)}
-        return cls(**{"index": k, **{n: v for n, v in data.items() if n in names}})
+        names = {f.name for f in fields(cls)} - {"document"}
+        known = {n: v for n, v in data.items() if n in names}
+        return cls(**{"index": k, **known, "document": data})
 
 
 def aggregate(records: list[SolutionRecord]) -> dict:
@@ -507,12 +535,16 @@ class RunSummary:
     @classmethod
     def from_dict(cls, data: dict, file: str | os.PathLike) -> RunSummary:
         """The summary in ``data``, the JSON of ``file``: ValueError (one line, naming the
-        file and the key) when what is read does not have the shape it must have."""
+        file and the key) when what is read does not have the shape it must have, or (naming
+        the versions) when it was written by another :data:`SCHEMA_VERSION`."""
+        if "schema_version" in data:  # another version may have other keys
+            check_version(data["schema_version"], file)
         missing = [k for k in SUMMARY_SHAPE.required if k not in data]
         if missing:
             raise RigidfoldError(
                 f"{str(file)!r} is not the summary of rigidfold generate (no {', '.join(missing)})"
             )
+        check_version(data.get("schema_version"), file)  # a summary made before versions
         check_shape(data, SUMMARY_SHAPE, file)
         return cls(
             stop=data["stop"],

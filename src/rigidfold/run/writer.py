@@ -2,15 +2,18 @@
 
 ``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form, a
 ``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
-``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.json``
-(every attempt) and ``DIR/summary.json`` (the paper's counters, the development and
-deformation figures (Step 9), each solution's :class:`~rigidfold.run.SolutionRecord`, the
-options, the verdict and stage times). Every file is written atomically (temporary file,
-then rename), so each one on disk is always valid.
+``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.jsonl``
+(every attempt, a line appended for each: :class:`AttemptLog`) and ``DIR/summary.json`` (the
+paper's counters, the development and deformation figures (Step 9), each solution's
+:class:`~rigidfold.run.SolutionRecord`, the options, the verdict and stage times, the
+:data:`~rigidfold.run.schema.SCHEMA_VERSION`). Every other file is written atomically
+(temporary file, then rename), so each one on disk is always valid; the log is only ever
+appended to, so a crash can tear only its last line, which its reader skips.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -23,6 +26,7 @@ from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import (
     Attempt,
+    AttemptOutcome,
     GenerateOptions,
     Generation,
     Solution,
@@ -31,6 +35,7 @@ from rigidfold.generate import (
 )
 from rigidfold.io import (
     FoldData,
+    append_json_line,
     crease_pattern_frame,
     motion_frames,
     prepare_output_dir,
@@ -44,7 +49,7 @@ from rigidfold.io import (
 from rigidfold.mesh import CreasePattern
 from rigidfold.run.built import check_built_options, structure_check, thick_panels
 from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
-from rigidfold.run.schema import SolutionRecord, aggregate
+from rigidfold.run.schema import LOG_FILE, SCHEMA_VERSION, SolutionRecord, aggregate
 from rigidfold.run.verdict import RunVerdict, run_verdict
 from rigidfold.structure import StructureCheck
 from rigidfold.structure.material import parse_material
@@ -108,6 +113,56 @@ def write_checked_shape(
     return [fold, svg]
 
 
+class AttemptLog:
+    """The attempt log of a run, ``DIR/log.jsonl`` (:data:`~rigidfold.run.schema.LOG_FILE`),
+    only ever appended to: a header line ``{"schema_version": N}``, then a line per attempt
+    (:meth:`rigidfold.generate.Attempt.to_dict`), each flushed and synced as it is written
+    (:func:`rigidfold.io.append_json_line`): O(1) per attempt however long the run.
+
+    :meth:`sync` appends the attempts of a run not yet logged, and again those whose outcome
+    changed since they were (backtracking: ``dead_end``, and ``accepted`` again), with the
+    same ``index``; the reader (:func:`rigidfold.run.reader.read_log`) takes the last line
+    of each index. The file is created (exclusively, no symbolic link followed) with the
+    first line written.
+    """
+
+    _CHANGING = frozenset({AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END})
+    """The outcomes that may change after an attempt was logged (backtracking)."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.outcomes: list[AttemptOutcome] = []  # the outcome last logged, by index
+        self.changing: set[int] = set()  # the indices whose outcome may still change
+        self.created = False
+
+    def sync(self, attempts: list[Attempt]) -> None:
+        """Append the attempts not logged yet and those whose outcome changed."""
+        for k in sorted(self.changing):
+            if attempts[k].outcome is not self.outcomes[k]:
+                self._append(attempts[k])
+        for attempt in attempts[len(self.outcomes) :]:
+            self._append(attempt)
+
+    def start(self) -> None:
+        """Create the log with its header, when it is not yet."""
+        if not self.created:
+            append_json_line(self.path, {"schema_version": SCHEMA_VERSION}, create=True)
+            self.created = True
+
+    def _append(self, attempt: Attempt) -> None:
+        self.start()
+        append_json_line(self.path, attempt.to_dict())
+        k = attempt.index
+        if k == len(self.outcomes):
+            self.outcomes.append(attempt.outcome)
+        else:
+            self.outcomes[k] = attempt.outcome
+        if attempt.outcome in self._CHANGING:
+            self.changing.add(k)
+        else:
+            self.changing.discard(k)
+
+
 class RunWriter:
     """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date.
 
@@ -158,6 +213,8 @@ class RunWriter:
         self.motions: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # step -> traced motion
         self.fabrication: Fabrication | None = None
         self.structure: StructureCheck | None = None
+        self.log = AttemptLog(self.out / LOG_FILE)
+        self.summary_written = -float("inf")  # time.monotonic() of the last summary.json
 
     @property
     def final_verdicts(self) -> str | None:
@@ -174,7 +231,8 @@ class RunWriter:
         """Write summary.json of a run stopped by Ctrl-C or SIGTERM: ``run`` (None when it
         was stopped before its first attempt ended) with the stop INTERRUPTED, its best
         design so far named (:func:`rigidfold.generate.best_so_far`: no path is traced, no
-        check is run and nothing is exported) and its verdict (fell short)."""
+        check is run and nothing is exported) and its verdict (fell short); the log gets the
+        attempts it has not yet (appended, never rewritten)."""
         if run is None:
             run = Generation()
         run.stop, run.stop_detail = Stop.INTERRUPTED, ""
@@ -188,7 +246,8 @@ class RunWriter:
             [p.relative_to(self.out) for p in self.files],
             self.options.target_dof,
         )
-        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
+        self.log.start()
+        self.log.sync(run.attempts)
         self.write_summary(run)
 
     def release(self) -> None:
@@ -196,8 +255,15 @@ class RunWriter:
         self.lock.unlink(missing_ok=True)
 
     def on_attempt(self, run: Generation, attempt: Attempt) -> None:
-        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
-        self.write_summary(run)
+        """Append the attempt to the log; summary.json is written again when
+        ``Settings.generation.summary_interval`` seconds have passed since it last was (a
+        solution, a retraction and the end write it every time)."""
+        self.log.sync(run.attempts)
+        if attempt.outcome is AttemptOutcome.ACCEPTED:
+            return  # its solution (:meth:`on_solution`) writes summary.json next
+        interval = self.case.settings.generation.summary_interval
+        if time.monotonic() - self.summary_written >= interval:
+            self.write_summary(run)
 
     def on_solution(self, run: Generation, solution: Solution) -> None:
         full = self.options.check == "all"
@@ -205,12 +271,14 @@ class RunWriter:
         self.records.append(SolutionRecord(solution.step, solution.mechanism.dof))
         deform = full and self.options.deform
         self.files.append(self._write_solution(solution, deform=deform, motion=full))
+        self.log.sync(run.attempts)  # backtracking may have accepted its attempt again
         self.write_summary(run)
 
     def on_retract(self, run: Generation, solution: Solution) -> None:
         """Backtracking retracted the last solution: its FOLD and SVG files leave
         ``solutions/`` and its record summary.json (the run stays a chain, and the next
-        solution takes its step); log.json keeps its attempt, with the outcome DEAD_END."""
+        solution takes its step); its attempt is appended to the log again, with the outcome
+        DEAD_END."""
         assert self.solutions and self.solutions[-1] is solution, "not the last solution"
         self.solutions.pop()
         self.records.pop()
@@ -219,7 +287,7 @@ class RunWriter:
         fold = self.files.pop()
         for path in (fold, fold.with_suffix(".svg")):
             path.unlink(missing_ok=True)
-        write_json(self.out / "log.json", {"attempts": [a.to_dict() for a in run.attempts]})
+        self.log.sync(run.attempts)
         self.write_summary(run)
 
     def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
@@ -307,6 +375,7 @@ class RunWriter:
             self.exports = export_design(
                 pattern, coords2d, self.out / "final", name=stem, title=f"rigidfold: {stem}"
             )
+        self.log.sync(run.attempts)
         self.write_summary(run)
         return self.verdict
 
@@ -344,11 +413,13 @@ class RunWriter:
         self.records[final.step] = record
 
     def write_summary(self, run: Generation) -> None:
+        """Write summary.json (atomically) as the run stands now."""
         summary = run.to_dict()
         summary["time_s"].update(self.stage_times)
         write_json(
             self.out / "summary.json",
             {
+                "schema_version": SCHEMA_VERSION,
                 **summary,
                 **aggregate(self.records),
                 "per_solution": [r.to_dict(history=False) for r in self.records],
@@ -360,6 +431,7 @@ class RunWriter:
                 "target_surface": self.target_file,
             },
         )
+        self.summary_written = time.monotonic()
 
 
 def _not_checked(what: str, exc: Exception) -> dict:

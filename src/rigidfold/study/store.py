@@ -9,6 +9,10 @@ The ``meta`` table holds the study *configuration* (settings, solver, target DOF
 Steps 8-9 run). Opening a database with another configuration is refused before anything is
 written: its numbers would not be comparable.
 
+The database's ``PRAGMA user_version`` is :data:`STUDY_SCHEMA_VERSION`, set when it is
+created; a database of another version (0: made before rigidfold recorded one) is refused
+in one line naming both versions, not read through layers of old formats.
+
 A run's ``stop`` column holds how it ended, the :class:`~rigidfold.generate.Stop` value (NULL
 for a run that could not run), and ``status`` the words (``Generation.stop_reason``) or
 "error: <message>"; :meth:`Store.runs` returns typed rows (:class:`RunRow`).
@@ -253,6 +257,10 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
     return f"file:{quote(absolute, safe='/')}?mode={mode}"
 
 
+STUDY_SCHEMA_VERSION = 1
+"""The version of the tables of :data:`SCHEMA`, the database's ``PRAGMA user_version``; raise
+it with any change to them that an older rigidfold cannot read."""
+
 READONLY_COPY_TRIES = 3
 """Times a database opened read-only is copied into memory before it is read in place
 instead (:meth:`Store._connect_readonly`): a copy is kept only if nothing wrote meanwhile."""
@@ -392,6 +400,8 @@ class Store:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")
             self.db.executescript(SCHEMA)
+            # a new database takes this version; an existing one was checked to have it
+            self.db.execute(f"PRAGMA user_version = {STUDY_SCHEMA_VERSION}")
             if config is not None:
                 self.db.execute(
                     "INSERT OR IGNORE INTO meta VALUES ('config', ?)",
@@ -411,13 +421,18 @@ class Store:
     def _check(self, con: sqlite3.Connection, config: dict | None = None) -> None:
         """Refuse, reading ``con`` only, a damaged SQLite file, one without the tables and
         columns of :data:`SCHEMA`, one with text in a number column or a ``meta`` config that
-        is not a JSON object; and, given ``config``, one with no or another configuration."""
+        is not a JSON object, one of another :data:`STUDY_SCHEMA_VERSION` (``user_version``;
+        0, a database made before it was recorded, once its tables are found); and, given
+        ``config``, one with no or another configuration."""
         name = str(self.path)
         try:
             verdict = con.execute("PRAGMA quick_check").fetchone()[0]
             if verdict != "ok":
                 first = [line for line in verdict.splitlines() if not line.startswith("***")]
                 raise RigidfoldError(f"{name!r}: damaged SQLite file: {(first or [verdict])[0]}")
+            version = con.execute("PRAGMA user_version").fetchone()[0]
+            if version != 0:  # another version's tables may differ: before they are read
+                self._check_version(version)
             for table, columns in SCHEMA_COLUMNS.items():
                 have = {row[1] for row in con.execute(f"PRAGMA table_info({table})")}
                 if not have:
@@ -440,6 +455,7 @@ class Store:
                                 f"{name!r}: not a rigidfold study database: {table}.{column} "
                                 f"holds {bad[0]!r}, not a number"
                             )
+            self._check_version(version)  # a rigidfold study database made before versions
             row = con.execute("SELECT value FROM meta WHERE key='config'").fetchone()
         except sqlite3.Error as exc:
             raise RigidfoldError(f"{name!r}: damaged SQLite file: {exc}") from None
@@ -463,6 +479,15 @@ class Store:
             )
         if self._numerics is not None and not self._allow_mixed:
             self._check_numerics(con, self._numerics)
+
+    def _check_version(self, version: int) -> None:
+        """Refuse a database whose ``user_version`` is not :data:`STUDY_SCHEMA_VERSION`."""
+        if version != STUDY_SCHEMA_VERSION:
+            made = " (made before rigidfold recorded one)" if version == 0 else ""
+            raise RigidfoldError(
+                f"{str(self.path)!r} is a study database of schema version {version}{made}; "
+                f"this rigidfold reads version {STUDY_SCHEMA_VERSION}"
+            )
 
     def _check_numerics(self, con: sqlite3.Connection, current: dict) -> None:
         """Refuse a database whose runs were computed with other numerics than ``current``."""
