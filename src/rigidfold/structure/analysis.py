@@ -99,7 +99,7 @@ def solve_shell(
         ops.load(int(i) + 1, *map(float, moved[i]), 0.0, 0.0, 0.0)
     ops.constraints("Transformation")
     ops.numberer("RCM")
-    ops.system("UmfPack")
+    ops.system("Mumps")
     ops.test("NormDispIncr", float(settings.structure.tol), int(settings.structure.max_iter), 0)
     steps = settings.structure.steps if nonlinear else 1
     ops.algorithm("Newton" if nonlinear else "Linear")
@@ -193,7 +193,7 @@ def _frequencies(
     )
     ops.constraints("Transformation")
     ops.numberer("RCM")
-    ops.system("UmfPack")
+    ops.system("Mumps")
     ops.algorithm("Linear")
     ops.integrator("LoadControl", 0.0)
     ops.analysis("Static")
