@@ -25,7 +25,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from rigidfold.case import make_case
@@ -37,22 +36,21 @@ RIGIDFOLD = [sys.executable, "-m", "rigidfold"]
 def measured(cmd: list[str], timeout: float) -> tuple[int, float, float, str]:
     """``cmd`` run under a small wrapper process that reports its child's peak RSS."""
     wrapper = (
-        "import json, os, resource, subprocess, sys, time\n"
+        "import json, resource, subprocess, sys, time\n"
         "t0 = time.perf_counter()\n"
-        "p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+        "try:\n"
+        "    p = subprocess.run(sys.argv[2:], capture_output=True, text=True,\n"
+        "                       timeout=float(sys.argv[1]))\n"
+        "    code, out, err = p.returncode, p.stdout, p.stderr[-2000:]\n"
+        "except subprocess.TimeoutExpired:\n"  # run() has killed the command
+        "    code, out, err = -9, '', 'timed out'\n"
         "wall = time.perf_counter() - t0\n"
         "peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024\n"
-        "print(json.dumps([p.returncode, wall, peak, p.stdout, p.stderr[-2000:]]))\n"
+        "print(json.dumps([code, wall, peak, out, err]))\n"
     )
-    try:
-        done = subprocess.run(
-            [sys.executable, "-c", wrapper, *cmd],
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-        )
-    except subprocess.TimeoutExpired:
-        return -9, timeout, float("nan"), "timed out"
+    done = subprocess.run(
+        [sys.executable, "-c", wrapper, str(timeout), *cmd], capture_output=True, text=True
+    )
     code, wall, peak, out, err = json.loads(done.stdout)
     return code, wall, peak, out or err
 

@@ -150,10 +150,10 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     else:
         p.add_argument(
             "--thickness",
-            type=positive,
+            type=length("thickness"),
             default=STRUCTURE.thickness,
             metavar="T",
-            help="panel thickness in metres (default: %(default)g)",
+            help="panel thickness in metres, or with a unit: 18mm, 1.8cm (default: %(default)g)",
         )
     material = (
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
@@ -219,9 +219,11 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
         action="append",
         default=None,
         metavar="KIND=VALUE",
-        help=f"{pre}a load besides self-weight, repeatable: uniform=KPA (kN/m^2 of plan, "
-        "downwards: snow), pressure=KPA (kN/m^2 normal to the panels, positive pressing on "
-        "the upper face: wind), point=V:FX,FY,FZ (newtons at vertex V)",
+        help=f"{pre}a load besides self-weight, repeatable: uniform=Q (per m^2 of plan, "
+        "downwards: snow), pressure=Q (normal to the panels, positive pressing on the upper "
+        "face: wind), point=V:FX,FY,FZ (a force at vertex V). Q in Pa, kPa, kN/m2 or MPa "
+        "(uniform=0.5kPa, 500Pa), a bare number in kPa; forces in N, kN or MN "
+        "(point=12:0,0,-2kN), a bare number in newtons",
     )
     p.add_argument(
         "--no-self-weight",

@@ -188,6 +188,15 @@ class LimitSettings(Group):
         "them, m growing as they are found: a flat sheet has a free motion per vertex). A "
         "larger design is refused in one line instead of running out of memory.",
     )
+    max_structure_value: float = setting(
+        1e12,
+        "Largest magnitude of a number the structure check (``rigidfold structure``) takes, "
+        "in SI units: the panels' thickness (m), Young's modulus (Pa), density (kg/m^3), "
+        "the hinge stiffness (N m/rad per m) and each load (Pa of a uniform load or a "
+        "pressure, N of a point load's components). A larger one is refused in one line; "
+        "beyond it the analysis's products overflow (``--thickness 1e300``, ``--load "
+        "uniform=1e300``: OverflowError before) or its figure has no finite axis.",
+    )
     max_study_runs: int = setting(
         1_000_000,
         "Largest number of runs (surfaces x patterns x criteria) a Bezier study may plan: a "
@@ -198,3 +207,4 @@ class LimitSettings(Group):
     def __post_init__(self) -> None:
         self._integer(max_svg_depth=1, max_svg_pairs=1, max_svg_size=1, max_mesh_triangles=1)
         self._integer(max_structure_bytes=1)
+        self._positive("max_structure_value")

@@ -14,6 +14,7 @@ both go through them.
 from __future__ import annotations
 
 import difflib
+import json
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -21,7 +22,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
-from rigidfold.io.files import atomic_write, write_json
+from rigidfold.io.files import atomic_write, jsonable
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
     StructureCheck,
@@ -209,7 +210,13 @@ class StructureOptions:
             material=self.material, loads=self.loads, limit=self.limit, modes=self.modes
         )
         object.__setattr__(self, "limit", divisor)
-        check_numbers(thickness=self.thickness, hinge_stiffness=self.hinge_stiffness)
+        mat, parsed, _ = check_options(material=self.material, loads=self.loads)
+        check_numbers(
+            thickness=self.thickness,
+            hinge_stiffness=self.hinge_stiffness,
+            loads=parsed,
+            material=mat,
+        )
         object.__setattr__(self, "thickness", float(self.thickness))
         object.__setattr__(self, "hinge_stiffness", float(self.hinge_stiffness))
         supports = self.supports
@@ -296,6 +303,8 @@ def plan_design(
         thickness=options.thickness,
         hinge_stiffness=options.hinge_stiffness,
         loads=parsed,
+        material=mat,
+        settings=settings,
     )
     rigidity, pool = design_supports(
         pattern,
@@ -335,12 +344,26 @@ def check_design(
 
 def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:
     """``OUT/structure.json`` (``{"file": source, **check.to_dict()}``) and, when the
-    structure was analysed, ``OUT/structure.png`` (the deflected shape,
-    :func:`rigidfold.structure.figure.deflection_png`); ``out`` exists. Returns them."""
+    structure was analysed to finite displacements, ``OUT/structure.png`` (the deflected
+    shape, :func:`rigidfold.structure.figure.deflection_png`); ``out`` exists. Both are made
+    in memory first and written together: when one cannot be written, those written by this
+    call are removed again and the error (RigidfoldError, one line) names the files missing.
+    Returns them."""
     from rigidfold.structure.figure import deflection_png
 
-    written = [write_json(out / STRUCTURE_FILES[0], {"file": source, **check.to_dict()})]
+    data = jsonable({"file": source, **check.to_dict()}, where="the structure check")
+    files: list[tuple[Path, str | bytes]] = []
     png = deflection_png(check)
     if png is not None:
-        written.append(atomic_write(out / STRUCTURE_FILES[1], png))
-    return written
+        files.append((out / STRUCTURE_FILES[1], png))
+    files.append((out / STRUCTURE_FILES[0], json.dumps(data, indent=2, allow_nan=False) + "\n"))
+    written: list[Path] = []
+    try:
+        for path, content in files:
+            written.append(atomic_write(path, content))
+    except RigidfoldError as exc:
+        for path in written:
+            path.unlink(missing_ok=True)
+        names = ", ".join(path.name for path, _ in files)
+        raise RigidfoldError(f"{exc}; none of {names} written") from None
+    return written[::-1]  # structure.json first, as before

@@ -3,12 +3,16 @@ point loads, as nodal forces of the shell mesh.
 
 ``--load`` values (one per option, any number):
 
-* ``uniform=KPA``: a load of KPA kN/m^2 per plan area, downwards (snow): each element
-  carries KPA x its area projected on the xy plane;
-* ``pressure=KPA``: a pressure of KPA kN/m^2 normal to the panels (wind), positive pressing
-  on the upper face (against the upward normal of a counter-clockwise pattern), negative a
-  suction;
-* ``point=V:FX,FY,FZ``: a force in newtons at vertex V (``point=12:0,0,-500``).
+* ``uniform=Q``: a load of Q per plan area, downwards (snow): each element carries Q x its
+  area projected on the xy plane;
+* ``pressure=Q``: a pressure of Q normal to the panels (wind), positive pressing on the
+  upper face (against the upward normal of a counter-clockwise pattern), negative a suction;
+* ``point=V:FX,FY,FZ``: a force at vertex V (``point=12:0,0,-500``, ``point=12:0,0,-2kN``).
+
+Units: a pressure or uniform load in ``Pa``, ``kPa`` (= ``kN/m2``) or ``MPa``, a bare number
+in kPa (``uniform=0.5``, ``0.5kPa`` and ``500Pa`` are the same load); a point load's
+components in ``N``, ``kN`` or ``MN``, a bare number in newtons. :data:`PRESSURE_UNITS`,
+:data:`FORCE_UNITS`.
 
 Self-weight (on unless ``--no-self-weight``) is density x g x thickness per panel area. An
 element's load goes to its three nodes in equal shares (the consistent load of a uniform
@@ -18,6 +22,7 @@ load on a linear triangle's translations).
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,9 +57,20 @@ class Load:
         return f"{self.kind} {self.kpa:g} kPa"
 
 
+PRESSURE_UNITS = {"Pa": 1e-3, "kPa": 1.0, "kN/m2": 1.0, "MPa": 1e3}
+"""A uniform load's or pressure's units in kPa (any case; ``kN/m^2`` too); a bare number is
+kPa."""
+
+FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
+"""A point load's units in newtons (any case); a bare number is newtons."""
+
+_UNIT = re.compile(r"\s*([-+0-9.eE]+(?:[eE][-+]?\d+)?)\s*([a-zA-Z][a-zA-Z/^0-9]*)?\s*")
+
+
 def parse_load(text: str) -> Load:
-    """``uniform=KPA``, ``pressure=KPA`` or ``point=V:FX,FY,FZ`` (see the module's text);
-    ValueError naming what was received for anything else."""
+    """``uniform=Q``, ``pressure=Q`` (kPa, or with a unit: ``0.5kPa``, ``500Pa``) or
+    ``point=V:FX,FY,FZ`` (newtons, or ``2kN``) (see the module's text); ValueError naming
+    what was received for anything else."""
     if not isinstance(text, str) or "=" not in text:
         raise RigidfoldError(
             f"a load is uniform=KPA, pressure=KPA or point=V:FX,FY,FZ, got {text!r}"
@@ -62,7 +78,7 @@ def parse_load(text: str) -> Load:
     kind, _, value = (s.strip() for s in text.partition("="))
     kind = kind.lower()
     if kind in ("uniform", "pressure"):
-        kpa = _number(value, text)
+        kpa = _number(value, text, PRESSURE_UNITS)
         return Load(kind, kpa=kpa)
     if kind == "point":
         vertex, sep, force = value.partition(":")
@@ -77,21 +93,42 @@ def parse_load(text: str) -> Load:
             ) from None
         if v < 0:
             raise RigidfoldError(f"a point load's vertex must be >= 0, got {text!r}")
-        fx, fy, fz = (_number(p, text) for p in parts)
+        fx, fy, fz = (_number(p, text, FORCE_UNITS) for p in parts)
         return Load("point", vertex=v, force=(fx, fy, fz))
     raise RigidfoldError(
         f"unknown load kind {kind!r} in {text!r} (choose from {', '.join(LOAD_KINDS)})"
     )
 
 
-def _number(value: str, text: str) -> float:
+def _number(value: str, text: str, units: dict[str, float]) -> float:
+    """``value``, a number with an optional unit of ``units``, in the units' base."""
+    match = _UNIT.fullmatch(value)
+    known = {u.lower(): f for u, f in units.items()} | {"kn/m^2": units.get("kN/m2", 1.0)}
+    unit = (match.group(2) or "").lower() if match else ""
+    if match and unit and unit not in known:
+        raise RigidfoldError(
+            f"unknown unit {match.group(2)!r} in the load {text!r} (use "
+            f"{', '.join(units)}, or a bare number)"
+        )
     try:
-        x = float(value)
-    except ValueError:
+        x = float(match.group(1)) * known.get(unit, 1.0) if match else math.nan
+    except (ValueError, OverflowError):
         x = math.nan
     if not math.isfinite(x):
         raise RigidfoldError(f"a load's value must be a finite number, got {text!r}")
     return x
+
+
+def check_magnitudes(loads: tuple[Load, ...], largest: float) -> None:
+    """ValueError (one line) for a load above ``largest`` in SI units (Pa, N)."""
+    for load in loads:
+        size = max(abs(f) for f in load.force) if load.kind == "point" else abs(load.kpa) * 1e3
+        if not size <= largest:
+            unit = "N" if load.kind == "point" else "Pa"
+            raise RigidfoldError(
+                f"the {load.describe()} is above {largest:g} {unit} "
+                "(Settings.limits.max_structure_value)"
+            )
 
 
 def check_loads(loads: tuple[Load, ...], n_vertices: int) -> None:

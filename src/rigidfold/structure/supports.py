@@ -315,7 +315,7 @@ def _sparse_modes(
         W = np.asfortranarray(rng.random((cols, n)).T - 0.5)
         for _ in range(settings.structure.soft_iterations):
             W = np.linalg.qr(lu.solve(W))[0]
-        R = np.linalg.qr(np.asarray(C @ W), mode="r")
+        R: np.ndarray = np.asarray(np.linalg.qr(np.asarray(C @ W), mode="r"))
         if R.shape[0] < cols:
             R = np.vstack([R, np.zeros((cols - R.shape[0], cols))])
         _, values, vt = np.linalg.svd(R)
