@@ -253,3 +253,17 @@ def square_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("square") / "square.fold"
     write_fold(path, square())
     return path
+
+
+def test_long_steps_report_progress():
+    """A large design (here: any, with ``structure_sparse_vertices`` 0) says each step as it
+    starts; a small one stays quiet for its first seconds."""
+    lines: list[str] = []
+    large = DEFAULTS.with_(structure_sparse_vertices=0)
+    options = StructureOptions(supports="0,2,6,8", modes=1)
+    plan_design(square(), options, settings=large, progress=lines.append).check()
+    assert [line.split()[0] for line in lines] == ["supports:", "linear", "natural"]
+    assert all(line.endswith(" s)") for line in lines)
+    quiet: list[str] = []
+    plan_design(square(), options, progress=quiet.append).check()
+    assert quiet == []

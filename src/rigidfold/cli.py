@@ -26,6 +26,7 @@ from rigidfold.cli_checks import (
     positive,
     structure_arguments,
     structure_options,
+    structure_progress,
 )
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, HESSIANS, check_seed
 from rigidfold.errors import RigidfoldError
@@ -936,7 +937,12 @@ def _cmd_structure(args: argparse.Namespace) -> int:
     from rigidfold.workflows import structure
 
     run = structure(
-        args.file, args.out, structure_options(args), up=args.up, overwrite=args.overwrite
+        args.file,
+        args.out,
+        structure_options(args),
+        up=args.up,
+        overwrite=args.overwrite,
+        progress=structure_progress,
     )
     code = 0 if run.status is StructureStatus.PASSED else EXIT_FAILED
     if args.json:

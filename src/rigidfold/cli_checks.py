@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 
 from rigidfold.config import DEFAULTS, SIDES
 from rigidfold.fabricate.options import FabricateOptions
@@ -266,6 +267,11 @@ def fabricate_options(args: argparse.Namespace) -> FabricateOptions | None:
         sheet=args.sheet,
         min_thickness=args.min_thickness,
     )
+
+
+def structure_progress(line: str) -> None:
+    """``rigidfold structure``'s progress: each long step of the check on a line of stderr."""
+    print(f"rigidfold structure: {line}", file=sys.stderr, flush=True)
 
 
 def structure_options(args: argparse.Namespace) -> StructureOptions:

@@ -26,6 +26,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -146,6 +147,7 @@ def solve_shell(
     nonlinear: bool = False,
     modes: int = 0,
     settings: Settings = DEFAULTS,
+    progress: Callable[[str], None] | None = None,
 ) -> ShellResponse:
     """Static analysis of the shell model under nodal ``forces`` (N, 3) newtons, then
     ``modes`` natural frequencies of the unloaded linear model (at most as many as it has:
@@ -203,6 +205,8 @@ def solve_shell(
     rotation = _hinge_rotations(mesh, disp)
     frequencies = np.zeros(0)
     if modes > 0:
+        if progress is not None:
+            progress(f"natural frequencies ({modes} asked)")
         frequencies, note = _frequencies(ops, model, modes)
         message = "; ".join(m for m in (message, note) if m)
     ops.wipe()

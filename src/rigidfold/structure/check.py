@@ -13,6 +13,7 @@ is twice the largest plan distance from a support to a vertex (the cantilever co
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -375,10 +376,12 @@ def check_structure(
     modes: int = DEFAULTS.structure.modes,
     auto: bool = False,
     settings: Settings = DEFAULTS,
+    progress: Callable[[str], None] | None = None,
 ) -> StructureCheck:
     """Load the design on the supports of ``rigidity`` (from
     :func:`~rigidfold.structure.supports.check_supports` or ``auto_supports``) and check
-    it; no analysis when the supports leave a mechanism."""
+    it; no analysis when the supports leave a mechanism. ``progress`` is handed a line as
+    each analysis starts."""
     check_inputs(
         pattern,
         thickness=thickness,
@@ -404,6 +407,11 @@ def check_structure(
     if not rigidity.stable:
         return StructureCheck(mesh=None, response=None, **common)  # type: ignore[arg-type]
     mesh = shell_mesh(held, settings.structure.subdivisions)
+    if progress is not None:
+        progress(
+            f"{'nonlinear' if nonlinear else 'linear'} static analysis of {mesh.n_elements} "
+            f"shells in OpenSees"
+        )
     weight = material.density * settings.structure.gravity * thickness if self_weight else 0.0
     forces = nodal_loads(mesh, tuple(loads), self_weight=weight)
     response = solve_shell(
@@ -417,5 +425,6 @@ def check_structure(
         nonlinear=nonlinear,
         modes=modes,
         settings=settings,
+        progress=progress,
     )
     return StructureCheck(mesh=mesh, response=response, **common)  # type: ignore[arg-type]

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import difflib
 import json
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -50,6 +52,26 @@ limit is met (:mod:`rigidfold.structure.service`)."""
 
 STRUCTURE_FILES = ("structure.json", "structure.png")
 """The files :func:`write_structure` writes into its directory."""
+
+Report = Callable[[str], None]
+"""Takes a line saying which step of the check starts (progress on stderr)."""
+
+
+class Steps:
+    """Progress of a structure check: :meth:`__call__` hands ``report`` a step's words and
+    the seconds since the check began, for designs of more than
+    ``Settings.structure.sparse_vertices`` vertices at once, for smaller ones once the check
+    has run ``QUIET_FOR`` seconds (a check of a few seconds says nothing)."""
+
+    QUIET_FOR = 2.0
+
+    def __init__(self, report: Report | None, *, large: bool) -> None:
+        self.report, self.large, self.t0 = report, large, time.perf_counter()
+
+    def __call__(self, words: str) -> None:
+        elapsed = time.perf_counter() - self.t0
+        if self.report is not None and (self.large or elapsed >= self.QUIET_FOR):
+            self.report(f"{words} ({elapsed:.1f} s)")
 
 
 def design_supports(
@@ -99,6 +121,8 @@ class DesignPlan:
     settings: Settings
     service: np.ndarray | None = None
     """(c,) int64 the candidates ``--supports service`` may pin, None for other supports."""
+    steps: Steps | None = None
+    """Where the check's steps are reported (:class:`Steps`), or None."""
 
     def check(self) -> StructureCheck:
         """The analysis and its verdict (:func:`rigidfold.structure.check.check_structure`);
@@ -108,12 +132,19 @@ class DesignPlan:
             return self._check(self.rigidity)
         from rigidfold.structure.service import grow_supports
 
+        count = [0]
+
+        def analyse(rigidity: Rigidity, hinges: float | None) -> StructureCheck:
+            count[0] += 1
+            self._step(
+                f"--supports service: analysis {count[0]}, "
+                f"{len(rigidity.supports.pinned)} pins"
+                + ("" if hinges is None else f", hinges of {hinges:.3g} N m/rad per m")
+            )
+            return self._check(rigidity, nonlinear=False, modes=0, hinges=hinges, quiet=True)
+
         found, growth = grow_supports(
-            self.pattern,
-            self.rigidity,
-            self.service,
-            lambda rigidity, k: self._check(rigidity, nonlinear=False, modes=0, hinges=k),
-            self.settings,
+            self.pattern, self.rigidity, self.service, analyse, self.settings
         )
         final = found if not self.nonlinear and not self.modes else self._check(found.rigidity)
         return replace(final, growth=growth)
@@ -125,6 +156,7 @@ class DesignPlan:
         nonlinear: bool | None = None,
         modes: int | None = None,
         hinges: float | None = None,
+        quiet: bool = False,
     ) -> StructureCheck:
         return check_structure(
             self.pattern,
@@ -139,7 +171,12 @@ class DesignPlan:
             modes=self.modes if modes is None else modes,
             auto=self.auto,
             settings=self.settings,
+            progress=None if quiet else self.steps,
         )
+
+    def _step(self, words: str) -> None:
+        if self.steps is not None:
+            self.steps(words)
 
 
 def check_options(
@@ -293,10 +330,12 @@ def plan_design(
     options: StructureOptions = StructureOptions(),
     *,
     settings: Settings = DEFAULTS,
+    progress: Report | None = None,
 ) -> DesignPlan:
     """The :class:`DesignPlan` of ``pattern`` with ``options`` (see the module's text and
     :func:`design_supports`); the indices and loads are checked against the design
-    (ValueError, one line)."""
+    (ValueError, one line). ``progress`` is handed a line as each long step starts
+    (:class:`Steps`)."""
     mat, parsed, _ = check_options(material=options.material, loads=options.loads)
     check_inputs(
         pattern,
@@ -305,6 +344,12 @@ def plan_design(
         loads=parsed,
         material=mat,
         settings=settings,
+    )
+    options.check_indices(pattern.n_vertices, pattern.n_edges)
+    steps = Steps(progress, large=pattern.n_vertices > settings.structure.sparse_vertices)
+    steps(
+        f"supports: the free motions of {pattern.n_vertices} vertices, "
+        f"{'the supports chosen' if options.auto else 'the supports checked'}"
     )
     rigidity, pool = design_supports(
         pattern,
@@ -328,6 +373,7 @@ def plan_design(
         options.modes,
         settings,
         pool if options.service else None,
+        steps,
     )
 
 
@@ -336,10 +382,11 @@ def check_design(
     options: StructureOptions = StructureOptions(),
     *,
     settings: Settings = DEFAULTS,
+    progress: Report | None = None,
 ) -> StructureCheck:
     """The structure check of ``pattern`` with ``options``: every input checked first
-    (ValueError, one line), then the analysis."""
-    return plan_design(pattern, options, settings=settings).check()
+    (ValueError, one line), then the analysis (``progress``: :func:`plan_design`)."""
+    return plan_design(pattern, options, settings=settings, progress=progress).check()
 
 
 def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:
