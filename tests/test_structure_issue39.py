@@ -21,8 +21,9 @@ from rigidfold.io import write_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure import (
     MATERIALS,
-    Load,
     Material,
+    Pins,
+    Point,
     StructureOptions,
     StructureStatus,
     Supports,
@@ -79,7 +80,7 @@ def test_more_modes_than_the_model_has_gives_all_it_has():
 )
 def test_numbers_that_overflow_are_refused_when_the_options_are_made(changes):
     with pytest.raises(RigidfoldError, match="max_structure_value") as err:
-        StructureOptions(**changes)
+        StructureOptions.from_strings(**changes)
     assert "\n" not in str(err.value)
 
 
@@ -88,7 +89,7 @@ def test_the_library_refuses_them_too():
     with pytest.raises(RigidfoldError, match="max_structure_value"):
         checked(p, thickness=1e300)
     with pytest.raises(RigidfoldError, match="max_structure_value"):
-        checked(p, loads=(Load("point", vertex=4, force=(0.0, 0.0, -1e300)),))
+        checked(p, loads=(Point(4, (0.0, 0.0, -1e300)),))
 
 
 def test_generate_refuses_them_before_the_run():
@@ -260,7 +261,7 @@ def test_long_steps_report_progress():
     starts; a small one stays quiet for its first seconds."""
     lines: list[str] = []
     large = DEFAULTS.with_(structure_sparse_vertices=0)
-    options = StructureOptions(supports="0,2,6,8", modes=1)
+    options = StructureOptions(supports=Pins((0, 2, 6, 8)), modes=1)
     plan_design(square(), options, settings=large, progress=lines.append).check()
     assert [line.split()[0] for line in lines] == ["supports:", "linear", "natural"]
     assert all(line.endswith(" s)") for line in lines)

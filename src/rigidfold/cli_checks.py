@@ -176,7 +176,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--supports",
-        default=STRUCTURE.supports,
+        default=STRUCTURE.supports.text,
         metavar="V,V,...|auto|service",
         help=f"{pre}pinned vertices (indices of the design's vertices); auto: the fewest "
         "--support-candidates that make the mechanism first-order rigid, of the largest "
@@ -233,7 +233,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--limit",
-        default=f"L/{STRUCTURE.limit:g}",
+        default=STRUCTURE.limit.text,
         metavar="L/N",
         help=f"{pre}serviceability: the largest displacement may be at most the span over N; "
         "the span is the largest plan distance between supports (twice the reach of a "
@@ -277,7 +277,7 @@ def structure_progress(line: str) -> None:
 def structure_options(args: argparse.Namespace) -> StructureOptions:
     """The structure check's options of the parsed arguments (checked); generate's
     ``--thickness`` and ``--material`` where not given: the check's defaults."""
-    return StructureOptions(
+    return StructureOptions.from_strings(
         thickness=STRUCTURE.thickness if args.thickness is None else args.thickness,
         material=STRUCTURE.material if args.material is None else args.material,
         supports=args.supports,

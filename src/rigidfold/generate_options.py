@@ -237,18 +237,19 @@ class GenerateOptions:
 
     @property
     def supports(self) -> str:
-        """The structure check's supports (its default where it does not run)."""
-        return (self.structure or StructureOptions()).supports
+        """The structure check's supports as text (its default where it does not run)."""
+        return (self.structure or StructureOptions()).supports.text
 
     @property
     def loads(self) -> tuple[str, ...]:
-        """The structure check's loads (none where it does not run)."""
-        return (self.structure or StructureOptions()).loads
+        """The structure check's loads as texts (none where it does not run)."""
+        return tuple((self.structure or StructureOptions()).texts()["loads"])
 
     @property
     def limit(self) -> float:
-        """The structure check's deflection limit (its default where it does not run)."""
-        return (self.structure or StructureOptions()).limit
+        """The structure check's deflection limit's divisor (its default where it does not
+        run)."""
+        return (self.structure or StructureOptions()).limit.divisor
 
     def replace(self, **changes) -> GenerateOptions:
         """These options with ``changes`` (field names, or the keywords of earlier versions),

@@ -24,7 +24,13 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
 from rigidfold.structure.analysis import ShellResponse, solve_shell
-from rigidfold.structure.loads import Load, check_loads, check_magnitudes, nodal_loads
+from rigidfold.structure.loads import (
+    Load,
+    SelfWeight,
+    check_loads,
+    check_magnitudes,
+    nodal_loads,
+)
 from rigidfold.structure.material import Material
 from rigidfold.structure.model import ShellMesh, shell_mesh
 from rigidfold.structure.stability import Stability
@@ -390,6 +396,9 @@ def check_structure(
         material=material,
         settings=settings,
     )
+    if any(isinstance(load, SelfWeight) for load in loads):
+        self_weight = True
+        loads = tuple(load for load in loads if not isinstance(load, SelfWeight))
     held = rigidity.supports.held(pattern)
     common = dict(
         pattern=held,

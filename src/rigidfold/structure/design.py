@@ -1,10 +1,11 @@
-"""The structure check of a design from its options as the user gives them, and its files.
+"""The structure check of a design from its options, and its files.
 
 :class:`StructureOptions` holds the options of ``rigidfold structure`` (which ``rigidfold
-generate --structure`` shares), checked once when made. :func:`plan_design` reads them
-against a design: the supports (``"auto"``, ``"service"`` or ``"V,V,..."``), the loads
-(``--load`` texts) and the material (a preset or ``"E,nu,density"``); it chooses or checks
-the supports (a :class:`DesignPlan`), whose ``check`` runs
+generate --structure`` shares), typed and checked once when made; the command line's texts
+(``--supports auto``, ``--load uniform=0.5kPa``, ``--limit L/250``) are read once by
+:meth:`StructureOptions.from_strings` into :mod:`rigidfold.structure.choices` and
+:mod:`rigidfold.structure.loads` values. :func:`plan_design` reads them against a design:
+it chooses or checks the supports (a :class:`DesignPlan`), whose ``check`` runs
 :func:`rigidfold.structure.check.check_structure` (:func:`check_design` does both);
 :func:`write_structure` writes ``structure.json`` and ``structure.png``
 (:data:`STRUCTURE_FILES`). ``rigidfold structure`` and ``rigidfold generate --structure``
@@ -13,7 +14,6 @@ both go through them.
 
 from __future__ import annotations
 
-import difflib
 import json
 import time
 from collections.abc import Callable
@@ -31,9 +31,17 @@ from rigidfold.structure.check import (
     check_inputs,
     check_numbers,
     check_structure,
-    parse_limit,
 )
-from rigidfold.structure.loads import Load, check_loads, parse_load
+from rigidfold.structure.choices import (
+    SUPPORT_TYPES,
+    Auto,
+    Limit,
+    Pins,
+    Service,
+    SupportSpec,
+    parse_supports,
+)
+from rigidfold.structure.loads import LOAD_TYPES, Load, SelfWeight, check_loads, parse_load
 from rigidfold.structure.material import Material, parse_material
 from rigidfold.structure.supports import (
     Rigidity,
@@ -44,11 +52,6 @@ from rigidfold.structure.supports import (
     parse_indices,
     support_candidates,
 )
-
-CHOSEN_SUPPORTS = ("auto", "service")
-"""The words ``--supports`` takes besides a list of vertices: ``auto``, the fewest pins that
-make the design first-order rigid; ``service``, those and more pins until the deflection
-limit is met (:mod:`rigidfold.structure.service`)."""
 
 STRUCTURE_FILES = ("structure.json", "structure.png")
 """The files :func:`write_structure` writes into its directory."""
@@ -76,7 +79,7 @@ class Steps:
 
 def design_supports(
     pattern: CreasePattern,
-    supports: str = "auto",
+    supports: SupportSpec = Auto(),  # noqa: B008 (frozen)
     *,
     candidates: str | None = None,
     clamped: str = "",
@@ -84,19 +87,20 @@ def design_supports(
     settings: Settings = DEFAULTS,
 ) -> tuple[Rigidity, np.ndarray | None]:
     """(the supports' first-order rigidity, the candidates they were chosen from or None
-    where they were given): ``supports``
-    ``"auto"`` (the fewest pinned ``candidates``: ``"boundary"``, ``"ground"`` or
-    ``"V,V,..."``; ``"service"`` starts from the same set) or ``"V,V,..."`` pinned
-    vertices, with ``clamped`` vertices and ``actuators`` (free creases held). ValueError
-    (one line) for an index the design lacks."""
+    where they were given): ``supports`` :class:`Auto` (the fewest pinned ``candidates``:
+    ``"boundary"``, ``"ground"`` or ``"V,V,..."``; :class:`Service` starts from the same
+    set) or :class:`Pins`, with ``clamped`` vertices and ``actuators`` (free creases held).
+    ValueError (one line) for an index the design lacks."""
     V = pattern.n_vertices
     clamp = parse_indices(clamped, V, "clamped vertices")
     held = parse_indices(actuators, pattern.n_edges, "actuators")
-    if supports.strip().lower() in CHOSEN_SUPPORTS:
+    if isinstance(supports, Auto | Service):
         pool = support_candidates(pattern, candidates, settings)
         rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
         return rigidity, pool
-    pins = parse_indices(supports, V, "supports")
+    if not isinstance(supports, Pins):
+        raise RigidfoldError(f"supports must be Auto, Service or Pins, got {supports!r}")
+    pins = parse_indices(supports.text, V, "supports")
     if not len(pins) and not len(clamp):
         raise RigidfoldError("give --supports V,V,..., auto or service, or --clamped vertices")
     return check_supports(pattern, Supports(pins, clamp, held), settings), None
@@ -182,56 +186,63 @@ class DesignPlan:
 def check_options(
     *,
     material: str | Material = DEFAULTS.structure.material,
-    loads: tuple[str, ...] = (),
-    limit: str | float = DEFAULTS.structure.limit,
+    loads: tuple[Load, ...] = (),
+    limit: Limit = Limit(DEFAULTS.structure.limit),  # noqa: B008 (frozen)
     modes: int = DEFAULTS.structure.modes,
 ) -> tuple[Material, tuple[Load, ...], float]:
-    """(material, loads, limit divisor) read from the options as given; ValueError (one
-    line) for any that is not valid, before the design is read."""
+    """(material, loads, limit divisor) of the options; ValueError (one line) for any that
+    is not valid, before the design is read."""
     mat = parse_material(material)
-    divisor = parse_limit(limit)
-    parsed = tuple(parse_load(text) for text in loads)
+    if not isinstance(limit, Limit):
+        raise RigidfoldError(f"limit must be a Limit (Limit.parse('L/250')), got {limit!r}")
     if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
         raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
-    return mat, parsed, divisor
+    return mat, tuple(loads), limit.divisor
+
+
+_TEXT_FIELDS = ("supports", "loads", "limit")
+"""The fields the command line gives as text (:meth:`StructureOptions.from_strings`)."""
 
 
 @dataclass(frozen=True)
 class StructureOptions:
-    """The structure check of a design as ``rigidfold structure`` takes it, every option as
-    the user gives it (``rigidfold generate --structure`` builds the same).
+    """The structure check of a design as ``rigidfold structure`` takes it (``rigidfold
+    generate --structure`` builds the same), every value typed.
 
     thickness : the panels' thickness, metres.
     material : a preset name (:data:`~rigidfold.structure.MATERIALS`) or ``"E,nu,density"``
         in SI units.
-    supports : ``"auto"`` (the fewest pinned ``candidates`` that make the mechanism
-        first-order rigid), ``"service"`` (those, and more until the deflection limit is
-        met: :mod:`rigidfold.structure.service`) or ``"V,V,..."`` pinned vertices.
+    supports : :class:`Auto` (the fewest pinned ``candidates`` that make the mechanism
+        first-order rigid), :class:`Service` (those, and more until the deflection limit is
+        met: :mod:`rigidfold.structure.service`) or :class:`Pins` (pinned vertices).
     candidates : the vertices ``auto`` may choose: None or ``"boundary"``, ``"ground"``, or
         ``"V,V,..."``.
     clamped : ``"V,V,..."`` clamped vertices; actuators : ``"I,J,..."`` free creases held
         at their angle (``""``: none).
     hinge_stiffness : N m/rad per metre of every free crease (0: free hinges).
-    loads : ``--load`` texts (:func:`~rigidfold.structure.parse_load`), kept as a tuple.
+    loads : :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`,
+        :class:`Pressure`, :class:`Point`; a :class:`SelfWeight` among them is
+        ``self_weight``), a tuple.
     self_weight : include the panels' weight.
-    limit : the deflection limit's divisor, or ``"L/250"``; kept as the divisor (a float).
+    limit : the deflection limit, a :class:`Limit`.
     nonlinear : geometrically nonlinear analysis; modes : natural frequencies computed.
 
-    Defaults from ``Settings.structure``. Every value is checked when the options are made
-    (ValueError, one line, naming what was received); the indices against a design by
-    :meth:`check_indices` and :func:`plan_design`.
+    :meth:`from_strings` reads the command line's texts (``"auto"``, ``"uniform=0.5kPa"``,
+    ``"L/250"``). Defaults from ``Settings.structure``. Every value is checked when the
+    options are made (ValueError, one line, naming what was received); the indices against
+    a design by :meth:`check_indices` and :func:`plan_design`.
     """
 
     thickness: float = DEFAULTS.structure.thickness
     material: str = DEFAULTS.structure.material
-    supports: str = "auto"
+    supports: SupportSpec = Auto()  # noqa: RUF009 (frozen)
     candidates: str | None = None
     clamped: str = ""
     actuators: str = ""
     hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness
-    loads: tuple[str, ...] = ()
+    loads: tuple[Load, ...] = ()
     self_weight: bool = True
-    limit: float = DEFAULTS.structure.limit
+    limit: Limit = Limit(DEFAULTS.structure.limit)  # noqa: RUF009 (frozen)
     nonlinear: bool = False
     modes: int = DEFAULTS.structure.modes
 
@@ -240,14 +251,27 @@ class StructureOptions:
             raise RigidfoldError(
                 f"material must be a preset name or E,nu,density, got {self.material!r}"
             )
+        if not isinstance(self.supports, SUPPORT_TYPES):
+            raise RigidfoldError(
+                "supports must be Auto(), Service() or Pins(...) (from_strings reads "
+                f"'auto', 'service', 'V,V,...'), got {self.supports!r}"
+            )
         if isinstance(self.loads, str) or not isinstance(self.loads, tuple | list):
-            raise RigidfoldError(f"loads must be a list of load texts, got {self.loads!r}")
-        object.__setattr__(self, "loads", tuple(self.loads))
-        _, _, divisor = check_options(
+            raise RigidfoldError(f"loads must be a tuple of loads, got {self.loads!r}")
+        bad = [x for x in self.loads if not isinstance(x, LOAD_TYPES)]
+        if bad:
+            raise RigidfoldError(
+                "loads must be Uniform, Pressure, Point or SelfWeight (from_strings reads "
+                f"'uniform=0.5kPa'), got {bad[0]!r}"
+            )
+        if any(isinstance(x, SelfWeight) for x in self.loads):
+            object.__setattr__(self, "self_weight", True)
+        object.__setattr__(
+            self, "loads", tuple(x for x in self.loads if not isinstance(x, SelfWeight))
+        )
+        mat, parsed, _ = check_options(
             material=self.material, loads=self.loads, limit=self.limit, modes=self.modes
         )
-        object.__setattr__(self, "limit", divisor)
-        mat, parsed, _ = check_options(material=self.material, loads=self.loads)
         check_numbers(
             thickness=self.thickness,
             hinge_stiffness=self.hinge_stiffness,
@@ -256,24 +280,9 @@ class StructureOptions:
         )
         object.__setattr__(self, "thickness", float(self.thickness))
         object.__setattr__(self, "hinge_stiffness", float(self.hinge_stiffness))
-        supports = self.supports
-        if isinstance(supports, str) and not self.auto and any(c.isalpha() for c in supports):
-            close = difflib.get_close_matches(supports.strip().lower(), CHOSEN_SUPPORTS, n=1)
-            raise RigidfoldError(
-                "supports must be auto, service or comma-separated vertex indices, got "
-                f"{supports!r}" + (f" (did you mean {close[0]}?)" if close else "")
-            )
-        if not isinstance(supports, str):
-            raise RigidfoldError(
-                "supports must be auto, service or comma-separated vertex indices, got "
-                f"{supports!r}"
-            )
         clamped = index_list(self.clamped, "clamped vertices")
-        if not self.auto and not index_list(supports, "supports"):
-            if not clamped:
-                raise RigidfoldError(
-                    "give --supports V,V,..., auto or service, or --clamped vertices"
-                )
+        if isinstance(self.supports, Pins) and not self.supports.vertices and not clamped:
+            raise RigidfoldError("give --supports V,V,..., auto or service, or --clamped vertices")
         candidates = self.candidates
         if candidates is not None and (
             not isinstance(candidates, str)
@@ -285,21 +294,43 @@ class StructureOptions:
             if not isinstance(getattr(self, name), bool):
                 raise RigidfoldError(f"{name} must be true or false, got {getattr(self, name)!r}")
 
+    @classmethod
+    def from_strings(
+        cls,
+        *,
+        supports: str = "auto",
+        loads: tuple[str, ...] | list[str] = (),
+        limit: str | float = DEFAULTS.structure.limit,
+        **others,
+    ) -> StructureOptions:
+        """The options of the command line's texts: ``supports`` ``"auto"``, ``"service"`` or
+        ``"V,V,..."``; ``loads`` ``--load`` texts (:func:`~rigidfold.structure.parse_load`:
+        ``"uniform=0.5kPa"``, a bare number in kPa; ``"point=12:0,0,-2kN"``, a bare number
+        in newtons); ``limit`` ``"L/250"`` or 250; the other fields as typed."""
+        if isinstance(loads, str) or not isinstance(loads, tuple | list):
+            raise RigidfoldError(f"loads must be a list of load texts, got {loads!r}")
+        return cls(
+            supports=parse_supports(supports),
+            loads=tuple(parse_load(text) for text in loads),
+            limit=Limit.parse(limit),
+            **others,
+        )
+
     @property
     def auto(self) -> bool:
-        """Whether the supports are chosen (``supports`` ``"auto"`` or ``"service"``)."""
-        return self.supports.strip().lower() in CHOSEN_SUPPORTS
+        """Whether the supports are chosen (:class:`Auto` or :class:`Service`)."""
+        return isinstance(self.supports, Auto | Service)
 
     @property
     def service(self) -> bool:
-        """Whether the chosen supports are grown for the deflection (``"service"``)."""
-        return self.supports.strip().lower() == "service"
+        """Whether the chosen supports are grown for the deflection (:class:`Service`)."""
+        return isinstance(self.supports, Service)
 
     def check_indices(self, n_vertices: int, n_edges: int) -> None:
         """ValueError (one line) for a support, candidate, clamped vertex, actuator or point
         load that a design of ``n_vertices`` vertices and ``n_edges`` edges lacks."""
-        if not self.auto:
-            parse_indices(self.supports, n_vertices, "supports")
+        if isinstance(self.supports, Pins):
+            parse_indices(self.supports.text, n_vertices, "supports")
         if self.candidates is not None and self.candidates.strip().lower() not in (
             "boundary",
             "ground",
@@ -307,22 +338,46 @@ class StructureOptions:
             parse_indices(self.candidates, n_vertices, "support candidates")
         parse_indices(self.clamped, n_vertices, "clamped vertices")
         parse_indices(self.actuators, n_edges, "actuators")
-        check_loads(tuple(parse_load(text) for text in self.loads), n_vertices)
+        check_loads(self.loads, n_vertices)
 
     def replace(self, **changes) -> StructureOptions:
-        """These options with ``changes`` (field names), checked."""
-        return replace(self, **changes) if changes else self
+        """These options with ``changes`` (field names), checked; ``supports``, ``loads`` and
+        ``limit`` may also be given as the texts of :meth:`from_strings` (the keywords of
+        :class:`~rigidfold.generate.GenerateOptions` of earlier versions)."""
+        if not changes:
+            return self
+        if isinstance(changes.get("supports"), str):
+            changes["supports"] = parse_supports(changes["supports"])
+        loads = changes.get("loads")
+        if isinstance(loads, tuple | list) and any(isinstance(x, str) for x in loads):
+            changes["loads"] = tuple(parse_load(x) if isinstance(x, str) else x for x in loads)
+        if "limit" in changes and not isinstance(changes["limit"], Limit):
+            changes["limit"] = Limit.parse(changes["limit"])
+        return replace(self, **changes)
+
+    def texts(self) -> dict:
+        """``supports``, ``loads`` and ``limit`` as the command line's texts (and
+        :meth:`from_strings`) take them: ``"auto"``, ``["uniform=0.5"]`` (kPa), the divisor."""
+        return {
+            "supports": self.supports.text,
+            "loads": [load.text for load in self.loads],
+            "limit": self.limit.divisor,
+        }
 
     def to_dict(self) -> dict:
-        """The options as JSON values; :meth:`from_dict` reads them."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
+        """The options as JSON values (``supports``, ``loads``, ``limit`` as their texts:
+        :meth:`texts`); :meth:`from_dict` reads them."""
+        data = {f.name: getattr(self, f.name) for f in fields(self)}
+        return data | self.texts()
 
     @classmethod
     def from_dict(cls, data: dict) -> StructureOptions:
-        """The options of :meth:`to_dict` (``loads`` a list); unknown keys are ignored,
-        missing ones take their defaults."""
+        """The options of :meth:`to_dict` (``loads`` a list of texts); unknown keys are
+        ignored, missing ones take their defaults."""
         names = {f.name for f in fields(cls)}
-        return cls(**{k: v for k, v in data.items() if k in names})
+        given = {k: v for k, v in data.items() if k in names}
+        texts = {k: given.pop(k) for k in _TEXT_FIELDS if k in given}
+        return cls.from_strings(**texts, **given)
 
 
 def plan_design(
@@ -369,7 +424,7 @@ def plan_design(
         options.self_weight,
         options.hinge_stiffness,
         options.nonlinear,
-        options.limit,
+        options.limit.divisor,
         options.modes,
         settings,
         pool if options.service else None,
