@@ -22,9 +22,15 @@ Actuated creases (``--actuators``) are held at their angle: they count as fixed 
 the boundary vertices at ground level) that is first-order rigid, and among those of that
 size the one of the largest smallest eigenvalue. Every set of one size is tried, smallest
 size first (from ceil((d + 6) / 3), as each pin gives three rows), while the number of sets
-is at most ``Settings.structure.max_support_sets``; beyond, a greedy search adds the
-candidate that raises log det of K~ (eigenvalues floored) the most until rigid, then drops
-any support not needed.
+is at most ``Settings.structure.max_support_sets`` (in chunks of at most 128 MiB); beyond, a
+greedy search adds the candidate that raises log det (K~ + tol I) the most until rigid (by
+the matrix determinant lemma and rank-3 updates: no eigenvalue problem per candidate), then
+drops supports while rigid, the one whose removal lowers that log det the least first.
+
+The free motions Q come from the dense singular value decomposition of C for designs of up
+to ``Settings.structure.sparse_vertices`` vertices, from a sparse factorisation of C^T C, a
+subspace iteration and Rayleigh-Ritz on C above (:func:`_sparse_modes`); the dense blocks
+that either needs are bounded by ``Settings.limits.max_structure_bytes``.
 
 Where first order is not enough (K~ has eigenvalues at most ``structure_rigidity_tol``: the
 supports leave first-order motions, the flexes, the eigenvectors of those eigenvalues), the
@@ -296,6 +302,11 @@ def _sparse_modes(
     spare. RigidfoldError (one line) when the subspace would pass
     ``Settings.limits.max_structure_bytes``."""
     n = C.shape[1]
+    p = settings.mechanism.sparse_oversampling
+    cols = min(n, start + p)
+    check_structure_bytes(
+        _modes_bytes(n, cols), f"{cols} free motions of the supports' search", settings
+    )
     M = (C.T @ C).tocsc()
     rng = np.random.default_rng(0)  # the same subspace on every run
     largest = spla.eigsh(M, k=1, which="LA", v0=rng.random(n) - 0.5, return_eigenvectors=False)
@@ -306,8 +317,6 @@ def _sparse_modes(
         diag_pivot_thresh=0.0,
         options={"SymmetricMode": True},
     )
-    p = settings.mechanism.sparse_oversampling
-    cols = min(n, start + p)
     while True:
         check_structure_bytes(
             _modes_bytes(n, cols), f"{cols} free motions of the supports' search", settings
