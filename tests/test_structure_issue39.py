@@ -268,3 +268,14 @@ def test_long_steps_report_progress():
     quiet: list[str] = []
     plan_design(square(), options, progress=quiet.append).check()
     assert quiet == []
+
+
+def test_too_many_flexes_for_the_second_order_check_are_refused_in_one_line():
+    """A flat grid on its boundary leaves a first-order motion per inner vertex: their
+    second-order check (a stress matrix per constraint on the flexes) is sized first."""
+    flat = square(6)
+    flat = flat.with_fixed(np.zeros(flat.n_edges, dtype=bool))
+    small = DEFAULTS.with_(max_structure_bytes=10_000)
+    with pytest.raises(RigidfoldError, match="second-order check") as err:
+        check_supports(flat, Supports(flat.boundary_vertices), small)
+    assert "\n" not in str(err.value)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -368,6 +368,13 @@ def check_numbers(
     check_magnitudes(tuple(loads), largest)
 
 
+@lru_cache(maxsize=2)
+def _shell_mesh(pattern: CreasePattern, subdivisions: int) -> ShellMesh:
+    """:func:`~rigidfold.structure.model.shell_mesh`, kept for the last designs (the
+    analyses of ``--supports service`` share one; a pattern is hashed by identity)."""
+    return shell_mesh(pattern, subdivisions)
+
+
 def check_structure(
     pattern: CreasePattern,
     rigidity: Rigidity,
@@ -415,7 +422,7 @@ def check_structure(
     )
     if not rigidity.stable:
         return StructureCheck(mesh=None, response=None, **common)  # type: ignore[arg-type]
-    mesh = shell_mesh(held, settings.structure.subdivisions)
+    mesh = _shell_mesh(held, settings.structure.subdivisions)
     if progress is not None:
         progress(
             f"{'nonlinear' if nonlinear else 'linear'} static analysis of {mesh.n_elements} "

@@ -241,6 +241,13 @@ class SupportModes:
         second = None
         if not rigid:
             held = held_vertices(self.pattern, supports.pinned, supports.clamped)
+            k = int(soft.sum())
+            rows = self.pattern.n_edges + len(self.pattern.fixed_creases) + 3 * len(held)
+            check_structure_bytes(
+                2 * 8 * rows * k * k,
+                f"the second-order check of the {k} first-order motions the supports leave",
+                self.settings,
+            )
             flexes = self.Q @ stiff.eigenvectors[:, soft]
             second = second_order(self.pattern, held, flexes, self.settings)
             weakest = second.witness
@@ -525,10 +532,12 @@ def _rigid(stiff: np.ndarray, tol: float) -> bool:
 def _greedy(G0: np.ndarray, B: np.ndarray, tol: float, least: int = 1) -> np.ndarray:
     """Indices into B (c, 3, m) of a rigid set (see the module's text): add the support that
     raises log det (K~ + tol I) the most until rigid (tested from ``least`` supports on),
-    then drop supports while rigid (the one whose removal lowers that log det the least
-    first). Each support's gain is log det(I_3 + B_v (K~ + tol I)^-1 B_v^T) (the matrix
-    determinant lemma), kept up to date by rank-3 updates of (K~ + tol I)^-1 B^T, so a step
-    costs O(c m), not an eigenvalue problem per candidate."""
+    then drop supports while rigid (of those that may go, the one whose removal lowers log
+    det (K~ - tol I) the least first). Each support's gain is
+    log det(I_3 + B_v (K~ + tol I)^-1 B_v^T) (the matrix determinant lemma), kept up to date
+    by rank-3 updates of (K~ + tol I)^-1 B^T, so a step costs O(c m), not an eigenvalue
+    problem per candidate; a support may go when I_3 - B_v (K~ - tol I)^-1 B_v^T is positive
+    definite (the Schur complement of K~ - tol I without it)."""
     c, _, m = B.shape
     eye = np.eye(m)
     current = G0.copy()
@@ -550,18 +559,23 @@ def _greedy(G0: np.ndarray, B: np.ndarray, tol: float, least: int = 1) -> np.nda
         cross = np.einsum("cim,jm->cij", B, W[pick])  # B_v K^-1 B_p^T, (c, 3, 3)
         W = W - np.einsum("cij,jk,km->cim", cross, np.linalg.inv(S[pick]), W[pick])
     while len(chosen) > 1:
-        factor = sla.cho_factor(current + tol * eye)
-        loss = []
-        for i in chosen:
-            inner = B[i] @ sla.cho_solve(factor, B[i].T)
-            loss.append((round(-float(np.linalg.slogdet(np.eye(3) - inner)[1]), 8), i))
-        for _, i in sorted(loss):
-            if _rigid(current - B[i].T @ B[i], tol):
-                chosen.remove(i)
-                current = current - B[i].T @ B[i]
-                break
-        else:
+        # K~ - tol I - B_i^T B_i is positive definite iff I_3 - B_i (K~ - tol I)^-1 B_i^T is
+        # (its Schur complement): one factorisation a round, a 3 x 3 test per support
+        try:
+            factor = sla.cho_factor(current - tol * eye)
+        except np.linalg.LinAlgError:
             break
+        trials = []
+        for i in chosen:
+            rest = np.eye(3) - B[i] @ sla.cho_solve(factor, B[i].T)
+            sign, logdet = np.linalg.slogdet(rest)
+            if sign > 0 and _rigid(rest, 1e-8):  # a margin over round-off
+                trials.append((round(-float(logdet), 8), i))
+        if not trials:
+            break
+        _, drop = min(trials)  # lowers log det the least; ties: the lowest index
+        chosen.remove(drop)
+        current = current - B[drop].T @ B[drop]
     return np.array(sorted(chosen), dtype=np.int64)
 
 
