@@ -8,12 +8,13 @@ Cases: ``grid:NxN`` spanning 3 m (every diagonal towards the centre,
 :func:`rigidfold.patterns.grid`) lifted onto the dome (``make_case("dome", "grid:NxN",
 size="3x3")``), every interior edge a free hinge: 2 (N - 1)^2 triangles, grid:40x40 the
 issue's 3042. Each is written to a FOLD file and checked by the command line
-(``rigidfold structure FILE --out DIR --supports S --modes M``, self-weight of 18 mm
+(``rigidfold structure FILE --out DIR --supports S --modes M --json``, self-weight of 18 mm
 plywood, L/250), one process per run, so that the command's own pinned numerics (one BLAS
-thread) apply; its peak resident set is the child's ``ru_maxrss`` (``os.wait4``). Printed
-per run: triangles, supports, the exit code, the verdict's first words, wall time (median
-over ``--repeat``) and peak memory; the issue's target is <= 90 s and <= 2.5 GB for
-grid:40x40 on the 2-core development machine.
+thread) apply; its peak resident set is ``ru_maxrss`` of the children of a small wrapper
+process that runs only it. Printed per run: triangles, supports, the exit code, wall time
+(median over ``--repeat``), peak memory and the verdict (status, pins, largest
+displacement); the issue's target is <= 90 s and <= 2.5 GB for grid:40x40 on the 2-core
+development machine.
 """
 
 from __future__ import annotations
@@ -83,12 +84,19 @@ def main() -> None:
                     supports,
                     "--modes",
                     str(args.modes),
+                    "--json",
                 ]
                 runs = [measured(cmd, args.timeout) for _ in range(args.repeat)]
                 code, _, _, text = runs[-1]
                 wall = statistics.median(r[1] for r in runs)
                 peak = max(r[2] for r in runs)
-                verdict = " ".join(text.strip().splitlines()[-1:])[:90] if text else ""
+                verdict = text.strip()[-200:]
+                if code in (0, 1):
+                    data = json.loads(text)
+                    verdict = (
+                        f"{data['status']}, {len(data['supports']['pinned'])} pins, largest "
+                        f"displacement {data.get('max_displacement_m', 0) * 1e3:.3g} mm"
+                    )
                 print(
                     f"{n}x{n} | {pattern.n_faces} | {supports} | {code} | {wall:.1f} | "
                     f"{peak:.0f} | {verdict}",

@@ -32,9 +32,9 @@ from rigidfold.structure.check import StructureCheck, StructureStatus
 from rigidfold.structure.supports import (
     Rigidity,
     SupportGrowth,
-    SupportModes,
     Supports,
     check_supports,
+    support_modes,
 )
 
 Analyse = Callable[[Rigidity, float | None], StructureCheck]
@@ -77,7 +77,7 @@ def grow_supports(
     sup = first.supports
     rigid = np.asarray(sup.pinned, dtype=np.int64)
     trail: list[tuple[str, int, int, float, float]] = []
-    modes = SupportModes(sup.held(pattern), settings)  # one design: its free motions once
+    modes = support_modes(sup.held(pattern), settings)  # one design: its free motions once
 
     def run(pins: list[int], step: str, vertex: int) -> StructureCheck:
         rigidity = (

@@ -46,7 +46,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 import scipy.linalg as sla
@@ -430,6 +430,14 @@ class Rigidity:
         }
 
 
+@lru_cache(maxsize=2)
+def support_modes(pattern: CreasePattern, settings: Settings = DEFAULTS) -> SupportModes:
+    """The :class:`SupportModes` of ``pattern`` (its actuated creases fixed), kept for the
+    last two designs: ``auto`` and ``--supports service`` find the free motions once (a
+    pattern is hashed by identity)."""
+    return SupportModes(pattern, settings)
+
+
 def check_supports(
     pattern: CreasePattern,
     supports: Supports,
@@ -440,7 +448,7 @@ def check_supports(
     ``modes``, the free motions of ``supports.held(pattern)`` found before (several sets of
     supports of one design)."""
     if modes is None:
-        modes = SupportModes(supports.held(pattern), settings)
+        modes = support_modes(supports.held(pattern), settings)
     return modes.rigidity(supports)
 
 
@@ -463,7 +471,7 @@ def auto_supports(
         none if clamped is None else np.asarray(clamped),
         none if actuated is None else np.asarray(actuated),
     )
-    modes = SupportModes(base.held(pattern), settings)
+    modes = support_modes(base.held(pattern), settings)
     cand = np.setdiff1d(np.asarray(candidates, dtype=np.int64), base.clamped)
     if not len(cand):
         raise RigidfoldError("no candidate vertex for the supports")
