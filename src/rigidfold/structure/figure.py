@@ -49,12 +49,18 @@ def deflection_figure(check: StructureCheck) -> Any:
         pat.coords[pat.edges], colors=[(0.3, 0.3, 0.3, 0.6)], linewidths=0.5, label="undeformed"
     )
     ax.add_collection3d(outline)
-    norm = Normalize(vmin=0.0, vmax=float(mag.max()) if mag.max() > 0 else 1.0)
+    norm = Normalize(vmin=0.0, vmax=biggest * 1e3 if biggest > 0 else 1.0)  # the largest node
     cmap = matplotlib.colormaps["viridis"]
     ax.add_collection3d(
         Poly3DCollection(moved[mesh.triangles], facecolor=cmap(norm(mag)), edgecolor="none")
     )
-    fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.6, label="displacement (mm)")
+    fig.colorbar(
+        ScalarMappable(norm=norm, cmap=cmap),
+        ax=ax,
+        shrink=0.6,
+        pad=0.12,
+        label="displacement (mm)",
+    )
     s = pat.coords[check.rigidity.supports.vertices]
     ax.scatter(s[:, 0], s[:, 1], s[:, 2], marker="^", s=60, color="red", label="supports")
     lo, hi = np.minimum(x.min(0), moved.min(0)), np.maximum(x.max(0), moved.max(0))
