@@ -279,3 +279,35 @@ def test_too_many_flexes_for_the_second_order_check_are_refused_in_one_line():
     with pytest.raises(RigidfoldError, match="second-order check") as err:
         check_supports(flat, Supports(flat.boundary_vertices), small)
     assert "\n" not in str(err.value)
+
+
+# ------------------------------------------------------------------ item 16: fabricate's thickness
+def test_structure_reads_the_thickness_fabricate_recorded(tmp_path):
+    """``rigidfold fabricate`` writes ``NAME_fabricate.json`` with ``thickness_m``: beside
+    the design, or in a run's ``final/thick/`` for ``solutions/NAME.fold``. Without
+    ``--thickness`` the check uses it and says so; ``--thickness`` still wins."""
+    from rigidfold.fabricate.files import FABRICATE_JSON
+
+    run = tmp_path / "run"
+    (run / "solutions").mkdir(parents=True)
+    (run / "final" / "thick").mkdir(parents=True)
+    design = run / "solutions" / "step.fold"
+    write_fold(design, square())
+    record = run / "final" / "thick" / FABRICATE_JSON.format("step")
+    record.write_text(json.dumps({"file": "solutions/step.fold", "thickness_m": 0.02}))
+    common = ["--supports", "0,2,6,8", "--modes", "0", "--json"]
+    res = run_cli("structure", str(design), "--out", str(tmp_path / "a"), *common)
+    assert res.returncode in (0, 1), res.stderr
+    data = json.loads(res.stdout)
+    assert data["thickness_m"] == 0.02 and "fabricate" in data["thickness_from"]
+    assert "20 mm thick, as fabricate made them" in res.stderr
+    res = run_cli(
+        "structure", str(design), "--out", str(tmp_path / "b"), "--thickness", "18mm", *common
+    )
+    data = json.loads(res.stdout)
+    assert data["thickness_m"] == pytest.approx(0.018) and data["thickness_from"] == "given"
+    record.unlink()
+    res = run_cli("structure", str(design), "--out", str(tmp_path / "c"), *common)
+    data = json.loads(res.stdout)
+    assert data["thickness_m"] == DEFAULTS.structure.thickness
+    assert data["thickness_from"].startswith("default")

@@ -152,9 +152,13 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
         p.add_argument(
             "--thickness",
             type=length("thickness"),
-            default=STRUCTURE.thickness,
+            default=None,
             metavar="T",
-            help="panel thickness in metres, or with a unit: 18mm, 1.8cm (default: %(default)g)",
+            help="panel thickness in metres, or with a unit: 18mm, 1.8cm (default: the "
+            "thickness rigidfold fabricate made this design's panels, read from "
+            "NAME_fabricate.json beside the design or, for a run's solutions/NAME.fold, in the "
+            f"run's final/thick/; else {STRUCTURE.thickness:g}; structure.json's "
+            "thickness_from says which)",
         )
     material = (
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
@@ -276,9 +280,28 @@ def structure_progress(line: str) -> None:
 
 def structure_options(args: argparse.Namespace) -> StructureOptions:
     """The structure check's options of the parsed arguments (checked); generate's
-    ``--thickness`` and ``--material`` where not given: the check's defaults."""
+    ``--thickness`` and ``--material`` where not given: the check's defaults.
+    ``rigidfold structure FILE`` without ``--thickness``: the thickness fabricate recorded
+    for the design (:func:`~rigidfold.structure.design.recorded_thickness`, said on stderr
+    and as ``thickness_from``), else the default."""
+    from rigidfold.structure.design import recorded_thickness
+
+    thickness, source = args.thickness, ""
+    design = getattr(args, "file", None)
+    if thickness is None and design is not None:
+        found = recorded_thickness(design)
+        if found is not None:
+            thickness, where = found
+            source = f"rigidfold fabricate ({where})"
+            structure_progress(
+                f"the panels are {thickness * 1e3:g} mm thick, as fabricate made them "
+                f"({where}); --thickness to check another"
+            )
+        else:
+            source = "default (Settings.structure.thickness)"
     return StructureOptions.from_strings(
-        thickness=STRUCTURE.thickness if args.thickness is None else args.thickness,
+        thickness=STRUCTURE.thickness if thickness is None else thickness,
+        thickness_from=source,
         material=STRUCTURE.material if args.material is None else args.material,
         supports=args.supports,
         candidates=args.support_candidates,

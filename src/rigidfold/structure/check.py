@@ -72,9 +72,11 @@ class StructureCheck:
     hinge_stiffness : N m/rad per m; nonlinear : geometrically nonlinear analysis; limit :
     the deflection limit's divisor (span / limit); mesh and response : the shell model and
     its response (None when the supports leave a mechanism); growth : how ``--supports
-    service`` grew the supports for the deflection (None otherwise); balance_tol : a static answer
-    whose reactions miss the loads by more than this share of them did not carry the load
-    (a singular stiffness: supports that are prestress stable only, with free hinges).
+    service`` grew the supports for the deflection (None otherwise); thickness_from : where
+    the thickness came from (``""``: given; ``StructureOptions.thickness_from``);
+    balance_tol : a static answer whose reactions miss the loads by more than this share of
+    them did not carry the load (a singular stiffness: supports that are prestress stable
+    only, with free hinges).
     """
 
     pattern: CreasePattern
@@ -91,6 +93,7 @@ class StructureCheck:
     auto: bool = False
     balance_tol: float = DEFAULTS.structure.balance_tol
     growth: SupportGrowth | None = None
+    thickness_from: str = ""
 
     # ------------------------------------------------------------------ verdict
     @property
@@ -254,6 +257,7 @@ class StructureCheck:
             "message": self.message,
             "material": self.material.to_dict(),
             "thickness_m": self.thickness,
+            "thickness_from": self.thickness_from or "given",
             "hinge_stiffness_Nm_per_rad_per_m": self.hinge_stiffness,
             "loads": [load.to_dict() for load in self.loads],
             "self_weight": self.self_weight,

@@ -24,7 +24,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
-from rigidfold.io.files import atomic_write, jsonable
+from rigidfold.io.files import atomic_write, jsonable, parse_json
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
     StructureCheck,
@@ -127,13 +127,15 @@ class DesignPlan:
     """(c,) int64 the candidates ``--supports service`` may pin, None for other supports."""
     steps: Steps | None = None
     """Where the check's steps are reported (:class:`Steps`), or None."""
+    thickness_from: str = ""
+    """:attr:`StructureOptions.thickness_from`."""
 
     def check(self) -> StructureCheck:
         """The analysis and its verdict (:func:`rigidfold.structure.check.check_structure`);
         with ``service``, after the supports have been grown for the deflection
         (:func:`rigidfold.structure.service.grow_supports`)."""
         if self.service is None:
-            return self._check(self.rigidity)
+            return replace(self._check(self.rigidity), thickness_from=self.thickness_from)
         from rigidfold.structure.service import grow_supports
 
         count = [0]
@@ -151,7 +153,7 @@ class DesignPlan:
             self.pattern, self.rigidity, self.service, analyse, self.settings
         )
         final = found if not self.nonlinear and not self.modes else self._check(found.rigidity)
-        return replace(final, growth=growth)
+        return replace(final, growth=growth, thickness_from=self.thickness_from)
 
     def _check(
         self,
@@ -245,6 +247,10 @@ class StructureOptions:
     limit: Limit = Limit(DEFAULTS.structure.limit)  # noqa: RUF009 (frozen)
     nonlinear: bool = False
     modes: int = DEFAULTS.structure.modes
+    thickness_from: str = ""
+    """Where ``thickness`` came from, for the output (``structure.json``'s
+    ``thickness_from``): ``""`` given, or the words of the command line
+    (:func:`recorded_thickness`)."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.material, str):
@@ -290,6 +296,8 @@ class StructureOptions:
         ):
             index_list(candidates, "support candidates")
         index_list(self.actuators, "actuators")
+        if not isinstance(self.thickness_from, str):
+            raise RigidfoldError(f"thickness_from must be text, got {self.thickness_from!r}")
         for name in ("self_weight", "nonlinear"):
             if not isinstance(getattr(self, name), bool):
                 raise RigidfoldError(f"{name} must be true or false, got {getattr(self, name)!r}")
@@ -429,6 +437,7 @@ def plan_design(
         settings,
         pool if options.service else None,
         steps,
+        options.thickness_from,
     )
 
 
@@ -442,6 +451,31 @@ def check_design(
     """The structure check of ``pattern`` with ``options``: every input checked first
     (ValueError, one line), then the analysis (``progress``: :func:`plan_design`)."""
     return plan_design(pattern, options, settings=settings, progress=progress).check()
+
+
+def recorded_thickness(path: str | Path) -> tuple[float, Path] | None:
+    """(the thickness, metres, that ``rigidfold fabricate`` made the panels of the design in
+    FOLD file ``path``, the file that records it) or None: fabricate writes it as
+    ``thickness_m`` of ``NAME_fabricate.json`` (:data:`rigidfold.fabricate.files.FABRICATE_JSON`)
+    in its output directory, looked for beside the design (``fabricate DESIGN.fold --out``
+    the design's directory) and, for a run's solution ``DIR/solutions/NAME.fold``, in the
+    run's ``DIR/final/thick/`` (``generate --thickness``)."""
+    from rigidfold.fabricate.files import FABRICATE_JSON
+
+    path = Path(path)
+    name = FABRICATE_JSON.format(path.stem)
+    places = [path.parent / name]
+    if path.parent.name == "solutions":
+        places.append(path.parent.parent / "final" / "thick" / name)
+    for place in places:
+        try:
+            data = parse_json(place.read_bytes())
+        except (OSError, ValueError):
+            continue
+        t = data.get("thickness_m") if isinstance(data, dict) else None
+        if isinstance(t, int | float) and not isinstance(t, bool) and 0 < t < float("inf"):
+            return float(t), place
+    return None
 
 
 def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:
