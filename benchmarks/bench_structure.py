@@ -32,6 +32,7 @@ import numpy as np
 
 from rigidfold.io import read_fold
 from rigidfold.structure import (
+    Service,
     StructureOptions,
     Supports,
     auto_supports,
@@ -69,7 +70,7 @@ def main() -> None:
                 lambda k=k, nonlinear=nonlinear: structure(
                     DESIGN,
                     Path(tmp) / "out",
-                    StructureOptions(
+                    StructureOptions.from_strings(
                         loads=("uniform=0.5",),
                         hinge_stiffness=k,
                         nonlinear=nonlinear,
@@ -106,7 +107,7 @@ def service() -> None:
                 lambda path=path: structure(
                     path,
                     Path(tmp) / "s",
-                    StructureOptions(supports="service", modes=0),
+                    StructureOptions(supports=Service(), modes=0),
                     overwrite=True,
                 ),
             )

@@ -17,7 +17,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricateOptions
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import read_fold
-from rigidfold.structure import StructureOptions
+from rigidfold.structure import Limit, Pins, StructureOptions, Uniform
 from test_generate_integration import FAST as INTEGRATION_FAST
 
 FAST = [*INTEGRATION_FAST, "--no-report"]
@@ -70,7 +70,7 @@ def test_fabricate_options_refuse_bad_values_in_one_line(changes):
 )
 def test_structure_options_refuse_bad_values_in_one_line(changes):
     with pytest.raises(RigidfoldError) as info:
-        StructureOptions(**changes)
+        StructureOptions.from_strings(**changes)
     message = str(info.value)
     assert "\n" not in message and message
 
@@ -80,9 +80,10 @@ def test_options_keep_what_the_user_gave():
     assert fab.thickness == pytest.approx(0.018) and fab.sheet == (3050.0, 1525.0)
     assert fab.min_thickness == pytest.approx(0.005)
     assert FabricateOptions.from_dict(json.loads(json.dumps(fab.to_dict()))) == fab
-    assert StructureOptions(supports="", clamped="0,6").clamped == "0,6"
-    st = StructureOptions(supports="0, 4,9", loads=["uniform=0.5"], limit="L/300")
-    assert st.loads == ("uniform=0.5",) and st.limit == 300.0 and st.supports == "0, 4,9"
+    assert StructureOptions.from_strings(supports="", clamped="0,6").clamped == "0,6"
+    st = StructureOptions.from_strings(supports="0, 4,9", loads=["uniform=0.5"], limit="L/300")
+    assert st.loads == (Uniform(0.5),) and st.limit == Limit(300.0)
+    assert st.supports == Pins((0, 4, 9))
     assert StructureOptions.from_dict(json.loads(json.dumps(st.to_dict()))) == st
     with pytest.raises(RigidfoldError, match="clamped vertices: 9 is out of range"):
         StructureOptions(clamped="9").check_indices(n_vertices=9, n_edges=20)

@@ -19,10 +19,10 @@ from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import face_areas
 from rigidfold.structure import (
     MATERIALS,
-    Load,
     Material,
     StructureStatus,
     Supports,
+    Uniform,
     auto_supports,
     check_structure,
     check_supports,
@@ -56,7 +56,7 @@ def solve_plate(p, material, thickness, *, pinned=(), clamped=(), kpa=1.0, modes
         rigidity,
         material=material,
         thickness=thickness,
-        loads=(Load("uniform", kpa=kpa),),
+        loads=(Uniform(kpa),),
         self_weight=False,
         modes=modes,
     )
@@ -133,7 +133,7 @@ def test_nonlinear_matches_linear_under_a_small_load_and_stiffens_under_a_large_
         common = dict(
             material=mat,
             thickness=t,
-            loads=(Load("uniform", kpa=kpa),),
+            loads=(Uniform(kpa),),
             self_weight=False,
             modes=0,
         )
@@ -243,7 +243,7 @@ def test_limit_and_load_parsing():
     for bad in ("L/0", "L/-3", "span", "L/x"):
         with pytest.raises(ValueError):
             parse_limit(bad)
-    assert parse_load("uniform=1.2") == Load("uniform", kpa=1.2)
+    assert parse_load("uniform=1.2") == Uniform(1.2)
     assert parse_load("point=3:0,0,-10").force == (0.0, 0.0, -10.0)
     for bad in ("snow=1", "uniform=", "point=3:1,2", "point=x:1,2,3", "uniform=inf"):
         with pytest.raises(ValueError):

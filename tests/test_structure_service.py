@@ -29,10 +29,10 @@ def test_service_supports_meet_the_limit_that_auto_misses(roof):
     """The roof on free hinges: auto's pins hold the mechanism but let it sag far past
     L/250; service keeps them, adds boundary pins, meets the limit, and each added pin is
     needed (without any one of them the same analysis misses the limit)."""
-    auto = plan_design(roof, StructureOptions(supports="auto", modes=0)).check()
+    auto = plan_design(roof, StructureOptions.from_strings(supports="auto", modes=0)).check()
     assert auto.rigidity.rigid and auto.status is StructureStatus.DEFLECTION
     assert "--supports service pins more vertices" in auto.message  # what may meet it
-    plan = plan_design(roof, StructureOptions(supports="service", modes=0))
+    plan = plan_design(roof, StructureOptions.from_strings(supports="service", modes=0))
     check = plan.check()
     assert check.status is StructureStatus.PASSED and check.chosen == "service"
     growth = check.growth
@@ -68,7 +68,7 @@ def test_a_search_that_cannot_meet_the_limit_says_how_far_it_went():
     design = folded_grid(4, 0.3)
     boundary = design.boundary_vertices
     check = plan_design(
-        design, StructureOptions(supports="service", limit="L/1e9", modes=0)
+        design, StructureOptions.from_strings(supports="service", limit="L/1e9", modes=0)
     ).check()
     assert check.status is StructureStatus.DEFLECTION and not check.growth.passed
     assert f"pins alone did not meet it ({len(boundary)} pinned of {len(boundary)}" in check.message
@@ -78,7 +78,9 @@ def test_a_search_that_cannot_meet_the_limit_says_how_far_it_went():
     )
     capped = DEFAULTS.with_(structure_service_max_pins=2)
     few = plan_design(
-        design, StructureOptions(supports="service", limit="L/1e9", modes=0), settings=capped
+        design,
+        StructureOptions.from_strings(supports="service", limit="L/1e9", modes=0),
+        settings=capped,
     ).check()
     assert len(few.growth.added) == 2 and len(few.growth.trail) == 3
     assert not few.growth.passed and few.status is StructureStatus.DEFLECTION
@@ -118,7 +120,7 @@ def test_cli_service_reports_the_added_pins(tmp_path):
 )
 def test_a_misspelt_support_word_is_one_line_naming_the_choices(text, words):
     with pytest.raises(ValueError) as err:
-        StructureOptions(supports=text)
+        StructureOptions.from_strings(supports=text)
     message = str(err.value)
     assert message.startswith("supports must be auto, service or comma-separated vertex indices")
     assert words in message and "\n" not in message
@@ -130,18 +132,22 @@ def test_where_pins_alone_miss_the_limit_the_hinge_stiffness_that_meets_it_is_na
     (20 % less does not), and an unreachable limit is said to be out of reach of hinges."""
     design = folded_grid(4, 0.3)
     pins = ",".join(map(str, plan_design(design).rigidity.supports.pinned))
-    options = StructureOptions(supports="service", candidates=pins, limit="L/1000", modes=0)
+    options = StructureOptions.from_strings(
+        supports="service", candidates=pins, limit="L/1000", modes=0
+    )
     check = plan_design(design, options).check()
     assert check.status is StructureStatus.DEFLECTION and check.growth.searched_hinges
     k, largest = check.growth.hinge_hint
     assert largest <= check.allowed_displacement
     assert "N m/rad per m would" in check.message
-    given = StructureOptions(supports=pins, limit="L/1000", modes=0)
+    given = StructureOptions.from_strings(supports=pins, limit="L/1000", modes=0)
     assert plan_design(design, given.replace(hinge_stiffness=k)).check().passed
     softer = plan_design(design, given.replace(hinge_stiffness=k / 1.2)).check()
     assert softer.status is StructureStatus.DEFLECTION
     data = check.to_dict()["supports"]["service"]["hinge_stiffness_that_meets_the_limit"]
     assert data == {"Nm_per_rad_per_m": k, "max_displacement_m": largest}
-    never = StructureOptions(supports="service", candidates=pins, limit="L/1e9", modes=0)
+    never = StructureOptions.from_strings(
+        supports="service", candidates=pins, limit="L/1e9", modes=0
+    )
     out = plan_design(design, never).check()
     assert out.growth.hinge_hint is None and "nor would stiffer hinges" in out.message

@@ -23,7 +23,7 @@ from collections.abc import Sequence
 from rigidfold import __version__
 from rigidfold.case_options import CaseOptions, SettingsOptions
 from rigidfold.cli_arguments import add_arguments
-from rigidfold.cli_checks import fabricate_options, structure_options
+from rigidfold.cli_checks import fabricate_options, structure_options, structure_progress
 from rigidfold.cli_parser import EXIT_USAGE, Parser, attached_values, one_line, options_of
 from rigidfold.cli_text import COMMANDS
 from rigidfold.errors import RigidfoldError
@@ -281,7 +281,12 @@ def _cmd_structure(args: argparse.Namespace) -> int:
     from rigidfold.workflows import structure
 
     run = structure(
-        args.file, args.out, structure_options(args), up=args.up, overwrite=args.overwrite
+        args.file,
+        args.out,
+        structure_options(args),
+        up=args.up,
+        overwrite=args.overwrite,
+        progress=structure_progress,
     )
     code = 0 if run.status is StructureStatus.PASSED else EXIT_FAILED
     if args.json:

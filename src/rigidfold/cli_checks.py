@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 
 from rigidfold.config import DEFAULTS, SIDES
 from rigidfold.fabricate.options import FabricateOptions
@@ -150,10 +151,14 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     else:
         p.add_argument(
             "--thickness",
-            type=positive,
-            default=STRUCTURE.thickness,
+            type=length("thickness"),
+            default=None,
             metavar="T",
-            help="panel thickness in metres (default: %(default)g)",
+            help="panel thickness in metres, or with a unit: 18mm, 1.8cm (default: the "
+            "thickness rigidfold fabricate made this design's panels, read from "
+            "NAME_fabricate.json beside the design or, for a run's solutions/NAME.fold, in the "
+            f"run's final/thick/; else {STRUCTURE.thickness:g}; structure.json's "
+            "thickness_from says which)",
         )
     material = (
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
@@ -175,7 +180,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--supports",
-        default=STRUCTURE.supports,
+        default=STRUCTURE.supports.text,
         metavar="V,V,...|auto|service",
         help=f"{pre}pinned vertices (indices of the design's vertices); auto: the fewest "
         "--support-candidates that make the mechanism first-order rigid, of the largest "
@@ -219,9 +224,11 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
         action="append",
         default=None,
         metavar="KIND=VALUE",
-        help=f"{pre}a load besides self-weight, repeatable: uniform=KPA (kN/m^2 of plan, "
-        "downwards: snow), pressure=KPA (kN/m^2 normal to the panels, positive pressing on "
-        "the upper face: wind), point=V:FX,FY,FZ (newtons at vertex V)",
+        help=f"{pre}a load besides self-weight, repeatable: uniform=Q (per m^2 of plan, "
+        "downwards: snow), pressure=Q (normal to the panels, positive pressing on the upper "
+        "face: wind), point=V:FX,FY,FZ (a force at vertex V). Q in Pa, kPa, kN/m2 or MPa "
+        "(uniform=0.5kPa, 500Pa), a bare number in kPa; forces in N, kN or MN "
+        "(point=12:0,0,-2kN), a bare number in newtons",
     )
     p.add_argument(
         "--no-self-weight",
@@ -230,7 +237,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--limit",
-        default=f"L/{STRUCTURE.limit:g}",
+        default=STRUCTURE.limit.text,
         metavar="L/N",
         help=f"{pre}serviceability: the largest displacement may be at most the span over N; "
         "the span is the largest plan distance between supports (twice the reach of a "
@@ -266,11 +273,35 @@ def fabricate_options(args: argparse.Namespace) -> FabricateOptions | None:
     )
 
 
+def structure_progress(line: str) -> None:
+    """``rigidfold structure``'s progress: each long step of the check on a line of stderr."""
+    print(f"rigidfold structure: {line}", file=sys.stderr, flush=True)
+
+
 def structure_options(args: argparse.Namespace) -> StructureOptions:
     """The structure check's options of the parsed arguments (checked); generate's
-    ``--thickness`` and ``--material`` where not given: the check's defaults."""
-    return StructureOptions(
-        thickness=STRUCTURE.thickness if args.thickness is None else args.thickness,
+    ``--thickness`` and ``--material`` where not given: the check's defaults.
+    ``rigidfold structure FILE`` without ``--thickness``: the thickness fabricate recorded
+    for the design (:func:`~rigidfold.structure.design.recorded_thickness`, said on stderr
+    and as ``thickness_from``), else the default."""
+    from rigidfold.structure.design import recorded_thickness
+
+    thickness, source = args.thickness, ""
+    design = getattr(args, "file", None)
+    if thickness is None and design is not None:
+        found = recorded_thickness(design)
+        if found is not None:
+            thickness, where = found
+            source = f"rigidfold fabricate ({where})"
+            structure_progress(
+                f"the panels are {thickness * 1e3:g} mm thick, as fabricate made them "
+                f"({where}); --thickness to check another"
+            )
+        else:
+            source = "default (Settings.structure.thickness)"
+    return StructureOptions.from_strings(
+        thickness=STRUCTURE.thickness if thickness is None else thickness,
+        thickness_from=source,
         material=STRUCTURE.material if args.material is None else args.material,
         supports=args.supports,
         candidates=args.support_candidates,

@@ -526,16 +526,17 @@ def structure(
     up: str = "z",
     overwrite: bool = False,
     settings: Settings = DEFAULTS,
+    progress: Callable[[str], None] | None = None,
 ) -> StructureRun:
     """Supports, loads and serviceability of the design in a FOLD file (read with ``up``)
     as ``options`` ask (:class:`rigidfold.structure.StructureOptions`, checked when made):
     ``OUT/structure.json`` and ``OUT/structure.png`` (:mod:`rigidfold.structure`). The
     indices and point loads are checked against the design before anything is written
-    (ValueError, one line).
+    (ValueError, one line). ``progress`` is handed a line as each long step starts.
     """
     refuse_replacing_inputs([path], [Path(out) / name for name in STRUCTURE_FILES])
     data = read_fold(path, up=up, settings=settings)
-    plan = plan_design(data.pattern, options, settings=settings)
+    plan = plan_design(data.pattern, options, settings=settings, progress=progress)
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
     check = plan.check()

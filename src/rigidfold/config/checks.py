@@ -197,6 +197,25 @@ class StructureSettings(Group):
         "supports must hold (the rigid-body motions, the mechanisms, and the near-mechanisms "
         "of nearly flat vertices), ``rigidfold.structure.supports``.",
     )
+    sparse_vertices: int = setting(
+        400,
+        "The free motions of a design of more vertices (``rigidfold.structure.supports``) "
+        "come from a sparse factorisation of C^T C (subspace iteration and Rayleigh-Ritz on "
+        "C) instead of the dense singular value decomposition of C, whose time grows with "
+        "the cube of the size (3 V x 3 V singular vectors).",
+    )
+    soft_shift: float = setting(
+        1e-8,
+        "The sparse free motions: delta of the filter ``(C^T C + delta s_max^2 I)^-1`` "
+        "(s_max the largest singular value of C): each solve keeps a direction of singular "
+        "value s with the factor ``delta / (s^2 / s_max^2 + delta)``.",
+    )
+    soft_iterations: int = setting(
+        3,
+        "The sparse free motions: solves with that filter (each followed by a QR) before "
+        "the Rayleigh-Ritz step; the subspace doubles while the motions found leave fewer "
+        "than half of ``mechanism_sparse_oversampling`` columns to spare.",
+    )
     rigidity_tol: float = setting(
         1e-6,
         "The supports make the design first-order rigid when the smallest eigenvalue of the "
@@ -257,6 +276,10 @@ class StructureSettings(Group):
         "A corrected flex meets every constraint within this fraction of the mean edge length "
         "(``structure_flex_step``).",
     )
+
+    def __post_init__(self) -> None:
+        self._integer(sparse_vertices=0, soft_iterations=1)
+        self._positive("soft_shift")
 
 
 @dataclass(frozen=True)

@@ -184,6 +184,24 @@ class LimitSettings(Group):
         "fit can use (decimate it). A polygon face of an OBJ file counts as the triangles of "
         "its fan.",
     )
+    max_structure_bytes: int = setting(
+        2 * 2**30,
+        "Largest memory (bytes) the structure check (``rigidfold structure``) may ask for at "
+        "once, estimated before it is asked: the shell model (about "
+        "``rigidfold.structure.design.SHELL_BYTES`` per shell element) and the dense blocks "
+        "of the supports' search (the free motions, 3 V x m, and the m x m stiffness on "
+        "them, m growing as they are found: a flat sheet has a free motion per vertex). A "
+        "larger design is refused in one line instead of running out of memory.",
+    )
+    max_structure_value: float = setting(
+        1e12,
+        "Largest magnitude of a number the structure check (``rigidfold structure``) takes, "
+        "in SI units: the panels' thickness (m), Young's modulus (Pa), density (kg/m^3), "
+        "the hinge stiffness (N m/rad per m) and each load (Pa of a uniform load or a "
+        "pressure, N of a point load's components). A larger one is refused in one line; "
+        "beyond it the analysis's products overflow (``--thickness 1e300``, ``--load "
+        "uniform=1e300``: OverflowError before) or its figure has no finite axis.",
+    )
     max_study_runs: int = setting(
         1_000_000,
         "Largest number of runs (surfaces x patterns x criteria) a Bezier study may plan: a "
@@ -209,3 +227,5 @@ class LimitSettings(Group):
         self._integer(max_svg_depth=1, max_svg_pairs=1, max_svg_size=1, max_mesh_triangles=1)
         self._integer(max_fabricate_panels=1)
         self._positive("max_sheet_size")
+        self._integer(max_structure_bytes=1)
+        self._positive("max_structure_value")

@@ -9,7 +9,8 @@ first order is not enough: prestress stability, or a finite mechanism),
 hinges), :mod:`~rigidfold.structure.loads` (self-weight, snow, wind, point loads),
 :mod:`~rigidfold.structure.analysis` (static and eigen analysis in OpenSees),
 :mod:`~rigidfold.structure.check` (the check and its verdict),
-:mod:`~rigidfold.structure.design` (the options as given, :class:`StructureOptions`, the check
+:mod:`~rigidfold.structure.choices` (the typed supports and limit of the options),
+:mod:`~rigidfold.structure.design` (the options, :class:`StructureOptions`, the check
 from them, and its files) and
 :mod:`~rigidfold.structure.figure` (the deflected shape). OpenSees and matplotlib are
 imported only when an analysis runs or a figure is drawn.
@@ -23,6 +24,7 @@ from rigidfold.structure.check import (
     check_structure,
     parse_limit,
 )
+from rigidfold.structure.choices import Auto, Limit, Pins, Service, SupportSpec, parse_supports
 from rigidfold.structure.design import (
     STRUCTURE_FILES,
     StructureOptions,
@@ -30,7 +32,15 @@ from rigidfold.structure.design import (
     design_supports,
     write_structure,
 )
-from rigidfold.structure.loads import LOAD_KINDS, Load, parse_load
+from rigidfold.structure.loads import (
+    LOAD_KINDS,
+    Load,
+    Point,
+    Pressure,
+    SelfWeight,
+    Uniform,
+    parse_load,
+)
 from rigidfold.structure.material import MATERIALS, Material, parse_material, presets_help
 from rigidfold.structure.supports import (
     CANDIDATE_FORMS,
@@ -48,16 +58,25 @@ __all__ = [
     "LOAD_KINDS",
     "MATERIALS",
     "STRUCTURE_FILES",
+    "Auto",
+    "Limit",
     "Load",
     "Material",
+    "Pins",
+    "Point",
+    "Pressure",
     "Rigidity",
     "SecondOrder",
+    "SelfWeight",
+    "Service",
     "Stability",
     "StructureCheck",
     "StructureOptions",
     "StructureStatus",
     "SupportModes",
+    "SupportSpec",
     "Supports",
+    "Uniform",
     "auto_supports",
     "check_design",
     "check_inputs",
@@ -68,6 +87,7 @@ __all__ = [
     "parse_limit",
     "parse_load",
     "parse_material",
+    "parse_supports",
     "presets_help",
     "second_order",
     "support_candidates",

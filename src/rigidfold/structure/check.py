@@ -13,8 +13,9 @@ is twice the largest plan distance from a support to a vertex (the cantilever co
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -24,7 +25,13 @@ from rigidfold.mechanism.second_order import Stability
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
 from rigidfold.structure.analysis import ShellResponse, solve_shell
-from rigidfold.structure.loads import Load, check_loads, nodal_loads
+from rigidfold.structure.loads import (
+    Load,
+    SelfWeight,
+    check_loads,
+    check_magnitudes,
+    nodal_loads,
+)
 from rigidfold.structure.material import Material
 from rigidfold.structure.model import ShellMesh, shell_mesh
 from rigidfold.structure.supports import Rigidity, SupportGrowth
@@ -65,9 +72,11 @@ class StructureCheck:
     hinge_stiffness : N m/rad per m; nonlinear : geometrically nonlinear analysis; limit :
     the deflection limit's divisor (span / limit); mesh and response : the shell model and
     its response (None when the supports leave a mechanism); growth : how ``--supports
-    service`` grew the supports for the deflection (None otherwise); balance_tol : a static answer
-    whose reactions miss the loads by more than this share of them did not carry the load
-    (a singular stiffness: supports that are prestress stable only, with free hinges).
+    service`` grew the supports for the deflection (None otherwise); thickness_from : where
+    the thickness came from (``""``: given; ``StructureOptions.thickness_from``);
+    balance_tol : a static answer whose reactions miss the loads by more than this share of
+    them did not carry the load (a singular stiffness: supports that are prestress stable
+    only, with free hinges).
     """
 
     pattern: CreasePattern
@@ -84,13 +93,18 @@ class StructureCheck:
     auto: bool = False
     balance_tol: float = DEFAULTS.structure.balance_tol
     growth: SupportGrowth | None = None
+    thickness_from: str = ""
 
     # ------------------------------------------------------------------ verdict
     @property
     def status(self) -> StructureStatus:
         if not self.rigidity.stable or self.response is None:
             return StructureStatus.MECHANISM
-        if not self.response.converged or not self.balance_error <= self.balance_tol:
+        if (
+            not self.response.converged
+            or not self.finite
+            or not self.balance_error <= self.balance_tol
+        ):
             return StructureStatus.NOT_CONVERGED
         if self.max_displacement > self.allowed_displacement:
             return StructureStatus.DEFLECTION
@@ -115,7 +129,9 @@ class StructureCheck:
                 else ""
             )
             why = self.response.message
-            if self.response.converged:
+            if self.response.converged and not self.finite:
+                why = "the displacements overflow (the loads or the stiffness are out of range)"
+            elif self.response.converged:
                 why = (
                     f"the reactions miss the loads by {self.balance_error:.3g} of them: the "
                     "stiffness is singular"
@@ -184,7 +200,14 @@ class StructureCheck:
     def magnitudes(self) -> np.ndarray:
         """(N,) float64 displacement magnitude of every shell node, m."""
         assert self.response is not None
-        return np.linalg.norm(self.response.displacements[:, :3], axis=1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            return np.linalg.norm(self.response.displacements[:, :3], axis=1)
+
+    @property
+    def finite(self) -> bool:
+        """Whether every displacement magnitude is a finite number (True without a
+        response)."""
+        return self.response is None or bool(np.all(np.isfinite(self.magnitudes)))
 
     @property
     def max_displacement(self) -> float:
@@ -201,9 +224,10 @@ class StructureCheck:
         """|sum of reactions + sum of loads| / |sum of loads|."""
         if self.response is None:
             return float("nan")
-        total = np.linalg.norm(self.total_load)
-        residual = np.linalg.norm(self.response.reactions.sum(axis=0) + self.total_load)
-        return float(residual / total) if total > 0 else float(residual)
+        with np.errstate(over="ignore", invalid="ignore"):
+            total = np.linalg.norm(self.total_load)
+            residual = np.linalg.norm(self.response.reactions.sum(axis=0) + self.total_load)
+            return float(residual / total) if total > 0 else float(residual)
 
     def hinge_table(self) -> list[dict]:
         """Per free crease: its largest rotation (deg) and its moment (total N m and largest
@@ -233,6 +257,7 @@ class StructureCheck:
             "message": self.message,
             "material": self.material.to_dict(),
             "thickness_m": self.thickness,
+            "thickness_from": self.thickness_from or "given",
             "hinge_stiffness_Nm_per_rad_per_m": self.hinge_stiffness,
             "loads": [load.to_dict() for load in self.loads],
             "self_weight": self.self_weight,
@@ -292,17 +317,40 @@ class StructureCheck:
 
 
 def check_inputs(
-    pattern: CreasePattern, *, thickness: float, hinge_stiffness: float, loads: tuple[Load, ...]
+    pattern: CreasePattern,
+    *,
+    thickness: float,
+    hinge_stiffness: float,
+    loads: tuple[Load, ...],
+    material: Material | None = None,
+    settings: Settings = DEFAULTS,
 ) -> None:
     """ValueError (one line, naming the value) for a thickness that is not a positive number
-    of metres, a negative hinge stiffness, a point load at a vertex the design lacks."""
-    check_numbers(thickness=thickness, hinge_stiffness=hinge_stiffness)
+    of metres, a negative hinge stiffness, a number above
+    ``Settings.limits.max_structure_value`` (:func:`check_numbers`), a point load at a
+    vertex the design lacks."""
+    check_numbers(
+        thickness=thickness,
+        hinge_stiffness=hinge_stiffness,
+        loads=tuple(loads),
+        material=material,
+        settings=settings,
+    )
     check_loads(tuple(loads), pattern.n_vertices)
 
 
-def check_numbers(*, thickness: float, hinge_stiffness: float) -> None:
+def check_numbers(
+    *,
+    thickness: float,
+    hinge_stiffness: float,
+    loads: tuple[Load, ...] = (),
+    material: Material | None = None,
+    settings: Settings = DEFAULTS,
+) -> None:
     """ValueError (one line, naming the value) for a thickness that is not a positive number
-    of metres, a hinge stiffness that is not a number >= 0."""
+    of metres, a hinge stiffness that is not a number >= 0, and for a thickness, hinge
+    stiffness, Young's modulus, density or load above ``Settings.limits.max_structure_value``
+    in SI units (beyond it the analysis overflows)."""
 
     def number(x) -> bool:
         return not isinstance(x, bool) and isinstance(x, int | float | np.number)
@@ -311,6 +359,24 @@ def check_numbers(*, thickness: float, hinge_stiffness: float) -> None:
         raise RigidfoldError(f"thickness must be a positive number of metres, got {thickness!r}")
     if not (number(hinge_stiffness) and np.isfinite(hinge_stiffness) and hinge_stiffness >= 0):
         raise RigidfoldError(f"hinge stiffness must be >= 0 N m/rad per m, got {hinge_stiffness!r}")
+    largest = settings.limits.max_structure_value
+    values = [("thickness", thickness, "m"), ("hinge stiffness", hinge_stiffness, "N m/rad/m")]
+    if material is not None:
+        values += [("Young's modulus", material.E, "Pa"), ("density", material.density, "kg/m^3")]
+    for what, value, unit in values:
+        if value > largest:
+            raise RigidfoldError(
+                f"{what} {value:g} {unit} is above {largest:g} "
+                "(Settings.limits.max_structure_value)"
+            )
+    check_magnitudes(tuple(loads), largest)
+
+
+@lru_cache(maxsize=2)
+def _shell_mesh(pattern: CreasePattern, subdivisions: int) -> ShellMesh:
+    """:func:`~rigidfold.structure.model.shell_mesh`, kept for the last designs (the
+    analyses of ``--supports service`` share one; a pattern is hashed by identity)."""
+    return shell_mesh(pattern, subdivisions)
 
 
 def check_structure(
@@ -327,11 +393,23 @@ def check_structure(
     modes: int = DEFAULTS.structure.modes,
     auto: bool = False,
     settings: Settings = DEFAULTS,
+    progress: Callable[[str], None] | None = None,
 ) -> StructureCheck:
     """Load the design on the supports of ``rigidity`` (from
     :func:`~rigidfold.structure.supports.check_supports` or ``auto_supports``) and check
-    it; no analysis when the supports leave a mechanism."""
-    check_inputs(pattern, thickness=thickness, hinge_stiffness=hinge_stiffness, loads=loads)
+    it; no analysis when the supports leave a mechanism. ``progress`` is handed a line as
+    each analysis starts."""
+    check_inputs(
+        pattern,
+        thickness=thickness,
+        hinge_stiffness=hinge_stiffness,
+        loads=loads,
+        material=material,
+        settings=settings,
+    )
+    if any(isinstance(load, SelfWeight) for load in loads):
+        self_weight = True
+        loads = tuple(load for load in loads if not isinstance(load, SelfWeight))
     held = rigidity.supports.held(pattern)
     common = dict(
         pattern=held,
@@ -348,7 +426,12 @@ def check_structure(
     )
     if not rigidity.stable:
         return StructureCheck(mesh=None, response=None, **common)  # type: ignore[arg-type]
-    mesh = shell_mesh(held, settings.structure.subdivisions)
+    mesh = _shell_mesh(held, settings.structure.subdivisions)
+    if progress is not None:
+        progress(
+            f"{'nonlinear' if nonlinear else 'linear'} static analysis of {mesh.n_elements} "
+            f"shells in OpenSees"
+        )
     weight = material.density * settings.structure.gravity * thickness if self_weight else 0.0
     forces = nodal_loads(mesh, tuple(loads), self_weight=weight)
     response = solve_shell(
@@ -362,5 +445,6 @@ def check_structure(
         nonlinear=nonlinear,
         modes=modes,
         settings=settings,
+        progress=progress,
     )
     return StructureCheck(mesh=mesh, response=response, **common)  # type: ignore[arg-type]

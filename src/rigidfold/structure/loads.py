@@ -3,12 +3,16 @@ point loads, as nodal forces of the shell mesh.
 
 ``--load`` values (one per option, any number):
 
-* ``uniform=KPA``: a load of KPA kN/m^2 per plan area, downwards (snow): each element
-  carries KPA x its area projected on the xy plane;
-* ``pressure=KPA``: a pressure of KPA kN/m^2 normal to the panels (wind), positive pressing
-  on the upper face (against the upward normal of a counter-clockwise pattern), negative a
-  suction;
-* ``point=V:FX,FY,FZ``: a force in newtons at vertex V (``point=12:0,0,-500``).
+* ``uniform=Q``: a load of Q per plan area, downwards (snow): each element carries Q x its
+  area projected on the xy plane;
+* ``pressure=Q``: a pressure of Q normal to the panels (wind), positive pressing on the
+  upper face (against the upward normal of a counter-clockwise pattern), negative a suction;
+* ``point=V:FX,FY,FZ``: a force at vertex V (``point=12:0,0,-500``, ``point=12:0,0,-2kN``).
+
+Units: a pressure or uniform load in ``Pa``, ``kPa`` (= ``kN/m2``) or ``MPa``, a bare number
+in kPa (``uniform=0.5``, ``0.5kPa`` and ``500Pa`` are the same load); a point load's
+components in ``N``, ``kN`` or ``MN``, a bare number in newtons. :data:`PRESSURE_UNITS`,
+:data:`FORCE_UNITS`.
 
 Self-weight (on unless ``--no-self-weight``) is density x g x thickness per panel area. An
 element's load goes to its three nodes in equal shares (the consistent load of a uniform
@@ -18,7 +22,9 @@ load on a linear triangle's translations).
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -26,35 +32,104 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.structure.model import ShellMesh
 
 LOAD_KINDS = ("uniform", "pressure", "point")
+"""The kinds of ``--load`` (self-weight is on unless ``--no-self-weight``)."""
 
 
 @dataclass(frozen=True)
-class Load:
-    """One load case term.
+class _AreaLoad:
+    """A load of ``kpa`` kN/m^2 over the panels."""
 
-    kind : one of :data:`LOAD_KINDS`; kpa : kN/m^2 of a uniform load or a pressure;
-    vertex, force : of a point load (vertex index, (3,) newtons).
-    """
-
-    kind: str
-    kpa: float = 0.0
-    vertex: int = -1
-    force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    kpa: float
+    kind: ClassVar[str] = ""
 
     def to_dict(self) -> dict:
-        if self.kind == "point":
-            return {"kind": "point", "vertex": self.vertex, "force_N": list(self.force)}
         return {"kind": self.kind, "kPa": self.kpa}
 
     def describe(self) -> str:
-        if self.kind == "point":
-            return f"point load {list(self.force)} N at vertex {self.vertex}"
         return f"{self.kind} {self.kpa:g} kPa"
+
+    @property
+    def text(self) -> str:
+        """The ``--load`` text of this load, its number in kPa, bare (:func:`parse_load`
+        reads it back)."""
+        return f"{self.kind}={self.kpa!r}"
+
+
+@dataclass(frozen=True)
+class Uniform(_AreaLoad):
+    """A load of ``kpa`` kN/m^2 per plan area, downwards (snow)."""
+
+    kind: ClassVar[str] = "uniform"
+
+
+@dataclass(frozen=True)
+class Pressure(_AreaLoad):
+    """A pressure of ``kpa`` kN/m^2 normal to the panels (wind), positive pressing on the
+    upper face, negative a suction."""
+
+    kind: ClassVar[str] = "pressure"
+
+
+@dataclass(frozen=True)
+class Point:
+    """A force ``force`` (3,) newtons at the design's vertex ``vertex``."""
+
+    vertex: int
+    force: tuple[float, float, float]
+    kind: ClassVar[str] = "point"
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "vertex": self.vertex, "force_N": list(self.force)}
+
+    def describe(self) -> str:
+        return f"point load {list(self.force)} N at vertex {self.vertex}"
+
+    @property
+    def text(self) -> str:
+        """The ``--load`` text of this load (:func:`parse_load` reads it back)."""
+        return f"point={self.vertex}:" + ",".join(repr(f) for f in self.force)
+
+
+@dataclass(frozen=True)
+class SelfWeight:
+    """The panels' weight, density x g x thickness per panel area: in
+    :class:`~rigidfold.structure.StructureOptions` ``loads`` the same as ``self_weight``."""
+
+    kind: ClassVar[str] = "self_weight"
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind}
+
+    def describe(self) -> str:
+        return "self-weight"
+
+    @property
+    def text(self) -> str:
+        return self.kind
+
+
+Load = Uniform | Pressure | Point | SelfWeight
+"""One load term: :class:`Uniform`, :class:`Pressure`, :class:`Point` or :class:`SelfWeight`."""
+
+LOAD_TYPES = (Uniform, Pressure, Point, SelfWeight)
+"""The classes of :data:`Load`, for ``isinstance``."""
+
+PRESSURE_UNITS = {"Pa": 1e-3, "kPa": 1.0, "kN/m2": 1.0, "MPa": 1e3}
+"""A uniform load's or pressure's units in kPa (any case; ``kN/m^2`` too); a bare number is
+kPa."""
+
+FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
+"""A point load's units in newtons (any case); a bare number is newtons."""
+
+_UNIT = re.compile(r"\s*([-+0-9.eE]+(?:[eE][-+]?\d+)?)\s*([a-zA-Z][a-zA-Z/^0-9]*)?\s*")
 
 
 def parse_load(text: str) -> Load:
-    """``uniform=KPA``, ``pressure=KPA`` or ``point=V:FX,FY,FZ`` (see the module's text);
-    ValueError naming what was received for anything else."""
+    """``uniform=Q``, ``pressure=Q`` (kPa, or with a unit: ``0.5kPa``, ``500Pa``) or
+    ``point=V:FX,FY,FZ`` (newtons, or ``2kN``) (see the module's text); ValueError naming
+    what was received for anything else."""
+    if isinstance(text, str) and text.strip().lower() in ("self_weight", "self-weight"):
+        return SelfWeight()
     if not isinstance(text, str) or "=" not in text:
         raise RigidfoldError(
             f"a load is uniform=KPA, pressure=KPA or point=V:FX,FY,FZ, got {text!r}"
@@ -62,8 +137,12 @@ def parse_load(text: str) -> Load:
     kind, _, value = (s.strip() for s in text.partition("="))
     kind = kind.lower()
     if kind in ("uniform", "pressure"):
-        kpa = _number(value, text)
-        return Load(kind, kpa=kpa)
+        kpa = _number(value, text, PRESSURE_UNITS)
+        return Uniform(kpa) if kind == "uniform" else Pressure(kpa)
+    if kind in ("self_weight", "self-weight"):
+        if value:
+            raise RigidfoldError(f"self-weight takes no value, got {text!r}")
+        return SelfWeight()
     if kind == "point":
         vertex, sep, force = value.partition(":")
         parts = force.split(",")
@@ -77,27 +156,57 @@ def parse_load(text: str) -> Load:
             ) from None
         if v < 0:
             raise RigidfoldError(f"a point load's vertex must be >= 0, got {text!r}")
-        fx, fy, fz = (_number(p, text) for p in parts)
-        return Load("point", vertex=v, force=(fx, fy, fz))
+        fx, fy, fz = (_number(p, text, FORCE_UNITS) for p in parts)
+        return Point(v, (fx, fy, fz))
     raise RigidfoldError(
         f"unknown load kind {kind!r} in {text!r} (choose from {', '.join(LOAD_KINDS)})"
     )
 
 
-def _number(value: str, text: str) -> float:
+def _number(value: str, text: str, units: dict[str, float]) -> float:
+    """``value``, a number with an optional unit of ``units``, in the units' base."""
+    match = _UNIT.fullmatch(value)
+    known = {u.lower(): f for u, f in units.items()} | {"kn/m^2": units.get("kN/m2", 1.0)}
+    unit = (match.group(2) or "").lower() if match else ""
+    if match and unit and unit not in known:
+        raise RigidfoldError(
+            f"unknown unit {match.group(2)!r} in the load {text!r} (use "
+            f"{', '.join(units)}, or a bare number)"
+        )
     try:
-        x = float(value)
-    except ValueError:
+        x = float(match.group(1)) * known.get(unit, 1.0) if match else math.nan
+    except (ValueError, OverflowError):
         x = math.nan
     if not math.isfinite(x):
         raise RigidfoldError(f"a load's value must be a finite number, got {text!r}")
     return x
 
 
-def check_loads(loads: tuple[Load, ...], n_vertices: int) -> None:
-    """ValueError when a point load names a vertex the design does not have."""
+def check_magnitudes(loads: tuple[Load, ...], largest: float) -> None:
+    """ValueError (one line) for a load above ``largest`` in SI units (Pa, N)."""
     for load in loads:
-        if load.kind == "point" and not 0 <= load.vertex < n_vertices:
+        if isinstance(load, Point):
+            size, unit = max(abs(f) for f in load.force), "N"
+        elif isinstance(load, _AreaLoad):
+            size, unit = abs(load.kpa) * 1e3, "Pa"
+        else:
+            continue
+        if not size <= largest:
+            raise RigidfoldError(
+                f"the {load.describe()} is above {largest:g} {unit} "
+                "(Settings.limits.max_structure_value)"
+            )
+
+
+def check_loads(loads: tuple[Load, ...], n_vertices: int) -> None:
+    """ValueError when a load is not a :data:`Load` or a point load names a vertex the
+    design does not have."""
+    for load in loads:
+        if not isinstance(load, LOAD_TYPES):
+            raise RigidfoldError(
+                f"a load must be Uniform, Pressure, Point or SelfWeight, got {load!r}"
+            )
+        if isinstance(load, Point) and not 0 <= load.vertex < n_vertices:
             raise RigidfoldError(
                 f"point load at vertex {load.vertex}: the design has vertices 0..{n_vertices - 1}"
             )
@@ -116,14 +225,14 @@ def nodal_loads(
     area = mesh.triangle_areas
     normal = mesh.triangle_normals
     for load in loads:
-        if load.kind == "uniform":
-            per_area[:, 2] -= 1e3 * load.kpa * np.abs(normal[:, 2])
-        elif load.kind == "pressure":
+        if isinstance(load, Pressure):
             per_area -= 1e3 * load.kpa * normal
+        elif isinstance(load, Uniform):
+            per_area[:, 2] -= 1e3 * load.kpa * np.abs(normal[:, 2])
     forces = np.zeros((mesh.n_nodes, 3))
     share = (per_area * area[:, None] / 3.0)[:, None, :].repeat(3, axis=1)
     np.add.at(forces, mesh.triangles.ravel(), share.reshape(-1, 3))
     for load in loads:
-        if load.kind == "point":
+        if isinstance(load, Point):
             forces[mesh.vertex_nodes(load.vertex)[0]] += load.force
     return forces

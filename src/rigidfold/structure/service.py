@@ -29,7 +29,13 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import StructureCheck, StructureStatus
-from rigidfold.structure.supports import Rigidity, SupportGrowth, Supports, check_supports
+from rigidfold.structure.supports import (
+    Rigidity,
+    SupportGrowth,
+    Supports,
+    check_supports,
+    support_modes,
+)
 
 Analyse = Callable[[Rigidity, float | None], StructureCheck]
 """The linear structure check of the design on the supports of a :class:`Rigidity`, with
@@ -71,6 +77,7 @@ def grow_supports(
     sup = first.supports
     rigid = np.asarray(sup.pinned, dtype=np.int64)
     trail: list[tuple[str, int, int, float, float]] = []
+    modes = support_modes(sup.held(pattern), settings)  # one design: its free motions once
 
     def run(pins: list[int], step: str, vertex: int) -> StructureCheck:
         rigidity = (
@@ -80,6 +87,7 @@ def grow_supports(
                 pattern,
                 Supports(np.array(sorted(pins), np.int64), sup.clamped, sup.actuated),
                 settings,
+                modes,
             )
         )
         check = analyse(rigidity, None)

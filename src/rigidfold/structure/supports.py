@@ -22,9 +22,15 @@ Actuated creases (``--actuators``) are held at their angle: they count as fixed 
 the boundary vertices at ground level) that is first-order rigid, and among those of that
 size the one of the largest smallest eigenvalue. Every set of one size is tried, smallest
 size first (from ceil((d + 6) / 3), as each pin gives three rows), while the number of sets
-is at most ``Settings.structure.max_support_sets``; beyond, a greedy search adds the
-candidate that raises log det of K~ (eigenvalues floored) the most until rigid, then drops
-any support not needed.
+is at most ``Settings.structure.max_support_sets`` (in chunks of at most 128 MiB); beyond, a
+greedy search adds the candidate that raises log det (K~ + tol I) the most until rigid (by
+the matrix determinant lemma and rank-3 updates: no eigenvalue problem per candidate), then
+drops supports while rigid, the one whose removal lowers that log det the least first.
+
+The free motions Q come from the dense singular value decomposition of C for designs of up
+to ``Settings.structure.sparse_vertices`` vertices, from a sparse factorisation of C^T C, a
+subspace iteration and Rayleigh-Ritz on C above (:func:`_sparse_modes`); the dense blocks
+that either needs are bounded by ``Settings.limits.max_structure_bytes``.
 
 Where first order is not enough (K~ has eigenvalues at most ``structure_rigidity_tol``: the
 supports leave first-order motions, the flexes, the eigenvectors of those eigenvalues), the
@@ -40,8 +46,12 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 
 import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
@@ -152,11 +162,12 @@ class SupportModes:
     def __init__(self, pattern: CreasePattern, settings: Settings = DEFAULTS) -> None:
         self.pattern = pattern
         self.settings = settings
-        C = constraint_matrix(pattern, 0)[:-9].toarray()  # the support triangle's rows dropped
-        _, sv, vt = np.linalg.svd(C, full_matrices=True)
-        sigma = np.zeros(3 * pattern.n_vertices)
-        sigma[: len(sv)] = sv
-        top = float(sv[0]) if len(sv) else 1.0
+        C = constraint_matrix(pattern, 0)[:-9]  # the support triangle's rows dropped
+        if pattern.n_vertices <= settings.structure.sparse_vertices:
+            sigma, vt, top = _dense_modes(C.toarray())
+        else:
+            start = len(pattern.boundary_vertices) + 6
+            sigma, vt, top = _sparse_modes(C, start, settings)
         soft = sigma <= settings.structure.soft_modes * top
         self.sigma = sigma[soft]
         self.Q = vt[soft].T
@@ -172,6 +183,11 @@ class SupportModes:
         self.scale = float(np.mean(pattern.edge_lengths))
         self._grams: dict[int, np.ndarray] = {}
 
+    @cached_property
+    def _angular(self) -> np.ndarray:
+        """(F, 3, 3, 3) :func:`~rigidfold.mechanism.kinematics.angular_velocity_blocks`."""
+        return angular_velocity_blocks(self.pattern)
+
     @property
     def n_modes(self) -> int:
         """m: 6 + d + the near-mechanisms."""
@@ -185,7 +201,7 @@ class SupportModes:
         """(3 + 3k, m) velocity of ``vertex`` and the angular velocities (times the mean edge
         length) of the k triangles at it."""
         faces = np.flatnonzero(np.any(self.pattern.faces == vertex, axis=1))
-        W = angular_velocity_blocks(self.pattern)[faces]  # (k, 3, 3, 3)
+        W = self._angular[faces]  # (k, 3, 3, 3)
         rows = [self.pin_rows(vertex)]
         for f, block in zip(faces, W, strict=True):
             cols = (3 * self.pattern.faces[f][:, None] + np.arange(3)).ravel()
@@ -225,6 +241,13 @@ class SupportModes:
         second = None
         if not rigid:
             held = held_vertices(self.pattern, supports.pinned, supports.clamped)
+            k = int(soft.sum())
+            rows = self.pattern.n_edges + len(self.pattern.fixed_creases) + 3 * len(held)
+            check_structure_bytes(
+                2 * 8 * rows * k * k,
+                f"the second-order check of the {k} first-order motions the supports leave",
+                self.settings,
+            )
             flexes = self.Q @ stiff.eigenvectors[:, soft]
             second = second_order(self.pattern, held, flexes, self.settings)
             weakest = second.witness
@@ -263,6 +286,77 @@ class SupportModes:
         if np.linalg.norm(w) * self.scale > 1e-6 * np.linalg.norm(t):
             return "a rigid-body rotation about the axis " + _vector(w / np.linalg.norm(w))
         return "a rigid-body translation along " + _vector(t / np.linalg.norm(t))
+
+
+def _dense_modes(C: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """(the singular values (3V,), zeros past the rows; the right singular vectors (3V, 3V)
+    as rows; the largest singular value) of the dense constraint matrix C."""
+    _, sv, vt = np.linalg.svd(C, full_matrices=True)
+    sigma = np.zeros(C.shape[1])
+    sigma[: len(sv)] = sv
+    return sigma, vt, float(sv[0]) if len(sv) else 1.0
+
+
+def _sparse_modes(
+    C: sp.csr_matrix, start: int, settings: Settings
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """(Ritz values (k,), ascending; their right vectors (k, 3V) as rows; the largest
+    singular value of C) of a subspace that holds every direction of C's singular values up
+    to ``structure_soft_modes`` times the largest: ``start`` random columns and
+    ``mechanism_sparse_oversampling`` more, filtered by ``(C^T C + delta I)^-1``
+    (``structure_soft_shift``, ``structure_soft_iterations`` solves), then Rayleigh-Ritz on
+    C; the columns double while the soft Ritz values leave fewer than half the oversampling
+    spare. RigidfoldError (one line) when the subspace would pass
+    ``Settings.limits.max_structure_bytes``."""
+    n = C.shape[1]
+    p = settings.mechanism.sparse_oversampling
+    cols = min(n, start + p)
+    check_structure_bytes(
+        _modes_bytes(n, cols), f"{cols} free motions of the supports' search", settings
+    )
+    M = (C.T @ C).tocsc()
+    rng = np.random.default_rng(0)  # the same subspace on every run
+    largest = spla.eigsh(M, k=1, which="LA", v0=rng.random(n) - 0.5, return_eigenvectors=False)
+    top = float(np.sqrt(max(float(largest[0]), 0.0))) or 1.0
+    lu = spla.splu(
+        (M + settings.structure.soft_shift * top**2 * sp.identity(n)).tocsc(),
+        permc_spec="MMD_AT_PLUS_A",
+        diag_pivot_thresh=0.0,
+        options={"SymmetricMode": True},
+    )
+    while True:
+        check_structure_bytes(
+            _modes_bytes(n, cols), f"{cols} free motions of the supports' search", settings
+        )
+        W = np.asfortranarray(rng.random((cols, n)).T - 0.5)
+        for _ in range(settings.structure.soft_iterations):
+            W = np.linalg.qr(lu.solve(W))[0]
+        R: np.ndarray = np.asarray(np.linalg.qr(np.asarray(C @ W), mode="r"))
+        if R.shape[0] < cols:
+            R = np.vstack([R, np.zeros((cols - R.shape[0], cols))])
+        _, values, vt = np.linalg.svd(R)
+        values, vt = values[::-1], vt[::-1]
+        found = int(np.sum(values <= settings.structure.soft_modes * top))
+        if cols == n or found <= cols - p // 2:
+            return values, vt @ W.T, top
+        cols = min(n, 2 * cols)
+
+
+def _modes_bytes(n: int, cols: int) -> int:
+    """Bytes of the sparse free motions' dense blocks: about four n x cols arrays."""
+    return 8 * 4 * n * cols
+
+
+def check_structure_bytes(need: int, what: str, settings: Settings = DEFAULTS) -> None:
+    """RigidfoldError (one line) when ``need`` bytes for ``what`` pass
+    ``Settings.limits.max_structure_bytes``."""
+    cap = settings.limits.max_structure_bytes
+    if need > cap:
+        raise RigidfoldError(
+            f"the design is too large for the structure check: {what} need about "
+            f"{need / 2**30:.3g} GiB, over Settings.limits.max_structure_bytes "
+            f"({cap / 2**30:.3g} GiB)"
+        )
 
 
 def _vector(v: np.ndarray) -> str:
@@ -336,11 +430,26 @@ class Rigidity:
         }
 
 
+@lru_cache(maxsize=2)
+def support_modes(pattern: CreasePattern, settings: Settings = DEFAULTS) -> SupportModes:
+    """The :class:`SupportModes` of ``pattern`` (its actuated creases fixed), kept for the
+    last two designs: ``auto`` and ``--supports service`` find the free motions once (a
+    pattern is hashed by identity)."""
+    return SupportModes(pattern, settings)
+
+
 def check_supports(
-    pattern: CreasePattern, supports: Supports, settings: Settings = DEFAULTS
+    pattern: CreasePattern,
+    supports: Supports,
+    settings: Settings = DEFAULTS,
+    modes: SupportModes | None = None,
 ) -> Rigidity:
-    """First-order rigidity of ``pattern`` (actuated creases held) on ``supports``."""
-    return SupportModes(supports.held(pattern), settings).rigidity(supports)
+    """First-order rigidity of ``pattern`` (actuated creases held) on ``supports``; with
+    ``modes``, the free motions of ``supports.held(pattern)`` found before (several sets of
+    supports of one design)."""
+    if modes is None:
+        modes = support_modes(supports.held(pattern), settings)
+    return modes.rigidity(supports)
 
 
 def auto_supports(
@@ -362,14 +471,16 @@ def auto_supports(
         none if clamped is None else np.asarray(clamped),
         none if actuated is None else np.asarray(actuated),
     )
-    modes = SupportModes(base.held(pattern), settings)
+    modes = support_modes(base.held(pattern), settings)
     cand = np.setdiff1d(np.asarray(candidates, dtype=np.int64), base.clamped)
     if not len(cand):
         raise RigidfoldError("no candidate vertex for the supports")
+    m = modes.n_modes
+    check_structure_bytes(8 * m * m * 8, f"the stiffness on {m} free motions", settings)
     G0 = modes.own + sum(
         (modes.gram(int(v), clamp=True) for v in base.clamped), np.zeros((modes.n_modes,) * 2)
     )
-    G = np.stack([modes.gram(int(v)) for v in cand])
+    B = np.stack([modes.pin_rows(int(v)) for v in cand])  # (c, 3, m)
     tol = settings.structure.rigidity_tol
     everything = modes.rigidity(Supports(cand, base.clamped, base.actuated))
     if not everything.rigid:
@@ -378,53 +489,101 @@ def auto_supports(
     k0 = max(1, math.ceil((need - 6 * len(base.clamped)) / 3))
     for k in range(k0, len(cand) + 1):
         if math.comb(len(cand), k) > settings.structure.max_support_sets:
-            chosen = _greedy(G0, G, tol)
+            chosen = _greedy(G0, B, tol, k)
             return modes.rigidity(Supports(cand[chosen], base.clamped, base.actuated))
-        best, best_lam = None, 0.0
-        combos = itertools.combinations(range(len(cand)), k)
-        while True:
-            chunk = np.array(list(itertools.islice(combos, 8192)), dtype=np.int64)
-            if not len(chunk):
-                break
-            lam = np.linalg.eigvalsh(G0 + G[chunk].sum(axis=1))
-            ok = lam[:, 0] > tol
-            if ok.any():
-                i = int(np.argmax(np.where(ok, lam[:, 0], -np.inf)))
-                if best is None or lam[i, 0] > best_lam:
-                    best, best_lam = chunk[i], float(lam[i, 0])
+        best = _best_set(G0, B, k, tol)
         if best is not None:
             return modes.rigidity(Supports(cand[best], base.clamped, base.actuated))
     return everything  # not reached: all candidates together are rigid
 
 
-def _greedy(G0: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
-    """Indices into G (c, m, m) of a rigid set: add the support that raises the floored log
-    det the most until rigid, then drop supports while rigid (the one whose removal keeps
-    the largest smallest eigenvalue first)."""
-    floor = tol
+_CHUNK_BYTES = 2**27
+"""Memory of one chunk of the exhaustive search's stiffness matrices (128 MiB)."""
 
-    def rigid(lam: np.ndarray) -> bool:
-        return bool(lam[0] > tol)
 
-    chosen: list[int] = []
+def _best_set(G0: np.ndarray, B: np.ndarray, k: int, tol: float) -> np.ndarray | None:
+    """Indices into B (c, 3, m) of the k supports, of all sets of k, whose K~ (G0 and their
+    rows' B^T B) has the largest smallest eigenvalue above ``tol``; None when none has."""
+    m = G0.shape[0]
+    grams = np.stack([b.T @ b for b in B]) if B.size * m <= _CHUNK_BYTES // 8 else None
+    size = max(1, min(8192, _CHUNK_BYTES // max(8 * m * m * (k if grams is not None else 1), 1)))
+    best, best_lam = None, 0.0
+    combos = itertools.combinations(range(len(B)), k)
+    while True:
+        chunk = np.array(list(itertools.islice(combos, size)), dtype=np.int64)
+        if not len(chunk):
+            break
+        if grams is not None:
+            stiff = G0 + grams[chunk].sum(axis=1)
+        else:
+            rows = B[chunk].reshape(len(chunk), 3 * k, m)
+            stiff = G0 + np.einsum("sim,sin->smn", rows, rows)
+        lam = np.linalg.eigvalsh(stiff)
+        ok = lam[:, 0] > tol
+        if ok.any():
+            i = int(np.argmax(np.where(ok, lam[:, 0], -np.inf)))
+            if best is None or lam[i, 0] > best_lam:
+                best, best_lam = chunk[i], float(lam[i, 0])
+    return best
+
+
+def _rigid(stiff: np.ndarray, tol: float) -> bool:
+    """Whether the symmetric ``stiff`` has every eigenvalue above ``tol`` (a Cholesky
+    factorisation of ``stiff - tol I``)."""
+    try:
+        np.linalg.cholesky(stiff - tol * np.eye(len(stiff)))
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+def _greedy(G0: np.ndarray, B: np.ndarray, tol: float, least: int = 1) -> np.ndarray:
+    """Indices into B (c, 3, m) of a rigid set (see the module's text): add the support that
+    raises log det (K~ + tol I) the most until rigid (tested from ``least`` supports on),
+    then drop supports while rigid (of those that may go, the one whose removal lowers log
+    det (K~ - tol I) the least first). Each support's gain is
+    log det(I_3 + B_v (K~ + tol I)^-1 B_v^T) (the matrix determinant lemma), kept up to date
+    by rank-3 updates of (K~ + tol I)^-1 B^T, so a step costs O(c m), not an eigenvalue
+    problem per candidate; a support may go when I_3 - B_v (K~ - tol I)^-1 B_v^T is positive
+    definite (the Schur complement of K~ - tol I without it)."""
+    c, _, m = B.shape
+    eye = np.eye(m)
     current = G0.copy()
-    while not chosen or not rigid(np.linalg.eigvalsh(current)):
-        rest = [i for i in range(len(G)) if i not in chosen]
-        lam = np.linalg.eigvalsh(current[None] + G[rest])
-        score = np.log(np.maximum(lam, floor)).sum(axis=1)
-        pick = rest[int(np.argmax(score))]
+    factor = sla.cho_factor(current + tol * eye)
+    W = sla.cho_solve(factor, B.reshape(3 * c, m).T).T.reshape(c, 3, m)  # B (K~ + tol I)^-1
+    chosen: list[int] = []
+    free = np.ones(c, dtype=bool)
+    while not (len(chosen) >= least and _rigid(current, tol)):
+        if not free.any():
+            break
+        S = np.eye(3) + np.einsum("cim,cjm->cij", B, W)  # (c, 3, 3)
+        gain = np.round(np.linalg.slogdet(S)[1], 8)  # round-off does not choose
+        gain[~free] = -np.inf
+        pick = int(np.argmax(gain))  # ties: the lowest index
         chosen.append(pick)
-        current = current + G[pick]
+        free[pick] = False
+        current = current + B[pick].T @ B[pick]
+        # (K + B_p^T B_p)^-1 = K^-1 - K^-1 B_p^T S_p^-1 B_p K^-1
+        cross = np.einsum("cim,jm->cij", B, W[pick])  # B_v K^-1 B_p^T, (c, 3, 3)
+        W = W - np.einsum("cij,jk,km->cim", cross, np.linalg.inv(S[pick]), W[pick])
     while len(chosen) > 1:
+        # K~ - tol I - B_i^T B_i is positive definite iff I_3 - B_i (K~ - tol I)^-1 B_i^T is
+        # (its Schur complement): one factorisation a round, a 3 x 3 test per support
+        try:
+            factor = sla.cho_factor(current - tol * eye)
+        except np.linalg.LinAlgError:
+            break
         trials = []
         for i in chosen:
-            lam = np.linalg.eigvalsh(current - G[i])
-            trials.append((float(lam[0]) if rigid(lam) else -np.inf, i))
-        value, drop = max(trials)
-        if value == -np.inf:
+            rest = np.eye(3) - B[i] @ sla.cho_solve(factor, B[i].T)
+            sign, logdet = np.linalg.slogdet(rest)
+            if sign > 0 and _rigid(rest, 1e-8):  # a margin over round-off
+                trials.append((round(-float(logdet), 8), i))
+        if not trials:
             break
+        _, drop = min(trials)  # lowers log det the least; ties: the lowest index
         chosen.remove(drop)
-        current = current - G[drop]
+        current = current - B[drop].T @ B[drop]
     return np.array(sorted(chosen), dtype=np.int64)
 
 
