@@ -100,7 +100,10 @@ class PathSettings(Group):
         "vertices.",
     )
     max_escapes: int = setting(
-        20, "Dense steps past stalls (``path_escape_tol``) one direction of a trace may take."
+        5,
+        "Dense steps past stalls (``path_escape_tol``) one direction of a trace may take: each "
+        "costs a dense SVD and dense corrections (seconds at 200 vertices), and a path that "
+        "stalls again after 5 rarely gets through (docs/deployability.md).",
     )
 
 
