@@ -173,7 +173,7 @@ def test_a_damaged_summary_or_log_is_one_line_naming_the_file_and_key(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
 
 
-MUTANTS = 40
+MUTANTS = 60
 
 
 def random_mutant(summary: dict, log: list, rng: random.Random) -> tuple[dict, list, list[str]]:

@@ -94,7 +94,7 @@ def test_the_library_refuses_them_too():
 
 def test_generate_refuses_them_before_the_run():
     with pytest.raises(RigidfoldError, match="max_structure_value"):
-        GenerateOptions(structure=True, loads=("uniform=1e300",))
+        GenerateOptions(structure=StructureOptions.from_strings(loads=("uniform=1e300",)))
 
 
 @pytest.mark.parametrize(

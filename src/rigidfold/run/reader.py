@@ -438,7 +438,11 @@ def load_run(directory: str | os.PathLike) -> RunData:
     if surface is None and summary.target_surface is not None:
         surface, note = _stored_surface(root, summary.target_surface)
     if surface is not None and not all(_measurable(d, surface) for d in designs):
-        surface, note = None, "the target surface could not be rebuilt: its heights are too large"
+        source = "" if summary.target_surface is None else f" (from {summary.target_surface})"
+        surface, note = (
+            None,
+            f"the target surface could not be rebuilt{source}: its heights are too large",
+        )
     return RunData(root, summary, attempts, tuple(designs), surface, note)
 
 
