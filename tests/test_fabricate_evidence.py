@@ -37,12 +37,14 @@ def large(tmp_path_factory):
     clearance (not checked over a motion: the outlines and the nesting need none), and its
     cut sheets written: (fabrication, files)."""
     from rigidfold.fabricate import Panels, fabricate_panels
-    from rigidfold.fabricate.cutsheets import write_cut_sheets
+    from rigidfold.fabricate.cutsheets import cut_sheet_data
+    from rigidfold.io.files import write_together
 
     pattern, flat = curved_grid(17)
     fab = fabricate_panels(Panels(pattern, flat, "bottom"), None, 0.02, clearance_angle=0.035)
     out = tmp_path_factory.mktemp("large")
-    files, _ = write_cut_sheets(fab, out, "grid", width=2440, height=1220, gap=10)
+    data, _ = cut_sheet_data(fab, out, "grid", width=2440, height=1220, gap=10)
+    files = write_together(data)
     return fab, files
 
 

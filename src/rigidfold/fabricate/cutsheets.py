@@ -44,13 +44,14 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import min_area_angle
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import text_bytes, write_together
+from rigidfold.io.files import text_bytes
 
 MM = 1000.0
 
 SHEET_FILE = r"{}_(?:sheet|oversize)_[0-9]{{2,}}\.(?:dxf|svg)"
-"""The names :func:`write_cut_sheets` writes (a regular expression, ``{}`` for the design's
-name, escaped): ``NAME_sheet_NN`` and ``NAME_oversize_NN``, ``.dxf`` and ``.svg``."""
+"""The names of the sheets :func:`cut_sheet_data` makes (a regular expression, ``{}`` for
+the design's name, escaped): ``NAME_sheet_NN`` and ``NAME_oversize_NN``, ``.dxf`` and
+``.svg``."""
 
 
 class Label(NamedTuple):
@@ -847,25 +848,6 @@ def cut_sheet_data(
         files.append((out / f"{stem}.dxf", dxf_bytes(sheet, title=label)))
         files.append((out / f"{stem}.svg", svg_text(sheet, title=label)))
     return files, sheets
-
-
-def write_cut_sheets(
-    fab: Fabrication,
-    out: Path,
-    name: str,
-    *,
-    width: float,
-    height: float,
-    gap: float,
-    title: str = "",
-    settings: Settings = DEFAULTS,
-) -> tuple[list[Path], list[StockSheet]]:
-    """Nest the panels and write their sheets together (:func:`cut_sheet_data`,
-    :func:`rigidfold.io.files.write_together`); returns the files and the sheets."""
-    files, sheets = cut_sheet_data(
-        fab, out, name, width=width, height=height, gap=gap, title=title, settings=settings
-    )
-    return write_together(files), sheets
 
 
 def sheet_files(directory: str | os.PathLike, name: str) -> list[str]:
