@@ -7,6 +7,7 @@ refused or, with ``--overwrite``, removed (:func:`clear_earlier_run`), never an 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -25,6 +26,23 @@ earlier run all the same (refused, or removed with ``--overwrite``)."""
 
 RUN_DIRS = ("solutions", "figures", "final")
 """The directories a generation run writes (solution files, figures, exports)."""
+
+_STEP = r"step_[0-9]+_dof_[0-9]+"
+RUN_DIR_FILES = {
+    "solutions": re.compile(rf"{_STEP}\.(?:fold|svg)"),
+    "figures": re.compile(r"[A-Za-z0-9_]+\.png"),
+    "final": re.compile(
+        rf"{_STEP}(?:\.[a-z0-9.]+|_[a-z0-9_]+\.[a-z0-9]+)"
+        rf"|thick|thick/{_STEP}_[a-z0-9_]+\.[a-z0-9]+"
+        r"|structure|structure/structure\.(?:json|png)"
+    ),
+}
+"""What a generation run writes in each of its directories (paths relative to it): the only
+entries ``--overwrite`` removes with them; an entry of another name there is the user's, and
+the directory is then refused, not removed. Temporary files of a killed run (``.NAME.<hex>.tmp``)
+count as the run's."""
+
+_TEMP = re.compile(r"(?:.*/)?\.[^/]*\.[0-9a-f]+\.tmp")
 
 
 LOCK_NAME = ".rigidfold-run.lock"
@@ -161,6 +179,16 @@ def clear_earlier_run(
                     f"--overwrite would remove the input file '{given}' with the earlier run's "
                     f"{path.name}: copy it out of '{out}' first, or use another --out"
                 )
+    for path in found:
+        pattern = RUN_DIR_FILES.get(path.name)
+        if pattern is not None and path.is_dir() and not path.is_symlink():
+            foreign = _foreign(path, pattern)
+            if foreign is not None:
+                raise RigidfoldError(
+                    f"output directory '{out}' holds '{path.name}/{foreign}', which rigidfold "
+                    f"did not write, in the run's {path.name}/ (--overwrite replaces only what "
+                    "the command writes): move it, or use another --out"
+                )
     try:
         for path in found:
             if path.name in dirs and path.is_dir() and not path.is_symlink():
@@ -172,3 +200,16 @@ def clear_earlier_run(
             f"cannot remove the earlier run's {exc.filename}: {exc.strerror}"
         ) from None
     return out
+
+
+def _foreign(directory: Path, pattern: re.Pattern) -> str | None:
+    """The first entry below ``directory`` (its path relative to it) that is not one a run
+    writes there (``pattern``, or a temporary file), None when there is none; a symbolic
+    link is an entry itself, never followed."""
+    for root, subdirs, files in os.walk(directory):
+        here = Path(root).relative_to(directory)
+        for name in sorted(subdirs) + sorted(files):
+            rel = (here / name).as_posix()
+            if not (pattern.fullmatch(rel) or _TEMP.fullmatch(rel)):
+                return rel
+    return None
