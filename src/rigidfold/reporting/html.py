@@ -129,7 +129,8 @@ def _answer(run: RunData) -> list[str]:
     margin = s.document.get("dof_margin") or {}
     dof_text = "–" if s.final_dof is None else str(s.final_dof)
     if margin and not margin.get("clear", True):
-        dof_text += f" (no clear margin: {margin.get('near')} near-mechanisms)"
+        near = margin.get("near")
+        dof_text += f" (no clear margin: {near} near-mechanism{'' if near == 1 else 's'})"
     lowest = s.document.get("lowest_dof")
     items = [
         ("final DOF", dof_text),
