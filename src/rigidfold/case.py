@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Unpack
 
 import numpy as np
 
@@ -98,13 +99,8 @@ def make_case(
     seed: int | None = None,
     expr: str | None = None,
     symmetric: bool = False,
-    size: str | tuple[float, float] | None = None,
-    diagonals: str | None = None,
-    edge_length: float | None = None,
-    scale: float | None = None,
-    up: str = "z",
-    rigid_panels: bool = False,
     settings: Settings = DEFAULTS,
+    **pattern_options: Unpack[patterns.PatternKeywords],
 ) -> Case:
     """Validate the user's choices and build the initial triangulated shape.
 
@@ -115,23 +111,16 @@ def make_case(
         is placed with its plan's lower-left corner at (0, 0); an "expr" surface and a
         Surface object are used as they are.
     pattern : a spec of :func:`rigidfold.patterns.parse_pattern` ("1", "1p", "2", "11",
-        "grid:NXxNY", "mesh:POLYGON", "FILE.fold", "FILE.svg"), with its ``size``,
-        ``diagonals``, ``edge_length``, ``scale`` and ``rigid_panels``.
-    up : the up axis (``"z"`` or ``"y"``) of a FOLD pattern and of a mesh or FOLD surface.
+        "grid:NXxNY", "mesh:POLYGON", "FILE.fold", "FILE.svg"), with its keywords
+        (:class:`rigidfold.patterns.PatternKeywords`: ``size``, ``diagonals``,
+        ``edge_length``, ``scale``, ``up``, ``rigid_panels``); ``up``, the up axis (``"z"``
+        or ``"y"``) of a FOLD pattern, is also that of a mesh or FOLD surface.
     ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
     """
     if seed is not None:
         check_seed(seed)
-    plan = patterns.parse_pattern(
-        pattern,
-        size=size,
-        diagonals=diagonals,
-        edge_length=edge_length,
-        scale=scale,
-        up=up,
-        rigid_panels=rigid_panels,
-        settings=settings,
-    )
+    up = pattern_options.get("up", "z")
+    plan = patterns.parse_pattern(pattern, settings=settings, **pattern_options)
     if isinstance(surface, Surface):
         surf = surface
     elif str(surface).partition(":")[0].strip().lower() == "fold":

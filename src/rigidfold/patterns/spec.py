@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypedDict
 
 import numpy as np
 
@@ -82,6 +83,18 @@ class Plan:
             "footprint_m": None if self.footprint is None else self.footprint.tolist(),
             "pattern_file": self.source,
         }
+
+
+class PatternKeywords(TypedDict, total=False):
+    """The keywords of :func:`parse_pattern` besides the spec and the settings, as
+    :func:`rigidfold.case.make_case` passes them on (one list, not two)."""
+
+    size: str | tuple[float, float] | None
+    diagonals: str | None
+    edge_length: float | None
+    scale: float | None
+    up: str
+    rigid_panels: bool
 
 
 def parse_pattern(
