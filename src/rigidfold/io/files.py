@@ -84,9 +84,10 @@ def text_bytes(text: str) -> bytes:
     Python as lone surrogates (``surrogateescape``); inside a document (a title, a label)
     each such character becomes U+FFFD, so the document stays valid UTF-8 (the name on disk
     keeps its bytes)."""
-    if not any("\udc80" <= ch <= "\udcff" for ch in text):
+    try:
         return text.encode("utf-8")
-    return os.fsencode(text).decode("utf-8", "replace").encode("utf-8")
+    except UnicodeEncodeError:  # rare: only then is the text looked at again
+        return os.fsencode(text).decode("utf-8", "replace").encode("utf-8")
 
 
 def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
