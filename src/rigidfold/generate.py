@@ -175,7 +175,8 @@ class Attempt:
         whether it is second-order rigid (outcome RIGID) and how strongly; None where it did
         not run.
     rigid_forecast : bool or None
-        With the look-ahead at a shape whose children are checked: whether this fix was
+        At a shape whose children are checked (with or without the look-ahead): whether this
+        fix was
         forecast to leave a second-order rigid shape (:class:`rigidfold.mechanism.
         second_order.ChildForecast`); None where no forecast was made.
     """
