@@ -176,8 +176,7 @@ class Attempt:
         not run.
     rigid_forecast : bool or None
         At a shape whose children are checked (with or without the look-ahead): whether this
-        fix was
-        forecast to leave a second-order rigid shape (:class:`rigidfold.mechanism.
+        fix was forecast to leave a second-order rigid shape (:class:`rigidfold.mechanism.
         second_order.ChildForecast`); None where no forecast was made.
     """
 
