@@ -1,11 +1,11 @@
 """Deployable anywhere, in minutes (issue 40): the share of runs on drawn patterns and a roof
 grid that end at DOF 1 with a design that deploys, the time and the solves per run, and why
-every rejected candidate was rejected; with the second-order test and forecast
-(``Settings.generation.second_order``, rigidfold's default) and without it (the search before
-it), in the same process.
+every rejected candidate was rejected; in each mode of :data:`MODES` (rigidfold's defaults,
+``after``; the search without the fold limit, ``before``; without the second-order test,
+``no-second-order``), in the same process.
 
 Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only TEXT]
-[--modes after,before]``. Every run uses S-hat with the look-ahead and the deployability
+[--modes after,before,no-second-order]``. Every run uses S-hat with the look-ahead and the deployability
 check, as the README recommends, and ``--time-limit`` (180 s for a drawn pattern, 420 s for
 the roof): a run that hits it ends with its best design, counted as not reaching DOF 1.
 
@@ -50,7 +50,14 @@ ROOF = {
     "size": "12x8",
     "expr": "0.08*x*(12-x)/6 + 0.02*(y-4)**2 - 0.05*y",
 }
-MODES = {"after": True, "before": False}
+MODES: dict[str, dict] = {
+    "after": {},
+    "before": {"fold_limit": None},
+    "no-second-order": {"second_order": False},
+}
+"""Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
+the search of session 17 (no fold limit: problem (6) without bound (12)); ``no-second-order``
+without the second-order test and forecast (the search before session 17)."""
 
 
 def paper_cases(surfaces: int) -> list[dict]:
@@ -95,12 +102,12 @@ def cause(attempt) -> str | None:
 
 
 def run(case: dict, mode: str) -> dict:
-    """One run of ``case`` with the second-order test and forecast (``after``) or without."""
+    """One run of ``case`` with the settings of ``mode`` (:data:`MODES`)."""
     from rigidfold.case import make_case
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import Stop, generate
 
-    settings = DEFAULTS.with_(second_order=MODES[mode])
+    settings = DEFAULTS.with_(**MODES[mode])
     t0 = time.perf_counter()
     built = make_case(
         case["surface"],
@@ -151,7 +158,7 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", type=Path, default=None)
     parser.add_argument("--only", default=None, metavar="TEXT", help="cases whose name holds it")
-    parser.add_argument("--modes", default="after,before", help="after, before or both")
+    parser.add_argument("--modes", default="after,before", help="comma-separated modes of MODES")
     parser.add_argument(
         "--paper",
         type=int,

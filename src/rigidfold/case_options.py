@@ -158,6 +158,15 @@ class SettingsOptions:
         parse=positive,
         metavar="DEG",
     )
+    fold_limit: float | None = option(
+        None,
+        "with the deployability check: bound (12) on the fold angle of every free crease in "
+        "every solve, degrees, so that no solution folds panels onto each other (default: "
+        f"{math.degrees(DEFAULTS.generation.fold_limit or 0):g}; 0: no bound; --rho-max, "
+        "where given, is the bound instead)",
+        parse=float,
+        metavar="DEG",
+    )
     hessian: str = option(
         DEFAULTS.solver.ipopt_hessian,
         "IPOPT's Hessian of the Lagrangian: closed-form or casadi, the symbolic reference (both "
@@ -190,7 +199,9 @@ class SettingsOptions:
 
     def settings(self) -> Settings:
         """The settings of these options, checked (RigidfoldError naming the setting)."""
-        backtrack = {} if self.backtrack is None else {"backtrack_max": self.backtrack}
+        given: dict = {} if self.backtrack is None else {"backtrack_max": self.backtrack}
+        if self.fold_limit is not None:  # 0: none
+            given["fold_limit"] = math.radians(self.fold_limit) if self.fold_limit else None
         return Settings.from_degrees(
             dz=self.dz,
             theta_min_deg=self.theta_min,
@@ -199,5 +210,5 @@ class SettingsOptions:
             zero_dof_ends=not self.retry_zero_dof,
             ipopt_hessian=self.hessian,
             svg_snap_tol=self.svg_tolerance,
-            **backtrack,
+            **given,
         )

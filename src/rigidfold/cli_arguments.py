@@ -45,7 +45,7 @@ def _generate(p: Parser) -> None:
         "exported in every format of rigidfold export) and report.html",
     )
     add_options(p, GenerateOptions)
-    add_options(p, SettingsOptions, only=("backtrack", "retry_zero_dof"))
+    add_options(p, SettingsOptions, only=("backtrack", "fold_limit", "retry_zero_dof"))
     fabricate_arguments(p, generate=True)
     structure_arguments(p, generate=True)
     p.add_argument(
@@ -218,7 +218,7 @@ def _study(p: Parser) -> None:
     # the study's options, but Step 9 runs unless --no-deform, as in generate
     runs = STUDY_OPTIONS.replace(deform=True)
     add_options(p, GenerateOptions, defaults=runs, only=("deform", "lookahead", "deploy_check"))
-    add_options(p, SettingsOptions, only=("backtrack", "hessian", "svg_tolerance"))
+    add_options(p, SettingsOptions, only=("backtrack", "fold_limit", "hessian", "svg_tolerance"))
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -693,6 +693,7 @@ def generate(
     after the callbacks of everything finished so far.
     """
     opts = (options or GenerateOptions()).replace(**changes)
+    case = with_fold_limit(case, opts)
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
     steps = _Steps(case, opts, on_attempt, on_solution, on_retract)
     run = steps.run
@@ -719,6 +720,22 @@ def generate(
         pattern = final.result.pattern
         run.dof_margin = dof_margin(pattern, steps.support_face(pattern), case.settings).to_dict()
     return run
+
+
+def with_fold_limit(case: Case, options: GenerateOptions) -> Case:
+    """The case whose problem (6) a run solves: with the deployability check and no bound
+    (12) of the user's (``Settings.design.rho_bar``), (12) at
+    ``Settings.generation.fold_limit``; otherwise ``case`` itself.
+
+    Each fix flattens a crease, and the solve makes up for it by folding the creases left
+    free further: unbounded, the chain folds panels onto each other (a crease near 180
+    degrees), and the folding paths of such shapes turn back or collide before the flat
+    state (docs/deployability.md, issue 40)."""
+    s = case.settings
+    limit = s.generation.fold_limit
+    if not options.deploy_check or s.design.rho_bar is not None or limit is None:
+        return case
+    return replace(case, settings=s.with_(rho_bar=limit))
 
 
 def best_so_far(run: Generation) -> None:

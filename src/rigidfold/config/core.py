@@ -134,6 +134,15 @@ class GenerationSettings(Group):
         "row were solved and found second-order rigid, instead of after "
         "``deploy_max_candidates`` (0: only that bound).",
     )
+    fold_limit: float | None = setting(
+        math.radians(120.0),
+        "With the deployability check (and no ``design.rho_bar`` of the user's): bound (12) "
+        "at this angle, radians, on every solve of the run, so that the chain never folds "
+        "two panels onto each other: each fix flattens a crease and the solve folds the "
+        "creases left free further, and the paths of shapes with creases near 180 degrees "
+        "turn back or collide before the flat state (issue 40; docs/deployability.md). "
+        "None: no bound (the paper's problem).",
+    )
     summary_interval: float = setting(
         2.0,
         "Seconds between writes of a run's summary.json after attempts that are rejected "
@@ -146,6 +155,10 @@ class GenerationSettings(Group):
         if not (isinstance(self.backtrack_max, int) and self.backtrack_max >= 0):
             raise RigidfoldError(
                 f"backtrack_max must be a whole number >= 0, got {self.backtrack_max!r}"
+            )
+        if self.fold_limit is not None and not (0 < self.fold_limit < math.pi):
+            raise RigidfoldError(
+                f"fold_limit must lie in (0, 180) degrees, got {math.degrees(self.fold_limit):g}"
             )
         self._non_negative("summary_interval")
 
