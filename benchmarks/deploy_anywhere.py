@@ -5,8 +5,8 @@ every rejected candidate was rejected; in each mode of :data:`MODES` (rigidfold'
 ``no-second-order``), in the same process.
 
 Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only TEXT]
-[--modes after,before,no-second-order]``. Every run uses S-hat with the look-ahead and the deployability
-check, as the README recommends, and ``--time-limit`` (180 s for a drawn pattern, 420 s for
+[--modes after,before,no-second-order]``. Every run uses S-hat with the look-ahead and the
+deployability check, as the README recommends, and ``--time-limit`` (180 s for a drawn pattern, 420 s for
 the roof): a run that hits it ends with its best design, counted as not reaching DOF 1.
 
 Cases: Origami Simulator's patterns in tests/data/origami_simulator (waterbomb, Huffman's
