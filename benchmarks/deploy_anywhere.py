@@ -6,8 +6,9 @@ every rejected candidate was rejected; in each mode of :data:`MODES` (rigidfold'
 
 Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only TEXT]
 [--modes after,before,no-second-order]``. Every run uses S-hat with the look-ahead and the
-deployability check, as the README recommends, and ``--time-limit`` (180 s for a drawn pattern, 420 s for
-the roof): a run that hits it ends with its best design, counted as not reaching DOF 1.
+deployability check, as the README recommends, and ``--time-limit`` (180 s for a drawn
+pattern, 420 s for the roof): a run that hits it ends with its best design, counted as not
+reaching DOF 1.
 
 Cases: Origami Simulator's patterns in tests/data/origami_simulator (waterbomb, Huffman's
 waterbomb, Resch's triangles, Miura-ori, Lang's wedge, the polygami cross, the sharp-angle
