@@ -346,7 +346,7 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     """The large-deformation analysis and the folding motion: both verdicts of every solution
     in summary.json, the final design's in one line before the last; and, when they differ
     (the motion tracer given a budget of one step), the reason."""
-    import rigidfold.run.writer
+    import rigidfold.run.checks
 
     assert main(["generate", *DEFORM_RUN, "--check", "all", "--out", str(tmp_path / "a")]) == 1
     lines = capsys.readouterr().out.strip().splitlines()
@@ -357,10 +357,10 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     assert summary["exports"][-1] == "final/step_02_dof_03.os.fold"
     assert (tmp_path / "a" / "final" / "step_02_dof_03.os.fold").is_file()
 
-    real = rigidfold.run.writer.verify
+    real = rigidfold.run.checks.verify
     tight = DEFAULTS.with_(path_max_steps=1)  # the tracer gives up after one step
     monkeypatch.setattr(
-        rigidfold.run.writer,
+        rigidfold.run.checks,
         "verify",
         lambda pattern, **kw: real(pattern, **{**kw, "path": None, "settings": tight}),
     )
