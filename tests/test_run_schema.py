@@ -108,3 +108,14 @@ def test_motion_frames_carry_their_fraction():
         f["frame_title"] = "a motion frame"
     other = read_frames({"file_frames": frames}, pattern.n_vertices, "test")
     np.testing.assert_array_equal(other.fraction, [0.0, 0.5, 1.0])
+
+
+def test_every_stage_has_its_rule():
+    """One table says when each check of a solution passes, and its enum reads its status."""
+    from rigidfold.run.schema import STAGES
+
+    assert set(STAGES) == set(Stage)
+    record = _record(motion="ok")
+    assert record.status(Stage.MOTION) is STAGES[Stage.MOTION].passing
+    assert record.status(Stage.DEFORMATION) is None
+    assert _record("error").status(Stage.DEVELOPMENT) == "error"

@@ -26,10 +26,12 @@ from rigidfold.run.schema import (
     DESIGN_SHAPE,
     LOG_FILE,
     LOG_SHAPE,
+    STAGES,
     AttemptRecord,
     RunSummary,
     SolutionRecord,
     Stage,
+    aggregate,
     check_shape,
     check_version,
     received,
@@ -325,58 +327,58 @@ class RunData:
         ]
 
     def _stages(self) -> list[Check]:
-        """:meth:`checks` as every solution counts."""
+        """:meth:`checks` as every solution counts: the figures are the run-wide ones of
+        summary.json (:func:`~rigidfold.run.schema.aggregate`), whether a stage passed
+        :meth:`SolutionRecord.passed`, its name and words ``STAGES``'s."""
         rows = self.summary.per_solution
         n = len(rows)
-        dev = [r.development or {} for r in rows]
+        figures = aggregate(rows)
+        dev = figures["development"]
         bad = _failed(rows, Stage.DEVELOPMENT)
-        max_d = max((d.get("D") or 0.0 for d in dev), default=0.0)
         checks = [
             Check(
-                "development",
+                STAGES[Stage.DEVELOPMENT].name,
                 None if n == 0 else not bad,
-                f"{n - len(bad)}/{n} converged, "
-                f"{sum(max(d.get('flipped') or 0, 0) for d in dev)} flipped, "
-                f"{sum(max(d.get('overlaps') or 0, 0) for d in dev)} overlapping, "
-                f"max D = {max_d:.2g}" + _steps(bad),
+                f"{n - len(bad)}/{n} converged, {dev['flipped']} flipped, "
+                f"{dev['overlaps']} overlapping, max D = {dev['max_D'] or 0.0:.2g}" + _steps(bad),
                 tuple(bad),
             )
         ]
-        motions = [r.motion for r in rows if r.motion is not None]
+        traced = sum(r.ran(Stage.MOTION) for r in rows)
         bad = _failed(rows, Stage.MOTION)
-        err = max((m.get("max_length_error") or 0.0 for m in motions), default=0.0)
+        err = figures["motion"]["max_length_error"] or 0.0
         checks.append(
             Check(
-                "folding motion",
-                None if not motions else not bad,
-                f"{len(motions) - len(bad)}/{len(motions)} traced{_checked(len(motions), n)}, "
+                STAGES[Stage.MOTION].name,
+                None if not traced else not bad,
+                f"{traced - len(bad)}/{traced} traced{_checked(traced, n)}, "
                 f"max |dl|/l = {err:.2g}" + _steps(bad)
-                if motions
+                if traced
                 else "no motion was traced",
                 tuple(bad),
             )
         )
-        deformed = [r.deformation for r in rows if r.deformation is not None]
+        deformed = figures["deformation"]
+        checked = deformed["checked"]
         bad = _failed(rows, Stage.DEFORMATION)
         checks.append(
             Check(
-                "large deformation",
-                None if not deformed else not bad,
-                f"{len(deformed) - len(bad)}/{len(deformed)} reached the plane"
-                f"{_checked(len(deformed), n)}, max |dl| = "
-                f"{max(d.get('max_dl_mm') or 0.0 for d in deformed):.3g} mm, max |drho_fix| "
-                f"= {max(d.get('max_drho_fix_deg') or 0.0 for d in deformed):.3g} deg" + _steps(bad)
-                if deformed
+                STAGES[Stage.DEFORMATION].name,
+                None if not checked else not bad,
+                f"{checked - len(bad)}/{checked} reached the plane"
+                f"{_checked(checked, n)}, max |dl| = {deformed['max_dl_mm'] or 0.0:.3g} mm, "
+                f"max |drho_fix| = {deformed['max_drho_fix_deg'] or 0.0:.3g} deg" + _steps(bad)
+                if checked
                 else "Step 9 did not run (--no-deform)",
                 tuple(bad),
             )
         )
-        for stage, name in ((Stage.FABRICATION, "thick panels"), (Stage.STRUCTURE, "structure")):
+        for stage in (s for s in Stage if STAGES[s].detailed):  # shown by their words
             ran = [r for r in rows if r.ran(stage)]
             if ran:  # only where asked: a run without them does not list them as not run
                 bad = _failed(rows, stage)
                 detail = "; ".join(r.detail(stage) for r in ran if r.detail(stage))
-                checks.append(Check(name, not bad, detail + _steps(bad), tuple(bad)))
+                checks.append(Check(STAGES[stage].name, not bad, detail + _steps(bad), tuple(bad)))
         return checks
 
 

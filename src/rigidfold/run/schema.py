@@ -321,6 +321,32 @@ class Stage(Outcome):
 
 
 @dataclass(frozen=True)
+class StageRule:
+    """How a :class:`Stage` is judged and shown.
+
+    passing : the status its figures pass with, a member of its result's
+    :class:`~rigidfold.status.Outcome` enum (whose values its ``status`` holds); name : its
+    name among the report's checks (:meth:`rigidfold.run.RunData.checks`); detailed : its
+    figures' ``message`` says more than the :class:`Stage` message (in the verdict and the
+    report).
+    """
+
+    passing: Outcome
+    name: str
+    detailed: bool = False
+
+
+STAGES: dict[Stage, StageRule] = {
+    Stage.DEVELOPMENT: StageRule(DevelopStatus.CONVERGED, "development"),
+    Stage.MOTION: StageRule(MotionStatus.OK, "folding motion"),
+    Stage.DEFORMATION: StageRule(DeformStatus.REACHED_PLANE, "large deformation"),
+    Stage.FABRICATION: StageRule(FabricationStatus.COLLISION_FREE, "thick panels", True),
+    Stage.STRUCTURE: StageRule(StructureStatus.PASSED, "structure", True),
+}
+"""Every :class:`Stage`'s rule: the one place that says when a check of a solution passes."""
+
+
+@dataclass(frozen=True)
 class SolutionRecord:
     """The checks of one accepted solution: an entry of ``summary.json``'s ``per_solution``.
 
@@ -388,26 +414,31 @@ class SolutionRecord:
         """Whether ``stage`` ran on this solution (the development always does)."""
         return stage is Stage.DEVELOPMENT or getattr(self, stage.value) is not None
 
+    def status(self, stage: Stage) -> Outcome | str | None:
+        """The status of ``stage`` as a member of its result's enum (that of
+        ``STAGES[stage].passing``), as text where it is none of them (``"error"``: a check
+        of the final design that could not run); None where the stage did not run (or its
+        figures have no status)."""
+        value = (getattr(self, stage.value) or {}).get("status") if self.ran(stage) else None
+        if not isinstance(value, str):
+            return None
+        try:
+            return type(STAGES[stage].passing)(value)
+        except ValueError:
+            return value
+
     def passed(self, stage: Stage) -> bool | None:
-        """Whether ``stage`` passed: the development converged, the motion was traced, the
-        frame reached the plane, the thick panels deploy without collision, the structure
-        check passed; None where it did not run."""
+        """Whether ``stage`` passed (its status is ``STAGES[stage].passing``: the development
+        converged, the motion was traced, the frame reached the plane, the thick panels
+        deploy without collision, the structure check passed); None where it did not run."""
         if not self.ran(stage):
             return None
-        figures = getattr(self, stage.value) or {}
-        status = figures.get("status")
-        return {
-            Stage.DEVELOPMENT: status == DevelopStatus.CONVERGED,
-            Stage.MOTION: status == MotionStatus.OK,
-            Stage.DEFORMATION: status == DeformStatus.REACHED_PLANE,
-            Stage.FABRICATION: status == FabricationStatus.COLLISION_FREE,
-            Stage.STRUCTURE: status == StructureStatus.PASSED,
-        }[stage]
+        return self.status(stage) is STAGES[stage].passing
 
     def detail(self, stage: Stage) -> str:
-        """The words of a stage that says more than its :class:`Stage` message (the thick
-        panels' and the structure's ``message``), "" for the others."""
-        if stage not in (Stage.FABRICATION, Stage.STRUCTURE):
+        """The words of a stage that says more than its :class:`Stage` message (its figures'
+        ``message``, where ``STAGES[stage].detailed``), "" for the others."""
+        if not STAGES[stage].detailed:
             return ""
         return str((getattr(self, stage.value) or {}).get("message") or "")
 
@@ -445,14 +476,15 @@ class AttemptRecord:
         return cls(**{"index": k, **known, "document": data})
 
 
-def aggregate(records: list[SolutionRecord]) -> dict:
-    """The run-wide figures of ``summary.json`` (``development``, ``deformation``,
-    ``motion``, ``fabrication``, ``structure``) over the solutions' records: means and
-    maxima of what ran."""
+def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dict:
+    """The run-wide figures over the solutions' records (means and maxima of what ran):
+    ``summary.json``'s ``development``, ``deformation``, ``motion``, ``fabrication`` and
+    ``structure``, the study's figures of a run and the report's checks
+    (:meth:`rigidfold.run.RunData.checks`). A figure that a record read back holds as null
+    is left out."""
     dev = [r.development or {} for r in records]
     deformed = [r.deformation for r in records if r.deformation is not None]
     motions = [r.motion for r in records if r.motion is not None]
-
     built = [r.fabrication for r in records if r.fabrication is not None]
     loaded = [r.structure for r in records if r.structure is not None]
 
@@ -462,34 +494,37 @@ def aggregate(records: list[SolutionRecord]) -> dict:
     def known(figures: list[dict], key: str) -> list:
         return [f[key] for f in figures if f.get(key) is not None]
 
+    def count(stage: Stage) -> int:  # the records on which ``stage`` passed
+        return sum(r.passed(stage) is True for r in records)
+
     return {
         "development": {
-            "mean_D": stat([d["D"] for d in dev], np.mean),
-            "max_D": stat([d["D"] for d in dev], np.max),
-            "flipped": sum(max(d["flipped"], 0) for d in dev),
-            "overlaps": sum(max(d["overlaps"], 0) for d in dev),
+            "mean_D": stat(known(dev, "D"), np.mean),
+            "max_D": stat(known(dev, "D"), np.max),
+            "flipped": sum(max(n, 0) for n in known(dev, "flipped")),
+            "overlaps": sum(max(n, 0) for n in known(dev, "overlaps")),
         },
         "deformation": {
             "checked": len(deformed),
-            "reached_plane": sum(d["reached_plane"] for d in deformed),
-            "mean_dl_mm": stat([d["mean_dl_mm"] for d in deformed], np.mean),
-            "max_dl_mm": stat([d["max_dl_mm"] for d in deformed], np.max),
-            "mean_drho_fix_deg": stat([d["mean_drho_fix_deg"] for d in deformed], np.mean),
-            "max_drho_fix_deg": stat([d["max_drho_fix_deg"] for d in deformed], np.max),
+            "reached_plane": sum(bool(d.get("reached_plane")) for d in deformed),
+            "mean_dl_mm": stat(known(deformed, "mean_dl_mm"), np.mean),
+            "max_dl_mm": stat(known(deformed, "max_dl_mm"), np.max),
+            "mean_drho_fix_deg": stat(known(deformed, "mean_drho_fix_deg"), np.mean),
+            "max_drho_fix_deg": stat(known(deformed, "max_drho_fix_deg"), np.max),
         },
         "motion": {
-            "traced": sum(m["status"] == MotionStatus.OK for m in motions),
-            "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
+            "traced": count(Stage.MOTION),
+            "max_length_error": stat(known(motions, "max_length_error"), np.max),
         },
         "fabrication": {
             "checked": len(built),
-            "collision_free": sum(f["status"] == FabricationStatus.COLLISION_FREE for f in built),
+            "collision_free": count(Stage.FABRICATION),
             "min_gap_m": stat(known(built, "min_gap_m"), np.min),
             "max_trimming_loss": stat(known(built, "trimming_loss"), np.max),
         },
         "structure": {
             "checked": len(loaded),
-            "passed": sum(f["status"] == StructureStatus.PASSED for f in loaded),
+            "passed": count(Stage.STRUCTURE),
             "max_displacement_m": stat(known(loaded, "max_displacement_m"), np.max),
         },
     }
