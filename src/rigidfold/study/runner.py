@@ -23,7 +23,8 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
-from rigidfold.study.store import ERROR_PREFIX, Key, Store
+from rigidfold.study.rows import ERROR_PREFIX, Key
+from rigidfold.study.store import Store
 
 PRESETS = {
     # Sections 6.5 and 6.6: the 11 x 11 grid with S, with and without the mirror planes
