@@ -313,8 +313,9 @@ class RunData:
 
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
-        solution, and the thick panels and the structure where they ran, from
-        ``summary.json``'s ``per_solution``
+        solution, and every other :class:`~rigidfold.run.Stage` where it ran (the thick
+        panels, the structure), in the words of the solutions it failed on, else of the last
+        it ran on, from ``summary.json``'s ``per_solution``
         (:meth:`rigidfold.run.SolutionRecord.passed`). A stage that failed on earlier
         solutions only, not on the final design, passed (as generate's verdict judges), and
         says at which steps it failed."""
@@ -377,7 +378,8 @@ class RunData:
             ran = [r for r in rows if r.ran(stage)]
             if ran:  # only where asked: a run without them does not list them as not run
                 bad = _failed(rows, stage)
-                detail = "; ".join(r.detail(stage) for r in ran if r.detail(stage))
+                said = [r for r in ran if r.passed(stage) is False] or ran[-1:]  # else the last
+                detail = "; ".join(r.detail(stage) for r in said if r.detail(stage))
                 checks.append(Check(STAGES[stage].name, not bad, detail + _steps(bad), tuple(bad)))
         return checks
 
