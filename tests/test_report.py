@@ -78,6 +78,7 @@ def test_report_writes_one_page_and_the_figures(reported, run_dir):
         "development": "passed",
         "folding motion": "passed",
         "large deformation": "passed",
+        "fit to the target": "passed",
     }
     assert 0 < info["size_bytes"] < 10e6
     assert sorted(p.name for p in run_dir.iterdir() if p.name.startswith(".")) == []
@@ -243,6 +244,7 @@ def test_run_without_step_9_says_not_run(tmp_path):
         "development": "passed",
         "folding motion": "passed",
         "large deformation": "not run",
+        "fit to the target": "passed",
     }
     assert "deformation.png" not in [p.name for p in report.figures]
     assert "Passed; the target DOF was reached and every check" in report.html.read_text()

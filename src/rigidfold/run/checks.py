@@ -21,12 +21,13 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.case import Case
+from rigidfold.config import Settings
 from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import GenerateOptions, Solution
 from rigidfold.run.built import structure_check, thick_panels
-from rigidfold.run.schema import SolutionRecord
+from rigidfold.run.schema import FitStatus, SolutionRecord
 from rigidfold.structure import StructureCheck
 from rigidfold.structure.material import parse_material
 
@@ -87,8 +88,9 @@ def check_solution(
     """Check one accepted ``solution`` of ``case``: Step 8; the folding motion with
     ``motion`` and Step 9 with ``deform`` (neither on a DOF-0 shape, which has no motion;
     Step 9's frame of strips of the panels with ``options.material``, supported at
-    ``options.support_face``); the fit to the target (``max_abs_dz_m``, ``rms_dz_m``) and
-    the deployability check's path where it was traced (``solution.path``)."""
+    ``options.support_face``); the fit to the target (``max_abs_dz_m``, ``rms_dz_m``, and
+    whether it is within ``dz``: ``Stage.FIT``) and the deployability check's path where it
+    was traced (``solution.path``)."""
     dof = solution.mechanism.dof
     pattern = solution.result.pattern
     settings = case.settings
@@ -102,8 +104,7 @@ def check_solution(
         **_frame_material(options, settings.structure.thickness),
         settings=settings,
     )
-    dz = case.deviation(pattern.coords)
-    fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
+    fit = _fit(case.deviation(pattern.coords), settings)
     record = SolutionRecord.from_check(
         solution.step,
         dof,
@@ -112,6 +113,20 @@ def check_solution(
         deployability=None if solution.path is None else solution.path.to_dict(),
     )
     return Checked(record, check)
+
+
+def _fit(dz: np.ndarray, settings: Settings) -> dict:
+    """The fit of a solution whose vertices lie ``dz`` (V,) above the target, metres: the
+    largest and RMS |dz|, and whether the largest is within the bound ``settings.design.dz``
+    by ``dz_bound_tol`` of it (:class:`~rigidfold.run.schema.FitStatus`, ``Stage.FIT``)."""
+    worst, bound = float(np.abs(dz).max()), settings.design.dz
+    within = worst <= bound * (1 + settings.design.dz_bound_tol)
+    return {
+        "max_abs_dz_m": worst,
+        "rms_dz_m": float(np.sqrt(np.mean(dz**2))),
+        "status": (FitStatus.WITHIN if within else FitStatus.BEYOND).value,
+        "message": f"max |z - target| {worst * 1e3:.4g} mm, bound dz {bound * 1e3:.4g} mm",
+    }
 
 
 def _frame_material(options: GenerateOptions, thickness: float) -> dict:

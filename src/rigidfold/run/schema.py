@@ -29,10 +29,11 @@ from rigidfold.generate import Stop
 from rigidfold.status import Outcome
 from rigidfold.structure import StructureStatus
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 """The version of the files of a run directory this rigidfold writes and reads: summary.json's
-``schema_version`` and the header line of log.jsonl (``{"schema_version": 1}``). A run of
-another version (0: written before rigidfold recorded one) is refused
+``schema_version`` and the header line of log.jsonl (``{"schema_version": 2}``; 2: a
+solution's ``fit`` has its ``status``). A run of another version (0: written before
+rigidfold recorded one) is refused
 (:func:`check_version`), not read through layers of old formats."""
 
 LOG_FILE = "log.jsonl"
@@ -123,7 +124,15 @@ SUMMARY_SHAPE = Record(
                     "verdicts": Nullable(
                         Record({"agreement": Nullable(str), "reason": Nullable(str)})
                     ),
-                    "fit": Nullable(Record({"max_abs_dz_m": _NUMBERS})),
+                    "fit": Nullable(
+                        Record(
+                            {
+                                "max_abs_dz_m": _NUMBERS,
+                                "status": Nullable(str),
+                                "message": Nullable(str),
+                            }
+                        )
+                    ),
                     "fabrication": Nullable(
                         Record(
                             {
@@ -318,6 +327,15 @@ class Stage(Outcome):
         "thick panels collide, are trimmed away or cannot be checked over the motion",
     )
     STRUCTURE = "structure", "the structure check failed"
+    FIT = "fit", "the design lies farther from the target surface than dz allows"
+
+
+class FitStatus(Outcome):
+    """How far a solution lies from its target surface (:data:`Stage.FIT`): its largest
+    |z - target| within the bound ``Settings.design.dz``, by ``dz_bound_tol`` of it."""
+
+    WITHIN = "within", "within dz of the target surface"
+    BEYOND = "beyond", "farther from the target surface than dz"
 
 
 @dataclass(frozen=True)
@@ -342,6 +360,7 @@ STAGES: dict[Stage, StageRule] = {
     Stage.DEFORMATION: StageRule(DeformStatus.REACHED_PLANE, "large deformation"),
     Stage.FABRICATION: StageRule(FabricationStatus.COLLISION_FREE, "thick panels", True),
     Stage.STRUCTURE: StageRule(StructureStatus.PASSED, "structure", True),
+    Stage.FIT: StageRule(FitStatus.WITHIN, "fit to the target", True),
 }
 """Every :class:`Stage`'s rule: the one place that says when a check of a solution passes."""
 
@@ -350,7 +369,8 @@ STAGES: dict[Stage, StageRule] = {
 class SolutionRecord:
     """The checks of one accepted solution: an entry of ``summary.json``'s ``per_solution``.
 
-    step, dof : int (None in a damaged file); fit : ``max_abs_dz_m``, ``rms_dz_m``;
+    step, dof : int (None in a damaged file); fit : ``max_abs_dz_m``, ``rms_dz_m``, its
+    ``status`` (:class:`FitStatus`) and ``message``;
     development, motion, deformation, verdicts : each stage's figures (its ``to_dict()``;
     None where it did not run); deployability : the folding path's
     (:meth:`rigidfold.mechanism.path.FoldingPath.to_dict`), None where it was not traced;
