@@ -223,7 +223,7 @@ def test_unknown_surface_reports_without_the_fit(copy):
 
 
 def test_lock_and_exceed_attempts_are_drawn(copy):
-    last = read_log(copy / "log.jsonl")[-1].document
+    last = read_log(copy / "log.jsonl")[-1].to_dict()
     with (copy / "log.jsonl").open("a") as log:  # appended, as the run writer does
         for line in (
             {**last, "index": 4, "outcome": "lock", "dof": 5, "locked": [7]},
@@ -252,7 +252,7 @@ def test_run_without_step_9_says_not_run(tmp_path):
 
 def test_run_without_solution_and_unfinished_run(copy):
     summary = json.loads((copy / "summary.json").read_text())
-    first = {**read_log(copy / "log.jsonl")[0].document, "outcome": "initial_failed", "dof": None}
+    first = {**read_log(copy / "log.jsonl")[0].to_dict(), "outcome": "initial_failed", "dof": None}
     header = json.dumps({"schema_version": SCHEMA_VERSION})
     (copy / "log.jsonl").write_text(f"{header}\n{json.dumps(first)}\n")
     failed = {

@@ -99,7 +99,7 @@ def test_the_reader_takes_the_last_line_of_each_index(logged, tmp_path):
     assert load_run(out).attempts == records
     # accepted again (backtracking settles on a chain it had left): the last line counts
     log = tmp_path / LOG_FILE
-    first = records[0].document
+    first = records[0].to_dict()
     rows = [
         {"schema_version": SCHEMA_VERSION},
         first,
@@ -156,7 +156,7 @@ def test_a_torn_last_line_is_skipped(logged, tmp_path, capsys):
     copy = shutil.copytree(out, tmp_path / "run")
     log = copy / LOG_FILE
     whole = read_log(log)
-    line = json.dumps({**whole[-1].document, "index": len(whole)}).encode()
+    line = json.dumps({**whole[-1].to_dict(), "index": len(whole)}).encode()
     for cut in (1, 20, len(line) - 1):  # a crash mid-write: the line without its end
         log.write_bytes((out / LOG_FILE).read_bytes() + line[:cut])
         assert read_log(log) == whole

@@ -4,7 +4,7 @@
 ``--overwrite`` handled (:mod:`.lock`); :func:`run_verdict` judges the finished run
 (:mod:`.verdict`); :func:`load_run` reads it back (:mod:`.reader`) for the report. Every
 file's content is a type of :mod:`.schema`: :class:`RunSummary` (summary.json),
-:class:`AttemptRecord` (a line of log.jsonl, read by :func:`read_log`),
+:class:`rigidfold.generate.Attempt` (a line of log.jsonl, read by :func:`read_log`),
 :class:`SolutionRecord` (a solution's checks; which failed:
 :meth:`SolutionRecord.failed_stages`).
 """
@@ -24,7 +24,6 @@ from rigidfold.run.reader import (
 from rigidfold.run.schema import (
     LOG_FILE,
     SCHEMA_VERSION,
-    AttemptRecord,
     RunSummary,
     SolutionRecord,
     Stage,
@@ -40,7 +39,6 @@ __all__ = [
     "RUN_DIRS",
     "RUN_FILES",
     "SCHEMA_VERSION",
-    "AttemptRecord",
     "Check",
     "RunData",
     "RunOutcome",

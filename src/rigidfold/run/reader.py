@@ -1,7 +1,7 @@
 """A finished (or running) ``rigidfold generate`` directory, read back.
 
 :func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.run.RunSummary`),
-``DIR/log.jsonl`` (:class:`~rigidfold.run.AttemptRecord`, :func:`read_log`) and every
+``DIR/log.jsonl`` (:class:`rigidfold.generate.Attempt` each, :func:`read_log`) and every
 solution's FOLD file (``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its
 development diagram and folding motion as frames (:func:`rigidfold.io.read_frames`), and
 the figures of Steps 8-9 with the large-deformation history under
@@ -12,6 +12,7 @@ it can. Anything that is not a generate run is a one-line
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,14 +21,15 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
+from rigidfold.generate import Attempt
 from rigidfold.io import parse_json, read_fold, read_frames
 from rigidfold.protocols import TargetSurface
 from rigidfold.run.schema import (
     DESIGN_SHAPE,
     LOG_FILE,
+    LOG_NAN_FIELDS,
     LOG_SHAPE,
     STAGES,
-    AttemptRecord,
     RunSummary,
     SolutionRecord,
     Stage,
@@ -215,7 +217,7 @@ class RunData:
 
     directory: Path
     summary: RunSummary
-    attempts: tuple[AttemptRecord, ...]
+    attempts: tuple[Attempt, ...]
     designs: tuple[SolutionFile, ...]
     surface: TargetSurface | None
     surface_note: str
@@ -458,7 +460,7 @@ def _measurable(design: SolutionFile, surface: TargetSurface) -> bool:
         return bool(np.all(np.isfinite((dz * 1e3) ** 2)))
 
 
-def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
+def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
     """The attempts of a run's log (``DIR/log.jsonl``, :data:`~rigidfold.run.schema.LOG_FILE`),
     by index: the last line of each index is its record (an attempt whose outcome
     backtracking changed was appended again).
@@ -496,7 +498,7 @@ def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
             "(no 'schema_version')"
         )
     check_version(header["schema_version"], path)
-    attempts: dict[int, AttemptRecord] = {}
+    attempts: dict[int, Attempt] = {}
     for n, row in enumerate(rows, start=2):
         check_shape(row, LOG_SHAPE, path, line=n)
         if row["outcome"] == "accepted" and row["dof"] is None:
@@ -504,7 +506,8 @@ def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
                 f"{str(path)!r}, line {n}: 'dof' is null, expected a whole number (an accepted "
                 "shape has a DOF)"
             )
-        attempts[row["index"]] = AttemptRecord.from_dict(row)
+        nan = {k: math.nan for k in LOG_NAN_FIELDS if row.get(k, 0) is None}  # written null
+        attempts[row["index"]] = Attempt.from_dict(row | nan)
     return tuple(attempts[k] for k in sorted(attempts))
 
 

@@ -2,7 +2,8 @@
 written through one set of types.
 
 :class:`SolutionRecord` is one solution's checks (``summary.json``'s ``per_solution``; the
-figures in its FOLD file), :class:`AttemptRecord` one solve (a line of ``log.jsonl``),
+figures in its FOLD file), :class:`rigidfold.generate.Attempt` one solve (a line of
+``log.jsonl``, of the shape :data:`LOG_SHAPE` made from it),
 :class:`RunSummary` the whole of ``summary.json``. What the readers rely on is checked
 against a shape first (:data:`SUMMARY_SHAPE`, :data:`LOG_SHAPE`, :func:`check_shape`), so a
 damaged file is a one-line ValueError naming the file and the key. Both files carry
@@ -14,9 +15,12 @@ which check of a solution failed.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
+import types
+import typing
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -25,7 +29,7 @@ from rigidfold.deform import DeformStatus, MotionStatus, Verification
 from rigidfold.develop import DevelopStatus
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
-from rigidfold.generate import Stop
+from rigidfold.generate import Attempt, Stop
 from rigidfold.status import Outcome
 from rigidfold.structure import StructureStatus
 
@@ -197,18 +201,6 @@ SUMMARY_SHAPE = Record(
 list ``[S]`` a list of S, a tuple a list of that many items of those shapes, a
 :class:`Record` an object, :class:`Nullable` also null."""
 
-LOG_SHAPE = Record(
-    {
-        "index": int,
-        "outcome": str,
-        "dof": Nullable(int),
-        "F": _NUMBERS,
-        "iterations": Nullable(int),
-        "path": Nullable(Record({"status": Nullable(str), "deploys": Nullable(bool)})),
-    },
-    ("index", "outcome", "dof"),
-)
-"""What the report reads of each attempt line of ``log.jsonl`` (see :data:`SUMMARY_SHAPE`)."""
 
 HISTORY_SHAPE = [
     Record(
@@ -259,6 +251,10 @@ def check_shape(
 
 def _has_shape(value, shape) -> bool:
     """Whether ``value`` is of the kind of ``shape`` (its items are checked apart)."""
+    if shape is object:
+        return True
+    if isinstance(shape, type) and issubclass(shape, Outcome):
+        return isinstance(value, str) and value in list(shape)
     if shape is bool:
         return isinstance(value, bool)
     if shape is int:  # within int64: numpy and matplotlib take it
@@ -288,6 +284,8 @@ def _expected(shape) -> str:
         float: "a finite number",
         str: "text",
     }
+    if isinstance(shape, type) and issubclass(shape, Outcome):
+        return f"one of {', '.join(shape)}"
     if isinstance(shape, type):
         return words[shape]
     if isinstance(shape, Record):
@@ -314,6 +312,52 @@ DESIGN_SHAPE = Record(
     }
 )
 """What the report reads of rigidfold's keys in a solution file (see :data:`SUMMARY_SHAPE`)."""
+
+
+def shape_of(hint: object) -> object:
+    """The shape (see :data:`SUMMARY_SHAPE`) of the JSON that a field of type ``hint`` is
+    written as: an int, str or bool itself, an :class:`~rigidfold.status.Outcome` enum
+    one of its values, a float a finite number or null (a NaN is written as null), a list
+    or a tuple of one kind a list of its shape, a dict an object, ``X | None`` also null;
+    another type anything."""
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin in (typing.Union, types.UnionType):
+        kinds = [a for a in args if a is not type(None)]
+        inner = shape_of(kinds[0]) if len(kinds) == 1 else object
+        return inner if isinstance(inner, Nullable) or inner is object else Nullable(inner)
+    if origin in (list, tuple) and args:
+        return [shape_of(args[0])]
+    if hint is float:
+        return Nullable(float)
+    if hint is dict or origin is dict:
+        return Record({})
+    if hint in (int, str, bool) or (isinstance(hint, type) and issubclass(hint, Outcome)):
+        return hint
+    return object
+
+
+def _log_shape() -> Record:
+    """The shape of a line of ``log.jsonl``: each field of
+    :class:`rigidfold.generate.Attempt` (:func:`shape_of` its type), those without a default
+    required."""
+    hints = typing.get_type_hints(Attempt)
+    fields_ = dataclasses.fields(Attempt)
+    missing = dataclasses.MISSING
+    return Record(
+        {f.name: shape_of(hints[f.name]) for f in fields_},
+        tuple(f.name for f in fields_ if f.default is missing and f.default_factory is missing),
+    )
+
+
+LOG_SHAPE = _log_shape()
+"""The shape of each attempt line of ``log.jsonl`` (see :data:`SUMMARY_SHAPE`), made from
+:class:`rigidfold.generate.Attempt`, which the line is read into."""
+
+LOG_NAN_FIELDS = tuple(
+    name for name, hint in typing.get_type_hints(Attempt).items() if hint is float
+)
+"""The fields of :class:`~rigidfold.generate.Attempt` that are floats, never None: a NaN of
+theirs is written as null and read back as NaN."""
 
 
 class Stage(Outcome):
@@ -465,35 +509,6 @@ class SolutionRecord:
     def failed_stages(self) -> list[Stage]:
         """The stages that ran on this solution and failed, in :class:`Stage` order."""
         return [stage for stage in Stage if self.passed(stage) is False]
-
-
-@dataclass(frozen=True)
-class AttemptRecord:
-    """What the report reads of one solve in ``log.jsonl`` (a line, checked with
-    :data:`LOG_SHAPE`).
-
-    index : int; outcome : the :class:`rigidfold.generate.AttemptOutcome` value; dof : None
-    when the solve was not analysed; F, iterations : the solve's; fixed_added, locked : the
-    creases fixed by it and locked at the shape found; path : the deployability check's
-    figures or None; document : the whole line (every field of
-    :meth:`rigidfold.generate.Attempt.to_dict`).
-    """
-
-    index: int
-    outcome: str
-    dof: int | None
-    F: float | None = None
-    iterations: int | None = None
-    fixed_added: list | None = None
-    locked: list | None = None
-    path: dict | None = None
-    document: dict = field(default_factory=dict, compare=False, repr=False)
-
-    @classmethod
-    def from_dict(cls, data: dict, k: int = 0) -> AttemptRecord:
-        names = {f.name for f in fields(cls)} - {"document"}
-        known = {n: v for n, v in data.items() if n in names}
-        return cls(**{"index": k, **known, "document": data})
 
 
 def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dict:
