@@ -28,8 +28,8 @@ from rigidfold.run.schema import (
     SolutionRecord,
     Stage,
     aggregate,
-    check_shape,
 )
+from rigidfold.run.shapes import check_shape
 from rigidfold.run.verdict import RunOutcome, RunVerdict, run_verdict
 from rigidfold.run.writer import RunWriter, verification_frames, write_checked_shape
 

@@ -34,10 +34,9 @@ from rigidfold.run.schema import (
     SolutionRecord,
     Stage,
     aggregate,
-    check_shape,
     check_version,
-    received,
 )
+from rigidfold.run.shapes import check_shape, received
 from rigidfold.surfaces import Bezier, SplineSurface, get_surface
 
 

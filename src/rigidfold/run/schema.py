@@ -16,10 +16,7 @@ which check of a solution failed.
 from __future__ import annotations
 
 import dataclasses
-import json
-import math
 import os
-import types
 import typing
 from dataclasses import dataclass, field, fields
 
@@ -30,6 +27,7 @@ from rigidfold.develop import DevelopStatus
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
 from rigidfold.generate import Attempt, Stop
+from rigidfold.run.shapes import Nullable, Record, check_shape, received, shape_of
 from rigidfold.status import Outcome
 from rigidfold.structure import StructureStatus
 
@@ -57,22 +55,6 @@ def check_version(version, file: str | os.PathLike) -> None:
         f"'{file}' was written by run schema version {given}; this rigidfold reads version "
         f"{SCHEMA_VERSION}"
     )
-
-
-@dataclass(frozen=True)
-class Nullable:
-    """A shape (see :data:`SUMMARY_SHAPE`) that may also be JSON ``null``."""
-
-    shape: object
-
-
-@dataclass(frozen=True)
-class Record:
-    """A JSON object whose keys, when present (``required``: always), have these shapes;
-    other keys may hold anything."""
-
-    keys: dict
-    required: tuple[str, ...] = ()
 
 
 _NUMBERS = Nullable(float)
@@ -211,99 +193,6 @@ HISTORY_SHAPE = [
 """The large-deformation history of a solution file (``deformation.history``)."""
 
 
-def check_shape(
-    value, shape, file: str | os.PathLike, where: str = "", *, line: int | None = None
-) -> None:
-    """ValueError naming ``file`` (and its ``line``, for a file of JSON lines) and the key
-    (``per_solution[0].development.D``) of the first part of ``value`` (JSON data) that does
-    not have ``shape`` (:data:`SUMMARY_SHAPE` says how shapes are written), and what it
-    holds instead."""
-    label = f"'{file}'" + ("" if line is None else f", line {line}")
-    whole = "the document" if line is None else "the line"
-    stack = [(value, shape, where)]
-    while stack:
-        value, given, where = stack.pop()
-        shape = given.shape if isinstance(given, Nullable) else given
-        if value is None and shape is not given:
-            continue
-        if not _has_shape(value, shape):
-            key = f"{where!r}" if where else whole
-            raise RigidfoldError(
-                f"{label}: {key} is {received(value)}, expected {_expected(given)}"
-            )
-        if isinstance(shape, Record):
-            missing = [k for k in shape.required if k not in value]
-            if missing:
-                key = f"{where!r}" if where else whole
-                raise RigidfoldError(f"{label}: {key} has no {', '.join(map(repr, missing))}")
-            stack += [
-                (value[k], s, f"{where}.{k}" if where else k)
-                for k, s in reversed(shape.keys.items())
-                if k in value
-            ]
-        elif isinstance(shape, list):
-            stack += [(v, shape[0], f"{where}[{i}]") for i, v in reversed(list(enumerate(value)))]
-        elif isinstance(shape, tuple):
-            stack += [
-                (v, s, f"{where}[{i}]") for i, (v, s) in enumerate(zip(value, shape, strict=True))
-            ]
-
-
-def _has_shape(value, shape) -> bool:
-    """Whether ``value`` is of the kind of ``shape`` (its items are checked apart)."""
-    if shape is object:
-        return True
-    if isinstance(shape, type) and issubclass(shape, Outcome):
-        return isinstance(value, str) and value in list(shape)
-    if shape is bool:
-        return isinstance(value, bool)
-    if shape is int:  # within int64: numpy and matplotlib take it
-        return isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2**63
-    if shape is float:
-        if not isinstance(value, int | float) or isinstance(value, bool):
-            return False
-        try:
-            return math.isfinite(value)
-        except OverflowError:  # an integer beyond the floats
-            return False
-    if shape is str:
-        return isinstance(value, str)
-    if isinstance(shape, Record):
-        return isinstance(value, dict)
-    if isinstance(shape, tuple):
-        return isinstance(value, list) and len(value) == len(shape)
-    return isinstance(value, list)
-
-
-def _expected(shape) -> str:
-    if isinstance(shape, Nullable):
-        return f"{_expected(shape.shape)} or null"
-    words = {
-        bool: "true or false",
-        int: "a whole number (64 bits)",
-        float: "a finite number",
-        str: "text",
-    }
-    if isinstance(shape, type) and issubclass(shape, Outcome):
-        return f"one of {', '.join(shape)}"
-    if isinstance(shape, type):
-        return words[shape]
-    if isinstance(shape, Record):
-        return "an object"
-    if isinstance(shape, tuple):
-        return f"a list of {len(shape)} items"
-    return "a list"
-
-
-def received(value) -> str:
-    """``value`` as JSON text, cut to 40 characters."""
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        text = repr(value)
-    return text if len(text) <= 40 else text[:39] + "…"
-
-
 DESIGN_SHAPE = Record(
     {
         "rigidfold:step": int,
@@ -312,28 +201,6 @@ DESIGN_SHAPE = Record(
     }
 )
 """What the report reads of rigidfold's keys in a solution file (see :data:`SUMMARY_SHAPE`)."""
-
-
-def shape_of(hint: object) -> object:
-    """The shape (see :data:`SUMMARY_SHAPE`) of the JSON that a field of type ``hint`` is
-    written as: an int, str or bool itself, an :class:`~rigidfold.status.Outcome` enum
-    one of its values, a float a finite number or null (a NaN is written as null), a list
-    or a tuple of one kind a list of its shape, a dict an object, ``X | None`` also null;
-    another type anything."""
-    origin, args = typing.get_origin(hint), typing.get_args(hint)
-    if origin in (typing.Union, types.UnionType):
-        kinds = [a for a in args if a is not type(None)]
-        inner = shape_of(kinds[0]) if len(kinds) == 1 else object
-        return inner if isinstance(inner, Nullable) or inner is object else Nullable(inner)
-    if origin in (list, tuple) and args:
-        return [shape_of(args[0])]
-    if hint is float:
-        return Nullable(float)
-    if hint is dict or origin is dict:
-        return Record({})
-    if hint in (int, str, bool) or (isinstance(hint, type) and issubclass(hint, Outcome)):
-        return hint
-    return object
 
 
 def _log_shape() -> Record:
