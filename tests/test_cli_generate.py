@@ -85,7 +85,7 @@ def test_generate_writes_solutions_log_and_summary(generated):
         assert 0 <= fit["rms_dz_m"] <= fit["max_abs_dz_m"] <= DEFAULTS.design.dz + 1e-6
     log = read_log(generated / "log.jsonl")
     assert len(log) == summary["n_solves"] and [a.index for a in log] == list(range(len(log)))
-    assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1].document)
+    assert {"fixed_added", "score", "status", "F", "locked", "solve_time"} <= set(log[1].to_dict())
     last = read_fold(generated / "solutions" / names[-1])
     assert len(last.pattern.fixed_creases) == 3
     assert last.metadata["dof"] == 18
@@ -346,7 +346,7 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     """The large-deformation analysis and the folding motion: both verdicts of every solution
     in summary.json, the final design's in one line before the last; and, when they differ
     (the motion tracer given a budget of one step), the reason."""
-    import rigidfold.run.writer
+    import rigidfold.run.checks
 
     assert main(["generate", *DEFORM_RUN, "--check", "all", "--out", str(tmp_path / "a")]) == 1
     lines = capsys.readouterr().out.strip().splitlines()
@@ -357,10 +357,10 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     assert summary["exports"][-1] == "final/step_02_dof_03.os.fold"
     assert (tmp_path / "a" / "final" / "step_02_dof_03.os.fold").is_file()
 
-    real = rigidfold.run.writer.verify
+    real = rigidfold.run.checks.verify
     tight = DEFAULTS.with_(path_max_steps=1)  # the tracer gives up after one step
     monkeypatch.setattr(
-        rigidfold.run.writer,
+        rigidfold.run.checks,
         "verify",
         lambda pattern, **kw: real(pattern, **{**kw, "path": None, "settings": tight}),
     )

@@ -99,7 +99,7 @@ MUTATIONS = [
     ("summary.json", ("solutions", 0), "../run/" + FINAL, "expected a file in the run's direc"),
     ("summary.json", ("solutions", 0), "", "'solutions[0]' is \"\", expected a file in the"),
     ("summary.json", ("per_solution",), DELETE, "not the summary of rigidfold generate (no per"),
-    ("summary.json", ("schema_version",), 2, "summary.json' was written by run schema version 2"),
+    ("summary.json", ("schema_version",), 9, "summary.json' was written by run schema version 9"),
     ("summary.json", ("schema_version",), DELETE, "run schema version 0 (none recorded); this"),
     ("summary.json", ("schema_version",), "1", 'run schema version "1"; this rigidfold reads'),
     # log.jsonl as its list of lines: 0 the header, then one per attempt

@@ -208,12 +208,12 @@ def test_a_check_that_cannot_run_is_a_failed_stage_not_a_lost_run(tmp_path, monk
     """A structure check that cannot run on the final design (a RigidfoldError from the
     analysis) fails its stage with its message: the run still ends with its verdict,
     summary.json and report (nothing computed is lost)."""
-    import rigidfold.run.writer as writer
+    import rigidfold.run.checks as checks
 
     def cannot(*args, **kwargs):
         raise RigidfoldError("the shell model is singular\nat load step 1")
 
-    monkeypatch.setattr(writer, "structure_check", cannot)
+    monkeypatch.setattr(checks, "structure_check", cannot)
     out = tmp_path / "run"
     assert main_code([*FAST, "--structure", "--out", str(out)]) == 1
     summary = json.loads((out / "summary.json").read_text())

@@ -354,6 +354,6 @@ def test_generate_command_passes_lookahead_to_the_log(tmp_path):
     )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["options"]["lookahead"] is True and summary["n_skipped"] == 0
-    (first, second) = [a.document for a in read_log(out / "log.jsonl")]
+    (first, second) = [a.to_dict() for a in read_log(out / "log.jsonl")]
     assert first["predicted_locks"] is None and second["predicted_locks"] == []
     assert second["skipped"] == 0 and second["skipped_locks"] == []

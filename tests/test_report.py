@@ -78,6 +78,7 @@ def test_report_writes_one_page_and_the_figures(reported, run_dir):
         "development": "passed",
         "folding motion": "passed",
         "large deformation": "passed",
+        "fit to the target": "passed",
     }
     assert 0 < info["size_bytes"] < 10e6
     assert sorted(p.name for p in run_dir.iterdir() if p.name.startswith(".")) == []
@@ -222,7 +223,7 @@ def test_unknown_surface_reports_without_the_fit(copy):
 
 
 def test_lock_and_exceed_attempts_are_drawn(copy):
-    last = read_log(copy / "log.jsonl")[-1].document
+    last = read_log(copy / "log.jsonl")[-1].to_dict()
     with (copy / "log.jsonl").open("a") as log:  # appended, as the run writer does
         for line in (
             {**last, "index": 4, "outcome": "lock", "dof": 5, "locked": [7]},
@@ -243,6 +244,7 @@ def test_run_without_step_9_says_not_run(tmp_path):
         "development": "passed",
         "folding motion": "passed",
         "large deformation": "not run",
+        "fit to the target": "passed",
     }
     assert "deformation.png" not in [p.name for p in report.figures]
     assert "Passed; the target DOF was reached and every check" in report.html.read_text()
@@ -250,7 +252,7 @@ def test_run_without_step_9_says_not_run(tmp_path):
 
 def test_run_without_solution_and_unfinished_run(copy):
     summary = json.loads((copy / "summary.json").read_text())
-    first = {**read_log(copy / "log.jsonl")[0].document, "outcome": "initial_failed", "dof": None}
+    first = {**read_log(copy / "log.jsonl")[0].to_dict(), "outcome": "initial_failed", "dof": None}
     header = json.dumps({"schema_version": SCHEMA_VERSION})
     (copy / "log.jsonl").write_text(f"{header}\n{json.dumps(first)}\n")
     failed = {

@@ -108,3 +108,43 @@ def test_motion_frames_carry_their_fraction():
         f["frame_title"] = "a motion frame"
     other = read_frames({"file_frames": frames}, pattern.n_vertices, "test")
     np.testing.assert_array_equal(other.fraction, [0.0, 0.5, 1.0])
+
+
+def test_every_stage_has_its_rule():
+    """One table says when each check of a solution passes, and its enum reads its status."""
+    from rigidfold.run.schema import STAGES
+
+    assert set(STAGES) == set(Stage)
+    record = _record(motion="ok")
+    assert record.status(Stage.MOTION) is STAGES[Stage.MOTION].passing
+    assert record.status(Stage.DEFORMATION) is None
+    assert _record("error").status(Stage.DEVELOPMENT) == "error"
+
+
+def test_a_design_beyond_dz_fails_the_fit_check(tmp_path):
+    """issue 38 demo: the fit check runs through the one pipeline on every solution; a design
+    farther from the target than dz fails it (Stage.FIT), with its words, in the verdict."""
+    from rigidfold.case import make_case
+    from rigidfold.config import DEFAULTS
+    from rigidfold.generate import generate
+    from rigidfold.run import run_verdict
+    from rigidfold.run.checks import check_solution
+
+    options = GenerateOptions(target_dof=18, deform=False)
+    case = make_case("bezier", "1", seed=1)
+    run = generate(case, options)
+    final = run.final
+    assert final is not None
+    kept = check_solution(final, case, options, motion=False, deform=False).record
+    assert kept.fit is not None and kept.fit["status"] == "within"
+    assert kept.failed_stages() == []
+    tight = make_case(
+        "bezier", "1", seed=1, settings=DEFAULTS.with_(dz=kept.fit["max_abs_dz_m"] / 2)
+    )
+    record = check_solution(final, tight, options, motion=False, deform=False).record
+    assert record.failed_stages() == [Stage.FIT]
+    assert record.detail(Stage.FIT).startswith("max |z - target| ")
+    records = [record] * len(run.solutions)
+    files = [tmp_path / f"step_{k}.fold" for k in range(len(records))]
+    verdict = run_verdict(run, records, files, options.target_dof)
+    assert f"{Stage.FIT.message} for the final design (max |z - target|" in verdict.shortfalls[0]

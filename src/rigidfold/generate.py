@@ -208,6 +208,20 @@ class Attempt:
         """JSON-serialisable fields (the enums as their values)."""
         return self.__dict__ | {"status": self.status.value, "outcome": self.outcome.value}
 
+    @classmethod
+    def from_dict(cls, data: dict) -> Attempt:
+        """The attempt :meth:`to_dict` wrote as ``data`` (a line of a run's log, whose shape
+        :func:`rigidfold.run.read_log` checks first); a field it lacks takes its default."""
+        known = {k: v for k, v in data.items() if k in cls.__dataclass_fields__}
+        return cls(
+            **known
+            | {
+                "fixed_added": tuple(data["fixed_added"]),
+                "status": Status(data["status"]),
+                "outcome": AttemptOutcome(data["outcome"]),
+            }
+        )
+
 
 @dataclass
 class Solution:

@@ -32,7 +32,8 @@ class DesignSettings(Group):
         1e-3,
         "The report of a run flags a final design whose largest |z - target| is within this "
         "fraction of ``dz`` of the bound (the constraint is active: the design is as far from "
-        "the target as ``dz`` allows).",
+        "the target as ``dz`` allows); the fit check of a solution (``Stage.FIT``) fails "
+        "where it is beyond the bound by more than this fraction.",
     )
 
     def __post_init__(self) -> None:

@@ -4,7 +4,7 @@
 ``--overwrite`` handled (:mod:`.lock`); :func:`run_verdict` judges the finished run
 (:mod:`.verdict`); :func:`load_run` reads it back (:mod:`.reader`) for the report. Every
 file's content is a type of :mod:`.schema`: :class:`RunSummary` (summary.json),
-:class:`AttemptRecord` (a line of log.jsonl, read by :func:`read_log`),
+:class:`rigidfold.generate.Attempt` (a line of log.jsonl, read by :func:`read_log`),
 :class:`SolutionRecord` (a solution's checks; which failed:
 :meth:`SolutionRecord.failed_stages`).
 """
@@ -24,13 +24,12 @@ from rigidfold.run.reader import (
 from rigidfold.run.schema import (
     LOG_FILE,
     SCHEMA_VERSION,
-    AttemptRecord,
     RunSummary,
     SolutionRecord,
     Stage,
     aggregate,
-    check_shape,
 )
+from rigidfold.run.shapes import check_shape
 from rigidfold.run.verdict import RunOutcome, RunVerdict, run_verdict
 from rigidfold.run.writer import RunWriter, verification_frames, write_checked_shape
 
@@ -40,7 +39,6 @@ __all__ = [
     "RUN_DIRS",
     "RUN_FILES",
     "SCHEMA_VERSION",
-    "AttemptRecord",
     "Check",
     "RunData",
     "RunOutcome",

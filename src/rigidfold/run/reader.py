@@ -1,7 +1,7 @@
 """A finished (or running) ``rigidfold generate`` directory, read back.
 
 :func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.run.RunSummary`),
-``DIR/log.jsonl`` (:class:`~rigidfold.run.AttemptRecord`, :func:`read_log`) and every
+``DIR/log.jsonl`` (:class:`rigidfold.generate.Attempt` each, :func:`read_log`) and every
 solution's FOLD file (``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its
 development diagram and folding motion as frames (:func:`rigidfold.io.read_frames`), and
 the figures of Steps 8-9 with the large-deformation history under
@@ -12,6 +12,7 @@ it can. Anything that is not a generate run is a one-line
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,20 +21,22 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
+from rigidfold.generate import Attempt
 from rigidfold.io import parse_json, read_fold, read_frames
 from rigidfold.protocols import TargetSurface
 from rigidfold.run.schema import (
     DESIGN_SHAPE,
     LOG_FILE,
+    LOG_NAN_FIELDS,
     LOG_SHAPE,
-    AttemptRecord,
+    STAGES,
     RunSummary,
     SolutionRecord,
     Stage,
-    check_shape,
+    aggregate,
     check_version,
-    received,
 )
+from rigidfold.run.shapes import check_shape, received
 from rigidfold.surfaces import Bezier, SplineSurface, get_surface
 
 
@@ -213,7 +216,7 @@ class RunData:
 
     directory: Path
     summary: RunSummary
-    attempts: tuple[AttemptRecord, ...]
+    attempts: tuple[Attempt, ...]
     designs: tuple[SolutionFile, ...]
     surface: TargetSurface | None
     surface_note: str
@@ -311,8 +314,9 @@ class RunData:
 
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
-        solution, and the thick panels and the structure where they ran, from
-        ``summary.json``'s ``per_solution``
+        solution, and every other :class:`~rigidfold.run.Stage` where it ran (the thick
+        panels, the structure), in the words of the solutions it failed on, else of the last
+        it ran on, from ``summary.json``'s ``per_solution``
         (:meth:`rigidfold.run.SolutionRecord.passed`). A stage that failed on earlier
         solutions only, not on the final design, passed (as generate's verdict judges), and
         says at which steps it failed."""
@@ -325,58 +329,59 @@ class RunData:
         ]
 
     def _stages(self) -> list[Check]:
-        """:meth:`checks` as every solution counts."""
+        """:meth:`checks` as every solution counts: the figures are the run-wide ones of
+        summary.json (:func:`~rigidfold.run.schema.aggregate`), whether a stage passed
+        :meth:`SolutionRecord.passed`, its name and words ``STAGES``'s."""
         rows = self.summary.per_solution
         n = len(rows)
-        dev = [r.development or {} for r in rows]
+        figures = aggregate(rows)
+        dev = figures["development"]
         bad = _failed(rows, Stage.DEVELOPMENT)
-        max_d = max((d.get("D") or 0.0 for d in dev), default=0.0)
         checks = [
             Check(
-                "development",
+                STAGES[Stage.DEVELOPMENT].name,
                 None if n == 0 else not bad,
-                f"{n - len(bad)}/{n} converged, "
-                f"{sum(max(d.get('flipped') or 0, 0) for d in dev)} flipped, "
-                f"{sum(max(d.get('overlaps') or 0, 0) for d in dev)} overlapping, "
-                f"max D = {max_d:.2g}" + _steps(bad),
+                f"{n - len(bad)}/{n} converged, {dev['flipped']} flipped, "
+                f"{dev['overlaps']} overlapping, max D = {dev['max_D'] or 0.0:.2g}" + _steps(bad),
                 tuple(bad),
             )
         ]
-        motions = [r.motion for r in rows if r.motion is not None]
+        traced = sum(r.ran(Stage.MOTION) for r in rows)
         bad = _failed(rows, Stage.MOTION)
-        err = max((m.get("max_length_error") or 0.0 for m in motions), default=0.0)
+        err = figures["motion"]["max_length_error"] or 0.0
         checks.append(
             Check(
-                "folding motion",
-                None if not motions else not bad,
-                f"{len(motions) - len(bad)}/{len(motions)} traced{_checked(len(motions), n)}, "
+                STAGES[Stage.MOTION].name,
+                None if not traced else not bad,
+                f"{traced - len(bad)}/{traced} traced{_checked(traced, n)}, "
                 f"max |dl|/l = {err:.2g}" + _steps(bad)
-                if motions
+                if traced
                 else "no motion was traced",
                 tuple(bad),
             )
         )
-        deformed = [r.deformation for r in rows if r.deformation is not None]
+        deformed = figures["deformation"]
+        checked = deformed["checked"]
         bad = _failed(rows, Stage.DEFORMATION)
         checks.append(
             Check(
-                "large deformation",
-                None if not deformed else not bad,
-                f"{len(deformed) - len(bad)}/{len(deformed)} reached the plane"
-                f"{_checked(len(deformed), n)}, max |dl| = "
-                f"{max(d.get('max_dl_mm') or 0.0 for d in deformed):.3g} mm, max |drho_fix| "
-                f"= {max(d.get('max_drho_fix_deg') or 0.0 for d in deformed):.3g} deg" + _steps(bad)
-                if deformed
+                STAGES[Stage.DEFORMATION].name,
+                None if not checked else not bad,
+                f"{checked - len(bad)}/{checked} reached the plane"
+                f"{_checked(checked, n)}, max |dl| = {deformed['max_dl_mm'] or 0.0:.3g} mm, "
+                f"max |drho_fix| = {deformed['max_drho_fix_deg'] or 0.0:.3g} deg" + _steps(bad)
+                if checked
                 else "Step 9 did not run (--no-deform)",
                 tuple(bad),
             )
         )
-        for stage, name in ((Stage.FABRICATION, "thick panels"), (Stage.STRUCTURE, "structure")):
+        for stage in (s for s in Stage if STAGES[s].detailed):  # shown by their words
             ran = [r for r in rows if r.ran(stage)]
             if ran:  # only where asked: a run without them does not list them as not run
                 bad = _failed(rows, stage)
-                detail = "; ".join(r.detail(stage) for r in ran if r.detail(stage))
-                checks.append(Check(name, not bad, detail + _steps(bad), tuple(bad)))
+                said = [r for r in ran if r.passed(stage) is False] or ran[-1:]  # else the last
+                detail = "; ".join(r.detail(stage) for r in said if r.detail(stage))
+                checks.append(Check(STAGES[stage].name, not bad, detail + _steps(bad), tuple(bad)))
         return checks
 
 
@@ -454,7 +459,7 @@ def _measurable(design: SolutionFile, surface: TargetSurface) -> bool:
         return bool(np.all(np.isfinite((dz * 1e3) ** 2)))
 
 
-def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
+def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
     """The attempts of a run's log (``DIR/log.jsonl``, :data:`~rigidfold.run.schema.LOG_FILE`),
     by index: the last line of each index is its record (an attempt whose outcome
     backtracking changed was appended again).
@@ -492,7 +497,7 @@ def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
             "(no 'schema_version')"
         )
     check_version(header["schema_version"], path)
-    attempts: dict[int, AttemptRecord] = {}
+    attempts: dict[int, Attempt] = {}
     for n, row in enumerate(rows, start=2):
         check_shape(row, LOG_SHAPE, path, line=n)
         if row["outcome"] == "accepted" and row["dof"] is None:
@@ -500,7 +505,8 @@ def read_log(path: str | os.PathLike) -> tuple[AttemptRecord, ...]:
                 f"{str(path)!r}, line {n}: 'dof' is null, expected a whole number (an accepted "
                 "shape has a DOF)"
             )
-        attempts[row["index"]] = AttemptRecord.from_dict(row)
+        nan = {k: math.nan for k in LOG_NAN_FIELDS if row.get(k, 0) is None}  # written null
+        attempts[row["index"]] = Attempt.from_dict(row | nan)
     return tuple(attempts[k] for k in sorted(attempts))
 
 

@@ -2,7 +2,8 @@
 written through one set of types.
 
 :class:`SolutionRecord` is one solution's checks (``summary.json``'s ``per_solution``; the
-figures in its FOLD file), :class:`AttemptRecord` one solve (a line of ``log.jsonl``),
+figures in its FOLD file), :class:`rigidfold.generate.Attempt` one solve (a line of
+``log.jsonl``, of the shape :data:`LOG_SHAPE` made from it),
 :class:`RunSummary` the whole of ``summary.json``. What the readers rely on is checked
 against a shape first (:data:`SUMMARY_SHAPE`, :data:`LOG_SHAPE`, :func:`check_shape`), so a
 damaged file is a one-line ValueError naming the file and the key. Both files carry
@@ -14,9 +15,9 @@ which check of a solution failed.
 
 from __future__ import annotations
 
-import json
-import math
+import dataclasses
 import os
+import typing
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -25,14 +26,16 @@ from rigidfold.deform import DeformStatus, MotionStatus, Verification
 from rigidfold.develop import DevelopStatus
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
-from rigidfold.generate import Stop
+from rigidfold.generate import Attempt, Stop
+from rigidfold.run.shapes import Nullable, Record, check_shape, received, shape_of
 from rigidfold.status import Outcome
 from rigidfold.structure import StructureStatus
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 """The version of the files of a run directory this rigidfold writes and reads: summary.json's
-``schema_version`` and the header line of log.jsonl (``{"schema_version": 1}``). A run of
-another version (0: written before rigidfold recorded one) is refused
+``schema_version`` and the header line of log.jsonl (``{"schema_version": 2}``; 2: a
+solution's ``fit`` has its ``status``). A run of another version (0: written before
+rigidfold recorded one) is refused
 (:func:`check_version`), not read through layers of old formats."""
 
 LOG_FILE = "log.jsonl"
@@ -52,22 +55,6 @@ def check_version(version, file: str | os.PathLike) -> None:
         f"'{file}' was written by run schema version {given}; this rigidfold reads version "
         f"{SCHEMA_VERSION}"
     )
-
-
-@dataclass(frozen=True)
-class Nullable:
-    """A shape (see :data:`SUMMARY_SHAPE`) that may also be JSON ``null``."""
-
-    shape: object
-
-
-@dataclass(frozen=True)
-class Record:
-    """A JSON object whose keys, when present (``required``: always), have these shapes;
-    other keys may hold anything."""
-
-    keys: dict
-    required: tuple[str, ...] = ()
 
 
 _NUMBERS = Nullable(float)
@@ -123,7 +110,15 @@ SUMMARY_SHAPE = Record(
                     "verdicts": Nullable(
                         Record({"agreement": Nullable(str), "reason": Nullable(str)})
                     ),
-                    "fit": Nullable(Record({"max_abs_dz_m": _NUMBERS})),
+                    "fit": Nullable(
+                        Record(
+                            {
+                                "max_abs_dz_m": _NUMBERS,
+                                "status": Nullable(str),
+                                "message": Nullable(str),
+                            }
+                        )
+                    ),
                     "fabrication": Nullable(
                         Record(
                             {
@@ -188,18 +183,6 @@ SUMMARY_SHAPE = Record(
 list ``[S]`` a list of S, a tuple a list of that many items of those shapes, a
 :class:`Record` an object, :class:`Nullable` also null."""
 
-LOG_SHAPE = Record(
-    {
-        "index": int,
-        "outcome": str,
-        "dof": Nullable(int),
-        "F": _NUMBERS,
-        "iterations": Nullable(int),
-        "path": Nullable(Record({"status": Nullable(str), "deploys": Nullable(bool)})),
-    },
-    ("index", "outcome", "dof"),
-)
-"""What the report reads of each attempt line of ``log.jsonl`` (see :data:`SUMMARY_SHAPE`)."""
 
 HISTORY_SHAPE = [
     Record(
@@ -210,93 +193,6 @@ HISTORY_SHAPE = [
 """The large-deformation history of a solution file (``deformation.history``)."""
 
 
-def check_shape(
-    value, shape, file: str | os.PathLike, where: str = "", *, line: int | None = None
-) -> None:
-    """ValueError naming ``file`` (and its ``line``, for a file of JSON lines) and the key
-    (``per_solution[0].development.D``) of the first part of ``value`` (JSON data) that does
-    not have ``shape`` (:data:`SUMMARY_SHAPE` says how shapes are written), and what it
-    holds instead."""
-    label = f"'{file}'" + ("" if line is None else f", line {line}")
-    whole = "the document" if line is None else "the line"
-    stack = [(value, shape, where)]
-    while stack:
-        value, given, where = stack.pop()
-        shape = given.shape if isinstance(given, Nullable) else given
-        if value is None and shape is not given:
-            continue
-        if not _has_shape(value, shape):
-            key = f"{where!r}" if where else whole
-            raise RigidfoldError(
-                f"{label}: {key} is {received(value)}, expected {_expected(given)}"
-            )
-        if isinstance(shape, Record):
-            missing = [k for k in shape.required if k not in value]
-            if missing:
-                key = f"{where!r}" if where else whole
-                raise RigidfoldError(f"{label}: {key} has no {', '.join(map(repr, missing))}")
-            stack += [
-                (value[k], s, f"{where}.{k}" if where else k)
-                for k, s in reversed(shape.keys.items())
-                if k in value
-            ]
-        elif isinstance(shape, list):
-            stack += [(v, shape[0], f"{where}[{i}]") for i, v in reversed(list(enumerate(value)))]
-        elif isinstance(shape, tuple):
-            stack += [
-                (v, s, f"{where}[{i}]") for i, (v, s) in enumerate(zip(value, shape, strict=True))
-            ]
-
-
-def _has_shape(value, shape) -> bool:
-    """Whether ``value`` is of the kind of ``shape`` (its items are checked apart)."""
-    if shape is bool:
-        return isinstance(value, bool)
-    if shape is int:  # within int64: numpy and matplotlib take it
-        return isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2**63
-    if shape is float:
-        if not isinstance(value, int | float) or isinstance(value, bool):
-            return False
-        try:
-            return math.isfinite(value)
-        except OverflowError:  # an integer beyond the floats
-            return False
-    if shape is str:
-        return isinstance(value, str)
-    if isinstance(shape, Record):
-        return isinstance(value, dict)
-    if isinstance(shape, tuple):
-        return isinstance(value, list) and len(value) == len(shape)
-    return isinstance(value, list)
-
-
-def _expected(shape) -> str:
-    if isinstance(shape, Nullable):
-        return f"{_expected(shape.shape)} or null"
-    words = {
-        bool: "true or false",
-        int: "a whole number (64 bits)",
-        float: "a finite number",
-        str: "text",
-    }
-    if isinstance(shape, type):
-        return words[shape]
-    if isinstance(shape, Record):
-        return "an object"
-    if isinstance(shape, tuple):
-        return f"a list of {len(shape)} items"
-    return "a list"
-
-
-def received(value) -> str:
-    """``value`` as JSON text, cut to 40 characters."""
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        text = repr(value)
-    return text if len(text) <= 40 else text[:39] + "…"
-
-
 DESIGN_SHAPE = Record(
     {
         "rigidfold:step": int,
@@ -305,6 +201,30 @@ DESIGN_SHAPE = Record(
     }
 )
 """What the report reads of rigidfold's keys in a solution file (see :data:`SUMMARY_SHAPE`)."""
+
+
+def _log_shape() -> Record:
+    """The shape of a line of ``log.jsonl``: each field of
+    :class:`rigidfold.generate.Attempt` (:func:`shape_of` its type), those without a default
+    required."""
+    hints = typing.get_type_hints(Attempt)
+    fields_ = dataclasses.fields(Attempt)
+    missing = dataclasses.MISSING
+    return Record(
+        {f.name: shape_of(hints[f.name]) for f in fields_},
+        tuple(f.name for f in fields_ if f.default is missing and f.default_factory is missing),
+    )
+
+
+LOG_SHAPE = _log_shape()
+"""The shape of each attempt line of ``log.jsonl`` (see :data:`SUMMARY_SHAPE`), made from
+:class:`rigidfold.generate.Attempt`, which the line is read into."""
+
+LOG_NAN_FIELDS = tuple(
+    name for name, hint in typing.get_type_hints(Attempt).items() if hint is float
+)
+"""The fields of :class:`~rigidfold.generate.Attempt` that are floats, never None: a NaN of
+theirs is written as null and read back as NaN."""
 
 
 class Stage(Outcome):
@@ -318,13 +238,50 @@ class Stage(Outcome):
         "thick panels collide, are trimmed away or cannot be checked over the motion",
     )
     STRUCTURE = "structure", "the structure check failed"
+    FIT = "fit", "the design lies farther from the target surface than dz allows"
+
+
+class FitStatus(Outcome):
+    """How far a solution lies from its target surface (:data:`Stage.FIT`): its largest
+    |z - target| within the bound ``Settings.design.dz``, by ``dz_bound_tol`` of it."""
+
+    WITHIN = "within", "within dz of the target surface"
+    BEYOND = "beyond", "farther from the target surface than dz"
+
+
+@dataclass(frozen=True)
+class StageRule:
+    """How a :class:`Stage` is judged and shown.
+
+    passing : the status its figures pass with, a member of its result's
+    :class:`~rigidfold.status.Outcome` enum (whose values its ``status`` holds); name : its
+    name among the report's checks (:meth:`rigidfold.run.RunData.checks`); detailed : its
+    figures' ``message`` says more than the :class:`Stage` message (in the verdict and the
+    report).
+    """
+
+    passing: Outcome
+    name: str
+    detailed: bool = False
+
+
+STAGES: dict[Stage, StageRule] = {
+    Stage.DEVELOPMENT: StageRule(DevelopStatus.CONVERGED, "development"),
+    Stage.MOTION: StageRule(MotionStatus.OK, "folding motion"),
+    Stage.DEFORMATION: StageRule(DeformStatus.REACHED_PLANE, "large deformation"),
+    Stage.FABRICATION: StageRule(FabricationStatus.COLLISION_FREE, "thick panels", True),
+    Stage.STRUCTURE: StageRule(StructureStatus.PASSED, "structure", True),
+    Stage.FIT: StageRule(FitStatus.WITHIN, "fit to the target", True),
+}
+"""Every :class:`Stage`'s rule: the one place that says when a check of a solution passes."""
 
 
 @dataclass(frozen=True)
 class SolutionRecord:
     """The checks of one accepted solution: an entry of ``summary.json``'s ``per_solution``.
 
-    step, dof : int (None in a damaged file); fit : ``max_abs_dz_m``, ``rms_dz_m``;
+    step, dof : int (None in a damaged file); fit : ``max_abs_dz_m``, ``rms_dz_m``, its
+    ``status`` (:class:`FitStatus`) and ``message``;
     development, motion, deformation, verdicts : each stage's figures (its ``to_dict()``;
     None where it did not run); deployability : the folding path's
     (:meth:`rigidfold.mechanism.path.FoldingPath.to_dict`), None where it was not traced;
@@ -388,26 +345,31 @@ class SolutionRecord:
         """Whether ``stage`` ran on this solution (the development always does)."""
         return stage is Stage.DEVELOPMENT or getattr(self, stage.value) is not None
 
+    def status(self, stage: Stage) -> Outcome | str | None:
+        """The status of ``stage`` as a member of its result's enum (that of
+        ``STAGES[stage].passing``), as text where it is none of them (``"error"``: a check
+        of the final design that could not run); None where the stage did not run (or its
+        figures have no status)."""
+        value = (getattr(self, stage.value) or {}).get("status") if self.ran(stage) else None
+        if not isinstance(value, str):
+            return None
+        try:
+            return type(STAGES[stage].passing)(value)
+        except ValueError:
+            return value
+
     def passed(self, stage: Stage) -> bool | None:
-        """Whether ``stage`` passed: the development converged, the motion was traced, the
-        frame reached the plane, the thick panels deploy without collision, the structure
-        check passed; None where it did not run."""
+        """Whether ``stage`` passed (its status is ``STAGES[stage].passing``: the development
+        converged, the motion was traced, the frame reached the plane, the thick panels
+        deploy without collision, the structure check passed); None where it did not run."""
         if not self.ran(stage):
             return None
-        figures = getattr(self, stage.value) or {}
-        status = figures.get("status")
-        return {
-            Stage.DEVELOPMENT: status == DevelopStatus.CONVERGED,
-            Stage.MOTION: status == MotionStatus.OK,
-            Stage.DEFORMATION: status == DeformStatus.REACHED_PLANE,
-            Stage.FABRICATION: status == FabricationStatus.COLLISION_FREE,
-            Stage.STRUCTURE: status == StructureStatus.PASSED,
-        }[stage]
+        return self.status(stage) is STAGES[stage].passing
 
     def detail(self, stage: Stage) -> str:
-        """The words of a stage that says more than its :class:`Stage` message (the thick
-        panels' and the structure's ``message``), "" for the others."""
-        if stage not in (Stage.FABRICATION, Stage.STRUCTURE):
+        """The words of a stage that says more than its :class:`Stage` message (its figures'
+        ``message``, where ``STAGES[stage].detailed``), "" for the others."""
+        if not STAGES[stage].detailed:
             return ""
         return str((getattr(self, stage.value) or {}).get("message") or "")
 
@@ -416,43 +378,15 @@ class SolutionRecord:
         return [stage for stage in Stage if self.passed(stage) is False]
 
 
-@dataclass(frozen=True)
-class AttemptRecord:
-    """What the report reads of one solve in ``log.jsonl`` (a line, checked with
-    :data:`LOG_SHAPE`).
-
-    index : int; outcome : the :class:`rigidfold.generate.AttemptOutcome` value; dof : None
-    when the solve was not analysed; F, iterations : the solve's; fixed_added, locked : the
-    creases fixed by it and locked at the shape found; path : the deployability check's
-    figures or None; document : the whole line (every field of
-    :meth:`rigidfold.generate.Attempt.to_dict`).
-    """
-
-    index: int
-    outcome: str
-    dof: int | None
-    F: float | None = None
-    iterations: int | None = None
-    fixed_added: list | None = None
-    locked: list | None = None
-    path: dict | None = None
-    document: dict = field(default_factory=dict, compare=False, repr=False)
-
-    @classmethod
-    def from_dict(cls, data: dict, k: int = 0) -> AttemptRecord:
-        names = {f.name for f in fields(cls)} - {"document"}
-        known = {n: v for n, v in data.items() if n in names}
-        return cls(**{"index": k, **known, "document": data})
-
-
-def aggregate(records: list[SolutionRecord]) -> dict:
-    """The run-wide figures of ``summary.json`` (``development``, ``deformation``,
-    ``motion``, ``fabrication``, ``structure``) over the solutions' records: means and
-    maxima of what ran."""
+def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dict:
+    """The run-wide figures over the solutions' records (means and maxima of what ran):
+    ``summary.json``'s ``development``, ``deformation``, ``motion``, ``fabrication`` and
+    ``structure``, the study's figures of a run and the report's checks
+    (:meth:`rigidfold.run.RunData.checks`). A figure that a record read back holds as null
+    is left out."""
     dev = [r.development or {} for r in records]
     deformed = [r.deformation for r in records if r.deformation is not None]
     motions = [r.motion for r in records if r.motion is not None]
-
     built = [r.fabrication for r in records if r.fabrication is not None]
     loaded = [r.structure for r in records if r.structure is not None]
 
@@ -462,34 +396,37 @@ def aggregate(records: list[SolutionRecord]) -> dict:
     def known(figures: list[dict], key: str) -> list:
         return [f[key] for f in figures if f.get(key) is not None]
 
+    def count(stage: Stage) -> int:  # the records on which ``stage`` passed
+        return sum(r.passed(stage) is True for r in records)
+
     return {
         "development": {
-            "mean_D": stat([d["D"] for d in dev], np.mean),
-            "max_D": stat([d["D"] for d in dev], np.max),
-            "flipped": sum(max(d["flipped"], 0) for d in dev),
-            "overlaps": sum(max(d["overlaps"], 0) for d in dev),
+            "mean_D": stat(known(dev, "D"), np.mean),
+            "max_D": stat(known(dev, "D"), np.max),
+            "flipped": sum(max(n, 0) for n in known(dev, "flipped")),
+            "overlaps": sum(max(n, 0) for n in known(dev, "overlaps")),
         },
         "deformation": {
             "checked": len(deformed),
-            "reached_plane": sum(d["reached_plane"] for d in deformed),
-            "mean_dl_mm": stat([d["mean_dl_mm"] for d in deformed], np.mean),
-            "max_dl_mm": stat([d["max_dl_mm"] for d in deformed], np.max),
-            "mean_drho_fix_deg": stat([d["mean_drho_fix_deg"] for d in deformed], np.mean),
-            "max_drho_fix_deg": stat([d["max_drho_fix_deg"] for d in deformed], np.max),
+            "reached_plane": sum(bool(d.get("reached_plane")) for d in deformed),
+            "mean_dl_mm": stat(known(deformed, "mean_dl_mm"), np.mean),
+            "max_dl_mm": stat(known(deformed, "max_dl_mm"), np.max),
+            "mean_drho_fix_deg": stat(known(deformed, "mean_drho_fix_deg"), np.mean),
+            "max_drho_fix_deg": stat(known(deformed, "max_drho_fix_deg"), np.max),
         },
         "motion": {
-            "traced": sum(m["status"] == MotionStatus.OK for m in motions),
-            "max_length_error": stat([m["max_length_error"] for m in motions], np.max),
+            "traced": count(Stage.MOTION),
+            "max_length_error": stat(known(motions, "max_length_error"), np.max),
         },
         "fabrication": {
             "checked": len(built),
-            "collision_free": sum(f["status"] == FabricationStatus.COLLISION_FREE for f in built),
+            "collision_free": count(Stage.FABRICATION),
             "min_gap_m": stat(known(built, "min_gap_m"), np.min),
             "max_trimming_loss": stat(known(built, "trimming_loss"), np.max),
         },
         "structure": {
             "checked": len(loaded),
-            "passed": sum(f["status"] == StructureStatus.PASSED for f in loaded),
+            "passed": count(Stage.STRUCTURE),
             "max_displacement_m": stat(known(loaded, "max_displacement_m"), np.max),
         },
     }

@@ -14,14 +14,12 @@ appended to, so a crash can tear only its last line, which its reader skips.
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from rigidfold.case import Case
-from rigidfold.deform import MotionStatus, Verification, verify
-from rigidfold.errors import RigidfoldError
+from rigidfold.deform import Verification
 from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import (
@@ -47,12 +45,12 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
-from rigidfold.run.built import check_built_options, structure_check, thick_panels
+from rigidfold.run.built import check_built_options
+from rigidfold.run.checks import Checked, check_final, check_solution, traced_motion
 from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
 from rigidfold.run.schema import LOG_FILE, SCHEMA_VERSION, SolutionRecord, aggregate
 from rigidfold.run.verdict import RunVerdict, run_verdict
 from rigidfold.structure import StructureCheck
-from rigidfold.structure.material import parse_material
 from rigidfold.surfaces import SplineSurface
 
 
@@ -61,17 +59,10 @@ def verification_frames(pattern: CreasePattern, check: Verification) -> list[dic
     (``creasePattern``), then its folding motion from flat to folded (``foldedForm``, each
     frame with its own fold angles) when it was traced."""
     frames = [crease_pattern_frame(check.development.coords2d)]
-    motion = _traced_motion(check)
+    motion = traced_motion(check)
     if motion is not None:
         frames += motion_frames(pattern, *motion)
     return frames
-
-
-def _traced_motion(check: Verification) -> tuple[np.ndarray, np.ndarray] | None:
-    """(frames (K, V, 3), parameter (K,)) of the folding motion, None unless it was traced."""
-    if check.motion is None or check.motion.status is not MotionStatus.OK:
-        return None
-    return check.motion.frames, check.motion.parameter
 
 
 def write_checked_shape(
@@ -104,7 +95,7 @@ def write_checked_shape(
     else:
         letters = source.shape_assignment()
         document = round_trip_dict(
-            source, coords2d, motion=_traced_motion(check), title=title, metadata=figures
+            source, coords2d, motion=traced_motion(check), title=title, metadata=figures
         )
         fold = write_document(path, document)
     svg = write_svg(
@@ -164,7 +155,9 @@ class AttemptLog:
 
 
 class RunWriter:
-    """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date.
+    """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date: the
+    checks are the pipeline's (:mod:`rigidfold.run.checks`, the study's too), the writer
+    writes their results.
 
     The development diagram (Step 8) runs on every solution as it comes; the folding motion
     and, with ``options.deform``, the large-deformation check (Step 9) run on the solutions
@@ -174,7 +167,8 @@ class RunWriter:
     (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
     target the verdict (:meth:`finish`) judges by. With ``options.fabricate`` and
     ``options.structure`` the final design's thick panels and structure are checked too
-    (:mod:`rigidfold.run.built`; ``DIR/final/thick/``, ``DIR/final/structure/``), their
+    (:func:`rigidfold.run.checks.check_final`; ``DIR/final/thick/``,
+    ``DIR/final/structure/``), their
     figures in its record; ``fabrication`` and ``structure`` hold the results.
     """
 
@@ -202,7 +196,7 @@ class RunWriter:
             raise
         self.case, self.options = case, options
         self.solutions: list[Solution] = []
-        self.developments: dict[int, np.ndarray] = {}  # step -> the development, (V, 2)
+        self.checked: dict[int, Checked] = {}  # step -> its checks (development, motion)
         self.files: list[Path] = []
         self.records: list[SolutionRecord] = []
         self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
@@ -210,7 +204,6 @@ class RunWriter:
         self.final: tuple[CreasePattern, np.ndarray] | None = None
         self.final_step: int | None = None
         self.exports: list[Path] = []
-        self.motions: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # step -> traced motion
         self.fabrication: Fabrication | None = None
         self.structure: StructureCheck | None = None
         self.log = AttemptLog(self.out / LOG_FILE)
@@ -282,8 +275,7 @@ class RunWriter:
         assert self.solutions and self.solutions[-1] is solution, "not the last solution"
         self.solutions.pop()
         self.records.pop()
-        self.developments.pop(solution.step, None)
-        self.motions.pop(solution.step, None)
+        self.checked.pop(solution.step, None)
         fold = self.files.pop()
         for path in (fold, fold.with_suffix(".svg")):
             path.unlink(missing_ok=True)
@@ -291,40 +283,20 @@ class RunWriter:
         self.write_summary(run)
 
     def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
-        """Check one solution (Step 8; the motion and Step 9 as asked) and write its FOLD and
-        SVG files; its record replaces ``records[solution.step]``. Returns the FOLD path."""
-        dof = solution.mechanism.dof
-        pattern = solution.result.pattern
-        check = verify(  # a DOF-0 shape (a target of 0) has no motion to trace or check
-            pattern,
-            run_deform=deform and dof > 0,
-            run_motion=motion and dof > 0,
-            dof=dof,
-            path=solution.path,
-            support_face=self.options.support_face,
-            **self._frame_material(),
-            settings=self.case.settings,
-        )
-        for stage, t in check.times.items():
+        """Check one solution (:func:`rigidfold.run.checks.check_solution`: Step 8; the
+        motion and Step 9 as asked) and write its FOLD and SVG files; its record replaces
+        ``records[solution.step]``. Returns the FOLD path."""
+        checked = check_solution(solution, self.case, self.options, motion=motion, deform=deform)
+        for stage, t in checked.record.time_s.items():
             self.stage_times[stage] += t
-        dz = self.case.deviation(pattern.coords)
-        fit = {"max_abs_dz_m": float(np.abs(dz).max()), "rms_dz_m": float(np.sqrt(np.mean(dz**2)))}
-        self.records[solution.step] = SolutionRecord.from_check(
-            solution.step,
-            dof,
-            check,
-            fit=fit,
-            deployability=None if solution.path is None else solution.path.to_dict(),
-        )
-        self.developments[solution.step] = check.development.coords2d
-        traced = _traced_motion(check)
-        if traced is not None:
-            self.motions[solution.step] = traced
+        self.records[solution.step] = checked.record
+        self.checked[solution.step] = checked
+        dof = solution.mechanism.dof
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
         write_checked_shape(
             path,
-            pattern,
-            check,
+            solution.result.pattern,
+            checked.verification,
             title=f"rigidfold generate: step {solution.step}, DOF {dof}",
             svg_title=f"step {solution.step}, DOF {dof}: development diagram",
             metadata={
@@ -338,31 +310,26 @@ class RunWriter:
         )
         return path
 
-    def _frame_material(self) -> dict:
-        """Step 9's frame of strips of the user's panels (``options.material``, of
-        ``options.panel_thickness`` or ``Settings.structure.thickness``); {} for the paper's
-        tubes."""
-        if self.options.material is None:
-            return {}
-        thickness = self.options.panel_thickness or self.case.settings.structure.thickness
-        return {"material": parse_material(self.options.material), "thickness": thickness}
-
     def finish(self, run: Generation) -> RunVerdict:
         """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
         and the final design (:attr:`rigidfold.generate.Generation.final`) exported to
         ``DIR/final/`` in every format of :func:`rigidfold.exports.export_design`, named
         after its solution file. With ``check="final"`` the final design's folding motion and
-        Step 9 run first and its files are written again with them."""
+        Step 9 run first and its files are written again with them; its thick panels and
+        structure are checked as the options ask (:func:`rigidfold.run.checks.check_final`)."""
         final = run.final
         if final is not None:
             self.final_step = final.step
             if self.options.check == "final":
                 self.solutions[final.step] = final  # its path may have been traced since
                 self._write_solution(final, deform=self.options.deform, motion=True)
-            pattern = final.result.pattern
-            coords2d = self.developments[final.step]
-            self.final = (pattern, coords2d)
-            self._build(final, coords2d)
+            checked = self.checked[final.step]
+            self.final = (final.result.pattern, checked.coords2d)
+            if self.options.fabricate is not None or self.options.structure is not None:
+                name = self.files[final.step].stem
+                built = check_final(checked, final, self.options, self.out, name)
+                self.records[final.step] = built.record
+                self.fabrication, self.structure = built.fabrication, built.structure
         self.verdict = run_verdict(
             run,
             self.records,
@@ -378,39 +345,6 @@ class RunWriter:
         self.log.sync(run.attempts)
         self.write_summary(run)
         return self.verdict
-
-    def _build(self, final: Solution, coords2d: np.ndarray) -> None:
-        """The final design's thick panels and structure check, as the options ask, their
-        figures written into its record."""
-        opts = self.options
-        if opts.fabricate is None and opts.structure is None:
-            return
-        pattern = final.result.pattern
-        name = self.files[final.step].stem
-        record = self.records[final.step]
-        # a check that cannot run on this design (RigidfoldError) is a failed stage with its
-        # message: the run still ends with its verdict, summary.json and report
-        if opts.fabricate is not None:
-            try:
-                figures, self.fabrication = thick_panels(
-                    self.out,
-                    name,
-                    pattern,
-                    coords2d,
-                    opts,
-                    frames=self.motions.get(final.step),
-                    path=final.path,
-                )
-            except RigidfoldError as exc:
-                figures = _not_checked("the thick panels", exc)
-            record = replace(record, fabrication=figures)
-        if opts.structure is not None:
-            try:
-                figures, self.structure = structure_check(self.out, name, pattern, opts)
-            except RigidfoldError as exc:
-                figures = _not_checked("the structure", exc)
-            record = replace(record, structure=figures)
-        self.records[final.step] = record
 
     def write_summary(self, run: Generation) -> None:
         """Write summary.json (atomically) as the run stands now."""
@@ -432,12 +366,3 @@ class RunWriter:
             },
         )
         self.summary_written = time.monotonic()
-
-
-def _not_checked(what: str, exc: Exception) -> dict:
-    """The figures of a check of the final design that could not run: status "error" and
-    why (a failed :class:`~rigidfold.run.Stage` with this message)."""
-    return {
-        "status": "error",
-        "message": f"{what} could not be checked: {' '.join(str(exc).split())}",
-    }

@@ -23,7 +23,8 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
-from rigidfold.study.store import ERROR_PREFIX, Key, Store
+from rigidfold.study.rows import ERROR_PREFIX, Key
+from rigidfold.study.store import Store
 
 PRESETS = {
     # Sections 6.5 and 6.6: the 11 x 11 grid with S, with and without the mirror planes
@@ -134,19 +135,19 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
     """
     from rigidfold import __version__
     from rigidfold.case import make_case
-    from rigidfold.deform import verify
     from rigidfold.generate import generate
     from rigidfold.mechanism.path import trace_path
     from rigidfold.numerics import numeric_environment
     from rigidfold.run import SolutionRecord, aggregate
+    from rigidfold.run.checks import check_solution
 
     settings, options = config.settings, config.options
     t0 = time.perf_counter()
     records: list[SolutionRecord] = []
 
-    def check(solution) -> None:
-        c = verify(solution.result.pattern, run_motion=False, settings=settings)
-        records.append(SolutionRecord.from_check(solution.step, solution.mechanism.dof, c))
+    def check(solution) -> None:  # Steps 8-9, as generate's run writer checks a solution
+        checked = check_solution(solution, case, options, motion=False, deform=True)
+        records.append(checked.record)
 
     def retract() -> None:  # backtracking retracted the last solution checked
         records.pop()

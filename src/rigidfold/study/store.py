@@ -25,169 +25,21 @@ import json
 import os
 import sqlite3
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, fields
 from pathlib import Path
 
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop
 from rigidfold.study.lock import StudyLock
-
-SCHEMA = """
-CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE IF NOT EXISTS runs (
-    study TEXT NOT NULL,          -- "bezier", or a preset ("dome", "hp")
-    seed INTEGER NOT NULL,        -- surface seed (0 for presets)
-    pattern TEXT NOT NULL,
-    criterion TEXT NOT NULL,
-    symmetric INTEGER NOT NULL,
-    status TEXT NOT NULL,         -- the generator's stop reason, or "error: ..."
-    n_reduce INTEGER, n_lock INTEGER, n_exceed INTEGER,
-    mean_f REAL, initial_dof INTEGER, final_dof INTEGER, n_solutions INTEGER, n_solves INTEGER,
-    mean_d REAL, mean_dl_mm REAL, mean_drho_fix_deg REAL, reached_plane INTEGER,
-    time_build REAL, time_solve REAL, time_analysis REAL, time_selection REAL,
-    time_develop REAL, time_deform REAL, time_total REAL,
-    version TEXT NOT NULL, worker TEXT,
-    numerics TEXT,                -- rigidfold.numerics.NumericEnvironment.key of its worker
-    n_path INTEGER,               -- N_path (0 without the deployability check)
-    final_deploys INTEGER,        -- whether the final design's folding path reaches flat
-    time_path REAL,               -- seconds of tracing
-    stop TEXT,                    -- the generate.Stop value (NULL: an error)
-    n_backtrack INTEGER,          -- generate.Generation.n_backtrack
-    n_rigid INTEGER,              -- N_rigid: solutions rejected as second-order rigid
-    lowest_dof INTEGER,           -- the lowest DOF reached (final_dof: the final design's)
-    PRIMARY KEY (study, seed, pattern, criterion, symmetric)
-);
-CREATE TABLE IF NOT EXISTS invocations (  -- one row per `rigidfold study` command that ended
-    started TEXT NOT NULL,        -- UTC, ISO 8601
-    argv TEXT NOT NULL,           -- the command line (JSON list)
-    workers INTEGER, scheduler TEXT,
-    ran INTEGER NOT NULL, skipped INTEGER NOT NULL, total INTEGER NOT NULL,
-    wall_s REAL NOT NULL, outcome TEXT NOT NULL, version TEXT NOT NULL
-);
-CREATE TABLE IF NOT EXISTS attempts (
-    study TEXT NOT NULL, seed INTEGER NOT NULL, pattern TEXT NOT NULL,
-    criterion TEXT NOT NULL, symmetric INTEGER NOT NULL,
-    idx INTEGER NOT NULL,
-    fixed_added TEXT NOT NULL, score REAL, status TEXT NOT NULL, f REAL, iterations INTEGER,
-    dof INTEGER, locked TEXT NOT NULL, outcome TEXT NOT NULL,
-    solve_time REAL, analysis_time REAL, selection_time REAL,
-    skipped INTEGER,              -- candidates skipped by the look-ahead just before
-    skipped_locks TEXT, predicted_locks TEXT,  -- JSON, see generate.Attempt
-    locked_predicted TEXT, locked_left TEXT, locked_fold_deg TEXT,  -- JSON, per locked crease
-    carried TEXT,                 -- JSON: creases the look-ahead fixed with the candidate
-    path TEXT, path_time REAL,    -- JSON: generate.Attempt.path, and its seconds
-    second_order TEXT,            -- JSON: generate.Attempt.second_order
-    rigid_forecast INTEGER,       -- forecast second-order rigid (NULL: no forecast)
-    PRIMARY KEY (study, seed, pattern, criterion, symmetric, idx)
-);
-"""
-
-JSON_ATTEMPT_FIELDS = (
-    "fixed_added",
-    "locked",
-    "skipped_locks",
-    "predicted_locks",
-    "locked_predicted",
-    "locked_left",
-    "locked_fold_deg",
-    "carried",
-    "path",
-    "second_order",
+from rigidfold.study.rows import (
+    ATTEMPT_FIELDS,
+    JSON_ATTEMPT_FIELDS,
+    KEY_COLUMNS,
+    RUN_FIELDS,
+    SCHEMA,
+    SCHEMA_COLUMNS,
+    Key,
+    RunRow,
 )
-"""Attempt fields stored as JSON text (decoded by :meth:`Store.attempt_runs`)."""
-
-KEY_COLUMNS = ("study", "seed", "pattern", "criterion", "symmetric")
-"""The columns of a run's :class:`Key`, first in ``runs`` and ``attempts``."""
-
-
-def schema_columns() -> dict[str, dict[str, str]]:
-    """The columns of every table of :data:`SCHEMA` and their declared types, by table."""
-    con = sqlite3.connect(":memory:")
-    con.executescript(SCHEMA)
-    tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")]
-    columns = {t: {r[1]: r[2] for r in con.execute(f"PRAGMA table_info({t})")} for t in tables}
-    con.close()
-    return columns
-
-
-SCHEMA_COLUMNS = schema_columns()
-RUN_FIELDS = tuple(c for c in SCHEMA_COLUMNS["runs"] if c not in KEY_COLUMNS)
-"""The columns of ``runs`` besides the key, in the order of :data:`SCHEMA`."""
-ATTEMPT_FIELDS = tuple(c for c in SCHEMA_COLUMNS["attempts"] if c not in KEY_COLUMNS)
-"""The columns of ``attempts`` besides the key, in the order of :data:`SCHEMA`."""
-
-
-ERROR_PREFIX = "error: "
-"""Start of the ``status`` of a run that could not run (a configuration error)."""
-
-
-@dataclass(frozen=True)
-class RunRow:
-    """One stored run (a row of ``runs``).
-
-    study, seed, pattern, criterion, symmetric : its :class:`Key`; stop : how it ended
-    (None: it could not run, ``status`` then "error: <message>"); status : the words; the
-    paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_rigid``,
-    ``n_backtrack``, the lowest DOF reached (``lowest_dof``), the final design's
-    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9 figures
-    (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the times in
-    seconds (``time_*``), and where it was computed (``version``, ``worker``,
-    ``numerics``); a figure the run (or its version) did not record is None.
-    """
-
-    study: str
-    seed: int
-    pattern: str
-    criterion: str
-    symmetric: bool
-    stop: Stop | None
-    status: str
-    n_reduce: int | None = None
-    n_lock: int | None = None
-    n_exceed: int | None = None
-    mean_f: float | None = None
-    initial_dof: int | None = None
-    final_dof: int | None = None
-    n_solutions: int | None = None
-    n_solves: int | None = None
-    mean_d: float | None = None
-    mean_dl_mm: float | None = None
-    mean_drho_fix_deg: float | None = None
-    reached_plane: int | None = None
-    time_build: float | None = None
-    time_solve: float | None = None
-    time_analysis: float | None = None
-    time_selection: float | None = None
-    time_develop: float | None = None
-    time_deform: float | None = None
-    time_total: float | None = None
-    version: str = ""
-    worker: str | None = None
-    numerics: str | None = None
-    n_path: int | None = None
-    final_deploys: int | None = None
-    time_path: float | None = None
-    n_backtrack: int | None = None
-    n_rigid: int | None = None
-    lowest_dof: int | None = None
-
-    @property
-    def key(self) -> Key:
-        return Key(self.study, self.seed, self.pattern, self.criterion, bool(self.symmetric))
-
-    @property
-    def error(self) -> str | None:
-        """The message of a run that could not run, None for the others."""
-        return self.status.removeprefix(ERROR_PREFIX) if self.stop is None else None
-
-    @classmethod
-    def from_columns(cls, values: dict) -> RunRow:
-        """The row of the ``runs`` columns ``values``."""
-        names = {f.name for f in fields(cls)}
-        known = {k: v for k, v in values.items() if k in names}
-        stop = known.pop("stop", None)
-        known["symmetric"] = bool(known["symmetric"])
-        return cls(stop=None if stop is None else Stop(stop), **known)
 
 
 def _stop_value(run: dict) -> str | None:
@@ -199,20 +51,6 @@ def _stop_value(run: dict) -> str | None:
 class StoreWriteError(RigidfoldError):
     """A study database could not be written (a full disk, a read-only file): the run or
     command being written is not stored, every run stored before is (one transaction each)."""
-
-
-@dataclass(frozen=True)
-class Key:
-    """Identifies one run: (study, seed, pattern, criterion, symmetric)."""
-
-    study: str
-    seed: int
-    pattern: str
-    criterion: str
-    symmetric: bool = False
-
-    def row(self) -> tuple:
-        return (self.study, self.seed, self.pattern, self.criterion, int(self.symmetric))
 
 
 # settings that change nothing without the deployability check: not compared between two

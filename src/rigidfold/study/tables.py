@@ -16,8 +16,9 @@ import numpy as np
 from rigidfold.generate import AttemptOutcome, Stop
 from rigidfold.selection import CRITERIA
 from rigidfold.study.paper import TABLES_5_6, TABLES_7_8
+from rigidfold.study.rows import ERROR_PREFIX
 from rigidfold.study.runner import PRESETS
-from rigidfold.study.store import ERROR_PREFIX, Store
+from rigidfold.study.store import Store
 
 ORDER = tuple(sorted(CRITERIA, key=[c for _, c in TABLES_5_6].index))
 """The criteria in the order of the rows of the paper's Tables 5 and 6."""
