@@ -25,7 +25,8 @@ OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=Fa
 
 
 def _case(backtrack_max: int):
-    settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max)
+    # backtracking alone: no restart with the fold limit (tests/test_fold_limit.py)
+    settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max, fold_limit=None)
     return make_case("bezier", "1", seed=SEED, settings=settings)
 
 
@@ -108,7 +109,9 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     lower chain, so the run ends with the one it had, and the chains it tried since leave no
     file."""
     case = make_case("dome", "grid:3x3")
-    plain = generate(make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0)))
+    plain = generate(
+        make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0, fold_limit=None))
+    )
     run = generate_case(RunWriter(tmp_path, case, GenerateOptions(deform=False)), report=False)
     assert plain.stop is run.stop is Stop.NO_CANDIDATE
     dofs = [s.mechanism.dof for s in run.solutions]

@@ -1,20 +1,23 @@
-"""The fold limit of a run with the deployability check (issue 40): bound (12) at
-``Settings.generation.fold_limit`` on every solve, so that no solution folds panels onto
-each other."""
+"""The restart with the fold limit (issue 40): where a run's chain dead-ends with the
+deployability check, it starts again from the initial shape with bound (12) at
+``Settings.generation.fold_limit`` on every solve."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
+import rigidfold.generate as generation
 from rigidfold.case import make_case
 from rigidfold.case_options import SettingsOptions
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
-from rigidfold.generate import generate, with_fold_limit
+from rigidfold.generate import AttemptOutcome, Stop, generate, with_fold_limit
 from rigidfold.generate_options import GenerateOptions
+from rigidfold.mechanism.path import PathStatus
 
 
 def _largest_fold_deg(pattern) -> float:
@@ -22,12 +25,12 @@ def _largest_fold_deg(pattern) -> float:
     return float(np.degrees(np.abs(pattern.fold_angles[free]).max()))
 
 
-def test_the_limit_is_bound_12_with_the_check_only():
+def test_the_restart_case_has_bound_12_at_the_limit():
     case = make_case("dome", "1", seed=1)
     bounded = with_fold_limit(case, GenerateOptions())
     assert bounded.settings.design.rho_bar == DEFAULTS.generation.fold_limit
     assert bounded.pattern is case.pattern and bounded.surface is case.surface
-    # the paper's Step 5 (no check), the user's own bound (12), no limit: the case itself
+    # the paper's Step 5 (no check), the user's own bound (12), no limit: no restart
     assert with_fold_limit(case, GenerateOptions(deploy_check=False)) is case
     own = make_case("dome", "1", seed=1, settings=DEFAULTS.with_(rho_bar=math.radians(90)))
     assert with_fold_limit(own, GenerateOptions()) is own
@@ -35,21 +38,46 @@ def test_the_limit_is_bound_12_with_the_check_only():
     assert with_fold_limit(free, GenerateOptions()) is free
 
 
-def test_every_solution_keeps_its_folds_within_the_limit():
-    """Pattern 1 on the dome folds its creases to about 50 degrees on the way to DOF 12;
-    with a limit of 25 degrees every solution stays within it (to the constraint
-    tolerance of the solver) and the run still reaches its target."""
-    limit = 25.0
-    runs = {}
-    for name, value in (("free", None), ("bounded", math.radians(limit))):
-        case = make_case("dome", "1", seed=1, settings=DEFAULTS.with_(fold_limit=value))
-        runs[name] = generate(case, target_dof=12, deform=False)
-    assert max(_largest_fold_deg(s.result.pattern) for s in runs["free"].solutions) > limit
-    bounded = runs["bounded"]
-    assert bounded.final_dof == 12
+def test_a_dead_end_restarts_the_chain_within_the_fold_limit(monkeypatch):
+    """The first DOF-1 candidate's path is made to turn back; with ``restart_after`` 1 the
+    chain is given up, its solutions after the initial one retracted, and the new chain
+    keeps every free crease within a limit of 40 degrees (pattern 1 folds to about 50 on
+    the way) down to a DOF-1 design that deploys."""
+    real = generation.trace_path
+    calls = []
+
+    def first_turns_back(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        calls.append(path)
+        if len(calls) == 1:
+            return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
+        return path
+
+    monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    limit = 40.0
+    settings = DEFAULTS.with_(restart_after=1, fold_limit=math.radians(limit))
+    case = make_case("bezier", "1", seed=1, settings=settings)
+    run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
+
+    first = [a for a in run.attempts if not a.fold_bound]
+    second = [a for a in run.attempts if a.fold_bound]
+    # the made-up dead end (its second-order test may find it rigid too)
+    assert first[-1].outcome in (AttemptOutcome.PATH, AttemptOutcome.RIGID)
+    assert first[0].outcome is AttemptOutcome.ACCEPTED  # the initial shape is kept
+    retracted = [a for a in first[1:] if a.outcome is AttemptOutcome.DEAD_END]
+    assert len(retracted) == len(first) - 2 == run.n_backtrack
+    assert second and all(a.index > first[-1].index for a in second)
+    assert run.stop is Stop.TARGET_REACHED and run.final is not None
+    assert run.final.path is not None and run.final.path.deploys
     tol = math.degrees(math.sqrt(2 * DEFAULTS.solver.constraint_tol)) + 1e-6
-    for solution in bounded.solutions:
+    for solution in run.solutions[1:]:  # the new chain's
         assert _largest_fold_deg(solution.result.pattern) <= limit + tol
+
+
+def test_a_chain_that_deploys_is_not_restarted():
+    run = generate(make_case("dome", "1", seed=1), target_dof=12, deform=False)
+    assert run.final_dof == 12
+    assert not any(a.fold_bound for a in run.attempts)
 
 
 def test_the_command_line_limit_in_degrees():

@@ -160,10 +160,10 @@ class SettingsOptions:
     )
     fold_limit: float | None = option(
         None,
-        "with the deployability check: bound (12) on the fold angle of every free crease in "
-        "every solve, degrees, so that no solution folds panels onto each other (default: "
-        f"{math.degrees(DEFAULTS.generation.fold_limit or 0):g}; 0: no bound; --rho-max, "
-        "where given, is the bound instead)",
+        "with the deployability check: where the chain's candidates do not deploy, it starts "
+        "again from the initial shape with bound (12) on the fold angle of every free crease "
+        "at this angle, degrees (default: "
+        f"{math.degrees(DEFAULTS.generation.fold_limit or 0):g}; 0: no restart)",
         parse=float,
         metavar="DEG",
     )

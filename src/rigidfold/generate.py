@@ -178,6 +178,10 @@ class Attempt:
         At a shape whose children are checked (with or without the look-ahead): whether this
         fix was forecast to leave a second-order rigid shape (:class:`rigidfold.mechanism.
         second_order.ChildForecast`); None where no forecast was made.
+    fold_bound : bool
+        Whether the solve kept every free crease within bound (12) at
+        ``Settings.generation.fold_limit``: the attempts of the chain started again after the
+        first chain's candidates did not deploy (:meth:`_Steps.restart`).
     """
 
     index: int
@@ -203,6 +207,7 @@ class Attempt:
     path_time: float = 0.0
     second_order: dict | None = None
     rigid_forecast: bool | None = None
+    fold_bound: bool = False
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""
@@ -414,6 +419,11 @@ class _Steps:
         self.shapes: list[_Shape] = []  # Step 6 at each solution being reduced, the last on top
         self.accepted: list[Attempt] = []  # the attempt of each solution
         self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
+        self.backtracks = 0  # retractions by backtracking in the chain being built
+        # the restart with bound (12) at the fold limit: its case (None: no restart left)
+        bounded = with_fold_limit(case, options)
+        self.restart_case: Case | None = None if bounded is case else bounded
+        self.fold_bound = False  # whether the solves are (12)-bounded (after the restart)
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
@@ -464,6 +474,7 @@ class _Steps:
             path=None if path is None else path.to_dict(),
             path_time=t_path,
             second_order=None if second is None else second.to_dict(),
+            fold_bound=self.fold_bound,
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
@@ -617,6 +628,9 @@ class _Steps:
             shape.undeployable += rigid or rec.outcome is AttemptOutcome.PATH
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             limit = self.settings.generation.deploy_max_candidates
+            if self.restart_case is not None:  # a restart is left: give the shape up sooner
+                sooner = self.settings.generation.restart_after
+                limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
             if shape.undeployable >= limit > 0 or (  # bounded cost
                 shape.forecast is not None
@@ -637,13 +651,48 @@ class _Steps:
             not self.options.deploy_check
             or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
             or len(run.solutions) < 2
-            or run.n_backtrack >= self.settings.generation.backtrack_max
+            or self.backtracks >= self.settings.generation.backtrack_max
         ):
             return False
-        if self.deepest is None or _dof(run.solutions) < _dof(self.deepest.solutions):
-            self.deepest = _Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
+        self.keep_deepest(stop)
         self.shapes.pop()
         self.retract()
+        self.backtracks += 1
+        run.stop_detail = ""
+        return True
+
+    def keep_deepest(self, stop: Stop) -> None:
+        """Keep the chain as it stands (with ``stop``) as :attr:`deepest` where it reached a
+        lower DOF than the one kept."""
+        run = self.run
+        if self.deepest is None or _dof(run.solutions) < _dof(self.deepest.solutions):
+            self.deepest = _Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
+
+    def restart(self, stop: Stop) -> bool:
+        """Step 7 beyond backtracking, once a run: after ``stop`` at the last solution's shape
+        (its candidates' paths do not reach the flat state, ``Settings.generation.
+        restart_after`` of them, or none is left), every solution after the initial one is
+        retracted and the chain starts again from the initial shape with bound (12) at
+        ``Settings.generation.fold_limit`` on every solve (:func:`with_fold_limit`; the
+        attempts' ``fold_bound``), with a backtracking budget of its own. Where the new chain
+        ends higher than the first, the run ends with the first (:meth:`settle`). Returns
+        whether it did."""
+        run = self.run
+        if (
+            self.restart_case is None
+            or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
+            or len(run.solutions) < 2
+        ):
+            return False
+        self.keep_deepest(stop)
+        while len(run.solutions) > 1:
+            self.retract()
+        self.shapes.clear()
+        t0 = time.perf_counter()
+        self.problem = self.restart_case.problem(build_ipopt=self.options.solver == "ipopt")
+        run.build_time += time.perf_counter() - t0
+        self.restart_case, self.fold_bound, self.backtracks = None, True, 0
+        self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
         run.stop_detail = ""
         return True
 
@@ -707,7 +756,6 @@ def generate(
     after the callbacks of everything finished so far.
     """
     opts = (options or GenerateOptions()).replace(**changes)
-    case = with_fold_limit(case, opts)
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
     steps = _Steps(case, opts, on_attempt, on_solution, on_retract)
     run = steps.run
@@ -723,7 +771,7 @@ def generate(
     steps.record(rec, trial)
     while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
         stop = steps.reduce(run.solutions[-1])
-        if stop is not None and not steps.backtrack(stop):
+        if stop is not None and not steps.restart(stop) and not steps.backtrack(stop):
             steps.settle(stop)
             _deployable_final(run, opts, case.settings)
             break
@@ -737,14 +785,16 @@ def generate(
 
 
 def with_fold_limit(case: Case, options: GenerateOptions) -> Case:
-    """The case whose problem (6) a run solves: with the deployability check and no bound
-    (12) of the user's (``Settings.design.rho_bar``), (12) at
-    ``Settings.generation.fold_limit``; otherwise ``case`` itself.
+    """The case of a run's restart (:meth:`_Steps.restart`): with the deployability check and
+    no bound (12) of the user's (``Settings.design.rho_bar``), (12) at
+    ``Settings.generation.fold_limit``; otherwise ``case`` itself (no restart).
 
     Each fix flattens a crease, and the solve makes up for it by folding the creases left
-    free further: unbounded, the chain folds panels onto each other (a crease near 180
-    degrees), and the folding paths of such shapes turn back or collide before the flat
-    state (docs/deployability.md, issue 40)."""
+    free further: on drawn patterns the chain ends with panels folded nearly onto each other
+    (creases near 180 degrees), and the folding paths of such shapes turn back or collide
+    before the flat state (docs/deployability.md, issue 40). Bound (12) keeps every solve
+    away from that, and IPOPT's barrier on it favours the less folded of the shapes that
+    solve (6)."""
     s = case.settings
     limit = s.generation.fold_limit
     if not options.deploy_check or s.design.rho_bar is not None or limit is None:

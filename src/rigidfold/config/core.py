@@ -137,12 +137,19 @@ class GenerationSettings(Group):
     )
     fold_limit: float | None = setting(
         math.radians(120.0),
-        "With the deployability check (and no ``design.rho_bar`` of the user's): bound (12) "
-        "at this angle, radians, on every solve of the run, so that the chain never folds "
-        "two panels onto each other: each fix flattens a crease and the solve folds the "
-        "creases left free further, and the paths of shapes with creases near 180 degrees "
-        "turn back or collide before the flat state (issue 40; docs/deployability.md). "
-        "None: no bound (the paper's problem).",
+        "With the deployability check (and no ``design.rho_bar`` of the user's): where the "
+        "run's chain dead-ends (``restart_after`` candidates of a shape whose paths do not "
+        "reach the flat state, or none left), it starts again from the initial shape with "
+        "bound (12) at this angle, radians, on every solve: each fix flattens a crease and "
+        "the solve folds the creases left free further, and the paths of shapes with creases "
+        "near 180 degrees turn back or collide before the flat state (issue 40; "
+        "docs/deployability.md). None: no restart.",
+    )
+    restart_after: int = setting(
+        5,
+        "With a ``fold_limit``: the candidates of one shape whose paths do not reach the "
+        "flat state (N_path, N_rigid) after which the first chain is given up and the run "
+        "starts again with the fold limit (``deploy_max_candidates`` once it has).",
     )
     summary_interval: float = setting(
         2.0,
@@ -160,6 +167,10 @@ class GenerationSettings(Group):
         if self.fold_limit is not None and not (0 < self.fold_limit < math.pi):
             raise RigidfoldError(
                 f"fold_limit must lie in (0, 180) degrees, got {math.degrees(self.fold_limit):g}"
+            )
+        if not (isinstance(self.restart_after, int) and self.restart_after >= 1):
+            raise RigidfoldError(
+                f"restart_after must be a whole number >= 1, got {self.restart_after!r}"
             )
         self._non_negative("summary_interval")
 
