@@ -46,7 +46,12 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.frame.model import default_support_face
 from rigidfold.mechanism.analysis import analyze
-from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System, correct
+from rigidfold.mechanism.rigid_folding import (
+    RigidFoldingConstraints,
+    System,
+    correct,
+    independent_rows,
+)
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
 
@@ -89,6 +94,8 @@ class FoldingPath:
     max_length_error : largest |l - l0| / l0 over all points and edges
     escapes : dense steps past points where the sparse continuation stalled
         (``Settings.path.escape_tol``: singular and bifurcation points)
+    dropped_rows : redundant constraint rows dropped where the projection continuation of a
+        1-DOF shape stalled (``Settings.path.reduce``; 0: none)
     """
 
     points: np.ndarray
@@ -106,6 +113,7 @@ class FoldingPath:
     factorizations: int
     max_length_error: float
     escapes: int = 0
+    dropped_rows: int = 0
 
     @property
     def deploys(self) -> bool:
@@ -179,6 +187,7 @@ class FoldingPath:
             "bifurcations": len(self.bifurcations),
             "max_length_error": self.max_length_error,
             "escapes": self.escapes,
+            "dropped_rows": self.dropped_rows,
         }
 
 
@@ -196,6 +205,7 @@ class _Trace:
     steps: int = 0
     factorizations: int = 0
     escapes: int = 0
+    dropped_rows: int = 0
 
 
 def _trace_direction(
@@ -222,6 +232,8 @@ def _trace_direction(
         rms * v for v in (settings.path.step, settings.path.max_step, settings.path.min_step)
     )
     x, h, travelled, slope_sign, slow, escapes = x0.copy(), first, 0.0, 0, 0, 0
+    rows: np.ndarray | None = None  # the independent rows, once the redundant ones are dropped
+    near_stress = 0.0  # then J's smallest singular value over its largest
     best = 1.0  # the smallest measure so far
     lowest = np.inf  # DOF 1: the smallest measure since m first fell
     while True:
@@ -254,8 +266,9 @@ def _trace_direction(
             s_star = -float(rho @ rate) / rr
             if 0 < s_star < step and np.abs(rho + s_star * rate).max() < 2 * flat_tol:
                 step = max(s_star, least)
-        y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings)
+        y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings, rows)
         tr.factorizations += nf
+        beyond = None if ok else _beyond_tolerance(cons, y, new, settings)
         if ok and mode != "descent":  # the tangent must not turn too far in one step
             chord = y - x
             ok = float(chord @ unit) > np.cos(settings.path.max_turn) * np.linalg.norm(chord)
@@ -263,8 +276,31 @@ def _trace_direction(
             h = step / 2
             if h >= least:
                 continue
+            if mode == "projection" and rows is None and _may_reduce(cons, settings):
+                assert t is not None
+                reduced = _reduce(cons, x, t, settings)
+                tr.factorizations += 1
+                if reduced is not None:  # go on by the square system of the independent rows
+                    rows, system, near_stress = reduced
+                    mode, t, h = "augmented", system.direction(t, rho), first
+                    det_sign = system.factors.det_sign
+                    tr.dropped_rows = cons.n_rows - len(rows)
+                    continue
+            if beyond is not None:  # the constraints have no solution within path_tol here
+                return (
+                    tr,
+                    PathStatus.STOPS_SHORT,
+                    (
+                        f"no rigid folding within path_tol ({settings.path.tol:g}) goes on from "
+                        f"m = {tr.measure[-1]:.3g} of the design's: a step of "
+                        f"{step / rms:.2g} mean edge lengths leaves a least-squares residual "
+                        f"of {beyond:.2g} in the constraints' near self-stress (singular value "
+                        f"{near_stress:.2g} of the largest), which no correction removes: the "
+                        "shape moves on only by straining its panels"
+                    ),
+                )
             escaped = (
-                _escape(cons, x, t, rho, first, mode, settings)
+                _escape(cons, x, t, rho, first, mode, settings, rows)
                 if escapes < settings.path.max_escapes
                 else None
             )
@@ -276,6 +312,7 @@ def _trace_direction(
                         f"the step fell below {settings.path.min_step:g} mean edge lengths at "
                         f"m = {tr.measure[-1]:.3g} of the design's"
                         + (f" ({escapes} dense steps past stalls)" if escapes else "")
+                        + _stall_reason(cons, y, new, mode, settings)
                     ),
                 )
             y, t, new, mode = escaped
@@ -358,6 +395,7 @@ def _escape(
     first: float,
     mode: str,
     settings: Settings,
+    rows: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, System, str] | None:
     """One step past the point x where the sparse continuation stalled (see
     ``Settings.path.escape_tol``): the null space N of J at x from a dense SVD; the
@@ -367,7 +405,8 @@ def _escape(
     with the pseudo-inverse truncated at ``mechanism_rank_tol``, until every constraint holds
     to ``path_tol``. Returns (the point, its direction, the factored system there, the mode:
     "projection" where the augmented matrix is singular), or None (no step converged, or more
-    than ``mechanism_second_order_vertices`` vertices)."""
+    than ``mechanism_second_order_vertices`` vertices). With ``rows`` (the independent rows)
+    the system there is made of those rows of J."""
     if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
         return None
     J, J_rho = cons.jacobian(x)
@@ -397,7 +436,7 @@ def _escape(
                     Jy, Jy_rho = cons.jacobian(y)
                     for kind in (mode, "projection"):
                         try:
-                            return y, d, System(Jy, Jy_rho, kind, d, settings), kind
+                            return y, d, System(Jy, Jy_rho, kind, d, settings, rows), kind
                         except RuntimeError:  # an exactly singular augmented matrix
                             continue
                     return None
@@ -405,6 +444,64 @@ def _escape(
                 dy = np.linalg.lstsq(A, np.r_[-c, 0.0], rcond=settings.mechanism.rank_tol)[0]
                 y = y + dy
     return None
+
+
+def _may_reduce(cons: RigidFoldingConstraints, settings: Settings) -> bool:
+    """The redundant rows of a 1-DOF shape are dropped where its projection continuation
+    stalls (``path_reduce``), up to ``mechanism_second_order_vertices`` vertices (one dense
+    SVD)."""
+    return (
+        settings.path.reduce and cons.pattern.n_vertices <= settings.mechanism.second_order_vertices
+    )
+
+
+def _reduce(
+    cons: RigidFoldingConstraints, x: np.ndarray, t: np.ndarray, settings: Settings
+) -> tuple[np.ndarray, System, float] | None:
+    """(rows (n - 1,) int, the factored ``[J_rows; t^T]`` at x, J's smallest singular value
+    over its largest there): the independent rows of the constraints of a 1-DOF shape at x
+    (:func:`rigidfold.mechanism.rigid_folding.independent_rows`) and the square augmented
+    system they make with the tangent t (n,); None where it is exactly singular."""
+    rows, sigma = independent_rows(cons.jacobian(x)[0], 1)
+    try:
+        return rows, System(*cons.jacobian(x), "augmented", t, settings, rows), sigma
+    except RuntimeError:
+        return None
+
+
+def _beyond_tolerance(
+    cons: RigidFoldingConstraints, y: np.ndarray, system: System | None, settings: Settings
+) -> float | None:
+    """Where the corrector failed at y with the square system of the independent rows: the
+    largest residual left (a float) when its correctable part is within ``path_tol`` and
+    the rest, the part in the self-stresses of the rows dropped, is not: Gauss-Newton has
+    reached the least-squares point of the constraints, and it is not within tolerance.
+    None otherwise (the corrector failed for another reason)."""
+    if system is None or system.stresses is None:
+        return None
+    c = cons.residual(y)
+    norm = float(np.abs(c).max())
+    if not np.isfinite(norm) or norm <= settings.path.tol:
+        return None
+    return norm if system.reducible_norm(c) <= settings.path.tol else None
+
+
+def _stall_reason(
+    cons: RigidFoldingConstraints,
+    y: np.ndarray,
+    system: System | None,
+    mode: str,
+    settings: Settings,
+) -> str:
+    """What the corrector's last failed attempt left at y: the residual, and (with the
+    square system of the independent rows) how much of it a correction could remove."""
+    c = np.abs(cons.residual(y))
+    if not np.isfinite(c).all():
+        return ": the corrector diverged (a triangle collapsed)"
+    where = f"{mode} system"
+    if system is not None and system.stresses is not None:
+        where += f", {system.reducible_norm(c):.1e} of it correctable: a singular point"
+    return f": the corrector's residual stayed at {c.max():.1e} ({where})"
 
 
 def trace_path(
@@ -527,4 +624,5 @@ def _result(
         ),
         max_length_error=error,
         escapes=sum(t.escapes for t in traces),
+        dropped_rows=max(t.dropped_rows for t in traces),
     )

@@ -26,6 +26,7 @@ from __future__ import annotations
 from functools import cached_property
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -152,8 +153,9 @@ class Factors:
     def __init__(self, A: sp.spmatrix) -> None:
         self.lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        return self.lu.solve(b)
+    def solve(self, b: np.ndarray, trans: str = "N") -> np.ndarray:
+        """A^-1 b (``trans`` "T": A^-T b); b (N,) or (N, k)."""
+        return self.lu.solve(b, trans=trans)
 
     @cached_property
     def det_sign(self) -> int:
@@ -186,6 +188,14 @@ class System:
     (DOF 1, self-stressed rows); "descent": ``K = [[J_rho^T J_rho + mu I, J^T], [J, -delta]]``
     (DOF > 1). :meth:`direction` is the next tangent (or Gauss-Newton direction),
     :meth:`correction` one corrector step.
+
+    ``rows`` (r,) int: the system is made of these rows of J (m, n) only, the independent
+    ones of :func:`independent_rows` (r = n - 1: ``[J_rows; t^T]`` is square). The rows
+    dropped then give a basis W (m, k) of the self-stresses at this point (k solves with
+    A^T: ``w^T J = 0`` with w = e_j on the j-th row dropped), and a correction is
+    Gauss-Newton's: it leaves the residual's part in the self-stresses, W W^T c, which no
+    step removes, and spreads it over the rows of W rather than into the dropped rows alone
+    (the least-squares residual of the linearised constraints).
     """
 
     def __init__(
@@ -195,12 +205,24 @@ class System:
         mode: str,
         t: np.ndarray | None,
         settings: Settings,
+        rows: np.ndarray | None = None,
     ) -> None:
+        self.rows, self.stresses = rows, None
+        full = J
+        if rows is not None:
+            J = sp.csc_matrix(full[rows])
         m, n = J.shape
         self.mode, self.n, self.m, self.J_rho = mode, n, m, J_rho
         if mode == "augmented":
             assert t is not None
             self.factors = Factors(sp.vstack([J, sp.csr_matrix(t[None])]))
+            if rows is not None and len(rows) < full.shape[0]:
+                dropped = np.setdiff1d(np.arange(full.shape[0]), rows)
+                Z = self.factors.solve(-full[dropped].T.toarray(), trans="T")
+                W = np.zeros((full.shape[0], len(dropped)))
+                W[rows] = Z[:-1]
+                W[dropped, np.arange(len(dropped))] = 1.0
+                self.stresses = np.linalg.qr(W)[0]
             return
         if mode == "projection":
             M = sp.identity(n, format="csc")
@@ -221,9 +243,24 @@ class System:
             d = self.factors.solve(np.concatenate([top, np.zeros(self.m)]))[: self.n]
         return d if self.mode == "descent" else d / np.linalg.norm(d)
 
+    def irreducible(self, c: np.ndarray) -> np.ndarray:
+        """(m,): the part W W^T c of the residual c (m,) in the self-stresses W of the rows
+        dropped (zeros without ``rows``): what no correction step removes."""
+        if self.stresses is None:
+            return np.zeros_like(c)
+        return self.stresses @ (self.stresses.T @ c)
+
+    def reducible_norm(self, c: np.ndarray) -> float:
+        """max |c - W W^T c|: the size of the part of the residual c (m,) a correction
+        removes (max |c| without ``rows``)."""
+        return float(np.abs(c if self.stresses is None else c - self.irreducible(c)).max())
+
     def correction(self, c: np.ndarray) -> np.ndarray:
-        """One corrector step for the residual ``c``: in the plane normal to the tangent
-        (augmented), or of least norm in the system's metric."""
+        """One corrector step for the residual ``c`` (m,) of every row: in the plane normal
+        to the tangent (augmented), or of least norm in the system's metric; with ``rows``,
+        Gauss-Newton's (see the class's text)."""
+        if self.rows is not None:
+            c = (c - self.irreducible(c))[self.rows]
         if self.mode == "augmented":
             return self.factors.solve(np.concatenate([-c, [0.0]]))
         return self.factors.solve(np.concatenate([np.zeros(self.n), -c]))[: self.n]
@@ -235,11 +272,14 @@ def correct(
     mode: str,
     t: np.ndarray | None,
     settings: Settings,
+    rows: np.ndarray | None = None,
 ) -> tuple[np.ndarray, bool, int, System | None]:
     """Corrector from the prediction y onto c = 0: chord steps on the factors of the latest
     iterate, refactored where they contract by less than ``path_contraction``; converged when
     every |c_i| <= ``path_tol`` (after at least one factorisation, which the next direction
-    needs).
+    needs). ``rows`` (r,) int: the system is made of these rows of J only (the independent
+    rows of :func:`independent_rows`, so that ``[J_rows; t^T]`` is square), but convergence
+    is still every row of c to ``path_tol``.
 
     returns (y, converged, factorizations, the last system).
     """
@@ -249,14 +289,39 @@ def correct(
         norm = float(np.abs(c).max())
         if not np.isfinite(norm):
             return y, False, factorizations, system
-        if system is None or norm > settings.path.contraction * previous:
+        # the contraction is that of the part of c a step removes (all of it without rows)
+        size = norm if system is None else system.reducible_norm(c)
+        if system is None or size > settings.path.contraction * previous:
             try:
-                system = System(*cons.jacobian(y), mode, t, settings)
+                system = System(*cons.jacobian(y), mode, t, settings, rows)
             except RuntimeError:  # an exactly singular factor
                 return y, False, factorizations, system
             factorizations += 1
+            size = system.reducible_norm(c)
         if norm <= settings.path.tol:
             return y, True, factorizations, system
-        previous = norm
+        previous = size
         y = y + system.correction(c)
     return y, False, factorizations, system
+
+
+def independent_rows(J: sp.spmatrix, dof: int) -> tuple[np.ndarray, float]:
+    """(rows (n - dof,) int sorted, J's smallest singular value over its largest): rows of
+    the constraint Jacobian J (m, n) of a shape of ``dof`` DOF that are independent, the
+    other m - (n - dof) (a basis of its self-stresses) dropped.
+
+    The self-stresses are the left singular vectors W (m, k) of the k = m - (n - dof)
+    smallest singular values of J (one dense SVD); the rows dropped are the k pivots of a
+    QR of W^T with column pivoting, so that W's rows there form a well-conditioned k x k
+    block and the rows kept span J's row space (rank n - dof). Where the constraints are
+    redundant along the path (a rigid quad cut by a fixed crease), the rows kept imply the
+    others near the path; the corrector still checks every row.
+    """
+    m, n = J.shape
+    k = m - (n - dof)
+    U, s, _ = np.linalg.svd(J.toarray(), full_matrices=True)
+    sigma = float(s[-1] / s[0]) if m >= n else 0.0
+    if k <= 0:
+        return np.arange(m), sigma
+    _, _, pivots = scipy.linalg.qr(U[:, m - k :].T, pivoting=True, mode="economic")
+    return np.setdiff1d(np.arange(m), pivots[:k]), sigma
