@@ -198,7 +198,6 @@ class FoldingPath:
             "bifurcations": len(self.bifurcations),
             "max_length_error": self.max_length_error,
             "escapes": self.escapes,
-            "dropped_rows": self.dropped_rows,
         }
 
 
