@@ -25,7 +25,9 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
   dropped (``path_reduce``: a basis W of the self-stresses from one dense SVD, the rows by
   a pivoted QR of W^T) and the trace goes on by the square ``[J_rows; t^T]``, unregularised,
   with a Gauss-Newton corrector: each step removes the residual's part outside the
-  self-stresses and leaves the part W W^T c, spread over their rows as least squares does.
+  self-stresses and leaves the part W W^T c, spread over their rows as least squares does
+  (where that stalls too, J's near flexes are held and the rows of their near self-stresses
+  dropped as well).
   Every row is still met to ``path_tol``; where the least-squares residual itself exceeds
   it (a *near* self-stress, its singular value below the rank threshold but not zero,
   strains the constraints in proportion to the distance moved), no rigid folding within
