@@ -212,3 +212,72 @@ def test_the_counters_are_stored_and_reported(tmp_path, capsys):
     assert final["rigidfold:motion"]["path"]["deploys"] is True
     html = (out / "report.html").read_text()
     assert "N_path" in html
+
+
+# DOF-1 shapes of Origami Simulator's waterbomb (195 vertices) whose paths stalled before:
+# six on the dome (a run of commit 48ded5e) and three on Bezier seed 7 (benchmarks/
+# deploy_anywhere.py, bezier:waterbomb); the test runs the six and the second of the three
+# (the others take some 8 s each)
+STALLED = [
+    *sorted((DATA / "stalled").glob("waterbomb_dome_*.npz")),
+    DATA / "stalled" / "waterbomb_bezier_1.npz",
+]
+
+
+def stalled_shape(file):
+    """A DOF-1 shape whose sparse continuation stalled (tests/data/stalled)."""
+    from rigidfold.mesh import CreasePattern
+
+    data = np.load(file)
+    shape = CreasePattern(
+        coords=data["coords"],
+        faces=data["faces"].astype(np.int64),
+        edges=data["edges"].astype(np.int64),
+        fixed=data["fixed"],
+    )
+    return shape, int(data["dof"])
+
+
+@pytest.mark.parametrize("file", STALLED, ids=[f.stem for f in STALLED])
+def test_a_path_whose_projection_continuation_stalled_ends_classified(file):
+    """Self-stressed constraints with near-singular values at the regularisation: once the
+    projection continuation stalls, the redundant rows are dropped and the square system of
+    the independent rows goes on (where it stalls too, with the near flexes held), to one
+    of the classified ends (not ``stalled``), every traced point on the constraints to
+    path_tol; a path that stops where least squares leaves a residual above path_tol says
+    so, with the near self-stress's singular value."""
+    shape, dof = stalled_shape(file)
+    path = trace_path(shape, dof=dof, support_face=default_support_face(shape))
+    assert path.status is not PathStatus.STALLED, path.message
+    assert path.dropped_rows > 0
+    assert path.max_length_error < 1e-8
+    if path.status is PathStatus.STOPS_SHORT and "least-squares residual" in path.message:
+        assert "near self-stress" in path.message  # it says why no step goes on
+
+
+def test_the_square_system_of_the_independent_rows_corrects_by_least_squares():
+    """On self-stressed constraints (a Miura-ori's rigid quads), the rows kept are
+    independent and n - 1 of them; the tangent of [J_rows; t^T] is in the null space of the
+    whole J; a correction leaves exactly the least-squares residual of the linearised
+    constraints (the part of c in the self-stresses), as dense least squares does."""
+    from rigidfold.mechanism.rigid_folding import independent_rows
+
+    shape = miura(3, 3, height=0.6)
+    cons = RigidFoldingConstraints(shape, default_support_face(shape))
+    J, J_rho = cons.jacobian(cons.x0)
+    rows, sigma = independent_rows(J, 1)
+    assert len(rows) == cons.n - 1 < cons.n_rows and sigma < DEFAULTS.mechanism.rank_tol
+    assert np.linalg.matrix_rank(J[rows].toarray()) == cons.n - 1
+    rho = cons.free_angles(cons.x0)
+    t0 = System(J, J_rho, "projection", None, DEFAULTS).direction(-(J_rho.T @ rho), rho)
+    system = System(J, J_rho, "augmented", t0, DEFAULTS, rows)
+    t = system.direction(t0, rho)
+    assert np.abs(J @ t).max() < 1e-9 and t @ t0 > 0
+    c = np.random.default_rng(2).standard_normal(cons.n_rows) * 1e-6
+    dy = system.correction(c)
+    assert abs(t0 @ dy) < 1e-12
+    A = np.vstack([J.toarray(), 1e6 * t0])  # the tangent row held (weighted)
+    best = np.linalg.lstsq(A, -np.r_[c, 0.0], rcond=None)[0]
+    left = c + J @ dy
+    assert np.allclose(left, c + J @ best, atol=1e-12)
+    assert np.allclose(left, system.irreducible(c), atol=1e-12)

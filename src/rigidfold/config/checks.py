@@ -88,6 +88,20 @@ class PathSettings(Group):
         "With DOF 1 the path stops short when this many steps in a row bring the folding "
         "measure no lower (by ``path_stall_ratio``) than its lowest so far.",
     )
+    reduce: bool = setting(
+        True,
+        "Where the projection continuation of a 1-DOF shape with self-stressed constraints "
+        "stalls (near-singular values of the constraint Jacobian at the regularisation "
+        "``path_regularization``, so its corrections are lost), drop the redundant rows "
+        "there (a basis of the self-stresses from one dense SVD, the rows by a pivoted QR of "
+        "it) and go on by pseudo-arclength continuation on the square system of the "
+        "independent rows and the tangent, unregularised, with a Gauss-Newton corrector (the "
+        "residual's part in the self-stresses is left, spread by least squares); where that "
+        "stalls too, J's near flexes (``path_escape_tol``) are held and their near "
+        "self-stresses' rows dropped as well. Every row is still met to ``path_tol``: where "
+        "the least-squares residual exceeds it, the path stops short there. Up to "
+        "``mechanism_second_order_vertices`` vertices.",
+    )
     escape_tol: float = setting(
         1e-6,
         "Where the sparse continuation stalls (the step halved below ``path_min_step``: a "

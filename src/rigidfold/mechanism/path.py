@@ -20,7 +20,18 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
   meet); where m comes no lower for ``path_wander_steps`` steps (the path *stops short*); when
   the budget runs out; or when the step does, and then the other direction from the design is
   traced too. A sign change of ``det [J; t^T]`` is a bifurcation point, which the
-  trace passes on its branch and records.
+  trace passes on its branch and records. Where the projection form stalls (near-singular
+  values of J at its regularisation delta lose the corrections), the redundant rows are
+  dropped (``path_reduce``: a basis W of the self-stresses from one dense SVD, the rows by
+  a pivoted QR of W^T) and the trace goes on by the square ``[J_rows; t^T]``, unregularised,
+  with a Gauss-Newton corrector: each step removes the residual's part outside the
+  self-stresses and leaves the part W W^T c, spread over their rows as least squares does
+  (where that stalls too, J's near flexes are held and the rows of their near self-stresses
+  dropped as well).
+  Every row is still met to ``path_tol``; where the least-squares residual itself exceeds
+  it (a *near* self-stress, its singular value below the rank threshold but not zero,
+  strains the constraints in proportion to the distance moved), no rigid folding within
+  tolerance goes on and the path *stops short* there, its message says so.
 * **DOF > 1** (or self-stressed constraints): the path is the one closest to the straight
   line in fold angles: each step moves along the Gauss-Newton direction d that takes the
   free fold angles rho towards 0 within the mechanism, ``min |rho + J_rho d|^2 + mu |d|^2``
@@ -45,8 +56,15 @@ import scipy.sparse as sp
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.frame.model import default_support_face
+from rigidfold.mechanism import rigid_folding
 from rigidfold.mechanism.analysis import analyze
-from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System, correct
+from rigidfold.mechanism.rigid_folding import (
+    RigidFoldingConstraints,
+    System,
+    correct,
+    independent_rows,
+    rows_without_stresses,
+)
 from rigidfold.mesh import CreasePattern
 from rigidfold.status import Outcome
 
@@ -89,6 +107,8 @@ class FoldingPath:
     max_length_error : largest |l - l0| / l0 over all points and edges
     escapes : dense steps past points where the sparse continuation stalled
         (``Settings.path.escape_tol``: singular and bifurcation points)
+    dropped_rows : redundant constraint rows dropped where the projection continuation of a
+        1-DOF shape stalled (``Settings.path.reduce``; 0: none)
     """
 
     points: np.ndarray
@@ -106,6 +126,7 @@ class FoldingPath:
     factorizations: int
     max_length_error: float
     escapes: int = 0
+    dropped_rows: int = 0
 
     @property
     def deploys(self) -> bool:
@@ -196,6 +217,7 @@ class _Trace:
     steps: int = 0
     factorizations: int = 0
     escapes: int = 0
+    dropped_rows: int = 0
 
 
 def _trace_direction(
@@ -222,6 +244,9 @@ def _trace_direction(
         rms * v for v in (settings.path.step, settings.path.max_step, settings.path.min_step)
     )
     x, h, travelled, slope_sign, slow, escapes = x0.copy(), first, 0.0, 0, 0, 0
+    rows: np.ndarray | None = None  # the independent rows, once the redundant ones are dropped
+    frozen: np.ndarray | None = None  # near flexes held, once their near stresses are dropped
+    near_stress = 0.0  # then J's smallest singular value over its largest
     best = 1.0  # the smallest measure so far
     lowest = np.inf  # DOF 1: the smallest measure since m first fell
     while True:
@@ -254,8 +279,9 @@ def _trace_direction(
             s_star = -float(rho @ rate) / rr
             if 0 < s_star < step and np.abs(rho + s_star * rate).max() < 2 * flat_tol:
                 step = max(s_star, least)
-        y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings)
+        y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings, rows, frozen)
         tr.factorizations += nf
+        beyond = None if ok else _beyond_tolerance(cons, y, new, settings)
         if ok and mode != "descent":  # the tangent must not turn too far in one step
             chord = y - x
             ok = float(chord @ unit) > np.cos(settings.path.max_turn) * np.linalg.norm(chord)
@@ -263,8 +289,41 @@ def _trace_direction(
             h = step / 2
             if h >= least:
                 continue
+            if mode == "projection" and rows is None and _may_reduce(cons, settings):
+                assert t is not None
+                reduced = _reduce(cons, x, t, settings)
+                tr.factorizations += 1
+                if reduced is not None:  # go on by the square system of the independent rows
+                    rows, system, near_stress = reduced
+                    mode, t, h = "augmented", system.direction(t, rho), first
+                    det_sign = system.factors.det_sign
+                    tr.dropped_rows = cons.n_rows - len(rows)
+                    continue
+            if mode == "augmented" and rows is not None and frozen is None and beyond is None:
+                assert t is not None
+                held = _hold_near_flexes(cons, x, t, settings)
+                tr.factorizations += 1
+                if held is not None:  # go on with the near self-stresses' rows dropped too
+                    rows, frozen, system, near_stress = held
+                    t, h = system.direction(t, rho), first
+                    det_sign = system.factors.det_sign
+                    tr.dropped_rows = cons.n_rows - len(rows)
+                    continue
+            if beyond is not None:  # the constraints have no solution within path_tol here
+                return (
+                    tr,
+                    PathStatus.STOPS_SHORT,
+                    (
+                        f"no rigid folding within path_tol ({settings.path.tol:g}) goes on from "
+                        f"m = {tr.measure[-1]:.3g} of the design's: a step of "
+                        f"{step / rms:.2g} mean edge lengths leaves a least-squares residual "
+                        f"of {beyond:.2g} in the constraints' near self-stress (singular value "
+                        f"{near_stress:.2g} of the largest), which no correction removes: the "
+                        "shape moves on only by straining its panels"
+                    ),
+                )
             escaped = (
-                _escape(cons, x, t, rho, first, mode, settings)
+                _escape(cons, x, t, rho, first, mode, settings, rows, frozen)
                 if escapes < settings.path.max_escapes
                 else None
             )
@@ -276,9 +335,12 @@ def _trace_direction(
                         f"the step fell below {settings.path.min_step:g} mean edge lengths at "
                         f"m = {tr.measure[-1]:.3g} of the design's"
                         + (f" ({escapes} dense steps past stalls)" if escapes else "")
+                        + _stall_reason(cons, y, new, mode, settings)
                     ),
                 )
             y, t, new, mode = escaped
+            if new.rows is not None and rows is None:
+                rows, tr.dropped_rows = new.rows, cons.n_rows - len(new.rows)
             escapes, step, nf = escapes + 1, first, 1
             tr.escapes += 1
         assert new is not None
@@ -358,33 +420,59 @@ def _escape(
     first: float,
     mode: str,
     settings: Settings,
+    rows: np.ndarray | None = None,
+    frozen: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, System, str] | None:
     """One step past the point x where the sparse continuation stalled (see
     ``Settings.path.escape_tol``): the null space N of J at x from a dense SVD; the
-    directions tried are the last tangent's part in N (the branch continued) and the part of
-    the steepest descent of the folding measure (a branch towards flat); each step of
-    ``first``, a quarter, a sixteenth, corrected by Gauss-Newton in the plane normal to it
-    with the pseudo-inverse truncated at ``mechanism_rank_tol``, until every constraint holds
-    to ``path_tol``. Returns (the point, its direction, the factored system there, the mode:
-    "projection" where the augmented matrix is singular), or None (no step converged, or more
-    than ``mechanism_second_order_vertices`` vertices)."""
+    directions tried are the last tangent's part in N (the branch continued), where N is a
+    plane the branches of the bifurcation equation in it (see :func:`_branches`: branch
+    switching), and the part of the steepest descent of the folding measure (a branch
+    towards flat); each step of ``first``, a quarter, a sixteenth. A 1-DOF trace corrects it
+    by the square system ``[J_rows; d^T]`` of the independent rows (dropped here if the
+    constraints are self-stressed and ``rows`` is None) with the Gauss-Newton corrector of
+    :func:`rigidfold.mechanism.rigid_folding.correct`; a trace of more DOF by Gauss-Newton
+    with the pseudo-inverse truncated at ``mechanism_rank_tol``; until every constraint
+    holds to ``path_tol``. Returns (the point, its direction, the factored system there, the
+    mode: "projection" where the augmented matrix is singular), or None (no step converged,
+    or more than ``mechanism_second_order_vertices`` vertices)."""
     if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
         return None
     J, J_rho = cons.jacobian(x)
-    _, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
+    U, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
     values = np.zeros(cons.n)
     values[: len(s)] = s
-    N = vt[values <= settings.path.escape_tol * values[0]].T
+    small = values <= settings.path.escape_tol * values[0]
+    N = vt[small].T
     if not N.shape[1]:
         return None
+    square = mode != "descent"
     tries = [] if t is None else [N @ (N.T @ t)]
+    if square and N.shape[1] == 2:
+        stresses = np.hstack([U[:, : len(s)][:, small[: len(s)]], U[:, len(s) :]])
+        tries += _branches(cons, x, N, stresses, rho, settings)
     tries.append(N @ (N.T @ -(J_rho.T @ rho)))
+    if square and rows is None and cons.n_rows > cons.n - 1:
+        rows = rows_without_stresses(U, cons.n, 1)
+    wide = settings.with_(path_corrector_iter=3 * settings.path.corrector_iter)
+    done: list[np.ndarray] = []
     for d in tries:
         size = float(np.linalg.norm(d))
         if not size > 0:
             continue
         d = d / size
+        if any(float(d @ e) > math.cos(settings.path.max_turn) for e in done):
+            continue  # tried already
+        done.append(d)
         for h in (first, first / 4, first / 16):
+            if square:
+                # the module's corrector (the continuation's, ``correct``, may be swapped)
+                y, ok, _, system = rigid_folding.correct(
+                    cons, x + h * d, "augmented", d, wide, rows, frozen
+                )
+                if ok and system is not None and float((y - x) @ d) > 0.5 * h:
+                    return y, d, system, "augmented"
+                continue
             y = x + h * d
             for _ in range(3 * settings.path.corrector_iter):
                 c = cons.residual(y)
@@ -397,7 +485,7 @@ def _escape(
                     Jy, Jy_rho = cons.jacobian(y)
                     for kind in (mode, "projection"):
                         try:
-                            return y, d, System(Jy, Jy_rho, kind, d, settings), kind
+                            return y, d, System(Jy, Jy_rho, kind, d, settings, rows), kind
                         except RuntimeError:  # an exactly singular augmented matrix
                             continue
                     return None
@@ -405,6 +493,126 @@ def _escape(
                 dy = np.linalg.lstsq(A, np.r_[-c, 0.0], rcond=settings.mechanism.rank_tol)[0]
                 y = y + dy
     return None
+
+
+def _branches(
+    cons: RigidFoldingConstraints,
+    x: np.ndarray,
+    N: np.ndarray,
+    W: np.ndarray,
+    rho: np.ndarray,
+    settings: Settings,
+) -> list[np.ndarray]:
+    """Branch directions (n,) at a simple bifurcation point x: N (n, 2) spans the null space
+    of J there, W (m, k) its (near) self-stresses; a branch leaves x along d in N with
+    ``w^T c''(d, d) = 0`` for every stress w (the algebraic bifurcation equation, Allgower &
+    Georg ch. 8), c'' by central differences of J along N (step sqrt(``path_tol``), so that
+    its error is of the order of the tolerance). The roots are the deepest minima of the sum
+    of squares over half a circle of directions (a degree apart); each is returned with both
+    signs, those that lower the folding measure first."""
+    eps = math.sqrt(settings.path.tol)
+    D = []
+    for j in range(2):
+        Jp = cons.jacobian(x + eps * N[:, j])[0]
+        Jm = cons.jacobian(x - eps * N[:, j])[0]
+        D.append(W.T @ ((Jp - Jm) @ N) / (2 * eps))  # (k, 2): w^T c''(n_i, n_j)
+    Q = np.stack([np.column_stack([D[0][:, i], D[1][:, i]]) for i in range(2)], axis=1)
+    Q = (Q + Q.transpose(0, 2, 1)) / 2  # (k, 2, 2)
+    theta = np.radians(np.arange(180.0))
+    a = np.stack([np.cos(theta), np.sin(theta)])  # (2, 180)
+    f = (np.einsum("ia,kij,ja->ka", a, Q, a) ** 2).sum(axis=0)
+    minima = np.flatnonzero((f <= np.roll(f, 1)) & (f <= np.roll(f, -1)))
+    best = minima[np.argsort(f[minima])][:2]
+    out = [sign * (N @ a[:, i]) for i in best for sign in (1.0, -1.0)]
+    J_rho = cons.jacobian(x)[1]
+    return sorted(out, key=lambda d: float(rho @ (J_rho @ d)))
+
+
+def _may_reduce(cons: RigidFoldingConstraints, settings: Settings) -> bool:
+    """The redundant rows of a 1-DOF shape are dropped where its projection continuation
+    stalls (``path_reduce``), up to ``mechanism_second_order_vertices`` vertices (one dense
+    SVD)."""
+    return (
+        settings.path.reduce and cons.pattern.n_vertices <= settings.mechanism.second_order_vertices
+    )
+
+
+def _reduce(
+    cons: RigidFoldingConstraints, x: np.ndarray, t: np.ndarray, settings: Settings
+) -> tuple[np.ndarray, System, float] | None:
+    """(rows (n - 1,) int, the factored ``[J_rows; t^T]`` at x, J's smallest singular value
+    over its largest there): the independent rows of the constraints of a 1-DOF shape at x
+    (:func:`rigidfold.mechanism.rigid_folding.independent_rows`) and the square augmented
+    system they make with the tangent t (n,); None where it is exactly singular."""
+    rows, sigma = independent_rows(cons.jacobian(x)[0], 1)
+    try:
+        return rows, System(*cons.jacobian(x), "augmented", t, settings, rows), sigma
+    except RuntimeError:
+        return None
+
+
+def _hold_near_flexes(
+    cons: RigidFoldingConstraints, x: np.ndarray, t: np.ndarray, settings: Settings
+) -> tuple[np.ndarray, np.ndarray, System, float] | None:
+    """Where the square system of the independent rows stalls too, at x: J's near flexes
+    there (right singular vectors of singular values below ``path_escape_tol`` of the
+    largest, but for the smallest, the path's own) are held, ``frozen`` (n, k), and the rows
+    of their near self-stresses dropped as well (``[J_rows; frozen^T; t^T]`` square): their
+    residual is then left to the Gauss-Newton corrector's least squares and checked
+    against ``path_tol`` like that of the exact self-stresses, rather than removed by
+    moves of residual / sigma along the near flexes, which Newton's method cannot make.
+    Returns (rows, frozen, the factored system at x, the largest such singular value over
+    the largest one), or None (no near flex, an exactly singular system, or more than
+    ``mechanism_second_order_vertices`` vertices)."""
+    if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
+        return None
+    J, J_rho = cons.jacobian(x)
+    U, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
+    near = np.flatnonzero(s[:-1] <= settings.path.escape_tol * s[0])
+    if not len(near):
+        return None
+    frozen = vt[near].T
+    rows = rows_without_stresses(U, cons.n, 1 + len(near))
+    try:
+        system = System(J, J_rho, "augmented", t, settings, rows, frozen)
+    except RuntimeError:
+        return None
+    return rows, frozen, system, float(s[near].max() / s[0])
+
+
+def _beyond_tolerance(
+    cons: RigidFoldingConstraints, y: np.ndarray, system: System | None, settings: Settings
+) -> float | None:
+    """Where the corrector failed at y with the square system of the independent rows: the
+    largest residual left (a float) when its correctable part is within ``path_tol`` and
+    the rest, the part in the self-stresses of the rows dropped, is not: Gauss-Newton has
+    reached the least-squares point of the constraints, and it is not within tolerance.
+    None otherwise (the corrector failed for another reason)."""
+    if system is None or system.stresses is None:
+        return None
+    c = cons.residual(y)
+    norm = float(np.abs(c).max())
+    if not np.isfinite(norm) or norm <= settings.path.tol:
+        return None
+    return norm if system.reducible_norm(c) <= settings.path.tol else None
+
+
+def _stall_reason(
+    cons: RigidFoldingConstraints,
+    y: np.ndarray,
+    system: System | None,
+    mode: str,
+    settings: Settings,
+) -> str:
+    """What the corrector's last failed attempt left at y: the residual, and (with the
+    square system of the independent rows) how much of it a correction could remove."""
+    c = np.abs(cons.residual(y))
+    if not np.isfinite(c).all():
+        return ": the corrector diverged (a triangle collapsed)"
+    where = f"{mode} system"
+    if system is not None and system.stresses is not None:
+        where += f", {system.reducible_norm(c):.1e} of it correctable: a singular point"
+    return f": the corrector's residual stayed at {c.max():.1e} ({where})"
 
 
 def trace_path(
@@ -527,4 +735,5 @@ def _result(
         ),
         max_length_error=error,
         escapes=sum(t.escapes for t in traces),
+        dropped_rows=max(t.dropped_rows for t in traces),
     )

@@ -8,7 +8,9 @@ pattern built once, in coordinates scaled by the mean edge length; :class:`Syste
 
 * ``"augmented"``: ``A = [J; t^T]`` for a 1-DOF shape (J has 3V - 1 independent rows): its
   solve with ``e_n`` is the next tangent, with ``[-c; 0]`` a pseudo-arclength correction, and
-  the sign of det A tells a bifurcation (Allgower & Georg, ch. 2 and 8);
+  the sign of det A tells a bifurcation (Allgower & Georg, ch. 2 and 8); a self-stressed J
+  takes this form too with its redundant rows dropped (:func:`independent_rows`), and then
+  a Gauss-Newton correction (see :class:`System`);
 * ``"projection"``: ``K = [[I, J^T], [J, -delta I]]`` for a 1-DOF shape whose constraints
   are self-stressed (redundant rows, as a Miura-ori's rigid quads): the tangent is the
   projection of the last one onto the null space of J, the correction of least norm;
@@ -26,6 +28,7 @@ from __future__ import annotations
 from functools import cached_property
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -99,7 +102,7 @@ class RigidFoldingConstraints:
         X = x.reshape(-1, 3)
         e = self.pattern.edges
         length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             rho_fixed = fold_angle_gradients(X[self.fixed_stencils])[0]
         return np.concatenate(
             [length - self.L0, rho_fixed - self.rho_fixed0, self._gauge(x) - self.gauge0]
@@ -107,7 +110,7 @@ class RigidFoldingConstraints:
 
     def free_angles(self, x: np.ndarray) -> np.ndarray:
         """The free creases' fold angles (n_free,) at x, radians."""
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             return fold_angle_gradients(x.reshape(-1, 3)[self.free_stencils])[0]
 
     def jacobian(self, x: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
@@ -117,7 +120,7 @@ class RigidFoldingConstraints:
         e = self.pattern.edges
         d = X[e[:, 1]] - X[e[:, 0]]
         u = d / np.linalg.norm(d, axis=1)[:, None]
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             grad_fixed = fold_angle_gradients(X[self.fixed_stencils])[1]
             grad_free = fold_angle_gradients(X[self.free_stencils])[1]
         J = self._J.fill(
@@ -152,8 +155,9 @@ class Factors:
     def __init__(self, A: sp.spmatrix) -> None:
         self.lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        return self.lu.solve(b)
+    def solve(self, b: np.ndarray, trans: str = "N") -> np.ndarray:
+        """A^-1 b (``trans`` "T": A^-T b); b (N,) or (N, k)."""
+        return self.lu.solve(b, trans=trans)
 
     @cached_property
     def det_sign(self) -> int:
@@ -186,6 +190,16 @@ class System:
     (DOF 1, self-stressed rows); "descent": ``K = [[J_rho^T J_rho + mu I, J^T], [J, -delta]]``
     (DOF > 1). :meth:`direction` is the next tangent (or Gauss-Newton direction),
     :meth:`correction` one corrector step.
+
+    ``rows`` (r,) int: the system is made of these rows of J (m, n) only, the independent
+    ones of :func:`independent_rows` (r = n - 1: ``[J_rows; t^T]`` is square); ``frozen``
+    (n, n - 1 - r): directions held in the augmented system besides t,
+    ``[J_rows; frozen^T; t^T]`` (near flexes whose near self-stresses' rows are dropped). The rows
+    dropped then give a basis W (m, k) of the self-stresses at this point (k solves with
+    A^T: ``w^T J = 0`` with w = e_j on the j-th row dropped), and a correction is
+    Gauss-Newton's: it leaves the residual's part in the self-stresses, W W^T c, which no
+    step removes, and spreads it over the rows of W rather than into the dropped rows alone
+    (the least-squares residual of the linearised constraints).
     """
 
     def __init__(
@@ -195,12 +209,26 @@ class System:
         mode: str,
         t: np.ndarray | None,
         settings: Settings,
+        rows: np.ndarray | None = None,
+        frozen: np.ndarray | None = None,
     ) -> None:
+        self.rows, self.stresses = rows, None
+        full = J
+        if rows is not None:
+            J = sp.csc_matrix(full[rows])
         m, n = J.shape
         self.mode, self.n, self.m, self.J_rho = mode, n, m, J_rho
         if mode == "augmented":
             assert t is not None
-            self.factors = Factors(sp.vstack([J, sp.csr_matrix(t[None])]))
+            extra = t[None] if frozen is None else np.vstack([frozen.T, t[None]])
+            self.factors = Factors(sp.vstack([J, sp.csr_matrix(extra)]))
+            if rows is not None and len(rows) < full.shape[0]:
+                dropped = np.setdiff1d(np.arange(full.shape[0]), rows)
+                Z = self.factors.solve(-full[dropped].T.toarray(), trans="T")
+                W = np.zeros((full.shape[0], len(dropped)))
+                W[rows] = Z[: len(rows)]
+                W[dropped, np.arange(len(dropped))] = 1.0
+                self.stresses = np.linalg.qr(W)[0]
             return
         if mode == "projection":
             M = sp.identity(n, format="csc")
@@ -221,11 +249,26 @@ class System:
             d = self.factors.solve(np.concatenate([top, np.zeros(self.m)]))[: self.n]
         return d if self.mode == "descent" else d / np.linalg.norm(d)
 
+    def irreducible(self, c: np.ndarray) -> np.ndarray:
+        """(m,): the part W W^T c of the residual c (m,) in the self-stresses W of the rows
+        dropped (zeros without ``rows``): what no correction step removes."""
+        if self.stresses is None:
+            return np.zeros_like(c)
+        return self.stresses @ (self.stresses.T @ c)
+
+    def reducible_norm(self, c: np.ndarray) -> float:
+        """max |c - W W^T c|: the size of the part of the residual c (m,) a correction
+        removes (max |c| without ``rows``)."""
+        return float(np.abs(c if self.stresses is None else c - self.irreducible(c)).max())
+
     def correction(self, c: np.ndarray) -> np.ndarray:
-        """One corrector step for the residual ``c``: in the plane normal to the tangent
-        (augmented), or of least norm in the system's metric."""
+        """One corrector step for the residual ``c`` (m,) of every row: in the plane normal
+        to the tangent (augmented), or of least norm in the system's metric; with ``rows``,
+        Gauss-Newton's (see the class's text)."""
+        if self.rows is not None:
+            c = (c - self.irreducible(c))[self.rows]
         if self.mode == "augmented":
-            return self.factors.solve(np.concatenate([-c, [0.0]]))
+            return self.factors.solve(np.concatenate([-c, np.zeros(self.n - len(c))]))
         return self.factors.solve(np.concatenate([np.zeros(self.n), -c]))[: self.n]
 
 
@@ -235,11 +278,15 @@ def correct(
     mode: str,
     t: np.ndarray | None,
     settings: Settings,
+    rows: np.ndarray | None = None,
+    frozen: np.ndarray | None = None,
 ) -> tuple[np.ndarray, bool, int, System | None]:
     """Corrector from the prediction y onto c = 0: chord steps on the factors of the latest
     iterate, refactored where they contract by less than ``path_contraction``; converged when
     every |c_i| <= ``path_tol`` (after at least one factorisation, which the next direction
-    needs).
+    needs). ``rows`` (r,) int: the system is made of these rows of J only (the independent
+    rows of :func:`independent_rows`, so that ``[J_rows; t^T]`` is square), but convergence
+    is still every row of c to ``path_tol``; ``frozen``: see :class:`System`.
 
     returns (y, converged, factorizations, the last system).
     """
@@ -249,14 +296,46 @@ def correct(
         norm = float(np.abs(c).max())
         if not np.isfinite(norm):
             return y, False, factorizations, system
-        if system is None or norm > settings.path.contraction * previous:
+        # the contraction is that of the part of c a step removes (all of it without rows)
+        size = norm if system is None else system.reducible_norm(c)
+        if system is None or size > settings.path.contraction * previous:
             try:
-                system = System(*cons.jacobian(y), mode, t, settings)
+                system = System(*cons.jacobian(y), mode, t, settings, rows, frozen)
             except RuntimeError:  # an exactly singular factor
                 return y, False, factorizations, system
             factorizations += 1
+            size = system.reducible_norm(c)
         if norm <= settings.path.tol:
             return y, True, factorizations, system
-        previous = norm
+        previous = size
         y = y + system.correction(c)
     return y, False, factorizations, system
+
+
+def independent_rows(J: sp.spmatrix, dof: int) -> tuple[np.ndarray, float]:
+    """(rows (n - dof,) int sorted, J's smallest singular value over its largest): rows of
+    the constraint Jacobian J (m, n) of a shape of ``dof`` DOF that are independent, the
+    other m - (n - dof) (a basis of its self-stresses) dropped.
+
+    The self-stresses are the left singular vectors W (m, k) of the k = m - (n - dof)
+    smallest singular values of J (one dense SVD); the rows dropped are the k pivots of a
+    QR of W^T with column pivoting, so that W's rows there form a well-conditioned k x k
+    block and the rows kept span J's row space (rank n - dof). Where the constraints are
+    redundant along the path (a rigid quad cut by a fixed crease), the rows kept imply the
+    others near the path; the corrector still checks every row.
+    """
+    m, n = J.shape
+    U, s, _ = np.linalg.svd(J.toarray(), full_matrices=True)
+    sigma = float(s[-1] / s[0]) if m >= n else 0.0
+    return rows_without_stresses(U, n, dof), sigma
+
+
+def rows_without_stresses(U: np.ndarray, n: int, dof: int) -> np.ndarray:
+    """(n - dof,) int, sorted: the rows kept by :func:`independent_rows`, from the left
+    singular vectors U (m, m) of J (m, n), in the order of decreasing singular values."""
+    m = U.shape[0]
+    k = m - (n - dof)
+    if k <= 0:
+        return np.arange(m)
+    _, _, pivots = scipy.linalg.qr(U[:, m - k :].T, pivoting=True, mode="economic")
+    return np.setdiff1d(np.arange(m), pivots[:k])
