@@ -32,6 +32,7 @@ from rigidfold.develop import develop
 from rigidfold.exports.design import read_design
 from rigidfold.fabricate import Panels, design_motion, fabricate_panels
 from rigidfold.fabricate.cutsheets import (
+    Stock,
     nest,
     nest_boxes,
     nest_by_outlines,
@@ -100,13 +101,13 @@ def main() -> None:
                 f"{fab.relief_rounds} relief rounds)"
             )
             items = parts(fab)
-            t_boxes, boxes = timed(lambda i=items: nest_boxes(i, *SHEET, GAP), args.repeat)
+            t_boxes, boxes = timed(lambda i=items: nest_boxes(i, Stock(*SHEET, GAP)), args.repeat)
             on_stock = {p.part.panel for s in boxes if not s.oversize for p in s.parts}
             fitting = [p for p in items if p.panel in on_stock]
             t_outlines, outlines = timed(
-                lambda i=fitting: nest_by_outlines(i, *SHEET, GAP), args.repeat
+                lambda i=fitting: nest_by_outlines(i, Stock(*SHEET, GAP)), args.repeat
             )
-            kept = sheets_summary(nest(items, *SHEET, GAP))
+            kept = sheets_summary(nest(items, Stock(*SHEET, GAP)))
             print(
                 f"  nest      {t * 1e3:3g} mm boxes {t_boxes:5.2f} s ({len(on_stock)} parts on "
                 f"{sum(not s.oversize for s in boxes)} sheets), outlines {t_outlines:5.2f} s "

@@ -53,7 +53,7 @@ def bench(run: Path, repeat: int) -> None:
         )
         times.append(time.perf_counter() - t0)
         cpu.append(_cpu() - c0)
-    summary = load_run(run).summary.document  # run files are read through rigidfold.run
+    summary = load_run(run).summary.to_dict()  # run files are read through rigidfold.run
     case = summary["case"]
     fields = [
         f"report of {case['pattern']} on {case['surface']['name']}: "

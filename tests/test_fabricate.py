@@ -231,24 +231,24 @@ def test_nesting_keeps_the_gap(built):
     gap between them and from the sheet's edges, are turned and never mirrored, and every
     panel is placed once; the sheets kept are no more than the boxes take, and the same
     every time."""
-    from rigidfold.fabricate.cutsheets import nest, nest_boxes, nest_by_outlines, parts
+    from rigidfold.fabricate.cutsheets import Stock, nest, nest_boxes, nest_by_outlines, parts
     from test_fabricate_nesting import check_nesting
 
     fab = built["result"].fabrication
     items = parts(fab)
-    sheets = nest(items, 2440, 1220, 10)
+    sheets = nest(items, Stock(2440, 1220, 10))
     placed = sorted(p.part.panel for s in sheets for p in s.parts)
     assert placed == list(range(fab.panels.n))
     check_nesting(sheets, items, 2440, 1220, 10)
-    boxes = nest_boxes(items, 2440, 1220, 10)
+    boxes = nest_boxes(items, Stock(2440, 1220, 10))
     check_nesting(boxes, items, 2440, 1220, 10)
     on_stock = {p.part.panel for s in boxes if not s.oversize for p in s.parts}
     fitting = [p for p in items if p.panel in on_stock]  # not the oversize ones
-    outlines = nest_by_outlines(fitting, 2440, 1220, 10)
+    outlines = nest_by_outlines(fitting, Stock(2440, 1220, 10))
     assert outlines is not None
     check_nesting(outlines, fitting, 2440, 1220, 10)
     assert sum(not s.oversize for s in sheets) <= sum(not s.oversize for s in boxes)
-    again = nest(items, 2440, 1220, 10)
+    again = nest(items, Stock(2440, 1220, 10))
     assert [[(p.part.panel, p.cut.wkt) for p in s.parts] for s in again] == [
         [(p.part.panel, p.cut.wkt) for p in s.parts] for s in sheets
     ]

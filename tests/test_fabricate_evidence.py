@@ -309,14 +309,14 @@ def test_sheets_have_a_legend_and_labels_apart(large):
     and its number) do not overlap, each edge's along its edge."""
     import shapely
 
-    from rigidfold.fabricate.cutsheets import _label_box, nest, parts
+    from rigidfold.fabricate.cutsheets import Stock, _label_box, nest, parts
 
     fab, files = large
     for path in files:
         if path.suffix == ".svg":
             text = path.read_text()
             assert 'id="LEGEND"' in text and "far face" in text and " mm</text>" in text
-    for sheet in nest(parts(fab), 2440, 1220, 10):
+    for sheet in nest(parts(fab), Stock(2440, 1220, 10)):
         for placed in sheet.parts:
             boxes = [_label_box(lab) for lab in placed.labels]
             mark = placed.part.mark

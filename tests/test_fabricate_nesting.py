@@ -15,6 +15,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.cutsheets import (
     Label,
     Part,
+    Stock,
     _fit,
     nest,
     nest_boxes,
@@ -85,13 +86,13 @@ def triangles():
 
 
 def test_outlines_use_fewer_sheets_than_boxes(triangles):
-    boxes = nest_boxes(triangles, W, H, GAP)
-    outlines = nest_by_outlines(triangles, W, H, GAP)
+    boxes = nest_boxes(triangles, Stock(W, H, GAP))
+    outlines = nest_by_outlines(triangles, Stock(W, H, GAP))
     assert outlines is not None
     check_nesting(outlines, triangles)
     check_nesting(boxes, triangles)
     assert len(outlines) < len(boxes)
-    kept = nest(triangles, W, H, GAP)
+    kept = nest(triangles, Stock(W, H, GAP))
     assert _placements(kept) == _placements(outlines)
     summary = sheets_summary(kept)
     assert summary["nested_by"] == "outlines" and summary["sheets"] == len(outlines)
@@ -102,9 +103,9 @@ def test_nesting_is_deterministic(triangles):
         _part(30 + k, [(0, 0), (200 + 90 * k, 0), (200 + 90 * k, 150 + 40 * k), (0, 300)])
         for k in range(8)
     ]
-    first = nest(mixed, W, H, GAP)
+    first = nest(mixed, Stock(W, H, GAP))
     check_nesting(first, mixed)
-    assert _placements(first) == _placements(nest(mixed, W, H, GAP))
+    assert _placements(first) == _placements(nest(mixed, Stock(W, H, GAP)))
 
 
 def test_concave_parts_and_oversize(triangles):
@@ -113,18 +114,18 @@ def test_concave_parts_and_oversize(triangles):
     ell = [(0, 0), (900, 0), (900, 200), (200, 200), (200, 700), (0, 700)]
     big = [(0, 0), (3000, 0), (3000, 500), (0, 500)]
     items = [_part(k, ell) for k in range(5)] + triangles[:4] + [_part(99, big)]
-    sheets = nest(items, W, H, GAP)
+    sheets = nest(items, Stock(W, H, GAP))
     check_nesting(sheets, items)
     assert [p.part.panel for s in sheets if s.oversize for p in s.parts] == [99]
     stock = [s for s in sheets if not s.oversize]
-    assert len(stock) <= len([s for s in nest_boxes(items, W, H, GAP) if not s.oversize])
+    assert len(stock) <= len([s for s in nest_boxes(items, Stock(W, H, GAP)) if not s.oversize])
     assert len(convex_pieces(items[0].cut, DEFAULTS.fabricate.nest_concavity)) > 1
 
 
 def test_nest_parts_zero_keeps_the_boxes(triangles):
     settings = DEFAULTS.with_(fabricate_nest_parts=0)
-    kept = nest(triangles, W, H, GAP, settings=settings)
-    assert _placements(kept) == _placements(nest_boxes(triangles, W, H, GAP))
+    kept = nest(triangles, Stock(W, H, GAP), settings=settings)
+    assert _placements(kept) == _placements(nest_boxes(triangles, Stock(W, H, GAP)))
     assert sheets_summary(kept)["nested_by"] == "boxes"
 
 

@@ -8,11 +8,11 @@ import json
 import numpy as np
 import pytest
 
-from rigidfold.generate import GenerateOptions
+from rigidfold.generate import GenerateOptions, Generation
 from rigidfold.io import FRACTION_KEY, motion_frames, read_frames
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns import pattern1
-from rigidfold.run import SolutionRecord, Stage, aggregate
+from rigidfold.run import RunSummary, SolutionRecord, Stage, aggregate
 
 
 def _record(development="converged", motion=None, deformation=None) -> SolutionRecord:
@@ -67,6 +67,32 @@ def test_record_round_trip_and_aggregate():
     assert figures["deformation"]["reached_plane"] == 1
     assert figures["motion"]["traced"] == 1
     assert figures["development"]["max_D"] == pytest.approx(1e-9)
+
+
+def test_summary_is_written_and_read_through_one_record():
+    """summary.json is RunSummary.to_dict (every key of the run's own to_dict kept, the
+    run-wide figures before per_solution) and reads back to the same content."""
+    records = [_record(motion="ok", deformation="reached_plane"), _record()]
+    summary = RunSummary.from_run(
+        Generation(),
+        records,
+        stage_times={"develop": 1.5},
+        options={"target_dof": 1},
+        case={"F_tol": 1e-7},
+        solutions=("solutions/a.fold", "solutions/b.fold"),
+        exports=("final/b.obj",),
+    )
+    data = summary.to_dict()
+    assert set(Generation().to_dict()) <= set(data)
+    assert data["time_s"]["develop"] == 1.5 and data["N_lock"] == 0
+    keys = list(data)
+    assert keys[0] == "schema_version"
+    assert keys.index("structure") + 1 == keys.index("per_solution")
+    assert {k: data[k] for k in aggregate(records)} == aggregate(records)
+    text = json.loads(json.dumps(data))
+    again = RunSummary.from_dict(text, "summary.json")
+    assert again.to_dict() == text
+    assert again.per_solution == tuple(records) and again.solutions == summary.solutions
 
 
 def test_generate_options_validate_and_round_trip():

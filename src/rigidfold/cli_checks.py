@@ -17,23 +17,15 @@ thick panels' density unless ``--density``; ``generate --density`` sets only the
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 
-from rigidfold.config import DEFAULTS, SIDES
+from rigidfold.cli_parser import add_options, options_of
+from rigidfold.config import DEFAULTS
 from rigidfold.fabricate.options import FabricateOptions
-from rigidfold.structure import StructureOptions, parse_material, presets_help
+from rigidfold.structure import StructureOptions, presets_help
 
 STRUCTURE = StructureOptions()
 """The structure check's defaults (``Settings.structure``)."""
-
-
-def positive(text: str) -> float:
-    """argparse type: a positive finite number."""
-    value = float(text)
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
-    return value
 
 
 def length(what: str):
@@ -50,21 +42,12 @@ def length(what: str):
     return parse
 
 
-def sheet(text: str) -> tuple[float, float]:
-    """argparse type: a stock sheet ``WxH`` in millimetres."""
-    from rigidfold.fabricate.build import parse_sheet
-
-    try:
-        return parse_sheet(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
 def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
-    """The thick panels' options (:class:`~rigidfold.fabricate.FabricateOptions`) on ``p``:
-    ``rigidfold fabricate``'s, where ``--thickness`` is required, or ``generate``'s, where
-    ``--thickness`` asks for the final design's thick panels and the others apply to them."""
-    pre = "with --thickness: " if generate else ""
+    """The thick panels' options (:class:`~rigidfold.fabricate.FabricateOptions`) on ``p``,
+    made from its fields (:func:`~rigidfold.cli_parser.add_options`): ``rigidfold
+    fabricate``'s, where ``--thickness`` is required, or ``generate``'s, where its own
+    ``--thickness`` asks for the final design's thick panels and the others, their help
+    prefixed "with --thickness: ", apply to them."""
     if generate:
         p.add_argument(
             "--thickness",
@@ -78,60 +61,18 @@ def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
             "frame with --material (default: no thick panels; --structure and --material "
             f"alone: {STRUCTURE.thickness:g})",
         )
-    else:
-        p.add_argument(
-            "--thickness",
-            required=True,
-            type=length("thickness"),
-            metavar="T",
-            help="panel thickness in metres, or with a unit: 18mm, 1.8cm",
+        add_options(
+            p,
+            FabricateOptions,
+            exclude=("thickness",),
+            prefix="with --thickness: ",
+            shown={
+                "density": f"that of --material, or of {STRUCTURE.material}; it does not "
+                "change the structure's self-weight"
+            },
         )
-    p.add_argument(
-        "--side",
-        default=FabricateOptions.side,
-        choices=SIDES,
-        help=f"{pre}the side of the design surface the solids lie on: bottom (below it, the "
-        "surface is their outer face) or top (default: %(default)s)",
-    )
-    p.add_argument(
-        "--clearance-angle",
-        type=float,
-        default=FabricateOptions.clearance_angle_deg,
-        metavar="DEG",
-        help=f"{pre}bevels leave this angle, degrees, to spare beyond each hinge's largest "
-        "fold (default: %(default)s)",
-    )
-    p.add_argument(
-        "--density",
-        type=positive,
-        default=None,
-        metavar="KG/M3",
-        help=f"{pre}density of the panel material for the masses "
-        + (
-            "(default: that of --material, or of "
-            f"{STRUCTURE.material}; it does not change the structure's self-weight)"
-            if generate
-            else f"(default: that of {STRUCTURE.material}, "
-            f"{parse_material(STRUCTURE.material).density:g})"
-        ),
-    )
-    w, h = FabricateOptions.sheet
-    p.add_argument(
-        "--sheet",
-        type=sheet,
-        default=f"{w:g}x{h:g}",
-        metavar="WxH",
-        help=f"{pre}stock sheet size in millimetres that the cut sheets are nested onto "
-        "(default: %(default)s)",
-    )
-    p.add_argument(
-        "--min-thickness",
-        type=length("min-thickness"),
-        default=None,
-        metavar="T",
-        help=f"{pre}a panel whose solid is nowhere this deep once bevelled fails (default: "
-        f"{DEFAULTS.fabricate.min_depth:g} x the thickness)",
-    )
+    else:
+        add_options(p, FabricateOptions)
 
 
 def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
@@ -261,16 +202,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
 def fabricate_options(args: argparse.Namespace) -> FabricateOptions | None:
     """The thick panels' options of the parsed arguments (checked); None without
     ``--thickness`` (generate)."""
-    if args.thickness is None:
-        return None
-    return FabricateOptions(
-        thickness=args.thickness,
-        side=args.side,
-        clearance_angle_deg=args.clearance_angle,
-        density=args.density,
-        sheet=args.sheet,
-        min_thickness=args.min_thickness,
-    )
+    return None if args.thickness is None else options_of(FabricateOptions, args)
 
 
 def structure_progress(line: str) -> None:

@@ -14,7 +14,7 @@ import dataclasses
 import difflib
 import re
 import unicodedata
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from rigidfold.errors import RigidfoldError
@@ -29,18 +29,25 @@ def add_options(
     *,
     defaults: Any = None,
     only: Sequence[str] | None = None,
+    exclude: Sequence[str] = (),
+    prefix: str = "",
+    shown: Mapping[str, str] | None = None,
 ) -> None:
     """A flag on ``parser`` for each field of the options record ``record`` that has one
-    (those named in ``only``, where given), with the defaults of ``defaults`` (default: the
-    record's). A bool is a switch: ``--NAME`` turns it on, ``--no-NAME`` off where it is on
-    by default. Any other field takes a value, parsed by its flag's ``parse``; its default,
-    unless None, ends its help."""
+    (those named in ``only``, where given, but not those in ``exclude``), with the defaults of
+    ``defaults`` (default: the record's). A bool is a switch: ``--NAME`` turns it on,
+    ``--no-NAME`` off where it is on by default. Any other field takes a value, parsed by its
+    flag's ``parse``; a field without a default is required. Its help is ``prefix`` and the
+    field's doc, ended by its default: ``shown[name]`` where given, else its flag's
+    ``shown``, else the value unless None. The shown text of a default that is not None is
+    the default's text (``2440x1220``), given to argparse as the default and parsed by the
+    flag's ``parse`` as the command line's would be."""
     for f in dataclasses.fields(record):
         flag: Flag | None = f.metadata.get("flag")
-        if flag is None or (only is not None and f.name not in only):
+        if flag is None or (only is not None and f.name not in only) or f.name in exclude:
             continue
         default = f.default if defaults is None else getattr(defaults, f.name)
-        doc = f.metadata["doc"]
+        doc = prefix + f.metadata["doc"]
         dashed = f.name.replace("_", "-")
         if isinstance(default, bool):
             on = "--no-" if default else "--"
@@ -49,11 +56,16 @@ def add_options(
                 dest=f.name,
                 action="store_false" if default else "store_true",
                 default=default,
-                help=f"turn {'off' if default else 'on'} {doc}",
+                help=f"{prefix}turn {'off' if default else 'on'} {f.metadata['doc']}",
             )
             continue
         required = default is dataclasses.MISSING
-        shown = "" if required or default is None else " (default: %(default)s)"
+        said = (shown or {}).get(f.name, flag.shown)
+        if said is not None and default is not None and not required:
+            default = said  # the default's text, parsed as the flag's (argparse does)
+        end = "" if required or default is None else " (default: %(default)s)"
+        if said is not None and default is None:
+            end = f" (default: {said})"
         how: dict[str, Any] = {"required": True} if required else {"default": default}
         if flag.parse is not None:
             how["type"] = argument_type(flag.parse)
@@ -62,7 +74,7 @@ def add_options(
             dest=f.name,
             choices=flag.choices,
             metavar=flag.metavar,
-            help=doc + shown,
+            help=doc + end,
             **how,
         )
 

@@ -28,18 +28,23 @@ class Flag:
         is True is turned off by ``--no-`` and that name).
     parse : the text to the value (an argparse ``type``; default: the text).
     metavar, choices : as argparse's.
+    shown : the default as the help says it, where that is not the value itself: for a
+        default of None what None means, else the default as text, which ``parse`` reads
+        back (a pair ``(2440.0, 1220.0)`` is ``"2440x1220"``).
     """
 
     name: str | None = None
     parse: Callable[[str], Any] | None = None
     metavar: str | None = None
     choices: tuple[str, ...] | None = None
+    shown: str | None = None
 
 
 def option(default: Any, doc: str, *, flag: bool = True, **how: Any) -> Any:
-    """A field of an options record: its default, what it means (a phrase that reads as the
-    command-line help too: a bool's says what it turns on) and, unless ``flag=False``, how the
-    command line gives it (:class:`Flag`'s ``name``, ``parse``, ``metavar``, ``choices``)."""
+    """A field of an options record: its default (``dataclasses.MISSING``: none, a required
+    field and flag), what it means (a phrase that reads as the command-line help too: a bool's
+    says what it turns on) and, unless ``flag=False``, how the command line gives it
+    (:class:`Flag`'s ``name``, ``parse``, ``metavar``, ``choices``, ``shown``)."""
     return dataclasses.field(
         default=default, metadata={"doc": doc, "flag": Flag(**how) if flag else None}
     )

@@ -172,6 +172,17 @@ class Placed:
     centre: tuple[float, float]
 
 
+@dataclass(frozen=True)
+class Stock:
+    """What parts are nested onto (:func:`nest`, :func:`nest_boxes`,
+    :func:`nest_by_outlines`): stock sheets ``width`` x ``height`` mm, the parts ``gap`` mm
+    apart and from the sheets' edges."""
+
+    width: float
+    height: float
+    gap: float
+
+
 @dataclass(frozen=True, eq=False)
 class StockSheet:
     """One stock sheet: its size (mm), its parts, whether it is an oversize one, and how
@@ -443,30 +454,23 @@ def group(
     return groups
 
 
-def nest(
-    items: list[Part],
-    width: float,
-    height: float,
-    gap: float,
-    *,
-    settings: Settings = DEFAULTS,
-) -> list[StockSheet]:
-    """Pack ``items`` onto stock sheets ``width`` x ``height`` mm with ``gap`` mm between
-    parts and from the edges (see the module's text): by their boxes (:func:`nest_boxes`)
-    and by their outlines (:func:`nest_by_outlines`, up to ``fabricate_nest_parts`` parts),
-    the one on fewer stock sheets kept, then the one that uses less of the last sheet's
-    width, the boxes where both are alike. Parts with an empty outline are left out."""
-    boxes = nest_boxes(items, width, height, gap, settings=settings)
-    stock = [s for s in boxes if not s.oversize]
-    panels = {p.part.panel for s in stock for p in s.parts}
+def nest(items: list[Part], stock: Stock, *, settings: Settings = DEFAULTS) -> list[StockSheet]:
+    """Pack ``items`` onto ``stock`` (see the module's text): by their boxes
+    (:func:`nest_boxes`) and by their outlines (:func:`nest_by_outlines`, up to
+    ``fabricate_nest_parts`` parts), the one on fewer stock sheets kept, then the one that
+    uses less of the last sheet's width, the boxes where both are alike. Parts with an
+    empty outline are left out."""
+    boxes = nest_boxes(items, stock, settings=settings)
+    sheets = [s for s in boxes if not s.oversize]
+    panels = {p.part.panel for s in sheets for p in s.parts}
     on_stock = [p for p in items if p.panel in panels]  # each in its own frame, not its pair's
     if not on_stock or len(on_stock) > settings.fabricate.nest_parts:
         return boxes
     try:
-        outlines = nest_by_outlines(on_stock, width, height, gap, settings=settings)
+        outlines = nest_by_outlines(on_stock, stock, settings=settings)
     except shapely.errors.GEOSException:  # a degenerate outline: the boxes still hold
         outlines = None
-    if outlines is None or _usage(outlines) >= _usage(stock):
+    if outlines is None or _usage(outlines) >= _usage(sheets):
         return boxes
     return outlines + [s for s in boxes if s.oversize]
 
@@ -478,19 +482,15 @@ def _usage(sheets: list[StockSheet]) -> tuple[int, float]:
 
 
 def nest_by_outlines(
-    items: list[Part],
-    width: float,
-    height: float,
-    gap: float,
-    *,
-    settings: Settings = DEFAULTS,
+    items: list[Part], stock: Stock, *, settings: Settings = DEFAULTS
 ) -> list[StockSheet] | None:
-    """``items`` placed by their true outlines on stock sheets ``width`` x ``height`` mm,
-    ``gap`` mm apart and from the edges (:func:`rigidfold.fabricate.nesting.nest_outlines`:
-    turned, never mirrored); ``None`` where one of them fits on no sheet."""
+    """``items`` placed by their true outlines on ``stock``
+    (:func:`rigidfold.fabricate.nesting.nest_outlines`: turned, never mirrored); ``None``
+    where one of them fits on no sheet."""
     from rigidfold.fabricate.nesting import nest_outlines
 
-    spots = nest_outlines([p.cut for p in items], width, height, gap, settings=settings)
+    width, height = stock.width, stock.height
+    spots = nest_outlines([p.cut for p in items], width, height, stock.gap, settings=settings)
     if spots is None:
         return None
     placed: dict[int, list[Placed]] = {}
@@ -502,17 +502,12 @@ def nest_by_outlines(
 
 
 def nest_boxes(
-    items: list[Part],
-    width: float,
-    height: float,
-    gap: float,
-    *,
-    settings: Settings = DEFAULTS,
+    items: list[Part], stock: Stock, *, settings: Settings = DEFAULTS
 ) -> list[StockSheet]:
-    """Pack ``items`` by their boxes (their pairs' boxes, :func:`group`) onto stock sheets
-    ``width`` x ``height`` mm with ``gap`` mm between parts and from the edges, by
+    """Pack ``items`` by their boxes (their pairs' boxes, :func:`group`) onto ``stock`` by
     ``rectpack`` (:func:`_pack`); a part larger than the stock on an oversize sheet of its
     own after them."""
+    width, height, gap = stock.width, stock.height, stock.gap
     inner_w, inner_h = math.floor(width - gap), math.floor(height - gap)
     boxes: dict[int, tuple[int, int, list[Part]]] = {}
     oversize = []
@@ -834,7 +829,7 @@ def cut_sheet_data(
     from rigidfold.fabricate.progress import step
 
     step(f"nesting the cut sheets of {fab.panels.n} panels", fab.panels.n, settings=settings)
-    sheets = nest(parts(fab), width, height, gap, settings=settings)
+    sheets = nest(parts(fab), Stock(width, height, gap), settings=settings)
     files: list[tuple[Path, str | bytes]] = []
     stock = oversize = 0
     for sheet in sheets:

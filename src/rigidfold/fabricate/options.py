@@ -2,7 +2,8 @@
 ``rigidfold generate --thickness`` build one :class:`FabricateOptions`.
 
 It holds every option of the command (the thickness, the side, the clearance angle in
-degrees, the density, the stock sheet, the minimum thickness), each default from
+degrees, the density, the stock sheet, the minimum thickness), each a field made by
+:func:`rigidfold.flags.option` whose doc is also its flag's help, each default from
 ``Settings.fabricate``, checked once when it is made (:func:`rigidfold.fabricate.build.
 fabrication_values`, :func:`~rigidfold.fabricate.build.parse_length`,
 :func:`~rigidfold.fabricate.build.parse_sheet`); :meth:`FabricateOptions.fabricate` runs
@@ -12,7 +13,8 @@ fabrication_values`, :func:`~rigidfold.fabricate.build.parse_length`,
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
+from functools import partial
 
 import numpy as np
 
@@ -27,34 +29,70 @@ from rigidfold.fabricate.build import (
 )
 from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
+from rigidfold.flags import option, positive
+from rigidfold.structure.material import parse_material
+
+_SHEET = (DEFAULTS.fabricate.sheet_width, DEFAULTS.fabricate.sheet_height)
+_MATERIAL = DEFAULTS.structure.material
 
 
 @dataclass(frozen=True)
 class FabricateOptions:
     """Thick panels of a design, as ``rigidfold fabricate`` takes them.
 
-    thickness : metres (a number, or a length text: ``"18mm"``, ``"1.8cm"``, ``"0.018"``),
-        kept as a float.
-    side : one of ``SIDES``: the side of the design surface the solids lie on.
-    clearance_angle_deg : degrees the bevels leave beyond each hinge's largest fold.
-    density : kg/m^3 of the panels for their masses; None: the density of the panels'
-        material (``rigidfold generate``: its ``--material``; else
-        ``Settings.structure.material``, plywood's 700).
-    sheet : (width, height) of the stock sheet in millimetres, or ``"2440x1220"``, kept as
-        a pair.
-    min_thickness : metres; a panel nowhere this deep once bevelled fails; None:
-        ``Settings.fabricate.min_depth`` times the thickness.
+    Each field is made by :func:`rigidfold.flags.option` with what it means, also the help of
+    its flag (:func:`rigidfold.cli_parser.add_options`: ``rigidfold fabricate``'s, and
+    ``generate``'s with ``--thickness``): a new option is a new field here. Besides the
+    command line's texts, ``thickness`` and ``min_thickness`` take a number of metres (kept
+    as a float), ``sheet`` a ``(width, height)`` pair (kept as one); ``density`` None: the
+    density of the panels' material (``rigidfold generate``: its ``--material``; else
+    ``Settings.structure.material``'s); ``min_thickness`` None:
+    ``Settings.fabricate.min_depth`` times the thickness.
 
     Every value is checked when the options are made (ValueError, one line, naming what
     was received).
     """
 
-    thickness: float
-    side: str = DEFAULTS.fabricate.side
-    clearance_angle_deg: float = round(math.degrees(DEFAULTS.fabricate.clearance_angle), 9)
-    density: float | None = None
-    sheet: tuple[float, float] = (DEFAULTS.fabricate.sheet_width, DEFAULTS.fabricate.sheet_height)
-    min_thickness: float | None = None
+    thickness: float = option(
+        MISSING,
+        "panel thickness in metres, or with a unit: 18mm, 1.8cm",
+        parse=partial(parse_length, what="thickness"),
+        metavar="T",
+    )
+    side: str = option(
+        DEFAULTS.fabricate.side,
+        "the side of the design surface the solids lie on: bottom (below it, the surface is "
+        "their outer face) or top",
+        choices=SIDES,
+    )
+    clearance_angle_deg: float = option(
+        round(math.degrees(DEFAULTS.fabricate.clearance_angle), 9),
+        "bevels leave this angle, degrees, to spare beyond each hinge's largest fold",
+        name="--clearance-angle",
+        parse=float,
+        metavar="DEG",
+    )
+    density: float | None = option(
+        None,
+        "density of the panel material for the masses",
+        parse=positive,
+        metavar="KG/M3",
+        shown=f"that of {_MATERIAL}, {parse_material(_MATERIAL).density:g}",
+    )
+    sheet: tuple[float, float] = option(
+        _SHEET,
+        "stock sheet size in millimetres that the cut sheets are nested onto",
+        parse=parse_sheet,
+        metavar="WxH",
+        shown="{:g}x{:g}".format(*_SHEET),
+    )
+    min_thickness: float | None = option(
+        None,
+        "a panel whose solid is nowhere this deep once bevelled fails",
+        parse=partial(parse_length, what="min-thickness"),
+        metavar="T",
+        shown=f"{DEFAULTS.fabricate.min_depth:g} x the thickness",
+    )
 
     def __post_init__(self) -> None:
         for name, what in (("thickness", "thickness"), ("min_thickness", "min-thickness")):

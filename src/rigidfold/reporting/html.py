@@ -126,23 +126,19 @@ def _answer(run: RunData) -> list[str]:
         passed = given["outcome"] == "passed"
         verdict, outcome = ("Passed" if passed else "Fell short"), given["message"]
         css = "ok" if passed else "bad"
-    margin = s.document.get("dof_margin") or {}
+    margin = s.dof_margin or {}
     dof_text = "–" if s.final_dof is None else str(s.final_dof)
     if margin and not margin.get("clear", True):
         near = margin.get("near")
         dof_text += f" (no clear margin: {near} near-mechanism{'' if near == 1 else 's'})"
-    lowest = s.document.get("lowest_dof")
+    lowest = s.lowest_dof
     items = [
         ("final DOF", dof_text),
         *((("lowest DOF reached", str(lowest)),) if lowest not in (None, s.final_dof) else ()),
         ("target DOF", "–" if target is None else str(target)),
         ("N_lock", str(s.n_lock)),
         *((("N_path", str(s.n_path)),) if s.deploy_check else ()),
-        *(
-            (("N_rigid (second-order rigid)", str(s.document["N_rigid"])),)
-            if s.document.get("N_rigid")
-            else ()
-        ),
+        *((("N_rigid (second-order rigid)", str(s.n_rigid)),) if s.n_rigid else ()),
         *((("retracted (backtracking)", str(s.n_backtrack)),) if s.n_backtrack else ()),
         (
             "deploys",
@@ -372,14 +368,14 @@ def _figure(figure: Figure) -> str:
 
 
 def _tables(run: RunData) -> list[str]:
-    s = run.summary.document
+    s = run.summary.to_dict()
     run_keys = (
         "stop_reason initial_dof final_dof lowest_dof N_reduce N_lock N_exceed N_path N_rigid "
         "N_backtrack "
         "deploy_check "
         "final_deploys n_solutions n_solves n_skipped mean_F_accepted mean_F_all_solves"
     ).split()
-    blocks = [("Run", _pairs({k: s.get(k) for k in run_keys if k in s}))]
+    blocks = [("Run", _pairs({k: s[k] for k in run_keys}))]
     for key, head in (
         ("development", "Development (Step 8), all solutions"),
         ("deformation", "Large deformation (Step 9), all solutions"),

@@ -19,6 +19,7 @@ import dataclasses
 import os
 import typing
 from dataclasses import dataclass, field, fields
+from typing import Any
 
 import numpy as np
 
@@ -26,7 +27,7 @@ from rigidfold.deform import DeformStatus, MotionStatus, Verification
 from rigidfold.develop import DevelopStatus
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
-from rigidfold.generate import Attempt, Stop
+from rigidfold.generate import Attempt, Generation, Stop
 from rigidfold.run.shapes import Nullable, Record, check_shape, received, shape_of
 from rigidfold.status import Outcome
 from rigidfold.structure import StructureStatus
@@ -175,6 +176,14 @@ SUMMARY_SHAPE = Record(
         "options": Nullable(Record({"target_dof": Nullable(int)})),
         "verdict": Nullable(Record({"outcome": str, "message": str}, ("outcome", "message"))),
         "target_surface": Nullable(str),
+        "n_solutions": Nullable(int),
+        "n_solves": Nullable(int),
+        "n_skipped": Nullable(int),
+        "mean_F_accepted": _NUMBERS,
+        "mean_F_all_solves": _NUMBERS,
+        "numerics": Nullable(Record({})),
+        "time_s": Nullable(Record({})),
+        "exports": Nullable([str]),
     },
     ("stop", "stop_reason", "final_dof", "N_lock", "solutions", "per_solution", "case"),
 )
@@ -432,48 +441,121 @@ def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dic
     }
 
 
-@dataclass(frozen=True, eq=False)
+_KEYS = {
+    "n_reduce": "N_reduce",
+    "n_lock": "N_lock",
+    "n_exceed": "N_exceed",
+    "n_path": "N_path",
+    "n_backtrack": "N_backtrack",
+    "n_rigid": "N_rigid",
+    "mean_f_accepted": "mean_F_accepted",
+    "mean_f_all_solves": "mean_F_all_solves",
+}
+"""The keys of ``summary.json`` that are not their :class:`RunSummary` field's name."""
+
+
+def _key(name: str) -> str:
+    """The key of ``summary.json`` of the :class:`RunSummary` field ``name``."""
+    return _KEYS.get(name, name)
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
 class RunSummary:
-    """``summary.json`` read back (checked with :data:`SUMMARY_SHAPE` first).
+    """``summary.json``: made by the run writer (:meth:`from_run`), written by
+    :meth:`to_dict`, read back by :meth:`from_dict` (checked with :data:`SUMMARY_SHAPE`
+    first). Its fields in the order of the file, each under its own name but those in
+    ``_KEYS`` (``n_lock``: ``N_lock``); the file's ``schema_version``
+    (:data:`SCHEMA_VERSION`) and the run-wide figures (:func:`aggregate` of
+    ``per_solution``) are written, not held.
 
     stop, stop_reason : how the run ended (:class:`rigidfold.generate.Stop` value and words);
-    initial_dof, final_dof, n_reduce, n_lock, n_exceed, n_path : the paper's counters and
-    N_path (None in a file without them); n_backtrack : the solutions retracted by
-    backtracking (None in a file written before it); deploy_check : whether the deployability check
-    ran; final_step, final_deploys : the final design's step and whether its path reaches
-    the flat state; solutions : the solution files, relative to the run's directory;
-    per_solution : their records; case, options : the case's metadata and the generate
-    options as written; verdict : the verdict's dict, None while the run goes on;
-    target_surface : the file in the run's directory that holds a mesh target's fitted
-    spline (``TARGET_FILE``), None for other targets; document : the whole file (for tables
-    of everything it holds).
+    initial_dof, final_dof, lowest_dof, n_reduce, n_lock, n_exceed, n_path, n_backtrack,
+    n_rigid : the paper's counters, N_path, the solutions retracted by backtracking and
+    the second-order rigid ones (None in a file without them); deploy_check : whether the
+    deployability check ran; final_step, final_deploys : the final design's step and
+    whether its path reaches the flat state; dof_margin, n_solutions, n_solves, n_skipped,
+    mean_f_accepted, mean_f_all_solves, numerics, time_s : the run's other figures
+    (:meth:`rigidfold.generate.Generation.to_dict`; ``time_s`` with the checks' stages);
+    per_solution : the solutions' records; options, case : the generate options and the
+    case's metadata as written; solutions : the solution files, relative to the run's
+    directory; verdict : the verdict's dict, None while the run goes on; exports : the
+    final design's files, relative to the run's directory; target_surface : the file in
+    the run's directory that holds a mesh target's fitted spline (``TARGET_FILE``), None
+    for other targets.
     """
 
     stop: str
     stop_reason: str
-    initial_dof: int | None
-    final_dof: int | None
-    n_reduce: int | None
-    n_lock: int | None
-    n_exceed: int | None
-    n_path: int | None
-    n_backtrack: int | None
-    deploy_check: bool
-    final_step: int | None
-    final_deploys: bool | None
-    solutions: tuple[str, ...]
-    per_solution: tuple[SolutionRecord, ...]
-    case: dict
-    options: dict
-    verdict: dict | None
-    target_surface: str | None
-    document: dict
+    initial_dof: int | None = None
+    final_dof: int | None = None
+    lowest_dof: int | None = None
+    n_reduce: int | None = None
+    n_lock: int | None = None
+    n_exceed: int | None = None
+    n_path: int | None = None
+    n_backtrack: int | None = None
+    n_rigid: int | None = None
+    deploy_check: bool = False
+    final_step: int | None = None
+    final_deploys: bool | None = None
+    dof_margin: dict | None = None
+    n_solutions: int | None = None
+    n_solves: int | None = None
+    n_skipped: int | None = None
+    mean_f_accepted: float | None = None
+    mean_f_all_solves: float | None = None
+    numerics: dict | None = None
+    time_s: dict = field(default_factory=dict)
+    per_solution: tuple[SolutionRecord, ...] = ()
+    options: dict = field(default_factory=dict)
+    case: dict = field(default_factory=dict)
+    solutions: tuple[str, ...] = ()
+    verdict: dict | None = None
+    exports: tuple[str, ...] = ()
+    target_surface: str | None = None
+
+    @classmethod
+    def from_run(
+        cls,
+        run: Generation,
+        records: list[SolutionRecord],
+        *,
+        stage_times: dict[str, float],
+        **given: Any,
+    ) -> RunSummary:
+        """The summary of ``run`` as it stands: its counters and figures
+        (:meth:`rigidfold.generate.Generation.to_dict`), ``stage_times`` (the checks' seconds)
+        added to its ``time_s``, the solutions' ``records`` and the other fields ``given``."""
+        produced = run.to_dict()
+        produced["time_s"] = produced["time_s"] | stage_times
+        names = [f.name for f in fields(cls)]
+        return cls(
+            **{n: produced[_key(n)] for n in names if _key(n) in produced},
+            per_solution=tuple(records),
+            **given,
+        )
+
+    def to_dict(self) -> dict:
+        """``summary.json``'s content: ``schema_version``, the fields under their keys and,
+        before ``per_solution`` (its records without the large-deformation history), the
+        run-wide figures (:func:`aggregate`); tuples as lists."""
+        out: dict = {"schema_version": SCHEMA_VERSION}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "per_solution":
+                out |= aggregate(self.per_solution)
+                value = [r.to_dict(history=False) for r in self.per_solution]
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[_key(f.name)] = value
+        return out
 
     @classmethod
     def from_dict(cls, data: dict, file: str | os.PathLike) -> RunSummary:
         """The summary in ``data``, the JSON of ``file``: ValueError (one line, naming the
         file and the key) when what is read does not have the shape it must have, or (naming
-        the versions) when it was written by another :data:`SCHEMA_VERSION`."""
+        the versions) when it was written by another :data:`SCHEMA_VERSION`. A key it lacks
+        (but the required ones of :data:`SUMMARY_SHAPE`) takes its field's default."""
         if "schema_version" in data:  # another version may have other keys
             check_version(data["schema_version"], file)
         missing = [k for k in SUMMARY_SHAPE.required if k not in data]
@@ -483,26 +565,17 @@ class RunSummary:
             )
         check_version(data.get("schema_version"), file)  # a summary made before versions
         check_shape(data, SUMMARY_SHAPE, file)
+        known = {f.name: data[_key(f.name)] for f in fields(cls) if _key(f.name) in data}
         return cls(
-            stop=data["stop"],
-            stop_reason=data["stop_reason"],
-            initial_dof=data.get("initial_dof"),
-            final_dof=data["final_dof"],
-            n_reduce=data.get("N_reduce"),
-            n_lock=data["N_lock"],
-            n_exceed=data.get("N_exceed"),
-            n_path=data.get("N_path"),
-            n_backtrack=data.get("N_backtrack"),
-            deploy_check=bool(data.get("deploy_check")),
-            final_step=data.get("final_step"),
-            final_deploys=data.get("final_deploys"),
-            solutions=tuple(data["solutions"]),
-            per_solution=tuple(SolutionRecord.from_dict(r) for r in data["per_solution"]),
-            case=data["case"],
-            options=data.get("options") or {},
-            verdict=data.get("verdict"),
-            target_surface=data.get("target_surface"),
-            document=data,
+            **known
+            | {
+                "deploy_check": bool(data.get("deploy_check")),
+                "time_s": data.get("time_s") or {},
+                "per_solution": tuple(SolutionRecord.from_dict(r) for r in data["per_solution"]),
+                "options": data.get("options") or {},
+                "solutions": tuple(data["solutions"]),
+                "exports": tuple(data.get("exports") or ()),
+            }
         )
 
     @property

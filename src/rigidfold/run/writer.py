@@ -3,8 +3,9 @@
 ``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form, a
 ``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
 ``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.jsonl``
-(every attempt, a line appended for each: :class:`AttemptLog`) and ``DIR/summary.json`` (the
-paper's counters, the development and deformation figures (Step 9), each solution's
+(every attempt, a line appended for each: :class:`AttemptLog`) and ``DIR/summary.json`` (a
+:class:`~rigidfold.run.RunSummary`, :meth:`RunWriter.summary`, written by its ``to_dict``:
+the paper's counters, the development and deformation figures (Step 9), each solution's
 :class:`~rigidfold.run.SolutionRecord`, the options, the verdict and stage times, the
 :data:`~rigidfold.run.schema.SCHEMA_VERSION`). Every other file is written atomically
 (temporary file, then rename), so each one on disk is always valid; the log is only ever
@@ -48,7 +49,7 @@ from rigidfold.mesh import CreasePattern
 from rigidfold.run.built import check_built_options
 from rigidfold.run.checks import Checked, check_final, check_solution, traced_motion
 from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
-from rigidfold.run.schema import LOG_FILE, SCHEMA_VERSION, SolutionRecord, aggregate
+from rigidfold.run.schema import LOG_FILE, SCHEMA_VERSION, RunSummary, SolutionRecord
 from rigidfold.run.verdict import RunVerdict, run_verdict
 from rigidfold.structure import StructureCheck
 from rigidfold.surfaces import SplineSurface
@@ -346,23 +347,21 @@ class RunWriter:
         self.write_summary(run)
         return self.verdict
 
-    def write_summary(self, run: Generation) -> None:
-        """Write summary.json (atomically) as the run stands now."""
-        summary = run.to_dict()
-        summary["time_s"].update(self.stage_times)
-        write_json(
-            self.out / "summary.json",
-            {
-                "schema_version": SCHEMA_VERSION,
-                **summary,
-                **aggregate(self.records),
-                "per_solution": [r.to_dict(history=False) for r in self.records],
-                "options": self.options.to_dict() | {"symmetric": bool(self.case.planes)},
-                "case": self.case.metadata(),
-                "solutions": [str(p.relative_to(self.out)) for p in self.files],
-                "verdict": None if self.verdict is None else self.verdict.to_dict(),
-                "exports": [str(p.relative_to(self.out)) for p in self.exports],
-                "target_surface": self.target_file,
-            },
+    def summary(self, run: Generation) -> RunSummary:
+        """summary.json's record of the run as it stands now."""
+        return RunSummary.from_run(
+            run,
+            self.records,
+            stage_times=self.stage_times,
+            options=self.options.to_dict() | {"symmetric": bool(self.case.planes)},
+            case=self.case.metadata(),
+            solutions=tuple(str(p.relative_to(self.out)) for p in self.files),
+            verdict=None if self.verdict is None else self.verdict.to_dict(),
+            exports=tuple(str(p.relative_to(self.out)) for p in self.exports),
+            target_surface=self.target_file,
         )
+
+    def write_summary(self, run: Generation) -> None:
+        """Write summary.json (atomically) as the run stands now (:meth:`summary`)."""
+        write_json(self.out / "summary.json", self.summary(run).to_dict())
         self.summary_written = time.monotonic()
