@@ -1,8 +1,9 @@
 """Deployable anywhere, in minutes (issue 40): the share of runs on drawn patterns and a roof
 grid that end at DOF 1 with a design that deploys, the time and the solves per run, and why
 every rejected candidate was rejected; in each mode of :data:`MODES` (rigidfold's defaults,
-``after``; the search without the fold limit, ``before``; without the second-order test,
-``no-second-order``), in the same process.
+``after``; the search without the restart with the fold limit, ``before``; without the
+second-order test, ``no-second-order``; every solve bounded, ``bounded``), in the same
+process.
 
 Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only TEXT]
 [--modes after,before,no-second-order]``. Every run uses S-hat with the look-ahead and the
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import statistics
 import time
 from collections import Counter
@@ -56,10 +58,12 @@ MODES: dict[str, dict] = {
     "after": {},
     "before": {"fold_limit": None},
     "no-second-order": {"second_order": False},
+    "bounded": {"rho_bar": math.radians(120.0)},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
-the search of session 17 (no fold limit: problem (6) without bound (12)); ``no-second-order``
-without the second-order test and forecast (the search before session 17)."""
+the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
+second-order test and forecast (the search before session 17); ``bounded`` bound (12) at 120
+degrees on every solve from the start (``generate --rho-max 120``)."""
 
 
 def paper_cases(surfaces: int) -> list[dict]:
