@@ -518,7 +518,12 @@ def test_sigterm_to_a_running_generate_exits_130(tmp_path):
         time.sleep(0.05)
     time.sleep(1.0)
     proc.send_signal(signal.SIGTERM)
-    _, err = proc.communicate(timeout=60)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:  # do not leave the process and its pipes behind
+        proc.kill()
+        proc.communicate()
+        raise
     assert proc.returncode == 130, err
     assert len(err.strip().splitlines()) == 1 and "interrupted" in err
     summary = out / "summary.json"

@@ -95,7 +95,7 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
     return f"file:{quote(absolute, safe='/')}?mode={mode}"
 
 
-STUDY_SCHEMA_VERSION = 1
+STUDY_SCHEMA_VERSION = 2
 """The version of the tables of :data:`SCHEMA`, the database's ``PRAGMA user_version``; raise
 it with any change to them that an older rigidfold cannot read."""
 
