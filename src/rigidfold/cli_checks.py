@@ -132,12 +132,14 @@ def structure_options(args: argparse.Namespace) -> StructureOptions:
     ``rigidfold structure FILE`` without ``--thickness``: the thickness fabricate recorded
     for the design (:func:`~rigidfold.structure.design.recorded_thickness`, said on stderr
     and as ``thickness_from``), else the default."""
+    from rigidfold.run.built import thick_dir_of
     from rigidfold.structure.design import recorded_thickness
 
     thickness, source = args.thickness, ""
     design = getattr(args, "file", None)
     if thickness is None and design is not None:
-        found = recorded_thickness(design)
+        run = thick_dir_of(design)
+        found = recorded_thickness(design, () if run is None else (run,))
         if found is not None:
             thickness, where = found
             source = f"rigidfold fabricate ({where})"

@@ -41,6 +41,13 @@ STRUCTURE_DIR = Path("final") / "structure"
 """Where the structure check's files go in the run's directory."""
 
 
+def thick_dir_of(design: str | Path) -> Path | None:
+    """The thick panels' directory (:data:`THICK_DIR`) of the run whose solution file is
+    ``design`` (``DIR/solutions/NAME.fold``: ``DIR/final/thick``); None for another file."""
+    design = Path(design)
+    return design.parent.parent / THICK_DIR if design.parent.name == "solutions" else None
+
+
 def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> None:
     """ValueError (one line) for supports, support candidates, clamped vertices, actuators
     or point loads that ``pattern`` (the run's crease pattern: every solution has its

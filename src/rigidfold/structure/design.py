@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -526,20 +526,18 @@ def check_design(
     return plan_design(pattern, options, settings=settings, progress=progress).check()
 
 
-def recorded_thickness(path: str | Path) -> tuple[float, Path] | None:
+def recorded_thickness(path: str | Path, also: Sequence[Path] = ()) -> tuple[float, Path] | None:
     """(the thickness, metres, that ``rigidfold fabricate`` made the panels of the design in
     FOLD file ``path``, the file that records it) or None: fabricate writes it as
     ``thickness_m`` of ``NAME_fabricate.json`` (:data:`rigidfold.fabricate.files.FABRICATE_JSON`)
     in its output directory, looked for beside the design (``fabricate DESIGN.fold --out``
-    the design's directory) and, for a run's solution ``DIR/solutions/NAME.fold``, in the
-    run's ``DIR/final/thick/`` (``generate --thickness``)."""
+    the design's directory), then in the directories ``also`` (for a run's solution, the
+    run's thick panels: :func:`rigidfold.run.built.thick_dir_of`)."""
     from rigidfold.fabricate.files import FABRICATE_JSON
 
     path = Path(path)
     name = FABRICATE_JSON.format(path.stem)
-    places = [path.parent / name]
-    if path.parent.name == "solutions":
-        places.append(path.parent.parent / "final" / "thick" / name)
+    places = [path.parent / name, *(where / name for where in also)]
     for place in places:
         try:
             data = parse_json(place.read_bytes())
