@@ -23,6 +23,9 @@ REPORT_FILE = "report.html"
 
 FIGURES_DIR = "figures"
 
+FINAL_DIR = "final"
+"""The final design's exports, its thick panels and its structure."""
+
 RUN_FILES = ("summary.json", "log.jsonl", REPORT_FILE, TARGET_FILE)
 """The files a generation run writes at the top of its directory."""
 
@@ -30,7 +33,7 @@ OLD_RUN_FILES = ("log.json",)
 """Files that runs of earlier rigidfold versions wrote at the top of their directory: an
 earlier run all the same (refused, or removed with ``--overwrite``)."""
 
-RUN_DIRS = ("solutions", FIGURES_DIR, "final")
+RUN_DIRS = ("solutions", FIGURES_DIR, FINAL_DIR)
 """The directories a generation run writes (solution files, figures, exports)."""
 
 _STEP = r"step_[0-9]+_dof_[0-9]+"

@@ -52,6 +52,7 @@ from rigidfold.run.built import check_built_options
 from rigidfold.run.checks import Checked, check_final, check_solution, traced_motion
 from rigidfold.run.lock import (
     FIGURES_DIR,
+    FINAL_DIR,
     REPORT_FILE,
     RUN_FILES,
     TARGET_FILE,
@@ -350,7 +351,7 @@ class RunWriter:
             pattern, coords2d = self.final
             stem = self.files[-1 if final is None else final.step].stem
             self.exports = export_design(
-                pattern, coords2d, self.out / "final", name=stem, title=f"rigidfold: {stem}"
+                pattern, coords2d, self.out / FINAL_DIR, name=stem, title=f"rigidfold: {stem}"
             )
         self.log.sync(run.attempts)
         self.write_summary(run)
