@@ -105,6 +105,8 @@ def _counters(summary: dict, stop_reason: str) -> str:
 def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.progress import GenerateProgress
     from rigidfold.run import RunOutcome, RunWriter
+    from rigidfold.run.built import STRUCTURE_DIR, THICK_DIR
+    from rigidfold.run.lock import FINAL_DIR, REPORT_FILE
     from rigidfold.workflows import generate_case
 
     structure = structure_options(args)  # checked even without --structure
@@ -139,24 +141,22 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     )
     if writer.exports:
         names = ", ".join(p.name for p in writer.exports)
-        print(f"exported the final design to {writer.out / 'final'}: {names}")
+        print(f"exported the final design to {writer.out / FINAL_DIR}: {names}")
     if writer.final_verdicts is not None:
         print(f"final design: {writer.final_verdicts}")
     if writer.fabrication is not None:
         print(
-            one_line(
-                f"thick panels ({writer.out / 'final' / 'thick'}): {writer.fabrication.last_line()}"
-            )
+            one_line(f"thick panels ({writer.out / THICK_DIR}): {writer.fabrication.last_line()}")
         )
     if writer.structure is not None:
         print(
             one_line(
-                f"structure ({writer.out / 'final' / 'structure'}): "
+                f"structure ({writer.out / STRUCTURE_DIR}): "
                 f"{writer.structure.status}: {writer.structure.message}"
             )
         )
     if not args.no_report:
-        print(f"report: {writer.out / 'report.html'}")
+        print(f"report: {writer.out / REPORT_FILE}")
     verdict = writer.verdict
     assert verdict is not None  # generate_case ends with writer.finish
     final = "none" if verdict.final_design is None else writer.out / verdict.final_design
@@ -165,6 +165,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
+    from rigidfold.run.lock import FIGURES_DIR
     from rigidfold.workflows import report_run
 
     report = report_run(args.dir)
@@ -174,7 +175,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
         info = report.to_dict()
         print(
             f"wrote {info['report']} ({info['size_bytes'] / 1e6:.1f} MB) and "
-            f"{len(report.figures)} figures in {report.html.parent / 'figures'}"
+            f"{len(report.figures)} figures in {report.html.parent / FIGURES_DIR}"
         )
     return 0
 

@@ -35,38 +35,49 @@ def add_options(
 ) -> None:
     """A flag on ``parser`` for each field of the options record ``record`` that has one
     (those named in ``only``, where given, but not those in ``exclude``), with the defaults of
-    ``defaults`` (default: the record's). A bool is a switch: ``--NAME`` turns it on,
-    ``--no-NAME`` off where it is on by default. Any other field takes a value, parsed by its
-    flag's ``parse``; a field without a default is required. Its help is ``prefix`` and the
-    field's doc, ended by its default: ``shown[name]`` where given, else its flag's
-    ``shown``, else the value unless None. The shown text of a default that is not None is
-    the default's text (``2440x1220``), given to argparse as the default and parsed by the
-    flag's ``parse`` as the command line's would be."""
+    ``defaults`` (default: the record's): another record, or a mapping of field names to the
+    defaults that differ (None: the command fills the value in). A bool is a switch:
+    ``--NAME`` turns it on, ``--no-NAME`` off where it is on by default, its help ``prefix``,
+    its flag's ``switch`` ("turn on", "turn off") and the field's doc. Any other field takes a
+    value, parsed by its flag's ``parse`` (each of a ``repeat`` flag's, into a list); a field
+    without a default is required. Its help is ``prefix`` and the field's doc, ended by its
+    default: ``shown[name]`` where given, else its flag's ``shown``, else the value unless
+    None or a repeat flag's. A shown default that is not text or a number (a pair, a typed
+    choice) is given to argparse as its shown text (``2440x1220``, ``auto``), which the
+    flag's ``parse`` (or the record's ``from_strings``) reads as the command line's."""
     for f in dataclasses.fields(record):
         flag: Flag | None = f.metadata.get("flag")
         if flag is None or (only is not None and f.name not in only) or f.name in exclude:
             continue
-        default = f.default if defaults is None else getattr(defaults, f.name)
+        if isinstance(defaults, Mapping):
+            default = defaults.get(f.name, f.default)
+        else:
+            default = f.default if defaults is None else getattr(defaults, f.name)
         doc = prefix + f.metadata["doc"]
         dashed = f.name.replace("_", "-")
         if isinstance(default, bool):
             on = "--no-" if default else "--"
+            switch = f"turn {'off' if default else 'on'}" if flag.switch is None else flag.switch
             parser.add_argument(
                 flag.name or on + dashed,
                 dest=f.name,
                 action="store_false" if default else "store_true",
                 default=default,
-                help=f"{prefix}turn {'off' if default else 'on'} {f.metadata['doc']}",
+                help=prefix + (switch + " " if switch else "") + f.metadata["doc"],
             )
             continue
         required = default is dataclasses.MISSING
         said = (shown or {}).get(f.name, flag.shown)
-        if said is not None and default is not None and not required:
-            default = said  # the default's text, parsed as the flag's (argparse does)
-        end = "" if required or default is None else " (default: %(default)s)"
-        if said is not None and default is None:
+        end = ""
+        if said is not None and not required:
             end = f" (default: {said})"
+        elif not (required or default is None or flag.repeat):
+            end = " (default: %(default)s)"
+        if said is not None and not (required or isinstance(default, str | int | float | None)):
+            default = said  # the default's text, parsed as the flag's (argparse does)
         how: dict[str, Any] = {"required": True} if required else {"default": default}
+        if flag.repeat:
+            how |= {"action": "append", "default": None}  # None: the record's default
         if flag.parse is not None:
             how["type"] = argument_type(flag.parse)
         parser.add_argument(
@@ -79,15 +90,25 @@ def add_options(
         )
 
 
-def options_of(record: type, args: argparse.Namespace, **given: Any) -> Any:
+def options_of(
+    record: type,
+    args: argparse.Namespace,
+    *,
+    make: Callable[..., Any] | None = None,
+    **given: Any,
+) -> Any:
     """The options record ``record`` of the parsed ``args`` (the fields that have a flag
-    there) and ``given``; checked by the record."""
+    there; None where the record's default is not: not given, the record's default) and
+    ``given``, made by ``make`` (default: the record; a record's ``from_strings`` where that
+    reads some of the texts); checked by the record."""
     flagged = {
         f.name: getattr(args, f.name)
         for f in dataclasses.fields(record)
-        if f.metadata.get("flag") is not None and hasattr(args, f.name)
+        if f.metadata.get("flag") is not None
+        and hasattr(args, f.name)
+        and (getattr(args, f.name) is not None or f.default is None)
     }
-    return record(**flagged | given)
+    return (record if make is None else make)(**flagged | given)
 
 
 def argument_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:

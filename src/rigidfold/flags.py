@@ -29,8 +29,12 @@ class Flag:
     parse : the text to the value (an argparse ``type``; default: the text).
     metavar, choices : as argparse's.
     shown : the default as the help says it, where that is not the value itself: for a
-        default of None what None means, else the default as text, which ``parse`` reads
-        back (a pair ``(2440.0, 1220.0)`` is ``"2440x1220"``).
+        default of None what None means, else the default as text (``""`` is ``"none"``);
+        one that is not text or a number, as text that ``parse`` (or the record's
+        ``from_strings``) reads back (a pair ``(2440.0, 1220.0)`` is ``"2440x1220"``).
+    switch : a bool's help before its doc, where that is not "turn on" (or "turn off" for a
+        bool on by default): ``"leave out"``, or ``""`` for a doc that reads as the help.
+    repeat : the flag may be given more than once, its values a list (none by default).
     """
 
     name: str | None = None
@@ -38,13 +42,16 @@ class Flag:
     metavar: str | None = None
     choices: tuple[str, ...] | None = None
     shown: str | None = None
+    switch: str | None = None
+    repeat: bool = False
 
 
 def option(default: Any, doc: str, *, flag: bool = True, **how: Any) -> Any:
     """A field of an options record: its default (``dataclasses.MISSING``: none, a required
     field and flag), what it means (a phrase that reads as the command-line help too: a bool's
     says what it turns on) and, unless ``flag=False``, how the command line gives it
-    (:class:`Flag`'s ``name``, ``parse``, ``metavar``, ``choices``, ``shown``)."""
+    (:class:`Flag`'s ``name``, ``parse``, ``metavar``, ``choices``, ``shown``, ``switch``,
+    ``repeat``)."""
     return dataclasses.field(
         default=default, metadata={"doc": doc, "flag": Flag(**how) if flag else None}
     )

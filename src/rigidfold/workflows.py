@@ -48,7 +48,6 @@ from rigidfold.fabricate import FabricateOptions, Fabrication, Panels, design_mo
 from rigidfold.generate import Attempt, Generation, generate
 from rigidfold.io import (
     FoldData,
-    atomic_write,
     prepare_output_dir,
     read_fold,
     refuse_replacing_inputs,
@@ -58,7 +57,14 @@ from rigidfold.io import (
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
 from rigidfold.reporting import page, render_figures, thick_figure, view_figure
-from rigidfold.run import RunData, RunWriter, clear_earlier_run, load_run, write_checked_shape
+from rigidfold.run import (
+    RunData,
+    RunWriter,
+    clear_earlier_run,
+    load_run,
+    write_checked_shape,
+    write_report,
+)
 from rigidfold.structure import (
     Material,
     StructureCheck,
@@ -483,14 +489,12 @@ def report_run(directory: str | os.PathLike) -> RunReport:
     in ``directory``. ValueError (one line) when it is not a generate run."""
     t0 = time.perf_counter()
     run = load_run(directory)
-    figure_dir = prepare_output_dir(run.directory / "figures")
     figures = render_figures(run)
     view = None if run.final is None else view_figure(run.final, run.surface)
     thick, note = run.thick_panels()
     solids = None if thick is None or run.final is None else thick_figure(thick, run.final)
     text = page(run, figures, view, solids, note)
-    written = tuple(atomic_write(figure_dir / f.name, f.png) for f in figures)
-    html = atomic_write(run.directory / "report.html", text)
+    html, written = write_report(run.directory, text, [(f.name, f.png) for f in figures])
     return RunReport(run, html, written, time.perf_counter() - t0)
 
 

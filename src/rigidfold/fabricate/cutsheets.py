@@ -333,25 +333,31 @@ def _longest_side(cut: shapely.Geometry) -> tuple[np.ndarray, np.ndarray, float]
     return ring[i], ring[i + 1], float(np.hypot(*sides[i]))
 
 
-def _joined(
-    first: Part,
-    second: Part,
-    gap: float,
-    sides: tuple[tuple[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray, float]],
-) -> list[list[Part]]:
-    """``second`` turned and moved so that the longest side of its convex hull runs along
-    that of ``first``'s (``sides``: both, :func:`_longest_side`), ``gap`` away on the other
-    side, its ends at either end: the two pairs, fitted (:func:`_fit`). The hulls lie on
-    the two sides of a strip ``gap`` wide, so the parts keep the gap."""
+Sides = tuple[tuple[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray, float]]
+"""The longest sides of two parts' convex hulls (:func:`_longest_side`)."""
+
+
+def _placements(gap: float, sides: Sides) -> tuple[np.ndarray, list[np.ndarray]]:
+    """(the turn, the two shifts) that put the second part's longest hull side along the
+    first's (``sides``), ``gap`` away on the other side, its ends at either end: a point
+    ``p`` of the second part goes to ``p @ turn + shift``."""
     (a, b, _), (c, d, _) = sides
     e = (b - a) / np.linalg.norm(b - a)
     normal = np.array([e[1], -e[0]])  # right of a -> b: away from first
     angle = math.atan2(*(a - b)[::-1]) - math.atan2(*(d - c)[::-1])
     co, si = math.cos(angle), math.sin(angle)
     turn = np.array([[co, si], [-si, co]])
+    return turn, [anchor + gap * normal - point @ turn for anchor, point in ((b, c), (a, d))]
+
+
+def _joined(first: Part, second: Part, gap: float, sides: Sides) -> list[list[Part]]:
+    """``second`` turned and moved so that the longest side of its convex hull runs along
+    that of ``first``'s (``sides``: both, :func:`_longest_side`), ``gap`` away on the other
+    side, its ends at either end (:func:`_placements`): the two pairs, fitted (:func:`_fit`).
+    The hulls lie on the two sides of a strip ``gap`` wide, so the parts keep the gap."""
+    turn, shifts = _placements(gap, sides)
     out = []
-    for anchor, point in ((b, c), (a, d)):
-        shift = anchor + gap * normal - point @ turn
+    for shift in shifts:
         moved = Part(
             second.panel,
             _moved(second.cut, turn, shift),
@@ -376,24 +382,12 @@ def _box_of(ring: np.ndarray) -> tuple[float, float]:
 
 
 def _joined_boxes(
-    first: np.ndarray,
-    second: np.ndarray,
-    gap: float,
-    sides: tuple[tuple[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray, float]],
+    first: np.ndarray, second: np.ndarray, gap: float, sides: Sides
 ) -> list[tuple[float, float]]:
     """The boxes of the two pairs :func:`_joined` makes of parts of hull points ``first``
     and ``second`` (n, 2), computed on those points alone (the same turns and shifts)."""
-    (a, b, _), (c, d, _) = sides
-    e = (b - a) / np.linalg.norm(b - a)
-    normal = np.array([e[1], -e[0]])
-    angle = math.atan2(*(a - b)[::-1]) - math.atan2(*(d - c)[::-1])
-    co, si = math.cos(angle), math.sin(angle)
-    turn = np.array([[co, si], [-si, co]])
-    out = []
-    for anchor, point in ((b, c), (a, d)):
-        shift = anchor + gap * normal - point @ turn
-        out.append(_box_of(np.vstack([first, second @ turn + shift])))
-    return out
+    turn, shifts = _placements(gap, sides)
+    return [_box_of(np.vstack([first, second @ turn + shift])) for shift in shifts]
 
 
 def group(

@@ -31,7 +31,7 @@ from rigidfold.run.schema import (
 )
 from rigidfold.run.shapes import check_shape
 from rigidfold.run.verdict import RunOutcome, RunVerdict, run_verdict
-from rigidfold.run.writer import RunWriter, verification_frames, write_checked_shape
+from rigidfold.run.writer import RunWriter, verification_frames, write_checked_shape, write_report
 
 __all__ = [
     "LOCK_NAME",
@@ -61,4 +61,5 @@ __all__ = [
     "target_surface",
     "verification_frames",
     "write_checked_shape",
+    "write_report",
 ]

@@ -26,6 +26,7 @@ from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
+from rigidfold.run.lock import FINAL_DIR
 from rigidfold.structure import (
     StructureCheck,
     check_design,
@@ -34,11 +35,18 @@ from rigidfold.structure import (
     write_structure,
 )
 
-THICK_DIR = Path("final") / "thick"
+THICK_DIR = Path(FINAL_DIR) / "thick"
 """Where the thick panels' files go in the run's directory."""
 
-STRUCTURE_DIR = Path("final") / "structure"
+STRUCTURE_DIR = Path(FINAL_DIR) / "structure"
 """Where the structure check's files go in the run's directory."""
+
+
+def thick_dir_of(design: str | Path) -> Path | None:
+    """The thick panels' directory (:data:`THICK_DIR`) of the run whose solution file is
+    ``design`` (``DIR/solutions/NAME.fold``: ``DIR/final/thick``); None for another file."""
+    design = Path(design)
+    return design.parent.parent / THICK_DIR if design.parent.name == "solutions" else None
 
 
 def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> None:

@@ -17,14 +17,23 @@ TARGET_FILE = "target_surface.json"
 """The fitted spline of a mesh target (:meth:`rigidfold.surfaces.SplineSurface.grid`), which
 summary.json names under ``target_surface`` so that the report can show the fit."""
 
-RUN_FILES = ("summary.json", "log.jsonl", "report.html", TARGET_FILE)
+REPORT_FILE = "report.html"
+"""The run's report (:func:`rigidfold.run.writer.write_report`), its figures in
+:data:`FIGURES_DIR`."""
+
+FIGURES_DIR = "figures"
+
+FINAL_DIR = "final"
+"""The final design's exports, its thick panels and its structure."""
+
+RUN_FILES = ("summary.json", "log.jsonl", REPORT_FILE, TARGET_FILE)
 """The files a generation run writes at the top of its directory."""
 
 OLD_RUN_FILES = ("log.json",)
 """Files that runs of earlier rigidfold versions wrote at the top of their directory: an
 earlier run all the same (refused, or removed with ``--overwrite``)."""
 
-RUN_DIRS = ("solutions", "figures", "final")
+RUN_DIRS = ("solutions", FIGURES_DIR, FINAL_DIR)
 """The directories a generation run writes (solution files, figures, exports)."""
 
 _STEP = r"step_[0-9]+_dof_[0-9]+"

@@ -15,6 +15,7 @@ appended to, so a crash can tear only its last line, which its reader skips.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,7 @@ from rigidfold.generate import (
 from rigidfold.io import (
     FoldData,
     append_json_line,
+    atomic_write,
     crease_pattern_frame,
     motion_frames,
     prepare_output_dir,
@@ -48,7 +50,15 @@ from rigidfold.io import (
 from rigidfold.mesh import CreasePattern
 from rigidfold.run.built import check_built_options
 from rigidfold.run.checks import Checked, check_final, check_solution, traced_motion
-from rigidfold.run.lock import RUN_FILES, TARGET_FILE, clear_earlier_run, lock_run_dir
+from rigidfold.run.lock import (
+    FIGURES_DIR,
+    FINAL_DIR,
+    REPORT_FILE,
+    RUN_FILES,
+    TARGET_FILE,
+    clear_earlier_run,
+    lock_run_dir,
+)
 from rigidfold.run.schema import LOG_FILE, SCHEMA_VERSION, RunSummary, SolutionRecord
 from rigidfold.run.verdict import RunVerdict, run_verdict
 from rigidfold.structure import StructureCheck
@@ -341,7 +351,7 @@ class RunWriter:
             pattern, coords2d = self.final
             stem = self.files[-1 if final is None else final.step].stem
             self.exports = export_design(
-                pattern, coords2d, self.out / "final", name=stem, title=f"rigidfold: {stem}"
+                pattern, coords2d, self.out / FINAL_DIR, name=stem, title=f"rigidfold: {stem}"
             )
         self.log.sync(run.attempts)
         self.write_summary(run)
@@ -365,3 +375,14 @@ class RunWriter:
         """Write summary.json (atomically) as the run stands now (:meth:`summary`)."""
         write_json(self.out / "summary.json", self.summary(run).to_dict())
         self.summary_written = time.monotonic()
+
+
+def write_report(
+    directory: Path, html: str, figures: Sequence[tuple[str, bytes]]
+) -> tuple[Path, tuple[Path, ...]]:
+    """The report of the run in ``directory``: each (name, PNG) of ``figures`` as
+    ``DIR/figures/NAME`` and the page ``html`` as ``DIR/report.html``, each written
+    atomically. Returns (the page, the figures)."""
+    figure_dir = prepare_output_dir(directory / FIGURES_DIR)
+    written = tuple(atomic_write(figure_dir / name, png) for name, png in figures)
+    return atomic_write(directory / REPORT_FILE, html), written

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -24,6 +24,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
+from rigidfold.flags import option
 from rigidfold.io.files import atomic_write, jsonable, parse_json
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
@@ -42,7 +43,7 @@ from rigidfold.structure.choices import (
     parse_supports,
 )
 from rigidfold.structure.loads import LOAD_TYPES, Load, SelfWeight, check_loads, parse_load
-from rigidfold.structure.material import Material, parse_material
+from rigidfold.structure.material import Material, parse_material, presets_help
 from rigidfold.structure.supports import (
     Rigidity,
     Supports,
@@ -206,28 +207,29 @@ _TEXT_FIELDS = ("supports", "loads", "limit")
 """The fields the command line gives as text (:meth:`StructureOptions.from_strings`)."""
 
 
+def _thickness(text: str) -> float:
+    """``--thickness``: a length in metres, or with a unit (``18mm``)."""
+    from rigidfold.fabricate.build import parse_length
+
+    return parse_length(text, "thickness")
+
+
+_S = DEFAULTS.structure
+
+
 @dataclass(frozen=True)
 class StructureOptions:
     """The structure check of a design as ``rigidfold structure`` takes it (``rigidfold
     generate --structure`` builds the same), every value typed.
 
-    thickness : the panels' thickness, metres.
-    material : a preset name (:data:`~rigidfold.structure.MATERIALS`) or ``"E,nu,density"``
-        in SI units.
-    supports : :class:`Auto` (the fewest pinned ``candidates`` that make the mechanism
-        first-order rigid), :class:`Service` (those, and more until the deflection limit is
-        met: :mod:`rigidfold.structure.service`) or :class:`Pins` (pinned vertices).
-    candidates : the vertices ``auto`` may choose: None or ``"boundary"``, ``"ground"``, or
-        ``"V,V,..."``.
-    clamped : ``"V,V,..."`` clamped vertices; actuators : ``"I,J,..."`` free creases held
-        at their angle (``""``: none).
-    hinge_stiffness : N m/rad per metre of every free crease (0: free hinges).
-    loads : :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`,
-        :class:`Pressure`, :class:`Point`; a :class:`SelfWeight` among them is
-        ``self_weight``), a tuple.
-    self_weight : include the panels' weight.
-    limit : the deflection limit, a :class:`Limit`.
-    nonlinear : geometrically nonlinear analysis; modes : natural frequencies computed.
+    Each field is made by :func:`rigidfold.flags.option` with what it means, also the help of
+    its flag (:func:`rigidfold.cli_parser.add_options`: ``rigidfold structure``'s, and
+    ``generate``'s prefixed "--structure: "): a new option is a new field here. ``supports``
+    is :class:`Auto`, :class:`Service` or :class:`Pins`; ``loads`` a tuple of
+    :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`, :class:`Pressure`,
+    :class:`Point`; a :class:`SelfWeight` among them is ``self_weight``); ``limit`` a
+    :class:`Limit`; ``candidates`` None is ``"boundary"``; ``material`` a preset name
+    (:data:`~rigidfold.structure.MATERIALS`) or ``"E,nu,density"``.
 
     :meth:`from_strings` reads the command line's texts (``"auto"``, ``"uniform=0.5kPa"``,
     ``"L/250"``). Defaults from ``Settings.structure``. Every value is checked when the
@@ -235,22 +237,93 @@ class StructureOptions:
     a design by :meth:`check_indices` and :func:`plan_design`.
     """
 
-    thickness: float = DEFAULTS.structure.thickness
-    material: str = DEFAULTS.structure.material
-    supports: SupportSpec = Auto()  # noqa: RUF009 (frozen)
-    candidates: str | None = None
-    clamped: str = ""
-    actuators: str = ""
-    hinge_stiffness: float = DEFAULTS.structure.hinge_stiffness
-    loads: tuple[Load, ...] = ()
-    self_weight: bool = True
-    limit: Limit = Limit(DEFAULTS.structure.limit)  # noqa: RUF009 (frozen)
-    nonlinear: bool = False
-    modes: int = DEFAULTS.structure.modes
-    thickness_from: str = ""
-    """Where ``thickness`` came from, for the output (``structure.json``'s
-    ``thickness_from``): ``""`` given, or the words of the command line
-    (:func:`recorded_thickness`)."""
+    thickness: float = option(
+        _S.thickness,
+        "panel thickness in metres, or with a unit: 18mm, 1.8cm",
+        parse=_thickness,
+        metavar="T",
+    )
+    material: str = option(
+        _S.material,
+        f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
+        "-, kg/m^3), e.g. 10e9,0.3,700",
+        metavar="NAME|E,nu,density",
+    )
+    supports: SupportSpec = option(  # noqa: RUF009 (frozen)
+        Auto(),
+        "pinned vertices (indices of the design's vertices); auto: the fewest "
+        "--support-candidates that make the mechanism first-order rigid, of the largest "
+        "smallest stiffness eigenvalue; service: those, then one more at a time where the "
+        "design deflects most until the deflection limit is met (a linear analysis each; "
+        "added pins that are not needed are taken away again). A boundary edge whose ends "
+        "are both supported is supported along its length",
+        metavar="V,V,...|auto|service",
+        shown=Auto().text,
+    )
+    candidates: str | None = option(
+        None,
+        "the vertices auto may choose: every boundary vertex, the boundary vertices at the "
+        f"lowest height (within {_S.ground_tol:g} m), or a list",
+        name="--support-candidates",
+        metavar="boundary|ground|V,V,...",
+        shown="boundary",
+    )
+    clamped: str = option(
+        "",
+        "clamped vertices: translations and the rotations of the panels there held",
+        metavar="V,V,...",
+        shown="none",
+    )
+    actuators: str = option(
+        "",
+        "free creases (indices into the design's edges_vertices) held at their angle by "
+        "actuators: supports of a hinge",
+        metavar="I,J,...",
+        shown="none",
+    )
+    hinge_stiffness: float = option(
+        _S.hinge_stiffness,
+        "rotational stiffness of every free crease, N m/rad per metre of crease",
+        parse=float,
+        metavar="K",
+        shown=f"{_S.hinge_stiffness}, a free hinge" if _S.hinge_stiffness == 0 else None,
+    )
+    loads: tuple[Load, ...] = option(
+        (),
+        "a load besides self-weight, repeatable: uniform=Q (per m^2 of plan, downwards: "
+        "snow), pressure=Q (normal to the panels, positive pressing on the upper face: wind), "
+        "point=V:FX,FY,FZ (a force at vertex V). Q in Pa, kPa, kN/m2 or MPa (uniform=0.5kPa, "
+        "500Pa), a bare number in kPa; forces in N, kN or MN (point=12:0,0,-2kN), a bare "
+        "number in newtons",
+        name="--load",
+        metavar="KIND=VALUE",
+        repeat=True,
+    )
+    self_weight: bool = option(
+        True, "the panels' weight (density x g x thickness)", switch="leave out"
+    )
+    limit: Limit = option(  # noqa: RUF009 (frozen)
+        Limit(_S.limit),
+        "serviceability: the largest displacement may be at most the span over N; the span is "
+        "the largest plan distance between supports (twice the reach of a cantilever)",
+        metavar="L/N",
+        shown=Limit(_S.limit).text,
+    )
+    nonlinear: bool = option(
+        False,
+        f"geometrically nonlinear analysis (corotational shells, {_S.steps} load steps) "
+        "instead of a linear one",
+        switch="",
+    )
+    modes: int = option(
+        _S.modes, "natural frequencies to compute, 0 for none", parse=int, metavar="N"
+    )
+    thickness_from: str = option(
+        "",
+        "where the thickness came from, for the output (structure.json's thickness_from): "
+        "empty where it was given, else the command line's words (recorded_thickness)",
+        flag=False,
+    )
 
     def __post_init__(self) -> None:
         if not isinstance(self.material, str):
@@ -453,20 +526,18 @@ def check_design(
     return plan_design(pattern, options, settings=settings, progress=progress).check()
 
 
-def recorded_thickness(path: str | Path) -> tuple[float, Path] | None:
+def recorded_thickness(path: str | Path, also: Sequence[Path] = ()) -> tuple[float, Path] | None:
     """(the thickness, metres, that ``rigidfold fabricate`` made the panels of the design in
     FOLD file ``path``, the file that records it) or None: fabricate writes it as
     ``thickness_m`` of ``NAME_fabricate.json`` (:data:`rigidfold.fabricate.files.FABRICATE_JSON`)
     in its output directory, looked for beside the design (``fabricate DESIGN.fold --out``
-    the design's directory) and, for a run's solution ``DIR/solutions/NAME.fold``, in the
-    run's ``DIR/final/thick/`` (``generate --thickness``)."""
+    the design's directory), then in the directories ``also`` (for a run's solution, the
+    run's thick panels: :func:`rigidfold.run.built.thick_dir_of`)."""
     from rigidfold.fabricate.files import FABRICATE_JSON
 
     path = Path(path)
     name = FABRICATE_JSON.format(path.stem)
-    places = [path.parent / name]
-    if path.parent.name == "solutions":
-        places.append(path.parent.parent / "final" / "thick" / name)
+    places = [path.parent / name, *(where / name for where in also)]
     for place in places:
         try:
             data = parse_json(place.read_bytes())
