@@ -56,7 +56,7 @@ ROOF = {
 }
 MODES: dict[str, dict] = {
     "after": {},
-    "before": {"fold_limit": None},
+    "before": {"fold_limits": ()},
     "no-second-order": {"second_order": False},
     "bounded": {"rho_bar": math.radians(120.0)},
 }

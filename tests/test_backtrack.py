@@ -26,7 +26,7 @@ OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=Fa
 
 def _case(backtrack_max: int):
     # backtracking alone: no restart with the fold limit (tests/test_fold_limit.py)
-    settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max, fold_limit=None)
+    settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max, fold_limits=())
     return make_case("bezier", "1", seed=SEED, settings=settings)
 
 
@@ -110,7 +110,7 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     file."""
     case = make_case("dome", "grid:3x3")
     plain = generate(
-        make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0, fold_limit=None))
+        make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0, fold_limits=()))
     )
     run = generate_case(RunWriter(tmp_path, case, GenerateOptions(deform=False)), report=False)
     assert plain.stop is run.stop is Stop.NO_CANDIDATE

@@ -122,6 +122,21 @@ class CaseOptions:
         )
 
 
+def _angles(text: str) -> tuple[float, ...]:
+    """Comma-separated angles in degrees, each in (0, 180); "0": none."""
+    if text.strip() == "0":
+        return ()
+    try:
+        angles = tuple(float(part) for part in text.split(","))
+    except ValueError:
+        raise RigidfoldError(
+            f"must be angles in degrees separated by commas, got {text!r}"
+        ) from None
+    if not all(0 < a < 180 for a in angles):
+        raise RigidfoldError(f"each angle must lie in (0, 180) degrees, got {text!r}")
+    return angles
+
+
 def _degrees(name: str) -> float:
     return math.degrees(getattr(DEFAULTS.design, name))
 
@@ -158,14 +173,15 @@ class SettingsOptions:
         parse=positive,
         metavar="DEG",
     )
-    fold_limit: float | None = option(
+    fold_limit: tuple[float, ...] | None = option(
         None,
         "with the deployability check: where the chain's candidates do not deploy, it starts "
         "again from the initial shape with bound (12) on the fold angle of every free crease "
-        "at this angle, degrees (default: "
-        f"{math.degrees(DEFAULTS.generation.fold_limit or 0):g}; 0: no restart)",
-        parse=float,
-        metavar="DEG",
+        "at the next of these angles, degrees (default: "
+        f"{','.join(f'{math.degrees(a):g}' for a in DEFAULTS.generation.fold_limits)}; 0: no "
+        "restart)",
+        parse=_angles,
+        metavar="DEG[,DEG...]",
     )
     hessian: str = option(
         DEFAULTS.solver.ipopt_hessian,
@@ -200,8 +216,8 @@ class SettingsOptions:
     def settings(self) -> Settings:
         """The settings of these options, checked (RigidfoldError naming the setting)."""
         given: dict = {} if self.backtrack is None else {"backtrack_max": self.backtrack}
-        if self.fold_limit is not None:  # 0: none
-            given["fold_limit"] = math.radians(self.fold_limit) if self.fold_limit else None
+        if self.fold_limit is not None:  # (): none
+            given["fold_limits"] = tuple(math.radians(a) for a in self.fold_limit)
         return Settings.from_degrees(
             dz=self.dz,
             theta_min_deg=self.theta_min,

@@ -43,6 +43,7 @@ fold angles (:class:`Attempt`).
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
@@ -169,10 +170,13 @@ class _Steps:
         self.accepted: list[Attempt] = []  # the attempt of each solution
         self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
         self.backtracks = 0  # retractions by backtracking in the chain being built
-        # the restart with bound (12) at the fold limit: its case (None: no restart left)
-        bounded = with_fold_limit(case, options)
-        self.restart_case: Case | None = None if bounded is case else bounded
-        self.fold_bound = False  # whether the solves are (12)-bounded (after the restart)
+        # the restarts with bound (12) at each fold limit in turn: (limit, case) not yet used
+        self.restarts: list[tuple[float, Case]] = [
+            (limit, bounded)
+            for limit in self.settings.generation.fold_limits
+            if (bounded := with_fold_limit(case, options, limit)) is not case
+        ]
+        self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
@@ -223,7 +227,7 @@ class _Steps:
             path=None if path is None else path.to_dict(),
             path_time=t_path,
             second_order=None if second is None else second.to_dict(),
-            fold_bound=self.fold_bound,
+            fold_limit_deg=None if self.fold_limit is None else math.degrees(self.fold_limit),
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
@@ -377,7 +381,7 @@ class _Steps:
             shape.undeployable += rigid or rec.outcome is AttemptOutcome.PATH
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             limit = self.settings.generation.deploy_max_candidates
-            if self.restart_case is not None:  # a restart is left: give the shape up sooner
+            if self.restarts and self.fold_limit is None:  # the first chain: give up sooner
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
@@ -417,18 +421,20 @@ class _Steps:
         if self.deepest is None or _dof(run.solutions) < _dof(self.deepest.solutions):
             self.deepest = _Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
 
-    def restart(self, stop: Stop) -> bool:
-        """Step 7 beyond backtracking, once a run: after ``stop`` at the last solution's shape
-        (its candidates' paths do not reach the flat state, ``Settings.generation.
-        restart_after`` of them, or none is left), every solution after the initial one is
-        retracted and the chain starts again from the initial shape with bound (12) at
-        ``Settings.generation.fold_limit`` on every solve (:func:`with_fold_limit`; the
-        attempts' ``fold_bound``), with a backtracking budget of its own. Where the new chain
-        ends higher than the first, the run ends with the first (:meth:`settle`). Returns
-        whether it did."""
+    def restart(self, stop: Stop, *, after_backtracking: bool = False) -> bool:
+        """Step 7 beyond backtracking: after ``stop`` at the last solution's shape (its
+        candidates' paths do not reach the flat state, or none is left), every solution after
+        the initial one is retracted and the chain starts again from the initial shape with
+        bound (12) at the next of ``Settings.generation.fold_limits`` on every solve
+        (:func:`with_fold_limit`; the attempts' ``fold_limit_deg``), with a backtracking
+        budget of its own. The first chain is given up after ``restart_after`` rejected paths
+        at one shape, before any backtracking; a bounded chain only once its backtracking is
+        spent (``after_backtracking``). Where no later chain ends lower, the run ends with
+        the lowest (:meth:`settle`). Returns whether it did."""
         run = self.run
         if (
-            self.restart_case is None
+            not self.restarts
+            or (self.fold_limit is not None) != after_backtracking
             or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
             or len(run.solutions) < 2
         ):
@@ -437,10 +443,11 @@ class _Steps:
         while len(run.solutions) > 1:
             self.retract()
         self.shapes.clear()
+        self.fold_limit, case = self.restarts.pop(0)
         t0 = time.perf_counter()
-        self.problem = self.restart_case.problem(build_ipopt=self.options.solver == "ipopt")
+        self.problem = case.problem(build_ipopt=self.options.solver == "ipopt")
         run.build_time += time.perf_counter() - t0
-        self.restart_case, self.fold_bound, self.backtracks = None, True, 0
+        self.backtracks = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
         run.stop_detail = ""
         return True
@@ -520,7 +527,11 @@ def generate(
     steps.record(rec, trial)
     while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
         stop = steps.reduce(run.solutions[-1])
-        if stop is not None and not steps.restart(stop) and not steps.backtrack(stop):
+        if stop is not None and not (
+            steps.restart(stop)
+            or steps.backtrack(stop)
+            or steps.restart(stop, after_backtracking=True)
+        ):
             steps.settle(stop)
             _deployable_final(run, opts, case.settings)
             break
@@ -533,10 +544,11 @@ def generate(
     return run
 
 
-def with_fold_limit(case: Case, options: GenerateOptions) -> Case:
-    """The case of a run's restart (:meth:`_Steps.restart`): with the deployability check and
-    no bound (12) of the user's (``Settings.design.rho_bar``), (12) at
-    ``Settings.generation.fold_limit``; otherwise ``case`` itself (no restart).
+def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
+    """The case of a run's restart at the fold limit ``limit`` (radians;
+    :meth:`_Steps.restart`): with the deployability check and no bound (12) of the user's
+    (``Settings.design.rho_bar``), (12) at ``limit``; otherwise ``case`` itself (no
+    restart).
 
     Each fix flattens a crease, and the solve makes up for it by folding the creases left
     free further: on drawn patterns the chain ends with panels folded nearly onto each other
@@ -545,8 +557,7 @@ def with_fold_limit(case: Case, options: GenerateOptions) -> Case:
     away from that, and IPOPT's barrier on it favours the less folded of the shapes that
     solve (6)."""
     s = case.settings
-    limit = s.generation.fold_limit
-    if not options.deploy_check or s.design.rho_bar is not None or limit is None:
+    if not options.deploy_check or s.design.rho_bar is not None:
         return case
     return replace(case, settings=s.with_(rho_bar=limit))
 

@@ -122,10 +122,10 @@ class Attempt:
         At a shape whose children are checked (with or without the look-ahead): whether this
         fix was forecast to leave a second-order rigid shape (:class:`rigidfold.mechanism.
         second_order.ChildForecast`); None where no forecast was made.
-    fold_bound : bool
-        Whether the solve kept every free crease within bound (12) at
-        ``Settings.generation.fold_limit``: the attempts of the chain started again after the
-        first chain's candidates did not deploy (the restart of :mod:`rigidfold.generate`).
+    fold_limit_deg : float or None
+        The bound (12) the solve kept every free crease within, degrees: that of the chain
+        started again after the one before dead-ended (``Settings.generation.fold_limits``,
+        the restarts of :mod:`rigidfold.generate`); None in the first chain.
     """
 
     index: int
@@ -151,7 +151,7 @@ class Attempt:
     path_time: float = 0.0
     second_order: dict | None = None
     rigid_forecast: bool | None = None
-    fold_bound: bool = False
+    fold_limit_deg: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""

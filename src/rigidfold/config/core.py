@@ -135,21 +135,22 @@ class GenerationSettings(Group):
         "row were solved and found second-order rigid, instead of after "
         "``deploy_max_candidates`` (0: only that bound).",
     )
-    fold_limit: float | None = setting(
-        math.radians(120.0),
+    fold_limits: tuple[float, ...] = setting(
+        (math.radians(120.0), math.radians(90.0)),
         "With the deployability check (and no ``design.rho_bar`` of the user's): where the "
-        "run's chain dead-ends (``restart_after`` candidates of a shape whose paths do not "
-        "reach the flat state, or none left), it starts again from the initial shape with "
-        "bound (12) at this angle, radians, on every solve: each fix flattens a crease and "
+        "run's chain dead-ends, it starts again from the initial shape with bound (12) at "
+        "the next of these angles, radians, on every solve: each fix flattens a crease and "
         "the solve folds the creases left free further, and the paths of shapes with creases "
         "near 180 degrees turn back or collide before the flat state (issue 40; "
-        "docs/deployability.md). None: no restart.",
+        "docs/deployability.md). The first chain is given up after ``restart_after`` "
+        "rejected paths at one shape, a bounded one once its backtracking is spent. (): no "
+        "restart.",
     )
     restart_after: int = setting(
         5,
-        "With a ``fold_limit``: the candidates of one shape whose paths do not reach the "
+        "With ``fold_limits``: the candidates of one shape whose paths do not reach the "
         "flat state (N_path, N_rigid) after which the first chain is given up and the run "
-        "starts again with the fold limit (``deploy_max_candidates`` once it has).",
+        "starts again with the first fold limit (``deploy_max_candidates`` after that).",
     )
     summary_interval: float = setting(
         2.0,
@@ -164,10 +165,11 @@ class GenerationSettings(Group):
             raise RigidfoldError(
                 f"backtrack_max must be a whole number >= 0, got {self.backtrack_max!r}"
             )
-        if self.fold_limit is not None and not (0 < self.fold_limit < math.pi):
-            raise RigidfoldError(
-                f"fold_limit must lie in (0, 180) degrees, got {math.degrees(self.fold_limit):g}"
-            )
+        for limit in self.fold_limits:
+            if not (0 < limit < math.pi):
+                raise RigidfoldError(
+                    f"a fold limit must lie in (0, 180) degrees, got {math.degrees(limit):g}"
+                )
         if not (isinstance(self.restart_after, int) and self.restart_after >= 1):
             raise RigidfoldError(
                 f"restart_after must be a whole number >= 1, got {self.restart_after!r}"

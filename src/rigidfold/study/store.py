@@ -55,7 +55,7 @@ class StoreWriteError(RigidfoldError):
 
 # settings that change nothing without the deployability check: not compared between two
 # configurations without it (a study of the paper's Step 5 resumes whatever they are)
-CHECK_ONLY_SETTINGS = frozenset({"backtrack_max"})
+CHECK_ONLY_SETTINGS = frozenset({"backtrack_max", "fold_limits", "restart_after"})
 
 
 def config_differences(stored: dict, current: dict) -> list[str]:
@@ -78,11 +78,17 @@ def config_differences(stored: dict, current: dict) -> list[str]:
             diff += [
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
-                if k not in inert and (a.get(k, defaults.get(k)) != b.get(k) or k not in b)
+                if k not in inert
+                and (_as_json(a.get(k, defaults.get(k))) != _as_json(b.get(k)) or k not in b)
             ]
         elif a != b:
             diff.append(key)
     return diff
+
+
+def _as_json(value) -> str:
+    """A setting as stored (a tuple is a list there)."""
+    return json.dumps(value, sort_keys=True)
 
 
 def sqlite_uri(path: str | Path, mode: str) -> str:
