@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions, Generation
 from rigidfold.io import FRACTION_KEY, motion_frames, read_frames
 from rigidfold.mesh import CreasePattern
@@ -93,6 +94,19 @@ def test_summary_is_written_and_read_through_one_record():
     again = RunSummary.from_dict(text, "summary.json")
     assert again.to_dict() == text
     assert again.per_solution == tuple(records) and again.solutions == summary.solutions
+
+
+@pytest.mark.parametrize("value", [float("inf"), 3.0, [1.0], "fast"])
+def test_a_damaged_stage_time_is_bad_input(value):
+    """A solution's ``time_s`` that is no object (a fuzzed summary.json once had Infinity
+    there) is refused in one line naming it, not read into a crash."""
+    summary = RunSummary.from_run(
+        Generation(), [_record()], stage_times={}, options={}, case={}, solutions=("a",)
+    )
+    data = json.loads(json.dumps(summary.to_dict()))
+    data["per_solution"][0]["time_s"] = value
+    with pytest.raises(RigidfoldError, match=r"per_solution\[0\]\.time_s"):
+        RunSummary.from_dict(data, "summary.json")
 
 
 def test_generate_options_validate_and_round_trip():

@@ -82,6 +82,7 @@ SUMMARY_SHAPE = Record(
                 {
                     "step": Nullable(int),
                     "dof": Nullable(int),
+                    "time_s": Nullable(Record({})),
                     "development": Nullable(
                         Record(
                             {
