@@ -69,21 +69,30 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         fold_limits=tuple(math.radians(a) for a in limits),
     )
     case = make_case("bezier", "1", seed=1, settings=settings)
-    run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
+    taken_at_once: list[int] = []
+    run = generate(
+        case,
+        criterion="s",
+        seed=1,
+        lookahead=True,
+        deform=False,
+        on_retract=lambda _run, taken: taken_at_once.append(len(taken)),
+    )
 
     chains: dict = {}
     for attempt in run.attempts:
         chains.setdefault(attempt.fold_limit_deg, []).append(attempt)
     assert list(chains) == [None, *(pytest.approx(a) for a in limits)]
-    retracted = 0
+    retracted = []
     for limit, attempts in list(chains.items())[:2]:  # the chains given up
         # the made-up dead end (its second-order test may find it rigid too)
         assert attempts[-1].outcome in (AttemptOutcome.PATH, AttemptOutcome.RIGID)
         accepted = [a for a in attempts if a.outcome is AttemptOutcome.DEAD_END]
-        retracted += len(accepted)
+        retracted.append(len(accepted))
         assert len(accepted) == len(attempts) - (2 if limit is None else 1)
+    assert taken_at_once == retracted  # each chain taken back in one call
     assert chains[None][0].outcome is AttemptOutcome.ACCEPTED  # the initial shape is kept
-    assert retracted == run.n_backtrack
+    assert sum(retracted) == run.n_backtrack
     assert run.stop is Stop.TARGET_REACHED and run.final is not None
     assert run.final.path is not None and run.final.path.deploys
     tol = math.degrees(math.sqrt(2 * DEFAULTS.solver.constraint_tol)) + 1e-6

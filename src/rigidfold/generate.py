@@ -145,7 +145,7 @@ class _Steps:
         options: GenerateOptions,
         on_attempt: Callable[[Generation, Attempt], None] | None,
         on_solution: Callable[[Generation, Solution], None] | None,
-        on_retract: Callable[[Generation, Solution], None] | None = None,
+        on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None = None,
     ) -> None:
         self.case, self.options, self.settings = case, options, case.settings
         self.on_attempt, self.on_solution, self.on_retract = on_attempt, on_solution, on_retract
@@ -440,8 +440,7 @@ class _Steps:
         ):
             return False
         self.keep_deepest(stop)
-        while len(run.solutions) > 1:
-            self.retract()
+        self.retract(keep=1)
         self.shapes.clear()
         self.fold_limit, case = self.restarts.pop(0)
         t0 = time.perf_counter()
@@ -452,14 +451,19 @@ class _Steps:
         run.stop_detail = ""
         return True
 
-    def retract(self) -> None:
-        """Take back the last solution: its attempt's outcome becomes DEAD_END."""
+    def retract(self, keep: int | None = None) -> None:
+        """Take back the last solution (``keep`` given: every solution after the first
+        ``keep``): their attempts' outcome becomes DEAD_END; the callback sees them at once,
+        the last first."""
         run = self.run
-        solution = run.solutions.pop()
-        self.accepted.pop().outcome = AttemptOutcome.DEAD_END
-        run.n_backtrack += 1
-        if self.on_retract:
-            self.on_retract(run, solution)
+        keep = len(run.solutions) - 1 if keep is None else keep
+        taken: list[Solution] = []
+        while len(run.solutions) > keep:
+            taken.append(run.solutions.pop())
+            self.accepted.pop().outcome = AttemptOutcome.DEAD_END
+            run.n_backtrack += 1
+        if self.on_retract and taken:
+            self.on_retract(run, tuple(taken))
 
     def settle(self, stop: Stop) -> None:
         """The run ends with ``stop`` at its last shape; where backtracking had left a chain
@@ -474,8 +478,7 @@ class _Steps:
             if a is not b:
                 break
             common += 1
-        while len(run.solutions) > common:
-            self.retract()
+        self.retract(keep=common)
         for solution, rec in zip(
             deepest.solutions[common:], deepest.accepted[common:], strict=True
         ):
@@ -496,13 +499,14 @@ def generate(
     *,
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
-    on_retract: Callable[[Generation, Solution], None] | None = None,
+    on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None = None,
     **changes,
 ) -> Generation:
     """Run Steps 2-7 on a case; callbacks see every attempt, every accepted solution and
-    every solution retracted by backtracking (``on_retract``, after it has left
-    ``run.solutions`` and its attempt's outcome became DEAD_END: the last solution seen by
-    ``on_solution``; the next solution takes its step).
+    the solutions retracted by backtracking or a restart (``on_retract(run, taken)``, once
+    they have left ``run.solutions`` and their attempts' outcome became DEAD_END: ``taken``
+    the last solutions seen by ``on_solution``, the last first, one call for each
+    retraction however many it takes back; the next solution takes the step of the earliest).
 
     ``options`` (default :class:`GenerateOptions`'s defaults) with ``changes`` to its fields
     given as keywords, e.g. ``generate(case, criterion="s", target_dof=2)``. With mirror

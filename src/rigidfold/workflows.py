@@ -339,9 +339,10 @@ def generate_case(
     report: bool = True,
 ) -> Generation:
     """Steps 2-9 on ``writer.case`` with ``writer.options``, every attempt and solution
-    written by ``writer`` as it comes (so an interrupt loses nothing), a solution retracted
-    by backtracking removed (:meth:`rigidfold.run.RunWriter.on_retract`); ``progress(run,
-    attempt)`` after each of them. ``summary.json`` is written once more at the end, with
+    written by ``writer`` as it comes (so an interrupt loses nothing), the solutions
+    retracted by backtracking or a restart removed at once
+    (:meth:`rigidfold.run.RunWriter.on_retract`); ``progress(run, attempt)`` after each of
+    them. ``summary.json`` is written once more at the end, with
     the run's verdict (``writer.verdict``, :func:`rigidfold.run.run_verdict`); then, with
     ``report``, ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is
     released at the end, however the run ends. A KeyboardInterrupt (Ctrl-C, SIGTERM from the
@@ -360,8 +361,8 @@ def generate_case(
         if progress:
             progress(run, None)
 
-    def on_retract(run: Generation, solution) -> None:
-        writer.on_retract(run, solution)
+    def on_retract(run: Generation, taken) -> None:
+        writer.on_retract(run, taken)
         if progress:
             progress(run, None)
 

@@ -278,18 +278,20 @@ class RunWriter:
         self.log.sync(run.attempts)  # backtracking may have accepted its attempt again
         self.write_summary(run)
 
-    def on_retract(self, run: Generation, solution: Solution) -> None:
-        """Backtracking retracted the last solution: its FOLD and SVG files leave
-        ``solutions/`` and its record summary.json (the run stays a chain, and the next
-        solution takes its step); its attempt is appended to the log again, with the outcome
-        DEAD_END."""
-        assert self.solutions and self.solutions[-1] is solution, "not the last solution"
-        self.solutions.pop()
-        self.records.pop()
-        self.checked.pop(solution.step, None)
-        fold = self.files.pop()
-        for path in (fold, fold.with_suffix(".svg")):
-            path.unlink(missing_ok=True)
+    def on_retract(self, run: Generation, taken: tuple[Solution, ...]) -> None:
+        """Backtracking or a restart retracted the last solutions (``taken``, the last
+        first): their FOLD and SVG files leave ``solutions/`` and their records summary.json
+        (the run stays a chain, and the next solution takes the first one's step); their
+        attempts are appended to the log again, with the outcome DEAD_END; summary.json is
+        written once."""
+        for solution in taken:
+            assert self.solutions and self.solutions[-1] is solution, "not the last solution"
+            self.solutions.pop()
+            self.records.pop()
+            self.checked.pop(solution.step, None)
+            fold = self.files.pop()
+            for path in (fold, fold.with_suffix(".svg")):
+                path.unlink(missing_ok=True)
         self.log.sync(run.attempts)
         self.write_summary(run)
 

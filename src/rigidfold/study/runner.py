@@ -149,8 +149,8 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         checked = check_solution(solution, case, options, motion=False, deform=True)
         records.append(checked.record)
 
-    def retract() -> None:  # backtracking retracted the last solution checked
-        records.pop()
+    def retract(taken) -> None:  # backtracking or a restart retracted the last solutions
+        del records[len(records) - len(taken) :]
 
     row: dict = {
         "version": __version__,
@@ -170,7 +170,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             case,
             options.replace(criterion=key.criterion, seed=key.seed),
             on_solution=(lambda _run, solution: check(solution)) if every else None,
-            on_retract=(lambda _run, _solution: retract()) if every else None,
+            on_retract=(lambda _run, taken: retract(taken)) if every else None,
         )
         final = run.final
         if final is not None and final.path is None:  # the paper's method: trace it after
