@@ -5,12 +5,12 @@ every rejected candidate was rejected; in each mode of :data:`MODES` (rigidfold'
 second-order test, ``no-second-order``; every solve bounded, ``bounded``), in the same
 process.
 
-Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only TEXT]
-[--modes after,before,no-second-order]``. Every run uses S-hat with the look-ahead and the
-deployability check, as the README recommends, and ``--time-limit`` (180 s for a drawn
-pattern, 420 s for the roof; ``--limit S`` for all): a run that hits it ends with its best
-design, counted as not reaching DOF 1. Each run's wall and CPU seconds are printed: on a
-machine shared with other jobs, the CPU time is the run's own.
+Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only
+TEXT[,TEXT...]] [--modes after,before,no-second-order]``. Every run uses S-hat with the
+look-ahead and the deployability check, as the README recommends, and ``--time-limit`` (180
+s for a drawn pattern, 420 s for the roof; ``--limit S`` for all): a run that hits it ends
+with its best design, counted as not reaching DOF 1. Each run's wall and CPU seconds are
+printed: on a machine shared with other jobs, the CPU time is the run's own.
 
 Cases: Origami Simulator's patterns in tests/data/origami_simulator (waterbomb, Huffman's
 waterbomb, Resch's triangles, Miura-ori, Lang's wedge, the polygami cross, the sharp-angle
@@ -164,7 +164,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", type=Path, default=None)
-    parser.add_argument("--only", default=None, metavar="TEXT", help="cases whose name holds it")
+    parser.add_argument(
+        "--only",
+        default=None,
+        metavar="TEXT[,TEXT...]",
+        help="cases whose name holds one of these comma-separated texts",
+    )
     parser.add_argument("--modes", default="after,before", help="comma-separated modes of MODES")
     parser.add_argument(
         "--paper",
@@ -193,7 +198,8 @@ def main() -> None:
     for c in every:
         c["lookahead"] = not args.no_lookahead
         c["limit"] = args.limit or c["limit"]
-    chosen = [c for c in every if args.only is None or args.only in name(c)]
+    wanted = None if args.only is None else args.only.split(",")
+    chosen = [c for c in every if wanted is None or any(w in name(c) for w in wanted)]
     work = [(c, m) for c in chosen for m in modes]
     rows = []
     with ProcessPoolExecutor(args.jobs) as pool:

@@ -47,9 +47,9 @@ def test_the_restart_case_has_bound_12_at_the_limit():
 def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch):
     """The first two DOF-1 candidates' paths are made to turn back: with ``restart_after``
     1 the first chain is given up at the first; the chain bounded at 60 degrees, whose
-    backtracking is spent (``backtrack_max`` 0), at the second; the chain bounded at 40
-    degrees (pattern 1 folds to about 50 on the way) keeps every free crease within it down
-    to a DOF-1 design that deploys."""
+    budget of rejected paths (``deploy_max_candidates`` 1) is spent, at the second, without
+    backtracking; the chain bounded at 40 degrees (pattern 1 folds to about 50 on the way)
+    keeps every free crease within it down to a DOF-1 design that deploys."""
     real = generation.trace_path
     calls = []
 
@@ -65,7 +65,6 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
     settings = DEFAULTS.with_(
         restart_after=1,
         deploy_max_candidates=1,
-        backtrack_max=0,
         fold_limits=tuple(math.radians(a) for a in limits),
     )
     case = make_case("bezier", "1", seed=1, settings=settings)
@@ -90,7 +89,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         accepted = [a for a in attempts if a.outcome is AttemptOutcome.DEAD_END]
         retracted.append(len(accepted))
         assert len(accepted) == len(attempts) - (2 if limit is None else 1)
-    assert taken_at_once == retracted  # each chain taken back in one call
+    assert taken_at_once == retracted  # each chain taken back in one call, none backtracked
     assert chains[None][0].outcome is AttemptOutcome.ACCEPTED  # the initial shape is kept
     assert sum(retracted) == run.n_backtrack
     assert run.stop is Stop.TARGET_REACHED and run.final is not None

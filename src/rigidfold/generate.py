@@ -170,6 +170,7 @@ class _Steps:
         self.accepted: list[Attempt] = []  # the attempt of each solution
         self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
         self.backtracks = 0  # retractions by backtracking in the chain being built
+        self.rejected = 0  # the chain's candidates whose paths do not reach the flat state
         # the restarts with bound (12) at each fold limit in turn: (limit, case) not yet used
         self.restarts: list[tuple[float, Case]] = [
             (limit, bounded)
@@ -378,20 +379,33 @@ class _Steps:
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
             rigid = rec.outcome is AttemptOutcome.RIGID
-            shape.undeployable += rigid or rec.outcome is AttemptOutcome.PATH
+            rejected = rigid or rec.outcome is AttemptOutcome.PATH
+            shape.undeployable += rejected
+            self.rejected += rejected
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             limit = self.settings.generation.deploy_max_candidates
             if self.restarts and self.fold_limit is None:  # the first chain: give up sooner
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
-            if shape.undeployable >= limit > 0 or (  # bounded cost
-                shape.forecast is not None
-                and shape.forecast.dead_end
-                and shape.rigid_in_row >= confirm > 0
+            if (
+                shape.undeployable >= limit > 0
+                or self.spent()
+                or (  # bounded cost
+                    shape.forecast is not None
+                    and shape.forecast.dead_end
+                    and shape.rigid_in_row >= confirm > 0
+                )
             ):
                 self.run.stop_detail = str(shape.undeployable)
                 return Stop.NO_DEPLOYABLE
+
+    def spent(self) -> bool:
+        """Whether the chain, bounded and with a further fold limit, has had as many
+        candidates rejected by their paths (N_path, N_rigid) as ``deploy_max_candidates``,
+        at whatever shapes: it is then given up for the next limit, not backtracked."""
+        budget = self.settings.generation.deploy_max_candidates
+        return self.fold_limit is not None and bool(self.restarts) and self.rejected >= budget > 0
 
     def backtrack(self, stop: Stop) -> bool:
         """Step 7 beyond the last fix: after ``stop`` at the last solution's shape, retract
@@ -428,13 +442,15 @@ class _Steps:
         bound (12) at the next of ``Settings.generation.fold_limits`` on every solve
         (:func:`with_fold_limit`; the attempts' ``fold_limit_deg``), with a backtracking
         budget of its own. The first chain is given up after ``restart_after`` rejected paths
-        at one shape, before any backtracking; a bounded chain only once its backtracking is
-        spent (``after_backtracking``). Where no later chain ends lower, the run ends with
-        the lowest (:meth:`settle`). Returns whether it did."""
+        at one shape, before any backtracking; a bounded chain once its backtracking is spent
+        (``after_backtracking``) or, where a further limit is left, once
+        ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
+        shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
+        (:meth:`settle`). Returns whether it did."""
         run = self.run
         if (
             not self.restarts
-            or (self.fold_limit is not None) != after_backtracking
+            or not (after_backtracking or self.fold_limit is None or self.spent())
             or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
             or len(run.solutions) < 2
         ):
@@ -446,7 +462,7 @@ class _Steps:
         t0 = time.perf_counter()
         self.problem = case.problem(build_ipopt=self.options.solver == "ipopt")
         run.build_time += time.perf_counter() - t0
-        self.backtracks = 0
+        self.backtracks = self.rejected = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
         run.stop_detail = ""
         return True

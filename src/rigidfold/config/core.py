@@ -143,8 +143,9 @@ class GenerationSettings(Group):
         "the solve folds the creases left free further, and the paths of shapes with creases "
         "near 180 degrees turn back or collide before the flat state (issue 40; "
         "docs/deployability.md). The first chain is given up after ``restart_after`` "
-        "rejected paths at one shape, a bounded one once its backtracking is spent. (): no "
-        "restart.",
+        "rejected paths at one shape; a bounded one once its backtracking is spent or, where "
+        "a further limit is left, once ``deploy_max_candidates`` of its candidates' paths "
+        "were rejected, at whatever shapes. (): no restart.",
     )
     restart_after: int = setting(
         5,
