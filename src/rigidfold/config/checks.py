@@ -98,7 +98,9 @@ class PathSettings(Group):
         "independent rows and the tangent, unregularised, with a Gauss-Newton corrector (the "
         "residual's part in the self-stresses is left, spread by least squares); where that "
         "stalls too, J's near flexes (``path_escape_tol``) are held and their near "
-        "self-stresses' rows dropped as well. Every row is still met to ``path_tol``: where "
+        "self-stresses' rows dropped as well (as where a trace of constraints without "
+        "redundant rows stalls after its dense steps, ``path_escape_tol``). Every row is "
+        "still met to ``path_tol``: where "
         "the least-squares residual exceeds it, the path stops short there. Up to "
         "``mechanism_second_order_vertices`` vertices.",
     )
@@ -108,7 +110,9 @@ class PathSettings(Group):
         "singular or bifurcation point, where the regularised systems lose the corrections), "
         "the null space of the constraint Jacobian there is taken from a dense SVD: the "
         "singular values below this times the largest. The path continues along it (the last "
-        "tangent's part in it, else the part of the steepest descent of the folding measure), "
+        "tangent's part in it, else the branches of the bifurcation equation in the plane of "
+        "the two smallest singular vectors, else the part of the steepest descent of the "
+        "folding measure), "
         "corrected by Gauss-Newton with the pseudo-inverse truncated at "
         "``mechanism_rank_tol`` to ``path_tol``; up to ``mechanism_second_order_vertices`` "
         "vertices.",

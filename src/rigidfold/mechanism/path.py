@@ -27,7 +27,8 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
   with a Gauss-Newton corrector: each step removes the residual's part outside the
   self-stresses and leaves the part W W^T c, spread over their rows as least squares does
   (where that stalls too, J's near flexes are held and the rows of their near self-stresses
-  dropped as well).
+  dropped as well; so too where a trace of n - 1 rows, none redundant, stalls after its
+  dense steps past stalls).
   Every row is still met to ``path_tol``; where the least-squares residual itself exceeds
   it (a *near* self-stress, its singular value below the rank threshold but not zero,
   strains the constraints in proportion to the distance moved), no rigid folding within
@@ -246,7 +247,8 @@ def _trace_direction(
     x, h, travelled, slope_sign, slow, escapes = x0.copy(), first, 0.0, 0, 0, 0
     rows: np.ndarray | None = None  # the independent rows, once the redundant ones are dropped
     frozen: np.ndarray | None = None  # near flexes held, once their near stresses are dropped
-    near_stress = 0.0  # then J's smallest singular value over its largest
+    near_stress = (0.0, 0.0)  # then J's near singular values over its largest (least, most)
+    strained: tuple[float, float] | None = None  # the largest step since x that strains
     best = 1.0  # the smallest measure so far
     lowest = np.inf  # DOF 1: the smallest measure since m first fell
     while True:
@@ -282,6 +284,8 @@ def _trace_direction(
         y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings, rows, frozen)
         tr.factorizations += nf
         beyond = None if ok else _beyond_tolerance(cons, y, new, settings)
+        if beyond is not None and strained is None:
+            strained = (step, beyond)
         if ok and mode != "descent":  # the tangent must not turn too far in one step
             chord = y - x
             ok = float(chord @ unit) > np.cos(settings.path.max_turn) * np.linalg.norm(chord)
@@ -294,7 +298,8 @@ def _trace_direction(
                 reduced = _reduce(cons, x, t, settings)
                 tr.factorizations += 1
                 if reduced is not None:  # go on by the square system of the independent rows
-                    rows, system, near_stress = reduced
+                    rows, system, sigma = reduced
+                    near_stress = (sigma, sigma)
                     mode, t, h = "augmented", system.direction(t, rho), first
                     det_sign = system.factors.det_sign
                     tr.dropped_rows = cons.n_rows - len(rows)
@@ -310,23 +315,30 @@ def _trace_direction(
                     tr.dropped_rows = cons.n_rows - len(rows)
                     continue
             if beyond is not None:  # the constraints have no solution within path_tol here
+                assert strained is not None
+                residual = float(np.abs(cons.residual(x)).max())
                 return (
                     tr,
                     PathStatus.STOPS_SHORT,
-                    (
-                        f"no rigid folding within path_tol ({settings.path.tol:g}) goes on from "
-                        f"m = {tr.measure[-1]:.3g} of the design's: a step of "
-                        f"{step / rms:.2g} mean edge lengths leaves a least-squares residual "
-                        f"of {beyond:.2g} in the constraints' near self-stress (singular value "
-                        f"{near_stress:.2g} of the largest), which no correction removes: the "
-                        "shape moves on only by straining its panels"
-                    ),
+                    _strained(tr, strained, (step, beyond), near_stress, residual, rms, settings),
                 )
             escaped = (
                 _escape(cons, x, t, rho, first, mode, settings, rows, frozen)
                 if escapes < settings.path.max_escapes
                 else None
             )
+            if escaped is None and mode == "augmented" and rows is None and frozen is None:
+                # a trace of n - 1 rows (none redundant) past its dense steps: J's near
+                # flexes are held and their near self-stresses' rows dropped, as above
+                assert t is not None
+                held = _hold_near_flexes(cons, x, t, settings)
+                tr.factorizations += 1
+                if held is not None:
+                    rows, frozen, system, near_stress = held
+                    t, h = system.direction(t, rho), first
+                    det_sign = system.factors.det_sign
+                    tr.dropped_rows = cons.n_rows - len(rows)
+                    continue
             if escaped is None:
                 return (
                     tr,
@@ -357,6 +369,7 @@ def _trace_direction(
                 ),
             )
         travelled += float(np.linalg.norm(y - x))
+        strained = None
         x, rho, system = y, rho_y, new
         if mode != "descent":
             t = system.direction(t, rho)
@@ -425,9 +438,10 @@ def _escape(
 ) -> tuple[np.ndarray, np.ndarray, System, str] | None:
     """One step past the point x where the sparse continuation stalled (see
     ``Settings.path.escape_tol``): the null space N of J at x from a dense SVD; the
-    directions tried are the last tangent's part in N (the branch continued), where N is a
-    plane the branches of the bifurcation equation in it (see :func:`_branches`: branch
-    switching), and the part of the steepest descent of the folding measure (a branch
+    directions tried are the last tangent's part in N (the branch continued), where N has
+    two or more columns the branches of the bifurcation equation in the plane of J's two
+    smallest singular vectors, the path's and its nearest flex (see :func:`_branches`:
+    branch switching), and the part of the steepest descent of the folding measure (a branch
     towards flat); each step of ``first``, a quarter, a sixteenth. A 1-DOF trace corrects it
     by the square system ``[J_rows; d^T]`` of the independent rows (dropped here if the
     constraints are self-stressed and ``rows`` is None) with the Gauss-Newton corrector of
@@ -448,9 +462,11 @@ def _escape(
         return None
     square = mode != "descent"
     tries = [] if t is None else [N @ (N.T @ t)]
-    if square and N.shape[1] == 2:
+    if square and N.shape[1] >= 2:
+        # the plane of the two smallest singular values (the path's and a near flex)
+        plane = vt[cons.n - 2 :].T
         stresses = np.hstack([U[:, : len(s)][:, small[: len(s)]], U[:, len(s) :]])
-        tries += _branches(cons, x, N, stresses, rho, settings)
+        tries += _branches(cons, x, plane, stresses, rho, settings)
     tries.append(N @ (N.T @ -(J_rho.T @ rho)))
     if square and rows is None and cons.n_rows > cons.n - 1:
         rows = rows_without_stresses(U, cons.n, 1)
@@ -553,7 +569,7 @@ def _reduce(
 
 def _hold_near_flexes(
     cons: RigidFoldingConstraints, x: np.ndarray, t: np.ndarray, settings: Settings
-) -> tuple[np.ndarray, np.ndarray, System, float] | None:
+) -> tuple[np.ndarray, np.ndarray, System, tuple[float, float]] | None:
     """Where the square system of the independent rows stalls too, at x: J's near flexes
     there (right singular vectors of singular values below ``path_escape_tol`` of the
     largest, but for the smallest, the path's own) are held, ``frozen`` (n, k), and the rows
@@ -561,14 +577,16 @@ def _hold_near_flexes(
     residual is then left to the Gauss-Newton corrector's least squares and checked
     against ``path_tol`` like that of the exact self-stresses, rather than removed by
     moves of residual / sigma along the near flexes, which Newton's method cannot make.
-    Returns (rows, frozen, the factored system at x, the largest such singular value over
-    the largest one), or None (no near flex, an exactly singular system, or more than
-    ``mechanism_second_order_vertices`` vertices)."""
+    Returns (rows, frozen, the factored system at x, (the smallest, the largest) of those
+    singular values over the largest one), or None (no near flex, an exactly singular
+    system, or more than ``mechanism_second_order_vertices`` vertices)."""
     if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
         return None
     J, J_rho = cons.jacobian(x)
     U, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
-    near = np.flatnonzero(s[:-1] <= settings.path.escape_tol * s[0])
+    values = np.zeros(cons.n)  # J's n singular values: zeros past the m of a J of m < n rows
+    values[: min(len(s), cons.n)] = s[: cons.n]
+    near = np.flatnonzero(values[:-1] <= settings.path.escape_tol * values[0])
     if not len(near):
         return None
     frozen = vt[near].T
@@ -577,7 +595,43 @@ def _hold_near_flexes(
         system = System(J, J_rho, "augmented", t, settings, rows, frozen)
     except RuntimeError:
         return None
-    return rows, frozen, system, float(s[near].max() / s[0])
+    return (
+        rows,
+        frozen,
+        system,
+        (float(values[near].min() / s[0]), float(values[near].max() / s[0])),
+    )
+
+
+def _strained(
+    tr: _Trace,
+    first: tuple[float, float],
+    last: tuple[float, float],
+    near_stress: tuple[float, float],
+    residual: float,
+    rms: float,
+    settings: Settings,
+) -> str:
+    """The message of a path that stops short where every step leaves a least-squares
+    residual above ``path_tol``: ``first`` and ``last`` (step, residual) the largest and the
+    smallest step tried from the last point (steps in rms vertex displacements, ``rms`` one
+    mean edge length of them), ``near_stress`` the near singular values (least, most) whose
+    self-stresses' rows were dropped, ``residual`` the largest |c| at the last point."""
+    lo, hi = near_stress
+    values = f"singular value {hi:.2g}" if lo == hi else f"singular values {lo:.2g} to {hi:.2g}"
+    steps = f"a step of {last[0] / rms:.2g} mean edge lengths leaves a least-squares residual of"
+    if first[0] > last[0]:
+        steps = (
+            f"a step of {first[0] / rms:.2g} mean edge lengths leaves a least-squares residual "
+            f"of {first[1]:.2g}, one of {last[0] / rms:.2g} still"
+        )
+    return (
+        f"no rigid folding within path_tol ({settings.path.tol:g}) goes on from "
+        f"m = {tr.measure[-1]:.3g} of the design's: {steps} {last[1]:.2g} in the constraints' "
+        f"near self-stress ({values} of the largest; the last point's residual "
+        f"{residual:.2g}), which no correction removes: the shape moves on only by straining "
+        "its panels"
+    )
 
 
 def _beyond_tolerance(
