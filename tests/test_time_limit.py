@@ -60,3 +60,30 @@ def test_generate_stops_at_the_limit_between_solves():
 def test_a_time_limit_must_be_a_positive_number_of_seconds(bad):
     with pytest.raises(RigidfoldError, match="time limit"):
         GenerateOptions(time_limit=bad)
+
+
+def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatch):
+    """Stopped by its time limit at DOF 9, a run whose solutions' paths deploy down to DOF
+    15 and none below names the DOF-15 solution after about log2 of its solutions' traces,
+    not one trace per solution from the last back."""
+    import math
+    from types import SimpleNamespace
+
+    import rigidfold.generate as generation
+
+    traced: list[int] = []
+
+    def deploys_down_to_15(pattern, *, dof, **_):
+        traced.append(dof)
+        return SimpleNamespace(deploys=dof >= 15)
+
+    solves = iter(range(10**6))
+    monkeypatch.setattr(generation, "trace_path", deploys_down_to_15)
+    monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: next(solves) >= 12)
+    options = GenerateOptions(deform=False, time_limit=3600.0)
+    run = generate(make_case("bezier", "1", seed=1), options)
+    assert run.stop is Stop.TIME_LIMIT
+    dofs = [s.mechanism.dof for s in run.solutions]
+    assert min(dofs) < 15 <= max(dofs)
+    assert run.final is not None and run.final.mechanism.dof == 15
+    assert 0 < len(traced) <= math.ceil(math.log2(len(dofs))) + 1 < len(dofs) - dofs.index(15)

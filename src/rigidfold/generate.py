@@ -553,7 +553,7 @@ def generate(
             or steps.restart(stop, after_backtracking=True)
         ):
             steps.settle(stop)
-            _deployable_final(run, opts, case.settings)
+            _deployable_final(run, opts, case.settings, bisect=stop is Stop.TIME_LIMIT)
             break
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
@@ -624,13 +624,24 @@ def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
     return AttemptOutcome.LOCK if mech.has_lock else AttemptOutcome.ACCEPTED
 
 
-def _deployable_final(run: Generation, options: GenerateOptions, settings: Settings) -> None:
+def _deployable_final(
+    run: Generation, options: GenerateOptions, settings: Settings, *, bisect: bool
+) -> None:
     """With the deployability check, a run that ends short of its target names as its final
     design the lowest-DOF solution whose folding path reaches the flat state (tracing the
-    paths not yet traced, from the last solution back); none: the last solution."""
+    paths not yet traced, from the last solution back); none: the last solution.
+
+    A run stopped by its time limit (``bisect``) bisects the chain instead, so that the
+    limit is not overrun by up to K traces of its K solutions (the many-DOF paths above the
+    lowest are the slow ones) but about log2(K): it names a solution whose own path deploys
+    and none of whose probed successors' does. Where the chain's paths deploy down to some
+    DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
+    the lowest-DOF solution that deploys, as the scan finds it.
+    """
     if not options.deploy_check:
         return
-    for solution in reversed(run.solutions):
+
+    def deploys(solution: Solution) -> bool:
         if solution.path is None:
             solution.path = trace_path(
                 solution.result.pattern,
@@ -638,7 +649,20 @@ def _deployable_final(run: Generation, options: GenerateOptions, settings: Setti
                 support_face=options.support_face,
                 settings=settings,
             )
-        if solution.path.deploys:
+        return solution.path.deploys
+
+    chain = run.solutions
+    if bisect:
+        known = [s.step for s in chain if s.path is not None and s.path.deploys]
+        lo, hi = (max(known) if known else -1), len(chain)  # deploys at lo; not known above
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
+        if lo >= 0:
+            run.final_step = chain[lo].step
+        return
+    for solution in reversed(chain):
+        if deploys(solution):
             run.final_step = solution.step
             return
 
