@@ -116,3 +116,37 @@ def test_the_command_line_limits_in_degrees():
     for bad in ("200", "abc", "90,"):
         with pytest.raises(RigidfoldError):
             flag.parse(bad)
+
+
+def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypatch):
+    """Under bound (12) a shape whose candidates' solves do not converge (N_exceed) is given
+    up after ``deploy_max_candidates`` of them, not after every candidate (the paper's Step
+    7, which the unbounded chain keeps); the run ends with the chain that got lowest."""
+    real_solve, real_trace = generation._Steps.solve, generation.trace_path
+    traces = []
+
+    def first_turns_back(pattern, **kwargs):
+        path = real_trace(pattern, **kwargs)
+        traces.append(path)
+        return (
+            dataclasses.replace(path, status=PathStatus.TURNED_BACK) if len(traces) == 1 else path
+        )
+
+    def bounded_solves_fail(self, *args):
+        rec, trial = real_solve(self, *args)
+        if self.fold_limit is not None:
+            rec.outcome = AttemptOutcome.EXCEED
+        return rec, trial
+
+    monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    monkeypatch.setattr(generation._Steps, "solve", bounded_solves_fail)
+    settings = DEFAULTS.with_(
+        restart_after=1, deploy_max_candidates=2, fold_limits=(math.radians(60.0),)
+    )
+    run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
+    bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
+    assert [a.outcome for a in bounded] == [AttemptOutcome.EXCEED] * 2
+    assert run.stop is Stop.NO_DEPLOYABLE  # the first chain's stop, with its chain
+    assert run.final_dof == run.lowest_dof > 1  # the first chain, taken back again
+    accepted = [a for a in run.attempts if a.outcome is AttemptOutcome.ACCEPTED]
+    assert len(accepted) == len(run.solutions) and all(a.fold_limit_deg is None for a in accepted)

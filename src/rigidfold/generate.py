@@ -112,14 +112,16 @@ class _Trial:
 class _Shape:
     """Step 6 at one accepted shape, kept while the shape may be reduced again: the ranked
     crease groups with their scores, the candidates not yet tried (an iterator, lazy with
-    look-ahead), the candidates whose paths did not reach the flat state, and the seconds of
-    selection not yet charged to an attempt."""
+    look-ahead), the candidates whose paths did not reach the flat state, the candidates
+    that failed for any reason, and the seconds of selection not yet charged to an
+    attempt."""
 
     solution: Solution
     ranked: list
     order: Iterator[Choice]
     forecast: ChildForecast | None = None
     undeployable: int = 0
+    failed: int = 0
     rigid_in_row: int = 0
     t_sel: float = 0.0
 
@@ -381,6 +383,7 @@ class _Steps:
             rigid = rec.outcome is AttemptOutcome.RIGID
             rejected = rigid or rec.outcome is AttemptOutcome.PATH
             shape.undeployable += rejected
+            shape.failed += 1
             self.rejected += rejected
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             limit = self.settings.generation.deploy_max_candidates
@@ -388,8 +391,11 @@ class _Steps:
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
+            budget = self.settings.generation.deploy_max_candidates
+            bounded = self.fold_limit is not None  # a solve that fails costs its iterations
             if (
                 shape.undeployable >= limit > 0
+                or (bounded and shape.failed >= budget > 0)
                 or self.spent()
                 or (  # bounded cost
                     shape.forecast is not None
@@ -397,7 +403,7 @@ class _Steps:
                     and shape.rigid_in_row >= confirm > 0
                 )
             ):
-                self.run.stop_detail = str(shape.undeployable)
+                self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
 
     def spent(self) -> bool:

@@ -106,7 +106,10 @@ class GenerationSettings(Group):
         "Step 7 gives up on a shape once this many of its candidates gave solutions whose "
         "folding paths do not reach the flat state (``Stop.NO_DEPLOYABLE``; 0: it tries them "
         "all): every candidate costs a solve and a trace, and a shape whose first candidates "
-        "all fail rarely has a deployable one further down the ranking.",
+        "all fail rarely has a deployable one further down the ranking. In a chain bounded "
+        "by a fold limit (``fold_limits``), a shape is also given up after this many failed "
+        "candidates of any kind: under the bound, solves that do not converge (N_exceed) "
+        "each cost a full solve, and the paper's Step 7 would try every candidate.",
     )
     backtrack_max: int = setting(
         3,
