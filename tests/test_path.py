@@ -273,9 +273,11 @@ def test_a_stall_without_redundant_rows_goes_on_by_the_branches_of_a_near_bifurc
 # DOF-1 shapes of the paper's pattern 2 (52 vertices) whose paths still stall: Bezier seed 24,
 # criterion S, with the look-ahead and the deployability check (the study of Tables 5-6,
 # issue 40, session 19). The augmented system's corrector diverges near m = 1 (its residual
-# stays at 1e3 to 1e7), n - 1 rows, none redundant. Known tracer failures, kept as the test
-# of their fix: the mark goes once they end classified.
-STILL_STALLED = sorted((DATA / "stalled").glob("paper2_s_24_*.npz"))
+# stays at 1e3 to 1e7). Known tracer failures, kept as the test of their fix: the mark goes
+# once they end classified. The fourth, paper2_s_24_3, is kept in the data but not here: its
+# outcome depends on the BLAS kernel (pinned it stalls; with this machine's own kernel it
+# runs out of steps within path_tol), so a strict xfail on it would not hold everywhere.
+STILL_STALLED = [DATA / "stalled" / f"paper2_s_24_{k}.npz" for k in range(3)]
 
 
 @pytest.mark.xfail(strict=True, reason="a tracer failure not yet removed (issue 40)")
