@@ -386,13 +386,12 @@ class _Steps:
             shape.failed += 1
             self.rejected += rejected
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
-            limit = self.settings.generation.deploy_max_candidates
-            if self.restarts and self.fold_limit is None:  # the first chain: give up sooner
+            budget = limit = self.settings.generation.deploy_max_candidates
+            bounded = self.fold_limit is not None  # a solve that fails costs its iterations
+            if self.restarts and not bounded:  # the first chain: give up sooner
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
-            budget = self.settings.generation.deploy_max_candidates
-            bounded = self.fold_limit is not None  # a solve that fails costs its iterations
             if (
                 shape.undeployable >= limit > 0
                 or (bounded and shape.failed >= budget > 0)
@@ -659,8 +658,8 @@ def _deployable_final(
 
     chain = run.solutions
     if bisect:
-        known = [s.step for s in chain if s.path is not None and s.path.deploys]
-        lo, hi = (max(known) if known else -1), len(chain)  # deploys at lo; not known above
+        known = [i for i, s in enumerate(chain) if s.path is not None and s.path.deploys]
+        lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not known above
         while hi - lo > 1:
             mid = (lo + hi) // 2
             lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
