@@ -38,8 +38,9 @@ class AttemptOutcome(Outcome):
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
         "dead_end",
-        "a solution retracted by backtracking: no candidate of its shape gave a deployable "
-        "solution, or a chain that reached a lower DOF was taken back (Step 7)",
+        "a solution retracted by backtracking or by a restart with a fold limit: no "
+        "candidate of its shape gave a deployable solution, or a chain that reached a lower "
+        "DOF was taken back (Step 7)",
     )
 
 
@@ -52,7 +53,8 @@ class Stop(Outcome):
     NO_CANDIDATE = "no_candidate", "no candidate crease succeeds (Step 7)"
     NO_DEPLOYABLE = (
         "no_deployable",
-        "the folding paths of the last candidates do not reach the flat state (Step 7, N_path)",
+        "none of the last candidates gave a solution whose folding path reaches the flat "
+        "state (Step 7, N_path; in a chain bounded by a fold limit, also solves that fail)",
     )
     INITIAL_FAILED = "initial_failed", "no developable polyhedron from the initial shape"
     INTERRUPTED = "interrupted", "the run was interrupted (Ctrl-C or SIGTERM)"
