@@ -358,3 +358,26 @@ def test_both_hessians_reach_the_same_solution():
 def test_unknown_hessian_is_refused():
     with pytest.raises(ValueError, match="ipopt_hessian must be"):
         DEFAULTS.with_(ipopt_hessian="bfgs")
+
+
+@pytest.mark.parametrize("fold_deg, folded", [(20.0, False), (100.0, True), (179.0, True)])
+def test_a_fixed_crease_folded_past_90_degrees_is_folded_back_not_a_flat_panel(fold_deg, folded):
+    """The flatness term |n_a x n_b|^2 = sin^2(rho) vanishes at 180 degrees too: a solve that
+    meets F_tol with a fixed crease folded onto its facets is not accepted."""
+    from rigidfold.mesh import CreasePattern
+    from rigidfold.optimize.problem import classify, folded_back
+    from rigidfold.optimize.solver import SolverOutcome
+
+    phi = np.radians(fold_deg)  # wing b turned about the crease (x axis) from the plane
+    coords = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -np.cos(phi), np.sin(phi)]])
+    pattern = CreasePattern.from_faces(coords, [[0, 1, 2], [1, 0, 3]])
+    crease = int(np.flatnonzero(~pattern.is_boundary_edge)[0])
+    assert np.isclose(np.degrees(abs(pattern.fold_angles[crease])), fold_deg)
+    fixed = np.zeros(pattern.n_edges, bool)
+    fixed[crease] = True
+    found = folded_back(coords, pattern, fixed)
+    assert found.tolist() == ([crease] if folded else [])
+    status, message = classify(SolverOutcome.SOLVED, 1e-12, 0.0, DEFAULTS, found)
+    assert status is (Status.FOLDED_BACK if folded else Status.CONVERGED)
+    if folded:
+        assert f"fixed crease {crease} folded back" in message

@@ -17,7 +17,14 @@ from rigidfold.status import Outcome
 
 # the values that JSON files and study databases of every version hold
 VALUES = {
-    Status: ["converged", "tolerance_not_met", "infeasible", "iteration_limit", "failed"],
+    Status: [
+        "converged",
+        "tolerance_not_met",
+        "infeasible",
+        "iteration_limit",
+        "folded_back",
+        "failed",
+    ],
     AttemptOutcome: [
         "accepted",
         "exceed",

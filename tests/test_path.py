@@ -270,23 +270,35 @@ def test_a_stall_without_redundant_rows_goes_on_by_the_branches_of_a_near_bifurc
     assert path.max_length_error < 1e-8
 
 
-# DOF-1 shapes of the paper's pattern 2 (52 vertices) whose paths still stall: Bezier seed 24,
+# DOF-1 shapes of the paper's pattern 2 (52 vertices) whose paths stalled: Bezier seed 24,
 # criterion S, with the look-ahead and the deployability check (the study of Tables 5-6,
-# issue 40, session 19). The augmented system's corrector diverges near m = 1 (its residual
-# stays at 1e3 to 1e7). Known tracer failures, kept as the test of their fix: the mark goes
-# once they end classified. The fourth, paper2_s_24_3, is kept in the data but not here: its
-# outcome depends on the BLAS kernel (pinned it stalls; with this machine's own kernel it
-# runs out of steps within path_tol), so a strict xfail on it would not hold everywhere.
-STILL_STALLED = [DATA / "stalled" / f"paper2_s_24_{k}.npz" for k in range(3)]
+# issue 40, session 19). Each holds a fixed crease at 180 degrees (its facets folded onto
+# each other); the fixed-angle residual jumped by 2 pi where atan2 flipped to -180, and the
+# corrector diverged from it (residuals of 1e3 to 1e11). Taken modulo 2 pi, they trace.
+FOLDED_FIXED = [DATA / "stalled" / f"paper2_s_24_{k}.npz" for k in range(4)]
 
 
-@pytest.mark.xfail(strict=True, reason="a tracer failure not yet removed (issue 40)")
-@pytest.mark.parametrize("file", STILL_STALLED, ids=[f.stem for f in STILL_STALLED])
-def test_the_paper_pattern_2_shapes_whose_augmented_corrector_diverges_end_classified(file):
+@pytest.mark.parametrize("file", FOLDED_FIXED, ids=[f.stem for f in FOLDED_FIXED])
+def test_a_shape_with_a_fixed_crease_at_180_degrees_traces_to_a_classified_end(file):
     shape, dof = stalled_shape(file)
-    path = trace_path(shape, dof=dof, support_face=default_support_face(shape))
+    fixed = shape.fixed_creases
+    assert np.abs(shape.fold_angles[fixed]).max() > np.radians(179.9)
+    support = default_support_face(shape)
+    path = trace_path(shape, dof=dof, support_face=support)
     assert path.status is not PathStatus.STALLED, path.message
     assert path.max_length_error < 1e-8
+    cons = RigidFoldingConstraints(shape, support)
+    for point in path.points:  # every fixed crease held, through the flip of atan2 too
+        assert np.abs(cons.residual(point.ravel() / cons.scale)).max() < 1e-8
+
+
+def test_a_fixed_angle_residual_is_continuous_through_180_degrees():
+    """The change of a fold angle is taken modulo 2 pi: +179.9 to -179.9 degrees is a turn of
+    0.2 degrees, not of 359.8."""
+    from rigidfold.mesh.geometry import angle_change
+
+    a, b = np.radians([179.9, -179.9, 10.0]), np.radians([-179.9, 179.9, -20.0])
+    assert np.allclose(np.degrees(angle_change(a, b)), [-0.2, 0.2, 30.0])
 
 
 def test_the_square_system_of_the_independent_rows_corrects_by_least_squares():

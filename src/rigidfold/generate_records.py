@@ -23,7 +23,11 @@ class AttemptOutcome(Outcome):
     """What generation made of one solve of problem (6) (Steps 4-5)."""
 
     ACCEPTED = "accepted", "DOF >= 1, F <= F_tol and no locked crease: a solution (Step 6)"
-    EXCEED = "exceed", "the solve missed F <= F_tol or did not converge (Step 4, N_exceed)"
+    EXCEED = (
+        "exceed",
+        "the solve missed F <= F_tol, did not converge, or folded a fixed crease back onto "
+        "its facets (Step 4, N_exceed)",
+    )
     LOCK = "lock", "the mechanism has a locked crease (Step 5, N_lock)"
     ZERO_DOF = "zero_dof", "the mechanism has DOF 0: generation ends (Step 5 -> Step 8)"
     PATH = (

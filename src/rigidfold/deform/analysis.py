@@ -51,6 +51,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
 from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.geometry import angle_change
 from rigidfold.quiet import native_quiet
 from rigidfold.status import Outcome
 
@@ -415,7 +416,7 @@ def deform(
         np.maximum.at(per_edge, pattern.face_edges.ravel(), dl.ravel())
         dl_max = np.maximum(dl_max, per_edge)
         corners = _face_vertices(x, lay.face_edge_node)
-        drho = np.abs(_dihedrals(corners, pattern, fixed) - rho0)
+        drho = np.abs(angle_change(_dihedrals(corners, pattern, fixed), rho0))
         drho_max = np.maximum(drho_max, drho)
         frames.append(_vertices(pattern, corners))
         history.append(

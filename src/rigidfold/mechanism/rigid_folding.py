@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 
 from rigidfold.config import Settings
 from rigidfold.mesh import CreasePattern
+from rigidfold.mesh.geometry import angle_change
 from rigidfold.optimize.residuals import fold_angle_gradients
 
 
@@ -97,16 +98,15 @@ class RigidFoldingConstraints:
         return np.bincount(self.gauge_rows, self.gauge_vals * x[self.gauge_cols], minlength=6)
 
     def residual(self, x: np.ndarray) -> np.ndarray:
-        """c(x) (m,): length errors, fixed-crease angle changes, gauge (not finite where a
-        triangle has collapsed)."""
+        """c(x) (m,): length errors, fixed-crease angle changes (in (-pi, pi]), gauge (not
+        finite where a triangle has collapsed)."""
         X = x.reshape(-1, 3)
         e = self.pattern.edges
         length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             rho_fixed = fold_angle_gradients(X[self.fixed_stencils])[0]
-        return np.concatenate(
-            [length - self.L0, rho_fixed - self.rho_fixed0, self._gauge(x) - self.gauge0]
-        )
+        turn = angle_change(rho_fixed, self.rho_fixed0)  # continuous through 180 degrees
+        return np.concatenate([length - self.L0, turn, self._gauge(x) - self.gauge0])
 
     def free_angles(self, x: np.ndarray) -> np.ndarray:
         """The free creases' fold angles (n_free,) at x, radians."""

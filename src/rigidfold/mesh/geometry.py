@@ -18,6 +18,13 @@ def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.einsum("...i,...i", a, b))
 
 
+def angle_change(angle: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``angle - reference`` taken modulo 2 pi, in [-pi, pi): the change of a fold angle
+    (arrays of one shape, radians), continuous where the angle passes +-180 degrees (a
+    crease whose facets are folded onto each other)."""
+    return np.remainder(angle - reference + np.pi, 2 * np.pi) - np.pi
+
+
 def skew(v: np.ndarray) -> np.ndarray:
     """Cross-product matrices: ``skew(v) @ w == cross(v, w)``.  (..., 3) -> (..., 3, 3)"""
     out = np.zeros((*v.shape[:-1], 3, 3))

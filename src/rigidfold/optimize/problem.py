@@ -225,7 +225,9 @@ class FormFindingProblem:
             status, verdict = Status.FAILED, f"its point is no shape ({exc}): the start is kept"
         F, F1, F2 = (float(v) for v in self.objective(xi, w))
         if status is None:
-            status, verdict = classify(run.outcome, F, viol, self.settings)
+            status, verdict = classify(
+                run.outcome, F, viol, self.settings, folded_back(coords, self.pattern, mask)
+            )
         return OptimizeResult(
             pattern=CreasePattern(
                 coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings
@@ -272,7 +274,9 @@ class FormFindingProblem:
         coords = self.map.expand(run.xi)
         F, F1, F2 = (float(v) for v in self.objective(run.xi, w))
         viol = self.violation(coords, result.pattern.fixed)
-        status, _ = classify(SolverOutcome.SOLVED, F, viol, self.settings)
+        status, _ = classify(
+            SolverOutcome.SOLVED, F, viol, self.settings, folded_back(coords, self.pattern, w > 0)
+        )
         if status is not Status.CONVERGED:
             return result
         return dataclasses.replace(
@@ -287,16 +291,38 @@ class FormFindingProblem:
         )
 
 
+def folded_back(coords: np.ndarray, pattern: CreasePattern, fixed: np.ndarray) -> np.ndarray:
+    """(k,) int: the fixed creases of the shape ``coords`` (V, 3) of ``pattern`` (``fixed``
+    (E,) bool) whose fold angle is above 90 degrees in magnitude. Problem (6) makes a fixed
+    crease's facets one flat panel through the term |n_a x n_b|^2 = sin^2(rho), whose zero
+    nearest such an angle is 180 degrees: the facets folded onto each other, not a panel."""
+    creases = np.flatnonzero(fixed)
+    rho = pattern.with_coords(coords).fold_angles[creases]
+    return creases[np.abs(rho) > np.pi / 2]
+
+
 def classify(
-    outcome: SolverOutcome, F: float, violation: float, settings: Settings
+    outcome: SolverOutcome,
+    F: float,
+    violation: float,
+    settings: Settings,
+    folded: np.ndarray | None = None,
 ) -> tuple[Status, str]:
     """rigidfold's verdict on a solver run.
 
     outcome : the solver's own flag (a ``SolverOutcome``, or its value).
-    A point with F <= F_tol that meets every constraint is accepted whatever the solver said.
+    folded : (k,) int, the fixed creases folded back (:func:`folded_back`), if any.
+    A point with F <= F_tol that meets every constraint is accepted whatever the solver said,
+    unless a fixed crease is folded back (``Status.FOLDED_BACK``).
     """
     feasible = violation <= settings.solver.constraint_tol
     if feasible and F <= settings.design.f_tol:
+        if folded is not None and len(folded):
+            return Status.FOLDED_BACK, (
+                f"F = {F:.3g} <= F_tol, but fixed crease{'s' if len(folded) > 1 else ''} "
+                f"{', '.join(str(int(c)) for c in folded)} folded back onto "
+                f"{'their' if len(folded) > 1 else 'its'} facets (near 180 degrees)"
+            )
         return Status.CONVERGED, f"accepted: F = {F:.3g} <= F_tol = {settings.design.f_tol:.3g}"
     if outcome == SolverOutcome.INFEASIBLE or (outcome == SolverOutcome.SOLVED and not feasible):
         return Status.INFEASIBLE, f"constraint violation {violation:.3g}"

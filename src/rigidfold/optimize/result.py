@@ -23,6 +23,12 @@ class Status(Outcome):
         "iteration_limit",
         "the iteration (or time) limit was reached before F <= F_tol",
     )
+    FOLDED_BACK = (
+        "folded_back",
+        "F <= F_tol, but a fixed crease is folded onto itself (|fold angle| above 90 "
+        "degrees): the flatness term |n_a x n_b|^2 = sin^2 vanishes at 180 degrees too, and "
+        "its two facets overlap instead of making one flat panel",
+    )
     FAILED = "failed", "any other solver failure (e.g. a line-search or evaluation error)"
 
 
