@@ -327,3 +327,24 @@ def test_the_square_system_of_the_independent_rows_corrects_by_least_squares():
     left = c + J @ dy
     assert np.allclose(left, c + J @ best, atol=1e-12)
     assert np.allclose(left, system.irreducible(c), atol=1e-12)
+
+
+# DOF-1 shapes of the paper's patterns whose constraints keep a second near flex along the
+# whole path (J's second smallest singular value about 1e-9 of the largest, at the rank
+# threshold): Newton's corrector converges there at its linear rate, the steps stay small,
+# and the trace needs 200 to 800 of them (the study of Tables 5-6, issue 40, session 20:
+# pattern 1, S-hat, Bezier seed 20; pattern 2, S-hat, seed 32). With a budget of 200 steps
+# they ended `max_steps` and were rejected; they deploy.
+NEAR_FLEX = sorted((DATA / "near_flex").glob("*.npz"))
+
+
+@pytest.mark.parametrize("file", NEAR_FLEX, ids=[f.stem for f in NEAR_FLEX])
+def test_a_path_along_a_second_near_flex_reaches_the_flat_state(file):
+    shape, dof = stalled_shape(file)
+    support = default_support_face(shape)
+    cons = RigidFoldingConstraints(shape, support)
+    s = np.linalg.svd(cons.jacobian(cons.x0)[0].toarray(), compute_uv=False)
+    assert s[-1] / s[0] < 1e-8  # J (n - 1, n): the path's flex, and a second near one
+    path = trace_path(shape, dof=dof, support_face=support)
+    assert path.status is PathStatus.FLAT, path.message
+    assert path.max_length_error < 1e-8

@@ -48,7 +48,13 @@ class PathSettings(Group):
         "traced points resolve the motion.",
     )
     max_steps: int = setting(
-        200, "Accepted steps of one direction of the trace before it gives up."
+        1000,
+        "Accepted steps of one direction of the trace before it gives up. A path along "
+        "which the constraints keep a second near flex (a singular value near the rank "
+        "threshold) is corrected by Newton's method at its linear rate, so its steps stay "
+        "small: such paths of the paper's patterns reach the flat state in 200 to 800 steps "
+        "(docs/deployability.md); a path that makes no progress ends sooner "
+        "(``path_wander_steps``).",
     )
     corrector_iter: int = setting(8, "Chord iterations of the corrector.")
     contraction: float = setting(
