@@ -87,3 +87,47 @@ def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatc
     assert min(dofs) < 15 <= max(dofs)
     assert run.final is not None and run.final.mechanism.dof == 15
     assert 0 < len(traced) <= math.ceil(math.log2(len(dofs))) + 1 < len(dofs) - dofs.index(15)
+
+
+def test_a_path_trace_ends_at_its_deadline_out_of_budget():
+    """A trace given a deadline that has passed ends at once, ``max_steps`` (out of budget),
+    saying the time limit ended it; a deadline far off changes nothing."""
+    import time
+
+    import numpy as np
+
+    from rigidfold.mechanism.path import PathStatus, trace_path
+    from rigidfold.patterns.miura import miura
+
+    shape = miura(3, 3, height=0.6)
+    cut = trace_path(shape, dof=1, deadline=time.monotonic())
+    assert cut.status is PathStatus.MAX_STEPS and cut.steps == 0
+    assert "time limit" in cut.message
+    free = trace_path(shape, dof=1, deadline=time.monotonic() + 3600.0)
+    plain = trace_path(shape, dof=1)
+    assert free.status is plain.status and free.steps == plain.steps
+    assert np.array_equal(free.points, plain.points)
+
+
+def test_the_candidates_paths_are_traced_to_the_runs_deadline(monkeypatch):
+    """Generation hands its time limit to every candidate's trace as a deadline, so that a
+    long trace does not overrun the limit (none without a limit)."""
+    import time
+
+    import rigidfold.generate as generation
+
+    seen: list = []
+    real = generation.trace_path
+
+    def spy(pattern, **kw):
+        seen.append(kw.get("deadline"))
+        return real(pattern, **kw)
+
+    monkeypatch.setattr(generation, "trace_path", spy)
+    case = make_case("bezier", "1", seed=1)
+    t0 = time.monotonic()
+    generate(case, GenerateOptions(deform=False, deploy_check=True, time_limit=3600.0))
+    assert seen and all(d is not None and t0 + 3599.0 < d < t0 + 3601.0 for d in seen)
+    seen.clear()
+    generate(case, GenerateOptions(deform=False, deploy_check=True, target_dof=18))
+    assert seen and all(d is None for d in seen)

@@ -205,11 +205,16 @@ class _Steps:
             assert mech is not None
             t2 = time.perf_counter()
             path = trace_path(
-                result.pattern, dof=mech.dof, support_face=opts.support_face, settings=settings
+                result.pattern,
+                dof=mech.dof,
+                support_face=opts.support_face,
+                settings=settings,
+                deadline=self.deadline,
             )
             if not path.deploys:
                 outcome = AttemptOutcome.PATH
-                second = self.obstruction(result.pattern, mech.dof)
+                # a trace cut by the time limit: the run ends, the second-order test is moot
+                second = None if self.out_of_time() else self.obstruction(result.pattern, mech.dof)
                 if second is not None and second.rigid:
                     outcome = AttemptOutcome.RIGID
             t_path = time.perf_counter() - t2
@@ -268,10 +273,17 @@ class _Steps:
             return None
         return ChildForecast.at(pattern, self.support_face(pattern), dof, settings)
 
+    @property
+    def deadline(self) -> float | None:
+        """The end of the run's time limit (``GenerateOptions.time_limit``), a time of
+        ``time.monotonic()``; None without a limit. A candidate's path trace ends there."""
+        limit = self.options.time_limit
+        return None if limit is None else self.started + limit
+
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
-        limit = self.options.time_limit
-        return limit is not None and time.monotonic() - self.started > limit
+        deadline = self.deadline
+        return deadline is not None and time.monotonic() > deadline
 
     def is_solution(self, rec: Attempt) -> bool:
         """Whether an attempt gives a solution: accepted, or the DOF-0 shape of a target 0."""

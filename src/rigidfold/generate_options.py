@@ -109,9 +109,9 @@ class GenerateOptions:
     )
     time_limit: float | None = option(
         None,
-        "solve no further candidate after this many seconds: the run ends with the lowest-DOF "
-        "design that deploys as its final design, checked as usual, and exits 1 (None: no "
-        "limit)",
+        "solve no further candidate after this many seconds (a candidate's path trace under "
+        "way ends there too): the run ends with the lowest-DOF design that deploys as its "
+        "final design, checked as usual, and exits 1 (None: no limit)",
         parse=positive,
         metavar="SECONDS",
     )

@@ -42,12 +42,15 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
 Each step costs one sparse LU factorisation (SuperLU through SciPy). The step length (in
 mean edge lengths) grows after an easy correction, halves after a failed one, and near the
 flat state is cut to the linear prediction of the closest approach, so the flat end is met
-rather than passed. Lengths are kept to ``path_tol`` at every point.
+rather than passed. Lengths are kept to ``path_tol`` at every point. A trace given a
+``deadline`` (the time limit of the run that asks for it) ends there, out of budget
+(``max_steps``).
 """
 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -84,7 +87,10 @@ class PathStatus(Outcome):
     )
     COLLISION = "collision", "a crease folds to 180 degrees (its panels meet) before the flat state"
     STALLED = "stalled", "the folding path could not be continued"
-    MAX_STEPS = "max_steps", "the step budget ran out before the flat state"
+    MAX_STEPS = (
+        "max_steps",
+        "the trace's budget (its steps, or the run's time limit) ran out before the flat state",
+    )
     RIGID = "rigid", "the shape has no mechanism (DOF 0): no folding path leaves it"
 
 
@@ -228,9 +234,11 @@ def _trace_direction(
     mode: str,
     m0: float,
     settings: Settings,
+    deadline: float | None = None,
 ) -> tuple[_Trace, PathStatus, str]:
     """Continue from the design x0 (mode "augmented"/"projection": along t0; "descent": the
-    Gauss-Newton direction) until the path ends (see the module's text)."""
+    Gauss-Newton direction) until the path ends (see the module's text), or until the time
+    ``deadline`` (of ``time.monotonic()``) has passed."""
     J, J_rho = cons.jacobian(x0)
     rho = cons.free_angles(x0)
     tr = _Trace([x0.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
@@ -254,6 +262,12 @@ def _trace_direction(
     while True:
         if tr.steps >= settings.path.max_steps:
             return tr, PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps"
+        if deadline is not None and time.monotonic() > deadline:
+            return (
+                tr,
+                PathStatus.MAX_STEPS,
+                f"the run's time limit passed after {tr.steps} steps, short of the flat state",
+            )
         if mode == "descent":
             d = system.direction(None, rho)
             size = float(np.linalg.norm(d))
@@ -675,12 +689,15 @@ def trace_path(
     dof: int | None = None,
     support_face: int | None = None,
     settings: Settings = DEFAULTS,
+    deadline: float | None = None,
 ) -> FoldingPath:
     """Trace the rigid-folding path of ``pattern`` from the design towards the flat state.
 
     dof : the shape's DOF where known; default that of :func:`rigidfold.mechanism.analyze`
         (with ``support_face``). ``support_face``: the gauge triangle (default
-        :func:`rigidfold.frame.model.default_support_face`). See the module's text.
+        :func:`rigidfold.frame.model.default_support_face`). ``deadline``: a time of
+        ``time.monotonic()`` after which the trace ends, ``max_steps`` (a run's time limit).
+        See the module's text.
     """
     if support_face is None:
         support_face = default_support_face(pattern)
@@ -715,10 +732,14 @@ def trace_path(
         traces = []
         for sign in (1.0, -1.0):
             try:
-                tr, status, message = _trace_direction(cons, x0, sign * t, mode, m0, settings)
+                tr, status, message = _trace_direction(
+                    cons, x0, sign * t, mode, m0, settings, deadline
+                )
             except RuntimeError:  # the augmented matrix is singular at the design
                 mode = "projection"
-                tr, status, message = _trace_direction(cons, x0, sign * t, mode, m0, settings)
+                tr, status, message = _trace_direction(
+                    cons, x0, sign * t, mode, m0, settings, deadline
+                )
             traces.append((tr, status, message))
             if status is not PathStatus.STALLED:
                 break
@@ -737,7 +758,7 @@ def trace_path(
             )
         factorizations = sum(t[0].factorizations for t in traces)
         return _result(cons, [tr], status, message, 1, m0, factorizations)
-    tr, status, message = _trace_direction(cons, x0, None, "descent", m0, settings)
+    tr, status, message = _trace_direction(cons, x0, None, "descent", m0, settings, deadline)
     return _result(cons, [tr], status, message, dof, m0)
 
 
