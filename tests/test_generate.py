@@ -88,6 +88,28 @@ def test_generate_does_not_depend_on_the_callers_blas_threads():
         assert blas_threads() == before
 
 
+def test_the_first_blas_limit_of_a_process_reaches_ipopts_openblas_too():
+    """CasADi loads its own OpenBLAS (MUMPS's, inside IPOPT) with its IPOPT plugin; a limit
+    set before that reached it only from a process's second run on, so a process's first
+    run (every ``rigidfold generate``) solved on more threads and could take another path.
+    Checked in a fresh process, where nothing has loaded it yet."""
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy\n"
+        "from threadpoolctl import threadpool_info\n"
+        "from rigidfold.config import one_blas_thread\n"
+        "with one_blas_thread():\n"
+        "    libs = [(i['filepath'], i['num_threads']) for i in threadpool_info()\n"
+        "            if i['user_api'] == 'blas']\n"
+        "assert any('casadi' in f for f, _ in libs), libs\n"
+        "assert {n for _, n in libs} == {1}, libs\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
 def test_generate_symmetric_fixes_mirror_groups():
     case = make_case("hp", "11", symmetric=True)
     run = generate(case, criterion="s", target_dof=33, seed=0)

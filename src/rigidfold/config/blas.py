@@ -15,14 +15,22 @@ def _blas_limits():
     """threadpoolctl's ``threadpool_limits``, taught CasADi's own copy of OpenBLAS.
 
     IPOPT's MUMPS calls the OpenBLAS that CasADi ships as ``libcasadi-tp-openblas``, a name
-    threadpoolctl does not know; registered here, ``one_blas_thread`` limits it too.
+    threadpoolctl does not know; registered here, ``one_blas_thread`` limits it too. A limit
+    reaches only the libraries loaded when it is set, and CasADi loads that one with its
+    IPOPT plugin, at the first solve: loaded here first, so that the first run of a process
+    (every ``rigidfold generate``) solves on one thread as the later runs of a study worker
+    do, and takes the same path (before, Huffman's waterbomb on Bezier seed 7 took 268
+    solves as a process's first run and 278 after any other).
     """
+    import casadi
+    import scipy.linalg  # noqa: F401  (SciPy's own OpenBLAS, loaded before the limit)
     from threadpoolctl import OpenBLASController, register, threadpool_limits
 
     class CasadiOpenBLAS(OpenBLASController):
         filename_prefixes = ("libcasadi-tp-openblas",)
 
     register(CasadiOpenBLAS)
+    casadi.load_nlpsol("ipopt")
     return threadpool_limits
 
 
