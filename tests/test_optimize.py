@@ -375,7 +375,7 @@ def test_a_fixed_crease_folded_past_90_degrees_is_folded_back_not_a_flat_panel(f
     assert np.isclose(np.degrees(abs(pattern.fold_angles[crease])), fold_deg)
     fixed = np.zeros(pattern.n_edges, bool)
     fixed[crease] = True
-    found = folded_back(coords, pattern, fixed)
+    found = folded_back(pattern.with_fixed(fixed))
     assert found.tolist() == ([crease] if folded else [])
     status, message = classify(SolverOutcome.SOLVED, 1e-12, 0.0, DEFAULTS, found)
     assert status is (Status.FOLDED_BACK if folded else Status.CONVERGED)

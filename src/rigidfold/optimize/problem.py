@@ -224,14 +224,13 @@ class FormFindingProblem:
             viol = self.violation(coords, mask)
             status, verdict = Status.FAILED, f"its point is no shape ({exc}): the start is kept"
         F, F1, F2 = (float(v) for v in self.objective(xi, w))
+        shape = CreasePattern(
+            coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings
+        )
         if status is None:
-            status, verdict = classify(
-                run.outcome, F, viol, self.settings, folded_back(coords, self.pattern, mask)
-            )
+            status, verdict = classify(run.outcome, F, viol, self.settings, folded_back(shape))
         return OptimizeResult(
-            pattern=CreasePattern(
-                coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings
-            ),
+            pattern=shape,
             F=F,
             F1=F1,
             F2=F2,
@@ -274,14 +273,13 @@ class FormFindingProblem:
         coords = self.map.expand(run.xi)
         F, F1, F2 = (float(v) for v in self.objective(run.xi, w))
         viol = self.violation(coords, result.pattern.fixed)
-        status, _ = classify(
-            SolverOutcome.SOLVED, F, viol, self.settings, folded_back(coords, self.pattern, w > 0)
-        )
+        shape = result.pattern.with_coords(coords)
+        status, _ = classify(SolverOutcome.SOLVED, F, viol, self.settings, folded_back(shape))
         if status is not Status.CONVERGED:
             return result
         return dataclasses.replace(
             result,
-            pattern=result.pattern.with_coords(coords),
+            pattern=shape,
             F=F,
             F1=F1,
             F2=F2,
@@ -291,14 +289,13 @@ class FormFindingProblem:
         )
 
 
-def folded_back(coords: np.ndarray, pattern: CreasePattern, fixed: np.ndarray) -> np.ndarray:
-    """(k,) int: the fixed creases of the shape ``coords`` (V, 3) of ``pattern`` (``fixed``
-    (E,) bool) whose fold angle is above 90 degrees in magnitude. Problem (6) makes a fixed
-    crease's facets one flat panel through the term |n_a x n_b|^2 = sin^2(rho), whose zero
-    nearest such an angle is 180 degrees: the facets folded onto each other, not a panel."""
-    creases = np.flatnonzero(fixed)
-    rho = pattern.with_coords(coords).fold_angles[creases]
-    return creases[np.abs(rho) > np.pi / 2]
+def folded_back(shape: CreasePattern) -> np.ndarray:
+    """(k,) int: the fixed creases of ``shape`` whose fold angle is above 90 degrees in
+    magnitude. Problem (6) makes a fixed crease's facets one flat panel through the term
+    |n_a x n_b|^2 = sin^2(rho), whose zero nearest such an angle is 180 degrees: the facets
+    folded onto each other, not a panel."""
+    creases = shape.fixed_creases
+    return creases[np.abs(shape.fold_angles[creases]) > np.pi / 2]
 
 
 def classify(
