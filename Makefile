@@ -19,7 +19,7 @@ demo: $(STAMP)
 	@echo "open the report: out/demo/report.html"
 
 # the suite on every core (pytest-xdist); the tests run with the pinned numerics
-# (rigidfold.numerics: pytest restarts itself with them)
+# (rigidfold.runtime.numerics: pytest restarts itself with them)
 test: $(STAMP) browser
 	$(PY) -m pytest -q -n $(shell nproc 2>/dev/null || echo 2)
 

@@ -15,10 +15,10 @@ import argparse
 import statistics
 import time
 
-from rigidfold.case import make_case
 from rigidfold.deform import deform, folding_motion
 from rigidfold.develop import develop
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 
 
 def main() -> None:

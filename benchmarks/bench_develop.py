@@ -14,8 +14,8 @@ import argparse
 import statistics
 import time
 
-from rigidfold.case import make_case
 from rigidfold.develop import develop
+from rigidfold.generate.case import make_case
 
 
 def bench(label: str, case, paper: float, repeat: int) -> None:

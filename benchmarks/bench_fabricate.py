@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 
 from bench_scale import timed  # this folder is on sys.path (a script)
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.develop import develop
 from rigidfold.exports.design import read_design
@@ -40,6 +39,7 @@ from rigidfold.fabricate.cutsheets import (
     sheets_summary,
 )
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 
 ROOF_EXPR = "0.06*x*(12-x)/6 + 0.05*y*(8-y)"
 """The README's 12 m x 8 m barrel roof."""

@@ -38,7 +38,7 @@ from pathlib import Path
 CHILD = """
 import json, resource, sys, time
 from rigidfold.fabricate import FabricateOptions
-from rigidfold.workflows import fabricate_file
+from rigidfold.pipeline.workflows import fabricate_file
 t0 = time.perf_counter()
 done = fabricate_file(sys.argv[1], sys.argv[2], FabricateOptions(thickness=float(sys.argv[3])))
 print(json.dumps({

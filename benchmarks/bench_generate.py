@@ -16,9 +16,9 @@ import argparse
 import statistics
 import time
 
-from rigidfold.case import make_case
 from rigidfold.config import one_blas_thread
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism import analyze
 from rigidfold.selection import rank_candidates, score_creases
 

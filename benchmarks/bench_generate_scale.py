@@ -18,9 +18,9 @@ import argparse
 import statistics
 import time
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 
 
 def main() -> None:

@@ -24,9 +24,9 @@ import time
 
 import numpy as np
 
-from rigidfold.case import make_case
 from rigidfold.config import one_blas_thread
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.selection import lock_forecast, lookahead_order, rank_candidates, score_creases
 

@@ -5,7 +5,7 @@ Run with ``python benchmarks/bench_numerics.py [--repeat 3] [--inner 7] [--skip-
 The script starts children of itself (``sys.executable``), one per mode and round, the modes
 alternating over ``--repeat`` rounds so that drifts in the machine's load hit both alike:
 
-* pinned: ``rigidfold.numerics.pinned_environ(os.environ)`` (OpenBLAS Prescott kernel and
+* pinned: ``rigidfold.runtime.numerics.pinned_environ(os.environ)`` (OpenBLAS Prescott kernel and
   L2 size, NumPy's baseline SIMD, glibc's libm without its FMA/AVX variants: the child is
   *started* with them, as the command line restarts itself);
 * native: ``RIGIDFOLD_NUMERICS=native`` and none of the pinning variables.
@@ -22,11 +22,11 @@ Each child runs on one BLAS thread (as ``generate``) and reports, as one JSON li
 * analysis 41: ``rigidfold.mechanism.analyze`` (method "auto", the sparse analysis) of the
   lifted 41 x 41 grid on the dome (as ``bench_scale.py``), on a fresh copy of the shape,
   median of ``--inner``;
-* the status and the canary of ``rigidfold.numerics.numeric_environment()``.
+* the status and the canary of ``rigidfold.runtime.numerics.numeric_environment()``.
 
 The parent prints, per metric, the median over the rounds of each mode and the ratio
 pinned / native, then both statuses and canaries (they differ on a CPU with AVX2 and FMA).
-The parent itself imports only ``rigidfold.numerics`` (not NumPy).
+The parent itself imports only ``rigidfold.runtime.numerics`` (not NumPy).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ import subprocess
 import sys
 import time
 
-from rigidfold.numerics import OPT_OUT_ENV, pinned_environ
+from rigidfold.runtime.numerics import OPT_OUT_ENV, pinned_environ
 
 MODES = ("pinned", "native")
 PIN_VARIABLES = (
@@ -74,11 +74,11 @@ def child(args: argparse.Namespace) -> None:
     """Measure in this process (started with the numerics of ``args.child``)."""
     # imported here: the parent must not load NumPy, and rigidfold must come first
     from bench_scale import timed as median_time  # this folder is on sys.path (a script)
-    from rigidfold.case import make_case
     from rigidfold.config import one_blas_thread
     from rigidfold.generate import generate
+    from rigidfold.generate.case import make_case
     from rigidfold.mechanism import analyze
-    from rigidfold.numerics import numeric_environment
+    from rigidfold.runtime.numerics import numeric_environment
 
     env = numeric_environment()
     row: dict = {"mode": args.child, "status": env.status.value, "canary": env.canary}

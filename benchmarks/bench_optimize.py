@@ -19,7 +19,7 @@ import argparse
 import statistics
 import time
 
-from rigidfold.case import make_case
+from rigidfold.generate.case import make_case
 
 PAPER_SECONDS = {"pattern 1": 72.4, "pattern 2": 79.3, "dome sym": 202, "dome asym": 1015}
 PAPER_SECONDS.update({"hp sym": 218, "hp asym": 1133})

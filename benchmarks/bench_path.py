@@ -22,10 +22,10 @@ from pathlib import Path
 
 from bench_scale import timed  # this folder is on sys.path (a script)
 from legacy_motion import legacy_folding_motion
-from rigidfold.case import make_case
 from rigidfold.deform import folding_motion
 from rigidfold.develop import develop
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 from rigidfold.patterns import miura
 
 RESCH = (

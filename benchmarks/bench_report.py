@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rigidfold.run import load_run
+from rigidfold.rundir import load_run
 
 
 def generate_run(out: Path) -> None:
@@ -53,7 +53,7 @@ def bench(run: Path, repeat: int) -> None:
         )
         times.append(time.perf_counter() - t0)
         cpu.append(_cpu() - c0)
-    summary = load_run(run).summary.to_dict()  # run files are read through rigidfold.run
+    summary = load_run(run).summary.to_dict()  # run files are read through rigidfold.rundir
     case = summary["case"]
     fields = [
         f"report of {case['pattern']} on {case['surface']['name']}: "

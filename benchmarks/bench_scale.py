@@ -41,8 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism import analyze
 from rigidfold.selection import score_creases
 

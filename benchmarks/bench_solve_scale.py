@@ -28,8 +28,8 @@ import time
 
 import numpy as np
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 
 IPOPT_ALONE = DEFAULTS.with_(projection_vertices=10**9)
 

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.io import read_fold
+from rigidfold.pipeline.workflows import structure
 from rigidfold.structure import (
     Service,
     StructureOptions,
@@ -39,7 +40,6 @@ from rigidfold.structure import (
     check_supports,
     support_candidates,
 )
-from rigidfold.workflows import structure
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
 DESIGN = DATA / "dome_sym_dof1.fold"

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import make_case
+from rigidfold.generate.case import make_case
 from rigidfold.io import write_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns.grids import grid

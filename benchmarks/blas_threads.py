@@ -24,10 +24,10 @@ import time
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.config import blas as config
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 
 
 @contextlib.contextmanager

@@ -109,9 +109,9 @@ def cause(attempt) -> str | None:
 
 def run(case: dict, mode: str) -> dict:
     """One run of ``case`` with the settings of ``mode`` (:data:`MODES`)."""
-    from rigidfold.case import make_case
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import Stop, generate
+    from rigidfold.generate.case import make_case
 
     settings = DEFAULTS.with_(**MODES[mode])
     t0, cpu0 = time.perf_counter(), time.process_time()

@@ -68,9 +68,9 @@ def _name(case: tuple[str, str, int]) -> str:
 def run(case: tuple[str, str, int], deploy: bool, backtrack: int | None = None) -> dict:
     """One run of ``case``, with the check (``deploy``) and ``backtrack_max`` = ``backtrack``
     (None: the default) or with the paper's Step 5."""
-    from rigidfold.case import make_case
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import Stop, generate
+    from rigidfold.generate.case import make_case
     from rigidfold.mechanism.path import trace_path
 
     surface, pattern, seed = case

@@ -14,8 +14,8 @@ from __future__ import annotations
 import argparse
 import statistics
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 
 BACKENDS = ("casadi", "closed-form")
 

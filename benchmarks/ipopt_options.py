@@ -19,8 +19,8 @@ import statistics
 
 import numpy as np
 
-from rigidfold.case import make_case
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 from rigidfold.optimize import ipopt
 
 _defaults = ipopt.ipopt_options

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import make_case
+from rigidfold.generate.case import make_case
+from rigidfold.pipeline.workflows import analyze_file
 from rigidfold.surfaces import Dome, sample_mesh
-from rigidfold.workflows import analyze_file
 
 
 def obj_dome(n: int) -> None:

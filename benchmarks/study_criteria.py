@@ -48,8 +48,8 @@ def standard_error(values: list[float]) -> float:
 
 
 def one_run(args: tuple[str, str, int, str, str]) -> dict:
-    from rigidfold.case import make_case
     from rigidfold.generate import generate
+    from rigidfold.generate.case import make_case
 
     pattern, criterion, seed, solver, support = args
     t0 = time.perf_counter()

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from rigidfold.mesh import CreasePattern
-from rigidfold.numerics import restart_pinned, restart_wanted
+from rigidfold.runtime.numerics import restart_pinned, restart_wanted
 
 
 def pytest_configure(config):
     """Run the tests, their xdist workers and the commands they start with the pinned
-    numerics (rigidfold.numerics): tests that assert one generation path's counts or digits
+    numerics (rigidfold.runtime.numerics): tests that assert one generation path's counts or digits
     then hold on every x86-64 CPU. A pytest started without them restarts itself once, with
     pytest's capture of the terminal suspended so that the new process writes to it. (The
     capture is touched only then: resuming it here, where pytest has it suspended, would hand
@@ -66,9 +66,9 @@ def run_cli(*args: str, cwd=None, timeout: float = 600) -> subprocess.CompletedP
 
 
 def main_code(argv: list[str]) -> int:
-    """``rigidfold.cli.main``'s exit code in this process, argparse's errors (SystemExit)
+    """``rigidfold.cli.commands.main``'s exit code in this process, argparse's errors (SystemExit)
     included."""
-    from rigidfold.cli import main
+    from rigidfold.cli.commands import main
 
     try:
         return main(argv)

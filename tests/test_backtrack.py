@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from conftest import main_code, paper_generate
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop, generate
-from rigidfold.run import RunWriter, load_run, read_log
-from rigidfold.workflows import generate_case
+from rigidfold.generate.case import make_case
+from rigidfold.pipeline import RunWriter
+from rigidfold.pipeline.workflows import generate_case
+from rigidfold.rundir import load_run, read_log
 
 SEED = 102
 OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False)

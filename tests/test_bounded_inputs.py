@@ -76,7 +76,7 @@ def test_seed_out_of_range_is_refused_at_once(tmp_path, seed):
 
 
 def test_seeds_are_checked_by_the_library():
-    from rigidfold.case import make_case
+    from rigidfold.generate.case import make_case
     from rigidfold.study import plan
 
     with pytest.raises(ValueError, match=r"seed must be a non-negative integer below 2\*\*63"):
@@ -111,7 +111,7 @@ def test_huge_study_is_refused_at_once(tmp_path):
 
 # ------------------------------------------------------------------- defect 12: small ones
 def test_expression_starting_with_minus_is_accepted(tmp_path):
-    from rigidfold.cli_parser import attached_values as _attached_values
+    from rigidfold.cli.parser import attached_values as _attached_values
 
     out = str(tmp_path / "o")
     proc = run_cli(

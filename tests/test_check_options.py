@@ -123,7 +123,7 @@ def test_generate_and_the_commands_share_each_option():
     """Every option of fabricate and structure is generate's too, with the same help (less
     the check it belongs to) and default, but the thickness, material and density (their
     generate meanings are in the help)."""
-    from rigidfold.cli import build_parser
+    from rigidfold.cli.commands import build_parser
 
     parser = build_parser()
     sub = next(a for a in parser._actions if a.dest == "command").choices

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from conftest import run_cli
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.io import read_fold, write_fold
 
 
@@ -233,7 +233,7 @@ def subcommands():
     """(name, parser) of every subcommand."""
     import argparse
 
-    from rigidfold.cli import build_parser
+    from rigidfold.cli.commands import build_parser
 
     parser = build_parser()
     (sub,) = (a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
@@ -269,7 +269,7 @@ def test_every_argument_says_what_it_means():
 
 
 def test_defaults_come_from_the_library():
-    from rigidfold.cli import build_parser
+    from rigidfold.cli.commands import build_parser
     from rigidfold.config import DEFAULT_SEED, DEFAULTS
     from rigidfold.generate import GenerateOptions
     from rigidfold.study import STUDY_DEFAULTS
@@ -376,7 +376,7 @@ def test_a_study_prints_only_its_own_lines(tmp_path):
 def test_native_quiet_drops_what_the_quiet_thread_prints_only(capsys, monkeypatch):
     import threading
 
-    from rigidfold.quiet import VERBOSE_ENV, native_quiet
+    from rigidfold.runtime.quiet import VERBOSE_ENV, native_quiet
 
     streams = sys.stdout, sys.stderr
     monkeypatch.delenv(VERBOSE_ENV, raising=False)
@@ -421,12 +421,12 @@ def test_an_empty_output_directory_is_refused(tmp_path, monkeypatch, capsys, arg
 def test_a_bug_is_not_called_bad_input(tmp_path, monkeypatch, capsys):
     """An exception that is not a RigidfoldError (here a ValueError of a library below) is a
     bug: one line saying so and where its traceback is, exit code 1."""
-    import rigidfold.workflows
+    import rigidfold.pipeline.workflows
 
     def broken(*args, **kwargs):
         raise ValueError("operands could not be broadcast together")
 
-    monkeypatch.setattr(rigidfold.workflows, "optimize_case", broken)
+    monkeypatch.setattr(rigidfold.pipeline.workflows, "optimize_case", broken)
     monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
     assert main([*OPTIMIZE_RUN, "--out", str(tmp_path / "o")]) == 1
     line = _one_line_error(capsys)
@@ -442,7 +442,7 @@ def test_a_documented_field_is_a_flag():
     import argparse
     from dataclasses import dataclass
 
-    from rigidfold.cli_parser import Parser, add_options, options_of
+    from rigidfold.cli.parser import Parser, add_options, options_of
     from rigidfold.flags import count, option, positive
 
     @dataclass(frozen=True)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.io import read_fold, svg_text, write_fold
 from rigidfold.patterns import miura
 

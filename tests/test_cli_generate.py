@@ -14,12 +14,12 @@ import pytest
 
 import rigidfold.generate as generate_module
 from conftest import run_cli
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import fold_dict, read_fold, write_fold
 from rigidfold.mesh.geometry import best_fit
 from rigidfold.patterns import miura
-from rigidfold.run import read_log
+from rigidfold.rundir import read_log
 
 
 @pytest.fixture(scope="module")
@@ -346,7 +346,7 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     """The large-deformation analysis and the folding motion: both verdicts of every solution
     in summary.json, the final design's in one line before the last; and, when they differ
     (the motion tracer given a budget of one step), the reason."""
-    import rigidfold.run.checks
+    import rigidfold.pipeline.checks
 
     assert main(["generate", *DEFORM_RUN, "--check", "all", "--out", str(tmp_path / "a")]) == 1
     lines = capsys.readouterr().out.strip().splitlines()
@@ -357,10 +357,10 @@ def test_generate_states_both_verdicts_of_the_final_design(tmp_path, capsys, mon
     assert summary["exports"][-1] == "final/step_02_dof_03.os.fold"
     assert (tmp_path / "a" / "final" / "step_02_dof_03.os.fold").is_file()
 
-    real = rigidfold.run.checks.verify
+    real = rigidfold.pipeline.checks.verify
     tight = DEFAULTS.with_(path_max_steps=1)  # the tracer gives up after one step
     monkeypatch.setattr(
-        rigidfold.run.checks,
+        rigidfold.pipeline.checks,
         "verify",
         lambda pattern, **kw: real(pattern, **{**kw, "path": None, "settings": tight}),
     )
@@ -428,7 +428,7 @@ def values(self, *args):  # IPOPT is running: its Hessian callback is being eval
         os.kill(os.getpid(), getattr(signal, sys.argv[1]))
     return real(self, *args)
 hessian.ClosedFormHessian.values = values
-from rigidfold.launch import main
+from rigidfold.cli.launch import main
 sys.exit(main(sys.argv[2:]))
 """
 
@@ -462,7 +462,7 @@ def test_an_ipopt_solve_raises_keyboard_interrupt(monkeypatch):
     instead of returning a failed solve."""
     import signal
 
-    from rigidfold.case import make_case
+    from rigidfold.generate.case import make_case
     from rigidfold.optimize import hessian
 
     real, calls = hessian.ClosedFormHessian.values, []

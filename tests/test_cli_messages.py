@@ -6,7 +6,7 @@ import unicodedata
 
 import pytest
 
-from rigidfold.cli import main, one_line
+from rigidfold.cli.commands import main, one_line
 
 
 def control_free(text: str) -> bool:

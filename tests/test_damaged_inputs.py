@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from rigidfold import launch
+from rigidfold.cli import launch
 from rigidfold.io import atomic_write
 from rigidfold.surfaces.mesh import read_mesh
 

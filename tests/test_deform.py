@@ -9,16 +9,16 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.deform import TubeSection, deform, folding_motion, verify
 from rigidfold.develop import develop
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate import generate
+from rigidfold.generate.case import make_case
 from rigidfold.io import read_fold, write_fold
 from rigidfold.mesh.geometry import best_fit, edge_lengths
 from rigidfold.patterns import miura
-from rigidfold.run import verification_frames
+from rigidfold.pipeline import verification_frames
 
 
 def locked_miura(shape):
@@ -234,12 +234,14 @@ def test_verdicts_differ_when_the_tracer_stops_on_a_shape_of_several_dof(free_mi
 def test_deform_cli_says_why_the_verdicts_differ(free_miura, tmp_path, capsys, monkeypatch):
     import functools
 
-    import rigidfold.workflows
+    import rigidfold.pipeline.workflows
     from rigidfold.config import DEFAULTS
 
     tight = DEFAULTS.with_(**TRACER_STOPS)
-    real = rigidfold.workflows.deform_file
-    monkeypatch.setattr(rigidfold.workflows, "deform_file", functools.partial(real, settings=tight))
+    real = rigidfold.pipeline.workflows.deform_file
+    monkeypatch.setattr(
+        rigidfold.pipeline.workflows, "deform_file", functools.partial(real, settings=tight)
+    )
     src = write_fold(tmp_path / "free.fold", free_miura)
     assert main(["deform", str(src), "--out", str(tmp_path / "out")]) == 0  # reached the plane
     lines = capsys.readouterr().out.splitlines()

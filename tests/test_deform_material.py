@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.deform import deform, panel_section
 from rigidfold.io import write_fold
 from rigidfold.mesh.geometry import face_areas

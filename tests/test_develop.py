@@ -8,10 +8,10 @@ from scipy.spatial.distance import pdist
 
 from conftest import degree_n_vertex, folded_grid
 from conftest import paper_generate as generate
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.develop import Development, count_flipped, count_overlaps, develop
 from rigidfold.develop import diagram as diagram_module
+from rigidfold.generate.case import make_case
 from rigidfold.patterns.miura import miura
 
 

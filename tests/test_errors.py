@@ -12,13 +12,13 @@ import pytest
 
 import rigidfold
 from rigidfold import RigidfoldError
-from rigidfold.case import make_case, parse_fixed
 from rigidfold.config import DEFAULTS
 from rigidfold.exports import parse_formats
+from rigidfold.generate.case import make_case, parse_fixed
 from rigidfold.io import read_fold
 from rigidfold.patterns import parse_pattern
+from rigidfold.pipeline.workflows import analyze_file, report_run
 from rigidfold.surfaces import get_surface, mesh_surface, parse_expression
-from rigidfold.workflows import analyze_file, report_run
 
 
 def test_the_package_docstring_shows_the_generation_function_and_runs():

@@ -15,8 +15,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.develop import develop
 from rigidfold.exports import (
     EXPORT_FORMATS,
@@ -28,6 +27,7 @@ from rigidfold.exports import (
 )
 from rigidfold.exports.mesh3d import Y_UP
 from rigidfold.exports.sheet import polygon_area
+from rigidfold.generate.case import make_case
 from rigidfold.io import crease_pattern_frame, read_fold, write_fold
 from rigidfold.io.fold import edge_assignments
 from rigidfold.mesh.geometry import face_areas

@@ -46,7 +46,7 @@ def design(tmp_path_factory):
 @pytest.fixture(scope="module")
 def built(design, tmp_path_factory):
     """``rigidfold fabricate`` at 20 mm and 50 mm: {thickness: (exit code, out dir, summary)}."""
-    from rigidfold.workflows import fabricate_file
+    from rigidfold.pipeline.workflows import fabricate_file
 
     runs = {}
     for t in (0.02, 0.05):
@@ -143,7 +143,7 @@ def test_collision_reported_with_panels_and_fraction(design, tmp_path, capsys):
     way: the check names them and the fraction (exit 1), and a thinner try is reported."""
     from rigidfold.config import DEFAULTS
     from rigidfold.fabricate import FabricationStatus
-    from rigidfold.workflows import fabricate_file
+    from rigidfold.pipeline.workflows import fabricate_file
 
     settings = DEFAULTS.with_(
         fabricate_vertex_relief=0.0, fabricate_relief_rounds=0, fabricate_thickness_tries=2

@@ -269,7 +269,7 @@ def test_full_disk_leaves_no_partial_run(tmp_path, monkeypatch):
     no temporary file); the error says so in one line."""
     import rigidfold.io.files as files
     from rigidfold.fabricate import FabricateOptions
-    from rigidfold.workflows import fabricate_file
+    from rigidfold.pipeline.workflows import fabricate_file
 
     synced = []
     fsync = files.os.fsync
@@ -292,7 +292,7 @@ def test_progress_on_stderr(tmp_path, capsys):
     """A design of at least ``fabricate_progress_panels`` panels gets a line on stderr as
     each long step begins; a smaller one none."""
     from rigidfold.fabricate import FabricateOptions
-    from rigidfold.workflows import fabricate_file
+    from rigidfold.pipeline.workflows import fabricate_file
 
     settings = DEFAULTS.with_(fabricate_progress_panels=3)
     fabricate_file(AFRAME, tmp_path / "a", FabricateOptions(thickness=0.018), settings=settings)

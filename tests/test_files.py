@@ -17,7 +17,7 @@ from rigidfold.io import (
     refuse_replacing_inputs,
     write_json,
 )
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 class Color(Outcome):

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 import rigidfold.generate as generation
-from rigidfold.case import make_case
-from rigidfold.case_options import SettingsOptions
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, Stop, generate, with_fold_limit
-from rigidfold.generate_options import GenerateOptions
+from rigidfold.generate.case import make_case
+from rigidfold.generate.case_options import SettingsOptions
+from rigidfold.generate.options import GenerateOptions
 from rigidfold.mechanism.path import PathStatus
 
 

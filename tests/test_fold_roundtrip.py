@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import UNITS, fold_dict, read_fold, round_trip_dict, write_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns import miura
-from rigidfold.workflows import FLAT_NOTE, UNITLESS_NOTE, analyze_file, develop_file
+from rigidfold.pipeline.workflows import FLAT_NOTE, UNITLESS_NOTE, analyze_file, develop_file
 
 EXAMPLES = Path(__file__).parent / "data" / "fold_examples"
 READABLE = {"simple": 3, "diagonal-cp": 1, "squaretwist": 1}  # example -> DOF

@@ -19,7 +19,7 @@ import pytest
 
 from conftest import main_code
 from fuzzing import byte_damage
-from rigidfold.run import load_run
+from rigidfold.rundir import load_run
 from test_fuzz_fold import JUNK, nodes, put
 
 MESH = Path(__file__).parent / "data" / "dome_yup.obj"

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from conftest import paper_generate as generate
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS, one_blas_thread
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism import analyze
 from rigidfold.selection import predicted_locks, score_creases
 

@@ -15,7 +15,7 @@ from conftest import main_code
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.generate import GenerateOptions
-from rigidfold.run import Stage, load_run
+from rigidfold.rundir import Stage, load_run
 from rigidfold.structure import StructureOptions
 from rigidfold.study import STUDY_OPTIONS, StudyConfig
 
@@ -208,7 +208,7 @@ def test_a_check_that_cannot_run_is_a_failed_stage_not_a_lost_run(tmp_path, monk
     """A structure check that cannot run on the final design (a RigidfoldError from the
     analysis) fails its stage with its message: the run still ends with its verdict,
     summary.json and report (nothing computed is lost)."""
-    import rigidfold.run.checks as checks
+    import rigidfold.pipeline.checks as checks
 
     def cannot(*args, **kwargs):
         raise RigidfoldError("the shell model is singular\nat load step 1")

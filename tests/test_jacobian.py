@@ -13,8 +13,8 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 from rigidfold.optimize import Status
 from rigidfold.optimize.jacobian import (
     ClosedFormGradient,

@@ -13,11 +13,11 @@ import pytest
 
 from conftest import degree_n_vertex, folded_grid
 from conftest import paper_generate as generate
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism import analyze
 from rigidfold.mesh import CreasePattern
-from rigidfold.run import read_log
+from rigidfold.rundir import read_log
 from rigidfold.selection import carried_angles, flat_groups, lock_forecast, lookahead_order
 
 PARALLEL = {87, 89, 103, 108}  # the demo's four creases with parallel rows at DOF 5 (issue 18)
@@ -345,7 +345,7 @@ def test_all_candidates_predicted_falls_back_to_the_criterions_order(monkeypatch
 
 
 def test_generate_command_passes_lookahead_to_the_log(tmp_path):
-    from rigidfold.cli import main
+    from rigidfold.cli.commands import main
 
     out = tmp_path / "gen"
     case = ["--surface", "bezier", "--seed", "1", "--pattern", "1", "--target-dof", "20"]

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from conftest import degree_n_vertex, folded_grid
-from rigidfold.case import make_case
 from rigidfold.frame import FrameModel
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism import analyze, kinematics
 from rigidfold.patterns import miura
 

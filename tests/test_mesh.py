@@ -163,7 +163,7 @@ def test_error_messages_show_plain_numbers():
 
 def test_settings_decide_corners_of_a_case():
     """DEFAULTS.with_(corner_angle=...) reaches the pattern that make_case builds."""
-    from rigidfold.case import make_case
+    from rigidfold.generate.case import make_case
 
     assert len(make_case("dome", "1").pattern.corners) == 4
     blunt = DEFAULTS.with_(corner_angle=np.radians(100.0))  # the square's corners turn by 90

@@ -162,7 +162,9 @@ def test_bad_arrays(vertices, triangles, match):
 
 
 def test_trimesh_stays_out_of_the_import_path():
-    code = "import sys, rigidfold.surfaces, rigidfold.case; print('trimesh' in sys.modules)"
+    code = (
+        "import sys, rigidfold.surfaces, rigidfold.generate.case; print('trimesh' in sys.modules)"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 
@@ -382,7 +384,7 @@ def test_too_many_triangles_are_refused_in_one_line(tmp_path):
             sys.executable,
             "-c",
             "import resource, sys; resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30)); "
-            "from rigidfold.cli import main; sys.exit(main(sys.argv[1:]))",
+            "from rigidfold.cli.commands import main; sys.exit(main(sys.argv[1:]))",
             "optimize",
             "--surface",
             f"mesh:{stl}",

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 
 HYPAR = Path(__file__).parent / "data" / "origami_simulator" / "hypar.svg"
 

@@ -1,4 +1,4 @@
-"""Reproducible numerics (rigidfold.numerics): the tests run pinned, every entry point pins,
+"""Reproducible numerics (rigidfold.runtime.numerics): the tests run pinned, every entry point pins,
 and the canary tells each CPU-dependent part of the floating point apart.
 
 The counts and digits of one generation path that other tests assert (the demo's N_lock,
@@ -15,8 +15,8 @@ import sys
 import pytest
 
 import rigidfold
-from rigidfold import numerics
-from rigidfold.numerics import (
+from rigidfold.runtime import numerics
+from rigidfold.runtime.numerics import (
     BLAS_KERNEL_NAMES,
     OPT_OUT_ENV,
     RESTARTED_ENV,
@@ -227,7 +227,7 @@ def test_the_libm_pin_is_measured():
     env = pinned_environ(unpinned_env())
     env.pop("GLIBC_TUNABLES")
     env[OPT_OUT_ENV] = "native"
-    code = "from rigidfold.numerics import libm_pinned; print(libm_pinned())"
+    code = "from rigidfold.runtime.numerics import libm_pinned; print(libm_pinned())"
     proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert proc.stdout.strip() == "False", proc.stderr
 
@@ -256,12 +256,12 @@ def test_pinned_refuses_a_file_it_cannot_run_in_one_line(tmp_path):
 
 
 def test_a_program_that_calls_the_entry_point_runs_once(tmp_path):
-    """rigidfold.launch.main() called from a program does not restart the process (which
+    """rigidfold.cli.launch.main() called from a program does not restart the process (which
     would run the program again from the top); the rigidfold command does."""
     script = tmp_path / "program.py"
     script.write_text(
         "import sys\nprint('top')\nsys.argv[1:] = ['--version']\n"
-        "import rigidfold.launch\nraise SystemExit(rigidfold.launch.main())\n"
+        "import rigidfold.cli.launch\nraise SystemExit(rigidfold.cli.launch.main())\n"
     )
     proc = subprocess.run(
         [sys.executable, str(script)], env=unpinned_env(), capture_output=True, text=True

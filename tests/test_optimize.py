@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 from rigidfold.optimize import FormFindingProblem, Status, build_linear_map
 from rigidfold.surfaces import get_surface
 

@@ -12,8 +12,8 @@ from rigidfold.develop import DevelopStatus
 from rigidfold.generate import STOP_REASONS, Attempt, AttemptOutcome, Generation, Stop
 from rigidfold.mechanism.path import PathStatus
 from rigidfold.optimize import Status
+from rigidfold.outcomes import Outcome
 from rigidfold.patterns import miura
-from rigidfold.status import Outcome
 
 # the values that JSON files and study databases of every version hold
 VALUES = {

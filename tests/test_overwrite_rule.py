@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 
 RUN = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "1", "--target-dof", "19"]
 QUIET = ["--no-deform", "--no-report", "--quiet"]

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from conftest import dome_mesh, main_code
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 from rigidfold.surfaces import Dome
 
 DATA = Path(__file__).parent / "data"

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pytest
 
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 
 SEEDS = range(20)
 

@@ -12,17 +12,17 @@ import pytest
 import scipy.sparse as sp
 
 from conftest import paper_generate
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate import AttemptOutcome, generate
+from rigidfold.generate.case import make_case
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism.path import PathStatus, trace_path
 from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
-from rigidfold.run import read_log
+from rigidfold.rundir import read_log
 
 DATA = Path(__file__).parent / "data"
 

@@ -11,8 +11,8 @@ import pytest
 
 from conftest import main_code
 from rigidfold import patterns
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
+from rigidfold.generate.case import make_case
 from rigidfold.io import read_fold
 from rigidfold.surfaces import Dome
 

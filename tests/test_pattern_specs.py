@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from rigidfold import patterns
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 from rigidfold.mesh import CreasePattern
+from rigidfold.pipeline.workflows import analyze_file
 from rigidfold.surfaces import Bezier, Dome, HyperbolicParaboloid
-from rigidfold.workflows import analyze_file
 
 
 def crease_pattern(plan: patterns.Plan) -> CreasePattern:

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from conftest import paper_generate as generate
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import GenerateOptions
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.optimize import Status
 from rigidfold.optimize.hessian import angle_derivatives

@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
+from rigidfold.generate.case import make_case
+from rigidfold.pipeline.workflows import report_run
 from rigidfold.reporting import page, render_figures, view_figure
 from rigidfold.reporting.view3d import best_fit
-from rigidfold.run import SCHEMA_VERSION, load_run, read_log, target_surface
-from rigidfold.workflows import report_run
+from rigidfold.rundir import SCHEMA_VERSION, load_run, read_log, target_surface
 
 PNG = b"\x89PNG\r\n\x1a\n"
 FIGURES = ["development", "dof_and_F", "surface_fit", "fold_angles", "deformation"]

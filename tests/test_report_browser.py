@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from chromium import browser, load_page
-from rigidfold.cli import main
-from rigidfold.workflows import report_run
+from rigidfold.cli.commands import main
+from rigidfold.pipeline.workflows import report_run
 
 pytestmark = pytest.mark.skipif(
     browser() is None,

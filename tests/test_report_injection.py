@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from rigidfold.reporting import view_figure
-from rigidfold.run import SolutionFile
+from rigidfold.rundir import SolutionFile
 from rigidfold.study import Key, Store, StudyConfig
 from rigidfold.study.markdown import md_code, md_text, write_report
 from rigidfold.study.store import RUN_FIELDS

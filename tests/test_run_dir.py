@@ -13,8 +13,8 @@ import time
 import pytest
 
 from conftest import main_code
-from rigidfold.run import LOCK_NAME, clear_earlier_run, lock_run_dir
-from rigidfold.run import lock as run_lock
+from rigidfold.rundir import LOCK_NAME, clear_earlier_run, lock_run_dir
+from rigidfold.rundir import layout as run_lock
 
 
 def _dead_pid() -> int:

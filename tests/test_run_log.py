@@ -19,15 +19,16 @@ import sqlite3
 import pytest
 
 from conftest import main_code
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, GenerateOptions
+from rigidfold.generate.case import make_case
 from rigidfold.io import append_json_line
-from rigidfold.run import LOG_FILE, SCHEMA_VERSION, RunWriter, load_run, read_log
+from rigidfold.pipeline import RunWriter
+from rigidfold.pipeline.workflows import generate_case
+from rigidfold.rundir import LOG_FILE, SCHEMA_VERSION, load_run, read_log
 from rigidfold.study import Store, StudyConfig
 from rigidfold.study.store import STUDY_SCHEMA_VERSION
-from rigidfold.workflows import generate_case
 
 SEED = 102
 OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False)

@@ -13,7 +13,7 @@ from rigidfold.generate import GenerateOptions, Generation
 from rigidfold.io import FRACTION_KEY, motion_frames, read_frames
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns import pattern1
-from rigidfold.run import RunSummary, SolutionRecord, Stage, aggregate
+from rigidfold.rundir import RunSummary, SolutionRecord, Stage, aggregate
 
 
 def _record(development="converged", motion=None, deformation=None) -> SolutionRecord:
@@ -152,7 +152,7 @@ def test_motion_frames_carry_their_fraction():
 
 def test_every_stage_has_its_rule():
     """One table says when each check of a solution passes, and its enum reads its status."""
-    from rigidfold.run.schema import STAGES
+    from rigidfold.rundir.schema import STAGES
 
     assert set(STAGES) == set(Stage)
     record = _record(motion="ok")
@@ -164,11 +164,11 @@ def test_every_stage_has_its_rule():
 def test_a_design_beyond_dz_fails_the_fit_check(tmp_path):
     """issue 38 demo: the fit check runs through the one pipeline on every solution; a design
     farther from the target than dz fails it (Stage.FIT), with its words, in the verdict."""
-    from rigidfold.case import make_case
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import generate
-    from rigidfold.run import run_verdict
-    from rigidfold.run.checks import check_solution
+    from rigidfold.generate.case import make_case
+    from rigidfold.pipeline import run_verdict
+    from rigidfold.pipeline.checks import check_solution
 
     options = GenerateOptions(target_dof=18, deform=False)
     case = make_case("bezier", "1", seed=1)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import folded_grid
-from rigidfold.case import make_case
+from rigidfold.generate.case import make_case
 from rigidfold.mechanism import analyze
 from rigidfold.mechanism.stiffness import PseudoStiffness, hinge_stiffness
 from rigidfold.selection import crease_groups, rank_candidates, score_creases

@@ -17,8 +17,8 @@ import pytest
 
 from conftest import degree_n_vertex, folded_grid
 from conftest import paper_generate as generate
-from rigidfold.case import make_case
 from rigidfold.config import DEFAULTS
+from rigidfold.generate.case import make_case
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism import (
     analysis_bytes,

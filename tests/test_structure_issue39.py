@@ -16,7 +16,7 @@ import pytest
 from conftest import folded_grid, run_cli
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
-from rigidfold.generate_options import GenerateOptions
+from rigidfold.generate.options import GenerateOptions
 from rigidfold.io import write_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure import (

@@ -234,7 +234,7 @@ def test_unwritable_database_and_missing_report(tmp_path):
 
 
 def test_progress_prints_plain_lines_when_stderr_is_not_a_terminal(capsys):
-    from rigidfold.progress import StudyProgress
+    from rigidfold.cli.progress import StudyProgress
 
     bar = StudyProgress(enabled=True, log_every=3600.0)
     bar.plain = True  # as under pytest's captured stderr, a log file or nohup
@@ -382,7 +382,7 @@ def test_report_figures_never_follow_a_link(uninterrupted, tmp_path):
 def test_generate_progress_shows_the_last_step_and_an_eta(capsys):
     from types import SimpleNamespace
 
-    from rigidfold.progress import GenerateProgress
+    from rigidfold.cli.progress import GenerateProgress
 
     bar = GenerateProgress(enabled=True, target=1, log_every=3600.0)
     bar.plain = True

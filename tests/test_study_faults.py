@@ -23,7 +23,7 @@ STUDY = ["study", "--patterns", "1", "--criteria", "s", "--no-deform", "--quiet"
 def fake_run(key, config):
     """A run computed in no time, whose 40 attempts take several database pages."""
     row = {f: 1 for f in RUN_FIELDS if f not in ("status", "stop", "version", "worker", "numerics")}
-    from rigidfold.numerics import numeric_environment
+    from rigidfold.runtime.numerics import numeric_environment
 
     row |= {
         "stop": "target_reached",

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import UNITS, SvgDrawing, read_svg
 from rigidfold.mesh import CreasePattern

@@ -6,11 +6,11 @@ import json
 
 import pytest
 
-from rigidfold.case import make_case
-from rigidfold.cli import main
+from rigidfold.cli.commands import main
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop, generate
-from rigidfold.generate_options import GenerateOptions
+from rigidfold.generate.case import make_case
+from rigidfold.generate.options import GenerateOptions
 
 
 def test_a_time_limit_ends_the_run_with_a_named_design_and_exit_1(tmp_path, capsys):

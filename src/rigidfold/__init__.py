@@ -4,7 +4,7 @@ The method of Hayakawa and Ohsaki in a few lines of Python: a case (target surfa
 crease pattern, Step 1), then :func:`rigidfold.generate.generate` (Steps 2-7: solve problem
 (6), fix the crease the criterion ranks first, solve again, down to the target DOF)::
 
-    from rigidfold.case import make_case
+    from rigidfold.generate.case import make_case
     from rigidfold.generate import generate
 
     case = make_case("bezier", "1", seed=1)  # surface, pattern; mirror planes, sizes, Settings
@@ -13,20 +13,20 @@ crease pattern, Step 1), then :func:`rigidfold.generate.generate` (Steps 2-7: so
     design = run.final.result.pattern  # the final design: a CreasePattern (coords, faces)
 
 :func:`rigidfold.deform.verify` checks a design (Steps 8-9 and its folding motion); each
-command of the command line is a function of :mod:`rigidfold.workflows` that writes the
+command of the command line is a function of :mod:`rigidfold.pipeline.workflows` that writes the
 same files (``generate_case``, ``optimize_case``, ``export_file``, ...); every tolerance and
 default is a field of :class:`rigidfold.config.Settings`. What the library cannot use (a
 spec, a file, an option value) raises :class:`RigidfoldError`, a ``ValueError`` whose
 message names what was received.
 
 Importing the package pins the BLAS kernel and NumPy's SIMD dispatch while NumPy is not yet
-loaded, so that a design is the same on every x86-64 CPU (:mod:`rigidfold.numerics`).
+loaded, so that a design is the same on every x86-64 CPU (:mod:`rigidfold.runtime.numerics`).
 """
 
 from importlib.metadata import version as _v
 
 from rigidfold.errors import RigidfoldError
-from rigidfold.numerics import pin_in_process as _pin
+from rigidfold.runtime.numerics import pin_in_process as _pin
 
 _pin()
 __version__ = _v("rigidfold")

@@ -1,6 +1,6 @@
 """``python -m rigidfold``: the command line, started with the pinned numerics."""
 
-from rigidfold.launch import main
+from rigidfold.cli.launch import main
 
 if __name__ == "__main__":
     raise SystemExit(main())

@@ -1,10 +1,10 @@
 """A field of an options record, with its documentation and how the command line gives it.
 
 An options record (:class:`rigidfold.generate.GenerateOptions`,
-:class:`rigidfold.case_options.CaseOptions`) is a frozen dataclass whose fields are made by
+:class:`rigidfold.generate.case_options.CaseOptions`) is a frozen dataclass whose fields are made by
 :func:`option`: the default, what the value means (``field.metadata["doc"]``, which is also
 the command-line help) and, unless ``flag=False``, a :class:`Flag` (``field.metadata
-["flag"]``) from which :mod:`rigidfold.cli_parser` makes the argument: so a documented field
+["flag"]``) from which :mod:`rigidfold.cli.parser` makes the argument: so a documented field
 is all it takes to add an option to the library and a flag to the commands that take the
 record.
 """

@@ -1,5 +1,5 @@
 """``python -m rigidfold.pinned``: this machine's numeric environment, or a command run with
-the pinned numerics of :mod:`rigidfold.numerics`.
+the pinned numerics of :mod:`rigidfold.runtime.numerics`.
 
 ::
 
@@ -15,7 +15,12 @@ import os
 import shutil
 import sys
 
-from rigidfold.numerics import RESTARTED_ENV, numeric_environment, pinned_environ, restart_pinned
+from rigidfold.runtime.numerics import (
+    RESTARTED_ENV,
+    numeric_environment,
+    pinned_environ,
+    restart_pinned,
+)
 
 EXIT_NOT_FOUND = 127  # as a shell reports a command it cannot find
 EXIT_CANNOT_RUN = 126  # as a shell reports one it found but cannot run

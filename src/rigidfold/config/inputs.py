@@ -70,7 +70,7 @@ class InputSettings(Group):
         1000.0,
         "A plan with a side of at least this many metres (1 km), or a ``dz`` larger than the "
         "plan's larger side, gets a warning that the sizes look like millimetres "
-        "(:attr:`rigidfold.case.Case.warnings`: ``--size 3000x3000`` is a 3 km plan).",
+        "(:attr:`rigidfold.generate.case.Case.warnings`: ``--size 3000x3000`` is a 3 km plan).",
     )
     surface_grid_nodes: int = setting(
         65,

@@ -24,7 +24,7 @@ midsegments of each triangle's edge nodes (``l_e = 2 |m_a - m_b|``), and the cha
 dihedral angle of every fixed crease, from the triangles' edge nodes. ``mean_dl_mm`` is the
 mean over edges of each edge's largest |Delta l| during the analysis; ``max`` is the largest.
 
-With a ``material`` and ``thickness`` (the panels' own, :mod:`rigidfold.structure.material`),
+With a ``material`` and ``thickness`` (the panels' own, :mod:`rigidfold.material`),
 the members are strips of the panel instead of tubes (:class:`PanelSection`): the triangle's
 area is shared equally by its three members, so member k of length l_k in triangle f is a
 solid rectangle of width ``b = area_f / (3 l_k)`` and the panel's thickness t, lying in the
@@ -52,11 +52,11 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.frame.model import default_support_face
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import angle_change
-from rigidfold.quiet import native_quiet
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
+from rigidfold.runtime.quiet import native_quiet
 
 if TYPE_CHECKING:  # the material is the structure check's; only its fields are read here
-    from rigidfold.structure.material import Material
+    from rigidfold.material import Material
 
 
 @dataclass(frozen=True)
@@ -324,7 +324,7 @@ def deform(
     ``deform_max_halvings`` times; then the analysis stops with status FAILED and the figures
     of the converged steps. The equalDOF pins are enforced with the penalty
     ``deform_penalty * E A / mean edge length``. What OpenSees prints is hidden
-    (:func:`rigidfold.quiet.native_quiet`).
+    (:func:`rigidfold.runtime.quiet.native_quiet`).
     """
     import openseespy.opensees as ops  # heavy: only when an analysis runs
 

@@ -24,10 +24,10 @@ from rigidfold.deform.motion import Motion, MotionStatus, folding_motion
 from rigidfold.develop import Development, DevelopStatus, develop
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 if TYPE_CHECKING:
-    from rigidfold.structure.material import Material
+    from rigidfold.material import Material
 
 
 class Agreement(Outcome):

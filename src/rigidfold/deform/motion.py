@@ -25,7 +25,7 @@ from rigidfold.frame.model import default_support_face
 from rigidfold.mechanism.path import FoldingPath, PathStatus, trace_path
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import best_fit, edge_lengths
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 class MotionStatus(Outcome):

@@ -37,8 +37,8 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.ipopt import ipopt_options
-from rigidfold.quiet import native_quiet
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
+from rigidfold.runtime.quiet import native_quiet
 
 _IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 

@@ -23,8 +23,8 @@ from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
 from rigidfold.fabricate.progress import check_size, step
 from rigidfold.fabricate.solids import Solids, bevel_angles, thicken
-from rigidfold.status import Outcome
-from rigidfold.structure.material import parse_material
+from rigidfold.material import parse_material
+from rigidfold.outcomes import Outcome
 
 
 class FabricationStatus(Outcome):

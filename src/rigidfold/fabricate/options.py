@@ -30,7 +30,7 @@ from rigidfold.fabricate.build import (
 from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
 from rigidfold.flags import option, positive
-from rigidfold.structure.material import parse_material
+from rigidfold.material import parse_material
 
 _SHEET = (DEFAULTS.fabricate.sheet_width, DEFAULTS.fabricate.sheet_height)
 _MATERIAL = DEFAULTS.structure.material
@@ -41,7 +41,7 @@ class FabricateOptions:
     """Thick panels of a design, as ``rigidfold fabricate`` takes them.
 
     Each field is made by :func:`rigidfold.flags.option` with what it means, also the help of
-    its flag (:func:`rigidfold.cli_parser.add_options`: ``rigidfold fabricate``'s, and
+    its flag (:func:`rigidfold.cli.parser.add_options`: ``rigidfold fabricate``'s, and
     ``generate``'s with ``--thickness``): a new option is a new field here. Besides the
     command line's texts, ``thickness`` and ``min_thickness`` take a number of metres (kept
     as a float), ``sheet`` a ``(width, height)`` pair (kept as one); ``density`` None: the

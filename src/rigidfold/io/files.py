@@ -266,7 +266,7 @@ def jsonable(value, *, where: str = "the value"):
     * non-finite floats (NaN, +-inf) become None (JSON ``null``);
     * tuples become lists; dicts get ``str(key)`` keys (keys are not checked otherwise);
     * str, int, bool, None and finite floats stay as they are (subclasses such as
-      :class:`rigidfold.status.Outcome` members included).
+      :class:`rigidfold.outcomes.Outcome` members included).
 
     Raises ValueError ``"<where> holds a <type>, which is not JSON data"`` for anything else
     (sets, arbitrary objects), and ``"<where> is nested deeper than N levels"`` for lists and

@@ -70,7 +70,7 @@ from rigidfold.mechanism.rigid_folding import (
     rows_without_stresses,
 )
 from rigidfold.mesh import CreasePattern
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 class PathStatus(Outcome):

@@ -75,7 +75,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.mesh import CreasePattern
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 class Stability(Outcome):

@@ -14,7 +14,7 @@ import numpy as np
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
 from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
-from rigidfold.quiet import native_quiet
+from rigidfold.runtime.quiet import native_quiet
 
 _OUTCOME = {
     "Solve_Succeeded": SolverOutcome.SOLVED,

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigidfold.mesh import CreasePattern
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 class Status(Outcome):

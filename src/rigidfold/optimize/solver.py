@@ -20,8 +20,8 @@ from rigidfold.config import Settings
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize.nlp import NLP
 from rigidfold.optimize.variables import LinearMap
+from rigidfold.outcomes import Outcome
 from rigidfold.protocols import TargetSurface
-from rigidfold.status import Outcome
 
 
 class SolverOutcome(Outcome):

@@ -87,7 +87,7 @@ class Plan:
 
 class PatternKeywords(TypedDict, total=False):
     """The keywords of :func:`parse_pattern` besides the spec and the settings, as
-    :func:`rigidfold.case.make_case` passes them on (one list, not two)."""
+    :func:`rigidfold.generate.case.make_case` passes them on (one list, not two)."""
 
     size: str | tuple[float, float] | None
     diagonals: str | None

@@ -1,9 +1,9 @@
 """The report of a generate run: ``DIR/report.html`` and the PNG figures in ``DIR/figures/``.
 
-A view over the run read back by :func:`rigidfold.run.load_run`: :func:`render_figures`
+A view over the run read back by :func:`rigidfold.rundir.load_run`: :func:`render_figures`
 draws the paper-style figures (matplotlib, :mod:`.figures`), :func:`view_figure` makes the
 interactive 3D view (a plotly figure dict, :mod:`.view3d`) and :func:`page` puts them into
-one self-contained HTML page (:mod:`.html`). ``rigidfold.workflows.report_run`` writes the
+one self-contained HTML page (:mod:`.html`). ``rigidfold.pipeline.workflows.report_run`` writes the
 files.
 """
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigidfold.run import RunData, SolutionFile
+from rigidfold.rundir import RunData, SolutionFile
 
 KINDS = {
     "F": ("flat crease", "#bbbbbb", 0.6, "-"),

@@ -20,7 +20,7 @@ import numpy as np
 
 from rigidfold.generate import Stop
 from rigidfold.reporting.figures import Figure
-from rigidfold.run import Check, RunData
+from rigidfold.rundir import Check, RunData
 
 CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, Arial, sans-serif;

@@ -20,7 +20,7 @@ import numpy as np
 from rigidfold.mesh.geometry import best_fit, rigid_motions
 from rigidfold.protocols import TargetSurface
 from rigidfold.reporting.figures import KINDS
-from rigidfold.run import SolutionFile, ThickPanels
+from rigidfold.rundir import SolutionFile, ThickPanels
 
 GRID = 40
 """Samples per side of the target surface overlay."""

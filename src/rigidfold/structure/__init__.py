@@ -1,7 +1,7 @@
 """The deployed structure: supports that stabilise the mechanism, and its panels and hinges
 under load in OpenSees (``rigidfold structure``).
 
-:mod:`~rigidfold.structure.material` (the panels' material, presets),
+:mod:`~rigidfold.material` (the panels' material, presets),
 :mod:`~rigidfold.structure.supports` (first-order rigidity of a design on its supports, and
 the fewest supports that give it), :mod:`~rigidfold.mechanism.second_order` (second order where
 first order is not enough: prestress stability, or a finite mechanism),
@@ -16,6 +16,7 @@ from them, and its files) and
 imported only when an analysis runs or a figure is drawn.
 """
 
+from rigidfold.material import MATERIALS, Material, parse_material, presets_help
 from rigidfold.mechanism.second_order import SecondOrder, Stability, second_order
 from rigidfold.structure.check import (
     StructureCheck,
@@ -41,7 +42,6 @@ from rigidfold.structure.loads import (
     Uniform,
     parse_load,
 )
-from rigidfold.structure.material import MATERIALS, Material, parse_material, presets_help
 from rigidfold.structure.supports import (
     CANDIDATE_FORMS,
     Rigidity,

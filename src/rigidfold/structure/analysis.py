@@ -13,7 +13,7 @@ Constraints are imposed by the ``Transformation`` handler (the ties of
 :mod:`rigidfold.structure.model` are exact); the static and the eigen analysis solve with
 MUMPS (sparse: OpenSees's default band solver of ``eigen`` took 21 s for the 2048 shells of a
 17 x 17 grid, MUMPS 2.2 s). What OpenSees prints is hidden
-(:func:`rigidfold.quiet.native_quiet`). Stresses: the elements' stress resultants at their
+(:func:`rigidfold.runtime.quiet.native_quiet`). Stresses: the elements' stress resultants at their
 Gauss points (N11, N22, N12, M11, M22, M12, Q13, Q23 per unit length) give the membrane and
 bending stresses on both faces, sigma = N / t +- 6 M / t^2; the largest von Mises stress of
 this plane stress state is reported.
@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
-from rigidfold.quiet import native_quiet
-from rigidfold.structure.material import Material
+from rigidfold.material import Material
+from rigidfold.runtime.quiet import native_quiet
 from rigidfold.structure.model import ShellMesh, build_model
 
 
@@ -114,8 +114,8 @@ def _quiet_exit() -> None:
     descriptor 2, after Python has finished) for scripts too (the command line does it for
     itself): at exit, descriptor 2 goes to the null device and ``sys.stderr`` to a copy of
     the former one, so that Python's own writes still show. Not with ``--verbose``
-    (:func:`rigidfold.quiet.native_output_shown`)."""
-    from rigidfold.quiet import native_output_shown
+    (:func:`rigidfold.runtime.quiet.native_output_shown`)."""
+    from rigidfold.runtime.quiet import native_output_shown
 
     if _EXIT_QUIET or native_output_shown():
         return

@@ -21,9 +21,10 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
+from rigidfold.material import Material
 from rigidfold.mechanism.second_order import Stability
 from rigidfold.mesh import CreasePattern
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 from rigidfold.structure.analysis import ShellResponse, solve_shell
 from rigidfold.structure.loads import (
     Load,
@@ -32,7 +33,6 @@ from rigidfold.structure.loads import (
     check_magnitudes,
     nodal_loads,
 )
-from rigidfold.structure.material import Material
 from rigidfold.structure.model import ShellMesh, shell_mesh
 from rigidfold.structure.supports import Rigidity, SupportGrowth
 

@@ -26,6 +26,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
 from rigidfold.io.files import atomic_write, jsonable, parse_json
+from rigidfold.material import Material, parse_material, presets_help
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
     StructureCheck,
@@ -43,7 +44,6 @@ from rigidfold.structure.choices import (
     parse_supports,
 )
 from rigidfold.structure.loads import LOAD_TYPES, Load, SelfWeight, check_loads, parse_load
-from rigidfold.structure.material import Material, parse_material, presets_help
 from rigidfold.structure.supports import (
     Rigidity,
     Supports,
@@ -223,7 +223,7 @@ class StructureOptions:
     generate --structure`` builds the same), every value typed.
 
     Each field is made by :func:`rigidfold.flags.option` with what it means, also the help of
-    its flag (:func:`rigidfold.cli_parser.add_options`: ``rigidfold structure``'s, and
+    its flag (:func:`rigidfold.cli.parser.add_options`: ``rigidfold structure``'s, and
     ``generate``'s prefixed "--structure: "): a new option is a new field here. ``supports``
     is :class:`Auto`, :class:`Service` or :class:`Pins`; ``loads`` a tuple of
     :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`, :class:`Pressure`,
@@ -532,7 +532,7 @@ def recorded_thickness(path: str | Path, also: Sequence[Path] = ()) -> tuple[flo
     ``thickness_m`` of ``NAME_fabricate.json`` (:data:`rigidfold.fabricate.files.FABRICATE_JSON`)
     in its output directory, looked for beside the design (``fabricate DESIGN.fold --out``
     the design's directory), then in the directories ``also`` (for a run's solution, the
-    run's thick panels: :func:`rigidfold.run.built.thick_dir_of`)."""
+    run's thick panels: :func:`rigidfold.pipeline.built.thick_dir_of`)."""
     from rigidfold.fabricate.files import FABRICATE_JSON
 
     path = Path(path)

@@ -47,8 +47,8 @@ from typing import Any
 import numpy as np
 
 from rigidfold.errors import RigidfoldError
+from rigidfold.material import Material
 from rigidfold.mesh import CreasePattern
-from rigidfold.structure.material import Material
 
 
 @dataclass(frozen=True, eq=False)

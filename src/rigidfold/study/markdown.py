@@ -127,7 +127,7 @@ def _configuration_lines(store: Store) -> list[str]:
 
 
 def _numerics_lines(store: Store) -> list[str]:
-    """Which numeric environments computed the runs (rigidfold.numerics); none before they
+    """Which numeric environments computed the runs (rigidfold.runtime.numerics); none before they
     were recorded."""
     numerics = store.numerics()
     keys = {r.numerics for r in store.runs()} - {None}

@@ -134,12 +134,12 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
     could not run; its status is then "error: <message>".
     """
     from rigidfold import __version__
-    from rigidfold.case import make_case
     from rigidfold.generate import generate
+    from rigidfold.generate.case import make_case
     from rigidfold.mechanism.path import trace_path
-    from rigidfold.numerics import numeric_environment
-    from rigidfold.run import SolutionRecord, aggregate
-    from rigidfold.run.checks import check_solution
+    from rigidfold.pipeline.checks import check_solution
+    from rigidfold.rundir import SolutionRecord, aggregate
+    from rigidfold.runtime.numerics import numeric_environment
 
     settings, options = config.settings, config.options
     t0 = time.perf_counter()
@@ -367,7 +367,7 @@ def connect(scheduler: str, timeout: float):
 
 def worker_numerics() -> str:
     """The key of a Dask worker's numeric environment (run on every worker)."""
-    from rigidfold.numerics import numeric_environment
+    from rigidfold.runtime.numerics import numeric_environment
 
     return numeric_environment().key
 
@@ -408,7 +408,7 @@ def run_study(
 
     on_done(key, run_row, finished, total) is called in the client after each stored run.
     ``numerics_key``: the numeric environment every worker must compute with
-    (:attr:`rigidfold.numerics.NumericEnvironment.key`); a worker with another is refused
+    (:attr:`rigidfold.runtime.numerics.NumericEnvironment.key`); a worker with another is refused
     (ValueError naming it) before any run starts. Local workers inherit this process's.
     """
     import logging

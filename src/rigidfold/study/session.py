@@ -80,7 +80,7 @@ def run_study_command(
     recorded when it can be: every run stored before is kept, and the same command resumes.
     The database is locked while the study runs (a second client is refused,
     :class:`~rigidfold.study.lock.StudyLock`). A database whose runs were computed with
-    other numerics (:mod:`rigidfold.numerics`), and Dask workers that compute with other
+    other numerics (:mod:`rigidfold.runtime.numerics`), and Dask workers that compute with other
     numerics than this process, are refused unless ``allow_mixed_numerics``.
     """
     # checked before the database is created: local workers within what the machine runs
@@ -88,7 +88,7 @@ def run_study_command(
     if scheduler is None:
         check_workers(workers)
     check_connect_timeout(connect_timeout)
-    from rigidfold.numerics import numeric_environment
+    from rigidfold.runtime.numerics import numeric_environment
 
     numerics = numeric_environment().to_dict()
     # refuses another configuration, or runs of other numerics, untouched

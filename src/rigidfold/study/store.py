@@ -121,7 +121,7 @@ class Store:
     (:meth:`_connect_readonly`: it reads from a read-only file system too), and takes no
     ``config`` and no lock.
 
-    ``numerics`` (:meth:`rigidfold.numerics.NumericEnvironment.to_dict` of the process that
+    ``numerics`` (:meth:`rigidfold.runtime.numerics.NumericEnvironment.to_dict` of the process that
     will add runs) is stored with the first runs; a database whose runs were computed with
     another numeric environment (another ``key``), or before rigidfold recorded it, is
     refused untouched unless ``allow_mixed_numerics``.

@@ -28,7 +28,7 @@ SURFACES = ("bezier", "dome", "hp", "expr")
 
 SURFACE_FORMS = f"{', '.join(SURFACES)}, mesh:FILE or fold:FILE"
 """The forms of a surface spec, for messages and help texts (``fold:FILE`` is read by
-:func:`rigidfold.case.make_case`, which can read FOLD files)."""
+:func:`rigidfold.generate.case.make_case`, which can read FOLD files)."""
 
 
 def get_surface(

@@ -18,7 +18,7 @@ TARGET_FILE = "target_surface.json"
 summary.json names under ``target_surface`` so that the report can show the fit."""
 
 REPORT_FILE = "report.html"
-"""The run's report (:func:`rigidfold.run.writer.write_report`), its figures in
+"""The run's report (:func:`rigidfold.pipeline.writer.write_report`), its figures in
 :data:`FIGURES_DIR`."""
 
 FIGURES_DIR = "figures"

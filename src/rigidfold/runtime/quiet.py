@@ -5,7 +5,7 @@ IPOPT's output and its own warnings through Python's ``sys.stdout`` and ``sys.st
 :func:`native_quiet` drops what the thread that runs a solver writes to them while the
 solver runs; what other threads write (a progress bar's refresh, Dask's logs) passes. It is
 a context manager and a decorator, used around every OpenSees analysis and IPOPT solve;
-it also keeps the interrupts that native code would swallow (:mod:`rigidfold.interrupts`).
+it also keeps the interrupts that native code would swallow (:mod:`rigidfold.runtime.interrupts`).
 
 The output is shown instead when the environment variable :data:`VERBOSE_ENV` is set to
 anything but ``""`` or ``"0"`` (``rigidfold --verbose`` sets it for its own run, so the local
@@ -24,7 +24,7 @@ import threading
 from collections.abc import Iterator
 from typing import TextIO
 
-from rigidfold.interrupts import kept_interrupts
+from rigidfold.runtime.interrupts import kept_interrupts
 
 VERBOSE_ENV = "RIGIDFOLD_VERBOSE"
 """Environment variable that shows what OpenSees, CasADi and IPOPT print."""
@@ -86,7 +86,7 @@ def native_quiet() -> Iterator[None]:
     runs (OpenSees's and CasADi's messages), unless :func:`native_output_shown`. Nested and
     concurrent uses (threads of a Dask worker) are safe: the streams are replaced once, while
     any thread is quiet. A Ctrl-C or SIGTERM that the native code swallows is raised when the
-    block ends (:func:`rigidfold.interrupts.kept_interrupts`)."""
+    block ends (:func:`rigidfold.runtime.interrupts.kept_interrupts`)."""
     with kept_interrupts():
         if native_output_shown():
             yield

@@ -4,7 +4,7 @@ A user error (a :class:`rigidfold.RigidfoldError`: a bad option value, a refused
 an unwritable directory, a malformed file) is reported as one line on stderr with exit code 2,
 never a traceback; any other exception is a bug of rigidfold: one line saying so and where
 its traceback was written, exit code 1. The options of each command come from the records it
-fills (:mod:`rigidfold.cli_parser`), its words from :mod:`rigidfold.cli_text`.
+fills (:mod:`rigidfold.cli.parser`), its words from :mod:`rigidfold.cli.text`.
 """
 
 from __future__ import annotations
@@ -21,16 +21,16 @@ import traceback
 from collections.abc import Sequence
 
 from rigidfold import __version__
-from rigidfold.case_options import CaseOptions, SettingsOptions
-from rigidfold.cli_arguments import add_arguments
-from rigidfold.cli_checks import fabricate_options, structure_options, structure_progress
-from rigidfold.cli_parser import EXIT_USAGE, Parser, attached_values, one_line, options_of
-from rigidfold.cli_text import COMMANDS
+from rigidfold.cli.arguments import add_arguments
+from rigidfold.cli.checks import fabricate_options, structure_options, structure_progress
+from rigidfold.cli.parser import EXIT_USAGE, Parser, attached_values, one_line, options_of
+from rigidfold.cli.text import COMMANDS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
-from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
+from rigidfold.generate.case_options import CaseOptions, SettingsOptions
 from rigidfold.io import jsonable
-from rigidfold.quiet import VERBOSE_ENV, native_output_shown
+from rigidfold.runtime.interrupts import EXIT_INTERRUPTED
+from rigidfold.runtime.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.study import STUDY_OPTIONS
 
 __all__ = ["build_parser", "main", "one_line"]
@@ -69,7 +69,7 @@ def _case(args: argparse.Namespace):
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
-    from rigidfold.workflows import optimize_case
+    from rigidfold.pipeline.workflows import optimize_case
 
     out = optimize_case(
         _case(args), args.out, fixed=args.fixed, solver=args.solver, overwrite=args.overwrite
@@ -82,7 +82,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     )
     print(f"wrote {' and '.join(str(p) for p in out.written)}")
     if not result.converged:
-        from rigidfold.run.verdict import SOLVE_HINT
+        from rigidfold.pipeline.verdict import SOLVE_HINT
 
         print(f"not accepted: {SOLVE_HINT}")
     return 0 if result.converged else 1
@@ -103,11 +103,11 @@ def _counters(summary: dict, stop_reason: str) -> str:
 
 
 def _cmd_generate(args: argparse.Namespace) -> int:
-    from rigidfold.progress import GenerateProgress
-    from rigidfold.run import RunOutcome, RunWriter
-    from rigidfold.run.built import STRUCTURE_DIR, THICK_DIR
-    from rigidfold.run.lock import FINAL_DIR, REPORT_FILE
-    from rigidfold.workflows import generate_case
+    from rigidfold.cli.progress import GenerateProgress
+    from rigidfold.pipeline import RunOutcome, RunWriter
+    from rigidfold.pipeline.built import STRUCTURE_DIR, THICK_DIR
+    from rigidfold.pipeline.workflows import generate_case
+    from rigidfold.rundir.layout import FINAL_DIR, REPORT_FILE
 
     structure = structure_options(args)  # checked even without --structure
     options = options_of(
@@ -165,8 +165,8 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from rigidfold.run.lock import FIGURES_DIR
-    from rigidfold.workflows import report_run
+    from rigidfold.pipeline.workflows import report_run
+    from rigidfold.rundir.layout import FIGURES_DIR
 
     report = report_run(args.dir)
     if args.json:
@@ -181,7 +181,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    from rigidfold.workflows import analyze_file
+    from rigidfold.pipeline.workflows import analyze_file
 
     analysis = analyze_file(args.file, up=args.up)
     report = analysis.to_dict()
@@ -212,7 +212,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def _cmd_develop(args: argparse.Namespace) -> int:
-    from rigidfold.workflows import develop_file
+    from rigidfold.pipeline.workflows import develop_file
 
     checked = develop_file(args.file, args.out, up=args.up)
     d = checked.verification.development
@@ -228,7 +228,7 @@ def _cmd_develop(args: argparse.Namespace) -> int:
 
 
 def _cmd_deform(args: argparse.Namespace) -> int:
-    from rigidfold.workflows import deform_file
+    from rigidfold.pipeline.workflows import deform_file
 
     checked = deform_file(
         args.file, args.out, up=args.up, material=args.material, thickness=args.thickness
@@ -263,7 +263,7 @@ def _cmd_deform(args: argparse.Namespace) -> int:
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
-    from rigidfold.workflows import export_file
+    from rigidfold.pipeline.workflows import export_file
 
     done = export_file(args.file, args.out, formats=args.to, convention=args.convention, up=args.up)
     if args.json:
@@ -278,8 +278,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 
 def _cmd_structure(args: argparse.Namespace) -> int:
+    from rigidfold.pipeline.workflows import structure
     from rigidfold.structure import StructureStatus
-    from rigidfold.workflows import structure
 
     run = structure(
         args.file,
@@ -328,7 +328,7 @@ def _cmd_structure(args: argparse.Namespace) -> int:
 
 
 def _cmd_fabricate(args: argparse.Namespace) -> int:
-    from rigidfold.workflows import fabricate_file
+    from rigidfold.pipeline.workflows import fabricate_file
 
     options = fabricate_options(args)
     assert options is not None  # --thickness is required
@@ -349,7 +349,7 @@ def _cmd_fabricate(args: argparse.Namespace) -> int:
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
-    from rigidfold.progress import StudyProgress
+    from rigidfold.cli.progress import StudyProgress
     from rigidfold.study import (
         StudyConfig,
         StudyInterrupted,
@@ -448,7 +448,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not (args.verbose or native_output_shown()):
         _quiet_exit()
     shown = os.environ.get(VERBOSE_ENV)
-    if args.verbose:  # rigidfold.quiet lets the solvers' output through, here and in workers
+    if (
+        args.verbose
+    ):  # rigidfold.runtime.quiet lets the solvers' output through, here and in workers
         os.environ[VERBOSE_ENV] = "1"
     if isinstance(sys.stdout, io.TextIOWrapper):
         # a file name whose bytes are not UTF-8 is printed as those bytes, as ls does, not
@@ -542,8 +544,3 @@ def _quiet_exit() -> None:
         os.dup2(devnull, sys.stderr.fileno())
 
     atexit.register(silence)
-
-
-if __name__ == "__main__":
-    terminate_interrupts()
-    sys.exit(main())

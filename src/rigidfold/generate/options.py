@@ -1,7 +1,7 @@
 """The one set of a generation run's options: :class:`GenerateOptions`.
 
 The CLI's ``generate``, :func:`rigidfold.generate.generate`, the run writer
-(:class:`rigidfold.run.RunWriter`) and the study (:class:`rigidfold.study.StudyConfig`) share
+(:class:`rigidfold.pipeline.RunWriter`) and the study (:class:`rigidfold.study.StudyConfig`) share
 it. The checks of the final design that have their own commands keep their options in those
 commands' records: the thick panels in a :class:`rigidfold.fabricate.FabricateOptions`
 (``rigidfold fabricate``), the structure in a :class:`rigidfold.structure.StructureOptions`
@@ -10,7 +10,7 @@ commands' records: the thick panels in a :class:`rigidfold.fabricate.FabricateOp
 
 Each field is made by :func:`rigidfold.flags.option` with what it means, which is also the
 help of its command-line flag (``rigidfold generate --target-dof``): a new option is a new
-field here, and :mod:`rigidfold.cli_parser` gives it its flag.
+field here, and :mod:`rigidfold.cli.parser` gives it its flag.
 """
 
 from __future__ import annotations
@@ -23,17 +23,17 @@ from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import count, option, positive
+from rigidfold.material import parse_material
 from rigidfold.optimize import SOLVERS
 from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
-from rigidfold.structure.material import parse_material
 
 
 @dataclass(frozen=True)
 class GenerateOptions:
     """How one generation run goes, in one place: Steps 2-7 (:func:`rigidfold.generate.
     generate`) and the checks that follow them (Steps 8-9 and the final design as built, run
-    by :class:`rigidfold.run.RunWriter`). Checked when made (:class:`RigidfoldError` naming
+    by :class:`rigidfold.pipeline.RunWriter`). Checked when made (:class:`RigidfoldError` naming
     what was received). What each field means: :func:`rigidfold.flags.docs`."""
 
     criterion: str = option(

@@ -1,7 +1,7 @@
 """The workflows behind the command line: read, compute, write, and return a result.
 
 Each function takes validated library objects (or a file path, validated on reading), runs
-the library, writes its files through the shared writers of :mod:`rigidfold.run` and
+the library, writes its files through the shared writers of :mod:`rigidfold.rundir` and
 :mod:`rigidfold.io`, and returns a frozen result whose ``to_dict()`` is what ``--json``
 prints. ``rigidfold.cli`` only parses arguments, calls these functions and prints.
 
@@ -10,7 +10,7 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``develop_file``       Step 8 of a FOLD shape: FOLD with its diagram, and an SVG
 ``deform_file``        Steps 8-9 and the folding motion of a FOLD shape
 ``optimize_case``      one solve of problem (6): ``solution.fold`` and ``summary.json``
-``generate_case``      Steps 2-9 into a :class:`rigidfold.run.RunWriter`
+``generate_case``      Steps 2-9 into a :class:`rigidfold.pipeline.RunWriter`
 ``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
 ``report_run``         ``DIR/report.html`` and ``DIR/figures/`` of a generate run
 ``structure``          supports and loads of a FOLD design (``rigidfold structure``)
@@ -29,7 +29,6 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import Case, parse_fixed, shape_summary
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.check import Verification, verify
 from rigidfold.develop import DevelopStatus
@@ -46,6 +45,7 @@ from rigidfold.exports import (
 )
 from rigidfold.fabricate import FabricateOptions, Fabrication, Panels, design_motion
 from rigidfold.generate import Attempt, Generation, generate
+from rigidfold.generate.case import Case, parse_fixed, shape_summary
 from rigidfold.io import (
     FoldData,
     prepare_output_dir,
@@ -56,15 +56,9 @@ from rigidfold.io import (
 )
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
+from rigidfold.pipeline import RunWriter, write_checked_shape, write_report
 from rigidfold.reporting import page, render_figures, thick_figure, view_figure
-from rigidfold.run import (
-    RunData,
-    RunWriter,
-    clear_earlier_run,
-    load_run,
-    write_checked_shape,
-    write_report,
-)
+from rigidfold.rundir import RunData, clear_earlier_run, load_run
 from rigidfold.structure import (
     Material,
     StructureCheck,
@@ -313,7 +307,7 @@ def optimize_case(
 
     Before any work, ValueError when one of the files would replace one of ``case.inputs``,
     and when OUT holds them from an earlier run, unless ``overwrite`` (then they are removed
-    first, like ``generate --overwrite``: :func:`rigidfold.run.clear_earlier_run`)."""
+    first, like ``generate --overwrite``: :func:`rigidfold.rundir.clear_earlier_run`)."""
     refuse_replacing_inputs(case.inputs, [Path(out) / name for name in OPTIMIZE_FILES])
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=case.inputs, names=OPTIMIZE_FILES)
@@ -341,13 +335,13 @@ def generate_case(
     """Steps 2-9 on ``writer.case`` with ``writer.options``, every attempt and solution
     written by ``writer`` as it comes (so an interrupt loses nothing), the solutions
     retracted by backtracking or a restart removed at once
-    (:meth:`rigidfold.run.RunWriter.on_retract`); ``progress(run, attempt)`` after each of
+    (:meth:`rigidfold.pipeline.RunWriter.on_retract`); ``progress(run, attempt)`` after each of
     them. ``summary.json`` is written once more at the end, with
-    the run's verdict (``writer.verdict``, :func:`rigidfold.run.run_verdict`); then, with
+    the run's verdict (``writer.verdict``, :func:`rigidfold.pipeline.run_verdict`); then, with
     ``report``, ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is
     released at the end, however the run ends. A KeyboardInterrupt (Ctrl-C, SIGTERM from the
     command line) propagates once summary.json says the run was interrupted
-    (:meth:`rigidfold.run.RunWriter.interrupted`)."""
+    (:meth:`rigidfold.pipeline.RunWriter.interrupted`)."""
     seen: list[Generation] = []  # the run, once an attempt has been written
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
@@ -596,7 +590,7 @@ def fabricate_file(
     whatever the verdict. Refused (ValueError, before anything is written) when one of them
     would replace ``path``, and when OUT holds an earlier fabricate's files of the same NAME
     (every cut sheet included), unless ``overwrite`` (then they are removed first, like
-    ``generate --overwrite``: :func:`rigidfold.run.clear_earlier_run`)."""
+    ``generate --overwrite``: :func:`rigidfold.rundir.clear_earlier_run`)."""
     from rigidfold.fabricate.cutsheets import sheet_files
     from rigidfold.fabricate.files import FABRICATE_JSON, SOLID_FILES, write_fabrication
 

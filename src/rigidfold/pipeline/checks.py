@@ -4,12 +4,12 @@ worker alike.
 :func:`check_solution` runs the checks of an accepted solution as the options ask: the
 development diagram (Step 8, always), the folding motion, the large deformation (Step 9),
 the fit to the target and the deployability check's path, and returns its
-:class:`~rigidfold.run.SolutionRecord` with what was computed (:class:`Checked`).
+:class:`~rigidfold.rundir.SolutionRecord` with what was computed (:class:`Checked`).
 :func:`check_final` adds the final design as built, its thick panels and its structure
-(``GenerateOptions.fabricate`` and ``.structure``, :mod:`rigidfold.run.built`), whose files
+(``GenerateOptions.fabricate`` and ``.structure``, :mod:`rigidfold.pipeline.built`), whose files
 go under the run's directory. Neither writes a solution file, the log or the summary: that
-is the run writer's (:class:`rigidfold.run.RunWriter`). A new check of a run is a field of
-the record, its :class:`~rigidfold.run.Stage` where it can fail (:mod:`rigidfold.run.schema`)
+is the run writer's (:class:`rigidfold.pipeline.RunWriter`). A new check of a run is a field of
+the record, its :class:`~rigidfold.rundir.Stage` where it can fail (:mod:`rigidfold.rundir.schema`)
 and its computation here.
 """
 
@@ -20,23 +20,23 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import Case
 from rigidfold.config import Settings
 from rigidfold.deform import MotionStatus, Verification, verify
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import GenerateOptions, Solution
-from rigidfold.run.built import structure_check, thick_panels
-from rigidfold.run.schema import FitStatus, SolutionRecord
+from rigidfold.generate.case import Case
+from rigidfold.material import parse_material
+from rigidfold.pipeline.built import structure_check, thick_panels
+from rigidfold.rundir.schema import FitStatus, SolutionRecord
 from rigidfold.structure import StructureCheck
-from rigidfold.structure.material import parse_material
 
 
 @dataclass(frozen=True, eq=False)
 class Checked:
     """A solution checked by :func:`check_solution`.
 
-    record : its :class:`~rigidfold.run.SolutionRecord` (the figures of every check that
+    record : its :class:`~rigidfold.rundir.SolutionRecord` (the figures of every check that
     ran); verification : the results of Steps 8-9 and the motion
     (:class:`rigidfold.deform.Verification`), which its files are written from.
     """
@@ -118,7 +118,7 @@ def check_solution(
 def _fit(dz: np.ndarray, settings: Settings) -> dict:
     """The fit of a solution whose vertices lie ``dz`` (V,) above the target, metres: the
     largest and RMS |dz|, and whether the largest is within the bound ``settings.design.dz``
-    by ``dz_bound_tol`` of it (:class:`~rigidfold.run.schema.FitStatus`, ``Stage.FIT``)."""
+    by ``dz_bound_tol`` of it (:class:`~rigidfold.rundir.schema.FitStatus`, ``Stage.FIT``)."""
     worst, bound = float(np.abs(dz).max()), settings.design.dz
     within = worst <= bound * (1 + settings.design.dz_bound_tol)
     return {
@@ -179,7 +179,7 @@ def check_final(
 
 def _not_checked(what: str, exc: Exception) -> dict:
     """The figures of a check of the final design that could not run: status "error" and
-    why (a failed :class:`~rigidfold.run.Stage` with this message)."""
+    why (a failed :class:`~rigidfold.rundir.Stage` with this message)."""
     return {
         "status": "error",
         "message": f"{what} could not be checked: {' '.join(str(exc).split())}",

@@ -1,20 +1,22 @@
 """The arguments of each command of the command line (:data:`ARGUMENTS`, by command): those
-of the records it fills, made from their fields (:func:`rigidfold.cli_parser.add_options`:
-:class:`~rigidfold.generate.GenerateOptions`, :class:`~rigidfold.case_options.CaseOptions`,
-:class:`~rigidfold.case_options.SettingsOptions`; the checks' in :mod:`rigidfold.cli_checks`),
+of the records it fills, made from their fields (:func:`rigidfold.cli.parser.add_options`:
+:class:`~rigidfold.generate.GenerateOptions`,
+:class:`~rigidfold.generate.case_options.CaseOptions`,
+:class:`~rigidfold.generate.case_options.SettingsOptions`; the checks' in
+:mod:`rigidfold.cli.checks`),
 and its own (its files, what it prints)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from rigidfold.case_options import CaseOptions, SettingsOptions
-from rigidfold.cli_checks import fabricate_arguments, structure_arguments
-from rigidfold.cli_parser import Parser, add_options, argument_type, directory
+from rigidfold.cli.checks import fabricate_arguments, structure_arguments
+from rigidfold.cli.parser import Parser, add_options, argument_type, directory
 from rigidfold.config import DEFAULTS
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.flags import seed
 from rigidfold.generate import GenerateOptions
+from rigidfold.generate.case_options import CaseOptions, SettingsOptions
 from rigidfold.io import UP_AXES
 from rigidfold.selection import CRITERIA
 from rigidfold.structure import MATERIALS

@@ -46,8 +46,8 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from rigidfold import libm_probe
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
+from rigidfold.runtime import libm_probe
 
 OPT_OUT_ENV = "RIGIDFOLD_NUMERICS"
 """Set to ``native`` to keep the machine's own BLAS kernel, SIMD and libm variants."""
@@ -320,7 +320,7 @@ LIBM_PROBE_TIMEOUT_S = 60
 @functools.cache
 def libm_pinned() -> bool:
     """Whether this process's libm computes the bits of the pinned one: the libm canary
-    (:func:`rigidfold.libm_probe.digest`) here and in a process started with the pinned
+    (:func:`rigidfold.runtime.libm_probe.digest`) here and in a process started with the pinned
     hwcaps are the same (measured, so a CPU without FMA and AVX2 is pinned whatever the
     environment says, and a loader that ignored the mask is not). False when that process
     could not run."""

@@ -19,7 +19,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rigidfold.cli_parser import add_options, options_of
+from rigidfold.cli.parser import add_options, options_of
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import docs
 from rigidfold.structure import StructureOptions
@@ -44,7 +44,7 @@ def length(what: str):
 
 def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     """The thick panels' options (:class:`~rigidfold.fabricate.FabricateOptions`) on ``p``,
-    made from its fields (:func:`~rigidfold.cli_parser.add_options`): ``rigidfold
+    made from its fields (:func:`~rigidfold.cli.parser.add_options`): ``rigidfold
     fabricate``'s, where ``--thickness`` is required, or ``generate``'s, where its own
     ``--thickness`` asks for the final design's thick panels and the others, their help
     prefixed "with --thickness: ", apply to them."""
@@ -77,7 +77,7 @@ def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
 
 def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     """The structure check's options (:class:`~rigidfold.structure.StructureOptions`) on
-    ``p``, made from its fields (:func:`~rigidfold.cli_parser.add_options`): ``rigidfold
+    ``p``, made from its fields (:func:`~rigidfold.cli.parser.add_options`): ``rigidfold
     structure``'s, where ``--thickness`` left out is the thickness fabricate recorded
     (:func:`structure_options`), or ``generate``'s, their help prefixed "--structure: ",
     where ``--structure`` asks for the check of the final design, ``--material`` is also
@@ -132,7 +132,7 @@ def structure_options(args: argparse.Namespace) -> StructureOptions:
     ``rigidfold structure FILE`` without ``--thickness``: the thickness fabricate recorded
     for the design (:func:`~rigidfold.structure.design.recorded_thickness`, said on stderr
     and as ``thickness_from``), else the default."""
-    from rigidfold.run.built import thick_dir_of
+    from rigidfold.pipeline.built import thick_dir_of
     from rigidfold.structure.design import recorded_thickness
 
     thickness, source = args.thickness, ""

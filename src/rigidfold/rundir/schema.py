@@ -28,8 +28,8 @@ from rigidfold.develop import DevelopStatus
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
 from rigidfold.generate import Attempt, Generation, Stop
-from rigidfold.run.shapes import Nullable, Record, check_shape, received, shape_of
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
+from rigidfold.rundir.json_shapes import Nullable, Record, check_shape, received, shape_of
 from rigidfold.structure import StructureStatus
 
 SCHEMA_VERSION = 2
@@ -264,8 +264,8 @@ class StageRule:
     """How a :class:`Stage` is judged and shown.
 
     passing : the status its figures pass with, a member of its result's
-    :class:`~rigidfold.status.Outcome` enum (whose values its ``status`` holds); name : its
-    name among the report's checks (:meth:`rigidfold.run.RunData.checks`); detailed : its
+    :class:`~rigidfold.outcomes.Outcome` enum (whose values its ``status`` holds); name : its
+    name among the report's checks (:meth:`rigidfold.rundir.RunData.checks`); detailed : its
     figures' ``message`` says more than the :class:`Stage` message (in the verdict and the
     report).
     """
@@ -392,7 +392,7 @@ def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dic
     """The run-wide figures over the solutions' records (means and maxima of what ran):
     ``summary.json``'s ``development``, ``deformation``, ``motion``, ``fabrication`` and
     ``structure``, the study's figures of a run and the report's checks
-    (:meth:`rigidfold.run.RunData.checks`). A figure that a record read back holds as null
+    (:meth:`rigidfold.rundir.RunData.checks`). A figure that a record read back holds as null
     is left out."""
     dev = [r.development or {} for r in records]
     deformed = [r.deformation for r in records if r.deformation is not None]

@@ -1,6 +1,6 @@
 """The part of the numerics canary that libm alone computes, runnable on its own:
 ``python -I -S libm_probe.py`` prints :func:`digest`, with nothing but the standard library
-(no NumPy, not rigidfold), so that :mod:`rigidfold.numerics` can start a process with the
+(no NumPy, not rigidfold), so that :mod:`rigidfold.runtime.numerics` can start a process with the
 pinned libm and compare what it computes with this process's (whether this process's libm
 is pinned is measured, not inferred from its environment)."""
 

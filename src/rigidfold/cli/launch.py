@@ -1,7 +1,7 @@
 """Entry point of the ``rigidfold`` command: pin the numerics, then run the command line.
 
 Kept apart from :mod:`rigidfold.cli` so that the restart with the pinned numerics
-(:func:`rigidfold.numerics.restart_pinned`) happens before NumPy, SciPy and CasADi load.
+(:func:`rigidfold.runtime.numerics.restart_pinned`) happens before NumPy, SciPy and CasADi load.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import sysconfig
 from collections.abc import Sequence
 from pathlib import Path
 
-from rigidfold.interrupts import EXIT_INTERRUPTED, terminate_interrupts
+from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, terminate_interrupts
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -23,11 +23,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     pins one)."""
     terminate_interrupts()
     try:
-        from rigidfold.numerics import restart_pinned
+        from rigidfold.runtime.numerics import restart_pinned
 
         if argv is None and _started_as_rigidfold():
             restart_pinned()
-        from rigidfold.cli import main as cli_main
+        from rigidfold.cli.commands import main as cli_main
 
         return cli_main(argv)
     except KeyboardInterrupt:

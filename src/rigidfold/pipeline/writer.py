@@ -4,10 +4,10 @@
 ``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
 ``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.jsonl``
 (every attempt, a line appended for each: :class:`AttemptLog`) and ``DIR/summary.json`` (a
-:class:`~rigidfold.run.RunSummary`, :meth:`RunWriter.summary`, written by its ``to_dict``:
+:class:`~rigidfold.rundir.RunSummary`, :meth:`RunWriter.summary`, written by its ``to_dict``:
 the paper's counters, the development and deformation figures (Step 9), each solution's
-:class:`~rigidfold.run.SolutionRecord`, the options, the verdict and stage times, the
-:data:`~rigidfold.run.schema.SCHEMA_VERSION`). Every other file is written atomically
+:class:`~rigidfold.rundir.SolutionRecord`, the options, the verdict and stage times, the
+:data:`~rigidfold.rundir.schema.SCHEMA_VERSION`). Every other file is written atomically
 (temporary file, then rename), so each one on disk is always valid; the log is only ever
 appended to, so a crash can tear only its last line, which its reader skips.
 """
@@ -20,7 +20,6 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.case import Case
 from rigidfold.deform import Verification
 from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
@@ -33,6 +32,7 @@ from rigidfold.generate import (
     Stop,
     best_so_far,
 )
+from rigidfold.generate.case import Case
 from rigidfold.io import (
     FoldData,
     append_json_line,
@@ -48,9 +48,10 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
-from rigidfold.run.built import check_built_options
-from rigidfold.run.checks import Checked, check_final, check_solution, traced_motion
-from rigidfold.run.lock import (
+from rigidfold.pipeline.built import check_built_options
+from rigidfold.pipeline.checks import Checked, check_final, check_solution, traced_motion
+from rigidfold.pipeline.verdict import RunVerdict, run_verdict
+from rigidfold.rundir.layout import (
     FIGURES_DIR,
     FINAL_DIR,
     REPORT_FILE,
@@ -59,8 +60,7 @@ from rigidfold.run.lock import (
     clear_earlier_run,
     lock_run_dir,
 )
-from rigidfold.run.schema import LOG_FILE, SCHEMA_VERSION, RunSummary, SolutionRecord
-from rigidfold.run.verdict import RunVerdict, run_verdict
+from rigidfold.rundir.schema import LOG_FILE, SCHEMA_VERSION, RunSummary, SolutionRecord
 from rigidfold.structure import StructureCheck
 from rigidfold.surfaces import SplineSurface
 
@@ -116,14 +116,14 @@ def write_checked_shape(
 
 
 class AttemptLog:
-    """The attempt log of a run, ``DIR/log.jsonl`` (:data:`~rigidfold.run.schema.LOG_FILE`),
+    """The attempt log of a run, ``DIR/log.jsonl`` (:data:`~rigidfold.rundir.schema.LOG_FILE`),
     only ever appended to: a header line ``{"schema_version": N}``, then a line per attempt
     (:meth:`rigidfold.generate.Attempt.to_dict`), each flushed and synced as it is written
     (:func:`rigidfold.io.append_json_line`): O(1) per attempt however long the run.
 
     :meth:`sync` appends the attempts of a run not yet logged, and again those whose outcome
     changed since they were (backtracking: ``dead_end``, and ``accepted`` again), with the
-    same ``index``; the reader (:func:`rigidfold.run.reader.read_log`) takes the last line
+    same ``index``; the reader (:func:`rigidfold.rundir.reader.read_log`) takes the last line
     of each index. The file is created (exclusively, no symbolic link followed) with the
     first line written.
     """
@@ -167,7 +167,7 @@ class AttemptLog:
 
 class RunWriter:
     """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date: the
-    checks are the pipeline's (:mod:`rigidfold.run.checks`, the study's too), the writer
+    checks are the pipeline's (:mod:`rigidfold.pipeline.checks`, the study's too), the writer
     writes their results.
 
     The development diagram (Step 8) runs on every solution as it comes; the folding motion
@@ -178,7 +178,7 @@ class RunWriter:
     (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
     target the verdict (:meth:`finish`) judges by. With ``options.fabricate`` and
     ``options.structure`` the final design's thick panels and structure are checked too
-    (:func:`rigidfold.run.checks.check_final`; ``DIR/final/thick/``,
+    (:func:`rigidfold.pipeline.checks.check_final`; ``DIR/final/thick/``,
     ``DIR/final/structure/``), their
     figures in its record; ``fabrication`` and ``structure`` hold the results.
     """
@@ -296,7 +296,7 @@ class RunWriter:
         self.write_summary(run)
 
     def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
-        """Check one solution (:func:`rigidfold.run.checks.check_solution`: Step 8; the
+        """Check one solution (:func:`rigidfold.pipeline.checks.check_solution`: Step 8; the
         motion and Step 9 as asked) and write its FOLD and SVG files; its record replaces
         ``records[solution.step]``. Returns the FOLD path."""
         checked = check_solution(solution, self.case, self.options, motion=motion, deform=deform)
@@ -329,7 +329,7 @@ class RunWriter:
         ``DIR/final/`` in every format of :func:`rigidfold.exports.export_design`, named
         after its solution file. With ``check="final"`` the final design's folding motion and
         Step 9 run first and its files are written again with them; its thick panels and
-        structure are checked as the options ask (:func:`rigidfold.run.checks.check_final`)."""
+        structure are checked as the options ask (:func:`rigidfold.pipeline.checks.check_final`)."""
         final = run.final
         if final is not None:
             self.final_step = final.step

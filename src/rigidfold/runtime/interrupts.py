@@ -10,7 +10,7 @@ shape were infeasible ("no developable polyhedron from the initial shape", exit 
 made it an interrupt) received while its block runs, raises KeyboardInterrupt in the handler
 as Python's own does (so a callback stops the solver at once), and raises it again when the
 block ends, whatever the native code made of the first: the run stops as interrupted. It is
-used around every IPOPT solve (:func:`rigidfold.quiet.native_quiet`). Outside the main
+used around every IPOPT solve (:func:`rigidfold.runtime.quiet.native_quiet`). Outside the main
 thread, or where the program installed handlers of its own, it does nothing.
 """
 

@@ -8,7 +8,7 @@ over it and writes their files into ``DIR/final/thick/`` (:func:`thick_panels`);
 :class:`~rigidfold.structure.StructureOptions`) checks the final design on its supports
 under load (:func:`rigidfold.structure.check_design`) and writes ``DIR/final/structure/``
 (:func:`structure_check`). Each returns the figures that the final design's
-:class:`~rigidfold.run.SolutionRecord` keeps (``fabrication``, ``structure``), with the
+:class:`~rigidfold.rundir.SolutionRecord` keeps (``fabrication``, ``structure``), with the
 files named relative to the run's directory, and the result itself.
 """
 
@@ -26,7 +26,7 @@ from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
-from rigidfold.run.lock import FINAL_DIR
+from rigidfold.rundir.layout import FINAL_DIR
 from rigidfold.structure import (
     StructureCheck,
     check_design,
@@ -114,7 +114,7 @@ def thick_panels(
 def _fabrication_figures(
     fab: Fabrication, run_dir: Path, written: list[Path], sheets: dict, seconds: float
 ) -> dict:
-    """What the record keeps of thick panels (see :data:`rigidfold.run.schema.SUMMARY_SHAPE`):
+    """What the record keeps of thick panels (see :data:`rigidfold.rundir.schema.SUMMARY_SHAPE`):
     the verdict, the slab and what was trimmed, the closest pair of panels (the worst
     meeting where they collide, else the smallest gap) and the files."""
     full = fab.to_dict()

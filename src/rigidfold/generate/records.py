@@ -16,7 +16,7 @@ import numpy as np
 from rigidfold.mechanism import Mechanism
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.optimize import OptimizeResult, Status
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 class AttemptOutcome(Outcome):
@@ -166,7 +166,7 @@ class Attempt:
     @classmethod
     def from_dict(cls, data: dict) -> Attempt:
         """The attempt :meth:`to_dict` wrote as ``data`` (a line of a run's log, whose shape
-        :func:`rigidfold.run.read_log` checks first); a field it lacks takes its default."""
+        :func:`rigidfold.rundir.read_log` checks first); a field it lacks takes its default."""
         known = {k: v for k, v in data.items() if k in cls.__dataclass_fields__}
         return cls(
             **known
@@ -219,7 +219,7 @@ class Generation:
     stop_detail: str = ""
     dof_margin: dict | None = None  # rigidfold.mechanism.margin.DofMargin.to_dict()
     build_time: float = 0.0
-    numerics: dict | None = None  # rigidfold.numerics.NumericEnvironment.to_dict()
+    numerics: dict | None = None  # rigidfold.runtime.numerics.NumericEnvironment.to_dict()
 
     @property
     def stop_reason(self) -> str:

@@ -10,10 +10,10 @@ from __future__ import annotations
 import math
 from dataclasses import MISSING, dataclass
 
-from rigidfold.case import Case, make_case
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import fraction, option, positive, seed
+from rigidfold.generate.case import Case, make_case
 from rigidfold.io import UP_AXES
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.surfaces import SURFACE_FORMS
@@ -21,8 +21,8 @@ from rigidfold.surfaces import SURFACE_FORMS
 
 @dataclass(frozen=True)
 class CaseOptions:
-    """The target surface and the crease pattern of a case (:func:`rigidfold.case.make_case`,
-    which checks them: :meth:`make`)."""
+    """The target surface and the crease pattern of a case
+    (:func:`rigidfold.generate.case.make_case`, which checks them: :meth:`make`)."""
 
     surface: str = option(
         MISSING,

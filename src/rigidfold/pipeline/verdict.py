@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rigidfold.generate import Generation, Stop
-from rigidfold.run.schema import SolutionRecord, Stage
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
+from rigidfold.rundir.schema import SolutionRecord, Stage
 
 
 class RunOutcome(Outcome):

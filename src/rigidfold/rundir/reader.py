@@ -1,6 +1,6 @@
 """A finished (or running) ``rigidfold generate`` directory, read back.
 
-:func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.run.RunSummary`),
+:func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.rundir.RunSummary`),
 ``DIR/log.jsonl`` (:class:`rigidfold.generate.Attempt` each, :func:`read_log`) and every
 solution's FOLD file (``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its
 development diagram and folding motion as frames (:func:`rigidfold.io.read_frames`), and
@@ -24,7 +24,8 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Attempt
 from rigidfold.io import parse_json, read_fold, read_frames
 from rigidfold.protocols import TargetSurface
-from rigidfold.run.schema import (
+from rigidfold.rundir.json_shapes import check_shape, received
+from rigidfold.rundir.schema import (
     DESIGN_SHAPE,
     LOG_FILE,
     LOG_NAN_FIELDS,
@@ -36,7 +37,6 @@ from rigidfold.run.schema import (
     aggregate,
     check_version,
 )
-from rigidfold.run.shapes import check_shape, received
 from rigidfold.surfaces import Bezier, SplineSurface, get_surface
 
 
@@ -314,10 +314,10 @@ class RunData:
 
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
-        solution, and every other :class:`~rigidfold.run.Stage` where it ran (the thick
+        solution, and every other :class:`~rigidfold.rundir.Stage` where it ran (the thick
         panels, the structure), in the words of the solutions it failed on, else of the last
         it ran on, from ``summary.json``'s ``per_solution``
-        (:meth:`rigidfold.run.SolutionRecord.passed`). A stage that failed on earlier
+        (:meth:`rigidfold.rundir.SolutionRecord.passed`). A stage that failed on earlier
         solutions only, not on the final design, passed (as generate's verdict judges), and
         says at which steps it failed."""
         final = None if self.final is None else self.final.step
@@ -330,7 +330,7 @@ class RunData:
 
     def _stages(self) -> list[Check]:
         """:meth:`checks` as every solution counts: the figures are the run-wide ones of
-        summary.json (:func:`~rigidfold.run.schema.aggregate`), whether a stage passed
+        summary.json (:func:`~rigidfold.rundir.schema.aggregate`), whether a stage passed
         :meth:`SolutionRecord.passed`, its name and words ``STAGES``'s."""
         rows = self.summary.per_solution
         n = len(rows)
@@ -416,7 +416,7 @@ def load_run(directory: str | os.PathLike) -> RunData:
     or malformed ``summary.json`` / ``log.jsonl`` (what the report reads of them not of the
     shape it must have, :data:`SUMMARY_SHAPE` and :data:`LOG_SHAPE`: the error names the
     file and the key; :func:`read_log`), either of another run schema version
-    (:data:`~rigidfold.run.schema.SCHEMA_VERSION`), or a listed solution file that is not in
+    (:data:`~rigidfold.rundir.schema.SCHEMA_VERSION`), or a listed solution file that is not in
     the directory, is missing or is not a FOLD file of a generate run.
     """
     root = Path(directory)
@@ -460,16 +460,16 @@ def _measurable(design: SolutionFile, surface: TargetSurface) -> bool:
 
 
 def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
-    """The attempts of a run's log (``DIR/log.jsonl``, :data:`~rigidfold.run.schema.LOG_FILE`),
+    """The attempts of a run's log (``DIR/log.jsonl``, :data:`~rigidfold.rundir.schema.LOG_FILE`),
     by index: the last line of each index is its record (an attempt whose outcome
     backtracking changed was appended again).
 
     The first line is the header, ``{"schema_version": N}``; a log of another version is
-    refused (:func:`~rigidfold.run.schema.check_version`). A last line that does not end the
+    refused (:func:`~rigidfold.rundir.schema.check_version`). A last line that does not end the
     file and does not parse (torn by a crash mid-write) is skipped, the lines before it
     kept. Raises ValueError (one line, naming the file and the line) for a missing or
     unreadable file, a line that is not JSON or an attempt of the wrong shape
-    (:data:`~rigidfold.run.schema.LOG_SHAPE`), and an accepted attempt without a DOF.
+    (:data:`~rigidfold.rundir.schema.LOG_SHAPE`), and an accepted attempt without a DOF.
     """
     path = Path(path)
     try:

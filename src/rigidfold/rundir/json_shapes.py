@@ -1,12 +1,12 @@
 """The shapes of JSON data and their check, for the files of a run directory.
 
 A shape says what a value must be: ``int`` a whole number, ``float`` a finite number,
-``str`` text, ``bool`` true or false, an :class:`~rigidfold.status.Outcome` enum one of its
+``str`` text, ``bool`` true or false, an :class:`~rigidfold.outcomes.Outcome` enum one of its
 values, ``object`` anything, a list ``[S]`` a list of S, a tuple a list of that many items
 of those shapes, a :class:`Record` an object, :class:`Nullable` also null.
 :func:`check_shape` checks a value against one, so that a damaged file is a one-line error
 naming the file and the key; :func:`shape_of` makes the shape of a record's field from its
-type (:data:`rigidfold.run.schema.LOG_SHAPE`).
+type (:data:`rigidfold.rundir.schema.LOG_SHAPE`).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import typing
 from dataclasses import dataclass
 
 from rigidfold.errors import RigidfoldError
-from rigidfold.status import Outcome
+from rigidfold.outcomes import Outcome
 
 
 @dataclass(frozen=True)
@@ -133,7 +133,7 @@ def received(value) -> str:
 
 def shape_of(hint: object) -> object:
     """The shape (see the module's text) of the JSON that a field of type ``hint`` is
-    written as: an int, str or bool itself, an :class:`~rigidfold.status.Outcome` enum
+    written as: an int, str or bool itself, an :class:`~rigidfold.outcomes.Outcome` enum
     one of its values, a float a finite number or null (a NaN is written as null), a list
     or a tuple of one kind a list of its shape, a dict an object, ``X | None`` also null;
     another type anything."""

@@ -50,15 +50,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rigidfold.case import Case
 from rigidfold.config import (
     Settings,
     one_blas_thread,
 )
 from rigidfold.frame.model import default_support_face
-from rigidfold.generate_options import GenerateOptions
-from rigidfold.generate_records import (
-    STOP_REASONS,
+from rigidfold.generate.case import Case
+from rigidfold.generate.options import GenerateOptions
+from rigidfold.generate.records import (
     Attempt,
     AttemptOutcome,
     Generation,
@@ -71,8 +70,8 @@ from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.second_order import ChildForecast, Obstruction, obstruction
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.mesh import CreasePattern
-from rigidfold.numerics import numeric_environment
 from rigidfold.optimize import OptimizeResult
+from rigidfold.runtime.numerics import numeric_environment
 from rigidfold.selection import (
     Choice,
     crease_groups,
@@ -81,21 +80,6 @@ from rigidfold.selection import (
     rank_candidates,
     score_creases,
 )
-
-__all__ = [
-    "STOP_REASONS",
-    "Attempt",
-    "AttemptOutcome",
-    "GenerateOptions",
-    "Generation",
-    "Solution",
-    "Stop",
-    "best_so_far",
-    "generate",
-    "with_fold_limit",
-]
-"""The records (:mod:`rigidfold.generate_records`) and the options
-(:mod:`rigidfold.generate_options`) are exported with the steps that make them."""
 
 
 @dataclass
