@@ -129,7 +129,7 @@ class BroadCase:
         return args
 
     def make_case_kwargs(self, work: Path) -> dict:
-        """The keywords of :func:`rigidfold.case.make_case` that build this case's initial
+        """The keywords of :func:`rigidfold.generate.case.make_case` that build this case's initial
         shape as the command line does (no solve)."""
         kwargs: dict = {"seed": self.seed, "expr": self.expr}
         if self.size is not None:
@@ -283,7 +283,7 @@ def candidates() -> list[BroadCase]:
 def refusal(case: BroadCase, work: Path) -> str | None:
     """Why ``rigidfold generate`` refuses the case's input before solving (the one-line
     message of the reader or of the initial shape's check), or None when it builds."""
-    from rigidfold.case import make_case
+    from rigidfold.generate.case import make_case
     from rigidfold.errors import RigidfoldError
 
     try:

@@ -6,7 +6,7 @@ a user types::
     rigidfold generate <the case's arguments> --lookahead --no-deform --time-limit 180 --out DIR
 
 in a subprocess (``python -m rigidfold.cli``) with the pinned numerics of ``python -m
-rigidfold.pinned`` (:func:`rigidfold.numerics.pinned_environ`), its wall time measured from
+rigidfold.pinned`` (:func:`rigidfold.runtime.numerics.pinned_environ`), its wall time measured from
 outside, so starting Python, drawing diagrams, writing files, exports and the report all count.
 The result is read from ``DIR/summary.json``: ``final_dof``, ``dof_margin`` (a clear gap?),
 ``final_deploys``, the solves, and the ``time_s`` breakdown.
@@ -78,7 +78,7 @@ def grace(limit: float) -> float:
 def run_environment() -> dict[str, str]:
     """This process's environment with the pinned numerics, as ``python -m rigidfold.pinned``
     starts a command, and this benchmark's ``src`` first on PYTHONPATH."""
-    from rigidfold.numerics import RESTARTED_ENV, pinned_environ
+    from rigidfold.runtime.numerics import RESTARTED_ENV, pinned_environ
 
     env = pinned_environ(os.environ)
     env[RESTARTED_ENV] = "1"

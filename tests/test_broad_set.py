@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rigidfold.case import make_case
+from rigidfold.generate.case import make_case
 from rigidfold.io.fold import read_fold
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
@@ -145,7 +145,7 @@ def test_harness_flags_an_overrun_and_summarizes_per_variant_and_family():
 
 
 def test_the_run_environment_is_pinned():
-    from rigidfold.numerics import RESTARTED_ENV, pinned_environ
+    from rigidfold.runtime.numerics import RESTARTED_ENV, pinned_environ
 
     env = bs.run_environment()
     assert env[RESTARTED_ENV] == "1"
