@@ -283,8 +283,8 @@ def candidates() -> list[BroadCase]:
 def refusal(case: BroadCase, work: Path) -> str | None:
     """Why ``rigidfold generate`` refuses the case's input before solving (the one-line
     message of the reader or of the initial shape's check), or None when it builds."""
-    from rigidfold.generate.case import make_case
     from rigidfold.errors import RigidfoldError
+    from rigidfold.generate.case import make_case
 
     try:
         make_case(**case.make_case_kwargs(work))
