@@ -18,12 +18,16 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
   (an arc, a Bezier curve, a circle, an ellipse, a rounded rect) is refused;
 * colours by hue (:data:`COLOURS`), so ``#FF0000``, ``#f00``, ``rgb(255,0,0)`` and ``red``
   are all mountains; green cuts are refused;
-* lines are split where they cross or where one ends on another, points closer than
+* lines are split where they cross (a crossing near an end too; lines along one line do
+  not cross) or where one ends on another, points closer than
   ``Settings.inputs.svg_merge_tol`` times the drawing's bounding-box diagonal are merged (the
   ends of the lines drawn before the crossings are found, as Origami Simulator does, so that
   lines drawn to one point from ends that miss it slightly meet there), and pieces shorter
   than that are dropped. A piece drawn twice is kept once: if one drawing
-  is black it stays boundary, other differing colours are refused. Where just two pieces
+  is black it stays boundary; one drawn in two crease colours is a slip when it is no
+  longer than ``Settings.inputs.svg_snap_tol`` times the diagonal (lines drawn to one point
+  that miss it, or one crease running on along another), and its ends become one vertex,
+  and is refused when it is longer. Where just two pieces
   of the same colour and opacity meet in a straight line, they become one line. Pieces of
   one colour and opacity drawn over each other along one line are made one before they are
   split (a line drawn back and forth many times costs no more than once), and a drawing
@@ -33,9 +37,10 @@ svgelements sees them (it would fail with a RecursionError, ZeroDivisionError or
   piece past a corner, or drawn over a crease inside the sheet, is dropped (the crease
   stays), and a gap between two ends of the boundary is closed halfway. Then the creases
   (:func:`_mend`): an overshoot past the line a crease crosses (the boundary among them) is
-  cut off, a piece drawn in two crease colours (one crease running on along another) is
-  dropped, and a crease that ends short of a line is extended to it;
-* the black lines must form one closed outline, every crease must lie inside it and end
+  cut off, and a crease that ends short of a line is extended to it;
+* the black lines must form one closed outline (in a drawing without black lines, the
+  outline of the lines drawn is the boundary, as Origami Simulator takes it), every crease
+  must lie inside it and end
   on another line, and every face must be a simple polygon (no holes, no crease loop
   hanging at one point). Each problem is a one-line ``ValueError`` naming the file.
 
@@ -201,6 +206,9 @@ def _read(svg: se.SVG, settings: Settings) -> SvgDrawing:
         xy, edges, letters, angles = _node(*pieces, tol, snap, settings.limits.max_svg_pairs)
         xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
         pieces = _mend(xy, edges, letters, angles, snap, tol, drawn)
+    if "B" not in drawn[1]:
+        letters, angles = _outline(xy, edges, letters, angles)
+        xy, edges, letters, angles = _join_straight(xy, edges, letters, angles, tol)
     boundary = _check_boundary(xy, edges, letters, snap)
     inside = _inside(xy, edges, boundary, letters, snap)
     if not inside.all():
@@ -548,8 +556,6 @@ def _lines(svg: se.SVG, to_user: se.Matrix) -> tuple[np.ndarray, list[str], list
             "no lines drawn: a crease pattern is <line>, <polyline>, <polygon>, <rect> or "
             "<path> elements with a stroke"
         )
-    if "B" not in letters:
-        raise RigidfoldError("no boundary: no black lines (Origami Simulator draws it black)")
     drawn = np.array(ends, dtype=float)
     with np.errstate(over="ignore"):
         across = float(np.linalg.norm(np.ptp(drawn.reshape(-1, 2), axis=0)))
@@ -606,8 +612,9 @@ def _node(
     """The drawn pieces split where they meet, close points merged, repeats dropped.
 
     ends : (n, 2, 2) float; letters, angles : n each; tol : merge distance; snap : a piece
-    no longer than this drawn in two crease colours (where a crease overshoots its end along
-    another) is dropped, for :func:`_mend` to join the lines again, instead of refused;
+    no longer than this drawn in two crease colours (the ends of lines drawn to one point
+    that miss it by more than ``tol``, or a crease that overshoots its end along another) is
+    contracted, its ends made one vertex (:func:`_pieces`), instead of refused;
     max_pairs : ``Settings.limits.max_svg_pairs`` (:func:`_splits`). Pieces of one colour and
     angle drawn over each other along one line are first made one (:func:`_merge_overlaps`),
     so that a line drawn back and forth many times costs no more than once.
@@ -621,51 +628,77 @@ def _node(
     if not len(drawn):
         raise RigidfoldError("the lines drawn have no length")
     a, b, length = a[drawn], b[drawn], length[drawn]
-    seg, t, points = _splits(a, b, length, tol, max_pairs)
+    seg, t, points, near = _splits(a, b, length, tol, max_pairs)
     n = len(drawn)
     seg = np.concatenate([np.arange(n), np.arange(n), seg])
     t = np.concatenate([np.zeros(n), np.ones(n), t])
     points = np.concatenate([a, b, points])
+    near = np.concatenate([np.zeros(2 * n, dtype=bool), near])
     order = np.lexsort((t, seg))
-    seg, points = seg[order], points[order]
+    seg, points, near = seg[order], points[order], near[order]
     distinct, same = np.unique(points, axis=0, return_inverse=True)  # ends drawn again
     pairs = cKDTree(distinct).query_pairs(tol, output_type="ndarray")
     vertex = connected_components(_graph(pairs, len(distinct)), directed=False)[1]
     vertex = vertex[same.reshape(-1)]
-    first = np.unique(vertex, return_index=True)[1]  # first point of each merged vertex
     piece = np.flatnonzero(seg[:-1] == seg[1:])
+    source = drawn[seg[piece]]
+    while True:
+        # each merged vertex at its first point (a crossing near an end only if it has no
+        # other); a piece drawn in two crease colours (a slip) contracted, until none is left
+        rank = np.lexsort((near, vertex))
+        first = rank[np.unique(vertex[rank], return_index=True)[1]]
+        xy = points[first]
+        edges, out_letters, out_angles, twice = _pieces(
+            vertex[piece], vertex[piece + 1], source, letters, angles, xy, snap
+        )
+        if not len(twice):
+            break
+        vertex = connected_components(_graph(twice, len(xy)), directed=False)[1][vertex]
+    return (*_compact(xy, edges), out_letters, out_angles)
+
+
+def _pieces(
+    tail: np.ndarray,
+    head: np.ndarray,
+    source: np.ndarray,
+    letters: list[str],
+    angles: list[float],
+    xy: np.ndarray,
+    snap: float,
+) -> tuple[np.ndarray, list[str], list[float], np.ndarray]:
+    """The edges of the pieces from vertex ``tail`` to ``head`` (k each), drawn as piece
+    ``source`` (k,) of ``letters`` and ``angles``, each edge once: one drawn black stays
+    boundary, one drawn in two crease colours no longer than ``snap`` (the ends of lines
+    drawn to one point that miss it, or a crease that runs on along another) is returned
+    among the vertex pairs to contract, a longer one is refused. Returns edges (E, 2) int64,
+    their letters and angles, and the pairs (m, 2) to contract."""
     kept: dict[tuple[int, int], int] = {}
     edges: list[tuple[int, int]] = []
-    dropped: set[int] = set()
+    twice: set[int] = set()
     out_letters, out_angles = [], []
-    for k in piece:
-        u, v, source = int(vertex[k]), int(vertex[k + 1]), drawn[seg[k]]
-        letter, key = letters[source], (min(u, v), max(u, v))
+    for u, v, k in zip(tail.tolist(), head.tolist(), source.tolist(), strict=True):
+        letter, key = letters[k], (min(u, v), max(u, v))
         if u == v:
             continue
         if key not in kept:
             kept[key] = len(edges)
             edges.append((u, v))
             out_letters.append(letter)
-            out_angles.append(angles[source])
+            out_angles.append(angles[k])
             continue
         e = kept[key]
         if letter == "B":
             out_letters[e], out_angles[e] = "B", 0.0
-            dropped.discard(e)
+            twice.discard(e)
         elif out_letters[e] not in ("B", letter):
-            if np.linalg.norm(points[first[u]] - points[first[v]]) > snap:
+            if np.linalg.norm(xy[u] - xy[v]) > snap:
                 raise RigidfoldError(
-                    f"the line from {_at(points[first[u]])} to {_at(points[first[v]])} is "
+                    f"the line from {_at(xy[u])} to {_at(xy[v])} is "
                     f"drawn both {COLOURS[out_letters[e]]} and {COLOURS[letter]}"
                 )
-            dropped.add(e)
-    keep = [e for e in range(len(edges)) if e not in dropped]
-    return (
-        *_compact(points[first], np.array(edges, dtype=np.int64).reshape(-1, 2)[keep]),
-        [out_letters[e] for e in keep],
-        [out_angles[e] for e in keep],
-    )
+            twice.add(e)
+    pairs = np.array(edges, dtype=np.int64).reshape(-1, 2)
+    return pairs, out_letters, out_angles, pairs[sorted(twice)]
 
 
 def _merge_ends(ends: np.ndarray, tol: float) -> np.ndarray:
@@ -763,13 +796,21 @@ def _splits(
     length: np.ndarray,
     tol: float,
     max_pairs: int = DEFAULTS.limits.max_svg_pairs,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Where pieces must be split: where an end of another piece lies within ``tol`` of
     their interior (a T-junction: split at the foot of the perpendicular from that end) and
     where two pieces cross.
 
+    Two pieces cross where each has its ends on both sides of the other's line, one of them
+    farther than ``tol`` from it: pieces along one line (within ``tol``) do not cross, since
+    the crossing of their lines is round-off (they meet at T-junctions instead). A crossing
+    within ``tol`` of an end of either piece is a split too (lines drawn to one point from
+    ends that miss each other, crossing each other on the way): merged with the ends near
+    it, it makes them one vertex.
+
     a, b : (n, 2) float, the pieces' ends; length : (n,) float, all > tol.
-    Returns the piece index (k,), the parameter along it (k,) and the point (k, 2).
+    Returns the piece index (k,), the parameter along it (k,), the point (k, 2), and (k,)
+    bool: True for a crossing within ``tol`` of an end.
     ValueError when more than ``max_pairs`` pairs of pieces come within ``tol`` of each
     other (``Settings.limits.max_svg_pairs``), counted in batches before the pairs are examined.
     """
@@ -790,7 +831,7 @@ def _splits(
         found.append((i, j))
     i = np.concatenate([p[0] for p in found])
     j = np.concatenate([p[1] for p in found])
-    seg, t, points = [], [], []
+    seg, t, points, near = [], [], [], []
 
     def interior(s: np.ndarray, on: np.ndarray) -> np.ndarray:
         return (s * length[on] > tol) & ((1 - s) * length[on] > tol)
@@ -807,17 +848,33 @@ def _splits(
                 seg.append(on[hit])
                 t.append(s[hit])
                 points.append(foot[hit])
+                near.append(np.zeros(hit.sum(), dtype=bool))
         di, dj, r = b[ik] - a[ik], b[jk] - a[jk], a[jk] - a[ik]
+        # signed distances times length: of j's ends from i's line, of i's ends from j's line
+        pj = np.stack([_cross(di, r), _cross(di, r + dj)], axis=1)
+        pi = np.stack([_cross(dj, -r), _cross(dj, di - r)], axis=1)
+        proper = (
+            (np.sign(pj[:, 0]) * np.sign(pj[:, 1]) < 0)
+            & (np.sign(pi[:, 0]) * np.sign(pi[:, 1]) < 0)
+            & (np.abs(pj).max(axis=1) > tol * length[ik])
+            & (np.abs(pi).max(axis=1) > tol * length[jk])
+        )
         denom = _cross(di, dj)
-        parallel = denom == 0
-        si = np.divide(_cross(r, dj), denom, out=np.full(len(ik), np.nan), where=~parallel)
-        sj = np.divide(_cross(r, di), denom, out=np.full(len(ik), np.nan), where=~parallel)
-        hit = interior(si, ik) & interior(sj, jk)
+        si = np.divide(_cross(r, dj), denom, out=np.full(len(ik), np.nan), where=proper)
+        sj = np.divide(_cross(r, di), denom, out=np.full(len(ik), np.nan), where=proper)
+        hit = (si > 0) & (si < 1) & (sj > 0) & (sj < 1)
         crossing = a[ik][hit] + si[hit, None] * di[hit]
+        end = ~(interior(si, ik) & interior(sj, jk))[hit]
         seg += [ik[hit], jk[hit]]
         t += [si[hit], sj[hit]]
         points += [crossing, crossing]
-    return np.concatenate(seg), np.concatenate(t), np.concatenate(points).reshape(-1, 2)
+        near += [end, end]
+    return (
+        np.concatenate(seg),
+        np.concatenate(t),
+        np.concatenate(points).reshape(-1, 2),
+        np.concatenate(near),
+    )
 
 
 def _join_straight(
@@ -1036,6 +1093,40 @@ def _check_boundary(
                 "are not supported"
             )
     raise RigidfoldError(f"the boundary (black) is {len(loops)} separate outlines, not one sheet")
+
+
+def _outline(
+    xy: np.ndarray, edges: np.ndarray, letters: list[str], angles: list[float]
+) -> tuple[list[str], list[float]]:
+    """The letters and angles of a drawing without black lines, the edges of the outline of
+    its lines (the outer face of each connected part) made boundary, as Origami Simulator
+    takes an edge with a face on one side only for one; ValueError when the lines enclose
+    no area or their outline passes twice through a point (a crease hanging out of it).
+    xy (V, 2), edges (E, 2) -> E letters, E angles."""
+    cycles = _cycles(xy, edges)
+    if not any(area > 0 for _, area in cycles):
+        raise RigidfoldError(
+            "no boundary: no black lines (Origami Simulator draws it black), and the lines "
+            "drawn enclose no area to take for the sheet"
+        )
+    number = {(min(u, v), max(u, v)): e for e, (u, v) in enumerate(edges.tolist())}
+    letters, angles = list(letters), list(angles)
+    for cycle, area in cycles:
+        if area >= 0:
+            continue
+        seen: set[int] = set()
+        for w in cycle:
+            if w in seen:
+                raise RigidfoldError(
+                    f"no boundary: no black lines, and the outline of the lines drawn, taken "
+                    f"for the sheet's, passes twice through {_at(xy[w])} (a crease hanging "
+                    "out of it)"
+                )
+            seen.add(w)
+        for u, v in zip(cycle, cycle[1:] + cycle[:1], strict=True):
+            e = number[(min(u, v), max(u, v))]
+            letters[e], angles[e] = "B", 0.0
+    return letters, angles
 
 
 def _inside(
