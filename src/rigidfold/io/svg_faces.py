@@ -172,15 +172,16 @@ def _cycles(xy: np.ndarray, edges: np.ndarray) -> list[tuple[list[int], float]]:
     start = np.searchsorted(tail[order], tail)  # where each vertex's ring begins
     degree = np.bincount(tail, minlength=len(xy))[tail]
     following = order[start[twin] + (rank[twin] - start[twin] - 1) % degree[twin]]
-    cycles, done = [], np.zeros(len(tail), dtype=bool)
+    # the shoelace term of each directed edge: a cycle's area is half their sum along it
+    term = xy[tail, 0] * xy[head, 1] - xy[head, 0] * xy[tail, 1]
+    after, vertex = following.tolist(), tail.tolist()
+    cycles, done = [], [False] * len(tail)
     for h in range(len(tail)):
-        cycle, g = [], h
+        walk, g = [], h
         while not done[g]:
             done[g] = True
-            cycle.append(int(tail[g]))
-            g = following[g]
-        if cycle:
-            x, y = xy[cycle].T
-            area = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-            cycles.append((cycle, area))
+            walk.append(g)
+            g = after[g]
+        if walk:
+            cycles.append(([vertex[g] for g in walk], 0.5 * float(np.sum(term[walk]))))
     return cycles
