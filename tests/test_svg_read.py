@@ -336,6 +336,98 @@ def test_refusals(tmp_path, case):
     assert "\n" not in str(info.value)
 
 
+def degree(drawing: SvgDrawing) -> np.ndarray:
+    """(V,) int: how many edges meet at each vertex."""
+    return np.bincount(drawing.edges.ravel(), minlength=len(drawing.xy))
+
+
+def test_pieces_along_one_line_do_not_cross(tmp_path):
+    """Huffman's stars-triangles (issue 49): a diagonal drawn as pieces of alternate colours
+    end to end, its ends merged with ends drawn 1e-3 units away, so that two pieces lie
+    along one line. The crossing of their lines is round-off (its denominator 4e-11 of
+    126 x 126), 2.8 units before their common end: it is not a split, and the lines
+    meeting there stay one vertex (before, it was refused: a face not a simple polygon)."""
+    body = (
+        '<rect x="0" y="0" width="2400" height="2400" fill="none" stroke="#000"/>'
+        '<line x1="0" y1="1096.42" x2="959.719" y2="1096.42" stroke="blue"/>'
+        '<line x1="959.719" y1="1096.421" x2="1049.005" y2="1185.706" stroke="blue"/>'
+        '<line x1="1138.291" y1="1274.992" x2="1227.577" y2="1364.277" stroke="blue"/>'
+        '<line x1="1138.292" y1="1274.992" x2="1049.005" y2="1185.706" stroke="red"/>'
+        '<line x1="1227.577" y1="1364.277" x2="2400" y2="1364.277" stroke="blue"/>'
+        '<line x1="1049.005" y1="1185.706" x2="2400" y2="1185.706" stroke="red"/>'
+    )
+    drawing = read_svg(write(tmp_path, body, 'width="2400" height="2400"'))
+    check_planar(drawing)
+    assert counts(drawing) == (11, 13, 3)
+    meet = np.flatnonzero(np.all(np.abs(drawing.xy - [1049.005, -1185.706]) < 1e-9, axis=1))
+    assert len(meet) == 1 and degree(drawing)[meet[0]] == 3
+
+
+def test_lines_that_cross_near_their_ends_meet_there(tmp_path):
+    """Lang's cardinal (issue 49): two creases drawn to the boundary at points 0.09 units
+    apart (more than the merge distance, 0.07) cross each other 0.045 units before it,
+    within the merge distance of both ends. The crossing is a split, merged with both ends:
+    they end at one vertex (before, neither piece was split there, as the crossing lies
+    within the merge distance of their ends, and the face was refused)."""
+    body = (
+        '<line x1="0" y1="50" x2="50.045" y2="0" stroke="red"/>'
+        '<line x1="100" y1="50" x2="49.955" y2="0" stroke="blue"/>'
+    )
+    drawing = read_svg(write(tmp_path, SQUARE + body))
+    check_planar(drawing)
+    assert counts(drawing) == (7, 9, 3)
+    creases = drawing.edges[[a != "B" for a in drawing.assignment]]
+    assert len(set(creases[0]) & set(creases[1])) == 1
+    assert degree(drawing).max() == 4
+
+
+def test_a_piece_drawn_in_two_crease_colours_within_the_snap_tolerance_is_one_point(
+    tmp_path,
+):
+    """Lang's cardinal and rattan weave (issue 49): a mountain misses the point where two
+    valleys meet by 0.05 units, at a shallow angle, and crosses one of them 0.25 units
+    before it. The 0.25-unit piece between is drawn both red and blue: within svg_snap_tol,
+    a slip, its two ends are made one vertex, where all four creases meet (before, it was
+    dropped and the valley ended at the crossing, away from the other)."""
+    body = (
+        '<line x1="0" y1="50" x2="50" y2="50" stroke="blue"/>'
+        '<line x1="50" y1="50" x2="50" y2="100" stroke="blue"/>'
+        '<line x1="0" y1="40.05" x2="100" y2="60.05" stroke="red"/>'
+    )
+    drawing = read_svg(write(tmp_path, SQUARE + body))
+    check_planar(drawing)
+    assert counts(drawing) == (9, 12, 4)
+    assert sorted(Counter(degree(drawing)).items()) == [(2, 4), (3, 4), (4, 1)]
+    with pytest.raises(ValueError, match=r"is drawn both (blue and red|red and blue)"):
+        read_svg(write(tmp_path, SQUARE + body), settings=DEFAULTS.with_(svg_snap_tol=0))
+
+
+def test_a_drawing_without_black_lines_is_bounded_by_its_outline(tmp_path):
+    """Origami Simulator's Origami_Sphere_16Flaps.svg draws no black line: its outline is
+    creases, which Origami Simulator takes for boundary (edges with a face on one side).
+    So does read_svg; lines that enclose no area, or whose outline passes twice through a
+    point, are refused."""
+    body = (
+        '<line x1="0" y1="0" x2="100" y2="0" stroke="red"/>'
+        '<line x1="100" y1="0" x2="100" y2="100" stroke="red"/>'
+        '<line x1="100" y1="100" x2="0" y2="100" stroke="blue"/>'
+        '<line x1="0" y1="100" x2="0" y2="0" stroke="red"/>'
+        '<line x1="0" y1="0" x2="100" y2="100" stroke="blue"/>'
+    )
+    drawing = read_svg(write(tmp_path, body))
+    check_planar(drawing)
+    assert counts(drawing) == (4, 5, 2)
+    assert Counter(drawing.assignment) == {"B": 4, "V": 1}
+    assert drawing.fold_angles.tolist().count(0.0) == 4
+    tail = '<line x1="100" y1="100" x2="150" y2="150" stroke="red"/>'
+    with pytest.raises(
+        ValueError,
+        match=r"no boundary: no black lines, and the outline of the lines drawn, taken for "
+        r"the sheet's, passes twice through \(100, 100\)",
+    ):
+        read_svg(write(tmp_path, body + tail))
+
+
 def test_unequal_scales_in_physical_units(tmp_path):
     size = 'width="100mm" height="100mm" viewBox="0 0 100 50" preserveAspectRatio="none"'
     path = write(tmp_path, SQUARE, size)
@@ -642,28 +734,44 @@ def test_whirlpool_reads():
 
 def test_whirlpool_boundary_is_closed_within_the_snap_tolerance():
     """With svg_merge_tol=1e-4 (0.08 units, the default before) the nine gaps of whirlpool's
-    boundary (0.08 to 0.25 units) are not merged: svg_snap_tol closes each halfway."""
-    drawing = read_svg(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
-    check_planar(drawing)
-    assert counts(drawing) == (201, 450, 250)
-    assert Counter(drawing.assignment)["B"] == 61
-    closed = np.array([517.172 + 517.345, -549.847 - 549.781]) / 2  # the first gap's middle
-    assert np.linalg.norm(drawing.xy - closed, axis=1).min() < 1e-9
-
-
-def test_whirlpool_with_a_small_merge_tolerance_names_the_face_it_cannot_cut():
-    """With svg_merge_tol=1e-4 (0.08 units, the default before) the points that whirlpool's
-    lines miss are several: a face is left with corners 0.1 apart that cannot be cut into
-    triangles. The refusal is one line naming its corners and its shortest side in the
-    file's coordinates, and the setting that joins them."""
+    boundary (0.08 to 0.25 units) are not merged: svg_snap_tol closes each. The first gap,
+    0.185 units between its ends, is closed at a vertex nearer than that to both ends,
+    where a mountain and a valley drawn to them cross 0.15 units before them; the
+    drawing reads and triangulates (before lines that cross near their ends were split
+    there, a face with corners 0.1 apart was left that could not be cut)."""
     from rigidfold.patterns.files import read_pattern_file
 
+    drawing = read_svg(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
+    check_planar(drawing)
+    assert counts(drawing) == (183, 446, 264)
+    assert Counter(drawing.assignment)["B"] == 61
+    ends = np.array([[517.172, -549.847], [517.345, -549.781]])  # the first gap's ends
+    gap = np.linalg.norm(ends[0] - ends[1])
+    assert np.linalg.norm(drawing.xy[:, None] - ends, axis=2).max(axis=1).min() < gap
+    assert len(read_pattern_file(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE)).faces) == 303
+
+
+def test_a_face_that_cannot_be_cut_is_named(tmp_path):
+    """A face that cannot be cut into triangles (here a sliver of a quadrilateral between
+    two creases drawn from one corner, whose corners 0.18 units apart are refused once
+    Settings.geometry.triangulation_area_tol is 1e-2) is one line naming its corners and
+    its shortest side in the file's coordinates, and the setting that joins them."""
+    from rigidfold.patterns.files import read_pattern_file
+
+    body = (
+        '<line x1="0" y1="100" x2="100" y2="0" stroke="#f00"/>'
+        '<line x1="0" y1="100" x2="100" y2="1" stroke="#00f"/>'
+        '<line x1="100" y1="1" x2="50" y2="50.25" stroke="#00f"/>'
+    )
+    path = write(tmp_path, SQUARE + body)
+    assert len(read_pattern_file(path).faces) == 7  # by default: 4 faces, 3 of them quadrilaterals
     with pytest.raises(ValueError) as info:
-        read_pattern_file(WHIRLPOOL, settings=DEFAULTS.with_(**OLD_MERGE))
+        read_pattern_file(path, settings=DEFAULTS.with_(triangulation_area_tol=1e-2))
     message = str(info.value)
     assert "\n" not in message
+    assert "(49.875, 50.125)" in message
     assert re.fullmatch(
-        r".*whirlpool\.svg: the face with corners (\(\d+\.?\d*, \d+\.?\d*\)(, | and |)){3,}.*"
+        r".*pattern\.svg: the face with corners (\(\d+\.?\d*, \d+\.?\d*\)(, | and |)){3,}.*"
         r"\(drawing units, y down\) cannot be cut into triangles: it is degenerate or nearly "
         r"so, its shortest side, from \(\S+, \S+\) to \(\S+, \S+\), 0\.\d+ long; lines drawn "
         r"to one point that miss each other by that much are joined with a larger "

@@ -150,7 +150,7 @@ class LimitSettings(Group):
         8_000_000,
         "Largest size of an SVG drawing, with each ``<use>`` element counted as what it "
         "refers to: the characters of its elements' attributes (path data, points, "
-        "coordinates, styles) plus ``rigidfold.io.svg_read.ELEMENT_SIZE`` (100) per element. "
+        "coordinates, styles) plus ``rigidfold.io.svg_xml.ELEMENT_SIZE`` (100) per element. "
         "A larger drawing is refused in one line before svgelements, which copies what every "
         "``<use>`` refers to, reads it (about 0.6 s per million: 55,000 lines drawn one by "
         "one are 6.2 million, 3.9 s). A file of 2 kB whose groups each use the one before "

@@ -42,7 +42,7 @@ import numpy as np
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.sheet import Sheet
 from rigidfold.io.files import atomic_write
-from rigidfold.io.svg_read import OS_STROKES
+from rigidfold.io.svg_lines import OS_STROKES
 
 CONVENTIONS = ("rigidfold", "origami-simulator")
 """SVG conventions of :func:`sheet_svg_text`."""
@@ -74,7 +74,7 @@ CREASE_LAYERS = {"B": "BOUNDARY", "M": "MOUNTAIN", "V": "VALLEY", "F": "FLAT"}
 """Layer of the edges of each assignment letter; fixed creases (``"J"``) are in none."""
 
 OS_LETTERS = {"B": "B", "M": "M", "V": "V", "J": "F", "F": "U"}
-"""Origami Simulator's letter (colour, :data:`rigidfold.io.svg_read.OS_STROKES`) of each
+"""Origami Simulator's letter (colour, :data:`rigidfold.io.svg_lines.OS_STROKES`) of each
 assignment letter: a fixed crease is a facet crease (yellow), a free crease left flat an
 undriven one (magenta)."""
 

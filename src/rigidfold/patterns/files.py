@@ -133,7 +133,7 @@ def _triangulate_drawing(
     cut into triangles (degenerate: points of it nearly on one line or nearly one point) is
     refused in one line naming its corners in the file's coordinates and its shortest side,
     the lines that make it degenerate."""
-    from rigidfold.io.svg_read import _at
+    from rigidfold.io.svg_planar import at
 
     polygons = drawing.polygons
     tol = settings.geometry.triangulation_area_tol
@@ -152,12 +152,12 @@ def _triangulate_drawing(
     xy = drawing.xy[next(p for p in polygons if refused(p))]
     side = np.linalg.norm(np.roll(xy, -1, axis=0) - xy, axis=1)
     k = int(np.argmin(side))
-    shown = ", ".join(_at(p) for p in xy[:_SHOWN])
+    shown = ", ".join(at(p) for p in xy[:_SHOWN])
     more = f" and {len(xy) - _SHOWN} more" if len(xy) > _SHOWN else ""
     raise RigidfoldError(
         f"{path}: the face with corners {shown}{more} (drawing units, y down) cannot be cut "
         "into triangles: it is degenerate or nearly so, its shortest side, from "
-        f"{_at(xy[k])} to {_at(xy[(k + 1) % len(xy)])}, {side[k]:.3g} long; lines drawn to "
+        f"{at(xy[k])} to {at(xy[(k + 1) % len(xy)])}, {side[k]:.3g} long; lines drawn to "
         "one point that miss each other by that much are joined with a larger "
         "Settings.inputs.svg_merge_tol"
     )
