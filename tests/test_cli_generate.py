@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rigidfold.generate as generate_module
+import rigidfold.generate.steps as generate_module
 from conftest import run_cli
 from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
@@ -49,7 +49,9 @@ def generated(tmp_path_factory):
 def test_generate_writes_solutions_log_and_summary(generated):
     names = sorted(p.name for p in (generated / "solutions").glob("*.fold"))
     assert names == [f"step_{k:02d}_dof_{21 - k:02d}.fold" for k in range(4)]
-    assert len(list((generated / "solutions").glob("*.svg"))) == 4
+    # the development diagram (and its SVG) of the final design only (issue 49: outputs off
+    # the search's path); the other solutions' records say it was not computed
+    assert [p.name for p in (generated / "solutions").glob("*.svg")] == ["step_03_dof_18.svg"]
     summary = json.loads((generated / "summary.json").read_text())
     assert (summary["initial_dof"], summary["final_dof"], summary["N_reduce"]) == (21, 18, 3)
     assert summary["N_lock"] == 0 and summary["N_exceed"] == 0
@@ -66,7 +68,14 @@ def test_generate_writes_solutions_log_and_summary(generated):
     dev = summary["development"]
     assert dev["max_D"] < 1e-8 and dev["flipped"] == 0 and dev["overlaps"] == 0
     assert len(summary["per_solution"]) == 4
-    # --no-deform: no Step 9; the development of every solution, the folding motion of the
+    assert [s["development"]["status"] for s in summary["per_solution"]] == ["not_computed"] * 3 + [
+        "converged"
+    ]
+    assert summary["time_s"]["develop"] > 0
+    for name in names[:-1]:  # a FOLD file without a diagram frame reads back whole
+        data = read_fold(generated / "solutions" / name)
+        assert data.metadata["dof"] == 21 - int(name[5:7]) and "development" not in data.metadata
+    # --no-deform: no Step 9; the development of the final design, the folding motion of the
     # final design (--check final, the default), its path traced for the deployability check
     assert summary["deformation"]["checked"] == 0 and summary["time_s"]["deform"] == 0.0
     assert summary["motion"]["traced"] == 1 and summary["motion"]["max_length_error"] < 1e-8
@@ -200,9 +209,10 @@ def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["n_solutions"] == 2
     assert summary["stop"] == "interrupted"  # never "running"
-    # the best design so far is named: the last solution (no path of it is known to deploy)
+    # no design is named: none is known to deploy (no path was traced)
     assert summary["verdict"]["outcome"] == "fell_short"
-    assert summary["verdict"]["final_design"] == summary["solutions"][-1]
+    assert summary["verdict"]["final_design"] is None
+    assert "no design is known to deploy" in summary["verdict"]["message"]
     assert len(read_log(tmp_path / "log.jsonl")) == 2
     for path in (tmp_path / "solutions").glob("*.fold"):
         read_fold(path)

@@ -29,7 +29,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.generate.case_options import CaseOptions, SettingsOptions
 from rigidfold.io import jsonable
-from rigidfold.runtime.interrupts import EXIT_INTERRUPTED
+from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, held_interrupts
 from rigidfold.runtime.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.study import STUDY_OPTIONS
 
@@ -104,10 +104,8 @@ def _counters(summary: dict, stop_reason: str) -> str:
 
 def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.cli.progress import GenerateProgress
-    from rigidfold.pipeline import RunOutcome, RunWriter
-    from rigidfold.pipeline.built import STRUCTURE_DIR, THICK_DIR
+    from rigidfold.pipeline import RunWriter
     from rigidfold.pipeline.workflows import generate_case
-    from rigidfold.rundir.layout import FINAL_DIR, REPORT_FILE
 
     structure = structure_options(args)  # checked even without --structure
     options = options_of(
@@ -123,18 +121,44 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     try:
         run = generate_case(writer, progress=progress.update, report=not args.no_report)
     except KeyboardInterrupt:
+        if writer.completed and writer.run is not None:  # it came as the run returned
+            run = writer.run
+        else:
+            return _interrupted(writer, progress)
+    with held_interrupts(reraise=False):  # the run's files are written: it has ended
         progress.close()
-        best = None if writer.verdict is None else writer.verdict.final_design
-        print(
-            one_line(
-                f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.jsonl "
-                f"and summary.json are in {writer.out}"
-                + ("" if best is None else f"; best design so far: {writer.out / best}")
-            ),
-            file=sys.stderr,
-        )
-        return EXIT_INTERRUPTED
+        return _print_generated(args, writer, run)
+
+
+def _interrupted(writer, progress) -> int:
+    """Say where an interrupted ``generate`` left its files; exit code 130."""
+    writer.interrupted()  # done already, unless the signal came before the run began
+    writer.release()
     progress.close()
+    best = None if writer.verdict is None else writer.verdict.final_design
+    print(
+        one_line(
+            f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.jsonl "
+            f"and summary.json are in {writer.out}"
+            + (
+                f"; best design known to deploy: {writer.out / best}"
+                if best is not None
+                else "; no design is known to deploy"
+                if writer.files
+                else ""
+            )
+        ),
+        file=sys.stderr,
+    )
+    return EXIT_INTERRUPTED
+
+
+def _print_generated(args: argparse.Namespace, writer, run) -> int:
+    """Print what a finished ``generate`` run wrote and its verdict; its exit code."""
+    from rigidfold.pipeline import RunOutcome
+    from rigidfold.pipeline.built import STRUCTURE_DIR, THICK_DIR
+    from rigidfold.rundir.layout import FINAL_DIR, REPORT_FILE
+
     print(_counters(run.to_dict(), run.stop_reason))
     print(
         f"wrote {_count(len(writer.files), 'solution')}, log.jsonl and summary.json to {writer.out}"
@@ -155,7 +179,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                 f"{writer.structure.status}: {writer.structure.message}"
             )
         )
-    if not args.no_report:
+    if not args.no_report and writer.write_error is None:
         print(f"report: {writer.out / REPORT_FILE}")
     verdict = writer.verdict
     assert verdict is not None  # generate_case ends with writer.finish

@@ -28,7 +28,7 @@ from rigidfold.generate import GenerateOptions, Solution
 from rigidfold.generate.case import Case
 from rigidfold.material import parse_material
 from rigidfold.pipeline.built import structure_check, thick_panels
-from rigidfold.rundir.schema import FitStatus, SolutionRecord
+from rigidfold.rundir.schema import NOT_DEVELOPED, FitStatus, SolutionRecord
 from rigidfold.structure import StructureCheck
 
 
@@ -113,6 +113,22 @@ def check_solution(
         deployability=None if solution.path is None else solution.path.to_dict(),
     )
     return Checked(record, check)
+
+
+def solution_record(solution: Solution, case: Case) -> SolutionRecord:
+    """The record of an accepted ``solution`` of ``case`` whose checks are not run as it comes
+    (``--check final``: every solution but the final design): its fit to the target and its
+    deployability check's path where it was traced; Step 8 is not run, its figures say so
+    (:data:`~rigidfold.rundir.schema.NOT_COMPUTED`, a stage that did not run), and neither is
+    anything that needs the diagram."""
+    pattern = solution.result.pattern
+    return SolutionRecord(
+        solution.step,
+        solution.mechanism.dof,
+        fit=_fit(case.deviation(pattern.coords), case.settings),
+        development=dict(NOT_DEVELOPED),
+        deployability=None if solution.path is None else solution.path.to_dict(),
+    )
 
 
 def _fit(dz: np.ndarray, settings: Settings) -> dict:

@@ -74,6 +74,8 @@ def run_verdict(
     records : each solution's checks, in the order of ``files`` (their FOLD paths, relative
     to the run's DIR); :meth:`SolutionRecord.failed_stages` says what failed.
     """
+    if run.stop is Stop.INTERRUPTED:
+        return _interrupted(run, records, files)
     short = []
     reached = run.stop is Stop.TARGET_REACHED or (run.stop is Stop.ZERO_DOF and target == 0)
     final = run.final
@@ -125,3 +127,30 @@ def run_verdict(
         warnings,
         files[k] if files else None,
     )
+
+
+def known_to_deploy(record: SolutionRecord) -> bool:
+    """Whether a solution is known to deploy: its deployability check's path reached the flat
+    state, or its folding motion was traced from flat (the checks of the final design)."""
+    path = record.deployability or {}
+    return path.get("deploys") is True or record.passed(Stage.MOTION) is True
+
+
+def _interrupted(run: Generation, records: list[SolutionRecord], files: list[Path]) -> RunVerdict:
+    """The verdict on a run interrupted by Ctrl-C or SIGTERM (it fell short): its final
+    design is the lowest-DOF solution known to deploy (:func:`known_to_deploy`), None when
+    none is, which it then says."""
+    if len(records) != len(files):
+        raise ValueError(f"{len(records)} records for {len(files)} solution files")
+    known = [k for k, record in enumerate(records) if known_to_deploy(record)]
+    if known:
+        k = known[-1]  # the chain's DOF falls as it goes: the last is the lowest
+        short = (f"interrupted; best design known to deploy: DOF {records[k].dof}",)
+    elif records:
+        short = (
+            f"interrupted; no design is known to deploy (none of the {len(records)} "
+            "solutions had its folding path traced to the flat state)",
+        )
+    else:
+        short = ("interrupted before the first solution",)
+    return RunVerdict(RunOutcome.FELL_SHORT, short, (), files[known[-1]] if known else None)

@@ -44,7 +44,7 @@ from rigidfold.exports import (
     read_design,
 )
 from rigidfold.fabricate import FabricateOptions, Fabrication, Panels, design_motion
-from rigidfold.generate import Attempt, Generation, generate
+from rigidfold.generate import Attempt, Generation, Stop, generate
 from rigidfold.generate.case import Case, parse_fixed, shape_summary
 from rigidfold.io import (
     FoldData,
@@ -59,6 +59,7 @@ from rigidfold.optimize import OptimizeResult
 from rigidfold.pipeline import RunWriter, write_checked_shape, write_report
 from rigidfold.reporting import page, render_figures, thick_figure, view_figure
 from rigidfold.rundir import RunData, clear_earlier_run, load_run
+from rigidfold.runtime.interrupts import kept_interrupts
 from rigidfold.structure import (
     Material,
     StructureCheck,
@@ -342,10 +343,8 @@ def generate_case(
     released at the end, however the run ends. A KeyboardInterrupt (Ctrl-C, SIGTERM from the
     command line) propagates once summary.json says the run was interrupted
     (:meth:`rigidfold.pipeline.RunWriter.interrupted`)."""
-    seen: list[Generation] = []  # the run, once an attempt has been written
 
     def on_attempt(run: Generation, attempt: Attempt) -> None:
-        seen[:] = [run]
         writer.on_attempt(run, attempt)
         if progress:
             progress(run, attempt)
@@ -370,11 +369,16 @@ def generate_case(
         )
         writer.finish(run)
         if report:
-            report_run(writer.out)
+            with kept_interrupts():  # matplotlib, plotly: an interrupt is never eaten
+                report_run(writer.out)
+        writer.completed = True  # from here a signal does not make it an interrupted run
     except KeyboardInterrupt:
-        if writer.verdict is None:  # the run had not ended
-            writer.interrupted(seen[0] if seen else None)
+        writer.interrupted()  # wherever it landed, the report's writing too
         raise
+    except RigidfoldError as exc:
+        if writer.run is None or writer.run.stop is Stop.RUNNING:
+            raise  # the search's: bad input
+        writer.failed(exc)  # the run ended, and its files could not all be written
     finally:
         writer.release()
     return run

@@ -1,8 +1,9 @@
 """Files of a generation run, written as the run goes so an interrupt loses nothing.
 
-``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form, a
-``creasePattern`` frame with its development diagram (Step 8) and the folding motion as
-``foldedForm`` frames, the support panel held still) and ``.svg`` beside it, ``DIR/log.jsonl``
+``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form and its
+figures; for the final design, and every solution with ``--check all``, a ``creasePattern``
+frame with its development diagram (Step 8) and the folding motion as ``foldedForm`` frames,
+the support panel held still, and the diagram as ``.svg`` beside it), ``DIR/log.jsonl``
 (every attempt, a line appended for each: :class:`AttemptLog`) and ``DIR/summary.json`` (a
 :class:`~rigidfold.rundir.RunSummary`, :meth:`RunWriter.summary`, written by its ``to_dict``:
 the paper's counters, the development and deformation figures (Step 9), each solution's
@@ -14,6 +15,10 @@ appended to, so a crash can tear only its last line, which its reader skips.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import secrets
+import shutil
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.deform import Verification
+from rigidfold.errors import RigidfoldError
 from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import (
@@ -49,8 +55,14 @@ from rigidfold.io import (
 )
 from rigidfold.mesh import CreasePattern
 from rigidfold.pipeline.built import check_built_options
-from rigidfold.pipeline.checks import Checked, check_final, check_solution, traced_motion
-from rigidfold.pipeline.verdict import RunVerdict, run_verdict
+from rigidfold.pipeline.checks import (
+    Checked,
+    check_final,
+    check_solution,
+    solution_record,
+    traced_motion,
+)
+from rigidfold.pipeline.verdict import RunOutcome, RunVerdict, run_verdict
 from rigidfold.rundir.layout import (
     FIGURES_DIR,
     FINAL_DIR,
@@ -61,6 +73,7 @@ from rigidfold.rundir.layout import (
     lock_run_dir,
 )
 from rigidfold.rundir.schema import LOG_FILE, SCHEMA_VERSION, RunSummary, SolutionRecord
+from rigidfold.runtime.interrupts import held_interrupts, kept_interrupts
 from rigidfold.structure import StructureCheck
 from rigidfold.surfaces import SplineSurface
 
@@ -170,11 +183,13 @@ class RunWriter:
     checks are the pipeline's (:mod:`rigidfold.pipeline.checks`, the study's too), the writer
     writes their results.
 
-    The development diagram (Step 8) runs on every solution as it comes; the folding motion
-    and, with ``options.deform``, the large-deformation check (Step 9) run on the solutions
-    ``options.check`` names (:data:`rigidfold.config.CHECKS`): the final design only, once
-    the run has ended (its FOLD file is then written again with them), or every solution as
-    it comes. ``overwrite``: replace the files of an earlier run in ``out``
+    The development diagram (Step 8), the folding motion and, with ``options.deform``, the
+    large-deformation check (Step 9) run on the solutions ``options.check`` names
+    (:data:`rigidfold.config.CHECKS`): the final design only, once the run has ended (its
+    FOLD file, written without them as it came, is then written with them, and its SVG), or
+    every solution as it comes. Writing stays off the search's path: a solution that is not
+    checked costs its FOLD file only. An interrupt anywhere ends with :meth:`interrupted`.
+    ``overwrite``: replace the files of an earlier run in ``out``
     (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
     target the verdict (:meth:`finish`) judges by. With ``options.fabricate`` and
     ``options.structure`` the final design's thick panels and structure are checked too
@@ -202,10 +217,14 @@ class RunWriter:
             if isinstance(case.surface, SplineSurface):
                 write_json(self.out / TARGET_FILE, case.surface.grid())
                 self.target_file = TARGET_FILE
-        except ValueError:
+        except BaseException:  # a user error, or Ctrl-C while the directory is prepared
             self.release()
             raise
         self.case, self.options = case, options
+        self.run: Generation | None = None  # the run, once an attempt or solution was written
+        self.completed = False  # every file of the run is written, its report too
+        self.ended = False  # summary.json says it was interrupted, or its files failed
+        self.write_error: str | None = None  # why the run's files could not all be written
         self.solutions: list[Solution] = []
         self.checked: dict[int, Checked] = {}  # step -> its checks (development, motion)
         self.files: list[Path] = []
@@ -231,28 +250,61 @@ class RunWriter:
         verdicts = self.records[step].verdicts
         return None if verdicts is None else verdicts["line"]
 
-    def interrupted(self, run: Generation | None) -> None:
-        """Write summary.json of a run stopped by Ctrl-C or SIGTERM: ``run`` (None when it
-        was stopped before its first attempt ended) with the stop INTERRUPTED, its best
-        design so far named (:func:`rigidfold.generate.best_so_far`: no path is traced, no
-        check is run and nothing is exported) and its verdict (fell short); the log gets the
-        attempts it has not yet (appended, never rewritten)."""
-        if run is None:
-            run = Generation()
-        run.stop, run.stop_detail = Stop.INTERRUPTED, ""
-        best_so_far(run)
-        final = run.final
-        if final is not None and final.step < len(self.files):
-            self.final_step = final.step
-        self.verdict = run_verdict(
+    def interrupted(self, run: Generation | None = None) -> None:
+        """Write summary.json of a run stopped by Ctrl-C or SIGTERM, wherever the signal
+        landed (in a solve, a diagram, a trace, the final checks, the exports, the report):
+        ``run`` (by default the last one the writer saw; None when it was stopped before its
+        first attempt ended) with the stop INTERRUPTED, and its verdict
+        (:func:`run_verdict`), which names the best design known to deploy, or says that
+        none is known (no path is traced, no check is run and nothing is exported); the log
+        gets the attempts it has not yet (appended, never rewritten). Further signals are
+        held while it writes; a second call does nothing."""
+        if self.ended or self.completed:
+            return
+        with held_interrupts(reraise=False):
+            run = run or self.run or Generation()
+            run.stop, run.stop_detail = Stop.INTERRUPTED, ""
+            best_so_far(run)
+            self.verdict = run_verdict(
+                run,
+                self.records,
+                [p.relative_to(self.out) for p in self.files],
+                self.options.target_dof,
+            )
+            final = self.verdict.final_design
+            self.final_step = (
+                None
+                if final is None
+                else [p.relative_to(self.out) for p in self.files].index(final)
+            )
+            self.log.start()
+            self.log.sync(run.attempts)
+            self.write_summary(run)
+            self.ended = True
+
+    def failed(self, error: RigidfoldError) -> None:
+        """Write summary.json of a run that ended but whose files could not all be written
+        (the final design's, its exports, the report: a full disk, the file size limit):
+        its verdict falls short, naming ``error``; ``write_error`` holds it. When even
+        summary.json cannot be written, it stays as it was last written."""
+        run = self.run or Generation()
+        verdict = self.verdict or run_verdict(
             run,
             self.records,
             [p.relative_to(self.out) for p in self.files],
             self.options.target_dof,
         )
-        self.log.start()
-        self.log.sync(run.attempts)
-        self.write_summary(run)
+        self.write_error = str(error)
+        self.verdict = RunVerdict(
+            RunOutcome.FELL_SHORT,
+            (*verdict.shortfalls, f"the run's files could not all be written: {error}"),
+            verdict.warnings,
+            verdict.final_design,
+        )
+        with contextlib.suppress(RigidfoldError):
+            self.log.sync(run.attempts)
+            self.write_summary(run)
+        self.ended = True
 
     def release(self) -> None:
         """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""
@@ -262,6 +314,7 @@ class RunWriter:
         """Append the attempt to the log; summary.json is written again when
         ``Settings.generation.summary_interval`` seconds have passed since it last was (a
         solution, a retraction and the end write it every time)."""
+        self.run = run
         self.log.sync(run.attempts)
         if attempt.outcome is AttemptOutcome.ACCEPTED:
             return  # its solution (:meth:`on_solution`) writes summary.json next
@@ -270,11 +323,26 @@ class RunWriter:
             self.write_summary(run)
 
     def on_solution(self, run: Generation, solution: Solution) -> None:
-        full = self.options.check == "all"
-        self.solutions.append(solution)
-        self.records.append(SolutionRecord(solution.step, solution.mechanism.dof))
-        deform = full and self.options.deform
-        self.files.append(self._write_solution(solution, deform=deform, motion=full))
+        """Write an accepted solution: with ``--check all`` checked as it comes
+        (:func:`rigidfold.pipeline.checks.check_solution`: Step 8, the motion, Step 9 as
+        asked) with its FOLD and SVG files; otherwise its FOLD file only (the folded form and
+        its figures: :func:`rigidfold.pipeline.checks.solution_record`), its diagram drawn
+        if it becomes the final design (:meth:`finish`). Its record and file are added
+        together (held from a signal), so summary.json lists only files on disk."""
+        self.run = run
+        checked = None
+        if self.options.check == "all":
+            checked = check_solution(
+                solution, self.case, self.options, motion=True, deform=self.options.deform
+            )
+        record = solution_record(solution, self.case) if checked is None else checked.record
+        path = self._write_solution(solution, checked)
+        with held_interrupts():
+            self.solutions.append(solution)
+            self.records.append(record)
+            self.files.append(path)
+            if checked is not None:
+                self._keep(solution.step, checked)
         self.log.sync(run.attempts)  # backtracking may have accepted its attempt again
         self.write_summary(run)
 
@@ -284,63 +352,82 @@ class RunWriter:
         (the run stays a chain, and the next solution takes the first one's step); their
         attempts are appended to the log again, with the outcome DEAD_END; summary.json is
         written once."""
-        for solution in taken:
-            assert self.solutions and self.solutions[-1] is solution, "not the last solution"
-            self.solutions.pop()
-            self.records.pop()
-            self.checked.pop(solution.step, None)
-            fold = self.files.pop()
-            for path in (fold, fold.with_suffix(".svg")):
-                path.unlink(missing_ok=True)
+        self.run = run
+        with held_interrupts():  # the records and the files go together
+            for solution in taken:
+                assert self.solutions and self.solutions[-1] is solution, "not the last solution"
+                self.solutions.pop()
+                self.records.pop()
+                self.checked.pop(solution.step, None)
+                fold = self.files.pop()
+                for path in (fold, fold.with_suffix(".svg")):
+                    path.unlink(missing_ok=True)
         self.log.sync(run.attempts)
         self.write_summary(run)
 
-    def _write_solution(self, solution: Solution, *, deform: bool, motion: bool) -> Path:
-        """Check one solution (:func:`rigidfold.pipeline.checks.check_solution`: Step 8; the
-        motion and Step 9 as asked) and write its FOLD and SVG files; its record replaces
-        ``records[solution.step]``. Returns the FOLD path."""
-        checked = check_solution(solution, self.case, self.options, motion=motion, deform=deform)
+    def _keep(self, step: int, checked: Checked) -> None:
+        """Note the checks of the solution at ``step``: its record, and the stages' times."""
         for stage, t in checked.record.time_s.items():
-            self.stage_times[stage] += t
-        self.records[solution.step] = checked.record
-        self.checked[solution.step] = checked
+            self.stage_times[stage] = self.stage_times.get(stage, 0.0) + t
+        self.records[step] = checked.record
+        self.checked[step] = checked
+
+    def _write_solution(self, solution: Solution, checked: Checked | None) -> Path:
+        """Write the FOLD file of ``solution`` (``solutions/step_XX_dof_YY.fold``): with its
+        ``checked`` results (Steps 8-9, :func:`write_checked_shape`) and the SVG of its
+        diagram beside it, or without them (the folded form and its figures, no diagram).
+        Returns the FOLD path."""
         dof = solution.mechanism.dof
         path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
-        write_checked_shape(
-            path,
-            solution.result.pattern,
-            checked.verification,
-            title=f"rigidfold generate: step {solution.step}, DOF {dof}",
-            svg_title=f"step {solution.step}, DOF {dof}: development diagram",
-            metadata={
-                **self.case.metadata(),
-                **solution.result.to_dict(),
-                "step": solution.step,
-                "dof": dof,
-                "criterion": self.options.criterion,
-                "lookahead": self.options.lookahead,
-            },
-        )
+        title = f"rigidfold generate: step {solution.step}, DOF {dof}"
+        metadata = {
+            **self.case.metadata(),
+            **solution.result.to_dict(),
+            "step": solution.step,
+            "dof": dof,
+            "criterion": self.options.criterion,
+            "lookahead": self.options.lookahead,
+        }
+        if checked is None:
+            write_fold(path, solution.result.pattern, title=title, metadata=metadata)
+        else:
+            write_checked_shape(
+                path,
+                solution.result.pattern,
+                checked.verification,
+                title=title,
+                svg_title=f"step {solution.step}, DOF {dof}: development diagram",
+                metadata=metadata,
+            )
         return path
 
     def finish(self, run: Generation) -> RunVerdict:
         """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
         and the final design (:attr:`rigidfold.generate.Generation.final`) exported to
         ``DIR/final/`` in every format of :func:`rigidfold.exports.export_design`, named
-        after its solution file. With ``check="final"`` the final design's folding motion and
-        Step 9 run first and its files are written again with them; its thick panels and
-        structure are checked as the options ask (:func:`rigidfold.pipeline.checks.check_final`)."""
+        after its solution file, the files written together (:meth:`_export`). With
+        ``check="final"`` the final design's development diagram (Step 8), folding motion
+        and Step 9 run here, once, and its FOLD file is written with them, its SVG beside
+        it; its thick panels and structure are checked as the options ask
+        (:func:`rigidfold.pipeline.checks.check_final`)."""
+        self.run = run
         final = run.final
         if final is not None:
             self.final_step = final.step
-            if self.options.check == "final":
-                self.solutions[final.step] = final  # its path may have been traced since
-                self._write_solution(final, deform=self.options.deform, motion=True)
+            if self.options.check == "final" or final.step not in self.checked:
+                checked = check_solution(
+                    final, self.case, self.options, motion=True, deform=self.options.deform
+                )
+                self._write_solution(final, checked)
+                with held_interrupts():
+                    self.solutions[final.step] = final  # its path may have been traced since
+                    self._keep(final.step, checked)
             checked = self.checked[final.step]
             self.final = (final.result.pattern, checked.coords2d)
             if self.options.fabricate is not None or self.options.structure is not None:
                 name = self.files[final.step].stem
-                built = check_final(checked, final, self.options, self.out, name)
+                with kept_interrupts():  # trimesh's code catches BaseException
+                    built = check_final(checked, final, self.options, self.out, name)
                 self.records[final.step] = built.record
                 self.fabrication, self.structure = built.fabrication, built.structure
         self.verdict = run_verdict(
@@ -352,12 +439,42 @@ class RunWriter:
         if self.final is not None:
             pattern, coords2d = self.final
             stem = self.files[-1 if final is None else final.step].stem
-            self.exports = export_design(
-                pattern, coords2d, self.out / FINAL_DIR, name=stem, title=f"rigidfold: {stem}"
-            )
+            self._export(pattern, coords2d, stem)
         self.log.sync(run.attempts)
         self.write_summary(run)
         return self.verdict
+
+    def _export(self, pattern: CreasePattern, coords2d: np.ndarray, stem: str) -> None:
+        """The final design's exports (:func:`rigidfold.exports.export_design`), written
+        together or not at all: into a new directory of their own in DIR, then, every one
+        written, renamed into ``DIR/final/`` while signals are held; a failed write (a full
+        disk) or an interrupt leaves none of them (``exports`` stays empty). Third-party
+        code that catches BaseException (trimesh, on import and in its functions) cannot
+        eat an interrupt: it is raised again when the export ends (:func:`kept_interrupts`)."""
+        final_dir = prepare_output_dir(self.out / FINAL_DIR)
+        stage = self.out / f".{FINAL_DIR}.{secrets.token_hex(6)}.tmp"
+        try:
+            with kept_interrupts():
+                written = export_design(
+                    pattern, coords2d, stage, name=stem, title=f"rigidfold: {stem}"
+                )
+            with held_interrupts():
+                moved = []
+                try:
+                    for path in written:
+                        os.replace(path, final_dir / path.name)
+                        moved.append(final_dir / path.name)
+                except OSError as exc:
+                    for path in moved:
+                        path.unlink(missing_ok=True)
+                    raise RigidfoldError(
+                        f"cannot write the final design's exports into '{final_dir}': "
+                        f"{exc.strerror or exc}"
+                    ) from None
+                self.exports = moved
+        finally:
+            with contextlib.suppress(OSError):
+                shutil.rmtree(stage)
 
     def summary(self, run: Generation) -> RunSummary:
         """summary.json's record of the run as it stands now."""

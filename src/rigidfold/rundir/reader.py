@@ -337,12 +337,16 @@ class RunData:
         figures = aggregate(rows)
         dev = figures["development"]
         bad = _failed(rows, Stage.DEVELOPMENT)
+        drawn = sum(r.ran(Stage.DEVELOPMENT) for r in rows)
         checks = [
             Check(
                 STAGES[Stage.DEVELOPMENT].name,
-                None if n == 0 else not bad,
-                f"{n - len(bad)}/{n} converged, {dev['flipped']} flipped, "
-                f"{dev['overlaps']} overlapping, max D = {dev['max_D'] or 0.0:.2g}" + _steps(bad),
+                None if not drawn else not bad,
+                f"{drawn - len(bad)}/{drawn} converged{_checked(drawn, n)}, "
+                f"{dev['flipped']} flipped, {dev['overlaps']} overlapping, "
+                f"max D = {dev['max_D'] or 0.0:.2g}" + _steps(bad)
+                if drawn
+                else "no development diagram was drawn",
                 tuple(bad),
             )
         ]

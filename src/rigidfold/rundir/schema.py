@@ -32,12 +32,13 @@ from rigidfold.outcomes import Outcome
 from rigidfold.rundir.json_shapes import Nullable, Record, check_shape, received, shape_of
 from rigidfold.structure import StructureStatus
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 """The version of the files of a run directory this rigidfold writes and reads: summary.json's
-``schema_version`` and the header line of log.jsonl (``{"schema_version": 2}``; 2: a
-solution's ``fit`` has its ``status``). A run of another version (0: written before
-rigidfold recorded one) is refused
-(:func:`check_version`), not read through layers of old formats."""
+``schema_version`` and the header line of log.jsonl (``{"schema_version": 3}``; 2: a
+solution's ``fit`` has its ``status``; 3: a solution's ``development`` may be
+:data:`NOT_COMPUTED`, the diagram drawn for the final design only). A run of another
+version (0: written before rigidfold recorded one) is refused (:func:`check_version`), not
+read through layers of old formats."""
 
 LOG_FILE = "log.jsonl"
 """The attempt log of a run: JSON Lines, a header (``{"schema_version": N}``), then one line
@@ -57,6 +58,18 @@ def check_version(version, file: str | os.PathLike) -> None:
         f"{SCHEMA_VERSION}"
     )
 
+
+NOT_COMPUTED = "not_computed"
+"""The ``status`` of a stage's figures in a solution's record when the stage was not run on
+it: the development diagram (Step 8) of a solution that is not the final design under
+``--check final`` (:data:`NOT_DEVELOPED`). :meth:`SolutionRecord.ran` is False for it."""
+
+NOT_DEVELOPED = {
+    "status": NOT_COMPUTED,
+    "message": "the development diagram is drawn for the final design only (--check all: for "
+    "every solution; rigidfold develop FILE: for this one)",
+}
+"""The ``development`` figures of a solution whose diagram was not drawn."""
 
 _NUMBERS = Nullable(float)
 SUMMARY_SHAPE = Record(
@@ -352,8 +365,13 @@ class SolutionRecord:
         return out
 
     def ran(self, stage: Stage) -> bool:
-        """Whether ``stage`` ran on this solution (the development always does)."""
-        return stage is Stage.DEVELOPMENT or getattr(self, stage.value) is not None
+        """Whether ``stage`` ran on this solution: its figures are there and do not say
+        :data:`NOT_COMPUTED` (the development ran unless its figures say so: a record read
+        back without them counts it as run, as written before it could be skipped)."""
+        figures = getattr(self, stage.value)
+        if figures is None:
+            return stage is Stage.DEVELOPMENT
+        return not (isinstance(figures, dict) and figures.get("status") == NOT_COMPUTED)
 
     def status(self, stage: Stage) -> Outcome | str | None:
         """The status of ``stage`` as a member of its result's enum (that of

@@ -62,6 +62,7 @@ def kept_interrupts() -> Iterator[None]:
         received.append(signum)
         raise KeyboardInterrupt
 
+    note.rigidfold_handler = True  # type: ignore[attr-defined]
     saved = {s: signal.getsignal(s) for s in _SIGNALS}
     kept = [s for s, handler in saved.items() if handler in _INTERRUPTING]
     for s in kept:
@@ -78,4 +79,39 @@ def kept_interrupts() -> Iterator[None]:
         for s in kept:
             signal.signal(s, saved[s])
     if received:
+        raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def held_interrupts(*, reraise: bool = True) -> Iterator[list[int]]:
+    """Run the block with SIGINT (and SIGTERM where it interrupts) held: a signal received
+    while it runs is noted, not raised, so that a few bookkeeping steps that must go
+    together (renaming a set of files into place, the records of a solution and its file)
+    are never torn. When the block ends, a KeyboardInterrupt is raised for a held signal
+    (``reraise``; otherwise the caller reads the list the block is given, the signals
+    received). Keep the block short: the interrupt waits for it. Outside the main thread,
+    or where the program installed handlers of its own, it holds nothing."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+
+    def note(signum: int, frame: FrameType | None) -> None:
+        received.append(signum)
+
+    note.rigidfold_handler = True  # type: ignore[attr-defined]
+    saved = {s: signal.getsignal(s) for s in _SIGNALS}
+    held = [
+        s
+        for s, handler in saved.items()
+        if handler in _INTERRUPTING or getattr(handler, "rigidfold_handler", False)
+    ]
+    for s in held:
+        signal.signal(s, note)
+    try:
+        yield received
+    finally:
+        for s in held:
+            signal.signal(s, saved[s])
+    if received and reraise:
         raise KeyboardInterrupt
