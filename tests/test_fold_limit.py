@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-import rigidfold.generate as generation
+import rigidfold.generate.steps as generation
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, Stop, generate, with_fold_limit

@@ -200,7 +200,7 @@ def test_zero_dof_on_the_way_ends_or_counts_as_lock(monkeypatch, ends):
     """A 0-DOF solution while seeking DOF 1 ends generation (paper) or is a lock (option)."""
     from types import SimpleNamespace
 
-    import rigidfold.generate as gen
+    import rigidfold.generate.steps as gen
 
     real = gen.analyze
     calls = {"n": 0}

@@ -69,7 +69,7 @@ def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatc
     import math
     from types import SimpleNamespace
 
-    import rigidfold.generate as generation
+    import rigidfold.generate.steps as generation
 
     traced: list[int] = []
 
@@ -114,7 +114,7 @@ def test_the_candidates_paths_are_traced_to_the_runs_deadline(monkeypatch):
     long trace does not overrun the limit (none without a limit)."""
     import time
 
-    import rigidfold.generate as generation
+    import rigidfold.generate.steps as generation
 
     seen: list = []
     real = generation.trace_path
