@@ -52,17 +52,21 @@ def control(
     return ok, still
 
 
-def zero_crossings(values: np.ndarray, s: np.ndarray, where: np.ndarray | None = None) -> list:
-    """The s (sorted) where ``values`` (K,) changes sign between two states, by linear
-    interpolation; only between states both ``where`` (K,) bool when given."""
+def crossings(values: np.ndarray, s: np.ndarray) -> list[tuple[float, int]]:
+    """(s, k) of each sign change of ``values`` (K,) between states k and k + 1, s by
+    linear interpolation, in order."""
     v = np.asarray(values, dtype=np.float64)
     out = []
     for k in np.flatnonzero(np.sign(v[1:]) * np.sign(v[:-1]) < 0).tolist():
-        if where is not None and not (where[k] and where[k + 1]):
-            continue
         a, b = v[k], v[k + 1]
-        out.append(float(s[k] + (s[k + 1] - s[k]) * a / (a - b)))
+        out.append((float(s[k] + (s[k + 1] - s[k]) * a / (a - b)), k))
     return out
+
+
+def zero_crossings(values: np.ndarray, s: np.ndarray, where: np.ndarray | None = None) -> list:
+    """The s (sorted) where ``values`` (K,) changes sign between two states, by linear
+    interpolation; only between states both ``where`` (K,) bool when given."""
+    return [at for at, k in crossings(values, s) if where is None or (where[k] and where[k + 1])]
 
 
 def runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -232,7 +236,8 @@ def best_pair(
     the torques of least norm (see the module's text); ``rate`` and ``fold`` (K, H) the
     hinges' rates and fold angles, ``edges`` (H,) their creases. None when no pair does."""
     index = {int(e): h for h, e in enumerate(edges.tolist())}
-    chosen = [index[a.ids[0]] for a in ranking if not a.still][: settings.drive.pair_candidates]
+    chosen = [index[a.ids[0]] for a in ranking if not a.still and a.ids[0] in index]
+    chosen = chosen[: settings.drive.pair_candidates]
     if len(chosen) < 2:
         return None
     i, j = np.triu_indices(len(chosen), 1)

@@ -10,9 +10,13 @@ material and thickness; the two sides of a free crease tied in translation, a hi
   nodes tied to them following;
 * self-weight: each shell's area x thickness x density x g, a third at each of its nodes;
   the hinge hardware along its crease, the point masses at their vertices; along -z;
-* the other hinges' springs (``k`` N m/rad per metre, lumped to the crease's nodes as in
-  ``structure``) as rotational springs, with the moment they carry in that state
-  (``k L (rho - rho_rest)``) applied to their nodes as couples about the crease;
+* the hinges' springs: the moment each carries in that state (``k L (rho - rho_rest)``,
+  lumped to the crease's nodes by their share of its length as in ``structure``) applied
+  to the nodes on its two sides as couples about the crease (the held crease's too: the
+  drive turns against its own spring). Their stiffness is left out: it would change the
+  held moment only through the panels' elastic deformation next to the couples (on a
+  3 x 2 Miura-ori with 3 N m/rad per metre, 3 % of the springs' part; 300: more than
+  half), which the rigid panels of the torque curve do not have;
 * the driven crease *held*: rotational springs about it of ``Settings.drive.check_hold``
   times the panels' plate rigidity per mean edge length. For a one-DOF mechanism held at one
   crease the moment they carry is fixed by equilibrium (virtual work along the mechanism's
@@ -127,9 +131,9 @@ class HeldModel:
     """What one state's analysis is made of.
 
     coords : (V, 3) the state in the base's frame; base_faces : (k,) the base panel's
-    triangles; edge : the held crease; hinge_edges (H,) and spring_moment (H,): the other
-    hinges and the moment their springs carry there (N m, on rho); stiffness : N m/rad per
-    metre of the other hinges; hardware : kg per metre of hinge; point_masses : (vertex, kg).
+    triangles; edge : the held crease; hinge_edges (H,) and spring_moment (H,): the hinges
+    (the held one among them) and the moment their springs carry there (N m, on rho);
+    hardware : kg per metre of hinge; point_masses : (vertex, kg).
     """
 
     coords: np.ndarray
@@ -137,7 +141,6 @@ class HeldModel:
     edge: int
     hinge_edges: np.ndarray
     spring_moment: np.ndarray
-    stiffness: float
     hardware: float
     point_masses: tuple[tuple[int, float], ...]
 
@@ -206,17 +209,14 @@ def held_moment(
     for s_, ((a, b), axis) in enumerate(zip(mesh.springs, mesh.spring_axis, strict=True)):
         e = int(mesh.spring_crease[s_])
         share = float(mesh.spring_length[s_])
-        if e == model.edge:
-            k = hold * share
-        elif e in moment_of:
-            k = model.stiffness * share
-            q = moment_of[e] * share / float(length[e])  # this node pair's part, on rho
-            couples[b] -= q * axis
-            couples[a] += q * axis
-        else:
+        if e not in moment_of:
             continue
-        if k <= 0:
+        q = moment_of[e] * share / float(length[e])  # this node pair's part, on rho
+        couples[b] -= q * axis
+        couples[a] += q * axis
+        if e != model.edge:  # a spring's moment, not its stiffness (see the module's text)
             continue
+        k = hold * share
         ops.uniaxialMaterial("Elastic", s_ + 1, float(k))
         ref = np.eye(3)[int(np.argmin(np.abs(axis)))]
         tag += 1
@@ -243,7 +243,7 @@ def held_moment(
     weight = mesh.triangle_areas * thickness * density * g
     np.add.at(forces[:, 2], mesh.triangles.ravel(), -np.repeat(weight / 3, 3))
     if model.hardware > 0:  # half of each hinge's hardware at each end (its centroid the middle)
-        for e in [*model.hinge_edges.tolist(), model.edge]:
+        for e in model.hinge_edges.tolist():
             half = 0.5 * model.hardware * float(length[e]) * g
             for v in shape.edges[e].tolist():
                 forces[int(mesh.vertex_nodes(v)[0]), 2] -= half

@@ -257,7 +257,6 @@ def _check(pattern, motion, en, base, ranking, drive, ok, options, thickness, se
             f"crease {chosen.ids[0]} is in control at {len(states)} states only", chosen.ids[0]
         )
     coords = motion.in_base(base)
-    others = np.flatnonzero(edges != chosen.ids[0])
     rest = en.fold[-1] if options.spring_rest == "built" else np.zeros(len(edges))
     models = []
     for k in states.tolist():
@@ -266,9 +265,8 @@ def _check(pattern, motion, en, base, ranking, drive, ok, options, thickness, se
             coords=coords[k],
             base_faces=panels.triangles[base],
             edge=int(chosen.ids[0]),
-            hinge_edges=edges[others],
-            spring_moment=moment[others],
-            stiffness=options.hinge_stiffness,
+            hinge_edges=edges,
+            spring_moment=moment,
             hardware=options.hardware,
             point_masses=options.point_masses,
         )

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigidfold.drive.actuators import zero_crossings
+from rigidfold.drive.actuators import crossings
 
 
 @dataclass(frozen=True)
@@ -46,9 +46,8 @@ def equilibria(u: np.ndarray, slope: np.ndarray, s: np.ndarray) -> list[Equilibr
     out = []
     if len(s) and slope[0] > 0:
         out.append(Equilibrium(float(s[0]), True, float(u[0]), "flat"))
-    for at in zero_crossings(slope, s):
-        k = int(np.clip(np.searchsorted(s, at) - 1, 0, len(s) - 2))
-        stable = slope[k] < 0 < slope[k + 1]
+    for at, k in crossings(slope, s):
+        stable = slope[k] < 0  # and > 0 at k + 1: a minimum
         w = (at - s[k]) / (s[k + 1] - s[k])
         out.append(Equilibrium(at, bool(stable), float((1 - w) * u[k] + w * u[k + 1])))
     if len(s) and slope[-1] < 0:

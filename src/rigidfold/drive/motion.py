@@ -205,14 +205,25 @@ def refine_frames(
     s = [float(fraction[0])]
     for k, n in enumerate(parts.tolist()):
         a, b = held[k], held[k + 1]
-        between = _continue(cons, b, a, n, loose)
-        if between is None:
+        inside: list[np.ndarray] = [a, b]
+        for _ in range(3):  # more steps where a hinge still turns too far in one
+            between = _continue(cons, b, a, n, loose) if n > 1 else []
+            if between is None:
+                return None
+            inside = [a, *between[::-1], b]
+            f = fold_angles_along(pattern, np.asarray(inside), panels.hinge_edges)
+            largest = float(np.abs(angle_change(f[1:], f[:-1])).max(initial=0.0))
+            if largest <= step * (1 + 1e-9):
+                break
+            n = math.ceil(n * largest / step) + 1
+        if len(states) + len(inside) > MAX_STATES:
             return None
-        inside = [a, *between[::-1]]
-        inside.append(b)
-        chord = np.linalg.norm(np.diff(np.asarray(inside), axis=0).reshape(n, -1), axis=1)
+        chord = np.linalg.norm(
+            np.diff(np.asarray(inside), axis=0).reshape(len(inside) - 1, -1), axis=1
+        )
         total = float(chord.sum())
-        where = np.cumsum(chord) / total if total > 0 else np.linspace(1 / n, 1.0, n)
+        m = len(inside) - 1
+        where = np.cumsum(chord) / total if total > 0 else np.linspace(1 / m, 1.0, m)
         s0, s1 = float(fraction[k]), float(fraction[k + 1])
         states.extend(inside[1:])
         s.extend((s0 + (s1 - s0) * where).tolist())
@@ -220,23 +231,28 @@ def refine_frames(
 
 
 def _continue(cons, start: np.ndarray, end: np.ndarray, n: int, settings: Settings):
-    """The n - 1 states (each (V, 3)) from ``start`` towards ``end`` (both on the
-    constraints, (V, 3)), n - 1 steps of a predictor-corrector continuation along the
-    constraints' one-dimensional manifold, each a chord of 1/n of theirs: the tangent the
-    projection of the last onto the null space of J (the first: towards ``end``), the
-    corrector of least norm; None where a step does not converge. It goes from the later
-    frame to the earlier, so that it never starts at the flat state, where the manifold
-    branches."""
+    """The states (each (V, 3)) from ``start`` towards ``end`` (both on the constraints,
+    (V, 3)) of a predictor-corrector continuation along the constraints' one-dimensional
+    manifold in steps of 1/n of their chord (the last two sharing what is left), until
+    ``end`` is within one step: the tangent
+    the projection of the last onto the null space of J (the first: towards ``end``), the
+    corrector of least norm. None where a step does not converge or does not come closer
+    (at most ``3 n`` steps). It goes from the later frame to the earlier, so that it never
+    starts at the flat state, where the manifold branches."""
     from rigidfold.mechanism.rigid_folding import System, correct
 
     x = start.ravel() / cons.scale
     goal = end.ravel() / cons.scale
     h = float(np.linalg.norm(goal - x)) / n
-    t = (goal - x) / (n * h) if h > 0 else np.zeros_like(x)
-    out = []
-    for _ in range(n - 1):
+    if not h > 0:
+        return []
+    t = (goal - x) / (n * h)
+    out: list[np.ndarray] = []
+    while (left := float(np.linalg.norm(goal - x))) > h * (1 + 1e-9):
+        if len(out) >= 3 * n:
+            return None
+        J, J_rho = cons.jacobian(x)
         try:
-            J, J_rho = cons.jacobian(x)
             system = System(J, J_rho, "projection", None, settings)
         except RuntimeError:
             return None
@@ -244,8 +260,9 @@ def _continue(cons, start: np.ndarray, end: np.ndarray, n: int, settings: Settin
         if not np.isfinite(t_new).all():
             return None
         t = t_new if float(t_new @ (goal - x)) >= 0 else -t_new
-        y, ok, _, _ = correct(cons, x + h * t, "projection", None, settings)
-        if not ok:
+        # within two steps of the end, halve what is left: no last step much shorter
+        y, ok, _, _ = correct(cons, x + min(h, left / 2) * t, "projection", None, settings)
+        if not ok or not np.linalg.norm(goal - y) < np.linalg.norm(goal - x):
             return None
         x = y
         out.append(y.reshape(-1, 3) * cons.scale)
