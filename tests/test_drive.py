@@ -174,6 +174,7 @@ def test_miura_strip_closed_form(tmp_path: Path) -> None:
     options = DriveOptions(thickness=0.012, ground=-5.0, hinge_stiffness=3.0, spring_rest="built")
     r = deploy_design(path, options, frames=(frames, heights / HEIGHT))
     assert r.status is DriveStatus.DRIVEN, r.message
+    assert r.motion["source"].startswith("the given 7 frames refined to")
     assert r.check.status.value == "agrees", r.check.message
     panels = Panels(built, miura_at(0.0).coords[:, :2], "top")
     hinges = panels.hinge_edges

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.drive import actuators as act
 from rigidfold.drive.base import below_ground, lowest_points, rank_bases
 from rigidfold.drive.check import HeldModel, check_curve, not_run, pick_states
@@ -64,6 +64,7 @@ def _read(
     return design, source, t, f"the default ({t * 1e3:g} mm: no thickness given or recorded)"
 
 
+@one_blas_thread()  # the same rounding on every machine, and no BLAS threads contending
 def deploy_design(
     design: Design | str | os.PathLike,
     options: DriveOptions | None = None,

@@ -247,21 +247,27 @@ def _continue(cons, start: np.ndarray, end: np.ndarray, n: int, settings: Settin
     if not h > 0:
         return []
     t = (goal - x) / (n * h)
+    # pseudo-arclength ([J; t^T], corrections across the tangent) where J has n - 1 rows, as
+    # the trace does; least norm where its rows are redundant (self-stressed)
+    mode = "augmented" if cons.n_rows == cons.n - 1 else "projection"
     out: list[np.ndarray] = []
+    system = None  # the corrector's last factors serve the next tangent, as in the trace
     while (left := float(np.linalg.norm(goal - x))) > h * (1 + 1e-9):
         if len(out) >= 3 * n:
             return None
-        J, J_rho = cons.jacobian(x)
         try:
-            system = System(J, J_rho, "projection", None, settings)
+            if system is None or mode == "augmented":
+                J, J_rho = cons.jacobian(x)
+                system = System(J, J_rho, mode, t, settings)
+            t_new = system.direction(t, cons.free_angles(x))
         except RuntimeError:
             return None
-        t_new = system.direction(t, cons.free_angles(x))
         if not np.isfinite(t_new).all():
             return None
         t = t_new if float(t_new @ (goal - x)) >= 0 else -t_new
         # within two steps of the end, halve what is left: no last step much shorter
-        y, ok, _, _ = correct(cons, x + min(h, left / 2) * t, "projection", None, settings)
+        step = x + min(h, left / 2) * t
+        y, ok, _, system = correct(cons, step, mode, t, settings)
         if not ok or not np.linalg.norm(goal - y) < np.linalg.norm(goal - x):
             return None
         x = y
