@@ -477,3 +477,14 @@ def test_a_motion_that_does_not_reach_flat_is_refused(hinge: Path, tmp_path: Pat
     with pytest.raises(RigidfoldError, match="does not reach the flat state"):
         deploy_design(hinge, DriveOptions(), out, path=path)
     assert not out.exists()
+
+
+def test_the_thickness_fabricate_recorded(hinge: Path) -> None:
+    """Without --thickness, the thickness ``rigidfold fabricate`` recorded beside the design
+    (its NAME_fabricate.json), and deploy.json says where it came from."""
+    (hinge.parent / "hinge_fabricate.json").write_text(json.dumps({"thickness_m": 0.025}))
+    r = deploy_design(hinge, DriveOptions(check=False), frames=hinge_frames())
+    assert r.thickness == 0.025 and "hinge_fabricate.json" in r.thickness_from
+    assert r.to_dict()["panels"]["thickness_from"] == r.thickness_from
+    given = deploy_design(hinge, DriveOptions(thickness=0.01, check=False), frames=hinge_frames())
+    assert given.thickness == 0.01 and given.to_dict()["panels"]["thickness_from"] == "given"

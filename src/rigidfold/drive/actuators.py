@@ -283,16 +283,20 @@ def cable_drives(
     power: np.ndarray,
     s: np.ndarray,
     *,
+    reference: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> list[Actuator]:
     """The cables between ``pairs`` (n, 2) of vertices, of ``lengths`` (K, n) along the
-    motion, with their tension ``-P / (dl/ds)`` (see the module's text), in the order given."""
+    motion, with their tension ``-P / (dl/ds)`` (see the module's text), in the order given;
+    ``reference``: the largest |dl/ds| a cable that does not move is measured against
+    (default: these cables' largest)."""
     from rigidfold.drive.energy import derivative
 
     if not len(pairs):
         return []
     rate = derivative(lengths.T, s).T
-    reference = float(np.abs(rate).max(initial=0.0)) if rate.size else 0.0
+    if reference is None:
+        reference = float(np.abs(rate).max(initial=0.0)) if rate.size else 0.0
     ok, still = control(rate, reference=reference, settings=settings)
     with np.errstate(divide="ignore", invalid="ignore"):
         tension = -power[:, None] / rate
@@ -344,17 +348,38 @@ def auto_cable_pairs(
 
 
 def best_cables(
-    lengths: np.ndarray,
+    coords: np.ndarray,
     pairs: np.ndarray,
     power: np.ndarray,
     s: np.ndarray,
     count: int,
     *,
     settings: Settings = DEFAULTS,
+    budget: int = 2_000_000,
 ) -> list[Actuator]:
-    """The ``count`` best cables among ``pairs``: those that drive the whole motion (never
-    push, no dead point) by their peak tension, then the others by peak."""
-    cables = cable_drives(lengths, pairs, power, s, settings=settings)
-    good = sorted((c for c in cables if c.controls), key=_rank_key)
-    rest = sorted((c for c in cables if not c.controls and not c.still), key=_rank_key)
+    """The ``count`` best cables among ``pairs`` (n, 2) of vertices of the states ``coords``
+    (K, V, 3): those that drive the whole motion (never push, no dead point) by their peak
+    tension, then the others by peak. The pairs are taken a few at a time (``budget``
+    numbers, pairs x states, at once), only the best kept."""
+    if not len(pairs) or count <= 0:
+        return []
+    lengths = cable_lengths(coords, pairs)
+    from rigidfold.drive.energy import derivative
+
+    reference = float(np.abs(derivative(lengths.T, s)).max(initial=0.0))
+    step = max(1, budget // max(len(s), 1))
+    good: list[Actuator] = []
+    rest: list[Actuator] = []
+    for lo in range(0, len(pairs), step):
+        some = cable_drives(
+            lengths[:, lo : lo + step],
+            pairs[lo : lo + step],
+            power,
+            s,
+            reference=reference,
+            settings=settings,
+        )
+        good = sorted(good + [c for c in some if c.controls], key=_rank_key)[:count]
+        rest = sorted(rest + [c for c in some if not c.controls and not c.still], key=_rank_key)
+        rest = rest[:count]
     return (good + rest)[:count]

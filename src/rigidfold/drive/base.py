@@ -100,7 +100,7 @@ def rank_bases(
     low: np.ndarray,
     *,
     settings: Settings = DEFAULTS,
-    chunk: int = 16,
+    budget: int = 4_000_000,
 ) -> list[Placement]:
     """Every panel as the base, ranked: clear of the ground first, then by effort (lowest
     first). ``powers`` (B, K) the drive's power per unit of s of each placement, ``rate``
@@ -108,7 +108,9 @@ def rank_bases(
     those that do not move (:func:`rigidfold.drive.actuators.control`: the same for every
     base, the rates do not depend on it), ``edges`` (H,) the hinges' creases, ``low``
     (B, K) (:func:`lowest_points`). The effort of a crease is ``|P| / |rate|`` at its states
-    in control: the creases that drive the whole motion where there are any, else all."""
+    in control: the creases that drive the whole motion where there are any, else all;
+    the bases are taken a few at a time, ``budget`` numbers (bases x states x creases) at
+    once."""
     whole = ok.all(axis=0) & ~still
     controls = bool(whole.any())
     use = np.flatnonzero(whole if controls else ~still)
@@ -120,6 +122,7 @@ def rank_bases(
             inverse = np.where(ok[:, use], 1.0 / np.abs(rate[:, use]), 0.0)  # (K, n)
         never = ~ok[:, use].any(axis=0)
         size = np.abs(powers)
+        chunk = max(1, budget // max(inverse.size, 1))
         for lo in range(0, n_bases, chunk):
             hi = min(lo + chunk, n_bases)
             peak = (size[lo:hi, :, None] * inverse[None]).max(axis=1)  # (c, n)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +42,10 @@ from rigidfold.fabricate.panels import Panels
 
 
 def _read(
-    design: Design | str | os.PathLike, options: DriveOptions, settings: Settings
+    design: Design | str | os.PathLike,
+    options: DriveOptions,
+    settings: Settings,
+    also: Sequence[Path] = (),
 ) -> tuple[Design, str, float, str]:
     """(the design, its source in words, the panels' thickness, where it came from)."""
     from rigidfold.exports import read_design
@@ -56,7 +60,7 @@ def _read(
         design = read_design(path, settings=settings)
     if options.thickness is not None:
         return design, source, options.thickness, options.thickness_from
-    recorded = recorded_thickness(path) if path is not None else None
+    recorded = recorded_thickness(path, also) if path is not None else None
     if recorded is not None:
         t, where = recorded
         return design, source, t, f"recorded by fabricate in {where.name}"
@@ -72,6 +76,7 @@ def deploy_design(
     *,
     frames: tuple[np.ndarray, np.ndarray] | None = None,
     path=None,
+    recorded_in: Sequence[str | os.PathLike] = (),
     settings: Settings = DEFAULTS,
 ) -> DriveResult:
     """The drive of ``design``'s deployment (see the module's text), its files written into
@@ -81,15 +86,19 @@ def deploy_design(
     design : a FOLD file or a :class:`~rigidfold.exports.Design`; options : the drive's
     (default :class:`DriveOptions`); frames : ((K, V, 3), fraction (K,)) the design's motion
     from flat at hand (a run's), instead of its file's; path : its folding path already
-    traced. Raises RigidfoldError (one line, nothing written) for bad input: an index the
-    design lacks, a design that is not DOF 1, a motion that does not reach flat.
+    traced; recorded_in : directories where ``rigidfold fabricate`` may have recorded the
+    panels' thickness besides the design's own (a run's thick panels,
+    :func:`rigidfold.run.built.thick_dir_of`), read when ``options.thickness`` is None.
+    Raises RigidfoldError (one line, nothing written) for bad input: an index the design
+    lacks, a design that is not DOF 1, a motion that does not reach flat.
     """
     options = DriveOptions() if options is None else options
     if not isinstance(options, DriveOptions):
         raise RigidfoldError(f"options must be DriveOptions, got {type(options).__name__}")
     times: dict[str, float] = {}
     t0 = time.perf_counter()
-    design, source, thickness, thickness_from = _read(design, options, settings)
+    also = [Path(p) for p in recorded_in]
+    design, source, thickness, thickness_from = _read(design, options, settings, also)
     pattern = design.pattern
     panels = Panels(pattern, design.coords2d, "top")
     options.check_indices(pattern.n_vertices, panels.n)
@@ -148,9 +157,8 @@ def deploy_design(
             pairs = np.asarray(
                 [p for p in pairs.tolist() if tuple(sorted(p)) not in known], dtype=np.int64
             ).reshape(-1, 2)
-        lengths = act.cable_lengths(motion.coords, pairs)
         cables += act.best_cables(
-            lengths, pairs, power, s, settings.drive.auto_cables, settings=settings
+            motion.coords, pairs, power, s, settings.drive.auto_cables, settings=settings
         )
     drive, over = _named(ranking, pair, cables, options)
     times["drives"] = time.perf_counter() - t0
