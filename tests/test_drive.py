@@ -488,3 +488,16 @@ def test_the_thickness_fabricate_recorded(hinge: Path) -> None:
     assert r.to_dict()["panels"]["thickness_from"] == r.thickness_from
     given = deploy_design(hinge, DriveOptions(thickness=0.01, check=False), frames=hinge_frames())
     assert given.thickness == 0.01 and given.to_dict()["panels"]["thickness_from"] == "given"
+
+
+def test_held_conditioning_tells_a_near_mechanism() -> None:
+    """One hinge held: rigid, well conditioned. A fan of three triangles (two free creases)
+    held at one crease still moves about the other: the check could not decide there."""
+    from rigidfold.drive.check import held_conditioning
+
+    pattern = hinge_pattern()
+    assert held_conditioning(pattern, pattern.coords, hinge_edge(pattern)) > 1e-3
+    x = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0.3], [-0.5, 1, 0.6], [-1, 0, 0.2]], float)
+    fan = CreasePattern.from_faces(x, np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4]]))
+    crease = int(fan.free_creases[0])
+    assert held_conditioning(fan, fan.coords, crease) < DEFAULTS.drive.check_conditioning

@@ -165,8 +165,10 @@ class DriveResult:
             )
         if self.status is DriveStatus.OVER_LIMIT:
             parts.append("over the limit")
-        if self.status is DriveStatus.CHECK_FAILED:
+        if self.check.status in (CheckStatus.DISAGREES, CheckStatus.FAILED):
             parts.append(f"check {self.check.status.value}")
+        elif self.check.status is CheckStatus.UNDECIDED:
+            parts.append("check undecided: the held structure keeps a near-mechanism")
         return "; ".join(parts)
 
     def states(self) -> list[dict]:
