@@ -461,15 +461,24 @@ class DriveSettings(Group):
         "The motion is refined so that no crease turns more than this between two states, "
         "radians (1 degree): the derivatives along it are central differences of that step.",
     )
+    max_turn: float = setting(
+        math.radians(1.0),
+        "Where the motion comes from the design file's frames, they are refined until the "
+        "motion, a curve in the space of all vertex coordinates, turns no more than this "
+        "from one chord to the next, radians (1 degree): near a bifurcation the path bends "
+        "sharply while no hinge turns far (a 12 m x 8 m roof: 7 degrees between two states "
+        "of 1 degree of hinge turn, the torque's differences flipping sign there).",
+    )
     refine_tol: float = setting(
-        1e-10,
-        "A state inserted into the design file's motion frames is continued onto the "
-        "rigid-folding constraints to this residual (edge lengths in mean edge lengths, fold "
-        "angles in radians; ``path_tol`` where that is larger), with three times "
-        "``path_corrector_iter`` chord steps. Near the flat state the constraints have near "
-        "flexes, along which a small residual is a large move: at 1e-7 the torque of the "
-        "722-panel waterbomb within half a degree of flat was 4 % off (the secants dU/drho "
-        "jumped), at 1e-10 it follows the traced path's.",
+        1e-13,
+        "Every state of the motion is corrected onto the rigid-folding constraints to this "
+        "residual (edge lengths in mean edge lengths, fold angles in radians) where the "
+        "constraints are square (pseudo-arclength, ``rigidfold.drive.motion.settle``), "
+        "else to ``path_tol``: along a near flex of singular value sigma a residual r leaves "
+        "a state anywhere within r / sigma, and the energy's differences between states "
+        "wander with it (a 12 m x 8 m roof, sigma 1e-8: at ``path_tol`` the torque's sign "
+        "flipped from one state to the next; the 722-panel waterbomb within half a degree "
+        "of flat: 4 % off at 1e-7).",
     )
     hinge_stiffness: float = setting(
         0.0,
@@ -526,14 +535,16 @@ class DriveSettings(Group):
         "Each triangle is divided into this squared shell elements in the OpenSees check "
         "(the reaction of a held crease of a mechanism does not depend on the mesh).",
     )
-    check_conditioning: float = setting(
-        1e-8,
-        "A state of the OpenSees check decides nothing where the structure held at the "
-        "driven crease keeps a near-mechanism: the rigid-folding constraints with the "
-        "crease's angle held have a singular value below this share of their largest. The "
-        "static analysis is then ill-conditioned (the demo's final design, 8e-10 to 3e-9: "
-        "reaction moments 0.2 to 11 times the curve's; the 722-panel waterbomb, 2e-7 to "
-        "1.4e-6: within 0.3 %), and the built design is softer than its rigid motion.",
+    check_spread: float = setting(
+        0.25,
+        "A state of the OpenSees check decides nothing where its reaction moment changes by "
+        "more than this share of the tolerance (``drive_check_tolerance`` of the peak) when "
+        "the held crease is made ten times stiffer: the moment does not depend on that "
+        "stiffness, so the model is near singular (a near-mechanism besides the held one: "
+        "on the demo's final design, whose constraints with the crease held have singular "
+        "values of 1e-9 to 4e-9 of their largest, the two analyses gave -6 and -20, 104 and 2 "
+        "N m where the curve has -26 and -31), and the built design is softer than its rigid "
+        "motion.",
     )
     check_hold: float = setting(
         1e3,
@@ -549,7 +560,7 @@ class DriveSettings(Group):
             "max_step",
             "refine_tol",
             "check_tolerance",
-            "check_conditioning",
+            "check_spread",
             "check_hold",
         )
         self._non_negative("hinge_stiffness", "friction", "hardware", "ground_tol")

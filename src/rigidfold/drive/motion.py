@@ -1,5 +1,7 @@
 """The motion a drive deploys: the design's rigid motion from flat (s = 0) to built (s = 1),
-refined so that no hinge turns more than ``Settings.drive.max_step`` between two states.
+refined so that no hinge turns more than ``Settings.drive.max_step`` between two states (and
+the motion, as a curve in the space of all coordinates, not more than ``max_turn`` from one
+chord to the next, where the frames are the design file's).
 
 Where the motion comes from, in order:
 
@@ -178,8 +180,10 @@ def refine_frames(
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """(states (K', V, 3), s (K',)): ``frames`` (K, V, 3) at ``fraction`` (K,), a rigid motion
     of ``panels``' design, with states inserted between two frames where a hinge turns more
-    than ``settings.drive.max_step`` (see the module's text), every frame held at the design's
-    support triangle; None where a state cannot be re-solved onto the constraints."""
+    than ``settings.drive.max_step``, or the motion turns more than ``settings.drive.
+    max_turn`` from one chord to the next, in the space of all coordinates (see the module's
+    text), every frame held at the design's support triangle; None where a state cannot be
+    re-solved onto the constraints."""
     from rigidfold.frame.model import default_support_face
     from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints
 
@@ -197,10 +201,8 @@ def refine_frames(
     parts = np.maximum(np.ceil(turn / step).astype(np.int64), 1)
     if 1 + int(parts.sum()) > MAX_STATES:
         return None
-    loose = settings.with_(
-        path_tol=max(settings.path.tol, settings.drive.refine_tol),
-        path_corrector_iter=3 * settings.path.corrector_iter,
-    )
+    loose = settings.with_(path_corrector_iter=3 * settings.path.corrector_iter)
+    max_turn = settings.drive.max_turn
     states = [held[0]]
     s = [float(fraction[0])]
     for k, n in enumerate(parts.tolist()):
@@ -213,9 +215,10 @@ def refine_frames(
             inside = [a, *between[::-1], b]
             f = fold_angles_along(pattern, np.asarray(inside), panels.hinge_edges)
             largest = float(np.abs(angle_change(f[1:], f[:-1])).max(initial=0.0))
-            if largest <= step * (1 + 1e-9):
+            turn = _largest_turn(np.asarray(inside))
+            if largest <= step * (1 + 1e-9) and turn <= max_turn * (1 + 1e-9):
                 break
-            n = math.ceil(n * largest / step) + 1
+            n = math.ceil(n * max(largest / step, turn / max_turn, 1.0)) + 1
         if len(states) + len(inside) > MAX_STATES:
             return None
         chord = np.linalg.norm(
@@ -228,6 +231,17 @@ def refine_frames(
         states.extend(inside[1:])
         s.extend((s0 + (s1 - s0) * where).tolist())
     return np.asarray(states), np.asarray(s)
+
+
+def _largest_turn(states: np.ndarray) -> float:
+    """The largest angle, radians, between two successive chords of ``states`` (K, V, 3)
+    (the motion's turn in the space of all coordinates from one state to the next)."""
+    chords = np.diff(states, axis=0).reshape(len(states) - 1, -1)
+    if len(chords) < 2:
+        return 0.0
+    size = np.linalg.norm(chords, axis=1)
+    cos = np.einsum("ij,ij->i", chords[1:], chords[:-1]) / (size[1:] * size[:-1])
+    return float(np.arccos(np.clip(cos, -1.0, 1.0)).max())
 
 
 def _continue(cons, start: np.ndarray, end: np.ndarray, n: int, settings: Settings):
@@ -300,7 +314,7 @@ def drive_motion(
                 states, s = _increasing(*refined)
                 where = "the given" if frames is not None else "the design file's"
                 source = f"{where} {len(shapes)} frames refined to {len(s)} states"
-                return DriveMotion(panels, panel_motion(panels, states, s, source), source)
+                return _settled(panels, states, s, source, settings)
             rejected = f" (the {len(shapes)} frames could not be refined)"
         else:
             rejected = f" (the {len(shapes)} frames are not its motion: {why})"
@@ -316,10 +330,60 @@ def drive_motion(
     rotations, translations = _flat_start(panels, motion, settings)
     s = np.asarray(motion.fraction, dtype=np.float64)
     keep = _strictly_rising(s)
-    source = f"{message}{rejected}"
     closing = closing_angles(panels, rotations)
-    pm = PanelMotion(rotations[keep], translations[keep], s[keep], closing[keep], source)
-    return DriveMotion(panels, pm, source)
+    traced = DriveMotion(
+        panels, PanelMotion(rotations[keep], translations[keep], s[keep], closing[keep], ""), ""
+    )
+    return _settled(panels, traced.coords, s[keep], f"{message}{rejected}", settings)
+
+
+def settle(panels: Panels, states: np.ndarray, *, settings: Settings = DEFAULTS) -> np.ndarray:
+    """(K, V, 3): ``states`` (K, V, 3), a motion on the rigid-folding constraints to
+    ``path_tol``, each corrected onto them to ``drive_refine_tol`` (held at the design's
+    support triangle): where the constraints have a near flex (a singular value sigma near
+    0 besides the motion's own), a residual r leaves a state anywhere within r / sigma
+    along it, and the energy's differences between states wander with it (a 12 m x 8 m
+    roof: sigma 1e-8, the torque's sign flipping from one state to the next). A square
+    system (no redundant row) is corrected across the motion's chord (pseudo-arclength,
+    Newton's quadratic rate to 1e-15); else, or where that fails (the flat state, where the
+    manifold branches), by the least-norm corrector to ``path_tol``; a state neither
+    corrects is kept."""
+    from rigidfold.frame.model import default_support_face
+    from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, correct
+
+    pattern = panels.pattern
+    face = default_support_face(pattern)
+    cons = RigidFoldingConstraints(pattern, face)
+    held = best_fit(np.asarray(states, dtype=np.float64), pattern.coords, pattern.faces[face])
+    iters = 3 * settings.path.corrector_iter
+    tight = settings.with_(path_tol=settings.drive.refine_tol, path_corrector_iter=iters)
+    loose = settings.with_(path_corrector_iter=iters)
+    square = cons.n_rows == cons.n - 1
+    out = held.copy()
+    for k in range(len(held)):
+        x = held[k].ravel() / cons.scale
+        y, ok = x, False
+        if square and len(held) > 1:
+            chord = (held[min(k + 1, len(held) - 1)] - held[max(k - 1, 0)]).ravel()
+            size = float(np.linalg.norm(chord))
+            if size > 0:
+                try:
+                    y, ok, _, _ = correct(cons, x, "augmented", chord / size, tight)
+                except RuntimeError:
+                    ok = False
+        if not ok:
+            y, ok, _, _ = correct(cons, x, "projection", None, loose)
+        if ok:
+            out[k] = y.reshape(-1, 3) * cons.scale
+    return out
+
+
+def _settled(
+    panels: Panels, states: np.ndarray, s: np.ndarray, source: str, settings: Settings
+) -> DriveMotion:
+    """The :class:`DriveMotion` of ``states`` (K, V, 3) at ``s`` (K,), each :func:`settle`d."""
+    fine = settle(panels, states, settings=settings)
+    return DriveMotion(panels, panel_motion(panels, fine, s, source), source)
 
 
 def _flat_start(
