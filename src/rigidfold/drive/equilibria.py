@@ -110,6 +110,11 @@ def released(slope: np.ndarray, friction: np.ndarray, s: np.ndarray) -> list[Rel
         else:
             how = "flat" if r == 0 else ("built" if r == n - 1 else "rest")
             at = float(s[r])
+            if how == "rest":  # where the drive's balance crosses zero, between two states
+                a, b = (r, r + 1) if down[k] else (r - 1, r)
+                v = slope - friction if down[k] else slope + friction
+                if v[a] != v[b]:
+                    at = float(s[a] + (s[b] - s[a]) * v[a] / (v[a] - v[b]))
         out.append(Release(float(s[k]), float(s[j]), at, how))
         k = j + 1
     return out
