@@ -500,3 +500,13 @@ def test_held_conditioning_tells_a_near_mechanism() -> None:
     fan = CreasePattern.from_faces(x, np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4]]))
     crease = int(fan.free_creases[0])
     assert held_conditioning(fan, fan.coords, crease) < 1e-8
+
+
+def test_its_own_output_does_not_replace_the_design(tmp_path: Path) -> None:
+    """deploy.fold read back and written into its own directory: refused before anything
+    is computed."""
+    path = write_fold(tmp_path / "deploy.fold", hinge_pattern())
+    before = path.read_bytes()
+    with pytest.raises(RigidfoldError, match="would replace the input file"):
+        deploy_design(path, DriveOptions(), tmp_path)
+    assert path.read_bytes() == before

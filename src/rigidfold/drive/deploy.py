@@ -97,6 +97,11 @@ def deploy_design(
         raise RigidfoldError(f"options must be DriveOptions, got {type(options).__name__}")
     times: dict[str, float] = {}
     t0 = time.perf_counter()
+    if out_dir is not None and not isinstance(design, Design):
+        from rigidfold.drive.files import DEPLOY_FILES
+        from rigidfold.io import refuse_replacing_inputs
+
+        refuse_replacing_inputs([design], [Path(out_dir) / name for name in DEPLOY_FILES])
     also = [Path(p) for p in recorded_in]
     design, source, thickness, thickness_from = _read(design, options, settings, also)
     pattern = design.pattern
