@@ -46,6 +46,7 @@ def _read(
     options: DriveOptions,
     settings: Settings,
     also: Sequence[Path] = (),
+    up: str = "z",
 ) -> tuple[Design, str, float, str]:
     """(the design, its source in words, the panels' thickness, where it came from)."""
     from rigidfold.exports import read_design
@@ -57,7 +58,7 @@ def _read(
     else:
         path = Path(design)
         source = str(path)
-        design = read_design(path, settings=settings)
+        design = read_design(path, up=up, settings=settings)
     if options.thickness is not None:
         return design, source, options.thickness, options.thickness_from
     recorded = recorded_thickness(path, also) if path is not None else None
@@ -77,6 +78,7 @@ def deploy_design(
     frames: tuple[np.ndarray, np.ndarray] | None = None,
     path=None,
     recorded_in: Sequence[str | os.PathLike] = (),
+    up: str = "z",
     settings: Settings = DEFAULTS,
 ) -> DriveResult:
     """The drive of ``design``'s deployment (see the module's text), its files written into
@@ -88,7 +90,9 @@ def deploy_design(
     from flat at hand (a run's), instead of its file's; path : its folding path already
     traced; recorded_in : directories where ``rigidfold fabricate`` may have recorded the
     panels' thickness besides the design's own (a run's thick panels,
-    :func:`rigidfold.run.built.thick_dir_of`), read when ``options.thickness`` is None.
+    :func:`rigidfold.run.built.thick_dir_of`), read when ``options.thickness`` is None;
+    up : the up axis the FOLD file is read with (:func:`rigidfold.io.read_fold`; motion
+    frames are rigidfold's, z up: a file read otherwise has its motion traced).
     Raises RigidfoldError (one line, nothing written) for bad input: an index the design
     lacks, a design that is not DOF 1, a motion that does not reach flat.
     """
@@ -103,7 +107,7 @@ def deploy_design(
 
         refuse_replacing_inputs([design], [Path(out_dir) / name for name in DEPLOY_FILES])
     also = [Path(p) for p in recorded_in]
-    design, source, thickness, thickness_from = _read(design, options, settings, also)
+    design, source, thickness, thickness_from = _read(design, options, settings, also, up)
     pattern = design.pattern
     panels = Panels(pattern, design.coords2d, "top")
     options.check_indices(pattern.n_vertices, panels.n)
@@ -112,7 +116,8 @@ def deploy_design(
     check_dof(pattern, settings=settings)
     times["read"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    motion = drive_motion(panels, design, frames=frames, path=path, settings=settings)
+    carrier = design if up == "z" else None  # frames of another up axis are not its motion
+    motion = drive_motion(panels, carrier, frames=frames, path=path, settings=settings)
     times["motion"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     density = options.panel_density
