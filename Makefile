@@ -57,6 +57,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_structure.py
 	$(PY) benchmarks/panel_pin_trend.py
 	$(PY) benchmarks/bench_fabricate.py
+	$(PY) benchmarks/bench_drive.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks

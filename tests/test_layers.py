@@ -14,7 +14,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("runtime",),
     ("surfaces", "mesh", "io", "patterns"),
     ("optimize", "frame", "mechanism", "selection", "develop", "deform"),
-    ("exports", "fabricate", "structure"),
+    ("exports", "fabricate", "structure", "drive"),
     ("generate",),
     ("rundir",),
     ("reporting",),

@@ -16,6 +16,7 @@ from rigidfold.config.blas import one_blas_thread
 from rigidfold.config.checks import (
     SIDES,
     DeformationSettings,
+    DriveSettings,
     FabricateSettings,
     PathSettings,
     StructureSettings,
@@ -47,6 +48,7 @@ __all__ = [
     "SIDES",
     "DeformationSettings",
     "DesignSettings",
+    "DriveSettings",
     "FabricateSettings",
     "GenerationSettings",
     "GeometrySettings",

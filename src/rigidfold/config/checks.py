@@ -444,3 +444,131 @@ class FabricateSettings(Group):
             raise RigidfoldError(
                 f"fabricate_nest_gap_sides must be even, got {self.nest_gap_sides}"
             )
+
+
+@dataclass(frozen=True)
+class DriveSettings(Group):
+    """The drive that deploys a design under its own weight (``rigidfold deploy``,
+    :mod:`rigidfold.drive`)."""
+
+    PREFIX = "drive_"
+
+    gravity: float = setting(
+        9.80665, "Acceleration of gravity of the self-weight, m/s^2 (the standard value)."
+    )
+    max_step: float = setting(
+        math.radians(1.0),
+        "The motion is refined so that no crease turns more than this between two states, "
+        "radians (1 degree): the derivatives along it are central differences of that step.",
+    )
+    max_turn: float = setting(
+        math.radians(1.0),
+        "Where the motion comes from the design file's frames, they are refined until the "
+        "motion, a curve in the space of all vertex coordinates, turns no more than this "
+        "from one chord to the next, radians (1 degree): near a bifurcation the path bends "
+        "sharply while no hinge turns far (a 12 m x 8 m roof: 7 degrees between two states "
+        "of 1 degree of hinge turn, the torque's differences flipping sign there).",
+    )
+    refine_tol: float = setting(
+        1e-13,
+        "Every state of the motion is corrected onto the rigid-folding constraints to this "
+        "residual (edge lengths in mean edge lengths, fold angles in radians) where the "
+        "constraints are square (pseudo-arclength, ``rigidfold.drive.motion.settle``), "
+        "else to ``path_tol``: along a near flex of singular value sigma a residual r leaves "
+        "a state anywhere within r / sigma, and the energy's differences between states "
+        "wander with it (a 12 m x 8 m roof, sigma 1e-8: at ``path_tol`` the torque's sign "
+        "flipped from one state to the next; the 722-panel waterbomb within half a degree "
+        "of flat: 4 % off at 1e-7).",
+    )
+    hinge_stiffness: float = setting(
+        0.0,
+        "Rotational stiffness of every hinge, N m/rad per metre of crease (0: free), as "
+        "``structure --hinge-stiffness``.",
+    )
+    friction: float = setting(
+        0.0,
+        "Coulomb friction torque of every hinge, N m per metre of crease (0: none); it resists "
+        "the motion in both directions.",
+    )
+    hardware: float = setting(
+        0.0, "Mass of the hinge hardware, kg per metre of hinge (at the hinge's midpoint)."
+    )
+    dead_fraction: float = setting(
+        0.05,
+        "A drive is at a dead point where its rate (the driven crease's turn, a cable's "
+        "length change, per unit of s) falls below this share of its largest over the motion "
+        "(its effort there beyond 1 / this times its typical one) or changes sign; its peak "
+        "is taken away from those states.",
+    )
+    still_fraction: float = setting(
+        1e-3,
+        "A hinge (or cable) whose largest rate over the motion is below this share of the "
+        "largest of all hinges does not move: it drives nothing (no peak, ranked last).",
+    )
+    pair_candidates: int = setting(
+        30,
+        "Where the best single crease has a dead point, the pairs of creases are searched "
+        "among this many best creases of the ranking.",
+    )
+    auto_cables: int = setting(
+        3, "``--cables auto`` names this many best pairs of boundary vertices as cables."
+    )
+    auto_cable_vertices: int = setting(
+        200,
+        "``--cables auto`` tries every pair of at most this many boundary vertices (evenly "
+        "spread along the boundary where there are more): pairs cost their square.",
+    )
+    ground_tol: float = setting(
+        1e-4,
+        "A vertex is below the ground when it is more than this (m, 0.1 mm) under it.",
+    )
+    check_states: int = setting(
+        5, "States along the motion at which the independent OpenSees check runs (>= 5)."
+    )
+    check_tolerance: float = setting(
+        0.02,
+        "The OpenSees check agrees when every held crease's reaction moment is within this "
+        "share of the torque curve's peak of the torque there (2 %).",
+    )
+    check_subdivisions: int = setting(
+        1,
+        "Each triangle is divided into this squared shell elements in the OpenSees check "
+        "(the reaction of a held crease of a mechanism does not depend on the mesh).",
+    )
+    check_spread: float = setting(
+        0.25,
+        "A state of the OpenSees check decides nothing where its reaction moment changes by "
+        "more than this share of the tolerance (``drive_check_tolerance`` of the peak) when "
+        "the held crease is made ten times stiffer: the moment does not depend on that "
+        "stiffness, so the model is near singular (a near-mechanism besides the held one: "
+        "on the demo's final design, whose constraints with the crease held have singular "
+        "values of 1e-9 to 4e-9 of their largest, the two analyses gave -6 and -20, 104 and 2 "
+        "N m where the curve has -26 and -31), and the built design is softer than its rigid "
+        "motion.",
+    )
+    check_hold: float = setting(
+        1e3,
+        "The held crease of the OpenSees check is a rotational spring of this many times "
+        "the panels' plate rigidity (E t^3 / 12 (1 - nu^2)) per metre of crease and mean "
+        "edge length: the moment it carries does not depend on it (a mechanism held at one "
+        "crease), its size keeps the hinge's turn small.",
+    )
+
+    def __post_init__(self) -> None:
+        self._positive(
+            "gravity",
+            "max_step",
+            "refine_tol",
+            "check_tolerance",
+            "check_spread",
+            "check_hold",
+        )
+        self._non_negative("hinge_stiffness", "friction", "hardware", "ground_tol")
+        self._fraction("dead_fraction", "still_fraction", below_one=True)
+        self._integer(
+            pair_candidates=2,
+            auto_cables=0,
+            auto_cable_vertices=2,
+            check_states=5,
+            check_subdivisions=1,
+        )

@@ -23,6 +23,7 @@ from typing import Any
 from rigidfold.config.base import Group
 from rigidfold.config.checks import (
     DeformationSettings,
+    DriveSettings,
     FabricateSettings,
     PathSettings,
     StructureSettings,
@@ -62,6 +63,8 @@ class Settings:
     """The structure under load: panels, supports, analysis, stability."""
     fabricate: FabricateSettings = field(default_factory=FabricateSettings)
     """Thick panels: bevels, clearances, the motion check, cut sheets."""
+    drive: DriveSettings = field(default_factory=DriveSettings)
+    """The drive of the deployment: masses, hinges, dead points, the OpenSees check."""
     inputs: InputSettings = field(default_factory=InputSettings)
     """Reading SVG drawings, ``mesh:`` footprints and target meshes."""
     limits: LimitSettings = field(default_factory=LimitSettings)
