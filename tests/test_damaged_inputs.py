@@ -72,15 +72,15 @@ def test_long_multibyte_file_name(tmp_path):
 
 
 def test_ctrl_c_while_the_libraries_load(monkeypatch, capsys):
-    """Ctrl-C while rigidfold.cli and its libraries are imported exits 130 with one line."""
+    """Ctrl-C while the command line and its libraries are imported exits 130 with one line."""
 
     class Interrupt:
         def find_spec(self, name, path=None, target=None):
-            if name == "rigidfold.cli":
+            if name == "rigidfold.cli.commands":
                 raise KeyboardInterrupt
             return None
 
-    monkeypatch.delitem(sys.modules, "rigidfold.cli", raising=False)
+    monkeypatch.delitem(sys.modules, "rigidfold.cli.commands", raising=False)
     monkeypatch.setattr(sys, "meta_path", [Interrupt(), *sys.meta_path])
     assert launch.main(["--version"]) == 130
     assert capsys.readouterr().err == "rigidfold: interrupted\n"

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from rigidfold.cli.checks import fabricate_arguments, structure_arguments
 from rigidfold.cli.parser import Parser, add_options, argument_type, directory
 from rigidfold.config import DEFAULTS
+from rigidfold.drive import DriveOptions
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
 from rigidfold.flags import seed
 from rigidfold.generate import GenerateOptions
@@ -37,6 +38,8 @@ OVERWRITE_HELP = {
     "structure": "replace DIR/structure.json and DIR/structure.png of an earlier check",
     "fabricate": "replace the files of an earlier fabricate of the same design in DIR (its cut "
     "sheets included); without it they are refused",
+    "deploy": "replace DIR/deploy.json, .fold, .csv and .png of an earlier drive (refused "
+    "otherwise); other files in DIR are kept",
 }
 
 
@@ -153,6 +156,11 @@ def _fabricate(p: Parser) -> None:
     fabricate_arguments(p, generate=False)
 
 
+def _deploy(p: Parser) -> None:
+    _file(p)
+    add_options(p, DriveOptions)
+
+
 def _study(p: Parser) -> None:
     plan = STUDY_DEFAULTS
     p.add_argument(
@@ -243,6 +251,7 @@ _ARGUMENTS: dict[str, Callable[[Parser], None]] = {
     "export": _export,
     "structure": _structure,
     "fabricate": _fabricate,
+    "deploy": _deploy,
     "study": _study,
     "study-report": _study_report,
     "optimize": _optimize,

@@ -372,6 +372,21 @@ def _cmd_fabricate(args: argparse.Namespace) -> int:
     return 0 if done.ok else 1
 
 
+def _cmd_deploy(args: argparse.Namespace) -> int:
+    from rigidfold.drive import DriveOptions
+    from rigidfold.pipeline.workflows import deploy_file
+
+    options = options_of(DriveOptions, args)
+    done = deploy_file(args.file, args.out, options, up=args.up, overwrite=args.overwrite)
+    if args.json:
+        print(json.dumps(jsonable(done.to_dict())))
+    else:
+        print(f"{done.status}: {done.message}")
+        print(f"wrote {', '.join(done.written)}")
+        print(one_line(done.summary_line()))
+    return 0 if done.ok else 1
+
+
 def _cmd_study(args: argparse.Namespace) -> int:
     from rigidfold.cli.progress import StudyProgress
     from rigidfold.study import (
@@ -458,6 +473,7 @@ _COMMANDS = {
     "export": _cmd_export,
     "structure": _cmd_structure,
     "fabricate": _cmd_fabricate,
+    "deploy": _cmd_deploy,
     "study": _cmd_study,
     "study-report": _cmd_study_report,
     "optimize": _cmd_optimize,

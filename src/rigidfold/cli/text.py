@@ -111,6 +111,32 @@ COMMANDS: dict[str, dict[str, str]] = {
             "would pass), 2 on bad input."
         ),
     },
+    "deploy": {
+        "help": (
+            "the drive that deploys a DOF-1 design under its own weight: which crease, pair "
+            "or cable to drive, its torque along the motion, dead points and brake zones"
+        ),
+        "description": (
+            "Take a DOF-1 FOLD design (a solution of rigidfold generate) along its folding "
+            "motion from flat (its motion frames, or traced) under self-weight: the panels' "
+            "mass from --thickness (or the thickness fabricate recorded beside the design) and "
+            "--material, hinge springs and friction, hardware and point masses; the base panel "
+            "clamped. For every free crease as the single drive: its torque along the whole "
+            "motion by virtual work (tau = dU/drho), its dead points (the crease stops turning, "
+            "the torque is unbounded) and sign changes (the motion runs away: a brake must hold "
+            "it), ranked by peak torque; a pair of creases where the best single one has a dead "
+            "point; cables between vertices (tension, which must stay positive); where the "
+            "released structure comes to rest; whether a vertex passes below the ground. "
+            "Checked by OpenSees at five states (the driven crease held: its reaction moment "
+            "against the curve). Writes DIR/deploy.json, DIR/deploy.fold (the motion as the "
+            "builder sees it, base clamped), DIR/deploy.csv (the motor schedule) and "
+            "DIR/deploy.png. The last line names the drive, its peak and the brake zones. Exit "
+            "code 0 when a crease, pair or cable drives the whole motion within --max-torque / "
+            "--max-tension with every vertex above the ground, 1 otherwise (the files are "
+            "written all the same), 2 on bad input (a design that is not DOF 1, an index the "
+            "design lacks, a negative mass)."
+        ),
+    },
     "study": {
         "help": "many generate runs on Dask, results in SQLite (Tables 5-8), resumable",
         "description": (

@@ -32,6 +32,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.deform.check import Verification, verify
 from rigidfold.develop import DevelopStatus
+from rigidfold.drive import DriveOptions, DriveResult
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports import (
     CONVENTIONS,
@@ -620,3 +621,27 @@ def fabricate_file(
         settings=settings,
     )
     return FabricateOutput(str(path), design, fab, summary, tuple(written))
+
+
+# ------------------------------------------------------------------------------ deploy
+def deploy_file(
+    path: str | os.PathLike,
+    out: str | os.PathLike,
+    options: DriveOptions,
+    *,
+    up: str = "z",
+    overwrite: bool = False,
+    settings: Settings = DEFAULTS,
+) -> DriveResult:
+    """The drive of the deployment of the DOF-1 FOLD design ``path`` (``rigidfold deploy``)
+    as ``options`` ask (:func:`rigidfold.drive.deploy_design`), its files
+    (:data:`rigidfold.drive.DEPLOY_FILES`) written together into OUT. The files of an earlier
+    drive in OUT are refused unless ``overwrite``; they are replaced only once the new ones
+    are written (nothing is removed before), and replacing ``path`` is refused always."""
+    from rigidfold.drive import DEPLOY_FILES, deploy_design
+
+    refuse_replacing_inputs([path], [Path(out) / n for n in DEPLOY_FILES])
+    out_dir = prepare_output_dir(out)
+    if not overwrite:
+        clear_earlier_run(out_dir, overwrite=False, inputs=(Path(path),), names=DEPLOY_FILES)
+    return deploy_design(path, options, out_dir, up=up, settings=settings)
