@@ -61,6 +61,11 @@ class Material:
     def to_dict(self) -> dict:
         return {"name": self.name, "E_Pa": self.E, "nu": self.nu, "density_kg_m3": self.density}
 
+    @classmethod
+    def from_dict(cls, data: dict) -> Material:
+        """The material of :meth:`to_dict`."""
+        return cls(data["E_Pa"], data["nu"], data["density_kg_m3"], data["name"])
+
     def describe(self) -> str:
         """``plywood (E = 10 GPa, nu = 0.3, 700 kg/m^3)``."""
         return f"{self.name} (E = {self.E / 1e9:g} GPa, nu = {self.nu:g}, {self.density:g} kg/m^3)"

@@ -54,6 +54,13 @@ def _generate(p: Parser) -> None:
     fabricate_arguments(p, generate=True)
     structure_arguments(p, generate=True)
     p.add_argument(
+        "--deploy",
+        action="store_true",
+        help="the final design's deployment drive as rigidfold deploy finds it with its "
+        "defaults (the panels of --thickness and --material): DIR/final/deploy/; the run "
+        "falls short when no crease, pair or cable drives the whole motion",
+    )
+    p.add_argument(
         "--quiet", action="store_true", help="no progress bar (the result lines are printed)"
     )
     p.add_argument(

@@ -104,6 +104,7 @@ def _counters(summary: dict, stop_reason: str) -> str:
 
 def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.cli.progress import GenerateProgress
+    from rigidfold.drive import DriveOptions
     from rigidfold.pipeline import RunWriter
     from rigidfold.pipeline.workflows import generate_case
 
@@ -115,6 +116,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         material=args.material,
         fabricate=fabricate_options(args),
         structure=structure if args.structure else None,
+        drive=DriveOptions() if args.deploy else None,
     )
     writer = RunWriter(args.out, _case(args), options, overwrite=args.overwrite)
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
@@ -156,7 +158,7 @@ def _interrupted(writer, progress) -> int:
 def _print_generated(args: argparse.Namespace, writer, run) -> int:
     """Print what a finished ``generate`` run wrote and its verdict; its exit code."""
     from rigidfold.pipeline import RunOutcome
-    from rigidfold.pipeline.built import STRUCTURE_DIR, THICK_DIR
+    from rigidfold.pipeline.built import DRIVE_DIR, STRUCTURE_DIR, THICK_DIR
     from rigidfold.rundir.layout import FINAL_DIR, REPORT_FILE
 
     print(_counters(run.to_dict(), run.stop_reason))
@@ -179,6 +181,8 @@ def _print_generated(args: argparse.Namespace, writer, run) -> int:
                 f"{writer.structure.status}: {writer.structure.message}"
             )
         )
+    if writer.drive is not None:
+        print(one_line(f"deployment ({writer.out / DRIVE_DIR}): {writer.drive.summary_line()}"))
     if not args.no_report and writer.write_error is None:
         print(f"report: {writer.out / REPORT_FILE}")
     verdict = writer.verdict

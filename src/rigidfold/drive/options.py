@@ -351,3 +351,16 @@ class DriveOptions:
         data["cables"] = [list(c) for c in self.cables]
         data["point_masses"] = [[v, m] for v, m in self.point_masses]
         return data
+
+    @classmethod
+    def from_dict(cls, data: dict) -> DriveOptions:
+        """The options of :meth:`to_dict` (``density`` there is the panels', kept only where
+        it is not the material's)."""
+        given = {f.name: data[f.name] for f in fields(cls) if f.name in data}
+        material = Material.from_dict(given.pop("material"))
+        density = given.pop("density", None)
+        return cls(
+            **given,
+            material=material,
+            density=None if density == material.density else density,
+        )

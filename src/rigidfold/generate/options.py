@@ -5,8 +5,9 @@ The CLI's ``generate``, :func:`rigidfold.generate.generate`, the run writer
 it. The checks of the final design that have their own commands keep their options in those
 commands' records: the thick panels in a :class:`rigidfold.fabricate.FabricateOptions`
 (``rigidfold fabricate``), the structure in a :class:`rigidfold.structure.StructureOptions`
-(``rigidfold structure``); None: the check does not run. summary.json records them under
-``fabricate`` and ``structure``.
+(``rigidfold structure``), the deployment drive in a :class:`rigidfold.drive.DriveOptions`
+(``rigidfold deploy``); None: the check does not run. summary.json records them under
+``fabricate``, ``structure`` and ``drive``.
 
 Each field is made by :func:`rigidfold.flags.option` with what it means, which is also the
 help of its command-line flag (``rigidfold generate --target-dof``): a new option is a new
@@ -20,6 +21,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, check_seed
+from rigidfold.drive.options import DriveOptions
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import count, option, positive
@@ -107,6 +109,11 @@ class GenerateOptions:
         "panels' thickness (None: none)",
         flag=False,
     )
+    drive: DriveOptions | None = option(  # noqa: RUF009
+        None,
+        "the final design's deployment drive as rigidfold deploy takes it (None: none)",
+        flag=False,
+    )
     time_limit: float | None = option(
         None,
         "solve no further candidate after this many seconds (a candidate's path trace under "
@@ -151,6 +158,8 @@ class GenerateOptions:
             raise RigidfoldError(f"fabricate must be FabricateOptions or None, got {fab!r}")
         if st is not None and not isinstance(st, StructureOptions):
             raise RigidfoldError(f"structure must be StructureOptions or None, got {st!r}")
+        if self.drive is not None and not isinstance(self.drive, DriveOptions):
+            raise RigidfoldError(f"drive must be DriveOptions or None, got {self.drive!r}")
         if st is None:
             return
         if self.material is not None and st.material != self.material:
@@ -194,10 +203,11 @@ class GenerateOptions:
         """The options as JSON values (summary.json's ``options``): the fields, the checks'
         options as theirs (None: not run)."""
         data = {f.name: getattr(self, f.name) for f in fields(self)}
-        fab, st = data.pop("fabricate"), data.pop("structure")
+        fab, st, dr = data.pop("fabricate"), data.pop("structure"), data.pop("drive")
         return data | {
             "fabricate": None if fab is None else fab.to_dict(),
             "structure": None if st is None else st.to_dict(),
+            "drive": None if dr is None else dr.to_dict(),
         }
 
     @classmethod
@@ -206,8 +216,10 @@ class GenerateOptions:
         ignored, missing ones take their defaults."""
         given = {f.name: data[f.name] for f in fields(cls) if f.name in data}
         fab, st = given.pop("fabricate", None), given.pop("structure", None)
+        dr = given.pop("drive", None)
         return cls(
             **given,
             fabricate=None if fab is None else FabricateOptions.from_dict(fab),
             structure=None if st is None else StructureOptions.from_dict(st),
+            drive=None if dr is None else DriveOptions.from_dict(dr),
         )

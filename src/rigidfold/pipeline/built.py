@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidfold.drive import DriveResult
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication, FabricationStatus, Panels
 from rigidfold.fabricate.motion import design_motion
@@ -186,3 +187,49 @@ def structure_check(
         "files": files,
         "time_s": time.perf_counter() - t0,
     }, check
+
+
+DRIVE_DIR = Path(FINAL_DIR) / "deploy"
+"""Where ``generate --deploy`` writes the final design's drive (``rigidfold deploy``'s
+files)."""
+
+
+def deployment_drive(
+    run_dir: Path,
+    name: str,
+    options: GenerateOptions,
+    *,
+    frames: tuple[np.ndarray, np.ndarray] | None = None,
+    path: FoldingPath | None = None,
+) -> tuple[dict, DriveResult]:
+    """The drive of the final design's deployment (``options.drive``, its panels of the
+    run's ``--thickness`` and ``--material`` unless it gives its own), along the motion the
+    run traced (``frames``: (frames (K, V, 3), fraction (K,))) or its folding ``path``:
+    :func:`rigidfold.drive.deploy_design` on ``solutions/NAME.fold``, its files in
+    ``run_dir/final/deploy/``. Returns (the record's figures, the result)."""
+    from rigidfold.drive import deploy_design
+    from rigidfold.material import parse_material
+
+    drive = options.drive
+    assert drive is not None
+    if drive.thickness is None and options.panel_thickness is not None:
+        drive = drive.replace(
+            thickness=options.panel_thickness, thickness_from="the run's --thickness"
+        )
+    if options.material is not None:
+        drive = drive.replace(material=parse_material(options.material))
+    t0 = time.perf_counter()
+    design = run_dir / "solutions" / f"{name}.fold"
+    result = deploy_design(
+        design, drive, run_dir / DRIVE_DIR, frames=frames, path=path, recorded_in=()
+    )
+    data = result.to_dict()
+    figures = {
+        "status": result.status.value,
+        "message": result.summary_line(),
+        "drive": data["drive"],
+        "base_panel": data["base_panel"],
+        "files": [str(Path(p).relative_to(run_dir)) for p in result.written],
+        "seconds": time.perf_counter() - t0,
+    }
+    return figures, result

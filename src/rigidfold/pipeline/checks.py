@@ -22,12 +22,13 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.deform import MotionStatus, Verification, verify
+from rigidfold.drive import DriveResult
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import GenerateOptions, Solution
 from rigidfold.generate.case import Case
 from rigidfold.material import parse_material
-from rigidfold.pipeline.built import structure_check, thick_panels
+from rigidfold.pipeline.built import deployment_drive, structure_check, thick_panels
 from rigidfold.rundir.schema import NOT_DEVELOPED, FitStatus, SolutionRecord
 from rigidfold.structure import StructureCheck
 
@@ -60,14 +61,15 @@ class Checked:
 class Built:
     """The final design as built (:func:`check_final`).
 
-    record : its record with the ``fabrication`` and ``structure`` figures (None where not
-    asked); fabrication, structure : the results themselves, None where not asked or where
-    the check could not run (its figures then say why, status "error").
+    record : its record with the ``fabrication``, ``structure`` and ``drive`` figures (None
+    where not asked); fabrication, structure, drive : the results themselves, None where not
+    asked or where the check could not run (its figures then say why, status "error").
     """
 
     record: SolutionRecord
     fabrication: Fabrication | None = None
     structure: StructureCheck | None = None
+    drive: DriveResult | None = None
 
 
 def traced_motion(check: Verification) -> tuple[np.ndarray, np.ndarray] | None:
@@ -164,7 +166,8 @@ def check_final(
     """The final design (``solution``, ``checked`` by :func:`check_solution`) as built, as
     ``options`` ask: its thick panels (``options.fabricate``, over the motion it was traced
     along, or its folding path) into ``run_dir/final/thick/`` and its structure
-    (``options.structure``) into ``run_dir/final/structure/``, files named after ``name``
+    (``options.structure``) into ``run_dir/final/structure/`` and its deployment drive
+    (``options.drive``) into ``run_dir/final/deploy/``, files named after ``name``
     (its solution file's stem). A check that cannot run on this design (RigidfoldError) is
     a failed stage with its message: the run still ends with its verdict, summary.json and
     report."""
@@ -190,7 +193,16 @@ def check_final(
         except RigidfoldError as exc:
             figures = _not_checked("the structure", exc)
         record = replace(record, structure=figures)
-    return Built(record, fab, st)
+    drive = None
+    if options.drive is not None:
+        try:
+            figures, drive = deployment_drive(
+                run_dir, name, options, frames=checked.motion, path=solution.path
+            )
+        except RigidfoldError as exc:
+            figures = _not_checked("the deployment drive", exc)
+        record = replace(record, drive=figures)
+    return Built(record, fab, st, drive)
 
 
 def _not_checked(what: str, exc: Exception) -> dict:

@@ -490,7 +490,7 @@ def report_run(directory: str | os.PathLike) -> RunReport:
     t0 = time.perf_counter()
     run = load_run(directory)
     figures = render_figures(run)
-    view = None if run.final is None else view_figure(run.final, run.surface)
+    view = None if run.final is None else view_figure(run.final, run.surface, run.driven_creases())
     thick, note = run.thick_panels()
     solids = None if thick is None or run.final is None else thick_figure(thick, run.final)
     text = page(run, figures, view, solids, note)

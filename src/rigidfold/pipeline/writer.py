@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.deform import Verification
+from rigidfold.drive import DriveResult
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports import export_design
 from rigidfold.fabricate import Fabrication
@@ -236,6 +237,7 @@ class RunWriter:
         self.exports: list[Path] = []
         self.fabrication: Fabrication | None = None
         self.structure: StructureCheck | None = None
+        self.drive: DriveResult | None = None
         self.log = AttemptLog(self.out / LOG_FILE)
         self.summary_written = -float("inf")  # time.monotonic() of the last summary.json
 
@@ -424,12 +426,14 @@ class RunWriter:
                     self._keep(final.step, checked)
             checked = self.checked[final.step]
             self.final = (final.result.pattern, checked.coords2d)
-            if self.options.fabricate is not None or self.options.structure is not None:
+            o = self.options
+            if o.fabricate is not None or o.structure is not None or o.drive is not None:
                 name = self.files[final.step].stem
                 with kept_interrupts():  # trimesh's code catches BaseException
                     built = check_final(checked, final, self.options, self.out, name)
                 self.records[final.step] = built.record
                 self.fabrication, self.structure = built.fabrication, built.structure
+                self.drive = built.drive
         self.verdict = run_verdict(
             run,
             self.records,

@@ -82,6 +82,7 @@ def page(
         *_view(run, view),
         *_thick(run, thick, thick_note),
         *_structure(run),
+        *_drive(run),
         '<h2 id="figures">Figures</h2>',
         *(_figure(f) for f in figures),
         '<h2 id="tables">Tables</h2>',
@@ -279,6 +280,33 @@ def _thick(run: RunData, view: dict | None, note: str) -> list[str]:
         else "The folding motion was not traced: the solids are shown in the design."
     )
     return [*out, div, f"<p class='sub'>{_e(motion)} Of every pair, {_e(what)}.</p>"]
+
+
+def _drive(run: RunData) -> list[str]:
+    """The deployment drive's section (``generate --deploy``), [] where it did not run."""
+    record = run.final_record
+    f = None if record is None else record.drive
+    if f is None:
+        return []
+    out = [
+        '<h2 id="drive">Deployment drive</h2>',
+        f"<p>{_e(str(f.get('message') or ''))}</p>",
+        "<p>The final design deployed from flat under its own weight by one actuator: the "
+        "drive's torque along the motion (s from 0, flat, to 1, built), its dead points and "
+        "the zones where a brake must hold it; the driven crease is drawn in orange in the 3D "
+        "view. <code>final/deploy/deploy.json</code> holds every figure, "
+        "<code>deploy.csv</code> the motor schedule.</p>",
+    ]
+    png = run.drive_figure()
+    if png is not None:
+        data = base64.b64encode(png).decode("ascii")
+        out.append(
+            '<figure id="deploy.png"><img alt="drive torque along the deployment" '
+            f'src="data:image/png;base64,{data}"><figcaption><b>Deployment drive.</b> The '
+            "torque of the named drive against s, dead points, sign changes and brake zones "
+            "marked; the energy (<code>final/deploy/deploy.png</code>).</figcaption></figure>"
+        )
+    return out
 
 
 def _structure(run: RunData) -> list[str]:

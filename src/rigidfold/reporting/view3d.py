@@ -57,19 +57,29 @@ def _lines(coords: np.ndarray, edges: np.ndarray) -> tuple[list, list, list]:
     return x, y, z
 
 
-def _shape_traces(coords: np.ndarray, design: SolutionFile, kinds: np.ndarray) -> list[dict]:
-    """The moving traces at ``coords``: the mesh, then one line trace per crease kind."""
+def _shape_traces(
+    coords: np.ndarray, design: SolutionFile, kinds: np.ndarray, driven: tuple[int, ...] = ()
+) -> list[dict]:
+    """The moving traces at ``coords``: the mesh, then one line trace per crease kind, then
+    the driven creases' (edge indices ``driven``) where there are any."""
     x, y, z = np.round(coords, 5).T
     traces = [{"type": "mesh3d", "x": x.tolist(), "y": y.tolist(), "z": z.tolist()}]
     for letter in KINDS:
         lx, ly, lz = _lines(coords, design.edges[kinds == letter])
         traces.append({"type": "scatter3d", "x": lx, "y": ly, "z": lz})
+    if driven:
+        lx, ly, lz = _lines(coords, design.edges[list(driven)])
+        traces.append({"type": "scatter3d", "x": lx, "y": ly, "z": lz})
     return traces
 
 
-def view_figure(design: SolutionFile, surface: TargetSurface | None) -> dict:
+def view_figure(
+    design: SolutionFile, surface: TargetSurface | None, driven: tuple[int, ...] = ()
+) -> dict:
     """The plotly figure dict of ``design`` (see the module's text); without ``surface`` the
-    mesh is coloured by height and no overlay is drawn."""
+    mesh is coloured by height and no overlay is drawn. ``driven``: the edges of the
+    deployment drive's creases (``generate --deploy``), drawn thick in orange."""
+    driven = tuple(e for e in driven if 0 <= e < len(design.edges))
     kinds = np.asarray(design.assignment)
     coords = design.coords
     if surface is not None:
@@ -81,7 +91,7 @@ def view_figure(design: SolutionFile, surface: TargetSurface | None) -> dict:
         colour = coords[:, 2]
         scale = {"colorscale": "Viridis"}
         title = "z (m)"
-    traces = _shape_traces(coords, design, kinds)
+    traces = _shape_traces(coords, design, kinds, driven)
     traces[0].update(
         i=design.faces[:, 0].tolist(),
         j=design.faces[:, 1].tolist(),
@@ -95,7 +105,8 @@ def view_figure(design: SolutionFile, surface: TargetSurface | None) -> dict:
         hovertemplate="x %{x:.3f} m<br>y %{y:.3f} m<br>z %{z:.3f} m<extra></extra>",
         **scale,
     )
-    for trace, (label, line, width, style) in zip(traces[1:], KINDS.values(), strict=True):
+    kinds_traces = traces[1 : 1 + len(KINDS)]
+    for trace, (label, line, width, style) in zip(kinds_traces, KINDS.values(), strict=True):
         trace.update(
             mode="lines",
             name=label,
@@ -106,12 +117,19 @@ def view_figure(design: SolutionFile, surface: TargetSurface | None) -> dict:
             },
             hoverinfo="skip",
         )
+    if driven:
+        traces[-1].update(
+            mode="lines",
+            name="driven crease",
+            line={"color": "#ff7f0e", "width": 9},
+            hoverinfo="skip",
+        )
     moving = list(range(len(traces)))
     placed = best_fit(design.motion, coords) if len(design.motion) > 1 else design.motion[:0]
     frames = [
         {
             "name": f"{100 * share:.0f}%",
-            "data": _shape_traces(shape, design, kinds),
+            "data": _shape_traces(shape, design, kinds, driven),
             "traces": moving,
         }
         for shape, share in zip(placed, design.fraction, strict=True)

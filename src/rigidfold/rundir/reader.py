@@ -312,6 +312,30 @@ class RunData:
         except OSError:
             return None
 
+    def drive_figure(self) -> bytes | None:
+        """The PNG of the final design's deployment drive (``final/deploy/deploy.png``,
+        ``generate --deploy``), None when it did not run or its file is missing."""
+        record = self.final_record
+        figures = None if record is None else record.drive
+        files = [] if figures is None else (figures.get("files") or [])
+        name = next((f for f in files if isinstance(f, str) and f.endswith(".png")), None)
+        path = None if name is None else self.run_file(name)
+        if path is None:
+            return None
+        try:
+            return path.read_bytes()
+        except OSError:
+            return None
+
+    def driven_creases(self) -> tuple[int, ...]:
+        """The edges (of the final design's FOLD file) of its named drive, () without one or
+        where the drive is a cable."""
+        record = self.final_record
+        drive = ((record.drive or {}).get("drive") or {}) if record is not None else {}
+        if drive.get("kind") not in ("crease", "pair"):
+            return ()
+        return tuple(int(e) for e in drive.get("edges") or () if isinstance(e, int))
+
     def checks(self) -> list[Check]:
         """Development (Step 8), folding motion and large deformation (Step 9) over every
         solution, and every other :class:`~rigidfold.rundir.Stage` where it ran (the thick

@@ -25,6 +25,7 @@ import numpy as np
 
 from rigidfold.deform import DeformStatus, MotionStatus, Verification
 from rigidfold.develop import DevelopStatus
+from rigidfold.drive import DriveStatus
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
 from rigidfold.generate import Attempt, Generation, Stop
@@ -32,11 +33,12 @@ from rigidfold.outcomes import Outcome
 from rigidfold.rundir.json_shapes import Nullable, Record, check_shape, received, shape_of
 from rigidfold.structure import StructureStatus
 
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 """The version of the files of a run directory this rigidfold writes and reads: summary.json's
-``schema_version`` and the header line of log.jsonl (``{"schema_version": 3}``; 2: a
+``schema_version`` and the header line of log.jsonl (``{"schema_version": 4}``; 2: a
 solution's ``fit`` has its ``status``; 3: a solution's ``development`` may be
-:data:`NOT_COMPUTED`, the diagram drawn for the final design only). A run of another
+:data:`NOT_COMPUTED`, the diagram drawn for the final design only; 4: a solution's ``drive``,
+``generate --deploy``). A run of another
 version (0: written before rigidfold recorded one) is refused (:func:`check_version`), not
 read through layers of old formats."""
 
@@ -168,6 +170,15 @@ SUMMARY_SHAPE = Record(
                             }
                         )
                     ),
+                    "drive": Nullable(
+                        Record(
+                            {
+                                "status": Nullable(str),
+                                "message": Nullable(str),
+                                "files": Nullable([str]),
+                            }
+                        )
+                    ),
                 }
             )
         ],
@@ -261,6 +272,7 @@ class Stage(Outcome):
         "thick panels collide, are trimmed away or cannot be checked over the motion",
     )
     STRUCTURE = "structure", "the structure check failed"
+    DRIVE = "drive", "no single crease, pair or cable drives the deployment within the limits"
     FIT = "fit", "the design lies farther from the target surface than dz allows"
 
 
@@ -294,6 +306,7 @@ STAGES: dict[Stage, StageRule] = {
     Stage.DEFORMATION: StageRule(DeformStatus.REACHED_PLANE, "large deformation"),
     Stage.FABRICATION: StageRule(FabricationStatus.COLLISION_FREE, "thick panels", True),
     Stage.STRUCTURE: StageRule(StructureStatus.PASSED, "structure", True),
+    Stage.DRIVE: StageRule(DriveStatus.DRIVEN, "deployment drive", True),
     Stage.FIT: StageRule(FitStatus.WITHIN, "fit to the target", True),
 }
 """Every :class:`Stage`'s rule: the one place that says when a check of a solution passes."""
@@ -322,6 +335,7 @@ class SolutionRecord:
     deployability: dict | None = None
     fabrication: dict | None = None
     structure: dict | None = None
+    drive: dict | None = None
 
     @classmethod
     def from_check(
