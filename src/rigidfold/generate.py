@@ -183,9 +183,13 @@ class _Steps:
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
-        (with the deployability check), analyse the mechanism, classify, trace the path."""
+        (with the deployability check), analyse the mechanism, classify, trace the path.
+        With a time limit the solve ends at the run's deadline, the initial solve (``start``
+        None: without it the run has no design) at :attr:`final_deadline`."""
         opts, settings = self.options, self.settings
-        result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver)
+        deadline = self.deadline if start is not None else self.final_deadline
+        result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
+        cut = deadline is not None and start is not None and time.monotonic() > deadline
         if opts.deploy_check:
             result = self.problem.polish(result)
         t1 = time.perf_counter()
@@ -196,6 +200,8 @@ class _Steps:
         )
         t_an = time.perf_counter() - t1
         outcome = _classify(mech, self.zero_ends)
+        if mech is None and cut:  # the time limit ended the solve: no verdict
+            outcome = AttemptOutcome.TIME_LIMIT
         path, t_path, second = None, 0.0, None
         if (
             outcome is AttemptOutcome.ACCEPTED
@@ -211,9 +217,10 @@ class _Steps:
                 settings=settings,
                 deadline=self.deadline,
             )
-            if not path.deploys:
+            if path.cut:  # the time limit ended the trace: no verdict on the candidate
+                outcome = AttemptOutcome.TIME_LIMIT
+            elif not path.deploys:
                 outcome = AttemptOutcome.PATH
-                # a trace cut by the time limit: the run ends, the second-order test is moot
                 second = None if self.out_of_time() else self.obstruction(result.pattern, mech.dof)
                 if second is not None and second.rigid:
                     outcome = AttemptOutcome.RIGID
@@ -276,9 +283,20 @@ class _Steps:
     @property
     def deadline(self) -> float | None:
         """The end of the run's time limit (``GenerateOptions.time_limit``), a time of
-        ``time.monotonic()``; None without a limit. A candidate's path trace ends there."""
+        ``time.monotonic()``; None without a limit. The solve under way and a candidate's
+        path trace end there."""
         limit = self.options.time_limit
         return None if limit is None else self.started + limit
+
+    @property
+    def final_deadline(self) -> float | None:
+        """The end of naming the final design after the time limit T: T + max(
+        ``time_limit_grace_min``, ``time_limit_grace`` T) (None without a limit)."""
+        limit = self.options.time_limit
+        if limit is None:
+            return None
+        g = self.settings.generation
+        return self.started + limit + max(g.time_limit_grace_min, g.time_limit_grace * limit)
 
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
@@ -367,6 +385,9 @@ class _Steps:
         next on failure, until one is accepted (None) or the run ends (its Stop). At a shape
         reduced before (backtracking returned to it), the candidates not yet tried."""
         if not self.shapes or self.shapes[-1].solution is not current:
+            if self.out_of_time():  # no ranking of a shape that no solve will reduce
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
             ranked, order, forecast, t_sel = self.rank(current)
             self.shapes.append(_Shape(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
@@ -392,6 +413,9 @@ class _Steps:
                 return None
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
+            if rec.outcome is AttemptOutcome.TIME_LIMIT:
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
             rigid = rec.outcome is AttemptOutcome.RIGID
             rejected = rigid or rec.outcome is AttemptOutcome.PATH
             shape.undeployable += rejected
@@ -570,7 +594,13 @@ def generate(
             or steps.restart(stop, after_backtracking=True)
         ):
             steps.settle(stop)
-            _deployable_final(run, opts, case.settings, bisect=stop is Stop.TIME_LIMIT)
+            _deployable_final(
+                run,
+                opts,
+                case.settings,
+                bisect=stop is Stop.TIME_LIMIT,
+                deadline=steps.final_deadline,
+            )
             break
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
@@ -642,7 +672,12 @@ def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
 
 
 def _deployable_final(
-    run: Generation, options: GenerateOptions, settings: Settings, *, bisect: bool
+    run: Generation,
+    options: GenerateOptions,
+    settings: Settings,
+    *,
+    bisect: bool,
+    deadline: float | None = None,
 ) -> None:
     """With the deployability check, a run that ends short of its target names as its final
     design the lowest-DOF solution whose folding path reaches the flat state (tracing the
@@ -654,18 +689,30 @@ def _deployable_final(
     and none of whose probed successors' does. Where the chain's paths deploy down to some
     DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
     the lowest-DOF solution that deploys, as the scan finds it.
+
+    ``deadline`` (of ``time.monotonic()``: the run's time limit and its grace): every trace
+    ends there (a trace it cuts counts as not deploying and is not kept), and none starts
+    after it; their seconds are ``Generation.final_path_time`` (``time_s.path``).
     """
     if not options.deploy_check:
         return
 
     def deploys(solution: Solution) -> bool:
         if solution.path is None:
-            solution.path = trace_path(
+            if deadline is not None and time.monotonic() > deadline:
+                return False
+            t0 = time.perf_counter()
+            path = trace_path(
                 solution.result.pattern,
                 dof=solution.mechanism.dof,
                 support_face=options.support_face,
                 settings=settings,
+                deadline=deadline,
             )
+            run.final_path_time += time.perf_counter() - t0
+            if path.cut:
+                return False
+            solution.path = path
         return solution.path.deploys
 
     chain = run.solutions

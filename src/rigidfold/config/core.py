@@ -156,6 +156,16 @@ class GenerationSettings(Group):
         "flat state (N_path, N_rigid) after which the first chain is given up and the run "
         "starts again with the first fold limit (``deploy_max_candidates`` after that).",
     )
+    time_limit_grace: float = setting(
+        0.025,
+        "With a time limit T (``--time-limit``): naming the final design of a run stopped by "
+        "it (the path traces of its chain's bisection, each with this deadline) ends by T + "
+        "max(``time_limit_grace_min``, this times T). Half of the overrun a run may have "
+        "(max(10 s, 5 % of T)); the checks and exports of the final design have the rest.",
+    )
+    time_limit_grace_min: float = setting(
+        5.0, "Seconds: the least of the grace after a time limit (``time_limit_grace``)."
+    )
     summary_interval: float = setting(
         2.0,
         "Seconds between writes of a run's summary.json after attempts that are rejected "
@@ -178,7 +188,7 @@ class GenerationSettings(Group):
             raise RigidfoldError(
                 f"restart_after must be a whole number >= 1, got {self.restart_after!r}"
             )
-        self._non_negative("summary_interval")
+        self._non_negative("summary_interval", "time_limit_grace", "time_limit_grace_min")
 
 
 @dataclass(frozen=True)

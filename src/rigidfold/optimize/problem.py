@@ -198,11 +198,17 @@ class FormFindingProblem:
         return self._solvers[name]
 
     def solve(
-        self, fixed=None, start: np.ndarray | None = None, solver: str = "ipopt"
+        self,
+        fixed=None,
+        start: np.ndarray | None = None,
+        solver: str = "ipopt",
+        deadline: float | None = None,
     ) -> OptimizeResult:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
         ``solver`` is one of ``SOLVERS``; the result's ``wall_time`` is that of the solve alone.
+        ``deadline``: a time of ``time.monotonic()`` (a run's time limit) at which the solve
+        ends at its iterate (judged as any other: accepted only at F <= F_tol).
         A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
         failed: the result is the start, Status.FAILED, its message saying why.
         """
@@ -212,7 +218,7 @@ class FormFindingProblem:
         w = mask.astype(float)
         t0 = time.perf_counter()
         with one_blas_thread():  # which zero of F is reached depends on round-off
-            run = backend.solve(xi0, w)
+            run = backend.solve(xi0, w) if deadline is None else backend.solve(xi0, w, deadline)
         wall = time.perf_counter() - t0
         xi = run.xi
         coords = self.map.expand(xi)
