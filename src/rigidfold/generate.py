@@ -124,6 +124,8 @@ class _Shape:
     failed: int = 0
     rigid_in_row: int = 0
     t_sel: float = 0.0
+    spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
+    fallback: bool = False  # the last candidate was forecast to lock or to be rigid
 
 
 @dataclass
@@ -180,6 +182,9 @@ class _Steps:
             if (bounded := with_fold_limit(case, options, limit)) is not case
         ]
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
+        # the fixes whose solutions were retracted, by the step of the shape they reduced:
+        # not tried again where a restart's kept shape is ranked anew
+        self.dead: dict[int, set[tuple[int, ...]]] = {}
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
@@ -403,10 +408,14 @@ class _Steps:
                 return Stop.NO_CANDIDATE
             group, score = ranked[choice.index]
             fix = (*group, *choice.carried.tolist())
+            if fix in self.dead.get(current.step, ()):  # retracted before: a dead end
+                continue
             trial_fixed = current.result.pattern.fixed.copy()
             trial_fixed[list(fix)] = True
             rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
             rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            shape.spent += _attempt_time(rec)
+            shape.fallback = choice.put_off  # every candidate forecast to deploy was tried
             self.annotate(rec, choice, shape, current)
             self.record(rec, trial)
             if self.is_solution(rec):
@@ -424,7 +433,8 @@ class _Steps:
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             budget = limit = self.settings.generation.deploy_max_candidates
             bounded = self.fold_limit is not None  # a solve that fails costs its iterations
-            if self.restarts and not bounded:  # the first chain: give up sooner
+            if self.restarts and not bounded and not self.worth_more(shape):
+                # the first chain: give up sooner
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
@@ -440,6 +450,15 @@ class _Steps:
             ):
                 self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
+
+    def worth_more(self, shape: _Shape) -> bool:
+        """Whether the first chain keeps trying candidates at ``shape`` past
+        ``restart_after`` rejected paths instead of restarting: while its next candidates
+        are still forecast to deploy (the last one tried was not put off by the look-ahead
+        or the second-order forecast) and what its candidates have cost so far is less than
+        re-solving the chain to this shape (the seconds of its accepted attempts)."""
+        chain = sum(_attempt_time(rec) for rec in self.accepted[1:])
+        return not shape.fallback and shape.spent < chain
 
     def spent(self) -> bool:
         """Whether the chain, bounded and with a further fold limit, has had as many
@@ -464,6 +483,8 @@ class _Steps:
             return False
         self.keep_deepest(stop)
         self.shapes.pop()
+        parent = len(run.solutions) - 2
+        self.dead.setdefault(parent, set()).add(tuple(self.accepted[-1].fixed_added))
         self.retract()
         self.backtracks += 1
         run.stop_detail = ""
@@ -493,13 +514,15 @@ class _Steps:
             not self.restarts
             or not (after_backtracking or self.fold_limit is None or self.spent())
             or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
-            or len(run.solutions) < 2
         ):
             return False
         self.keep_deepest(stop)
-        self.retract(keep=1)
+        limit, case = self.restarts.pop(0)
+        keep = _within(run.solutions, limit)
+        self.retract(keep=keep)
+        self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
         self.shapes.clear()
-        self.fold_limit, case = self.restarts.pop(0)
+        self.fold_limit = limit
         t0 = time.perf_counter()
         self.problem = case.problem(build_ipopt=self.options.solver == "ipopt")
         run.build_time += time.perf_counter() - t0
@@ -653,6 +676,26 @@ def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterato
         else:
             yield Choice(k)
     yield from rigid
+
+
+def _attempt_time(rec: Attempt) -> float:
+    """Seconds of one attempt: its selection, solve, analysis and trace."""
+    return rec.selection_time + rec.solve_time + rec.analysis_time + rec.path_time
+
+
+def _within(solutions: list[Solution], limit: float) -> int:
+    """How many solutions of a chain a restart at the fold limit ``limit`` (radians) keeps:
+    those before the first whose free creases are not all within it (they solve problem (6)
+    with bound (12) too), but not the chain's last (its candidates failed), and at least
+    the initial shape."""
+    keep = 1
+    for k, solution in enumerate(solutions[1:-1], start=1):
+        shape = solution.result.pattern
+        free = ~shape.fixed & ~shape.is_boundary_edge
+        if np.abs(shape.fold_angles[free]).max(initial=0.0) > limit:
+            break
+        keep = k + 1
+    return keep
 
 
 def _dof(solutions: list[Solution]) -> int:
