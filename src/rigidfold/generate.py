@@ -166,6 +166,15 @@ class _Steps:
         )
         # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
         # over-reduction, retried like a lock (as with zero_dof_ends=False)
+        # the DOF the search counts (Settings.mechanism.dof_count): with "gap", the analysis
+        # counts the singular values below dof_gap times rank_tol (near-mechanisms are DOF)
+        self.count = _dof_count(self.settings, options)
+        m = self.settings.mechanism
+        self.asettings = (
+            self.settings.with_(mechanism_rank_tol=m.rank_tol * m.dof_gap)
+            if self.count == "gap"
+            else self.settings
+        )
         self.zero_ends = (
             self.settings.generation.zero_dof_ends and not options.deploy_check
         ) or options.target_dof == 0
@@ -199,7 +208,7 @@ class _Steps:
             result = self.problem.polish(result)
         t1 = time.perf_counter()
         mech = (
-            analyze(result.pattern, support_face=opts.support_face, settings=settings)
+            analyze(result.pattern, support_face=opts.support_face, settings=self.asettings)
             if result.converged
             else None
         )
@@ -340,14 +349,14 @@ class _Steps:
         K = hinge_stiffness(
             current.mechanism.frame.n_hinges, int(self.rng.integers(2**32)), settings
         )
-        scores = score_creases(current.mechanism, K=K, settings=settings)
+        scores = score_creases(current.mechanism, K=K, settings=self.asettings)
         ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
         forecast = self.child_forecast(current)
         order: Iterator[Choice] = (
             lookahead_order(
                 current.mechanism,
                 [g for g, _ in ranked],
-                settings=settings,
+                settings=self.asettings,
                 dof0_ends=self.zero_ends,
                 locked_before=self.locked_before,
                 rigid=None if forecast is None else forecast.rigid,
@@ -380,7 +389,7 @@ class _Steps:
             ]
         if rec.locked:
             rec.locked_predicted, rec.locked_left = _explain_lock(
-                rec, current.mechanism, self.settings
+                rec, current.mechanism, self.asettings
             )
             if self.options.lookahead and not len(choice.carried):
                 self.locked_before[group] = rec.locked
@@ -630,7 +639,13 @@ def generate(
     final = run.final
     if final is not None:
         pattern = final.result.pattern
-        run.dof_margin = dof_margin(pattern, steps.support_face(pattern), case.settings).to_dict()
+        run.dof_margin = dof_margin(
+            pattern,
+            steps.support_face(pattern),
+            case.settings,
+            count=steps.count,
+            counted=final.mechanism.dof,
+        ).to_dict()
     return run
 
 
@@ -676,6 +691,15 @@ def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterato
         else:
             yield Choice(k)
     yield from rigid
+
+
+def _dof_count(settings: Settings, options: GenerateOptions) -> str:
+    """The DOF count of a run (``Settings.mechanism.dof_count``): "auto" is "gap" with the
+    deployability check, the paper's "threshold" without it (the paper's Step 5)."""
+    count = settings.mechanism.dof_count
+    if count == "auto":
+        return "gap" if options.deploy_check else "threshold"
+    return count
 
 
 def _attempt_time(rec: Attempt) -> float:

@@ -10,6 +10,8 @@ from rigidfold.config.base import Group, setting
 from rigidfold.errors import RigidfoldError
 
 HESSIANS = ("closed-form", "casadi")
+DOF_COUNTS = ("auto", "gap", "threshold")
+"""How generation counts a shape's DOF (``MechanismSettings.dof_count``)."""
 """The Hessians of the Lagrangian IPOPT can use (``SolverSettings.ipopt_hessian``)."""
 
 
@@ -350,6 +352,17 @@ class MechanismSettings(Group):
         "second_order`) factorises the constraint matrix densely (one SVD of about 3V x 3V): "
         "above this many vertices it is not made (the failed path stays in N_path).",
     )
+    dof_count: str = setting(
+        "auto",
+        "How generation counts a shape's DOF. \"threshold\": the paper's, the singular values "
+        'of the constraints below ``mechanism_rank_tol`` times the largest. "gap": those '
+        "below ``dof_gap`` times that (1e-6 of the largest by default): a near-mechanism "
+        "within the gap of the threshold is a mechanism of the built design (its stiffness "
+        "goes with sigma^2 times the panels' bar stiffness: below 1e-12 of it, far below what "
+        "a panel's weight asks; docs/deployability.md), so it is counted as a DOF and the "
+        'search goes on until the DOF has a clear gap. "auto": "gap" with the '
+        "deployability check, the paper's \"threshold\" with the paper's Step 5 (the study).",
+    )
     dof_gap: float = setting(
         1e3,
         "The DOF of a design is *clear* when the smallest singular value counted as non-zero "
@@ -360,6 +373,7 @@ class MechanismSettings(Group):
     )
 
     def __post_init__(self) -> None:
+        self._choice("dof_count", DOF_COUNTS)
         if not 0 < self.sparse_shift < 1:
             raise RigidfoldError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
         self._integer(sparse_analysis_vertices=3, sparse_oversampling=2, sparse_iterations=1)
