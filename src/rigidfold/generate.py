@@ -81,6 +81,7 @@ from rigidfold.selection import (
     rank_candidates,
     score_creases,
 )
+from rigidfold.selection.batch import compatible_set
 
 __all__ = [
     "STOP_REASONS",
@@ -125,6 +126,7 @@ class _Shape:
     rigid_in_row: int = 0
     t_sel: float = 0.0
     spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
+    batched: bool = False  # a set of several creases was tried here (GenerateOptions.batch)
     fallback: bool = False  # the last candidate was forecast to lock or to be rigid
 
 
@@ -175,6 +177,8 @@ class _Steps:
             if self.count == "gap"
             else self.settings
         )
+        self.batch = options.batch == "on" or (options.batch == "auto" and options.deploy_check)
+        self.batch_size = self.settings.generation.batch_first  # the next set's size
         self.zero_ends = (
             self.settings.generation.zero_dof_ends and not options.deploy_check
         ) or options.target_dof == 0
@@ -205,7 +209,7 @@ class _Steps:
         result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
         cut = deadline is not None and start is not None and time.monotonic() > deadline
         if opts.deploy_check:
-            result = self.problem.polish(result)
+            result = self.problem.polish(result, deadline)
         t1 = time.perf_counter()
         mech = (
             analyze(result.pattern, support_face=opts.support_face, settings=self.asettings)
@@ -406,6 +410,11 @@ class _Steps:
             self.shapes.append(_Shape(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
+        if self.batch and not shape.batched:
+            shape.batched = True
+            done = self.fix_set(current, shape)
+            if done is not False:
+                return None if done is True else done
         while True:
             if self.out_of_time():
                 self.run.stop_detail = f"{self.options.time_limit:g}"
@@ -459,6 +468,54 @@ class _Steps:
             ):
                 self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
+
+    def fix_set(self, current: Solution, shape: _Shape) -> Stop | bool:
+        """Several creases in one solve (``GenerateOptions.batch``; :mod:`rigidfold.selection.
+        batch`): at a shape more than ``batch_single_dof`` DOF above the target, the largest
+        compatible set of its ranked candidates, of at most the next set's size and never
+        taking the DOF within ``batch_single_dof`` of the target, is solved; on failure, half
+        of it, down to two candidates. Returns True when a set gave a solution (the next set
+        may be twice as large), the run's Stop (the time limit), or False (the shape goes on
+        one crease at a time)."""
+        g = self.settings.generation
+        dof = current.mechanism.dof
+        room = dof - max(self.options.target_dof, 1) - g.batch_single_dof
+        size = min(self.batch_size, g.batch_max, room)
+        if size < 2:
+            return False
+        t1 = time.perf_counter()
+        groups = [tuple(map(int, grp)) for grp, _ in shape.ranked]
+        chosen = compatible_set(
+            current.mechanism,
+            groups,
+            size,
+            settings=self.asettings,
+            skip=lambda k: groups[k] in self.locked_before,
+        )
+        shape.t_sel += time.perf_counter() - t1
+        while len(chosen) >= 2:
+            if self.out_of_time():
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
+            fix = tuple(e for k in chosen for e in groups[k])
+            trial_fixed = current.result.pattern.fixed.copy()
+            trial_fixed[list(fix)] = True
+            rec, trial = self.solve(
+                trial_fixed, current.result.coords, fix, shape.ranked[chosen[0]][1]
+            )
+            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            rec.batch = len(chosen)
+            shape.spent += _attempt_time(rec)
+            self.record(rec, trial)
+            if self.is_solution(rec):
+                self.batch_size = min(2 * len(chosen), g.batch_max)
+                return True
+            if rec.outcome is AttemptOutcome.TIME_LIMIT:
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
+            chosen = chosen[: len(chosen) // 2]
+            self.batch_size = max(2, len(chosen))
+        return False
 
     def worth_more(self, shape: _Shape) -> bool:
         """Whether the first chain keeps trying candidates at ``shape`` past

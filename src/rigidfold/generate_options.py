@@ -28,6 +28,9 @@ from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
 from rigidfold.structure.material import parse_material
 
+BATCH_CHOICES = ("auto", "on", "off")
+"""``GenerateOptions.batch``: several creases per solve (auto: with the deployability check)."""
+
 
 @dataclass(frozen=True)
 class GenerateOptions:
@@ -107,6 +110,15 @@ class GenerateOptions:
         "panels' thickness (None: none)",
         flag=False,
     )
+    batch: str = option(
+        "off",
+        "several creases per solve: from the ranked candidates, the largest set whose fixes "
+        "are independent and lock no crease at first order (rigidfold.selection.batch), "
+        "halved on failure; one crease per solve near the target DOF. off = the paper's one "
+        "crease per solve (the default and the study's, until the broad benchmark of issue 49 "
+        "has judged it); auto = on with the deployability check, off without it",
+        choices=BATCH_CHOICES,
+    )
     time_limit: float | None = option(
         None,
         "solve no further candidate after this many seconds (a candidate's path trace under "
@@ -122,7 +134,12 @@ class GenerateOptions:
 
     def _check_run(self) -> None:
         """Validate the options of Steps 2-9."""
-        for name, choices in (("criterion", CRITERIA), ("solver", SOLVERS), ("check", CHECKS)):
+        for name, choices in (
+            ("criterion", CRITERIA),
+            ("solver", SOLVERS),
+            ("check", CHECKS),
+            ("batch", BATCH_CHOICES),
+        ):
             value = getattr(self, name)
             if value not in choices:
                 raise RigidfoldError(f"unknown {name} {value!r} (choose from {', '.join(choices)})")

@@ -137,6 +137,10 @@ class Attempt:
         The bound (12) the solve kept every free crease within, degrees: that of the chain
         started again after the one before dead-ended (``Settings.generation.fold_limits``,
         the restarts of :mod:`rigidfold.generate`); None in the first chain.
+    batch : int
+        With several creases per solve (``GenerateOptions.batch``): the number of ranked
+        candidates fixed together in this solve (``fixed_added`` holds their creases);
+        0 for a solve of one candidate.
     """
 
     index: int
@@ -163,6 +167,7 @@ class Attempt:
     second_order: dict | None = None
     rigid_forecast: bool | None = None
     fold_limit_deg: float | None = None
+    batch: int = 0
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""

@@ -158,6 +158,30 @@ class GenerationSettings(Group):
         "flat state (N_path, N_rigid) after which the first chain is given up and the run "
         "starts again with the first fold limit (``deploy_max_candidates`` after that).",
     )
+    batch_first: int = setting(
+        8,
+        "With several creases per solve (``GenerateOptions.batch``): the size of the first "
+        "set of creases fixed together; a set that solves doubles the next one (up to "
+        "``batch_max``), one that fails is tried again with half of its creases, down to two, "
+        "then the shape goes on one crease at a time.",
+    )
+    batch_max: int = setting(
+        32, "With ``GenerateOptions.batch``: the most creases fixed together in one solve."
+    )
+    batch_single_dof: int = setting(
+        10,
+        "With ``GenerateOptions.batch``: within this many DOF of the target (and wherever the "
+        "deployability check or the second-order forecast applies) one crease is fixed per "
+        "solve, as in the paper; a set never takes a shape closer to the target.",
+    )
+    batch_tol: float = setting(
+        1e-3,
+        "With ``GenerateOptions.batch``: a candidate joins the set when each of its creases' "
+        "rotation rows (restricted to the shape's mechanisms) keeps at least this share of "
+        "its norm outside the span of the set's rows, and every folded free crease outside "
+        "the set keeps at least this share of its own rotations (no first-order lock; "
+        ":mod:`rigidfold.selection.batch`).",
+    )
     time_limit_grace: float = setting(
         0.025,
         "With a time limit T (``--time-limit``): naming the final design of a run stopped by "
@@ -190,7 +214,13 @@ class GenerationSettings(Group):
             raise RigidfoldError(
                 f"restart_after must be a whole number >= 1, got {self.restart_after!r}"
             )
-        self._non_negative("summary_interval", "time_limit_grace", "time_limit_grace_min")
+        self._non_negative(
+            "summary_interval", "time_limit_grace", "time_limit_grace_min", "batch_tol"
+        )
+        for name in ("batch_first", "batch_max", "batch_single_dof"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+                raise RigidfoldError(f"{name} must be a whole number >= 1, got {value!r}")
 
 
 @dataclass(frozen=True)

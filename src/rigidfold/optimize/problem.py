@@ -250,7 +250,7 @@ class FormFindingProblem:
         )
 
     # ------------------------------------------------------------------ polish
-    def polish(self, result: OptimizeResult) -> OptimizeResult:
+    def polish(self, result: OptimizeResult, deadline: float | None = None) -> OptimizeResult:
         """An accepted ``result`` projected onto F = 0 to ``Settings.solver.polish_tol``
         (:class:`rigidfold.optimize.projection.Projection`, every constraint of (6) kept).
 
@@ -259,7 +259,8 @@ class FormFindingProblem:
         path passes the flat state at a distance of about the square root of the defects. The
         projection moves the vertices by about that defect times the edge length. Returns
         ``result`` itself when it was not accepted, or the projection does not lower F or
-        meets a singular factor.
+        meets a singular factor. ``deadline`` (of ``time.monotonic()``): the projection
+        stops there, with what it reached.
         """
         if result.status is not Status.CONVERGED:
             return result
@@ -270,7 +271,10 @@ class FormFindingProblem:
         try:
             with one_blas_thread():
                 run = self._projection(
-                    self.start_point(result.coords), w, tol=self.settings.solver.polish_tol
+                    self.start_point(result.coords),
+                    w,
+                    tol=self.settings.solver.polish_tol,
+                    deadline=deadline,
                 )
         except RuntimeError:  # a singular factor (redundant rows at F ~ 0): keep the result
             return result
