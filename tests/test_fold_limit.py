@@ -150,3 +150,104 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
     assert run.final_dof == run.lowest_dof > 1  # the first chain, taken back again
     accepted = [a for a in run.attempts if a.outcome is AttemptOutcome.ACCEPTED]
     assert len(accepted) == len(run.solutions) and all(a.fold_limit_deg is None for a in accepted)
+
+
+def _first_turn_back(monkeypatch, count: int, then: PathStatus | None = None) -> list:
+    """The first ``count`` traced paths are made to turn back, the later ones to end as
+    ``then`` (None: as traced); returns the traces."""
+    real = generation.trace_path
+    calls: list = []
+
+    def turn_back(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        calls.append(path)
+        if len(calls) <= count:
+            return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
+        return path if then is None else dataclasses.replace(path, status=then)
+
+    monkeypatch.setattr(generation, "trace_path", turn_back)
+    return calls
+
+
+def test_the_ladder_goes_on_whatever_the_bounded_chain_accepted(monkeypatch):
+    """Issue 49, item 4: a bounded chain that accepts no solution at all (every bounded
+    solve fails) still hands over to the next fold limit; each limit is tried in turn."""
+    _first_turn_back(monkeypatch, 1)
+    real_solve = generation._Steps.solve
+
+    def bounded_solves_fail(self, *args):
+        rec, trial = real_solve(self, *args)
+        if self.fold_limit is not None:
+            rec.outcome = AttemptOutcome.EXCEED
+        return rec, trial
+
+    monkeypatch.setattr(generation._Steps, "solve", bounded_solves_fail)
+    limits = (60.0, 40.0)
+    settings = DEFAULTS.with_(
+        restart_after=1,
+        deploy_max_candidates=2,
+        fold_limits=tuple(math.radians(a) for a in limits),
+    )
+    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+    run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
+    tried = {a.fold_limit_deg for a in run.attempts if a.fold_limit_deg is not None}
+    assert sorted(round(t) for t in tried) == sorted(limits)
+    assert run.final_dof == run.lowest_dof  # the first chain, the lowest, is the run's
+
+
+def test_a_restart_keeps_the_solutions_within_its_bound(monkeypatch):
+    """A restart at a fold limit keeps the chain's solutions before the first one with a
+    free crease beyond the limit (they solve (6) under bound (12) too), never the last (its
+    candidates failed); a limit below the first solution's folds keeps the initial shape
+    only."""
+    for limit_deg in (179.0, 20.0):
+        _first_turn_back(monkeypatch, 1)
+        monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+        settings = DEFAULTS.with_(
+            restart_after=1, deploy_max_candidates=3, fold_limits=(math.radians(limit_deg),)
+        )
+        case = make_case("bezier", "1", seed=1, settings=settings)
+        taken: list[int] = []
+        run = generate(
+            case,
+            criterion="s",
+            seed=1,
+            lookahead=True,
+            deform=False,
+            on_retract=lambda _run, t: taken.append(len(t)),  # noqa: B023
+        )
+        first = [a for a in run.attempts if a.fold_limit_deg is None]
+        chain = [a for a in first if a.outcome.value in ("accepted", "dead_end")]
+        assert len(chain) > 2
+        assert taken, "the first chain was restarted"
+        kept = len(chain) - taken[0]
+        if limit_deg > 90:  # every free crease of pattern 1 stays far below it
+            assert taken[0] == 1 and kept == len(chain) - 1
+        else:
+            assert kept == 1  # the initial shape
+
+
+def test_the_first_chain_is_not_given_up_while_trying_is_cheaper(monkeypatch):
+    """Past ``restart_after`` rejected paths, the first chain keeps trying the candidates of
+    its shape forecast to deploy while they have cost less than re-solving the chain (here
+    every attempt costs 1: the chain's solutions cost more than three candidates), and a
+    candidate that deploys (here the fourth, made to) ends the run without a restart; where
+    re-solving costs nothing, it restarts after ``restart_after``."""
+    settings = DEFAULTS.with_(
+        restart_after=1, second_order=False, fold_limits=(math.radians(60.0),)
+    )
+    case = make_case("bezier", "1", seed=1, settings=settings)
+    _first_turn_back(monkeypatch, 3, then=PathStatus.FLAT)
+    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 1.0)
+    run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
+    assert all(a.fold_limit_deg is None for a in run.attempts)
+    assert sum(a.outcome is AttemptOutcome.PATH for a in run.attempts) >= 3
+    assert run.stop is Stop.TARGET_REACHED and run.final.path.deploys
+    _first_turn_back(monkeypatch, 3, then=PathStatus.FLAT)
+    monkeypatch.setattr(
+        generation,
+        "_attempt_time",
+        lambda rec: 0.0 if rec.outcome is AttemptOutcome.ACCEPTED else 1.0,
+    )
+    run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
+    assert any(a.fold_limit_deg is not None for a in run.attempts)

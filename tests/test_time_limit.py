@@ -7,6 +7,7 @@ import json
 import pytest
 
 from rigidfold.cli.commands import main
+from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop, generate
 from rigidfold.generate.case import make_case
@@ -75,11 +76,10 @@ def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatc
 
     def deploys_down_to_15(pattern, *, dof, **_):
         traced.append(dof)
-        return SimpleNamespace(deploys=dof >= 15)
+        return SimpleNamespace(deploys=dof >= 15, cut=False)
 
-    solves = iter(range(10**6))
     monkeypatch.setattr(generation, "trace_path", deploys_down_to_15)
-    monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: next(solves) >= 12)
+    monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 12)
     options = GenerateOptions(deform=False, time_limit=3600.0)
     run = generate(make_case("bezier", "1", seed=1), options)
     assert run.stop is Stop.TIME_LIMIT
@@ -131,3 +131,125 @@ def test_the_candidates_paths_are_traced_to_the_runs_deadline(monkeypatch):
     seen.clear()
     generate(case, GenerateOptions(deform=False, deploy_check=True, target_dof=18))
     assert seen and all(d is None for d in seen)
+
+
+@pytest.mark.parametrize(
+    ("solver", "settings"),
+    [
+        ("ipopt", {}),
+        ("ipopt", {"projection_vertices": 10}),  # the composite: projection, IPOPT, projection
+        ("slsqp", {}),
+    ],
+)
+def test_a_solve_past_its_deadline_ends_at_its_iterate(solver, settings):
+    """Issue 49, item 3: the solve under way gets the run's remaining time. A deadline that
+    has passed ends it at once, as an iteration limit (not accepted: the start is no zero of
+    F); one far off changes nothing."""
+    import time
+
+    from rigidfold.config import DEFAULTS
+    from rigidfold.optimize import Status
+
+    case = make_case("dome", "grid:5x5", size="3x3", settings=DEFAULTS.with_(**settings))
+    problem = case.problem(build_ipopt=solver == "ipopt")
+    plain = problem.solve(solver=solver)
+    assert plain.status is Status.CONVERGED
+    far = problem.solve(solver=solver, deadline=time.monotonic() + 3600.0)
+    assert far.status is plain.status and far.iterations == plain.iterations and far.F == plain.F
+    cut = problem.solve(solver=solver, deadline=time.monotonic() - 1.0)
+    assert cut.status is Status.ITERATION_LIMIT
+    assert cut.iterations < plain.iterations
+    again = problem.solve(solver=solver)  # the deadline was that solve's only
+    assert again.status is Status.CONVERGED and again.iterations == plain.iterations
+
+
+def test_a_solve_cut_by_the_time_limit_is_no_rejected_candidate(monkeypatch):
+    """A candidate's solve that the time limit ends is recorded as ``time_limit``, not in
+    N_exceed, and the run stops at the limit with its last solution."""
+    import time
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.generate import AttemptOutcome
+
+    def passed_after_three(self):
+        return time.monotonic() - 1.0 if len(self.run.attempts) >= 3 else None
+
+    monkeypatch.setattr(generation._Steps, "deadline", property(passed_after_three))
+    monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 3)
+    options = GenerateOptions(deform=False, time_limit=3600.0)
+    run = generate(make_case("bezier", "1", seed=1), options)
+    assert run.stop is Stop.TIME_LIMIT
+    last = run.attempts[-1]
+    assert last.outcome is AttemptOutcome.TIME_LIMIT and last.iterations <= 1
+    assert run.n_exceed == 0 and run.n_path == 0
+    assert len(run.solutions) == 3 and run.to_dict()["n_solves"] == 4
+
+
+def test_a_trace_cut_by_the_time_limit_is_no_rejected_path(monkeypatch):
+    """A candidate whose path trace the time limit ends has no verdict: outcome
+    ``time_limit``, not N_path, and the run stops there; a cut trace is never kept as a
+    solution's path."""
+    import time
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.generate import AttemptOutcome
+
+    real = generation.trace_path
+
+    def cut(pattern, **kw):
+        return real(pattern, **(kw | {"deadline": time.monotonic() - 1.0}))
+
+    monkeypatch.setattr(generation, "trace_path", cut)
+    options = GenerateOptions(deform=False, time_limit=3600.0)
+    run = generate(make_case("bezier", "1", seed=1), options)
+    assert run.stop is Stop.TIME_LIMIT
+    assert run.attempts[-1].outcome is AttemptOutcome.TIME_LIMIT
+    assert run.attempts[-1].path is not None and run.attempts[-1].path["cut"]
+    assert run.n_path == 0 and run.n_rigid == 0
+    assert all(s.path is None or not s.path.cut for s in run.solutions)
+
+
+def test_the_traces_naming_the_final_design_have_a_deadline_and_are_counted(monkeypatch):
+    """After the limit T, the bisection's traces end by T + max(time_limit_grace_min,
+    time_limit_grace T), and their seconds are in time_s.path."""
+    import time
+
+    import rigidfold.generate.steps as generation
+
+    seen: list = []
+    real = generation.trace_path
+
+    def slow(pattern, **kw):
+        seen.append(kw.get("deadline"))
+        time.sleep(0.01)
+        return real(pattern, **kw)
+
+    monkeypatch.setattr(generation, "trace_path", slow)
+    monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 6)
+    t0 = time.monotonic()
+    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False, time_limit=100))
+    assert run.stop is Stop.TIME_LIMIT and seen
+    g = DEFAULTS.generation
+    grace = max(g.time_limit_grace_min, g.time_limit_grace * 100)
+    assert all(d is not None and t0 + 100 + grace - 1 < d < t0 + 100 + grace + 1 for d in seen)
+    assert run.final_path_time >= 0.01 * len(seen)
+    assert run.to_dict()["time_s"]["path"] >= run.final_path_time
+
+
+def test_a_time_limited_run_ends_within_its_grace():
+    """Issue 49, item 3: a run of a pattern that needs far longer than its limit T returns
+    by T + max(time_limit_grace_min, time_limit_grace T) (what it may take after the last
+    solve's deadline: the analysis of one shape and the margin of the final design, here
+    given a few seconds more on a shared machine)."""
+    import time
+
+    t0 = time.monotonic()
+    run = generate(
+        make_case("dome", "grid:15x15", size="3x3"),
+        GenerateOptions(deform=False, criterion="s", lookahead=True),
+        time_limit=2.0,
+    )
+    wall = time.monotonic() - t0
+    assert run.stop is Stop.TIME_LIMIT
+    g = DEFAULTS.generation
+    assert wall < 2.0 + max(g.time_limit_grace_min, 2.0 * g.time_limit_grace) + 3.0

@@ -10,6 +10,8 @@ from rigidfold.config.base import Group, setting
 from rigidfold.errors import RigidfoldError
 
 HESSIANS = ("closed-form", "casadi")
+DOF_COUNTS = ("auto", "gap", "threshold")
+"""How generation counts a shape's DOF (``MechanismSettings.dof_count``)."""
 """The Hessians of the Lagrangian IPOPT can use (``SolverSettings.ipopt_hessian``)."""
 
 
@@ -156,6 +158,40 @@ class GenerationSettings(Group):
         "flat state (N_path, N_rigid) after which the first chain is given up and the run "
         "starts again with the first fold limit (``deploy_max_candidates`` after that).",
     )
+    batch_first: int = setting(
+        8,
+        "With several creases per solve (``GenerateOptions.batch``): the size of the first "
+        "set of creases fixed together; a set that solves doubles the next one (up to "
+        "``batch_max``), one that fails is tried again with half of its creases, down to two, "
+        "then the shape goes on one crease at a time.",
+    )
+    batch_max: int = setting(
+        32, "With ``GenerateOptions.batch``: the most creases fixed together in one solve."
+    )
+    batch_single_dof: int = setting(
+        10,
+        "With ``GenerateOptions.batch``: within this many DOF of the target (and wherever the "
+        "deployability check or the second-order forecast applies) one crease is fixed per "
+        "solve, as in the paper; a set never takes a shape closer to the target.",
+    )
+    batch_tol: float = setting(
+        1e-3,
+        "With ``GenerateOptions.batch``: a candidate joins the set when each of its creases' "
+        "rotation rows (restricted to the shape's mechanisms) keeps at least this share of "
+        "its norm outside the span of the set's rows, and every folded free crease outside "
+        "the set keeps at least this share of its own rotations (no first-order lock; "
+        ":mod:`rigidfold.selection.batch`).",
+    )
+    time_limit_grace: float = setting(
+        0.025,
+        "With a time limit T (``--time-limit``): naming the final design of a run stopped by "
+        "it (the path traces of its chain's bisection, each with this deadline) ends by T + "
+        "max(``time_limit_grace_min``, this times T). Half of the overrun a run may have "
+        "(max(10 s, 5 % of T)); the checks and exports of the final design have the rest.",
+    )
+    time_limit_grace_min: float = setting(
+        5.0, "Seconds: the least of the grace after a time limit (``time_limit_grace``)."
+    )
     summary_interval: float = setting(
         2.0,
         "Seconds between writes of a run's summary.json after attempts that are rejected "
@@ -178,7 +214,13 @@ class GenerationSettings(Group):
             raise RigidfoldError(
                 f"restart_after must be a whole number >= 1, got {self.restart_after!r}"
             )
-        self._non_negative("summary_interval")
+        self._non_negative(
+            "summary_interval", "time_limit_grace", "time_limit_grace_min", "batch_tol"
+        )
+        for name in ("batch_first", "batch_max", "batch_single_dof"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+                raise RigidfoldError(f"{name} must be a whole number >= 1, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -340,6 +382,17 @@ class MechanismSettings(Group):
         "second_order`) factorises the constraint matrix densely (one SVD of about 3V x 3V): "
         "above this many vertices it is not made (the failed path stays in N_path).",
     )
+    dof_count: str = setting(
+        "auto",
+        "How generation counts a shape's DOF. \"threshold\": the paper's, the singular values "
+        'of the constraints below ``mechanism_rank_tol`` times the largest. "gap": those '
+        "below ``dof_gap`` times that (1e-6 of the largest by default): a near-mechanism "
+        "within the gap of the threshold is a mechanism of the built design (its stiffness "
+        "goes with sigma^2 times the panels' bar stiffness: below 1e-12 of it, far below what "
+        "a panel's weight asks; docs/deployability.md), so it is counted as a DOF and the "
+        'search goes on until the DOF has a clear gap. "auto": "gap" with the '
+        "deployability check, the paper's \"threshold\" with the paper's Step 5 (the study).",
+    )
     dof_gap: float = setting(
         1e3,
         "The DOF of a design is *clear* when the smallest singular value counted as non-zero "
@@ -350,6 +403,7 @@ class MechanismSettings(Group):
     )
 
     def __post_init__(self) -> None:
+        self._choice("dof_count", DOF_COUNTS)
         if not 0 < self.sparse_shift < 1:
             raise RigidfoldError(f"sparse_shift must lie in (0, 1), got {self.sparse_shift!r}")
         self._integer(sparse_analysis_vertices=3, sparse_oversampling=2, sparse_iterations=1)

@@ -30,6 +30,9 @@ from rigidfold.optimize import SOLVERS
 from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
 
+BATCH_CHOICES = ("auto", "on", "off")
+"""``GenerateOptions.batch``: several creases per solve (auto: with the deployability check)."""
+
 
 @dataclass(frozen=True)
 class GenerateOptions:
@@ -114,6 +117,15 @@ class GenerateOptions:
         "the final design's deployment drive as rigidfold deploy takes it (None: none)",
         flag=False,
     )
+    batch: str = option(
+        "off",
+        "several creases per solve: from the ranked candidates, the largest set whose fixes "
+        "are independent and lock no crease at first order (rigidfold.selection.batch), "
+        "halved on failure; one crease per solve near the target DOF. off = the paper's one "
+        "crease per solve (the default and the study's, until the broad benchmark of issue 49 "
+        "has judged it); auto = on with the deployability check, off without it",
+        choices=BATCH_CHOICES,
+    )
     time_limit: float | None = option(
         None,
         "solve no further candidate after this many seconds (a candidate's path trace under "
@@ -129,7 +141,12 @@ class GenerateOptions:
 
     def _check_run(self) -> None:
         """Validate the options of Steps 2-9."""
-        for name, choices in (("criterion", CRITERIA), ("solver", SOLVERS), ("check", CHECKS)):
+        for name, choices in (
+            ("criterion", CRITERIA),
+            ("solver", SOLVERS),
+            ("check", CHECKS),
+            ("batch", BATCH_CHOICES),
+        ):
             value = getattr(self, name)
             if value not in choices:
                 raise RigidfoldError(f"unknown {name} {value!r} (choose from {', '.join(choices)})")

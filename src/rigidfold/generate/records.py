@@ -39,6 +39,11 @@ class AttemptOutcome(Outcome):
         "the shape is mobile at first order only: a self-stress holds its flexes at second "
         "order, so it cannot fold (Step 5, N_rigid)",
     )
+    TIME_LIMIT = (
+        "time_limit",
+        "the run's time limit cut the solve or its path trace short: no verdict on the "
+        "candidate (not counted in N_exceed or N_path; the run ends)",
+    )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
         "dead_end",
@@ -132,6 +137,10 @@ class Attempt:
         The bound (12) the solve kept every free crease within, degrees: that of the chain
         started again after the one before dead-ended (``Settings.generation.fold_limits``,
         the restarts of :mod:`rigidfold.generate`); None in the first chain.
+    batch : int
+        With several creases per solve (``GenerateOptions.batch``): the number of ranked
+        candidates fixed together in this solve (``fixed_added`` holds their creases);
+        0 for a solve of one candidate.
     """
 
     index: int
@@ -158,6 +167,7 @@ class Attempt:
     second_order: dict | None = None
     rigid_forecast: bool | None = None
     fold_limit_deg: float | None = None
+    batch: int = 0
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""
@@ -219,6 +229,7 @@ class Generation:
     stop_detail: str = ""
     dof_margin: dict | None = None  # rigidfold.mechanism.margin.DofMargin.to_dict()
     build_time: float = 0.0
+    final_path_time: float = 0.0  # the traces that named the final design (time_s.path)
     numerics: dict | None = None  # rigidfold.runtime.numerics.NumericEnvironment.to_dict()
 
     @property
@@ -293,6 +304,6 @@ class Generation:
                 "solve": sum(a.solve_time for a in self.attempts),
                 "analysis": sum(a.analysis_time for a in self.attempts),
                 "selection": sum(a.selection_time for a in self.attempts),
-                "path": sum(a.path_time for a in self.attempts),
+                "path": sum(a.path_time for a in self.attempts) + self.final_path_time,
             },
         }

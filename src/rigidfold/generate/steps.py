@@ -80,6 +80,7 @@ from rigidfold.selection import (
     rank_candidates,
     score_creases,
 )
+from rigidfold.selection.batch import compatible_set
 
 
 @dataclass
@@ -108,6 +109,9 @@ class _Shape:
     failed: int = 0
     rigid_in_row: int = 0
     t_sel: float = 0.0
+    spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
+    batched: bool = False  # a set of several creases was tried here (GenerateOptions.batch)
+    fallback: bool = False  # the last candidate was forecast to lock or to be rigid
 
 
 @dataclass
@@ -148,6 +152,17 @@ class _Steps:
         )
         # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
         # over-reduction, retried like a lock (as with zero_dof_ends=False)
+        # the DOF the search counts (Settings.mechanism.dof_count): with "gap", the analysis
+        # counts the singular values below dof_gap times rank_tol (near-mechanisms are DOF)
+        self.count = _dof_count(self.settings, options)
+        m = self.settings.mechanism
+        self.asettings = (
+            self.settings.with_(mechanism_rank_tol=m.rank_tol * m.dof_gap)
+            if self.count == "gap"
+            else self.settings
+        )
+        self.batch = options.batch == "on" or (options.batch == "auto" and options.deploy_check)
+        self.batch_size = self.settings.generation.batch_first  # the next set's size
         self.zero_ends = (
             self.settings.generation.zero_dof_ends and not options.deploy_check
         ) or options.target_dof == 0
@@ -164,22 +179,31 @@ class _Steps:
             if (bounded := with_fold_limit(case, options, limit)) is not case
         ]
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
+        # the fixes whose solutions were retracted, by the step of the shape they reduced:
+        # not tried again where a restart's kept shape is ranked anew
+        self.dead: dict[int, set[tuple[int, ...]]] = {}
 
     def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
-        (with the deployability check), analyse the mechanism, classify, trace the path."""
+        (with the deployability check), analyse the mechanism, classify, trace the path.
+        With a time limit the solve ends at the run's deadline, the initial solve (``start``
+        None: without it the run has no design) at :attr:`final_deadline`."""
         opts, settings = self.options, self.settings
-        result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver)
+        deadline = self.deadline if start is not None else self.final_deadline
+        result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
+        cut = deadline is not None and start is not None and time.monotonic() > deadline
         if opts.deploy_check:
-            result = self.problem.polish(result)
+            result = self.problem.polish(result, deadline)
         t1 = time.perf_counter()
         mech = (
-            analyze(result.pattern, support_face=opts.support_face, settings=settings)
+            analyze(result.pattern, support_face=opts.support_face, settings=self.asettings)
             if result.converged
             else None
         )
         t_an = time.perf_counter() - t1
         outcome = _classify(mech, self.zero_ends)
+        if mech is None and cut:  # the time limit ended the solve: no verdict
+            outcome = AttemptOutcome.TIME_LIMIT
         path, t_path, second = None, 0.0, None
         if (
             outcome is AttemptOutcome.ACCEPTED
@@ -195,9 +219,10 @@ class _Steps:
                 settings=settings,
                 deadline=self.deadline,
             )
-            if not path.deploys:
+            if path.cut:  # the time limit ended the trace: no verdict on the candidate
+                outcome = AttemptOutcome.TIME_LIMIT
+            elif not path.deploys:
                 outcome = AttemptOutcome.PATH
-                # a trace cut by the time limit: the run ends, the second-order test is moot
                 second = None if self.out_of_time() else self.obstruction(result.pattern, mech.dof)
                 if second is not None and second.rigid:
                     outcome = AttemptOutcome.RIGID
@@ -260,9 +285,20 @@ class _Steps:
     @property
     def deadline(self) -> float | None:
         """The end of the run's time limit (``GenerateOptions.time_limit``), a time of
-        ``time.monotonic()``; None without a limit. A candidate's path trace ends there."""
+        ``time.monotonic()``; None without a limit. The solve under way and a candidate's
+        path trace end there."""
         limit = self.options.time_limit
         return None if limit is None else self.started + limit
+
+    @property
+    def final_deadline(self) -> float | None:
+        """The end of naming the final design after the time limit T: T + max(
+        ``time_limit_grace_min``, ``time_limit_grace`` T) (None without a limit)."""
+        limit = self.options.time_limit
+        if limit is None:
+            return None
+        g = self.settings.generation
+        return self.started + limit + max(g.time_limit_grace_min, g.time_limit_grace * limit)
 
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
@@ -301,14 +337,14 @@ class _Steps:
         K = hinge_stiffness(
             current.mechanism.frame.n_hinges, int(self.rng.integers(2**32)), settings
         )
-        scores = score_creases(current.mechanism, K=K, settings=settings)
+        scores = score_creases(current.mechanism, K=K, settings=self.asettings)
         ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
         forecast = self.child_forecast(current)
         order: Iterator[Choice] = (
             lookahead_order(
                 current.mechanism,
                 [g for g, _ in ranked],
-                settings=settings,
+                settings=self.asettings,
                 dof0_ends=self.zero_ends,
                 locked_before=self.locked_before,
                 rigid=None if forecast is None else forecast.rigid,
@@ -341,7 +377,7 @@ class _Steps:
             ]
         if rec.locked:
             rec.locked_predicted, rec.locked_left = _explain_lock(
-                rec, current.mechanism, self.settings
+                rec, current.mechanism, self.asettings
             )
             if self.options.lookahead and not len(choice.carried):
                 self.locked_before[group] = rec.locked
@@ -351,10 +387,18 @@ class _Steps:
         next on failure, until one is accepted (None) or the run ends (its Stop). At a shape
         reduced before (backtracking returned to it), the candidates not yet tried."""
         if not self.shapes or self.shapes[-1].solution is not current:
+            if self.out_of_time():  # no ranking of a shape that no solve will reduce
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
             ranked, order, forecast, t_sel = self.rank(current)
             self.shapes.append(_Shape(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
+        if self.batch and not shape.batched:
+            shape.batched = True
+            done = self.fix_set(current, shape)
+            if done is not False:
+                return None if done is True else done
         while True:
             if self.out_of_time():
                 self.run.stop_detail = f"{self.options.time_limit:g}"
@@ -366,16 +410,23 @@ class _Steps:
                 return Stop.NO_CANDIDATE
             group, score = ranked[choice.index]
             fix = (*group, *choice.carried.tolist())
+            if fix in self.dead.get(current.step, ()):  # retracted before: a dead end
+                continue
             trial_fixed = current.result.pattern.fixed.copy()
             trial_fixed[list(fix)] = True
             rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
             rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            shape.spent += _attempt_time(rec)
+            shape.fallback = choice.put_off  # every candidate forecast to deploy was tried
             self.annotate(rec, choice, shape, current)
             self.record(rec, trial)
             if self.is_solution(rec):
                 return None
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
+            if rec.outcome is AttemptOutcome.TIME_LIMIT:
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
             rigid = rec.outcome is AttemptOutcome.RIGID
             rejected = rigid or rec.outcome is AttemptOutcome.PATH
             shape.undeployable += rejected
@@ -384,7 +435,8 @@ class _Steps:
             shape.rigid_in_row = shape.rigid_in_row + 1 if rigid else 0
             budget = limit = self.settings.generation.deploy_max_candidates
             bounded = self.fold_limit is not None  # a solve that fails costs its iterations
-            if self.restarts and not bounded:  # the first chain: give up sooner
+            if self.restarts and not bounded and not self.worth_more(shape):
+                # the first chain: give up sooner
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             confirm = self.settings.generation.rigid_confirmations
@@ -400,6 +452,63 @@ class _Steps:
             ):
                 self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
+
+    def fix_set(self, current: Solution, shape: _Shape) -> Stop | bool:
+        """Several creases in one solve (``GenerateOptions.batch``; :mod:`rigidfold.selection.
+        batch`): at a shape more than ``batch_single_dof`` DOF above the target, the largest
+        compatible set of its ranked candidates, of at most the next set's size and never
+        taking the DOF within ``batch_single_dof`` of the target, is solved; on failure, half
+        of it, down to two candidates. Returns True when a set gave a solution (the next set
+        may be twice as large), the run's Stop (the time limit), or False (the shape goes on
+        one crease at a time)."""
+        g = self.settings.generation
+        dof = current.mechanism.dof
+        room = dof - max(self.options.target_dof, 1) - g.batch_single_dof
+        size = min(self.batch_size, g.batch_max, room)
+        if size < 2:
+            return False
+        t1 = time.perf_counter()
+        groups = [tuple(map(int, grp)) for grp, _ in shape.ranked]
+        chosen = compatible_set(
+            current.mechanism,
+            groups,
+            size,
+            settings=self.asettings,
+            skip=lambda k: groups[k] in self.locked_before,
+        )
+        shape.t_sel += time.perf_counter() - t1
+        while len(chosen) >= 2:
+            if self.out_of_time():
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
+            fix = tuple(e for k in chosen for e in groups[k])
+            trial_fixed = current.result.pattern.fixed.copy()
+            trial_fixed[list(fix)] = True
+            rec, trial = self.solve(
+                trial_fixed, current.result.coords, fix, shape.ranked[chosen[0]][1]
+            )
+            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            rec.batch = len(chosen)
+            shape.spent += _attempt_time(rec)
+            self.record(rec, trial)
+            if self.is_solution(rec):
+                self.batch_size = min(2 * len(chosen), g.batch_max)
+                return True
+            if rec.outcome is AttemptOutcome.TIME_LIMIT:
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
+            chosen = chosen[: len(chosen) // 2]
+            self.batch_size = max(2, len(chosen))
+        return False
+
+    def worth_more(self, shape: _Shape) -> bool:
+        """Whether the first chain keeps trying candidates at ``shape`` past
+        ``restart_after`` rejected paths instead of restarting: while its next candidates
+        are still forecast to deploy (the last one tried was not put off by the look-ahead
+        or the second-order forecast) and what its candidates have cost so far is less than
+        re-solving the chain to this shape (the seconds of its accepted attempts)."""
+        chain = sum(_attempt_time(rec) for rec in self.accepted[1:])
+        return not shape.fallback and shape.spent < chain
 
     def spent(self) -> bool:
         """Whether the chain, bounded and with a further fold limit, has had as many
@@ -424,6 +533,8 @@ class _Steps:
             return False
         self.keep_deepest(stop)
         self.shapes.pop()
+        parent = len(run.solutions) - 2
+        self.dead.setdefault(parent, set()).add(tuple(self.accepted[-1].fixed_added))
         self.retract()
         self.backtracks += 1
         run.stop_detail = ""
@@ -453,13 +564,15 @@ class _Steps:
             not self.restarts
             or not (after_backtracking or self.fold_limit is None or self.spent())
             or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
-            or len(run.solutions) < 2
         ):
             return False
         self.keep_deepest(stop)
-        self.retract(keep=1)
+        limit, case = self.restarts.pop(0)
+        keep = _within(run.solutions, limit)
+        self.retract(keep=keep)
+        self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
         self.shapes.clear()
-        self.fold_limit, case = self.restarts.pop(0)
+        self.fold_limit = limit
         t0 = time.perf_counter()
         self.problem = case.problem(build_ipopt=self.options.solver == "ipopt")
         run.build_time += time.perf_counter() - t0
@@ -554,14 +667,26 @@ def generate(
             or steps.restart(stop, after_backtracking=True)
         ):
             steps.settle(stop)
-            _deployable_final(run, opts, case.settings, bisect=stop is Stop.TIME_LIMIT)
+            _deployable_final(
+                run,
+                opts,
+                case.settings,
+                bisect=stop is Stop.TIME_LIMIT,
+                deadline=steps.final_deadline,
+            )
             break
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
     final = run.final
     if final is not None:
         pattern = final.result.pattern
-        run.dof_margin = dof_margin(pattern, steps.support_face(pattern), case.settings).to_dict()
+        run.dof_margin = dof_margin(
+            pattern,
+            steps.support_face(pattern),
+            case.settings,
+            count=steps.count,
+            counted=final.mechanism.dof,
+        ).to_dict()
     return run
 
 
@@ -609,6 +734,35 @@ def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterato
     yield from rigid
 
 
+def _dof_count(settings: Settings, options: GenerateOptions) -> str:
+    """The DOF count of a run (``Settings.mechanism.dof_count``): "auto" is "gap" with the
+    deployability check, the paper's "threshold" without it (the paper's Step 5)."""
+    count = settings.mechanism.dof_count
+    if count == "auto":
+        return "gap" if options.deploy_check else "threshold"
+    return count
+
+
+def _attempt_time(rec: Attempt) -> float:
+    """Seconds of one attempt: its selection, solve, analysis and trace."""
+    return rec.selection_time + rec.solve_time + rec.analysis_time + rec.path_time
+
+
+def _within(solutions: list[Solution], limit: float) -> int:
+    """How many solutions of a chain a restart at the fold limit ``limit`` (radians) keeps:
+    those before the first whose free creases are not all within it (they solve problem (6)
+    with bound (12) too), but not the chain's last (its candidates failed), and at least
+    the initial shape."""
+    keep = 1
+    for k, solution in enumerate(solutions[1:-1], start=1):
+        shape = solution.result.pattern
+        free = ~shape.fixed & ~shape.is_boundary_edge
+        if np.abs(shape.fold_angles[free]).max(initial=0.0) > limit:
+            break
+        keep = k + 1
+    return keep
+
+
 def _dof(solutions: list[Solution]) -> int:
     """The DOF of a chain's last solution."""
     return solutions[-1].mechanism.dof
@@ -626,7 +780,12 @@ def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
 
 
 def _deployable_final(
-    run: Generation, options: GenerateOptions, settings: Settings, *, bisect: bool
+    run: Generation,
+    options: GenerateOptions,
+    settings: Settings,
+    *,
+    bisect: bool,
+    deadline: float | None = None,
 ) -> None:
     """With the deployability check, a run that ends short of its target names as its final
     design the lowest-DOF solution whose folding path reaches the flat state (tracing the
@@ -638,18 +797,30 @@ def _deployable_final(
     and none of whose probed successors' does. Where the chain's paths deploy down to some
     DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
     the lowest-DOF solution that deploys, as the scan finds it.
+
+    ``deadline`` (of ``time.monotonic()``: the run's time limit and its grace): every trace
+    ends there (a trace it cuts counts as not deploying and is not kept), and none starts
+    after it; their seconds are ``Generation.final_path_time`` (``time_s.path``).
     """
     if not options.deploy_check:
         return
 
     def deploys(solution: Solution) -> bool:
         if solution.path is None:
-            solution.path = trace_path(
+            if deadline is not None and time.monotonic() > deadline:
+                return False
+            t0 = time.perf_counter()
+            path = trace_path(
                 solution.result.pattern,
                 dof=solution.mechanism.dof,
                 support_face=options.support_face,
                 settings=settings,
+                deadline=deadline,
             )
+            run.final_path_time += time.perf_counter() - t0
+            if path.cut:
+                return False
+            solution.path = path
         return solution.path.deploys
 
     chain = run.solutions

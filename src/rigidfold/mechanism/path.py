@@ -116,6 +116,8 @@ class FoldingPath:
         (``Settings.path.escape_tol``: singular and bifurcation points)
     dropped_rows : redundant constraint rows dropped where the projection continuation of a
         1-DOF shape stalled (``Settings.path.reduce``; 0: none)
+    cut : the trace was ended by its ``deadline`` (status ``max_steps``): it says nothing
+        of the shape, only that the time ran out
     """
 
     points: np.ndarray
@@ -134,6 +136,7 @@ class FoldingPath:
     max_length_error: float
     escapes: int = 0
     dropped_rows: int = 0
+    cut: bool = False
 
     @property
     def deploys(self) -> bool:
@@ -207,6 +210,7 @@ class FoldingPath:
             "bifurcations": len(self.bifurcations),
             "max_length_error": self.max_length_error,
             "escapes": self.escapes,
+            "cut": self.cut,
         }
 
 
@@ -225,6 +229,7 @@ class _Trace:
     factorizations: int = 0
     escapes: int = 0
     dropped_rows: int = 0
+    cut: bool = False
 
 
 def _trace_direction(
@@ -263,6 +268,7 @@ def _trace_direction(
         if tr.steps >= settings.path.max_steps:
             return tr, PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps"
         if deadline is not None and time.monotonic() > deadline:
+            tr.cut = True
             return (
                 tr,
                 PathStatus.MAX_STEPS,
@@ -811,4 +817,5 @@ def _result(
         max_length_error=error,
         escapes=sum(t.escapes for t in traces),
         dropped_rows=max(t.dropped_rows for t in traces),
+        cut=any(t.cut for t in traces),
     )

@@ -3,10 +3,14 @@
 The first derivatives are the problem's (CasADi's) or, for large patterns, given in closed
 form, and IPOPT can be stopped early by an iteration callback (:class:`EarlyStop`): both
 are what the composite solver of large patterns (:mod:`rigidfold.optimize.large`) asks of
-it.
+it. The same callback ends a solve at a deadline (a run's time limit, :meth:`IpoptSolver.
+solve`): CasADi fixes IPOPT's options (its ``max_wall_time`` too) when it builds the solver
+once per problem, so the remaining time of each solve is the callback's to keep.
 """
 
 from __future__ import annotations
+
+import time
 
 import casadi as ca
 import numpy as np
@@ -23,7 +27,8 @@ _OUTCOME = {
     "Maximum_Iterations_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_WallTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
-    "User_Requested_Stop": SolverOutcome.SOLVED,  # only EarlyStop asks, at F <= ipopt_stop_f
+    # EarlyStop asks, at F <= ipopt_stop_f (SOLVED) or at its deadline (see IpoptSolver.solve)
+    "User_Requested_Stop": SolverOutcome.SOLVED,
 }
 
 
@@ -72,7 +77,9 @@ class IpoptSolver:
     ) -> None:
         nlp = problem.nlp
         self._lbg, self._ubg = nlp.lbg, nlp.ubg
-        self._stop = early_stop  # kept alive: CasADi keeps no reference to a callback
+        # kept alive: CasADi keeps no reference to a callback; without an F to stop at, it
+        # only keeps the deadline of a solve
+        self._stop = early_stop or EarlyStop(problem, None)
         # default: the problem's, so that CasADi does not differentiate (6) again
         self._first = first_derivatives or (
             problem.objective_gradient,
@@ -86,8 +93,7 @@ class IpoptSolver:
             "calc_lam_p": False,
             "no_nlp_grad": True,
         }
-        if self._stop is not None:
-            options["iteration_callback"] = self._stop
+        options["iteration_callback"] = self._stop
         self._hess_lag = None
         if problem.settings.solver.ipopt_hessian == "closed-form":
             self._hess_lag = closed_form_hess_lag(problem)
@@ -95,13 +101,21 @@ class IpoptSolver:
         with native_quiet():
             self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 
-    def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
+    def solve(self, xi0: np.ndarray, w: np.ndarray, deadline: float | None = None) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,); the run's message
-        is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``."""
-        with native_quiet():
-            sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
+        is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``. ``deadline``: a time
+        of ``time.monotonic()`` after which the solve ends at its iterate (an iteration
+        limit, ``"IPOPT: Maximum_WallTime_Exceeded"``)."""
+        self._stop.start(deadline)
+        try:
+            with native_quiet():
+                sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
+        finally:
+            timed_out = self._stop.start(None)
         stats = self.nlpsol.stats()
         status = str(stats.get("return_status", "unknown"))
+        if timed_out and status == "User_Requested_Stop":
+            status = "Maximum_WallTime_Exceeded"
         return SolverRun(
             xi=np.asarray(sol["x"], dtype=float).ravel(),
             iterations=int(stats.get("iter_count", 0)),
@@ -111,15 +125,18 @@ class IpoptSolver:
 
 
 class EarlyStop(ca.Callback):
-    """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f``.
+    """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f`` (None:
+    never), or at the first iterate after the solve's deadline (:meth:`start`).
 
     CasADi calls it with nlpsol's outputs (x, f, g, lam_x, lam_g, lam_p) after each iteration;
     a return value of 1 ends the run as ``User_Requested_Stop`` at that iterate.
     """
 
-    def __init__(self, problem: SolverProblem, stop_f: float) -> None:
+    def __init__(self, problem: SolverProblem, stop_f: float | None) -> None:
         ca.Callback.__init__(self)
         self.stop_f = stop_f
+        self.deadline: float | None = None
+        self.timed_out = False
         self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
         self.tol = 0.1 * problem.settings.solver.constraint_tol
         self.sizes = {
@@ -148,9 +165,18 @@ class EarlyStop(ca.Callback):
         size = self.sizes[ca.nlpsol_out(i)]
         return ca.Sparsity.dense(size, 1) if size else ca.Sparsity(0, 1)
 
+    def start(self, deadline: float | None) -> bool:
+        """Set the deadline of the next solve (a time of ``time.monotonic()``; None: none);
+        returns whether the solve before was ended by its deadline."""
+        timed_out, self.deadline, self.timed_out = self.timed_out, deadline, False
+        return timed_out
+
     def eval(self, arg):
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            self.timed_out = True
+            return [1]
         f = float(arg[1])
-        if not f <= self.stop_f:
+        if self.stop_f is None or not f <= self.stop_f:
             return [0]
         g = np.asarray(arg[2], dtype=float).ravel()
         violation = max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0))

@@ -198,11 +198,17 @@ class FormFindingProblem:
         return self._solvers[name]
 
     def solve(
-        self, fixed=None, start: np.ndarray | None = None, solver: str = "ipopt"
+        self,
+        fixed=None,
+        start: np.ndarray | None = None,
+        solver: str = "ipopt",
+        deadline: float | None = None,
     ) -> OptimizeResult:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
         ``solver`` is one of ``SOLVERS``; the result's ``wall_time`` is that of the solve alone.
+        ``deadline``: a time of ``time.monotonic()`` (a run's time limit) at which the solve
+        ends at its iterate (judged as any other: accepted only at F <= F_tol).
         A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
         failed: the result is the start, Status.FAILED, its message saying why.
         """
@@ -212,7 +218,7 @@ class FormFindingProblem:
         w = mask.astype(float)
         t0 = time.perf_counter()
         with one_blas_thread():  # which zero of F is reached depends on round-off
-            run = backend.solve(xi0, w)
+            run = backend.solve(xi0, w) if deadline is None else backend.solve(xi0, w, deadline)
         wall = time.perf_counter() - t0
         xi = run.xi
         coords = self.map.expand(xi)
@@ -244,7 +250,7 @@ class FormFindingProblem:
         )
 
     # ------------------------------------------------------------------ polish
-    def polish(self, result: OptimizeResult) -> OptimizeResult:
+    def polish(self, result: OptimizeResult, deadline: float | None = None) -> OptimizeResult:
         """An accepted ``result`` projected onto F = 0 to ``Settings.solver.polish_tol``
         (:class:`rigidfold.optimize.projection.Projection`, every constraint of (6) kept).
 
@@ -253,7 +259,8 @@ class FormFindingProblem:
         path passes the flat state at a distance of about the square root of the defects. The
         projection moves the vertices by about that defect times the edge length. Returns
         ``result`` itself when it was not accepted, or the projection does not lower F or
-        meets a singular factor.
+        meets a singular factor. ``deadline`` (of ``time.monotonic()``): the projection
+        stops there, with what it reached.
         """
         if result.status is not Status.CONVERGED:
             return result
@@ -264,7 +271,10 @@ class FormFindingProblem:
         try:
             with one_blas_thread():
                 run = self._projection(
-                    self.start_point(result.coords), w, tol=self.settings.solver.polish_tol
+                    self.start_point(result.coords),
+                    w,
+                    tol=self.settings.solver.polish_tol,
+                    deadline=deadline,
                 )
         except RuntimeError:  # a singular factor (redundant rows at F ~ 0): keep the result
             return result

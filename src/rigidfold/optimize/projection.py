@@ -33,6 +33,7 @@ family of zeros of F without meeting IPOPT's own tolerance (see ``rigidfold.opti
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,9 +102,17 @@ class Projection:
         coords = self.problem.map.expand(xi)
         return self.problem.violation(coords, w > 0) <= 0.1 * self.settings.solver.constraint_tol
 
-    def __call__(self, xi0: np.ndarray, w: np.ndarray, *, tol: float | None = None) -> Projected:
+    def __call__(
+        self,
+        xi0: np.ndarray,
+        w: np.ndarray,
+        *,
+        tol: float | None = None,
+        deadline: float | None = None,
+    ) -> Projected:
         """Project from ``xi0`` (n,) with fixed-crease weights ``w`` (E,) to F <= ``tol``
-        (default ``Settings.solver.projection_tol``)."""
+        (default ``Settings.solver.projection_tol``); ``deadline`` (of ``time.monotonic()``):
+        it stops there ("stopped")."""
         s = self.settings
         tol = s.solver.projection_tol if tol is None else tol
         xi = np.asarray(xi0, dtype=float).copy()
@@ -124,6 +133,8 @@ class Projection:
         for k in range(s.solver.projection_max_iter):
             if F <= tol:
                 return self._end(xi, F, k, held, "converged", tol)
+            if deadline is not None and time.monotonic() > deadline:
+                return self._end(xi, F, k, held, "stopped (its deadline)", tol)
             AA = (A @ A.T).tocsc()
             if scale < 0:
                 scale = float(AA.diagonal().max())
@@ -197,7 +208,7 @@ class Projection:
         words = (
             f"{how}, F = {F:.3g} in {k} steps"
             if how == "converged"
-            else (f"stopped at F = {F:.3g} after {k} steps")
+            else (f"{how} at F = {F:.3g} after {k} steps")
         )
         if held.size:
             words += f", {held.size} constraint{'s' if held.size > 1 else ''} held"

@@ -7,6 +7,8 @@ paper did (its baseline: 72 s per solve for 115 variables).
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
@@ -39,10 +41,12 @@ class SlsqpSolver:
         self._hi_rows = np.flatnonzero(np.isfinite(ubg))
         self._lo, self._hi = lbg[self._lo_rows], ubg[self._hi_rows]
 
-    def solve(self, xi0: np.ndarray, w: np.ndarray) -> SolverRun:
+    def solve(self, xi0: np.ndarray, w: np.ndarray, deadline: float | None = None) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
         The run's message is SciPy's, e.g. ``"SLSQP: Optimization terminated successfully"``.
+        ``deadline`` (of ``time.monotonic()``): the run ends at the first iterate after it
+        (SciPy's callback stops it; an iteration limit).
         """
         from scipy.optimize import minimize  # only when SLSQP runs: not on the import path
 
@@ -63,6 +67,10 @@ class SlsqpSolver:
             jac = self._constraint_jacobian(xi, w)[1].full()
             return np.vstack([jac[lo_rows], -jac[hi_rows]])
 
+        def callback(intermediate_result):
+            if deadline is not None and time.monotonic() > deadline:
+                raise StopIteration
+
         s = self._settings
         constraint = {"type": "ineq", "fun": inequalities}
         options = {"maxiter": s.solver.slsqp_max_iter, "ftol": s.solver.slsqp_ftol}
@@ -75,10 +83,23 @@ class SlsqpSolver:
                 method="SLSQP",
                 constraints=[constraint],
                 options=options,
+                callback=callback,
             )
         else:
             res = minimize(
-                objective, xi0, method="SLSQP", constraints=[constraint], options=options
+                objective,
+                xi0,
+                method="SLSQP",
+                constraints=[constraint],
+                options=options,
+                callback=callback,
+            )
+        if deadline is not None and time.monotonic() > deadline and int(res.status) != 0:
+            return SolverRun(
+                xi=np.asarray(res.x, dtype=float),
+                iterations=int(res.nit),
+                outcome=SolverOutcome.ITERATION_LIMIT,
+                message=f"SLSQP: stopped at its deadline ({res.message})",
             )
         return SolverRun(
             xi=np.asarray(res.x, dtype=float),
