@@ -96,7 +96,7 @@ def thick_panels(
         motion_message=message,
         settings=settings,
     )
-    out = prepare_output_dir(run_dir / THICK_DIR)
+    out = prepare_output_dir(run_dir / THICK_DIR, within=run_dir)
     written, sheets = write_fabrication(
         fab,
         out,
@@ -175,7 +175,7 @@ def structure_check(
     assert options.structure is not None
     t0 = time.perf_counter()
     check = check_design(pattern, options.structure, settings=pattern.settings)
-    out = prepare_output_dir(run_dir / STRUCTURE_DIR)
+    out = prepare_output_dir(run_dir / STRUCTURE_DIR, within=run_dir)
     written = write_structure(check, out, f"solutions/{name}.fold")
     files = [str(p.relative_to(run_dir)) for p in written]
     full = check.to_dict()

@@ -197,7 +197,7 @@ class RunWriter:
         self.lock = lock_run_dir(self.out)
         try:
             clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
-            self.solutions_dir = prepare_output_dir(self.out / "solutions")
+            self.solutions_dir = prepare_output_dir(self.out / "solutions", within=self.out)
             self.target_file: str | None = None  # a mesh target's spline, for the report
             if isinstance(case.surface, SplineSurface):
                 write_json(self.out / TARGET_FILE, case.surface.grid())
@@ -352,8 +352,9 @@ class RunWriter:
         if self.final is not None:
             pattern, coords2d = self.final
             stem = self.files[-1 if final is None else final.step].stem
+            final_dir = prepare_output_dir(self.out / FINAL_DIR, within=self.out)  # no link
             self.exports = export_design(
-                pattern, coords2d, self.out / FINAL_DIR, name=stem, title=f"rigidfold: {stem}"
+                pattern, coords2d, final_dir, name=stem, title=f"rigidfold: {stem}"
             )
         self.log.sync(run.attempts)
         self.write_summary(run)
@@ -385,6 +386,6 @@ def write_report(
     """The report of the run in ``directory``: each (name, PNG) of ``figures`` as
     ``DIR/figures/NAME`` and the page ``html`` as ``DIR/report.html``, each written
     atomically. Returns (the page, the figures)."""
-    figure_dir = prepare_output_dir(directory / FIGURES_DIR)
+    figure_dir = prepare_output_dir(directory / FIGURES_DIR, within=directory)
     written = tuple(atomic_write(figure_dir / name, png) for name, png in figures)
     return atomic_write(directory / REPORT_FILE, html), written
