@@ -21,6 +21,7 @@ import numpy as np
 
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication, FabricationStatus, Panels
+from rigidfold.fabricate.build import check_thickness
 from rigidfold.fabricate.motion import design_motion
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
@@ -53,7 +54,10 @@ def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> Non
     """ValueError (one line) for supports, support candidates, clamped vertices, actuators
     or point loads that ``pattern`` (the run's crease pattern: every solution has its
     vertices and edges) lacks, and for an actuator that is not one of its free creases (a
-    run only fixes more), before the run starts."""
+    run only fixes more), and for thick panels too thin for the design's size
+    (:func:`rigidfold.fabricate.build.check_thickness`), before the run starts."""
+    if options.fabricate is not None:
+        check_thickness(options.fabricate.thickness, pattern.coords, settings=pattern.settings)
     st = options.structure
     if st is None:
         return
