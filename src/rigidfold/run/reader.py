@@ -429,7 +429,14 @@ def load_run(directory: str | os.PathLike) -> RunData:
     attempts = read_log(inside_dir(root, root / LOG_FILE))
     names = summary.solutions
     designs = []
+    seen: dict[str, int] = {}
     for k, name in enumerate(names):
+        if name in seen:  # each solution once: a repeated name is a damaged summary
+            raise RigidfoldError(
+                f"'{root / 'summary.json'}': 'solutions[{k}]' is {received(name)}, which "
+                f"'solutions[{seen[name]}]' already lists"
+            )
+        seen[name] = k
         parts = Path(name).parts
         if not parts or Path(name).is_absolute() or ".." in parts:
             raise RigidfoldError(
@@ -466,7 +473,8 @@ def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
     backtracking changed was appended again).
 
     The first line is the header, ``{"schema_version": N}``; a log of another version is
-    refused (:func:`~rigidfold.run.schema.check_version`). A last line that does not end the
+    refused (:func:`~rigidfold.run.schema.check_version`), and so is one without a header
+    (empty, or its only line torn): its version cannot be checked. A last line that does not end the
     file and does not parse (torn by a crash mid-write) is skipped, the lines before it
     kept. Raises ValueError (one line, naming the file and the line) for a missing or
     unreadable file, a line that is not JSON or an attempt of the wrong shape
@@ -489,8 +497,12 @@ def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
             records.append(_log_line(path, len(lines) + 1, last))
         except ValueError:
             pass  # torn by a crash mid-write
-    if not records:
-        return ()
+    if not records:  # empty, or only a torn first line: no version to check
+        what = "is empty" if not data.strip() else "holds only a torn first line"
+        raise RigidfoldError(
+            f'{str(path)!r} {what}: no header line {{"schema_version": N}}, so it is not a '
+            "run log this version can read"
+        )
     header, *rows = records
     if "schema_version" not in header:
         raise RigidfoldError(

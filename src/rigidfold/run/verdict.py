@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from rigidfold.generate import Generation, Stop
+from rigidfold.generate import Generation, Stop, known_to_deploy
 from rigidfold.run.schema import SolutionRecord, Stage
 from rigidfold.status import Outcome
 
@@ -93,6 +93,15 @@ def run_verdict(
                 f"{failed} solution{'s' if failed > 1 else ''} did not reach the flat "
                 f"state ({counts})"
             )
+    named = final is not None and bool(files)
+    if run.stop is Stop.INTERRUPTED and final is not None and not known_to_deploy(final):
+        # interrupted before any path reached the flat state: no design is named as one
+        short.append(
+            f"no solution is known to deploy: none of the {len(run.solutions)} solutions' "
+            "folding paths was traced to the flat state before the interrupt, so no design "
+            f"is named (the last solution has DOF {final.mechanism.dof})"
+        )
+        named = False
     if records:
         final_record = records[k]
         for stage in final_record.failed_stages():
@@ -123,5 +132,5 @@ def run_verdict(
         RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
         tuple(short),
         warnings,
-        files[k] if files else None,
+        files[k] if named else None,
     )
