@@ -394,7 +394,8 @@ def test_target_dof_0_saves_and_names_the_dof_0_shape(tmp_path, capsys):
     A DOF-0 design has no mechanism: no folding motion or Step 9 is asked of it, a note says
     so."""
     argv = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "grid:4x4"]
-    code = main([*argv, "--target-dof", "0", "--no-deform", "--quiet", "--out", str(tmp_path)])
+    argv += ["--target-dof", "0", "--no-deploy-check"]  # a rigid design: it cannot deploy
+    code = main([*argv, "--no-deform", "--quiet", "--out", str(tmp_path)])
     last = capsys.readouterr().out.strip().splitlines()[-1]
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert (

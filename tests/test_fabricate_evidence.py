@@ -366,7 +366,7 @@ def test_collision_pairs_from_a_kd_tree():
     fab = fabricate_panels(panels, motion, 0.02, search=False)
     assert fab.ok
     solids = fab.solids
-    reach = DEFAULTS.fabricate.clearance + solids.thickness
+    reach = DEFAULTS.fabricate.clearance(solids.thickness) + solids.thickness
     ia, ib = _near_pairs(solids, motion, reach)
     n = panels.n
     assert len(ia) < n * (n - 1) // 4

@@ -429,3 +429,28 @@ def test_report_figures_of_patterns_with_directories_are_written(tmp_path, capsy
         assert f"]({png})" in text
         assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert figure_name("?#", set()) == "figure.png"
+
+
+def test_one_lock_whatever_the_path_to_the_database(tmp_path):
+    """Issue 47, item 7: the lock is named from the database file itself, so a symbolic link
+    to it (or to its directory, or to a database yet to be made) takes the same lock."""
+    config = StudyConfig(STUDY_OPTIONS.replace(deform=False)).as_dict()
+    real_dir = tmp_path / "real"
+    real_dir.mkdir()
+    db = real_dir / "s.sqlite"
+    link = tmp_path / "link.sqlite"
+    link.symlink_to(db)  # dangling: the first study makes the database through it
+    dir_link = tmp_path / "dir_link"
+    dir_link.symlink_to(real_dir, target_is_directory=True)
+    first = Store(link, config)
+    assert db.is_file() and (real_dir / "s.sqlite.lock").exists()
+    assert not (tmp_path / "link.sqlite.lock").exists()
+    for other in (db, link, dir_link / "s.sqlite"):
+        with pytest.raises(ValueError, match="in use by another rigidfold study"):
+            Store(other, config)
+    first.close()
+    assert not (real_dir / "s.sqlite.lock").exists()
+    second = Store(dir_link / "s.sqlite", config)  # released: taken through another path
+    with pytest.raises(ValueError, match=f"'{link}' is in use by another rigidfold study"):
+        Store(link, config)
+    second.close()

@@ -26,8 +26,25 @@ EXIT_NOT_FOUND = 127  # as a shell reports a command it cannot find
 EXIT_CANNOT_RUN = 126  # as a shell reports one it found but cannot run
 
 
+USAGE = """usage: python -m rigidfold.pinned [-h] [COMMAND [ARG ...]]
+
+Without a command: print this machine's numeric environment as JSON (the process restarted
+with the pinned numerics of rigidfold.runtime.numerics first). With one: run COMMAND with those
+numerics (its environment pinned), e.g. a study worker or a script whose designs match
+the command line's:
+
+  python -m rigidfold.pinned
+  python -m rigidfold.pinned dask worker tcp://host:8786
+  python -m rigidfold.pinned python script.py
+
+Exit code: the command's; 127 when it is not found, 126 when it cannot be run."""
+
+
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
+    if args and args[0] in ("-h", "--help"):  # an option of this module, not a command
+        print(USAGE)
+        return 0
     if args:
         program = shutil.which(args[0])
         if program is None:

@@ -325,10 +325,30 @@ class FabricateSettings(Group):
         "Every solid is bevelled along each hinge so that the two solids stay apart up to the "
         "crease's largest fold over the motion plus this angle, radians (2 degrees).",
     )
-    clearance: float = setting(
-        1e-3,
-        "Smallest gap, metres, that solids of panels without a common hinge keep at every "
-        "point of the motion (1 mm).",
+    clearance_share: float = setting(
+        0.05,
+        "Smallest gap that solids of panels without a common hinge keep at every point of "
+        "the motion, as a share of the thickness (5 %: 1 mm at 20 mm, 0.05 mm at 1 mm; "
+        "never below ``fabricate_clearance_min``). The room two parts need to pass each "
+        "other (cutting tolerance, a hinge's play, a panel's warp) grows with the panels, "
+        "and the gaps the vertex reliefs open between such panels are a share of the "
+        "thickness too (``fabricate_vertex_relief``), so a fixed length is out of scale "
+        "(a fixed 1 mm was a whole relief at 1 mm of thickness, which no check can prove).",
+    )
+    clearance_min: float = setting(
+        1e-5,
+        "The least gap, metres, that solids of panels without a common hinge keep whatever "
+        "the thickness (0.01 mm: about what a laser cutter or a CNC router holds; a gap "
+        "below it cannot be made). It acts below 0.2 mm of thickness.",
+    )
+    thinnest: float = setting(
+        1e-6,
+        "The thinnest panels built, as a share of the design's size (the diagonal of its "
+        "box): 1e-6, 1 um on a 1 m design, far below any sheet (paper is 100 um). The "
+        "solids are computed in double precision next to the design's coordinates, and a "
+        "slab much thinner than that share is not resolved (0.1 um on the 1.6 m A-frame, "
+        "6e-8 of its size: its triangles' pieces vanish while the panels keep their whole "
+        "volume), so a thinner thickness is refused and the thinner tries stop there.",
     )
     vertex_relief: float = setting(
         1.0,
@@ -337,9 +357,9 @@ class FabricateSettings(Group):
     )
     relief_rounds: int = setting(
         4,
-        "Where two such panels still come closer than ``fabricate_clearance`` near a shared "
-        "vertex, the relief there is doubled and the check run again, this many times at "
-        "most.",
+        "Where two such panels still come closer than the clearance (``clearance_share`` of "
+        "the thickness, at least ``clearance_min``) near a shared vertex, the relief there "
+        "is doubled and the check run again, this many times at most.",
     )
     frame_step: float = setting(
         math.radians(2.0),
@@ -426,6 +446,12 @@ class FabricateSettings(Group):
         "times to name one that passes.",
     )
 
+    def clearance(self, thickness: float) -> float:
+        """The smallest gap, metres, that solids of panels ``thickness`` metres thick and
+        without a common hinge keep over the motion: ``clearance_share`` of the thickness,
+        at least ``clearance_min``."""
+        return max(self.clearance_share * thickness, self.clearance_min)
+
     def __post_init__(self) -> None:
         self._choice("side", SIDES)
         if not 0 <= self.clearance_angle < math.pi / 2:
@@ -433,9 +459,11 @@ class FabricateSettings(Group):
                 "fabricate_clearance_angle must lie in [0, 90) degrees, got "
                 f"{math.degrees(self.clearance_angle):g}"
             )
-        self._non_negative("clearance", "vertex_relief", "sheet_gap", "nest_margin")
+        self._non_negative("clearance_share", "clearance_min", "vertex_relief", "sheet_gap")
+        self._non_negative("nest_margin")
         self._non_negative("nest_concavity")
         self._positive("frame_step", "frame_tol", "sheet_width", "sheet_height", "nest_round")
+        self._positive("thinnest")
         self._fraction("min_depth", "trimmed_away")
         self._integer(relief_rounds=0, subdivisions=0, thickness_tries=0, nest_parts=0)
         self._integer(nest_pair_window=1, progress_panels=0)

@@ -135,7 +135,8 @@ class Development:
                 "non-finite coordinates); it is not a crease pattern"
             )
         coords = np.column_stack([self.coords2d, np.zeros(len(self.coords2d))])
-        return pattern.with_coords(coords)
+        # a crease pattern built: the sheet's rule checked (not a state of ``pattern``)
+        return CreasePattern(coords, pattern.faces, pattern.edges, pattern.fixed, pattern.settings)
 
 
 def signed_areas(coords2d: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -174,6 +174,7 @@ def fabricate_panels(
     ``fabricate_min_depth`` times the thickness). With ``search``, a failing thickness is
     followed by thinner tries (see the module's text)."""
     check_size(panels.n, settings=settings)
+    thinnest = check_thickness(thickness, panels.pattern.coords, settings=settings)
     c, least, rho = fabrication_values(
         thickness,
         clearance_angle=clearance_angle,
@@ -189,6 +190,8 @@ def fabricate_panels(
     share = least / thickness
     for k in range(settings.fabricate.thickness_tries):
         trial = bad / 2 if good is None else 0.5 * (good + bad)
+        if trial < thinnest:  # below what the solids resolve: no try tells anything
+            break
         step(
             f"a thinner try, {trial * 1e3:.3g} mm ({k + 1} of "
             f"{settings.fabricate.thickness_tries})",
@@ -208,6 +211,25 @@ def fabricate_panels(
             "thickness_tries": tuple(tries),
         }
     )
+
+
+def check_thickness(
+    thickness: float, coords: np.ndarray, *, settings: Settings = DEFAULTS
+) -> float:
+    """The thinnest panels built for a design of vertices ``coords`` (V, 3), metres:
+    ``settings.fabricate.thinnest`` times its size (the diagonal of its box). ValueError (one
+    line, naming the thickness) for a ``thickness`` below it, whose solids the geometry
+    cannot resolve next to the design's size."""
+    coords = np.asarray(coords, dtype=np.float64).reshape(-1, 3)
+    size = float(np.linalg.norm(np.ptp(coords, axis=0))) if len(coords) else 0.0
+    thinnest = settings.fabricate.thinnest * size
+    if isinstance(thickness, int | float | np.number) and 0 < thickness < thinnest:
+        raise RigidfoldError(
+            f"thickness {thickness * 1e3:.3g} mm is too thin for a design {size:.3g} m across: "
+            f"its solids cannot be resolved below {thinnest * 1e3:.3g} mm "
+            f"({settings.fabricate.thinnest:g} of its size, Settings.fabricate.thinnest)"
+        )
+    return thinnest
 
 
 def fabrication_values(
@@ -294,7 +316,7 @@ def _evaluate(
             check = check_clearance(
                 solids,
                 motion,
-                clearance=settings.fabricate.clearance,
+                clearance=settings.fabricate.clearance(thickness),
                 subdivisions=settings.fabricate.subdivisions,
             )
         if check is None or check.collision_free or rounds >= settings.fabricate.relief_rounds:
@@ -332,16 +354,24 @@ def _verdict(
     t = solids.thickness
     share = solids.volumes / np.maximum(p.areas * t, 1e-300)
     faces = solids.empty_faces
-    gone = sorted(
-        set(p.label[faces].tolist())
-        | set(np.flatnonzero(share < settings.fabricate.trimmed_away).tolist())
-    )
+    emptied = p.label[faces]  # the panel of each triangle trimmed away completely
+    low = share < settings.fabricate.trimmed_away
+    gone = sorted(set(emptied.tolist()) | set(np.flatnonzero(low).tolist()))
     if gone:
-        k = gone[0]
-        return FabricationStatus.PANEL_TRIMMED_AWAY, (
-            f"panel {k} keeps {100 * share[k]:.0f}% of its area x thickness"
-            + (f" and {len(gone) - 1} more" if len(gone) > 1 else "")
-            + ("" if not len(faces) else f"; {len(faces)} triangles trimmed away completely")
+        # the panel that lost the most of its volume, in the words of what it lost
+        k = min(gone, key=lambda j: (share[j], j))
+        if low[k]:
+            what = (
+                f"panel {k} keeps {100 * share[k]:.0f}% of its area x thickness (less than "
+                f"{100 * settings.fabricate.trimmed_away:g}%)"
+            )
+        else:
+            n = int((emptied == k).sum())
+            what = (
+                f"panel {k} has {n} of its {len(p.triangles[k])} triangles trimmed away completely"
+            )
+        return FabricationStatus.PANEL_TRIMMED_AWAY, what + (
+            f" ({len(gone) - 1} more panels)" if len(gone) > 1 else ""
         )
     thin = np.flatnonzero(solids.depth < min_thickness * (1 - 1e-9))
     if len(thin):

@@ -15,7 +15,7 @@ from rigidfold.generate.records import (
     Solution,
     Stop,
 )
-from rigidfold.generate.steps import best_so_far, generate, with_fold_limit
+from rigidfold.generate.steps import best_so_far, generate, known_to_deploy, with_fold_limit
 
 __all__ = [
     "STOP_REASONS",
@@ -27,5 +27,6 @@ __all__ = [
     "Stop",
     "best_so_far",
     "generate",
+    "known_to_deploy",
     "with_fold_limit",
 ]

@@ -51,7 +51,8 @@ class GenerateOptions:
     target_dof: int = option(
         1,
         "stop at a shape with this many degrees of freedom (DOF: independent rigid folding "
-        "motions; 1 = folds along one path, stabilised by one support or actuator)",
+        "motions; 1 = folds along one path, stabilised by one support or actuator; 0, a "
+        "rigid design, only without the deployability check)",
         parse=count,
     )
     seed: int = option(
@@ -153,6 +154,13 @@ class GenerateOptions:
         target = self.target_dof
         if isinstance(target, bool) or not isinstance(target, int | np.integer) or target < 0:
             raise RigidfoldError(f"target DOF must be an integer >= 0, got {target!r}")
+        if target == 0 and self.deploy_check:
+            # a DOF-0 design is rigid: it has no folding motion, so it never deploys
+            raise RigidfoldError(
+                "target DOF 0 asks for a rigid design, which cannot deploy, with the "
+                "deployability check, which accepts only designs that deploy: add "
+                "--no-deploy-check (deploy_check=False, the paper's Step 5) or aim at DOF 1"
+            )
         face = self.support_face
         if face is not None and (isinstance(face, bool) or not isinstance(face, int | np.integer)):
             raise RigidfoldError(f"support face must be a face index, got {face!r}")

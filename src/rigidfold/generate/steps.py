@@ -710,12 +710,19 @@ def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
 
 def best_so_far(run: Generation) -> None:
     """Name the final design of a run that stops before its end (interrupted): the
-    lowest-DOF solution whose folding path is known to reach the flat state, else the last
-    (no path is traced)."""
-    for solution in reversed(run.solutions):
-        if solution.path is not None and solution.path.deploys:
-            run.final_step = solution.step
-            return
+    lowest-DOF solution whose folding path is known to reach the flat state (of two at one
+    DOF, the later); where none is known, ``final_step`` stays None (the last solution),
+    which the verdict does not name as a design (:func:`known_to_deploy`). No path is
+    traced."""
+    known = [s for s in run.solutions if known_to_deploy(s)]
+    if known:
+        run.final_step = min(known, key=lambda s: (s.mechanism.dof, -s.step)).step
+
+
+def known_to_deploy(solution: Solution) -> bool:
+    """Whether the solution's folding path was traced and reached the flat state (the
+    deployability check of Step 5)."""
+    return solution.path is not None and bool(solution.path.deploys)
 
 
 def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterator[Choice]:

@@ -27,14 +27,20 @@ from rigidfold.errors import RigidfoldError
 _TEMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
 
 
-def prepare_output_dir(path: str | os.PathLike) -> Path:
+def prepare_output_dir(path: str | os.PathLike, *, within: str | os.PathLike | None = None) -> Path:
     """Create the output directory and check it is writable, before any computation.
 
-    The check creates and removes a new, uniquely named file in it.
+    The check creates and removes a new, uniquely named file in it. ``within``: ``path`` is
+    a directory of that one (a run's ``figures/``, ``final/``), and no directory from
+    ``within`` down to ``path`` may be a symbolic link, so nothing is written through a
+    link to another place (the user's own output directory, ``within``, may be one).
 
-    Raises ValueError ``"cannot write to output directory 'PATH': reason"``.
+    Raises ValueError ``"cannot write to output directory 'PATH': reason"``, and
+    ``"'DIR' is a symbolic link ..."`` for a linked directory below ``within``.
     """
     out = Path(path)
+    if within is not None:
+        _refuse_linked_dirs(Path(within), out)
     try:
         out.mkdir(parents=True, exist_ok=True)
         fd, probe = _create_temp(out, ".rigidfold-write-test")
@@ -43,6 +49,63 @@ def prepare_output_dir(path: str | os.PathLike) -> Path:
     except OSError as exc:
         raise RigidfoldError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
     return out
+
+
+def _refuse_linked_dirs(root: Path, path: Path) -> None:
+    """ValueError when a directory of ``path`` below ``root`` is a symbolic link (or
+    ``path`` is not below ``root``)."""
+    try:
+        parts = path.relative_to(root).parts
+    except ValueError:
+        raise RigidfoldError(f"'{path}' is not a directory of '{root}'") from None
+    here = root
+    for part in parts:
+        here = here / part
+        if here.is_symlink():
+            raise RigidfoldError(
+                f"'{here}' is a symbolic link (to '{os.readlink(here)}'): rigidfold writes no "
+                "file through a linked directory; remove the link"
+            )
+
+
+def inside_dir(root: str | os.PathLike, path: str | os.PathLike) -> Path:
+    """``path`` (a file or directory under the directory ``root``, which need not exist) as a
+    Path, when it stays inside ``root`` with every symbolic link followed (``root``'s own
+    links included: a run directory may be reached through a link). A reader of a run's
+    files passes each through it, so that no link leads it out of the run.
+
+    Raises ValueError ``"'PATH' leads to 'REAL', outside the directory 'ROOT' ..."``.
+    """
+    path = Path(path)
+    base = Path(os.path.realpath(root))
+    real = Path(os.path.realpath(path))
+    if real != base and base not in real.parents:
+        raise RigidfoldError(
+            f"'{path}' leads to '{real}', outside the directory '{root}': rigidfold reads no "
+            "file of a run through a symbolic link out of its directory"
+        )
+    return path
+
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+"""The eight bytes every PNG file starts with."""
+
+
+def read_png(path: str | os.PathLike) -> bytes:
+    """The bytes of the PNG image ``path``, checked to start with the PNG signature (a
+    report embeds no other file as an image).
+
+    Raises ValueError ``"'PATH' is not a PNG image ..."`` or ``"cannot read 'PATH': ..."``.
+    """
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise RigidfoldError(f"cannot read '{path}': {_reason(exc)}") from None
+    if not data.startswith(PNG_SIGNATURE):
+        raise RigidfoldError(
+            f"'{path}' is not a PNG image (it starts with {data[:8]!r}, not the PNG signature)"
+        )
+    return data
 
 
 def refuse_replacing_inputs(

@@ -45,6 +45,12 @@ class CreasePattern:
         Tolerances of the model: ``degenerate_area`` and ``plan_area_tol`` (checked on
         construction) and ``corner_angle`` (which boundary vertices are :attr:`corners`). Kept by
         :meth:`with_coords` and :meth:`with_fixed`; not shown in the repr.
+    sheet : bool
+        True (the default) for a crease pattern as it is built or read: the sheet's rule is
+        checked, its faces counter-clockwise seen from +z over an area in plan. False for a
+        folded state of a pattern already checked (:meth:`with_coords`, a solver's shape, a
+        motion frame): its faces keep the pattern's orientation whatever the shape, so a
+        state folded past vertical (negative or zero projected area) is still a state.
 
     Derived data are cached properties; the arrays are read-only. Construction validates
     the input once and raises ``ValueError`` naming the problem.
@@ -55,6 +61,7 @@ class CreasePattern:
     edges: np.ndarray
     fixed: np.ndarray
     settings: Settings = field(default=DEFAULTS, repr=False, compare=False)
+    sheet: bool = field(default=True, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.settings, Settings):
@@ -91,6 +98,8 @@ class CreasePattern:
             raise RigidfoldError(
                 f"face {f} {tuple(faces[f].tolist())} is degenerate (area {areas[f]:.3g} m^2)"
             )
+        if not self.sheet:  # a folded state: the sheet's orientation rule is not its
+            return
         plan, surface, zero = geometry.plan_area(
             coords, faces, self.settings.geometry.plan_area_tol
         )
@@ -141,13 +150,16 @@ class CreasePattern:
         return cls(coords=coords, faces=faces, edges=edges, fixed=fixed, settings=settings)
 
     def with_coords(self, coords: np.ndarray) -> CreasePattern:
-        """Same topology and assignment, new vertex coordinates (V, 3)."""
+        """A folded state of this pattern: same topology and assignment, new vertex
+        coordinates (V, 3). Checked as coordinates (finite, no degenerate face), not as a
+        crease pattern (``sheet=False``: it may be folded past vertical)."""
         return CreasePattern(
             coords=coords,
             faces=self.faces,
             edges=self.edges,
             fixed=self.fixed,
             settings=self.settings,
+            sheet=False,
         )
 
     def with_fixed(self, fixed: np.ndarray) -> CreasePattern:
@@ -158,6 +170,7 @@ class CreasePattern:
             edges=self.edges,
             fixed=np.asarray(fixed, bool),
             settings=self.settings,
+            sheet=self.sheet,
         )
 
     # ------------------------------------------------------------------ sizes

@@ -230,8 +230,9 @@ class FormFindingProblem:
             viol = self.violation(coords, mask)
             status, verdict = Status.FAILED, f"its point is no shape ({exc}): the start is kept"
         F, F1, F2 = (float(v) for v in self.objective(xi, w))
+        # the solver's shape is a state of the pattern, which may fold past vertical
         shape = CreasePattern(
-            coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings
+            coords, self.pattern.faces, self.pattern.edges, mask, self.pattern.settings, sheet=False
         )
         if status is None:
             status, verdict = classify(run.outcome, F, viol, self.settings, folded_back(shape))

@@ -22,6 +22,7 @@ import numpy as np
 from rigidfold.drive import DriveResult
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication, FabricationStatus, Panels
+from rigidfold.fabricate.build import check_thickness
 from rigidfold.fabricate.motion import design_motion
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
@@ -54,7 +55,10 @@ def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> Non
     """ValueError (one line) for supports, support candidates, clamped vertices, actuators
     or point loads that ``pattern`` (the run's crease pattern: every solution has its
     vertices and edges) lacks, and for an actuator that is not one of its free creases (a
-    run only fixes more), before the run starts."""
+    run only fixes more), and for thick panels too thin for the design's size
+    (:func:`rigidfold.fabricate.build.check_thickness`), before the run starts."""
+    if options.fabricate is not None:
+        check_thickness(options.fabricate.thickness, pattern.coords, settings=pattern.settings)
     st = options.structure
     if st is None:
         return
@@ -97,7 +101,7 @@ def thick_panels(
         motion_message=message,
         settings=settings,
     )
-    out = prepare_output_dir(run_dir / THICK_DIR)
+    out = prepare_output_dir(run_dir / THICK_DIR, within=run_dir)
     written, sheets = write_fabrication(
         fab,
         out,
@@ -176,7 +180,7 @@ def structure_check(
     assert options.structure is not None
     t0 = time.perf_counter()
     check = check_design(pattern, options.structure, settings=pattern.settings)
-    out = prepare_output_dir(run_dir / STRUCTURE_DIR)
+    out = prepare_output_dir(run_dir / STRUCTURE_DIR, within=run_dir)
     written = write_structure(check, out, f"solutions/{name}.fold")
     files = [str(p.relative_to(run_dir)) for p in written]
     full = check.to_dict()

@@ -95,6 +95,7 @@ def run_verdict(
                 f"{failed} solution{'s' if failed > 1 else ''} did not reach the flat "
                 f"state ({counts})"
             )
+    named = final is not None and bool(files)
     if records:
         final_record = records[k]
         for stage in final_record.failed_stages():
@@ -125,7 +126,7 @@ def run_verdict(
         RunOutcome.FELL_SHORT if short else RunOutcome.PASSED,
         tuple(short),
         warnings,
-        files[k] if files else None,
+        files[k] if named else None,
     )
 
 

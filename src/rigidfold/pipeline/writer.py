@@ -213,7 +213,7 @@ class RunWriter:
         self.lock = lock_run_dir(self.out)
         try:
             clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
-            self.solutions_dir = prepare_output_dir(self.out / "solutions")
+            self.solutions_dir = prepare_output_dir(self.out / "solutions", within=self.out)
             self.target_file: str | None = None  # a mesh target's spline, for the report
             if isinstance(case.surface, SplineSurface):
                 write_json(self.out / TARGET_FILE, case.surface.grid())
@@ -455,7 +455,7 @@ class RunWriter:
         disk) or an interrupt leaves none of them (``exports`` stays empty). Third-party
         code that catches BaseException (trimesh, on import and in its functions) cannot
         eat an interrupt: it is raised again when the export ends (:func:`kept_interrupts`)."""
-        final_dir = prepare_output_dir(self.out / FINAL_DIR)
+        final_dir = prepare_output_dir(self.out / FINAL_DIR, within=self.out)  # no link
         stage = self.out / f".{FINAL_DIR}.{secrets.token_hex(6)}.tmp"
         try:
             with kept_interrupts():
@@ -506,6 +506,6 @@ def write_report(
     """The report of the run in ``directory``: each (name, PNG) of ``figures`` as
     ``DIR/figures/NAME`` and the page ``html`` as ``DIR/report.html``, each written
     atomically. Returns (the page, the figures)."""
-    figure_dir = prepare_output_dir(directory / FIGURES_DIR)
+    figure_dir = prepare_output_dir(directory / FIGURES_DIR, within=directory)
     written = tuple(atomic_write(figure_dir / name, png) for name, png in figures)
     return atomic_write(directory / REPORT_FILE, html), written

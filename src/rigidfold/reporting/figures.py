@@ -26,6 +26,20 @@ KINDS = {
 """FOLD letter -> (label, colour, line width, line style), drawn in this order (the boundary
 last). The 3D view uses the same colours."""
 
+F_SHOWN = (1 / math.sqrt(np.finfo(float).max), math.sqrt(np.finfo(float).max))
+"""The range of F drawn on the log scale (about 1e-154 to 1e154, the square root of the
+largest float): a value beyond it (a damaged log's F = 1e308) is drawn at the bound, so
+that the axis' limits and margins stay within the floats (no overflow in matplotlib)."""
+
+
+def _shown_f(value) -> float | None:
+    """F as drawn: None where there is nothing to draw on a log scale (None, NaN, 0 or
+    below), else clipped to :data:`F_SHOWN`."""
+    if not isinstance(value, int | float) or not value > 0:  # NaN is not > 0
+        return None
+    return min(max(float(value), F_SHOWN[0]), F_SHOWN[1])
+
+
 OUTCOME_STYLE = {
     "accepted": ("o", "#1f77b4", "accepted"),
     "lock": ("x", "#d62728", "lock (N_lock)"),
@@ -136,14 +150,14 @@ def _attempts(plt, run: RunData):
         dof = [(i, a.dof) for i, a in rows if a.dof is not None]
         if dof:
             top.scatter(*zip(*dof, strict=True), marker=marker, color=colour, s=22, zorder=3)
-        f = [(i, a.F) for i, a in rows if a.F is not None and a.F > 0]
+        f = [(i, _shown_f(a.F)) for i, a in rows if _shown_f(a.F) is not None]
         if f:
             bottom.scatter(*zip(*f, strict=True), marker=marker, color=colour, s=22, label=label)
         if outcome == "lock":
             for i, _ in rows:
                 for ax in (top, bottom):
                     ax.axvline(i, color=colour, lw=0.8, alpha=0.35)
-    f_tol = run.summary.case.get("F_tol")
+    f_tol = _shown_f(run.summary.case.get("F_tol"))
     if f_tol:
         bottom.axhline(f_tol, color="k", ls=":", lw=0.9, label="F_tol")
     bottom.set_yscale("log")
@@ -162,9 +176,9 @@ def _attempts(plt, run: RunData):
         fig,
         "DOF and F per attempt",
         "Every solve of problem (6) in the order made (log.jsonl): the DOF of the shape found "
-        "and its objective F. Red crosses and lines mark the lock events (a crease locked, the "
-        "fix replaced, Step 7); pink stars, solutions retracted by backtracking (no candidate "
-        "of their shape gave a deployable solution).",
+        "and its objective F (drawn within 1e-154 to 1e154). Red crosses and lines mark the "
+        "lock events (a crease locked, the fix replaced, Step 7); pink stars, solutions "
+        "retracted by backtracking (no candidate of their shape gave a deployable solution).",
     )
 
 

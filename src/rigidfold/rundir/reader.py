@@ -7,7 +7,8 @@ development diagram and folding motion as frames (:func:`rigidfold.io.read_frame
 the figures of Steps 8-9 with the large-deformation history under
 ``rigidfold:deformation``), and rebuilds the target surface from the case's metadata where
 it can. Anything that is not a generate run is a one-line
-``ValueError``.
+``ValueError``, and so is a file of the run that a symbolic link leads out of its directory
+(:func:`rigidfold.io.inside_dir`): nothing outside the run is read.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Attempt
-from rigidfold.io import parse_json, read_fold, read_frames
+from rigidfold.io import inside_dir, parse_json, read_fold, read_frames, read_png
 from rigidfold.protocols import TargetSurface
 from rigidfold.rundir.json_shapes import check_shape, received
 from rigidfold.rundir.schema import (
@@ -270,13 +271,14 @@ class RunData:
 
     def run_file(self, name: str | None) -> Path | None:
         """The file ``name`` (relative to the run's directory, as summary.json names it),
-        None when there is none or it is not a file inside the directory."""
+        None when there is none or it is not a file inside the directory. ValueError for
+        one that a symbolic link leads out of the directory (:func:`rigidfold.io.inside_dir`)."""
         if not name:
             return None
         parts = Path(name).parts
         if Path(name).is_absolute() or ".." in parts:
             return None
-        path = self.directory / name
+        path = inside_dir(self.directory, self.directory / name)
         return path if path.is_file() else None
 
     def thick_panels(self) -> tuple[ThickPanels | None, str]:
@@ -301,16 +303,15 @@ class RunData:
 
     def structure_figure(self) -> bytes | None:
         """The PNG of the final design's deflected shape (``structure.png``), None when the
-        structure was not checked or not analysed, or its file is missing."""
+        structure was not checked or not analysed, or its file is missing. ValueError for a
+        file that is not a PNG image (:func:`rigidfold.io.read_png`) or lies outside the run
+        (:meth:`run_file`)."""
         record = self.final_record
         figures = None if record is None else record.structure
         path = None if figures is None else self.run_file(figures.get("figure"))
         if path is None:
             return None
-        try:
-            return path.read_bytes()
-        except OSError:
-            return None
+        return read_png(path)
 
     def drive_figure(self) -> bytes | None:
         """The PNG of the final design's deployment drive (``final/deploy/deploy.png``,
@@ -453,17 +454,24 @@ def load_run(directory: str | os.PathLike) -> RunData:
             f"{str(root)!r} is not a directory (give the --out of rigidfold generate)"
         )
     summary = RunSummary.from_dict(_json_object(root, "summary.json"), root / "summary.json")
-    attempts = read_log(root / LOG_FILE)
+    attempts = read_log(inside_dir(root, root / LOG_FILE))
     names = summary.solutions
     designs = []
+    seen: dict[str, int] = {}
     for k, name in enumerate(names):
+        if name in seen:  # each solution once: a repeated name is a damaged summary
+            raise RigidfoldError(
+                f"'{root / 'summary.json'}': 'solutions[{k}]' is {received(name)}, which "
+                f"'solutions[{seen[name]}]' already lists"
+            )
+        seen[name] = k
         parts = Path(name).parts
         if not parts or Path(name).is_absolute() or ".." in parts:
             raise RigidfoldError(
                 f"'{root / 'summary.json'}': 'solutions[{k}]' is {received(name)}, expected "
                 "a file in the run's directory"
             )
-        path = root / name
+        path = inside_dir(root, root / name)
         if not path.is_file():
             raise RigidfoldError(f"solution file {str(path)!r} listed in summary.json is missing")
         designs.append(read_solution(path, name))
@@ -493,7 +501,8 @@ def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
     backtracking changed was appended again).
 
     The first line is the header, ``{"schema_version": N}``; a log of another version is
-    refused (:func:`~rigidfold.rundir.schema.check_version`). A last line that does not end the
+    refused (:func:`~rigidfold.rundir.schema.check_version`), and so is one without a header
+    (empty, or its only line torn): its version cannot be checked. A last line that does not end the
     file and does not parse (torn by a crash mid-write) is skipped, the lines before it
     kept. Raises ValueError (one line, naming the file and the line) for a missing or
     unreadable file, a line that is not JSON or an attempt of the wrong shape
@@ -516,8 +525,12 @@ def read_log(path: str | os.PathLike) -> tuple[Attempt, ...]:
             records.append(_log_line(path, len(lines) + 1, last))
         except ValueError:
             pass  # torn by a crash mid-write
-    if not records:
-        return ()
+    if not records:  # empty, or only a torn first line: no version to check
+        what = "is empty" if not data.strip() else "holds only a torn first line"
+        raise RigidfoldError(
+            f'{str(path)!r} {what}: no header line {{"schema_version": N}}, so it is not a '
+            "run log this version can read"
+        )
     header, *rows = records
     if "schema_version" not in header:
         raise RigidfoldError(
@@ -557,7 +570,7 @@ def _stored_surface(root: Path, name: str) -> tuple[TargetSurface | None, str]:
     parts = Path(name).parts
     if len(parts) != 1 or parts[0] in (".", ".."):
         return None, f"the target surface could not be rebuilt: {name!r} is not a file name"
-    if not (root / name).is_file():
+    if not inside_dir(root, root / name).is_file():
         return None, f"the target surface could not be rebuilt: its file {name} is missing"
     try:
         grid = _json_object(root, name)
@@ -570,7 +583,7 @@ def _stored_surface(root: Path, name: str) -> tuple[TargetSurface | None, str]:
 
 
 def _json_object(root: Path, name: str) -> dict:
-    path = root / name
+    path = inside_dir(root, root / name)
     try:
         data = parse_json(path.read_text(encoding="utf-8"))
     except FileNotFoundError:

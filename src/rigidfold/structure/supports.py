@@ -69,10 +69,18 @@ CANDIDATE_FORMS = ("boundary", "ground", "V,V,...")
 
 def index_list(text: str, what: str) -> list[int]:
     """The integers of ``"3,7,12"`` (``""``: none), not yet checked against a design;
-    ValueError naming ``what`` and the text for anything else."""
+    ValueError naming ``what`` and the text for anything else, an empty item included
+    (``"0,,1"``, ``"0,1,"``: a number left out is a slip, not nothing)."""
     if not isinstance(text, str):
         raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}")
-    items = [t.strip() for t in text.split(",") if t.strip()]
+    if not text.strip():
+        return []
+    items = [t.strip() for t in text.split(",")]
+    if not all(items):
+        raise RigidfoldError(
+            f"{what} must be comma-separated integers, got {text!r}: item "
+            f"{items.index('') + 1} is empty"
+        )
     try:
         return [int(t) for t in items]
     except ValueError:

@@ -3,9 +3,11 @@
 Two clients writing one database would run the same runs twice and race to create its
 tables; so a client opening a database for writing first takes an exclusive ``flock`` on the
 file ``DB.lock`` beside it, which holds the client's pid and host, and the second client is
-refused with one line naming that pid. The kernel drops the lock when its process dies (also
-on SIGKILL), so a lock left by a killed study is taken over by the next one. Reports open the
-database read-only and take no lock.
+refused with one line naming that pid. The lock file is named from the database file itself,
+its path resolved (every symbolic link followed, as SQLite follows them), so two paths to one
+database, a link and its target, take one lock. The kernel drops the lock when its process
+dies (also on SIGKILL), so a lock left by a killed study is taken over by the next one.
+Reports open the database read-only and take no lock.
 """
 
 from __future__ import annotations
@@ -19,11 +21,13 @@ from rigidfold.errors import RigidfoldError
 
 
 class StudyLock:
-    """An exclusive lock on the study database ``db``, held until :meth:`release`."""
+    """An exclusive lock on the study database ``db``, held until :meth:`release`: the file
+    ``DB.lock`` beside the database file that ``db`` resolves to (``db`` may be a link)."""
 
     def __init__(self, db: str | Path) -> None:
         db = Path(db)
-        self.path = db.with_name(db.name + ".lock")
+        real = Path(os.path.realpath(db))  # a link's target, also a target yet to be made
+        self.path = real.with_name(real.name + ".lock")
         while True:
             try:
                 fd = os.open(

@@ -57,14 +57,20 @@ class StoreWriteError(RigidfoldError):
 # configurations without it (a study of the paper's Step 5 resumes whatever they are)
 CHECK_ONLY_SETTINGS = frozenset({"backtrack_max", "fold_limits", "restart_after"})
 
+UNUSED_PREFIXES = ("fabricate_",)
+"""Settings a study never uses (it builds no thick panels), never compared: a study written
+before one of them changed (``fabricate_clearance``, now ``fabricate_clearance_share`` and
+``fabricate_clearance_min``) is resumed all the same."""
+
 
 def config_differences(stored: dict, current: dict) -> list[str]:
     """Names of the configuration entries in which ``current`` differs from ``stored``.
 
     A setting that a later rigidfold added (absent from ``stored["settings"]``) counts as
     equal when ``current`` has it at its default; one that acts only with the deployability
-    check (``CHECK_ONLY_SETTINGS``) is not compared where neither configuration has it. So
-    a study can be resumed by a newer version as long as nothing it measures has changed.
+    check (``CHECK_ONLY_SETTINGS``) is not compared where neither configuration has it, and
+    one a study never uses (``UNUSED_PREFIXES``) never. So a study can be resumed by a newer
+    version as long as nothing it measures has changed.
     """
     from rigidfold.config import DEFAULTS
 
@@ -79,6 +85,7 @@ def config_differences(stored: dict, current: dict) -> list[str]:
                 f"settings.{k}"
                 for k in sorted(set(a) | set(b))
                 if k not in inert
+                and not k.startswith(UNUSED_PREFIXES)
                 and (_as_json(a.get(k, defaults.get(k))) != _as_json(b.get(k)) or k not in b)
             ]
         elif a != b:
