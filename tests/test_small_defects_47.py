@@ -138,14 +138,19 @@ def _interrupted(run, solutions):
     stopped.stop, stopped.stop_detail = Stop.INTERRUPTED, ""
     best_so_far(stopped)
     files = [Path(f"solutions/step_{s.step:02d}_dof_{s.mechanism.dof:02d}.fold") for s in solutions]
-    records = [SolutionRecord(s.step, s.mechanism.dof) for s in solutions]  # as the writer
+    records = [  # as the writer: the deployability check's path in each record
+        SolutionRecord(
+            s.step, s.mechanism.dof, deployability=None if s.path is None else s.path.to_dict()
+        )
+        for s in solutions
+    ]
     return run_verdict(stopped, records, files, 1)
 
 
 def test_an_interrupted_run_names_the_lowest_dof_design_known_to_deploy(chain):
     verdict = _interrupted(chain, chain.solutions)
     assert verdict.final_design == Path("solutions/step_04_dof_01.fold")
-    assert "known to deploy" not in verdict.message
+    assert "best design known to deploy: DOF 1" in verdict.message
 
 
 def test_an_interrupted_run_names_no_design_when_none_is_known_to_deploy(chain):
@@ -153,5 +158,5 @@ def test_an_interrupted_run_names_no_design_when_none_is_known_to_deploy(chain):
     best design so far, which the README calls the lowest-DOF one known to deploy."""
     verdict = _interrupted(chain, chain.solutions[:3])
     assert verdict.final_design is None
-    assert "no solution is known to deploy" in verdict.message
-    assert "the last solution has DOF 3" in verdict.message
+    assert "no design is known to deploy" in verdict.message
+    assert "none of the 3 solutions" in verdict.message
