@@ -10,6 +10,7 @@ at a time (:func:`append_json_line`): a crash can tear only its last line.
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import math
 import os
@@ -358,5 +359,17 @@ def _cut_from(stem: str, name: str) -> bool:
     return stem == name or stem == _cut(name, _TEMP_STEM_BYTES)
 
 
+_CAUSES = {
+    errno.ENOSPC: "the disk is full",
+    errno.EDQUOT: "the disk quota is reached",
+    errno.EFBIG: "the file size limit is reached (ulimit -f)",
+}
+"""What a write that failed for want of room means, said with the system's words."""
+
+
 def _reason(exc: OSError) -> str:
-    return str(exc.strerror or exc)
+    """Why a file could not be written: the system's words, and for want of room its cause
+    (a full disk, the quota, the file size limit)."""
+    words = str(exc.strerror or exc)
+    cause = _CAUSES.get(exc.errno) if exc.errno is not None else None
+    return words if cause is None else f"{words}: {cause}"
