@@ -198,8 +198,8 @@ def rhino_bytes(fab: Fabrication) -> bytes:
         point = rhino3dm.Point3d(*centre)
         model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))  # type: ignore[call-arg]
     options = rhino3dm.File3dmWriteOptions()
-    options.Version = 7
-    data = base64.b64decode(model.Encode(options) or "")
+    options.Version = 7  # type: ignore[misc]
+    data = base64.b64decode(model.Encode(options) or "")  # type: ignore[attr-defined]
     if not data:
         raise RigidfoldError("cannot make the Rhino model (rhino3dm made no file of it)")
     return data
