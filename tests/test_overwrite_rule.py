@@ -81,7 +81,8 @@ def test_a_tampered_summary_never_names_a_file_outside_the_runs_forms(first, tmp
     (out / "mine" / "a.txt").write_text("keep")
     summary = json.loads((out / "summary.json").read_text())
     summary["solutions"] += ["../outside.txt", "mine/a.txt", "solutions/../mine/a.txt"]
-    summary["exports"] += ["final/../../outside.txt", "final/../mine/a.txt", "final"]
+    summary["exports"] += ["final/../../outside.txt", "final/../mine/a.txt", "final", "final/.."]
+    summary["exports"] += ["final/thick", "final/thick/.."]  # a directory: never removed
     (out / "summary.json").write_text(json.dumps(summary))
     assert main([*RUN, *QUIET, "--out", str(out), "--overwrite"]) == 0
     assert (tmp_path / "outside.txt").read_text() == "keep"

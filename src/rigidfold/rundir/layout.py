@@ -208,7 +208,7 @@ def earlier_run(
             *recorded_files(out),
         )
     for n in names:
-        if (out / n).is_dir() and not (out / n).is_symlink():
+        if "/" not in n and (out / n).is_dir() and not (out / n).is_symlink():
             raise RigidfoldError(
                 f"output directory '{out}' holds a directory '{n}' where this command writes "
                 "a file (--overwrite replaces only files the command writes): move it, or use "
@@ -243,7 +243,7 @@ def earlier_run(
     by_dir: dict[Path, list[str]] = {}
     for path in files:
         by_dir.setdefault(path.parent, []).append(path.name)
-    files = [p for p in files if _present(p)]
+    files = [p for p in files if p.is_symlink() or (p.exists() and not p.is_dir())]
     for directory, members in by_dir.items():
         files += temp_files(directory, members)
     for path in [*files, *trees]:
@@ -320,7 +320,7 @@ def recorded_files(out: Path) -> list[str]:
     return list(dict.fromkeys(out_names))
 
 
-_NAME = r"[^/\x00]+"
+_NAME = r"(?!\.\.?(?:/|$))[^/\x00]+"
 _RECORDED = re.compile(
     rf"solutions/{_NAME}\.fold|{FINAL_DIR}/(?:thick/|structure/)?{_NAME}|{TARGET_FILE}"
 )
