@@ -252,3 +252,32 @@ def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
     assert summary["stop"] == "interrupted" and summary["exports"] == []
     assert not (out / "final").exists() or not list((out / "final").iterdir())
     assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_an_interrupt_that_native_code_eats_in_the_search_stops_the_run(tmp_path, monkeypatch):
+    """The contract test's signal 0.1 s after the first solution: CasADi's overloads took
+    the interrupted conversion of a NumPy array for a failed match and tried the next
+    (symbolic) one, so the interrupt was eaten and the run went on to a TypeError, reported
+    as a bug. The whole run is kept (``kept_interrupts``): an interrupt eaten anywhere in it
+    stops the run at the next attempt, or turns what the native code made of it into the
+    interrupt; exit 130, the summary says interrupted, nothing is exported."""
+    import rigidfold.generate.steps as steps
+    from rigidfold.cli.commands import main
+
+    real, calls = steps.analyze, []
+
+    def eaten(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            try:  # as native code does with the exception of a Python callback
+                os.kill(os.getpid(), signal.SIGINT)
+            except BaseException:
+                pass
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(steps, "analyze", eaten)
+    out = tmp_path / "run"
+    assert main([*CASE, "--out", str(out)]) == 130
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stop"] == "interrupted" and summary["exports"] == []
+    assert len(calls) <= 3  # stopped at once, not at the end of the run

@@ -344,12 +344,18 @@ def generate_case(
     command line) propagates once summary.json says the run was interrupted
     (:meth:`rigidfold.pipeline.RunWriter.interrupted`)."""
 
+    received: list[int] = []  # the signals kept_interrupts noted (one native code ate)
+
     def on_attempt(run: Generation, attempt: Attempt) -> None:
+        if received:
+            raise KeyboardInterrupt  # native code ate it: the run stops here
         writer.on_attempt(run, attempt)
         if progress:
             progress(run, attempt)
 
     def on_solution(run: Generation, solution) -> None:
+        if received:
+            raise KeyboardInterrupt
         writer.on_solution(run, solution)
         if progress:
             progress(run, None)
@@ -360,16 +366,17 @@ def generate_case(
             progress(run, None)
 
     try:
-        run = generate(
-            writer.case,
-            writer.options,
-            on_attempt=on_attempt,
-            on_solution=on_solution,
-            on_retract=on_retract,
-        )
-        writer.finish(run)
-        if report:
-            with kept_interrupts():  # matplotlib, plotly: an interrupt is never eaten
+        # CasADi, IPOPT, trimesh, matplotlib: native code never eats an interrupt
+        with kept_interrupts() as received:
+            run = generate(
+                writer.case,
+                writer.options,
+                on_attempt=on_attempt,
+                on_solution=on_solution,
+                on_retract=on_retract,
+            )
+            writer.finish(run)
+            if report:
                 report_run(writer.out)
         writer.completed = True  # from here a signal does not make it an interrupted run
     except KeyboardInterrupt:

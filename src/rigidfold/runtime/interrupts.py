@@ -73,16 +73,33 @@ def command_ended() -> None:
 
 
 _INTERRUPTING = (signal.default_int_handler, _interrupt)
-_ACTIVE: list[bool] = []  # the outermost kept_interrupts of the main thread is active
+_ACTIVE: list[list[int]] = []  # the signals the active outermost kept_interrupts noted
 
 
 @contextlib.contextmanager
-def kept_interrupts() -> Iterator[None]:
+def kept_interrupts() -> Iterator[list[int]]:
     """Run the block with SIGINT (and SIGTERM where it interrupts) noted: a KeyboardInterrupt
     is raised in the handler as usual, and again when the block ends if native code swallowed
-    the first (see the module's text). Nested uses rely on the outermost."""
-    if _ACTIVE or threading.current_thread() is not threading.main_thread():
-        yield
+    the first (see the module's text); an exception that native code made of it (CasADi's
+    overloads try the next one when a conversion is interrupted, and a symbolic result
+    then fails as a TypeError) becomes the KeyboardInterrupt. The block is given the list
+    of the signals received, for a long block to check between its steps. Nested uses share
+    the outermost's handler and list, and raise again at their own end for a signal
+    received while they ran."""
+    if threading.current_thread() is not threading.main_thread():
+        yield []
+        return
+    if _ACTIVE:
+        shared = _ACTIVE[0]
+        before = len(shared)
+        try:
+            yield shared
+        except BaseException as exc:
+            if len(shared) > before and not isinstance(exc, KeyboardInterrupt):
+                raise KeyboardInterrupt from exc
+            raise
+        if len(shared) > before:
+            raise KeyboardInterrupt
         return
     received: list[int] = []
 
@@ -95,9 +112,9 @@ def kept_interrupts() -> Iterator[None]:
     kept = [s for s, handler in saved.items() if handler in _INTERRUPTING]
     for s in kept:
         signal.signal(s, note)
-    _ACTIVE.append(True)
+    _ACTIVE.append(received)
     try:
-        yield
+        yield received
     except BaseException as exc:
         if received and not isinstance(exc, KeyboardInterrupt):
             raise KeyboardInterrupt from exc  # what the native code made of it
