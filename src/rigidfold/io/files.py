@@ -24,6 +24,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
+from rigidfold.runtime.interrupts import held_interrupts
 
 _TEMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
 
@@ -38,9 +39,10 @@ def prepare_output_dir(path: str | os.PathLike) -> Path:
     out = Path(path)
     try:
         out.mkdir(parents=True, exist_ok=True)
-        fd, probe = _create_temp(out, ".rigidfold-write-test")
-        os.close(fd)
-        probe.unlink()
+        with held_interrupts():  # an interrupt here leaves no probe behind
+            fd, probe = _create_temp(out, ".rigidfold-write-test")
+            os.close(fd)
+            probe.unlink()
     except OSError as exc:
         raise RigidfoldError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
     return out
