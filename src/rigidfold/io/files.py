@@ -112,7 +112,8 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
         )
     tmp = None
     try:
-        fd, tmp = _create_temp(path.parent, path.name)
+        with held_interrupts():  # the file and the note of it go together
+            fd, tmp = _create_temp(path.parent, path.name)
         with os.fdopen(fd, "wb") as file:
             file.write(data)
             file.flush()
@@ -141,8 +142,9 @@ def write_together(files: list[tuple[Path, str | bytes]]) -> list[Path]:
         for path, data in files:
             path = Path(path)
             raw = text_bytes(data) if isinstance(data, str) else data
-            fd, tmp = _create_temp(path.parent, path.name)
-            staged.append((tmp, path))
+            with held_interrupts():  # the file and the note of it go together
+                fd, tmp = _create_temp(path.parent, path.name)
+                staged.append((tmp, path))
             with os.fdopen(fd, "wb") as file:
                 file.write(raw)
                 file.flush()
