@@ -65,6 +65,35 @@ def run_cli(*args: str, cwd=None, timeout: float = 600) -> subprocess.CompletedP
     )
 
 
+def run_cli_size_limited(limit: int, *args: str, timeout: float = 600):
+    """``python -m rigidfold.cli ARGS`` in a new process whose files may be at most
+    ``limit`` bytes (``RLIMIT_FSIZE``, as ``ulimit -f``; SIGXFSZ ignored, so a write past it
+    fails with EFBIG): its exit code, stdout and stderr."""
+    import resource
+    import signal
+
+    def limited() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, resource.RLIM_INFINITY))
+
+    return subprocess.run(
+        [sys.executable, "-m", "rigidfold.cli", *args],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=timeout,
+        preexec_fn=limited,
+    )
+
+
+def files_of(directory) -> dict:
+    """{name: bytes} of every file below ``directory`` (hidden ones too)."""
+    from pathlib import Path
+
+    root = Path(directory)
+    return {p.relative_to(root).as_posix(): p.read_bytes() for p in root.rglob("*") if p.is_file()}
+
+
 def main_code(argv: list[str]) -> int:
     """``rigidfold.cli.commands.main``'s exit code in this process, argparse's errors (SystemExit)
     included."""

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import rigidfold.generate.steps as generate_module
-from conftest import run_cli
+from conftest import run_cli, run_cli_size_limited
 from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.io import fold_dict, read_fold, write_fold
@@ -286,12 +286,30 @@ def test_an_earlier_run_is_refused_unless_overwrite(tmp_path, capsys):
     )
     assert stale.exists()  # refused: nothing touched
     assert main(["generate", *SHORT_RUN, "--out", str(out), "--overwrite"]) == 1
-    assert not stale.exists() and (out / "notes.txt").read_text() == "mine"
+    # a file the earlier run did not record stays, whatever its name (issue 47, item 4)
+    assert stale.read_text() == "{}" and (out / "notes.txt").read_text() == "mine"
     # the link was removed, not followed; the new run's figures are a directory of their own
     assert not (out / "figures").is_symlink() and (out / "figures").is_dir()
     assert [p.name for p in outside.iterdir()] == ["keep.txt"]
     assert (outside / "keep.txt").read_text() == "keep"
-    assert len(list((out / "solutions").glob("*.fold"))) == 3
+    assert len(list((out / "solutions").glob("*.fold"))) == 3 + 1
+
+
+def test_a_report_that_cannot_be_written_is_not_bad_input(tmp_path):
+    """Issue 47, item 5: a run that passed and whose report.html could not be written (here
+    past the file size limit) exited 2, as if its input were bad. It exits 1, and its
+    summary.json's verdict names the cause."""
+    out = tmp_path / "run"
+    args = ["generate", "--surface", "dome", "--pattern", "grid:3x3", "--no-deform"]
+    res = run_cli_size_limited(200_000, *args, "--quiet", "--out", str(out))
+    assert res.returncode == 1, res.stderr
+    assert "Traceback" not in res.stderr and "bug" not in res.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    verdict = summary["verdict"]
+    assert summary["stop"] != "running" and verdict["outcome"] == "fell_short"
+    assert "report.html" in verdict["message"] and "file size limit" in verdict["message"]
+    assert not (out / "report.html").exists()
+    assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")]
 
 
 def test_a_directory_in_use_by_a_running_generate_is_refused(tmp_path, capsys):

@@ -317,8 +317,9 @@ def test_parse_length():
 
 def test_earlier_fabricate_refused_unless_overwrite(design, tmp_path, capsys):
     """A second fabricate into the same DIR is refused (exit 2, one line naming the files,
-    nothing touched); with --overwrite the earlier files go first, every cut sheet of the
-    earlier run among them (a stale sheet 99 is not left behind); other files stay."""
+    nothing touched); with --overwrite the earlier run's files that its NAME_fabricate.json
+    recorded go (a recorded sheet 98 that the new run does not write is not left behind);
+    every other file stays, a sheet the earlier run did not record (99) too (issue 47)."""
     out = tmp_path / "out"
     args = ["fabricate", str(design), "--thickness", "20mm", "--out", str(out)]
     assert main_code(args) == 0
@@ -327,6 +328,12 @@ def test_earlier_fabricate_refused_unless_overwrite(design, tmp_path, capsys):
     before = summary.read_bytes()
     stale = out / f"{stem}_sheet_99.svg"
     stale.write_text("<svg/>")
+    recorded = out / f"{stem}_sheet_98.svg"  # as if the earlier run had written 98 sheets
+    recorded.write_text("<svg/>")
+    record = json.loads(summary.read_text())
+    record["written"].append(str(recorded))
+    summary.write_text(json.dumps(record))
+    before = summary.read_bytes()
     other = out / "notes.txt"
     other.write_text("mine")
     capsys.readouterr()
@@ -335,9 +342,29 @@ def test_earlier_fabricate_refused_unless_overwrite(design, tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "--overwrite" in err and f"{stem}_solids.glb" in err
     assert summary.read_bytes() == before and stale.exists()
     assert main_code([*args, "--overwrite"]) == 0
-    assert not stale.exists() and other.read_text() == "mine"
+    assert not recorded.exists() and stale.read_text() == "<svg/>"
+    assert other.read_text() == "mine"
     done = json.loads(summary.read_text())
-    assert len(list(out.glob(f"{stem}_sheet_*.svg"))) == done["cut_sheets"]["sheets"]
+    assert len(list(out.glob(f"{stem}_sheet_*.svg"))) == done["cut_sheets"]["sheets"] + 1
+
+
+def test_a_failed_overwrite_keeps_the_earlier_files_and_names_the_cause(design, tmp_path):
+    """Issue 47, item 5: under ``ulimit -f 100`` ``fabricate --overwrite`` removed the 17
+    files of the earlier run, wrote none and blamed rhino3dm. The new files are written
+    aside first: a write past the file size limit leaves every earlier file as it was, no
+    temporary file, and the message names the limit."""
+    from conftest import files_of, run_cli_size_limited
+
+    out = tmp_path / "out"
+    args = ["fabricate", str(design), "--thickness", "20mm", "--out", str(out)]
+    assert main_code(args) == 0
+    before = files_of(out)
+    biggest = max(len(b) for b in before.values())
+    res = run_cli_size_limited(biggest // 2, *args, "--overwrite")
+    err = res.stderr.strip()
+    assert res.returncode == 2 and len(err.splitlines()) == 1, err
+    assert "file size limit" in err and "rhino3dm" not in err, err
+    assert files_of(out) == before
 
 
 def test_only_a_stale_sheet_counts_as_earlier(design, tmp_path, capsys):

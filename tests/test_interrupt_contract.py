@@ -1,12 +1,13 @@
 """One interrupt contract wherever the signal lands (issue 47, items 1 and 2).
 
 SIGTERM is sent to a real ``rigidfold generate`` process at many moments spread over its
-whole run (the search, the final design's diagram and motion, the exports, the report), and
-each time: exit 130 within a few seconds (or a normal exit when the run had ended before the
-signal: its report written first); summary.json says ``"stop": "interrupted"`` with a
-verdict that names a design known to deploy or none; every file it lists is on disk; the
-exports are all there or none; nothing is reported as a bug; no temporary file or lock is
-left; the run reads back (``load_run``).
+whole run (the start, the search, the final design's diagram and motion, the exports, the
+report, the end), each found by the file the run writes there (so a loaded machine moves no
+moment out of its stage), two runs at a time, and each time: exit 130 within a few seconds
+(or a normal exit when the run had ended before the signal: its report written first);
+summary.json says ``"stop": "interrupted"`` with a verdict that names a design known to
+deploy or none; every file it lists is on disk; the exports are all there or none; nothing
+is reported as a bug; no temporary file or lock is left; the run reads back (``load_run``).
 """
 
 from __future__ import annotations
@@ -41,10 +42,34 @@ CASE = [
     "--no-deform",
     "--quiet",
 ]
-MOMENTS = 20
-"""How many runs are signalled, at moments spread over the reference run's length."""
+FINAL = "solutions/step_02_dof_19"
+MOMENTS = [
+    # (what the run has written, then seconds, its options): "" is the process's start
+    ("", 0.4, ()),
+    ("", 1.0, ()),
+    ("log.jsonl", 0.0, ()),
+    ("log.jsonl", 0.2, ("--check", "all")),
+    ("solutions/step_00_dof_21.fold", 0.0, ("--check", "all")),
+    ("solutions/step_00_dof_21.fold", 0.1, ()),
+    ("solutions/step_01_dof_20.fold", 0.0, ("--check", "all")),
+    ("solutions/step_01_dof_20.fold", 0.1, ()),
+    (f"{FINAL}.fold", 0.0, ()),  # the final design's diagram and motion
+    (f"{FINAL}.fold", 0.05, ()),
+    (f"{FINAL}.fold", 0.15, ()),
+    (f"{FINAL}.fold", 0.3, ("--check", "all")),
+    (f"{FINAL}.svg", 0.0, ()),
+    ("final", 0.0, ()),  # the exports
+    ("final", 0.05, ()),
+    ("final", 0.15, ()),
+    ("final", 0.3, ()),
+    ("figures", 0.0, ()),  # the report
+    ("figures", 0.1, ()),
+    ("report.html", 0.0, ()),  # the end
+]
+"""Where each run is signalled: once the file or directory is there (relative to the run
+directory), that many seconds later; spread over the whole run."""
 AT_ONCE = 2
-"""Runs at a time (the reference is timed the same way, so the moments keep their place)."""
+"""Runs at a time."""
 
 
 def _start(out: Path, extra: tuple[str, ...] = ()) -> subprocess.Popen:
@@ -56,34 +81,15 @@ def _start(out: Path, extra: tuple[str, ...] = ()) -> subprocess.Popen:
     )
 
 
-def _reference(tmp: Path) -> tuple[float, float]:
-    """(when its run directory appears, how long it takes), seconds from the start: the
-    mean of AT_ONCE runs side by side."""
-    runs, begun = [], {}
-    t0 = time.monotonic()
-    for k in range(AT_ONCE):
-        runs.append(_start(tmp / f"ref{k}"))
-    ends = {}
-    while len(ends) < len(runs):
-        now = time.monotonic() - t0
-        for k, proc in enumerate(runs):
-            if k not in begun and (tmp / f"ref{k}" / "log.jsonl").exists():
-                begun[k] = now
-            if k not in ends and proc.poll() is not None:
-                ends[k] = now
-                _, stderr = proc.communicate()
-                assert proc.returncode == 0, stderr
-        time.sleep(0.02)
-    return sum(begun.values()) / len(begun), sum(ends.values()) / len(ends)
-
-
-def _signalled(out: Path, delay: float, extra: tuple[str, ...]) -> dict:
-    """Run the case, SIGTERM it ``delay`` seconds after its start (unless it has ended);
-    what happened."""
+def _signalled(out: Path, moment: tuple[str, float, tuple[str, ...]]) -> dict:
+    """Run the case, SIGTERM it at ``moment`` (unless it has ended); what happened."""
+    marker, delay, extra = moment
     proc = _start(out, extra)
+    while marker and not (out / marker).exists() and proc.poll() is None:
+        time.sleep(0.002)
     t0 = time.monotonic()
     while time.monotonic() - t0 < delay and proc.poll() is None:
-        time.sleep(0.005)
+        time.sleep(0.002)
     sent = None
     if proc.poll() is None:
         proc.send_signal(signal.SIGTERM)
@@ -92,7 +98,7 @@ def _signalled(out: Path, delay: float, extra: tuple[str, ...]) -> dict:
     stdout, stderr = proc.communicate(timeout=120)
     return {
         "out": out,
-        "delay": delay,
+        "delay": f"{marker or 'start'} + {delay} s {' '.join(extra)}",
         "sent": sent,
         "exit_s": time.monotonic() - t_sent,
         "code": proc.returncode,
@@ -102,11 +108,15 @@ def _signalled(out: Path, delay: float, extra: tuple[str, ...]) -> dict:
 
 
 def _check(r: dict) -> None:
-    out, where = r["out"], f"signal at {r['delay']:.2f} s: {r['stderr']!r} {r['stdout'][-300:]!r}"
+    out, where = r["out"], f"signal at {r['delay']}: {r['stderr']!r} {r['stdout'][-300:]!r}"
     assert "bug" not in r["stderr"] and "Traceback" not in r["stderr"], where
     assert not (out / LOCK_NAME).exists(), where
     assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")], where
     summary_file = out / "summary.json"
+    if r["code"] == -signal.SIGTERM:
+        # only while Python starts, before rigidfold's handler is set: nothing written
+        assert not out.exists() or not list(out.iterdir()), where
+        return
     if r["sent"] is None or r["code"] != 130:
         # not signalled, or a normal exit: only when everything was written before the signal
         assert r["code"] == 0, where
@@ -148,46 +158,72 @@ def _check(r: dict) -> None:
     load_run(out)  # reads back
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="open: 1 of 20 moments (a signal near the end of the run, about the report) "
-    "exited -2 (SIGINT) after printing the interrupted line; not yet understood",
-)
 def test_sigterm_anywhere_in_a_run_keeps_the_contract(tmp_path):
-    begin, length = _reference(tmp_path)
-    # from just before the run directory appears to just past the end of the run
-    start, stop = max(0.0, begin - 0.3), length + 0.5
-    delays = [start + (stop - start) * k / (MOMENTS - 1) for k in range(MOMENTS)]
     results: list[dict] = []
     lock = threading.Lock()
 
-    def worker(items: list[tuple[int, float]]) -> None:
-        for k, delay in items:
-            extra = ("--check", "all") if k % 2 else ()
-            r = _signalled(tmp_path / f"run{k:02d}", delay, extra)
+    def worker(items: list[tuple[int, tuple]]) -> None:
+        for k, moment in items:
+            r = _signalled(tmp_path / f"run{k:02d}", moment)
             with lock:
                 results.append(r)
 
     threads = [
-        threading.Thread(target=worker, args=(list(enumerate(delays))[j::AT_ONCE],))
+        threading.Thread(target=worker, args=(list(enumerate(MOMENTS))[j::AT_ONCE],))
         for j in range(AT_ONCE)
     ]
     for t in threads:
         t.start()
     for t in threads:
         t.join()
-    assert len(results) == MOMENTS
-    for r in sorted(results, key=lambda r: r["delay"]):
+    assert len(results) == len(MOMENTS) >= 20
+    for r in sorted(results, key=lambda r: str(r["out"])):
         _check(r)
     interrupted = [r for r in results if r["code"] == 130]
-    assert len(interrupted) >= MOMENTS // 2  # most moments fall inside the run
+    assert len(interrupted) >= len(MOMENTS) // 2  # most moments fall inside the run
     # some of them after the search, in the final checks, the exports or the report
     assert any(
         json.loads((r["out"] / "summary.json").read_text())["stop"] == "interrupted"
-        and (r["out"] / "solutions" / "step_02_dof_19.fold").exists()
+        and (r["out"] / f"{FINAL}.fold").exists()
         for r in interrupted
         if (r["out"] / "summary.json").exists()
     )
+
+
+def test_the_exit_code_is_the_commands_once_it_has_ended(tmp_path):
+    """The one moment the contract test found wrong (issue 47): SIGTERM while a library was
+    imported during the exports exited -2 (killed by SIGINT) after rigidfold had said
+    "interrupted" and chosen 130. The KeyboardInterrupt had left code run by ``exec`` of a
+    string (a dataclass being made), which CPython notes as unhandled however it is handled
+    after; a process started with ``python -m`` then kills itself with SIGINT as it exits.
+    And a signal during Python's own exit (its handlers put back) killed a run that had
+    written everything (-15). :func:`command_ended` clears both."""
+    module = tmp_path / "ends.py"
+    module.write_text(
+        "import os, signal, sys\n"
+        "from rigidfold.runtime.interrupts import command_ended, terminate_interrupts\n"
+        "terminate_interrupts()\n"
+        "try:\n"
+        "    exec('import os, signal; os.kill(os.getpid(), signal.SIGTERM)\\nx = 1')\n"
+        "    sys.exit(3)  # not reached: the signal interrupts\n"
+        "except KeyboardInterrupt:\n"
+        "    code = 130\n"
+        "if 'ended' in sys.argv:\n"
+        "    command_ended()\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)  # after the end: changes nothing\n"
+        "    os.kill(os.getpid(), signal.SIGINT)\n"
+        "sys.exit(code)\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    runs = {
+        how: subprocess.run(
+            [sys.executable, "-m", "ends", *how], env=env, capture_output=True, text=True
+        )
+        for how in ((), ("ended",))
+    }
+    assert runs[("ended",)].returncode == 130, runs[("ended",)].stderr
+    # without it, this Python's own rule (CPython 3.11: -2); the command's code where fixed
+    assert runs[()].returncode in (-signal.SIGINT, 130), runs[()].stderr
 
 
 def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
@@ -216,3 +252,32 @@ def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
     assert summary["stop"] == "interrupted" and summary["exports"] == []
     assert not (out / "final").exists() or not list((out / "final").iterdir())
     assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_an_interrupt_that_native_code_eats_in_the_search_stops_the_run(tmp_path, monkeypatch):
+    """The contract test's signal 0.1 s after the first solution: CasADi's overloads took
+    the interrupted conversion of a NumPy array for a failed match and tried the next
+    (symbolic) one, so the interrupt was eaten and the run went on to a TypeError, reported
+    as a bug. The whole run is kept (``kept_interrupts``): an interrupt eaten anywhere in it
+    stops the run at the next attempt, or turns what the native code made of it into the
+    interrupt; exit 130, the summary says interrupted, nothing is exported."""
+    import rigidfold.generate.steps as steps
+    from rigidfold.cli.commands import main
+
+    real, calls = steps.analyze, []
+
+    def eaten(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            try:  # as native code does with the exception of a Python callback
+                os.kill(os.getpid(), signal.SIGINT)
+            except BaseException:
+                pass
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(steps, "analyze", eaten)
+    out = tmp_path / "run"
+    assert main([*CASE, "--out", str(out)]) == 130
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stop"] == "interrupted" and summary["exports"] == []
+    assert len(calls) <= 3  # stopped at once, not at the end of the run

@@ -137,3 +137,16 @@ def test_generate_overwrite_removes_them(tmp_path, capsys):
     assert main_code([*args, "--target-dof", "6", "--out", str(out), "--overwrite"]) == 0
     assert not [p.name for p in out.iterdir() if p.name.endswith(".tmp")]
     assert (out / "report.html").is_file()
+
+
+def test_the_report_figures_overwrite_removes_are_every_figure_the_report_draws():
+    """--overwrite removes the report's figures by exact name (issue 47, item 4): the names
+    in :data:`FIGURE_NAMES` are every one :func:`rigidfold.reporting.render_figures` writes."""
+    import re
+    from pathlib import Path
+
+    import rigidfold.reporting.figures as figures
+    from rigidfold.rundir.layout import FIGURE_NAMES
+
+    drawn = re.findall(r'_figure\(plt, "([^"]+)"', Path(figures.__file__).read_text())
+    assert drawn and sorted(drawn) == sorted(FIGURE_NAMES)

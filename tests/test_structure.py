@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import folded_grid, run_cli
+from conftest import files_of, folded_grid, run_cli, run_cli_size_limited
 from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
 from rigidfold.io import read_fold, write_fold
@@ -291,6 +291,22 @@ def test_cli_auto_writes_json_and_figure(design_file, tmp_path):
     ):
         assert key in saved
     assert saved["balance_error"] < 1e-3
+
+
+def test_a_failed_overwrite_keeps_the_earlier_files_and_names_the_cause(design_file, tmp_path):
+    """Issue 47, item 5: ``structure --overwrite`` removed the earlier structure.json and
+    structure.png before writing, so a write past the file size limit lost both. The new
+    files are written aside first: the earlier ones stay as they were, and the message
+    names the limit."""
+    out = tmp_path / "s"
+    args = ["structure", str(design_file), "--out", str(out), "--load", "uniform=0.5"]
+    assert run_cli(*args).returncode in (0, 1)  # written whatever the verdict
+    before = files_of(out)
+    assert sorted(before) == ["structure.json", "structure.png"]
+    res = run_cli_size_limited(min(len(b) for b in before.values()) // 2, *args, "--overwrite")
+    err = res.stderr.strip()
+    assert res.returncode == 2 and "file size limit" in err.splitlines()[-1], err
+    assert files_of(out) == before
 
 
 def test_cli_deflection_limit_decides_the_exit_code(design_file, tmp_path):

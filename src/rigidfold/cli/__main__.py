@@ -2,9 +2,19 @@
 
 import sys
 
-from rigidfold.cli.commands import main
-from rigidfold.runtime.interrupts import terminate_interrupts
+from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, command_ended, terminate_interrupts
 
 if __name__ == "__main__":
-    terminate_interrupts()
-    sys.exit(main())
+    terminate_interrupts()  # before the command line's modules load: SIGTERM then exits 130
+    code = None
+    try:
+        from rigidfold.cli.commands import main
+
+        code = main()
+        command_ended()  # ended: a signal now changes nothing
+    except KeyboardInterrupt:
+        if code is None:
+            print("rigidfold: interrupted", file=sys.stderr)
+            code = EXIT_INTERRUPTED
+        command_ended()
+    sys.exit(code)

@@ -485,10 +485,14 @@ _COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    argv = attached_values(sys.argv[1:] if argv is None else argv)
-    parser.refuse_unknown_options(argv)
-    args = parser.parse_args(argv)
+    try:  # a signal while the command line is read ends as any other: exit 130
+        parser = build_parser()
+        argv = attached_values(sys.argv[1:] if argv is None else argv)
+        parser.refuse_unknown_options(argv)
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        print("rigidfold: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     if not (args.verbose or native_output_shown()):
         _quiet_exit()
     shown = os.environ.get(VERBOSE_ENV)

@@ -11,7 +11,7 @@ import sysconfig
 from collections.abc import Sequence
 from pathlib import Path
 
-from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, terminate_interrupts
+from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, command_ended, terminate_interrupts
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -20,19 +20,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     ``rigidfold`` command (or ``python -m rigidfold``), the process first restarts itself
     with the pinned numerics; called from another program, it does not (restarting would
     run that program again from the top: ``python -m rigidfold.pinned python script.py``
-    pins one)."""
+    pins one). Started as the command, its exit code is the command's whatever signal
+    comes once it has ended (:func:`rigidfold.runtime.interrupts.command_ended`)."""
     terminate_interrupts()
+    entry = argv is None and _started_as_rigidfold()  # this process is the command
+    code = None
     try:
         from rigidfold.runtime.numerics import restart_pinned
 
-        if argv is None and _started_as_rigidfold():
+        if entry:
             restart_pinned()
         from rigidfold.cli.commands import main as cli_main
 
-        return cli_main(argv)
+        code = cli_main(argv)
     except KeyboardInterrupt:
-        print("rigidfold: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        if code is None:
+            print("rigidfold: interrupted", file=sys.stderr)
+            code = EXIT_INTERRUPTED
+    if entry:
+        command_ended()  # a signal from now on changes nothing, the exit code included
+    return code
 
 
 def _started_as_rigidfold() -> bool:

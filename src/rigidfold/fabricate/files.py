@@ -21,7 +21,8 @@ import csv
 import io
 import json
 import math
-import tempfile
+import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -143,9 +144,11 @@ def obj_text(fab: Fabrication, *, title: str = "") -> str:
 
 
 def rhino_bytes(fab: Fabrication) -> bytes:
-    """The Rhino model (see the module's text), written through a file in a private
-    temporary directory (rhino3dm writes files only, and takes only paths it can encode in
-    UTF-8: the output directory's name need not be)."""
+    """The Rhino model (see the module's text) as the bytes of a version 7 file, made in
+    memory (``File3dm.Encode``): no file is written, so a full disk or the file size limit
+    shows where the files are written, with its cause, not as a refusal of rhino3dm."""
+    import base64
+
     import rhino3dm  # its stubs do not know the setters and the attribute arguments
 
     p = fab.panels
@@ -194,11 +197,12 @@ def rhino_bytes(fab: Fabrication) -> bytes:
         centre = coords[p.vertices[k]].mean(axis=0)
         point = rhino3dm.Point3d(*centre)
         model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))  # type: ignore[call-arg]
-    with tempfile.TemporaryDirectory(prefix="rigidfold-") as private:
-        tmp = Path(private) / "model.3dm"
-        if not model.Write(str(tmp), 7):
-            raise RigidfoldError("cannot write the Rhino model (rhino3dm refused it)")
-        return tmp.read_bytes()
+    options = rhino3dm.File3dmWriteOptions()
+    options.Version = 7  # type: ignore[misc]
+    data = base64.b64decode(model.Encode(options) or "")  # type: ignore[attr-defined]
+    if not data:
+        raise RigidfoldError("cannot make the Rhino model (rhino3dm made no file of it)")
+    return data
 
 
 def hinge_rows(fab: Fabrication) -> list[dict]:
@@ -340,3 +344,30 @@ SOLID_FILES = (
     "{}_vertices.csv",
 )
 """The names :func:`write_solid_files` writes, ``{}`` for the design's name."""
+
+
+def recorded_files(out: Path, name: str) -> list[str]:
+    """The files of design ``name`` that an earlier ``fabricate`` into ``out`` recorded in
+    its ``NAME_fabricate.json`` (``"written"``, and the file itself): their names in
+    ``out``, only those of a form it writes (:data:`SOLID_FILES`, the cut sheets'
+    :data:`rigidfold.fabricate.cutsheets.SHEET_FILE`); ``[]`` when the file cannot be read
+    (absent, not JSON, a symbolic link). ``--overwrite`` removes exactly these."""
+    from rigidfold.fabricate.cutsheets import SHEET_FILE
+    from rigidfold.io.files import parse_json
+
+    own = FABRICATE_JSON.format(name)
+    try:
+        fd = os.open(out / own, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+        with os.fdopen(fd, "rb") as file:
+            data = parse_json(file.read())
+    except (OSError, ValueError):
+        return []
+    written = data.get("written") if isinstance(data, dict) else None
+    fixed = {t.format(name) for t in SOLID_FILES}
+    sheet = re.compile(SHEET_FILE.format(re.escape(name)), re.DOTALL)
+    names = [
+        Path(w).name
+        for w in (written if isinstance(written, list) else [])
+        if isinstance(w, str) and (Path(w).name in fixed or sheet.fullmatch(Path(w).name))
+    ]
+    return list(dict.fromkeys([*names, own]))

@@ -10,6 +10,7 @@ at a time (:func:`append_json_line`): a crash can tear only its last line.
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import math
 import os
@@ -23,6 +24,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
+from rigidfold.runtime.interrupts import held_interrupts
 
 _TEMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
 
@@ -43,9 +45,10 @@ def prepare_output_dir(path: str | os.PathLike, *, within: str | os.PathLike | N
         _refuse_linked_dirs(Path(within), out)
     try:
         out.mkdir(parents=True, exist_ok=True)
-        fd, probe = _create_temp(out, ".rigidfold-write-test")
-        os.close(fd)
-        probe.unlink()
+        with held_interrupts():  # an interrupt here leaves no probe behind
+            fd, probe = _create_temp(out, ".rigidfold-write-test")
+            os.close(fd)
+            probe.unlink()
     except OSError as exc:
         raise RigidfoldError(f"cannot write to output directory '{out}': {_reason(exc)}") from None
     return out
@@ -172,7 +175,8 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
         )
     tmp = None
     try:
-        fd, tmp = _create_temp(path.parent, path.name)
+        with held_interrupts():  # the file and the note of it go together
+            fd, tmp = _create_temp(path.parent, path.name)
         with os.fdopen(fd, "wb") as file:
             file.write(data)
             file.flush()
@@ -201,8 +205,9 @@ def write_together(files: list[tuple[Path, str | bytes]]) -> list[Path]:
         for path, data in files:
             path = Path(path)
             raw = text_bytes(data) if isinstance(data, str) else data
-            fd, tmp = _create_temp(path.parent, path.name)
-            staged.append((tmp, path))
+            with held_interrupts():  # the file and the note of it go together
+                fd, tmp = _create_temp(path.parent, path.name)
+                staged.append((tmp, path))
             with os.fdopen(fd, "wb") as file:
                 file.write(raw)
                 file.flush()
@@ -421,5 +426,17 @@ def _cut_from(stem: str, name: str) -> bool:
     return stem == name or stem == _cut(name, _TEMP_STEM_BYTES)
 
 
+_CAUSES = {
+    errno.ENOSPC: "the disk is full",
+    errno.EDQUOT: "the disk quota is reached",
+    errno.EFBIG: "the file size limit is reached (ulimit -f)",
+}
+"""What a write that failed for want of room means, said with the system's words."""
+
+
 def _reason(exc: OSError) -> str:
-    return str(exc.strerror or exc)
+    """Why a file could not be written: the system's words, and for want of room its cause
+    (a full disk, the quota, the file size limit)."""
+    words = str(exc.strerror or exc)
+    cause = _CAUSES.get(exc.errno) if exc.errno is not None else None
+    return words if cause is None else f"{words}: {cause}"

@@ -59,7 +59,7 @@ from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
 from rigidfold.pipeline import RunWriter, write_checked_shape, write_report
 from rigidfold.reporting import page, render_figures, thick_figure, view_figure
-from rigidfold.rundir import RunData, clear_earlier_run, load_run
+from rigidfold.rundir import RunData, clear_earlier_run, earlier_run, load_run
 from rigidfold.runtime.interrupts import kept_interrupts
 from rigidfold.structure import (
     Material,
@@ -345,12 +345,18 @@ def generate_case(
     command line) propagates once summary.json says the run was interrupted
     (:meth:`rigidfold.pipeline.RunWriter.interrupted`)."""
 
+    received: list[int] = []  # the signals kept_interrupts noted (one native code ate)
+
     def on_attempt(run: Generation, attempt: Attempt) -> None:
+        if received:
+            raise KeyboardInterrupt  # native code ate it: the run stops here
         writer.on_attempt(run, attempt)
         if progress:
             progress(run, attempt)
 
     def on_solution(run: Generation, solution) -> None:
+        if received:
+            raise KeyboardInterrupt
         writer.on_solution(run, solution)
         if progress:
             progress(run, None)
@@ -361,16 +367,17 @@ def generate_case(
             progress(run, None)
 
     try:
-        run = generate(
-            writer.case,
-            writer.options,
-            on_attempt=on_attempt,
-            on_solution=on_solution,
-            on_retract=on_retract,
-        )
-        writer.finish(run)
-        if report:
-            with kept_interrupts():  # matplotlib, plotly: an interrupt is never eaten
+        # CasADi, IPOPT, trimesh, matplotlib: native code never eats an interrupt
+        with kept_interrupts() as received:
+            run = generate(
+                writer.case,
+                writer.options,
+                on_attempt=on_attempt,
+                on_solution=on_solution,
+                on_retract=on_retract,
+            )
+            writer.finish(run)
+            if report:
                 report_run(writer.out)
         writer.completed = True  # from here a signal does not make it an interrupted run
     except KeyboardInterrupt:
@@ -536,15 +543,19 @@ def structure(
     as ``options`` ask (:class:`rigidfold.structure.StructureOptions`, checked when made):
     ``OUT/structure.json`` and ``OUT/structure.png`` (:mod:`rigidfold.structure`). The
     indices and point loads are checked against the design before anything is written
-    (ValueError, one line). ``progress`` is handed a line as each long step starts.
+    (ValueError, one line). ``progress`` is handed a line as each long step starts. An
+    earlier run's files are refused unless ``overwrite``: then the new ones are written
+    together, and only then is an earlier file not written again removed; a failed write
+    leaves the earlier files as they were.
     """
     refuse_replacing_inputs([path], [Path(out) / name for name in STRUCTURE_FILES])
     data = read_fold(path, up=up, settings=settings)
     plan = plan_design(data.pattern, options, settings=settings, progress=progress)
     out_dir = prepare_output_dir(out)
-    clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
+    earlier = earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=STRUCTURE_FILES)
     check = plan.check()
     written = write_structure(check, out_dir, str(path))
+    earlier.remove(keep=written)  # the new files are in place: an earlier figure goes
     return StructureRun(str(path), check, tuple(written))
 
 
@@ -594,17 +605,32 @@ def fabricate_file(
     ``options.sheet`` (mm) stock, and ``NAME_fabricate.json``. The files are written
     whatever the verdict. Refused (ValueError, before anything is written) when one of them
     would replace ``path``, and when OUT holds an earlier fabricate's files of the same NAME
-    (every cut sheet included), unless ``overwrite`` (then they are removed first, like
-    ``generate --overwrite``: :func:`rigidfold.rundir.clear_earlier_run`)."""
+    (every cut sheet included), unless ``overwrite``: then the new files are written
+    beside them and renamed into place together, and only then are the earlier run's
+    files that were not written again removed, exactly those its ``NAME_fabricate.json``
+    recorded (:func:`rigidfold.rundir.earlier_run`); a failed write (a full disk, the file
+    size limit, named) leaves the earlier files as they were."""
     from rigidfold.fabricate.cutsheets import sheet_files
-    from rigidfold.fabricate.files import FABRICATE_JSON, SOLID_FILES, write_fabrication
+    from rigidfold.fabricate.files import (
+        FABRICATE_JSON,
+        SOLID_FILES,
+        recorded_files,
+        write_fabrication,
+    )
 
     stem = Path(path).stem
     label = stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
-    names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)] + sheet_files(out, stem)
-    refuse_replacing_inputs([path], [Path(out) / n for n in names])
+    names = [t.format(stem) for t in (*SOLID_FILES, FABRICATE_JSON)]
+    sheets = sheet_files(out, stem)  # an earlier run's, recorded or not: refused
+    refuse_replacing_inputs([path], [Path(out) / n for n in (*names, *sheets)])
     out_dir = prepare_output_dir(out)
-    clear_earlier_run(out_dir, overwrite=overwrite, inputs=(Path(path),), names=tuple(names))
+    earlier = earlier_run(
+        out_dir,
+        overwrite=overwrite,
+        inputs=(Path(path),),
+        names=tuple(dict.fromkeys([*names, *recorded_files(out_dir, stem)])),
+        others=tuple(sheets),
+    )
     design = read_design(path, up=up, settings=settings)
     panels = Panels(design.pattern, design.coords2d, options.side)
     motion, message = design_motion(panels, design, up=up, settings=settings)
@@ -620,6 +646,7 @@ def fabricate_file(
         gap=settings.fabricate.sheet_gap,
         settings=settings,
     )
+    earlier.remove(keep=written)  # the new files are in place: the earlier run's others go
     return FabricateOutput(str(path), design, fab, summary, tuple(written))
 
 

@@ -160,10 +160,13 @@ class AttemptLog:
             self._append(attempt)
 
     def start(self) -> None:
-        """Create the log with its header, when it is not yet."""
+        """Create the log with its header, when it is not yet. The file and the note that it
+        is made go together (held from a signal): a signal as it was created left the note
+        unset, and the interrupted run's summary then failed on "log.jsonl: File exists"."""
         if not self.created:
-            append_json_line(self.path, {"schema_version": SCHEMA_VERSION}, create=True)
-            self.created = True
+            with held_interrupts():
+                append_json_line(self.path, {"schema_version": SCHEMA_VERSION}, create=True)
+                self.created = True
 
     def _append(self, attempt: Attempt) -> None:
         self.start()
@@ -210,7 +213,8 @@ class RunWriter:
         refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
         check_built_options(case.pattern, options)
         self.out = prepare_output_dir(out)
-        self.lock = lock_run_dir(self.out)
+        with held_interrupts():  # the lock and the note of it go together
+            self.lock = lock_run_dir(self.out)
         try:
             clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
             self.solutions_dir = prepare_output_dir(self.out / "solutions", within=self.out)

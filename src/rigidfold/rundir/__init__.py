@@ -9,7 +9,15 @@ report). :mod:`rigidfold.pipeline` writes it. Every file's content is a type of
 """
 
 from rigidfold.rundir.json_shapes import check_shape
-from rigidfold.rundir.layout import LOCK_NAME, RUN_DIRS, RUN_FILES, clear_earlier_run, lock_run_dir
+from rigidfold.rundir.layout import (
+    LOCK_NAME,
+    RUN_DIRS,
+    RUN_FILES,
+    EarlierRun,
+    clear_earlier_run,
+    earlier_run,
+    lock_run_dir,
+)
 from rigidfold.rundir.reader import (
     Check,
     RunData,
@@ -37,6 +45,7 @@ __all__ = [
     "RUN_FILES",
     "SCHEMA_VERSION",
     "Check",
+    "EarlierRun",
     "RunData",
     "RunSummary",
     "SolutionFile",
@@ -46,6 +55,7 @@ __all__ = [
     "aggregate",
     "check_shape",
     "clear_earlier_run",
+    "earlier_run",
     "load_run",
     "lock_run_dir",
     "read_log",

@@ -44,17 +44,62 @@ def terminate_interrupts() -> None:
 
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def command_ended() -> None:
+    """The command has ended and its exit code is decided: what is left is Python's exit,
+    which no signal may change. Call it only where the process is the command (its entry
+    point), from the main thread.
+
+    * SIGINT and SIGTERM are ignored from here: Python's exit (freeing every module, a
+      second or more on a loaded machine) puts the default handlers back early, and a signal
+      then killed a process whose run had written every file (exit -15, not 0). A signal
+      received just before is dropped with them.
+    * CPython notes a KeyboardInterrupt that leaves code run by ``exec`` of a string (as
+      dataclasses and named tuples are made, while a library is imported) as unhandled,
+      however the program handles it after, and a process started with ``python -m`` then
+      kills itself with SIGINT as it exits (exit -2 after rigidfold said "interrupted" and
+      chose 130). Running ``exec`` once more clears that note (it is kept for the last
+      ``exec`` only), so the exit code is the command's.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for s in _SIGNALS:
+        try:
+            signal.signal(s, signal.SIG_IGN)
+        except KeyboardInterrupt:  # one received just before: its handler ran first
+            signal.signal(s, signal.SIG_IGN)
+    exec("pass")  # clears CPython's unhandled-KeyboardInterrupt note (see above)
+
+
 _INTERRUPTING = (signal.default_int_handler, _interrupt)
-_ACTIVE: list[bool] = []  # the outermost kept_interrupts of the main thread is active
+_ACTIVE: list[list[int]] = []  # the signals the active outermost kept_interrupts noted
 
 
 @contextlib.contextmanager
-def kept_interrupts() -> Iterator[None]:
+def kept_interrupts() -> Iterator[list[int]]:
     """Run the block with SIGINT (and SIGTERM where it interrupts) noted: a KeyboardInterrupt
     is raised in the handler as usual, and again when the block ends if native code swallowed
-    the first (see the module's text). Nested uses rely on the outermost."""
-    if _ACTIVE or threading.current_thread() is not threading.main_thread():
-        yield
+    the first (see the module's text); an exception that native code made of it (CasADi's
+    overloads try the next one when a conversion is interrupted, and a symbolic result
+    then fails as a TypeError) becomes the KeyboardInterrupt. The block is given the list
+    of the signals received, for a long block to check between its steps. Nested uses share
+    the outermost's handler and list, and raise again at their own end for a signal
+    received while they ran."""
+    if threading.current_thread() is not threading.main_thread():
+        yield []
+        return
+    if _ACTIVE:
+        shared = _ACTIVE[0]
+        before = len(shared)
+        try:
+            yield shared
+        except BaseException as exc:
+            if len(shared) > before and not isinstance(exc, KeyboardInterrupt):
+                raise KeyboardInterrupt from exc
+            raise
+        if len(shared) > before:
+            raise KeyboardInterrupt
         return
     received: list[int] = []
 
@@ -67,9 +112,9 @@ def kept_interrupts() -> Iterator[None]:
     kept = [s for s, handler in saved.items() if handler in _INTERRUPTING]
     for s in kept:
         signal.signal(s, note)
-    _ACTIVE.append(True)
+    _ACTIVE.append(received)
     try:
-        yield
+        yield received
     except BaseException as exc:
         if received and not isinstance(exc, KeyboardInterrupt):
             raise KeyboardInterrupt from exc  # what the native code made of it
@@ -89,17 +134,21 @@ def held_interrupts(*, reraise: bool = True) -> Iterator[list[int]]:
     together (renaming a set of files into place, the records of a solution and its file)
     are never torn. When the block ends, a KeyboardInterrupt is raised for a held signal
     (``reraise``; otherwise the caller reads the list the block is given, the signals
-    received). Keep the block short: the interrupt waits for it. Outside the main thread,
-    or where the program installed handlers of its own, it holds nothing."""
+    received). Keep the block short: the interrupt waits for it. Inside another held block
+    it changes nothing (the outer one notes the signal and decides). Outside the main
+    thread, or where the program installed handlers of its own, it holds nothing."""
     received: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
-        yield received
+    if threading.current_thread() is not threading.main_thread() or any(
+        getattr(signal.getsignal(s), "rigidfold_held", False) for s in _SIGNALS
+    ):
+        yield received  # inside another held block: that one notes the signal
         return
 
     def note(signum: int, frame: FrameType | None) -> None:
         received.append(signum)
 
     note.rigidfold_handler = True  # type: ignore[attr-defined]
+    note.rigidfold_held = True  # type: ignore[attr-defined]
     saved = {s: signal.getsignal(s) for s in _SIGNALS}
     held = [
         s

@@ -25,7 +25,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
-from rigidfold.io.files import atomic_write, jsonable, parse_json
+from rigidfold.io.files import jsonable, parse_json, write_together
 from rigidfold.material import Material, parse_material, presets_help
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
@@ -553,9 +553,10 @@ def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]
     """``OUT/structure.json`` (``{"file": source, **check.to_dict()}``) and, when the
     structure was analysed to finite displacements, ``OUT/structure.png`` (the deflected
     shape, :func:`rigidfold.structure.figure.deflection_png`); ``out`` exists. Both are made
-    in memory first and written together: when one cannot be written, those written by this
-    call are removed again and the error (RigidfoldError, one line) names the files missing.
-    Returns them."""
+    in memory first and written together (:func:`rigidfold.io.files.write_together`): each
+    beside its place first, then all renamed into place, so a failed write (a full disk, the
+    file size limit) leaves the files there as they were, and the error (RigidfoldError, one
+    line) names its cause. Returns them, structure.json first."""
     from rigidfold.structure.figure import deflection_png
 
     data = jsonable({"file": source, **check.to_dict()}, where="the structure check")
@@ -564,13 +565,5 @@ def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]
     if png is not None:
         files.append((out / STRUCTURE_FILES[1], png))
     files.append((out / STRUCTURE_FILES[0], json.dumps(data, indent=2, allow_nan=False) + "\n"))
-    written: list[Path] = []
-    try:
-        for path, content in files:
-            written.append(atomic_write(path, content))
-    except RigidfoldError as exc:
-        for path in written:
-            path.unlink(missing_ok=True)
-        names = ", ".join(path.name for path, _ in files)
-        raise RigidfoldError(f"{exc}; none of {names} written") from None
+    written = write_together(files)
     return written[::-1]  # structure.json first, as before
