@@ -71,7 +71,8 @@ def test_the_run_directory_holds_only_the_chain(backtracked):
     assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]
     assert [r["step"] for r in summary["per_solution"]] == list(range(len(run.solutions)))
     on_disk = sorted(p.name for p in (out / "solutions").iterdir())
-    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{n}.svg" for n in names])
+    final = names[summary["final_step"]]  # the development diagram of the final design only
+    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{final}.svg"])
     assert summary["n_solutions"] == len(run.solutions)
     # it reads back, and the report (written by the run) is made again from it
     data = load_run(out)
@@ -127,4 +128,5 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     names = [f"step_{k:02d}_dof_{d:02d}" for k, d in enumerate(dofs)]
     assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]
     on_disk = sorted(p.name for p in (tmp_path / "solutions").iterdir())
-    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{n}.svg" for n in names])
+    final = names[summary["final_step"]]  # the development diagram of the final design only
+    assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{final}.svg"])

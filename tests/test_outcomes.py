@@ -32,6 +32,7 @@ VALUES = {
         "zero_dof",
         "path",
         "second_order_rigid",
+        "time_limit",
         "initial_failed",
         "dead_end",
     ],

@@ -130,22 +130,24 @@ def test_non_finite_displacements_are_not_converged_and_not_drawn(tmp_path):
 
 # ------------------------------------------------------------------ item 12: files together
 def test_files_are_written_together_or_not_at_all(tmp_path, monkeypatch):
-    import rigidfold.structure.design as design
+    import errno
+
+    import rigidfold.io.files as files
 
     check = checked(square())
-    real = design.atomic_write
+    real = files._create_temp
 
-    def full_disk(path, data):
-        if Path(path).name == "structure.json":
-            raise RigidfoldError(f"cannot write '{path}': No space left on device")
-        return real(path, data)
+    def full_disk(directory, name):  # the second file finds the disk full
+        if name == "structure.png":
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(directory, name)
 
-    monkeypatch.setattr(design, "atomic_write", full_disk)
+    monkeypatch.setattr(files, "_create_temp", full_disk)
     with pytest.raises(RigidfoldError) as err:
         write_structure(check, tmp_path, "square")
-    assert "structure.json" in str(err.value) and "structure.png" in str(err.value)
+    assert "none written" in str(err.value) and "disk is full" in str(err.value)
     assert not list(tmp_path.iterdir())
-    monkeypatch.setattr(design, "atomic_write", real)
+    monkeypatch.setattr(files, "_create_temp", real)
     names = [p.name for p in write_structure(check, tmp_path, "square")]
     assert names == ["structure.json", "structure.png"]
 
