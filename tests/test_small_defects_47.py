@@ -160,3 +160,23 @@ def test_an_interrupted_run_names_no_design_when_none_is_known_to_deploy(chain):
     assert verdict.final_design is None
     assert "no design is known to deploy" in verdict.message
     assert "none of the 3 solutions" in verdict.message
+
+
+# ------------------------------------------- a failed write of the final design's FOLD file
+def test_a_failed_final_fold_write_ends_the_run_with_its_cause(tmp_path, monkeypatch, capsys):
+    """Item 5: the final design's FOLD file (written with its diagram at the end) cannot be
+    written: summary.json does not stay "running"; the run falls short naming the cause."""
+    import rigidfold.pipeline.writer as writer
+
+    def full_disk(path, *args, **kwargs):
+        raise RigidfoldError(f"cannot write '{path}' (the disk is full)")
+
+    monkeypatch.setattr(writer, "write_checked_shape", full_disk)
+    out = tmp_path / "run"
+    argv = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "1"]
+    code = main_code([*argv, "--target-dof", "19", "--no-deform", "--quiet", "--out", str(out)])
+    assert code == 1
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stop"] != "running"
+    assert summary["verdict"]["outcome"] == "fell_short"
+    assert "the disk is full" in summary["verdict"]["message"]
