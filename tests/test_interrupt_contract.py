@@ -226,6 +226,17 @@ def test_the_exit_code_is_the_commands_once_it_has_ended(tmp_path):
     assert runs[()].returncode in (-signal.SIGINT, 130), runs[()].stderr
 
 
+@pytest.fixture
+def ctrl_c():
+    """SIGINT raises KeyboardInterrupt in this process, as at a terminal: a process started
+    in the background by a non-interactive shell inherits SIGINT ignored, and Python then
+    leaves it ignored (the signal these tests send would do nothing)."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
+@pytest.mark.usefixtures("ctrl_c")
 def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
     """Third-party code that catches BaseException (trimesh, on import and in its functions)
     swallowed the KeyboardInterrupt of a signal received during the final export: the run
@@ -254,6 +265,7 @@ def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
     assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")]
 
 
+@pytest.mark.usefixtures("ctrl_c")
 def test_an_interrupt_that_native_code_eats_in_the_search_stops_the_run(tmp_path, monkeypatch):
     """The contract test's signal 0.1 s after the first solution: CasADi's overloads took
     the interrupted conversion of a NumPy array for a failed match and tried the next
