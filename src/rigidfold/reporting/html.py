@@ -299,12 +299,15 @@ def _drive(run: RunData) -> list[str]:
     ]
     png = run.drive_figure()
     if png is not None:
-        data = base64.b64encode(png).decode("ascii")
         out.append(
-            '<figure id="deploy.png"><img alt="drive torque along the deployment" '
-            f'src="data:image/png;base64,{data}"><figcaption><b>Deployment drive.</b> The '
-            "torque of the named drive against s, dead points, sign changes and brake zones "
-            "marked; the energy (<code>final/deploy/deploy.png</code>).</figcaption></figure>"
+            _png_figure(
+                "deploy.png",
+                "drive torque along the deployment",
+                png,
+                "<b>Deployment drive.</b> The torque of the named drive against s, dead points, "
+                "sign changes and brake zones marked; the energy "
+                "(<code>final/deploy/deploy.png</code>).",
+            )
         )
     return out
 
@@ -368,15 +371,26 @@ def _structure(run: RunData) -> list[str]:
         ]
     png = run.structure_figure()
     if png is not None:
-        data = base64.b64encode(png).decode("ascii")
         out.append(
-            '<figure id="structure.png"><img alt="deflected shape" '
-            f'src="data:image/png;base64,{data}"><figcaption><b>Deflected shape.</b> The '
-            "design (grey) and its deflected shape, scaled, coloured by the displacement; the "
-            "supports as red triangles (<code>final/structure/structure.png</code>)."
-            "</figcaption></figure>"
+            _png_figure(
+                "structure.png",
+                "deflected shape",
+                png,
+                "<b>Deflected shape.</b> The design (grey) and its deflected shape, scaled, "
+                "coloured by the displacement; the supports as red triangles "
+                "(<code>final/structure/structure.png</code>).",
+            )
         )
     return out
+
+
+def _png_figure(name: str, alt: str, png: bytes, caption: str) -> str:
+    """A ``<figure>`` of the PNG ``png`` embedded, its id ``name``, its caption (HTML)."""
+    data = base64.b64encode(png).decode("ascii")
+    return (
+        f'<figure id="{name}"><img alt="{alt}" src="data:image/png;base64,{data}">'
+        f"<figcaption>{caption}</figcaption></figure>"
+    )
 
 
 def _mm(metres) -> float | None:

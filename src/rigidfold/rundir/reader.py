@@ -308,25 +308,23 @@ class RunData:
         (:meth:`run_file`)."""
         record = self.final_record
         figures = None if record is None else record.structure
-        path = None if figures is None else self.run_file(figures.get("figure"))
-        if path is None:
-            return None
-        return read_png(path)
+        return self._png(None if figures is None else figures.get("figure"))
 
     def drive_figure(self) -> bytes | None:
         """The PNG of the final design's deployment drive (``final/deploy/deploy.png``,
-        ``generate --deploy``), None when it did not run or its file is missing."""
+        ``generate --deploy``), None when it did not run or its file is missing; checked as
+        :meth:`structure_figure`'s."""
         record = self.final_record
         figures = None if record is None else record.drive
         files = [] if figures is None else (figures.get("files") or [])
-        name = next((f for f in files if isinstance(f, str) and f.endswith(".png")), None)
+        png = (f for f in files if isinstance(f, str) and f.endswith(".png"))
+        return self._png(next(png, None))
+
+    def _png(self, name: str | None) -> bytes | None:
+        """The PNG image of the run file ``name`` (:func:`rigidfold.io.read_png`), None
+        without a name or where the file is missing (:meth:`run_file`)."""
         path = None if name is None else self.run_file(name)
-        if path is None:
-            return None
-        try:
-            return path.read_bytes()
-        except OSError:
-            return None
+        return None if path is None else read_png(path)
 
     def driven_creases(self) -> tuple[int, ...]:
         """The edges (of the final design's FOLD file) of its named drive, () without one or
