@@ -57,9 +57,11 @@ from broad_cases import FAMILIES, BroadCase, cases
 VARIANTS: dict[str, tuple[str, ...]] = {
     "today": (),
     "criterion-s": ("--criterion", "s"),
+    "batch-auto": ("--batch", "auto"),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
-``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat."""
+``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
+``batch-auto`` several creases fixed per solve where the first-order analysis allows."""
 
 COMMON = ("--lookahead", "--no-deform", "--quiet")
 """The flags every run gets (besides ``--time-limit`` and ``--out``): the README's command;
@@ -313,6 +315,22 @@ def read_rows(path: Path) -> list[dict]:
     return rows
 
 
+def stratified(chosen: list[BroadCase], n: int) -> list[BroadCase]:
+    """About ``n`` of ``chosen``, the same share of each family (every k-th case in the
+    family's order, so the pick does not depend on the machine), at least
+    ``min(6, family size)`` of each."""
+    by_family: dict[str, list[BroadCase]] = defaultdict(list)
+    for c in chosen:
+        by_family[c.family].append(c)
+    share = min(1.0, n / max(1, len(chosen)))
+    picked: list[BroadCase] = []
+    for members in by_family.values():
+        want = max(min(6, len(members)), round(share * len(members)))
+        step = len(members) / want
+        picked += [members[int(i * step)] for i in range(want)]
+    return picked
+
+
 # --- the command line --------------------------------------------------------------------
 
 
@@ -321,6 +339,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
     parser.add_argument(
         "--only", default=None, metavar="TEXT[,TEXT...]", help="cases whose name holds one"
+    )
+    parser.add_argument(
+        "--sample",
+        type=int,
+        default=None,
+        metavar="N",
+        help="about N cases, every k-th of each family (at least 6 of each where it has them)",
     )
     parser.add_argument(
         "--limit",
@@ -376,6 +401,8 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         wanted = None if args.only is None else [w for w in args.only.split(",") if w]
         chosen = [c for c in every if wanted is None or any(w in c.name for w in wanted)]
+        if args.sample is not None:
+            chosen = stratified(chosen, args.sample)
         done: set[tuple[str, str]] = set()
         if args.resume and args.out.is_file():
             done = {(r["case"], r["variant"]) for r in read_rows(args.out)}
