@@ -17,8 +17,7 @@ from conftest import main_code, paper_generate
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop, generate
 from rigidfold.generate.case import make_case
-from rigidfold.pipeline import RunWriter
-from rigidfold.pipeline.workflows import generate_case
+from rigidfold.pipeline import RunWriter, run
 from rigidfold.rundir import load_run, read_log
 
 SEED = 102
@@ -34,9 +33,8 @@ def _case(backtrack_max: int):
 @pytest.fixture(scope="module")
 def backtracked(tmp_path_factory):
     out = tmp_path_factory.mktemp("backtrack")
-    writer = RunWriter(out, _case(DEFAULTS.generation.backtrack_max), OPTIONS)
-    run = generate_case(writer, report=True)
-    return out, run
+    case = _case(DEFAULTS.generation.backtrack_max)
+    return out, run(case, OPTIONS, [RunWriter(out, case, OPTIONS)]).generation
 
 
 def test_a_backtracking_run_ends_with_a_chain(backtracked):
@@ -114,16 +112,18 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     plain = generate(
         make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0, fold_limits=()))
     )
-    run = generate_case(RunWriter(tmp_path, case, GenerateOptions(deform=False)), report=False)
-    assert plain.stop is run.stop is Stop.NO_CANDIDATE
-    dofs = [s.mechanism.dof for s in run.solutions]
+    options = GenerateOptions(deform=False)
+    writer = RunWriter(tmp_path, case, options, report=False)
+    generation = run(case, options, [writer]).generation
+    assert plain.stop is generation.stop is Stop.NO_CANDIDATE
+    dofs = [s.mechanism.dof for s in generation.solutions]
     assert dofs == [s.mechanism.dof for s in plain.solutions]
-    for a, b in zip(plain.solutions, run.solutions, strict=True):
+    for a, b in zip(plain.solutions, generation.solutions, strict=True):
         assert a.result.F == b.result.F
-    assert len(run.attempts) > len(plain.attempts)  # it went back and tried more
-    outcomes = [a.outcome for a in run.attempts]
-    assert outcomes.count(AttemptOutcome.DEAD_END) == run.n_backtrack >= 1
-    assert outcomes.count(AttemptOutcome.ACCEPTED) == len(run.solutions)
+    assert len(generation.attempts) > len(plain.attempts)  # it went back and tried more
+    outcomes = [a.outcome for a in generation.attempts]
+    assert outcomes.count(AttemptOutcome.DEAD_END) == generation.n_backtrack >= 1
+    assert outcomes.count(AttemptOutcome.ACCEPTED) == len(generation.solutions)
     summary = json.loads((tmp_path / "summary.json").read_text())
     names = [f"step_{k:02d}_dof_{d:02d}" for k, d in enumerate(dofs)]
     assert summary["solutions"] == [f"solutions/{n}.fold" for n in names]

@@ -242,10 +242,12 @@ def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
     swallowed the KeyboardInterrupt of a signal received during the final export: the run
     exited 0 "passed". The export runs under ``kept_interrupts``: the interrupt is raised
     again when it ends, and no export is left half written."""
-    import rigidfold.pipeline.writer as writer_module
+    import importlib
+
     from rigidfold.cli.commands import main
 
-    real = writer_module.export_design
+    run_module = importlib.import_module("rigidfold.pipeline.run")  # the function's module
+    real = run_module.export_design
 
     def eaten(*args, **kwargs):
         written = real(*args, **kwargs)
@@ -255,7 +257,7 @@ def test_an_interrupt_in_an_export_is_not_eaten(tmp_path, monkeypatch):
             pass
         return written
 
-    monkeypatch.setattr(writer_module, "export_design", eaten)
+    monkeypatch.setattr(run_module, "export_design", eaten)
     out = tmp_path / "run"
     code = main([*CASE, "--out", str(out)])
     assert code == 130

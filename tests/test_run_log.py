@@ -24,8 +24,13 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, GenerateOptions
 from rigidfold.generate.case import make_case
 from rigidfold.io import append_json_line
-from rigidfold.pipeline import RunWriter
-from rigidfold.pipeline.workflows import generate_case
+from rigidfold.pipeline import (
+    AttemptEnded,
+    RunWriter,
+    SolutionAccepted,
+    SolutionsRetracted,
+    run,
+)
 from rigidfold.rundir import LOG_FILE, SCHEMA_VERSION, load_run, read_log
 from rigidfold.study import Store, StudyConfig
 from rigidfold.study.store import STUDY_SCHEMA_VERSION
@@ -42,32 +47,30 @@ def logged(tmp_path_factory):
     seen)."""
     out = tmp_path_factory.mktemp("log")
     settings = DEFAULTS.with_(deploy_max_candidates=1, summary_interval=1e9)
-    writer = RunWriter(out, make_case("bezier", "1", seed=SEED, settings=settings), OPTIONS)
+    case = make_case("bezier", "1", seed=SEED, settings=settings)
+    writer = RunWriter(out, case, OPTIONS, report=False)
     snapshots: list[tuple[bytes, int]] = []
     writes = {"summary": 0, "solution": 0, "retract": 0}
-    write_summary, on_solution, on_retract = (
-        writer.write_summary,
-        writer.on_solution,
-        writer.on_retract,
-    )
+    write_summary = writer.write_summary
 
-    def counted(name, method):
-        def call(*args):
-            writes[name] += 1
-            return method(*args)
+    def counted(result) -> None:
+        writes["summary"] += 1
+        write_summary(result)
 
-        return call
+    writer.write_summary = counted  # type: ignore[method-assign]
 
-    writer.write_summary = counted("summary", write_summary)  # type: ignore[method-assign]
-    writer.on_solution = counted("solution", on_solution)  # type: ignore[method-assign]
-    writer.on_retract = counted("retract", on_retract)  # type: ignore[method-assign]
+    class Snapshots:  # after the writer: the log as each attempt, solution, retraction left it
+        def on_event(self, event) -> None:
+            if isinstance(event, SolutionAccepted):
+                writes["solution"] += 1
+            if isinstance(event, SolutionsRetracted):
+                writes["retract"] += 1
+            if isinstance(event, AttemptEnded | SolutionAccepted | SolutionsRetracted):
+                path = out / LOG_FILE
+                snapshots.append((path.read_bytes(), os.stat(path).st_ino))
 
-    def progress(run, attempt) -> None:
-        path = out / LOG_FILE
-        snapshots.append((path.read_bytes(), os.stat(path).st_ino))
-
-    run = generate_case(writer, progress=progress, report=False)
-    return out, run, snapshots, writes
+    generation = run(case, OPTIONS, [writer, Snapshots()]).generation
+    return out, generation, snapshots, writes
 
 
 def test_the_log_is_appended_to_never_rewritten(logged):
@@ -131,17 +134,21 @@ def test_summary_json_is_written_when_it_changes_and_exact_at_the_end(logged):
 
 def test_summary_interval_0_writes_summary_json_after_every_attempt(tmp_path):
     settings = DEFAULTS.with_(deploy_max_candidates=1, summary_interval=0)
-    writer = RunWriter(tmp_path, make_case("bezier", "1", seed=SEED, settings=settings), OPTIONS)
+    case = make_case("bezier", "1", seed=SEED, settings=settings)
     seen = []
 
-    def progress(run, attempt) -> None:
-        if attempt is not None and attempt.outcome is not AttemptOutcome.ACCEPTED:
-            summary = json.loads((tmp_path / "summary.json").read_text())
-            seen.append(summary["n_solves"] == len(run.attempts))
+    class Exact:  # after the writer: summary.json as each rejected attempt left it
+        def on_event(self, event) -> None:
+            if isinstance(event, AttemptEnded) and (
+                event.attempt.outcome is not AttemptOutcome.ACCEPTED
+            ):
+                summary = json.loads((tmp_path / "summary.json").read_text())
+                seen.append(summary["n_solves"] == len(event.result.generation.attempts))
 
-    run = generate_case(writer, progress=progress, report=False)
+    writer = RunWriter(tmp_path, case, OPTIONS, report=False)
+    generation = run(case, OPTIONS, [writer, Exact()]).generation
     assert seen and all(seen)  # exact after every rejected attempt
-    assert run.n_backtrack >= 1
+    assert generation.n_backtrack >= 1
 
 
 def test_summary_interval_is_checked():

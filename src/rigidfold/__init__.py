@@ -12,9 +12,11 @@ crease pattern, Step 1), then :func:`rigidfold.generate.generate` (Steps 2-7: so
     print(run.stop_reason, run.n_lock)  # "target DOF 1 reached", the paper's counters
     design = run.final.result.pattern  # the final design: a CreasePattern (coords, faces)
 
-:func:`rigidfold.deform.verify` checks a design (Steps 8-9 and its folding motion); each
-command of the command line is a function of :mod:`rigidfold.pipeline.workflows` that writes the
-same files (``generate_case``, ``optimize_case``, ``export_file``, ...); every tolerance and
+:func:`rigidfold.deform.verify` checks a design (Steps 8-9 and its folding motion);
+``rigidfold generate`` is :func:`rigidfold.pipeline.run` with the run directory's sink
+(:class:`rigidfold.pipeline.RunWriter`), each other command a function of
+:mod:`rigidfold.pipeline.workflows` that writes the same files (``optimize_case``,
+``export_file``, ...); every tolerance and
 default is a field of :class:`rigidfold.config.Settings`. What the library cannot use (a
 spec, a file, an option value) raises :class:`RigidfoldError`, a ``ValueError`` whose
 message names what was received.

@@ -105,8 +105,7 @@ def _counters(summary: dict, stop_reason: str) -> str:
 def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.cli.progress import GenerateProgress
     from rigidfold.drive import DriveOptions
-    from rigidfold.pipeline import RunWriter
-    from rigidfold.pipeline.workflows import generate_case
+    from rigidfold.pipeline import Interrupted, RunWriter, run
 
     structure = structure_options(args)  # checked even without --structure
     options = options_of(
@@ -118,35 +117,40 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         structure=structure if args.structure else None,
         drive=DriveOptions() if args.deploy else None,
     )
-    writer = RunWriter(args.out, _case(args), options, overwrite=args.overwrite)
+    case = _case(args)
     progress = GenerateProgress(enabled=not args.quiet, target=args.target_dof)
-    try:
-        run = generate_case(writer, progress=progress.update, report=not args.no_report)
-    except KeyboardInterrupt:
-        if writer.completed and writer.run is not None:  # it came as the run returned
-            run = writer.run
-        else:
-            return _interrupted(writer, progress)
+    # the lock on DIR is released however the run ends
+    with RunWriter(
+        args.out, case, options, overwrite=args.overwrite, report=not args.no_report
+    ) as writer:
+        try:
+            result = run(case, options, (writer, progress))
+        except Interrupted as stop:
+            return _interrupted(stop.result, writer, progress)
+        except KeyboardInterrupt:  # before the run began, or as it returned
+            result = writer.interrupted()  # its end, or summary.json saying interrupted
+            if result.interrupted:
+                return _interrupted(result, writer, progress)
     with held_interrupts(reraise=False):  # the run's files are written: it has ended
         progress.close()
-        return _print_generated(args, writer, run)
+        return _print_generated(args, writer.out, result)
 
 
-def _interrupted(writer, progress) -> int:
+def _interrupted(result, writer, progress) -> int:
     """Say where an interrupted ``generate`` left its files; exit code 130."""
-    writer.interrupted()  # done already, unless the signal came before the run began
     writer.release()
     progress.close()
-    best = None if writer.verdict is None else writer.verdict.final_design
+    best = None if result.verdict is None else result.verdict.final_design
+    n = len(result.records)
     print(
         one_line(
-            f"rigidfold: interrupted; {_count(len(writer.files), 'solution')}, log.jsonl "
+            f"rigidfold: interrupted; {_count(n, 'solution')}, log.jsonl "
             f"and summary.json are in {writer.out}"
             + (
                 f"; best design known to deploy: {writer.out / best}"
                 if best is not None
                 else "; no design is known to deploy"
-                if writer.files
+                if n
                 else ""
             )
         ),
@@ -155,39 +159,38 @@ def _interrupted(writer, progress) -> int:
     return EXIT_INTERRUPTED
 
 
-def _print_generated(args: argparse.Namespace, writer, run) -> int:
-    """Print what a finished ``generate`` run wrote and its verdict; its exit code."""
+def _print_generated(args: argparse.Namespace, out, result) -> int:
+    """Print what a finished ``generate`` run (``result``, a
+    :class:`rigidfold.pipeline.RunResult`) wrote into ``out`` and its verdict; its exit
+    code."""
     from rigidfold.pipeline import RunOutcome
     from rigidfold.pipeline.built import DRIVE_DIR, STRUCTURE_DIR, THICK_DIR
     from rigidfold.rundir.layout import FINAL_DIR, REPORT_FILE
 
+    run = result.generation
     print(_counters(run.to_dict(), run.stop_reason))
-    print(
-        f"wrote {_count(len(writer.files), 'solution')}, log.jsonl and summary.json to {writer.out}"
-    )
-    if writer.exports:
-        names = ", ".join(p.name for p in writer.exports)
-        print(f"exported the final design to {writer.out / FINAL_DIR}: {names}")
-    if writer.final_verdicts is not None:
-        print(f"final design: {writer.final_verdicts}")
-    if writer.fabrication is not None:
-        print(
-            one_line(f"thick panels ({writer.out / THICK_DIR}): {writer.fabrication.last_line()}")
-        )
-    if writer.structure is not None:
+    print(f"wrote {_count(len(result.records), 'solution')}, log.jsonl and summary.json to {out}")
+    if result.exports:
+        names = ", ".join(p.name for p in result.exports)
+        print(f"exported the final design to {out / FINAL_DIR}: {names}")
+    if result.final_verdicts is not None:
+        print(f"final design: {result.final_verdicts}")
+    if result.fabrication is not None:
+        print(one_line(f"thick panels ({out / THICK_DIR}): {result.fabrication.last_line()}"))
+    if result.structure is not None:
         print(
             one_line(
-                f"structure ({writer.out / STRUCTURE_DIR}): "
-                f"{writer.structure.status}: {writer.structure.message}"
+                f"structure ({out / STRUCTURE_DIR}): "
+                f"{result.structure.status}: {result.structure.message}"
             )
         )
-    if writer.drive is not None:
-        print(one_line(f"deployment ({writer.out / DRIVE_DIR}): {writer.drive.summary_line()}"))
-    if not args.no_report and writer.write_error is None:
-        print(f"report: {writer.out / REPORT_FILE}")
-    verdict = writer.verdict
-    assert verdict is not None  # generate_case ends with writer.finish
-    final = "none" if verdict.final_design is None else writer.out / verdict.final_design
+    if result.drive is not None:
+        print(one_line(f"deployment ({out / DRIVE_DIR}): {result.drive.summary_line()}"))
+    if not args.no_report and result.write_error is None:
+        print(f"report: {out / REPORT_FILE}")
+    verdict = result.verdict
+    assert verdict is not None  # the run ended with its verdict
+    final = "none" if verdict.final_design is None else out / verdict.final_design
     print(f"{verdict.outcome.value.replace('_', ' ')}: {verdict.message}; final design: {final}")
     return 0 if verdict.outcome is RunOutcome.PASSED else EXIT_FAILED
 

@@ -13,6 +13,8 @@ import sys
 import time
 from typing import TYPE_CHECKING
 
+from rigidfold.pipeline.events import AttemptEnded, Event, SolutionAccepted, SolutionsRetracted
+
 if TYPE_CHECKING:  # rich is imported only when a bar is first drawn
     from rich.progress import Progress, TaskID
 
@@ -39,8 +41,9 @@ def _rich_bar(label: str, *columns: str, eta: bool = False) -> Progress:
 
 
 class GenerateProgress:
-    """Progress of a generation run over the DOF to remove; call :meth:`update` after every
-    attempt and solution.
+    """Progress of a generation run over the DOF to remove: a sink of
+    :func:`rigidfold.pipeline.run` (:meth:`on_event`: :meth:`update` after every attempt,
+    solution and retraction).
 
     It shows the DOF, the locks and exceeds so far, the cost of the last attempt (solve and
     mechanism analysis, seconds) and an ETA from the mean time per DOF removed. On a terminal
@@ -97,6 +100,14 @@ class GenerateProgress:
         if done and stuck > elapsed / done:  # longer at this shape than a DOF takes
             eta = f"? ({self.tried} candidates tried at this DOF in {stuck / 60:.1f} min)"
         return done, total, f"{text}  elapsed {elapsed / 60:.1f} min  ETA {eta}"
+
+    def on_event(self, event: Event) -> None:
+        """Follow the run's attempts, solutions and retractions."""
+        match event:
+            case AttemptEnded(result, attempt):
+                self.update(result.generation, attempt)
+            case SolutionAccepted(result) | SolutionsRetracted(result):
+                self.update(result.generation)
 
     def update(self, run, attempt=None) -> None:
         if not self.enabled or run.initial_dof is None:

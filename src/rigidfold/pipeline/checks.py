@@ -28,6 +28,7 @@ from rigidfold.fabricate import Fabrication
 from rigidfold.generate import GenerateOptions, Solution
 from rigidfold.generate.case import Case
 from rigidfold.material import parse_material
+from rigidfold.mechanism.path import FoldingPath
 from rigidfold.pipeline.built import deployment_drive, structure_check, thick_panels
 from rigidfold.rundir.schema import NOT_DEVELOPED, FitStatus, SolutionRecord
 from rigidfold.structure import StructureCheck
@@ -86,13 +87,15 @@ def check_solution(
     *,
     motion: bool,
     deform: bool,
+    path: FoldingPath | None = None,
 ) -> Checked:
     """Check one accepted ``solution`` of ``case``: Step 8; the folding motion with
     ``motion`` and Step 9 with ``deform`` (neither on a DOF-0 shape, which has no motion;
     Step 9's frame of strips of the panels with ``options.material``, supported at
     ``options.support_face``); the fit to the target (``max_abs_dz_m``, ``rms_dz_m``, and
     whether it is within ``dz``: ``Stage.FIT``) and the deployability check's path where it
-    was traced (``solution.path``)."""
+    was traced (``solution.path``). The motion follows ``solution.path``, else ``path`` (the
+    final design's, traced once by the pipeline), else it traces its own."""
     dof = solution.mechanism.dof
     pattern = solution.result.pattern
     settings = case.settings
@@ -101,7 +104,7 @@ def check_solution(
         run_deform=deform and dof > 0,
         run_motion=motion and dof > 0,
         dof=dof,
-        path=solution.path,
+        path=solution.path or path,
         support_face=options.support_face,
         **_frame_material(options, settings.structure.thickness),
         settings=settings,

@@ -10,9 +10,9 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 ``develop_file``       Step 8 of a FOLD shape: FOLD with its diagram, and an SVG
 ``deform_file``        Steps 8-9 and the folding motion of a FOLD shape
 ``optimize_case``      one solve of problem (6): ``solution.fold`` and ``summary.json``
-``generate_case``      Steps 2-9 into a :class:`rigidfold.pipeline.RunWriter`
 ``export_file``        3D, CAD and cut-sheet files of a FOLD design (``rigidfold export``)
 ``report_run``         ``DIR/report.html`` and ``DIR/figures/`` of a generate run
+                       (:mod:`rigidfold.pipeline.report`)
 ``structure``          supports and loads of a FOLD design (``rigidfold structure``)
 ``fabricate_file``     thick panels of a FOLD design, checked over its deployment, and their
                        solids, schedules and nested cut sheets (``rigidfold fabricate``)
@@ -22,7 +22,6 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 from __future__ import annotations
 
 import os
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,7 +44,6 @@ from rigidfold.exports import (
     read_design,
 )
 from rigidfold.fabricate import FabricateOptions, Fabrication, Panels, design_motion
-from rigidfold.generate import Attempt, Generation, Stop, generate
 from rigidfold.generate.case import Case, parse_fixed, shape_summary
 from rigidfold.io import (
     FoldData,
@@ -57,10 +55,10 @@ from rigidfold.io import (
 )
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
-from rigidfold.pipeline import RunWriter, write_checked_shape, write_report
-from rigidfold.reporting import page, render_figures, thick_figure, view_figure
-from rigidfold.rundir import RunData, clear_earlier_run, earlier_run, load_run
-from rigidfold.runtime.interrupts import kept_interrupts
+from rigidfold.pipeline.report import RunReport as RunReport  # the command's, kept here
+from rigidfold.pipeline.report import report_run as report_run
+from rigidfold.pipeline.writer import write_checked_shape
+from rigidfold.rundir import clear_earlier_run, earlier_run
 from rigidfold.structure import (
     Material,
     StructureCheck,
@@ -327,71 +325,6 @@ def optimize_case(
     return OptimizeOutput(result, problem.build_time, report, (fold, summary))
 
 
-# ------------------------------------------------------------------------------ generate
-def generate_case(
-    writer: RunWriter,
-    *,
-    progress: Callable[[Generation, Attempt | None], None] | None = None,
-    report: bool = True,
-) -> Generation:
-    """Steps 2-9 on ``writer.case`` with ``writer.options``, every attempt and solution
-    written by ``writer`` as it comes (so an interrupt loses nothing), the solutions
-    retracted by backtracking or a restart removed at once
-    (:meth:`rigidfold.pipeline.RunWriter.on_retract`); ``progress(run, attempt)`` after each of
-    them. ``summary.json`` is written once more at the end, with
-    the run's verdict (``writer.verdict``, :func:`rigidfold.pipeline.run_verdict`); then, with
-    ``report``, ``DIR/report.html`` (:func:`report_run`). The writer's lock on DIR is
-    released at the end, however the run ends. A KeyboardInterrupt (Ctrl-C, SIGTERM from the
-    command line) propagates once summary.json says the run was interrupted
-    (:meth:`rigidfold.pipeline.RunWriter.interrupted`)."""
-
-    received: list[int] = []  # the signals kept_interrupts noted (one native code ate)
-
-    def on_attempt(run: Generation, attempt: Attempt) -> None:
-        if received:
-            raise KeyboardInterrupt  # native code ate it: the run stops here
-        writer.on_attempt(run, attempt)
-        if progress:
-            progress(run, attempt)
-
-    def on_solution(run: Generation, solution) -> None:
-        if received:
-            raise KeyboardInterrupt
-        writer.on_solution(run, solution)
-        if progress:
-            progress(run, None)
-
-    def on_retract(run: Generation, taken) -> None:
-        writer.on_retract(run, taken)
-        if progress:
-            progress(run, None)
-
-    try:
-        # CasADi, IPOPT, trimesh, matplotlib: native code never eats an interrupt
-        with kept_interrupts() as received:
-            run = generate(
-                writer.case,
-                writer.options,
-                on_attempt=on_attempt,
-                on_solution=on_solution,
-                on_retract=on_retract,
-            )
-            writer.finish(run)
-            if report:
-                report_run(writer.out)
-        writer.completed = True  # from here a signal does not make it an interrupted run
-    except KeyboardInterrupt:
-        writer.interrupted()  # wherever it landed, the report's writing too
-        raise
-    except RigidfoldError as exc:
-        if writer.run is None or writer.run.stop is Stop.RUNNING:
-            raise  # the search's: bad input
-        writer.failed(exc)  # the run ended, and its files could not all be written
-    finally:
-        writer.release()
-    return run
-
-
 # ------------------------------------------------------------------------------ export
 @dataclass(frozen=True, eq=False)
 class DesignExport:
@@ -460,49 +393,6 @@ def export_file(
         convention=convention,
     )
     return DesignExport(str(path), design, chosen, convention, tuple(written))
-
-
-# -------------------------------------------------------------------------------- report
-@dataclass(frozen=True, eq=False)
-class RunReport:
-    """The report of a generate run: the run read back, the files written and the time.
-
-    run : RunData; html : ``DIR/report.html``; figures : the PNG files in ``DIR/figures/``;
-    seconds : wall time of reading, drawing and writing.
-    """
-
-    run: RunData
-    html: Path
-    figures: tuple[Path, ...]
-    seconds: float
-
-    def to_dict(self) -> dict:
-        final = self.run.final
-        return {
-            "report": str(self.html),
-            "size_bytes": self.html.stat().st_size,
-            "figures": [str(p) for p in self.figures],
-            "final_design": None if final is None else final.name,
-            "final_dof": self.run.summary.final_dof,
-            "N_lock": self.run.summary.n_lock,
-            "checks": {c.name: c.word for c in self.run.checks()},
-            "seconds": self.seconds,
-        }
-
-
-def report_run(directory: str | os.PathLike) -> RunReport:
-    """Write ``DIR/report.html`` (one self-contained page: the answer, the 3D view with the
-    folding motion, the figures, the tables) and ``DIR/figures/*.png`` for the generate run
-    in ``directory``. ValueError (one line) when it is not a generate run."""
-    t0 = time.perf_counter()
-    run = load_run(directory)
-    figures = render_figures(run)
-    view = None if run.final is None else view_figure(run.final, run.surface, run.driven_creases())
-    thick, note = run.thick_panels()
-    solids = None if thick is None or run.final is None else thick_figure(thick, run.final)
-    text = page(run, figures, view, solids, note)
-    html, written = write_report(run.directory, text, [(f.name, f.png) for f in figures])
-    return RunReport(run, html, written, time.perf_counter() - t0)
 
 
 # ----------------------------------------------------------------------------- structure

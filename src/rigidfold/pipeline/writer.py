@@ -1,5 +1,6 @@
 """Files of a generation run, written as the run goes so an interrupt loses nothing.
 
+:class:`RunWriter` is a sink of :func:`rigidfold.pipeline.run` (:mod:`rigidfold.pipeline.events`).
 ``DIR/solutions/step_XX_dof_YY.fold`` for every accepted solution (its folded form and its
 figures; for the final design, and every solution with ``--check all``, a ``creasePattern``
 frame with its development diagram (Step 8) and the folding motion as ``foldedForm`` frames,
@@ -16,34 +17,22 @@ appended to, so a crash can tear only its last line, which its reader skips.
 from __future__ import annotations
 
 import contextlib
-import os
-import secrets
-import shutil
 import time
-from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
 from rigidfold.deform import Verification
-from rigidfold.drive import DriveResult
 from rigidfold.errors import RigidfoldError
-from rigidfold.exports import export_design
-from rigidfold.fabricate import Fabrication
 from rigidfold.generate import (
     Attempt,
     AttemptOutcome,
     GenerateOptions,
     Generation,
     Solution,
-    Stop,
-    best_so_far,
 )
 from rigidfold.generate.case import Case
 from rigidfold.io import (
     FoldData,
     append_json_line,
-    atomic_write,
     crease_pattern_frame,
     motion_frames,
     prepare_output_dir,
@@ -56,26 +45,30 @@ from rigidfold.io import (
 )
 from rigidfold.mesh import CreasePattern
 from rigidfold.pipeline.built import check_built_options
-from rigidfold.pipeline.checks import (
-    Checked,
-    check_final,
-    check_solution,
-    solution_record,
-    traced_motion,
+from rigidfold.pipeline.checks import Checked, traced_motion
+from rigidfold.pipeline.events import (
+    AttemptEnded,
+    Event,
+    FinalChecked,
+    RunEnded,
+    RunFailed,
+    RunInterrupted,
+    SolutionAccepted,
+    SolutionsRetracted,
 )
-from rigidfold.pipeline.verdict import RunOutcome, RunVerdict, run_verdict
+from rigidfold.pipeline.report import report_run
+from rigidfold.pipeline.result import RunResult
+from rigidfold.pipeline.run import stopped
 from rigidfold.rundir.layout import (
-    FIGURES_DIR,
-    FINAL_DIR,
-    REPORT_FILE,
     RUN_FILES,
+    SOLUTIONS_DIR,
     TARGET_FILE,
     clear_earlier_run,
     lock_run_dir,
+    solution_file,
 )
-from rigidfold.rundir.schema import LOG_FILE, SCHEMA_VERSION, RunSummary, SolutionRecord
-from rigidfold.runtime.interrupts import held_interrupts, kept_interrupts
-from rigidfold.structure import StructureCheck
+from rigidfold.rundir.schema import LOG_FILE, SCHEMA_VERSION, RunSummary
+from rigidfold.runtime.interrupts import held_interrupts
 from rigidfold.surfaces import SplineSurface
 
 
@@ -183,23 +176,33 @@ class AttemptLog:
 
 
 class RunWriter:
-    """Callbacks for :func:`rigidfold.generate.generate` that keep DIR up to date: the
-    checks are the pipeline's (:mod:`rigidfold.pipeline.checks`, the study's too), the writer
-    writes their results.
+    """The run directory of ``rigidfold generate``, a sink of :func:`rigidfold.pipeline.run`
+    (:mod:`rigidfold.pipeline.events`): it writes the files of the run from its events, so
+    an interrupt loses nothing, and computes nothing.
 
-    The development diagram (Step 8), the folding motion and, with ``options.deform``, the
-    large-deformation check (Step 9) run on the solutions ``options.check`` names
-    (:data:`rigidfold.config.CHECKS`): the final design only, once the run has ended (its
-    FOLD file, written without them as it came, is then written with them, and its SVG), or
-    every solution as it comes. Writing stays off the search's path: a solution that is not
-    checked costs its FOLD file only. An interrupt anywhere ends with :meth:`interrupted`.
-    ``overwrite``: replace the files of an earlier run in ``out``
-    (:func:`clear_earlier_run`), which are refused otherwise. ``options.target_dof`` is the
-    target the verdict (:meth:`finish`) judges by. With ``options.fabricate`` and
-    ``options.structure`` the final design's thick panels and structure are checked too
-    (:func:`rigidfold.pipeline.checks.check_final`; ``DIR/final/thick/``,
-    ``DIR/final/structure/``), their
-    figures in its record; ``fabrication`` and ``structure`` hold the results.
+    * :class:`~rigidfold.pipeline.events.AttemptEnded`: the attempt appended to the log;
+      summary.json again when ``Settings.generation.summary_interval`` seconds have passed
+      since it last was (a solution, a retraction and the end write it every time).
+    * :class:`~rigidfold.pipeline.events.SolutionAccepted`: its FOLD file (with its checks
+      and the SVG of its diagram where they ran, :func:`write_checked_shape`; else its
+      folded form and figures), then summary.json.
+    * :class:`~rigidfold.pipeline.events.SolutionsRetracted`: their FOLD and SVG files
+      leave ``solutions/``; their attempts are appended to the log again (DEAD_END).
+    * :class:`~rigidfold.pipeline.events.FinalChecked`: the final design's FOLD file again,
+      with its checks, and its SVG.
+    * :class:`~rigidfold.pipeline.events.RunEnded`: summary.json with the verdict, then,
+      with ``report``, ``DIR/report.html`` (:func:`rigidfold.pipeline.report.report_run`).
+    * :class:`~rigidfold.pipeline.events.RunInterrupted`,
+      :class:`~rigidfold.pipeline.events.RunFailed`: summary.json of the run as it stopped
+      (signals held while it is written; a failed write keeps the one written last).
+
+    ``run_dir`` (DIR) is where the run writes the final design's as-built checks and exports
+    (:func:`rigidfold.pipeline.checks.check_final`). ``overwrite``: replace the files of an
+    earlier run in ``out`` (:func:`clear_earlier_run`), which are refused otherwise. The lock
+    on DIR is taken when it is made and released when the run ends, or when a ``with`` block
+    around it ends, however (:meth:`release`). :meth:`interrupted` writes summary.json of an
+    interrupt that came outside the run (before it began); ``result`` is the run's result
+    once the writer has written its end.
     """
 
     def __init__(
@@ -209,6 +212,7 @@ class RunWriter:
         options: GenerateOptions,
         *,
         overwrite: bool = False,
+        report: bool = True,
     ) -> None:
         refuse_replacing_inputs(case.inputs, [Path(out) / name for name in RUN_FILES])
         check_built_options(case.pattern, options)
@@ -217,7 +221,7 @@ class RunWriter:
             self.lock = lock_run_dir(self.out)
         try:
             clear_earlier_run(self.out, overwrite=overwrite, inputs=case.inputs)
-            self.solutions_dir = prepare_output_dir(self.out / "solutions", within=self.out)
+            self.solutions_dir = prepare_output_dir(self.out / SOLUTIONS_DIR, within=self.out)
             self.target_file: str | None = None  # a mesh target's spline, for the report
             if isinstance(case.surface, SplineSurface):
                 write_json(self.out / TARGET_FILE, case.surface.grid())
@@ -225,158 +229,88 @@ class RunWriter:
         except BaseException:  # a user error, or Ctrl-C while the directory is prepared
             self.release()
             raise
-        self.case, self.options = case, options
-        self.run: Generation | None = None  # the run, once an attempt or solution was written
-        self.completed = False  # every file of the run is written, its report too
-        self.ended = False  # summary.json says it was interrupted, or its files failed
-        self.write_error: str | None = None  # why the run's files could not all be written
-        self.solutions: list[Solution] = []
-        self.checked: dict[int, Checked] = {}  # step -> its checks (development, motion)
-        self.files: list[Path] = []
-        self.records: list[SolutionRecord] = []
-        self.stage_times = {"develop": 0.0, "deform": 0.0, "motion": 0.0}
-        self.verdict: RunVerdict | None = None
-        self.final: tuple[CreasePattern, np.ndarray] | None = None
-        self.final_step: int | None = None
-        self.exports: list[Path] = []
-        self.fabrication: Fabrication | None = None
-        self.structure: StructureCheck | None = None
-        self.drive: DriveResult | None = None
+        self.case, self.options, self.report = case, options, report
+        self.seen: RunResult | None = None  # the run as last written
+        self.result: RunResult | None = None  # the run's result, once its end is written
         self.log = AttemptLog(self.out / LOG_FILE)
         self.summary_written = -float("inf")  # time.monotonic() of the last summary.json
 
     @property
-    def final_verdicts(self) -> str | None:
-        """The final design's verdicts of the large-deformation analysis and the folding motion
-        in one line, and why they differ when they do (:class:`rigidfold.deform.Verdicts`);
-        None without a solution, or when one of the two did not run."""
-        if not self.records:
-            return None
-        step = -1 if self.final_step is None else self.final_step
-        verdicts = self.records[step].verdicts
-        return None if verdicts is None else verdicts["line"]
+    def run_dir(self) -> Path:
+        """The run's directory: the pipeline's as-built checks and exports write there."""
+        return self.out
 
-    def interrupted(self, run: Generation | None = None) -> None:
-        """Write summary.json of a run stopped by Ctrl-C or SIGTERM, wherever the signal
-        landed (in a solve, a diagram, a trace, the final checks, the exports, the report):
-        ``run`` (by default the last one the writer saw; None when it was stopped before its
-        first attempt ended) with the stop INTERRUPTED, and its verdict
-        (:func:`run_verdict`), which names the best design known to deploy, or says that
-        none is known (no path is traced, no check is run and nothing is exported); the log
-        gets the attempts it has not yet (appended, never rewritten). Further signals are
-        held while it writes; a second call does nothing."""
-        if self.ended or self.completed:
-            return
-        with held_interrupts(reraise=False):
-            run = run or self.run or Generation()
-            run.stop, run.stop_detail = Stop.INTERRUPTED, ""
-            best_so_far(run)
-            self.verdict = run_verdict(
-                run,
-                self.records,
-                [p.relative_to(self.out) for p in self.files],
-                self.options.target_dof,
-            )
-            final = self.verdict.final_design
-            self.final_step = (
-                None
-                if final is None
-                else [p.relative_to(self.out) for p in self.files].index(final)
-            )
-            self.log.start()
-            self.log.sync(run.attempts)
-            self.write_summary(run)
-            self.ended = True
+    def __enter__(self) -> RunWriter:
+        return self
 
-    def failed(self, error: RigidfoldError) -> None:
-        """Write summary.json of a run that ended but whose files could not all be written
-        (the final design's, its exports, the report: a full disk, the file size limit):
-        its verdict falls short, naming ``error``; ``write_error`` holds it. When even
-        summary.json cannot be written, it stays as it was last written."""
-        run = self.run or Generation()
-        verdict = self.verdict or run_verdict(
-            run,
-            self.records,
-            [p.relative_to(self.out) for p in self.files],
-            self.options.target_dof,
-        )
-        self.write_error = str(error)
-        self.verdict = RunVerdict(
-            RunOutcome.FELL_SHORT,
-            (*verdict.shortfalls, f"the run's files could not all be written: {error}"),
-            verdict.warnings,
-            verdict.final_design,
-        )
-        with contextlib.suppress(RigidfoldError):
-            self.log.sync(run.attempts)
-            self.write_summary(run)
-        self.ended = True
+    def __exit__(self, *exc: object) -> None:
+        self.release()
 
     def release(self) -> None:
-        """Remove the run's lock on DIR (:func:`lock_run_dir`); call once the run has ended."""
+        """Remove the run's lock on DIR (:func:`lock_run_dir`); again changes nothing."""
         self.lock.unlink(missing_ok=True)
 
-    def on_attempt(self, run: Generation, attempt: Attempt) -> None:
-        """Append the attempt to the log; summary.json is written again when
-        ``Settings.generation.summary_interval`` seconds have passed since it last was (a
-        solution, a retraction and the end write it every time)."""
-        self.run = run
-        self.log.sync(run.attempts)
-        if attempt.outcome is AttemptOutcome.ACCEPTED:
-            return  # its solution (:meth:`on_solution`) writes summary.json next
-        interval = self.case.settings.generation.summary_interval
-        if time.monotonic() - self.summary_written >= interval:
-            self.write_summary(run)
+    def on_event(self, event: Event) -> None:
+        match event:
+            case AttemptEnded(result, attempt):
+                self.log.sync(result.generation.attempts)
+                interval = self.case.settings.generation.summary_interval
+                if attempt.outcome is not AttemptOutcome.ACCEPTED and (
+                    time.monotonic() - self.summary_written >= interval
+                ):
+                    self.write_summary(result)  # an accepted one: its solution's writes it
+            case SolutionAccepted(result, solution, checked):
+                self._write_solution(solution, checked)
+                self.log.sync(result.generation.attempts)  # backtracking: accepted again
+                self.write_summary(result)
+            case SolutionsRetracted(result, taken):
+                with held_interrupts():  # the files go together
+                    for solution in taken:
+                        fold = self.out / solution_file(solution.step, solution.mechanism.dof)
+                        for path in (fold, fold.with_suffix(".svg")):
+                            path.unlink(missing_ok=True)
+                self.log.sync(result.generation.attempts)
+                self.write_summary(result)
+            case FinalChecked(result, solution, checked):
+                self._write_solution(solution, checked)
+                self.seen = result
+            case RunEnded(result):
+                self.log.sync(result.generation.attempts)
+                self.write_summary(result)
+                if self.report:
+                    report_run(self.out)
+                self._end(result)
+            case RunInterrupted(result):
+                with held_interrupts(reraise=False):
+                    self.log.start()
+                    self.log.sync(result.generation.attempts)
+                    self.write_summary(result)
+                    self._end(result)
+            case RunFailed(result):
+                with contextlib.suppress(RigidfoldError):
+                    self.log.sync(result.generation.attempts)
+                    self.write_summary(result)
+                self._end(result)
 
-    def on_solution(self, run: Generation, solution: Solution) -> None:
-        """Write an accepted solution: with ``--check all`` checked as it comes
-        (:func:`rigidfold.pipeline.checks.check_solution`: Step 8, the motion, Step 9 as
-        asked) with its FOLD and SVG files; otherwise its FOLD file only (the folded form and
-        its figures: :func:`rigidfold.pipeline.checks.solution_record`), its diagram drawn
-        if it becomes the final design (:meth:`finish`). Its record and file are added
-        together (held from a signal), so summary.json lists only files on disk."""
-        self.run = run
-        checked = None
-        if self.options.check == "all":
-            checked = check_solution(
-                solution, self.case, self.options, motion=True, deform=self.options.deform
-            )
-        record = solution_record(solution, self.case) if checked is None else checked.record
-        path = self._write_solution(solution, checked)
-        with held_interrupts():
-            self.solutions.append(solution)
-            self.records.append(record)
-            self.files.append(path)
-            if checked is not None:
-                self._keep(solution.step, checked)
-        self.log.sync(run.attempts)  # backtracking may have accepted its attempt again
-        self.write_summary(run)
+    def _end(self, result: RunResult) -> None:
+        self.result = result
+        self.release()
 
-    def on_retract(self, run: Generation, taken: tuple[Solution, ...]) -> None:
-        """Backtracking or a restart retracted the last solutions (``taken``, the last
-        first): their FOLD and SVG files leave ``solutions/`` and their records summary.json
-        (the run stays a chain, and the next solution takes the first one's step); their
-        attempts are appended to the log again, with the outcome DEAD_END; summary.json is
-        written once."""
-        self.run = run
-        with held_interrupts():  # the records and the files go together
-            for solution in taken:
-                assert self.solutions and self.solutions[-1] is solution, "not the last solution"
-                self.solutions.pop()
-                self.records.pop()
-                self.checked.pop(solution.step, None)
-                fold = self.files.pop()
-                for path in (fold, fold.with_suffix(".svg")):
-                    path.unlink(missing_ok=True)
-        self.log.sync(run.attempts)
-        self.write_summary(run)
-
-    def _keep(self, step: int, checked: Checked) -> None:
-        """Note the checks of the solution at ``step``: its record, and the stages' times."""
-        for stage, t in checked.record.time_s.items():
-            self.stage_times[stage] = self.stage_times.get(stage, 0.0) + t
-        self.records[step] = checked.record
-        self.checked[step] = checked
+    def interrupted(self) -> RunResult:
+        """The run's result once the writer has written its end; otherwise (an interrupt
+        that came outside the run: before it began) summary.json of the run as last written
+        (none: stopped before its first attempt ended) with the stop INTERRUPTED and its
+        verdict (:func:`rigidfold.pipeline.run.stopped`), the log's missing attempts
+        appended, signals held."""
+        if self.result is not None:
+            return self.result
+        with held_interrupts(reraise=False):
+            result = stopped(self.seen or RunResult(self.case, self.options, Generation()))
+            self.log.start()
+            self.log.sync(result.generation.attempts)
+            self.write_summary(result)
+            self._end(result)
+        return result
 
     def _write_solution(self, solution: Solution, checked: Checked | None) -> Path:
         """Write the FOLD file of ``solution`` (``solutions/step_XX_dof_YY.fold``): with its
@@ -384,7 +318,7 @@ class RunWriter:
         diagram beside it, or without them (the folded form and its figures, no diagram).
         Returns the FOLD path."""
         dof = solution.mechanism.dof
-        path = self.solutions_dir / f"step_{solution.step:02d}_dof_{dof:02d}.fold"
+        path = self.out / solution_file(solution.step, dof)
         title = f"rigidfold generate: step {solution.step}, DOF {dof}"
         metadata = {
             **self.case.metadata(),
@@ -407,109 +341,22 @@ class RunWriter:
             )
         return path
 
-    def finish(self, run: Generation) -> RunVerdict:
-        """The verdict on the finished run (:func:`run_verdict`), written into summary.json,
-        and the final design (:attr:`rigidfold.generate.Generation.final`) exported to
-        ``DIR/final/`` in every format of :func:`rigidfold.exports.export_design`, named
-        after its solution file, the files written together (:meth:`_export`). With
-        ``check="final"`` the final design's development diagram (Step 8), folding motion
-        and Step 9 run here, once, and its FOLD file is written with them, its SVG beside
-        it; its thick panels and structure are checked as the options ask
-        (:func:`rigidfold.pipeline.checks.check_final`)."""
-        self.run = run
-        final = run.final
-        if final is not None:
-            self.final_step = final.step
-            if self.options.check == "final" or final.step not in self.checked:
-                checked = check_solution(
-                    final, self.case, self.options, motion=True, deform=self.options.deform
-                )
-                self._write_solution(final, checked)
-                with held_interrupts():
-                    self.solutions[final.step] = final  # its path may have been traced since
-                    self._keep(final.step, checked)
-            checked = self.checked[final.step]
-            self.final = (final.result.pattern, checked.coords2d)
-            o = self.options
-            if o.fabricate is not None or o.structure is not None or o.drive is not None:
-                name = self.files[final.step].stem
-                with kept_interrupts():  # trimesh's code catches BaseException
-                    built = check_final(checked, final, self.options, self.out, name)
-                self.records[final.step] = built.record
-                self.fabrication, self.structure = built.fabrication, built.structure
-                self.drive = built.drive
-        self.verdict = run_verdict(
-            run,
-            self.records,
-            [p.relative_to(self.out) for p in self.files],
-            self.options.target_dof,
-        )
-        if self.final is not None:
-            pattern, coords2d = self.final
-            stem = self.files[-1 if final is None else final.step].stem
-            self._export(pattern, coords2d, stem)
-        self.log.sync(run.attempts)
-        self.write_summary(run)
-        return self.verdict
-
-    def _export(self, pattern: CreasePattern, coords2d: np.ndarray, stem: str) -> None:
-        """The final design's exports (:func:`rigidfold.exports.export_design`), written
-        together or not at all: into a new directory of their own in DIR, then, every one
-        written, renamed into ``DIR/final/`` while signals are held; a failed write (a full
-        disk) or an interrupt leaves none of them (``exports`` stays empty). Third-party
-        code that catches BaseException (trimesh, on import and in its functions) cannot
-        eat an interrupt: it is raised again when the export ends (:func:`kept_interrupts`)."""
-        final_dir = prepare_output_dir(self.out / FINAL_DIR, within=self.out)  # no link
-        stage = self.out / f".{FINAL_DIR}.{secrets.token_hex(6)}.tmp"
-        try:
-            with kept_interrupts():
-                written = export_design(
-                    pattern, coords2d, stage, name=stem, title=f"rigidfold: {stem}"
-                )
-            with held_interrupts():
-                moved = []
-                try:
-                    for path in written:
-                        os.replace(path, final_dir / path.name)
-                        moved.append(final_dir / path.name)
-                except OSError as exc:
-                    for path in moved:
-                        path.unlink(missing_ok=True)
-                    raise RigidfoldError(
-                        f"cannot write the final design's exports into '{final_dir}': "
-                        f"{exc.strerror or exc}"
-                    ) from None
-                self.exports = moved
-        finally:
-            with contextlib.suppress(OSError):
-                shutil.rmtree(stage)
-
-    def summary(self, run: Generation) -> RunSummary:
-        """summary.json's record of the run as it stands now."""
+    def summary(self, result: RunResult) -> RunSummary:
+        """summary.json's record of the run ``result``."""
         return RunSummary.from_run(
-            run,
-            self.records,
-            stage_times=self.stage_times,
+            result.generation,
+            list(result.records),
+            stage_times=dict(result.stage_times),
             options=self.options.to_dict() | {"symmetric": bool(self.case.planes)},
             case=self.case.metadata(),
-            solutions=tuple(str(p.relative_to(self.out)) for p in self.files),
-            verdict=None if self.verdict is None else self.verdict.to_dict(),
-            exports=tuple(str(p.relative_to(self.out)) for p in self.exports),
+            solutions=tuple(str(p) for p in result.solution_files),
+            verdict=None if result.verdict is None else result.verdict.to_dict(),
+            exports=tuple(str(p) for p in result.exports),
             target_surface=self.target_file,
         )
 
-    def write_summary(self, run: Generation) -> None:
-        """Write summary.json (atomically) as the run stands now (:meth:`summary`)."""
-        write_json(self.out / "summary.json", self.summary(run).to_dict())
+    def write_summary(self, result: RunResult) -> None:
+        """Write summary.json (atomically) of the run ``result`` (:meth:`summary`)."""
+        write_json(self.out / "summary.json", self.summary(result).to_dict())
         self.summary_written = time.monotonic()
-
-
-def write_report(
-    directory: Path, html: str, figures: Sequence[tuple[str, bytes]]
-) -> tuple[Path, tuple[Path, ...]]:
-    """The report of the run in ``directory``: each (name, PNG) of ``figures`` as
-    ``DIR/figures/NAME`` and the page ``html`` as ``DIR/report.html``, each written
-    atomically. Returns (the page, the figures)."""
-    figure_dir = prepare_output_dir(directory / FIGURES_DIR, within=directory)
-    written = tuple(atomic_write(figure_dir / name, png) for name, png in figures)
-    return atomic_write(directory / REPORT_FILE, html), written
+        self.seen = result

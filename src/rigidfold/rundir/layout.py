@@ -22,7 +22,7 @@ TARGET_FILE = "target_surface.json"
 summary.json names under ``target_surface`` so that the report can show the fit."""
 
 REPORT_FILE = "report.html"
-"""The run's report (:func:`rigidfold.pipeline.writer.write_report`), its figures in
+"""The run's report (:func:`rigidfold.pipeline.report.write_report`), its figures in
 :data:`FIGURES_DIR`."""
 
 FIGURES_DIR = "figures"
@@ -55,7 +55,7 @@ _RUN_SUBDIRS = ("solutions", FIGURES_DIR, FINAL_DIR, f"{FINAL_DIR}/thick", f"{FI
 
 _STAGING = re.compile(rf"\.{FINAL_DIR}\.[0-9a-f]+\.tmp")
 """The directory the final design's exports are written to before they are moved into
-:data:`FINAL_DIR` together (:meth:`rigidfold.pipeline.RunWriter._export`): a killed run's
+:data:`FINAL_DIR` together (:meth:`rigidfold.pipeline.run._Run.export`): a killed run's
 own, removed by ``--overwrite``."""
 
 LOCK_NAME = ".rigidfold-run.lock"
@@ -336,3 +336,14 @@ def _entries(directory: Path) -> list[Path]:
         return [Path(e.path) for e in os.scandir(directory)]
     except OSError:
         return []
+
+
+SOLUTIONS_DIR = "solutions"
+"""Where a generation run writes its solutions' FOLD files (:func:`solution_file`)."""
+
+
+def solution_file(step: int, dof: int) -> Path:
+    """The FOLD file of the solution at ``step`` with ``dof``, relative to the run's
+    directory: ``solutions/step_XX_dof_YY.fold`` (its development diagram as ``.svg``
+    beside it)."""
+    return Path(SOLUTIONS_DIR) / f"step_{step:02d}_dof_{dof:02d}.fold"

@@ -17,6 +17,7 @@ import socket
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
 from rigidfold.errors import RigidfoldError
@@ -25,6 +26,9 @@ from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
 from rigidfold.study.rows import ERROR_PREFIX, Key
 from rigidfold.study.store import Store
+
+if TYPE_CHECKING:  # the pipeline is imported in the worker
+    from rigidfold.pipeline import RunResult
 
 PRESETS = {
     # Sections 6.5 and 6.6: the 11 x 11 grid with S, with and without the mirror planes
@@ -127,37 +131,26 @@ def preset(name: str) -> list[Key]:
 
 
 def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
-    """Execute one run (in a worker): generate, and Steps 8-9 of the solutions
-    ``config.options.check`` names if ``config.options.deform``.
+    """Execute one run (in a worker): :func:`rigidfold.pipeline.run` with the study's checks
+    (no motion: Steps 8-9 of the solutions ``config.options.check`` names if
+    ``config.options.deform``, and the final design's path traced after the search), its
+    row made from the result (:func:`run_row`).
 
     The run's row holds the ``runs`` columns, and ``error`` (the message) for a run that
     could not run; its status is then "error: <message>".
     """
     from rigidfold import __version__
-    from rigidfold.generate import generate
     from rigidfold.generate.case import make_case
-    from rigidfold.mechanism.path import trace_path
-    from rigidfold.pipeline.checks import check_solution
-    from rigidfold.rundir import SolutionRecord, aggregate
+    from rigidfold.pipeline import run
     from rigidfold.runtime.numerics import numeric_environment
 
     settings, options = config.settings, config.options
     t0 = time.perf_counter()
-    records: list[SolutionRecord] = []
-
-    def check(solution) -> None:  # Steps 8-9, as generate's run writer checks a solution
-        checked = check_solution(solution, case, options, motion=False, deform=True)
-        records.append(checked.record)
-
-    def retract(taken) -> None:  # backtracking or a restart retracted the last solutions
-        del records[len(records) - len(taken) :]
-
     row: dict = {
         "version": __version__,
         "worker": f"{socket.gethostname()}:{os.getpid()}",
         "numerics": numeric_environment().key,
     }
-    every = options.deform and options.check == "all"
     try:
         case = make_case(
             key.study,
@@ -166,28 +159,26 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             symmetric=key.symmetric,
             settings=settings,
         )
-        run = generate(
-            case,
-            options.replace(criterion=key.criterion, seed=key.seed),
-            on_solution=(lambda _run, solution: check(solution)) if every else None,
-            on_retract=(lambda _run, taken: retract(taken)) if every else None,
-        )
-        final = run.final
-        if final is not None and final.path is None:  # the paper's method: trace it after
-            t_path = time.perf_counter()
-            final.path = trace_path(
-                final.result.pattern, dof=final.mechanism.dof, settings=settings
-            )
-            row["time_path_final"] = time.perf_counter() - t_path
-        if final is not None and options.deform and not every:
-            check(final)
+        result = run(case, options.replace(criterion=key.criterion, seed=key.seed), motion=False)
     except RigidfoldError as exc:  # a configuration that cannot run: recorded, not retried
         row.update(
             status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
         )
         return key, row, []
-    s = run.to_dict()
-    row.update(
+    row.update(run_row(result))
+    row["time_total"] = time.perf_counter() - t0
+    return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in result.generation.attempts]
+
+
+def run_row(result: RunResult) -> dict:
+    """The ``runs`` columns of a finished run (:class:`rigidfold.pipeline.RunResult`): its
+    counters and times, whether its final design deploys (its path, traced after the search
+    where the search did not), and the figures of the solutions whose checks ran."""
+    from rigidfold.rundir import aggregate
+
+    s = result.generation.to_dict()
+    path = result.final_path
+    row = dict(
         stop=s["stop"],
         status=s["stop_reason"],
         n_reduce=s["N_reduce"],
@@ -206,9 +197,10 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         n_backtrack=s["N_backtrack"],
         n_rigid=s["N_rigid"],
         lowest_dof=s["lowest_dof"],
-        final_deploys=None if final is None or final.path is None else int(final.path.deploys),
-        time_path=s["time_s"]["path"] + row.pop("time_path_final", 0.0),
+        final_deploys=None if result.final is None or path is None else int(path.deploys),
+        time_path=s["time_s"]["path"] + result.final_path_time,
     )
+    records = [result.checked[step].record for step in sorted(result.checked)]
     if records:
         figures = aggregate(records)
         row.update(
@@ -219,8 +211,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             time_develop=sum(r.time_s.get("develop", 0.0) for r in records),
             time_deform=sum(r.time_s.get("deform", 0.0) for r in records),
         )
-    row["time_total"] = time.perf_counter() - t0
-    return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in run.attempts]
+    return row
 
 
 def lost_run(exc: Exception) -> dict:
