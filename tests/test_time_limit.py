@@ -253,3 +253,39 @@ def test_a_time_limited_run_ends_within_its_grace():
     assert run.stop is Stop.TIME_LIMIT
     g = DEFAULTS.generation
     assert wall < 2.0 + max(g.time_limit_grace_min, 2.0 * g.time_limit_grace) + 3.0
+
+
+def test_a_first_solve_cut_by_the_time_limit_ends_the_run_at_the_limit(monkeypatch):
+    """The first solve that the limit ends says so: the stop is ``time_limit`` (no
+    "no developable polyhedron", whose hints (a larger dz, other bounds) would mislead), its
+    attempt's outcome ``time_limit``, no solution."""
+    import time
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.generate import AttemptOutcome
+
+    monkeypatch.setattr(
+        generation._Steps, "final_deadline", property(lambda self: time.monotonic() - 1.0)
+    )
+    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False), time_limit=5)
+    assert run.stop is Stop.TIME_LIMIT and run.stop_reason == "time limit of 5 s reached"
+    assert [a.outcome for a in run.attempts] == [AttemptOutcome.TIME_LIMIT]
+    assert run.solutions == [] and run.final is None
+
+
+def test_a_motion_cut_by_its_deadline_says_so_and_not_that_the_shape_is_stuck():
+    """The final design's folding motion traced after a run's time limit ends at the run's
+    deadline: its status is ``cut`` (the motion stage fails with that message), and the shape
+    is not said to have no path to the plane."""
+    import time
+
+    from rigidfold.deform import MotionStatus, folding_motion
+    from rigidfold.develop import develop
+
+    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False))
+    pattern = run.final.result.pattern
+    flat = develop(pattern).coords2d
+    cut = folding_motion(pattern, flat, dof=run.final_dof, deadline=time.monotonic() - 1.0)
+    assert cut.status is MotionStatus.CUT and "time limit" in cut.message
+    whole = folding_motion(pattern, flat, dof=run.final_dof, deadline=time.monotonic() + 3600)
+    assert whole.status is MotionStatus.OK

@@ -119,6 +119,8 @@ def _not_traced(development: Development, motion: Motion, settings: Settings) ->
             "reaches the plane",
             "",
         )
+    if motion.status is MotionStatus.CUT:
+        return "the run's time limit ended the motion's trace before the plane", ""
     if motion.dof == 0:
         return (
             "the shape has no mechanism (DOF 0 with its fixed creases), so no rigid-folding "
@@ -185,6 +187,7 @@ def verify(
     path: FoldingPath | None = None,
     material: Material | None = None,
     thickness: float | None = None,
+    deadline: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> Verification:
     """Development (Step 8), large-deformation check (Step 9) and motion of one shape.
@@ -192,7 +195,9 @@ def verify(
     ``dof``, ``path``: the shape's DOF and traced folding path where they are known
     (:func:`rigidfold.deform.folding_motion` traces the path otherwise). ``material``,
     ``thickness``: Step 9's frame as strips of the panels
-    (:func:`rigidfold.deform.analysis.panel_section`) instead of the paper's tubes."""
+    (:func:`rigidfold.deform.analysis.panel_section`) instead of the paper's tubes.
+    ``deadline`` (of ``time.monotonic()``): the motion's trace ends there
+    (:attr:`rigidfold.deform.MotionStatus.CUT`)."""
     times = {}
     t0 = time.perf_counter()
     development = develop(pattern, settings=settings)
@@ -217,6 +222,7 @@ def verify(
             support_face=support_face,
             dof=dof,
             path=path,
+            deadline=deadline,
             settings=settings,
         )
         times["motion"] = time.perf_counter() - t0

@@ -191,7 +191,7 @@ class _Steps:
         opts, settings = self.options, self.settings
         deadline = self.deadline if start is not None else self.final_deadline
         result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
-        cut = deadline is not None and start is not None and time.monotonic() > deadline
+        cut = deadline is not None and time.monotonic() > deadline
         if opts.deploy_check:
             result = self.problem.polish(result, deadline)
         t1 = time.perf_counter()
@@ -651,6 +651,10 @@ def generate(
     run = steps.run
     # Steps 2-5 for the triangulated target surface
     rec, trial = steps.solve(case.pattern.fixed.copy(), None, (), None)
+    if rec.outcome is AttemptOutcome.TIME_LIMIT:  # the limit ended the first solve
+        run.stop, run.stop_detail = Stop.TIME_LIMIT, f"{opts.time_limit:g}"
+        steps.record(rec, trial)
+        return run
     if not steps.is_solution(rec):
         run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
         rec.outcome = AttemptOutcome.INITIAL_FAILED
