@@ -289,3 +289,26 @@ def test_a_motion_cut_by_its_deadline_says_so_and_not_that_the_shape_is_stuck():
     assert cut.status is MotionStatus.CUT and "time limit" in cut.message
     whole = folding_motion(pattern, flat, dof=run.final_dof, deadline=time.monotonic() + 3600)
     assert whole.status is MotionStatus.OK
+
+
+def test_the_process_age_counts_from_the_start_of_the_process():
+    """``--time-limit`` counts from the command's start: the age of this process is
+    positive and grows with the clock (0.0 only where /proc cannot be read)."""
+    import time
+
+    from rigidfold.runtime.clock import process_age
+
+    first = process_age()
+    time.sleep(0.05)
+    second = process_age()
+    assert first > 0.0 and second >= first + 0.04
+
+
+def test_the_graces_after_a_time_limit():
+    """Naming the final design ends a grace after T, the whole run by two graces:
+    T + max(10 s, 5 % of T) with the defaults."""
+    from rigidfold.generate.steps import past_time_limit
+
+    assert past_time_limit(100.0, None, DEFAULTS) is None
+    assert past_time_limit(100.0, 180.0, DEFAULTS, 2.0) == 100.0 + 180.0 + 10.0
+    assert past_time_limit(100.0, 600.0, DEFAULTS, 2.0) == 100.0 + 600.0 + 30.0

@@ -136,6 +136,7 @@ class _Steps:
         on_attempt: Callable[[Generation, Attempt], None] | None,
         on_solution: Callable[[Generation, Solution], None] | None,
         on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None = None,
+        started: float | None = None,
     ) -> None:
         self.case, self.options, self.settings = case, options, case.settings
         self.on_attempt, self.on_solution, self.on_retract = on_attempt, on_solution, on_retract
@@ -144,7 +145,7 @@ class _Steps:
             numerics=numeric_environment().to_dict(), deploy_check=options.deploy_check
         )
         t0 = time.perf_counter()
-        self.started = time.monotonic()
+        self.started = time.monotonic() if started is None else started
         self.problem = case.problem(build_ipopt=options.solver == "ipopt")
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
@@ -294,11 +295,7 @@ class _Steps:
     def final_deadline(self) -> float | None:
         """The end of naming the final design after the time limit T: T + max(
         ``time_limit_grace_min``, ``time_limit_grace`` T) (None without a limit)."""
-        limit = self.options.time_limit
-        if limit is None:
-            return None
-        g = self.settings.generation
-        return self.started + limit + max(g.time_limit_grace_min, g.time_limit_grace * limit)
+        return past_time_limit(self.started, self.options.time_limit, self.settings)
 
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
@@ -630,6 +627,7 @@ def generate(
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
     on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None = None,
+    started: float | None = None,
     **changes,
 ) -> Generation:
     """Run Steps 2-7 on a case; callbacks see every attempt, every accepted solution and
@@ -643,11 +641,13 @@ def generate(
     planes in the case, creases are fixed in mirror groups (2 or 4 at once). With
     ``target_dof=0`` the DOF-0 shape that ends the run is its last solution (its attempt's
     outcome stays ZERO_DOF) and the stop is TARGET_REACHED. A KeyboardInterrupt propagates
-    after the callbacks of everything finished so far.
+    after the callbacks of everything finished so far. ``started``: the time of
+    ``time.monotonic()`` that the time limit counts from (default: the call; the command
+    line gives its process's start, :func:`rigidfold.runtime.clock.process_age`).
     """
     opts = (options or GenerateOptions()).replace(**changes)
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
-    steps = _Steps(case, opts, on_attempt, on_solution, on_retract)
+    steps = _Steps(case, opts, on_attempt, on_solution, on_retract, started)
     run = steps.run
     # Steps 2-5 for the triangulated target surface
     rec, trial = steps.solve(case.pattern.fixed.copy(), None, (), None)
@@ -692,6 +692,21 @@ def generate(
             counted=final.mechanism.dof,
         ).to_dict()
     return run
+
+
+def past_time_limit(
+    started: float, limit: float | None, settings: Settings, graces: float = 1.0
+) -> float | None:
+    """The time of ``time.monotonic()`` ``graces`` graces after a run's time limit ``limit``
+    (seconds from ``started``; None: no limit, no time). The grace is max(
+    ``time_limit_grace_min``, ``time_limit_grace`` x limit): naming the final design ends
+    one grace after the limit, the final design's folding motion one and a half, and the
+    whole run (its exports, summary and report) by two: T + max(10 s, 5 % of T) with the
+    defaults."""
+    if limit is None:
+        return None
+    g = settings.generation
+    return started + limit + graces * max(g.time_limit_grace_min, g.time_limit_grace * limit)
 
 
 def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
