@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from conftest import files_of, folded_grid, run_cli, run_cli_size_limited
+from rigidfold.cli.structure_specs import parse_limit, parse_load, parse_material
 from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
 from rigidfold.io import read_fold, write_fold
@@ -26,9 +27,6 @@ from rigidfold.structure import (
     auto_supports,
     check_structure,
     check_supports,
-    parse_limit,
-    parse_load,
-    parse_material,
 )
 
 DATA = Path(__file__).parent / "data"

@@ -30,8 +30,8 @@ class Flag:
     metavar, choices : as argparse's.
     shown : the default as the help says it, where that is not the value itself: for a
         default of None what None means, else the default as text (``""`` is ``"none"``);
-        one that is not text or a number, as text that ``parse`` (or the record's
-        ``from_strings``) reads back (a pair ``(2440.0, 1220.0)`` is ``"2440x1220"``).
+        one that is not text or a number, as text that ``parse`` (or the command line's
+        reader of the record) reads back (a pair ``(2440.0, 1220.0)`` is ``"2440x1220"``).
     switch : a bool's help before its doc, where that is not "turn on" (or "turn off" for a
         bool on by default): ``"leave out"``, or ``""`` for a doc that reads as the help.
     repeat : the flag may be given more than once, its values a list (none by default).

@@ -44,7 +44,7 @@ def add_options(
     default: ``shown[name]`` where given, else its flag's ``shown``, else the value unless
     None or a repeat flag's. A shown default that is not text or a number (a pair, a typed
     choice) is given to argparse as its shown text (``2440x1220``, ``auto``), which the
-    flag's ``parse`` (or the record's ``from_strings``) reads as the command line's."""
+    flag's ``parse`` (or ``options_of``'s ``make``) reads as the command line's."""
     for f in dataclasses.fields(record):
         flag: Flag | None = f.metadata.get("flag")
         if flag is None or (only is not None and f.name not in only) or f.name in exclude:
@@ -99,8 +99,9 @@ def options_of(
 ) -> Any:
     """The options record ``record`` of the parsed ``args`` (the fields that have a flag
     there; None where the record's default is not: not given, the record's default) and
-    ``given``, made by ``make`` (default: the record; a record's ``from_strings`` where that
-    reads some of the texts); checked by the record."""
+    ``given``, made by ``make`` (default: the record; a reader of the command line's texts
+    where some are not yet typed, such as
+    :func:`rigidfold.cli.structure_specs.read_structure_options`); checked by the record."""
     flagged = {
         f.name: getattr(args, f.name)
         for f in dataclasses.fields(record)

@@ -25,7 +25,7 @@ from rigidfold.drive.options import DriveOptions
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import count, option, positive
-from rigidfold.material import parse_material
+from rigidfold.material import Material, parse_material
 from rigidfold.optimize import SOLVERS
 from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
@@ -187,9 +187,9 @@ class GenerateOptions:
             raise RigidfoldError(f"drive must be DriveOptions or None, got {self.drive!r}")
         if st is None:
             return
-        if self.material is not None and st.material != self.material:
+        if self.material is not None and st.material != parse_material(self.material):
             raise RigidfoldError(
-                f"the structure's material {st.material!r} is not the panels' material "
+                f"the structure's material {st.material.name!r} is not the panels' material "
                 f"{self.material!r}"
             )
         if fab is not None and st.thickness != fab.thickness:
@@ -199,7 +199,7 @@ class GenerateOptions:
             )
 
     @property
-    def panel_material(self) -> str:
+    def panel_material(self) -> str | Material:
         """The material of the structure check and of the thick panels' masses."""
         if self.material is not None:
             return self.material
@@ -221,7 +221,7 @@ class GenerateOptions:
             raise RigidfoldError(f"unknown generate option {', '.join(map(repr, unknown))}")
         material = changes.get("material")
         if material is not None and self.structure is not None and "structure" not in changes:
-            changes["structure"] = self.structure.replace(material=material)
+            changes["structure"] = self.structure.replace(material=parse_material(material))
         return replace(self, **changes) if changes else self
 
     def to_dict(self) -> dict:

@@ -26,16 +26,11 @@ from rigidfold.fabricate.build import check_thickness
 from rigidfold.fabricate.motion import design_motion
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
+from rigidfold.material import parse_material
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
 from rigidfold.rundir.layout import FINAL_DIR
-from rigidfold.structure import (
-    StructureCheck,
-    check_design,
-    parse_indices,
-    parse_material,
-    write_structure,
-)
+from rigidfold.structure import StructureCheck, check_design, write_structure
 
 THICK_DIR = Path(FINAL_DIR) / "thick"
 """Where the thick panels' files go in the run's directory."""
@@ -64,7 +59,7 @@ def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> Non
         return
     st.check_indices(pattern.n_vertices, pattern.n_edges)
     free = set(pattern.free_creases.tolist())
-    fixed = [e for e in parse_indices(st.actuators, pattern.n_edges, "actuators") if e not in free]
+    fixed = [e for e in sorted(set(st.actuators)) if e not in free]
     if fixed:
         raise RigidfoldError(f"actuator {fixed[0]} is not a free crease of the crease pattern")
 

@@ -55,18 +55,14 @@ from rigidfold.io import (
     write_fold,
     write_json,
 )
+from rigidfold.material import parse_material
 from rigidfold.mechanism import Mechanism, analyze
 from rigidfold.optimize import OptimizeResult
 from rigidfold.pipeline import RunWriter, write_checked_shape, write_report
 from rigidfold.reporting import page, render_figures, thick_figure, view_figure
 from rigidfold.rundir import RunData, clear_earlier_run, earlier_run, load_run
 from rigidfold.runtime.interrupts import kept_interrupts
-from rigidfold.structure import (
-    Material,
-    StructureCheck,
-    StructureStatus,
-    parse_material,
-)
+from rigidfold.structure import Material, StructureCheck, StructureStatus
 from rigidfold.structure.design import (
     STRUCTURE_FILES,
     StructureOptions,
