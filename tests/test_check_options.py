@@ -13,10 +13,12 @@ from pathlib import Path
 import pytest
 
 from conftest import main_code
+from rigidfold.cli.units import parse_length, parse_sheet
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricateOptions
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import read_fold
+from rigidfold.material import MATERIALS
 from rigidfold.structure import Limit, Pins, StructureOptions, Uniform
 from test_generate_integration import FAST as INTEGRATION_FAST
 
@@ -76,7 +78,9 @@ def test_structure_options_refuse_bad_values_in_one_line(changes):
 
 
 def test_options_keep_what_the_user_gave():
-    fab = FabricateOptions("18mm", sheet="3050x1525", min_thickness="5mm")
+    fab = FabricateOptions(
+        parse_length("18mm"), sheet=parse_sheet("3050x1525"), min_thickness=parse_length("5mm")
+    )
     assert fab.thickness == pytest.approx(0.018) and fab.sheet == (3050.0, 1525.0)
     assert fab.min_thickness == pytest.approx(0.005)
     assert FabricateOptions.from_dict(json.loads(json.dumps(fab.to_dict()))) == fab
@@ -94,21 +98,21 @@ def test_options_keep_what_the_user_gave():
 def test_generate_options_hold_the_checks():
     fab = FabricateOptions(0.02, clearance_angle_deg=3.0)
     st = StructureOptions(thickness=0.02, nonlinear=True, clamped="0")
-    opts = GenerateOptions(fabricate=fab, structure=st, material="plywood")
+    opts = GenerateOptions(fabricate=fab, structure=st, material=MATERIALS["plywood"])
     assert opts.panel_thickness == 0.02
     data = json.loads(json.dumps(opts.to_dict()))
     assert data["fabricate"]["thickness"] == 0.02 and data["structure"]["nonlinear"] is True
     assert GenerateOptions.from_dict(data) == opts
     assert pickle.loads(pickle.dumps(opts)) == opts  # a study hands it to its workers
     assert GenerateOptions.from_dict({"structure": None, "fabricate": None}) == GenerateOptions()
-    moved = opts.replace(material="steel")  # a new material is the structure's too
-    assert moved.structure.material == "steel" and moved.structure.nonlinear
+    moved = opts.replace(material=MATERIALS["steel"])  # a new material is the structure's too
+    assert moved.structure.material == MATERIALS["steel"] and moved.structure.nonlinear
 
 
 @pytest.mark.parametrize(
     "options",
     [
-        {"material": "steel", "structure": StructureOptions(material="plywood")},
+        {"material": MATERIALS["steel"], "structure": StructureOptions()},  # plywood
         {"fabricate": FabricateOptions(0.02), "structure": StructureOptions(thickness=0.018)},
         {"structure": "yes"},
     ],

@@ -443,14 +443,14 @@ def test_a_documented_field_is_a_flag():
     from dataclasses import dataclass
 
     from rigidfold.cli.parser import Parser, add_options, options_of
-    from rigidfold.flags import count, option, positive
+    from rigidfold.flags import option
 
     @dataclass(frozen=True)
     class Options:
         time_limit: float | None = option(
-            None, "stop after this many seconds", parse=positive, metavar="S"
+            None, "stop after this many seconds", parse="positive", metavar="S"
         )
-        retries: int = option(2, "tries of each solve", parse=count)
+        retries: int = option(2, "tries of each solve", parse="count")
         fast: bool = option(False, "the fast path")
         check: bool = option(True, "the final check")
         hidden: str = option("x", "not on the command line", flag=False)

@@ -19,10 +19,10 @@ from rigidfold.cli.commands import main
 from rigidfold.develop import develop
 from rigidfold.exports import (
     EXPORT_FORMATS,
+    check_formats,
     export_design,
     layout_sheet,
     panel_loops,
-    parse_formats,
     read_design,
 )
 from rigidfold.exports.mesh3d import Y_UP
@@ -355,9 +355,13 @@ def test_origami_simulator_fold_reads_back_as_the_same_design(design, exported):
 
 # ------------------------------------------------------------------------------ API
 def test_parse_formats():
+    from rigidfold.cli.units import parse_formats
+
     assert parse_formats("SVG, obj,obj") == ("obj", "svg")
-    assert parse_formats(["csv", "dxf"]) == ("dxf", "csv")
+    assert check_formats(["csv", "dxf"]) == ("dxf", "csv")
     assert parse_formats(",".join(EXPORT_FORMATS)) == EXPORT_FORMATS
+    with pytest.raises(ValueError, match="sequence of format names"):
+        check_formats("obj")
     with pytest.raises(ValueError, match="unknown export format 'xyz'"):
         parse_formats("obj,xyz")
     with pytest.raises(ValueError, match="no export format"):

@@ -19,7 +19,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rigidfold.cli.parser import add_options, options_of
+from rigidfold.cli.parser import add_options, argument_type, options_of
+from rigidfold.cli.units import parse_length, parse_material
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import docs
 from rigidfold.structure import StructureOptions
@@ -30,16 +31,7 @@ STRUCTURE = StructureOptions()
 
 def length(what: str):
     """argparse type: a length in metres, or with a unit (``18mm``)."""
-
-    def parse(text: str) -> float:
-        from rigidfold.fabricate.build import parse_length
-
-        try:
-            return parse_length(text, what)
-        except ValueError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-
-    return parse
+    return argument_type(lambda text: parse_length(text, what))
 
 
 def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
@@ -105,6 +97,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--material",
+        type=argument_type(parse_material),
         default=None,
         metavar="NAME|E,nu,density",
         help=docs(StructureOptions)["material"] + "; Step 9's frame is then of strips of these "

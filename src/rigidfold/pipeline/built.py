@@ -33,7 +33,6 @@ from rigidfold.structure import (
     StructureCheck,
     check_design,
     parse_indices,
-    parse_material,
     write_structure,
 )
 
@@ -97,7 +96,7 @@ def thick_panels(
     fab = fabricate.fabricate(
         panels,
         motion,
-        density=parse_material(options.panel_material).density,
+        density=options.panel_material.density,
         motion_message=message,
         settings=settings,
     )
@@ -212,7 +211,6 @@ def deployment_drive(
     :func:`rigidfold.drive.deploy_design` on ``solutions/NAME.fold``, its files in
     ``run_dir/final/deploy/``. Returns (the record's figures, the result)."""
     from rigidfold.drive import deploy_design
-    from rigidfold.material import parse_material
 
     drive = options.drive
     assert drive is not None
@@ -221,7 +219,7 @@ def deployment_drive(
             thickness=options.panel_thickness, thickness_from="the run's --thickness"
         )
     if options.material is not None:
-        drive = drive.replace(material=parse_material(options.material))
+        drive = drive.replace(material=options.material)
     t0 = time.perf_counter()
     design = run_dir / "solutions" / f"{name}.fold"
     result = deploy_design(

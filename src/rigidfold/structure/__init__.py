@@ -16,7 +16,7 @@ from them, and its files) and
 imported only when an analysis runs or a figure is drawn.
 """
 
-from rigidfold.material import MATERIALS, Material, parse_material, presets_help
+from rigidfold.material import MATERIALS, Material, presets_help
 from rigidfold.mechanism.second_order import SecondOrder, Stability, second_order
 from rigidfold.structure.check import (
     StructureCheck,
@@ -86,7 +86,6 @@ __all__ = [
     "parse_indices",
     "parse_limit",
     "parse_load",
-    "parse_material",
     "parse_supports",
     "presets_help",
     "second_order",

@@ -26,7 +26,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
 from rigidfold.io.files import jsonable, parse_json, write_together
-from rigidfold.material import Material, parse_material, presets_help
+from rigidfold.material import Material, material_named, presets_help
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
     StructureCheck,
@@ -188,30 +188,24 @@ class DesignPlan:
 
 def check_options(
     *,
-    material: str | Material = DEFAULTS.structure.material,
+    material: Material = material_named(DEFAULTS.structure.material),  # noqa: B008 (frozen)
     loads: tuple[Load, ...] = (),
     limit: Limit = Limit(DEFAULTS.structure.limit),  # noqa: B008 (frozen)
     modes: int = DEFAULTS.structure.modes,
 ) -> tuple[Material, tuple[Load, ...], float]:
     """(material, loads, limit divisor) of the options; ValueError (one line) for any that
     is not valid, before the design is read."""
-    mat = parse_material(material)
+    if not isinstance(material, Material):
+        raise RigidfoldError(f"material must be a Material, got {material!r}")
     if not isinstance(limit, Limit):
         raise RigidfoldError(f"limit must be a Limit (Limit.parse('L/250')), got {limit!r}")
     if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
         raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
-    return mat, tuple(loads), limit.divisor
+    return material, tuple(loads), limit.divisor
 
 
 _TEXT_FIELDS = ("supports", "loads", "limit")
 """The fields the command line gives as text (:meth:`StructureOptions.from_strings`)."""
-
-
-def _thickness(text: str) -> float:
-    """``--thickness``: a length in metres, or with a unit (``18mm``)."""
-    from rigidfold.fabricate.build import parse_length
-
-    return parse_length(text, "thickness")
 
 
 _S = DEFAULTS.structure
@@ -228,8 +222,9 @@ class StructureOptions:
     is :class:`Auto`, :class:`Service` or :class:`Pins`; ``loads`` a tuple of
     :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`, :class:`Pressure`,
     :class:`Point`; a :class:`SelfWeight` among them is ``self_weight``); ``limit`` a
-    :class:`Limit`; ``candidates`` None is ``"boundary"``; ``material`` a preset name
-    (:data:`~rigidfold.structure.MATERIALS`) or ``"E,nu,density"``.
+    :class:`Limit`; ``candidates`` None is ``"boundary"``; ``material`` a
+    :class:`~rigidfold.material.Material` (the command line: a preset of
+    :data:`~rigidfold.structure.MATERIALS` or ``"E,nu,density"``).
 
     :meth:`from_strings` reads the command line's texts (``"auto"``, ``"uniform=0.5kPa"``,
     ``"L/250"``). Defaults from ``Settings.structure``. Every value is checked when the
@@ -240,14 +235,16 @@ class StructureOptions:
     thickness: float = option(
         _S.thickness,
         "panel thickness in metres, or with a unit: 18mm, 1.8cm",
-        parse=_thickness,
+        parse="thickness",
         metavar="T",
     )
-    material: str = option(
-        _S.material,
+    material: Material = option(  # noqa: RUF009 (frozen)
+        material_named(_S.material),
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
         "-, kg/m^3), e.g. 10e9,0.3,700",
+        parse="material",
         metavar="NAME|E,nu,density",
+        shown=_S.material,
     )
     supports: SupportSpec = option(  # noqa: RUF009 (frozen)
         Auto(),
@@ -326,10 +323,8 @@ class StructureOptions:
     )
 
     def __post_init__(self) -> None:
-        if not isinstance(self.material, str):
-            raise RigidfoldError(
-                f"material must be a preset name or E,nu,density, got {self.material!r}"
-            )
+        if not isinstance(self.material, Material):
+            raise RigidfoldError(f"material must be a Material, got {self.material!r}")
         if not isinstance(self.supports, SUPPORT_TYPES):
             raise RigidfoldError(
                 "supports must be Auto(), Service() or Pins(...) (from_strings reads "
@@ -449,6 +444,7 @@ class StructureOptions:
         """The options as JSON values (``supports``, ``loads``, ``limit`` as their texts:
         :meth:`texts`); :meth:`from_dict` reads them."""
         data = {f.name: getattr(self, f.name) for f in fields(self)}
+        data["material"] = self.material.key
         return data | self.texts()
 
     @classmethod
@@ -458,6 +454,8 @@ class StructureOptions:
         names = {f.name for f in fields(cls)}
         given = {k: v for k, v in data.items() if k in names}
         texts = {k: given.pop(k) for k in _TEXT_FIELDS if k in given}
+        if "material" in given:
+            given["material"] = Material.from_key(given["material"])
         return cls.from_strings(**texts, **given)
 
 
