@@ -224,7 +224,7 @@ def test_svg_cut_sheet_measures_in_mm_and_keeps_the_boundary_length(design, expo
 def test_origami_simulator_svg_uses_its_colours_and_opacities(design, tmp_path):
     shape, coords2d = design
     (path,) = export_design(
-        shape, coords2d, tmp_path, "svg", name="os", convention="origami-simulator"
+        shape, coords2d, tmp_path, ("svg",), name="os", convention="origami-simulator"
     )
     root = ET.parse(path).getroot()
     assert root.get("width").endswith("mm")
@@ -386,7 +386,7 @@ def test_an_existing_link_is_replaced_not_followed(design, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     (out / "design.obj").symlink_to(target)
-    export_design(shape, coords2d, out, "obj")
+    export_design(shape, coords2d, out, ("obj",))
     assert target.read_text() == "keep"
     assert not (out / "design.obj").is_symlink()
 

@@ -1,7 +1,7 @@
 """The panels' material: an isotropic elastic plate of Young's modulus, Poisson's ratio and
 density (:class:`Material`), a preset of :data:`MATERIALS` or any other; the panels of a built
 design, a material and a thickness (:class:`Panel`). The command line reads a preset's name or
-``E,nu,density`` in SI units (:func:`rigidfold.cli.units.parse_material`).
+``E,nu,density`` in SI units (:mod:`rigidfold.cli.units`).
 
 The presets are typical values, for a first design; a structural check uses the values of
 the product that will be built (its data sheet or the relevant code):

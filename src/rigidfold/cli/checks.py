@@ -59,7 +59,7 @@ def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
             exclude=("thickness",),
             prefix="with --thickness: ",
             shown={
-                "density": f"that of --material, or of {STRUCTURE.material}; it does not "
+                "density": f"that of --material, or of {STRUCTURE.material.key}; it does not "
                 "change the structure's self-weight"
             },
         )
@@ -103,7 +103,7 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
         help=docs(StructureOptions)["material"] + "; Step 9's frame is then of strips of these "
         f"panels (of --thickness, or {STRUCTURE.thickness * 1e3:g} mm), and --structure and "
         "the thick panels' masses use it (default: the paper's steel tubes for Step 9, "
-        f"{STRUCTURE.material} for the others)",
+        f"{STRUCTURE.material.key} for the others)",
     )
     add_options(p, StructureOptions, exclude=("thickness", "material"), prefix="--structure: ")
 
