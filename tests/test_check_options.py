@@ -14,6 +14,7 @@ import pytest
 
 from conftest import main_code
 from rigidfold.cli.structure_specs import read_structure_options
+from rigidfold.cli.units import parse_length, parse_sheet
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricateOptions
 from rigidfold.generate import GenerateOptions
@@ -105,7 +106,9 @@ def test_the_record_takes_typed_values_not_texts(changes):
 
 
 def test_options_keep_what_the_user_gave():
-    fab = FabricateOptions("18mm", sheet="3050x1525", min_thickness="5mm")
+    fab = FabricateOptions(
+        parse_length("18mm"), sheet=parse_sheet("3050x1525"), min_thickness=parse_length("5mm")
+    )
     assert fab.thickness == pytest.approx(0.018) and fab.sheet == (3050.0, 1525.0)
     assert fab.min_thickness == pytest.approx(0.005)
     assert FabricateOptions.from_dict(json.loads(json.dumps(fab.to_dict()))) == fab
@@ -144,21 +147,24 @@ def test_options_keep_what_the_user_gave():
 def test_generate_options_hold_the_checks():
     fab = FabricateOptions(0.02, clearance_angle_deg=3.0)
     st = StructureOptions(thickness=0.02, nonlinear=True, clamped=(0,))
-    opts = GenerateOptions(fabricate=fab, structure=st, material="plywood")
+    opts = GenerateOptions(fabricate=fab, structure=st, material=MATERIALS["plywood"])
     assert opts.panel_thickness == 0.02
     data = json.loads(json.dumps(opts.to_dict()))
     assert data["fabricate"]["thickness"] == 0.02 and data["structure"]["nonlinear"] is True
     assert GenerateOptions.from_dict(data) == opts
     assert pickle.loads(pickle.dumps(opts)) == opts  # a study hands it to its workers
     assert GenerateOptions.from_dict({"structure": None, "fabricate": None}) == GenerateOptions()
-    moved = opts.replace(material="steel")  # a new material is the structure's too
+    moved = opts.replace(material=MATERIALS["steel"])  # a new material is the structure's too
     assert moved.structure.material == MATERIALS["steel"] and moved.structure.nonlinear
 
 
 @pytest.mark.parametrize(
     "options",
     [
-        {"material": "steel", "structure": StructureOptions(material=MATERIALS["plywood"])},
+        {
+            "material": MATERIALS["steel"],
+            "structure": StructureOptions(material=MATERIALS["plywood"]),
+        },
         {"fabricate": FabricateOptions(0.02), "structure": StructureOptions(thickness=0.018)},
         {"structure": "yes"},
     ],

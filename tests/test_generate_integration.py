@@ -197,9 +197,10 @@ def test_step9_takes_the_users_material(tmp_path):
         figures[name] = deformed["max_dl_mm"]
     assert figures["tubes"] != pytest.approx(figures["plywood"], rel=1e-3)
     from rigidfold.config import DEFAULTS
+    from rigidfold.material import MATERIALS
 
-    assert GenerateOptions().panel_material == DEFAULTS.structure.material
-    assert GenerateOptions(material="steel").panel_material == "steel"
+    assert GenerateOptions().panel_material == MATERIALS[DEFAULTS.structure.material]
+    assert GenerateOptions(material=MATERIALS["steel"]).panel_material == MATERIALS["steel"]
 
 
 def test_a_check_that_cannot_run_is_a_failed_stage_not_a_lost_run(tmp_path, monkeypatch):

@@ -12,6 +12,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop, generate
 from rigidfold.generate.case import make_case
 from rigidfold.generate.options import GenerateOptions
+from rigidfold.optimize import SolverName
 
 
 def test_a_time_limit_ends_the_run_with_a_named_design_and_exit_1(tmp_path, capsys):
@@ -136,9 +137,10 @@ def test_the_candidates_paths_are_traced_to_the_runs_deadline(monkeypatch):
 @pytest.mark.parametrize(
     ("solver", "settings"),
     [
-        ("ipopt", {}),
-        ("ipopt", {"projection_vertices": 10}),  # the composite: projection, IPOPT, projection
-        ("slsqp", {}),
+        (SolverName.IPOPT, {}),
+        # the composite: projection, IPOPT, projection
+        (SolverName.IPOPT, {"projection_vertices": 10}),
+        (SolverName.SLSQP, {}),
     ],
 )
 def test_a_solve_past_its_deadline_ends_at_its_iterate(solver, settings):
@@ -151,7 +153,7 @@ def test_a_solve_past_its_deadline_ends_at_its_iterate(solver, settings):
     from rigidfold.optimize import Status
 
     case = make_case("dome", "grid:5x5", size="3x3", settings=DEFAULTS.with_(**settings))
-    problem = case.problem(build_ipopt=solver == "ipopt")
+    problem = case.problem(build_ipopt=solver is SolverName.IPOPT)
     plain = problem.solve(solver=solver)
     assert plain.status is Status.CONVERGED
     far = problem.solve(solver=solver, deadline=time.monotonic() + 3600.0)

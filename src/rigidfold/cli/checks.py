@@ -19,8 +19,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rigidfold.cli.parser import add_options, options_of
+from rigidfold.cli.parser import add_options, argument_type, options_of
 from rigidfold.cli.structure_specs import read_structure_options
+from rigidfold.cli.units import parse_length, parse_material
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import docs
 from rigidfold.structure import StructureOptions
@@ -35,16 +36,7 @@ texts (:func:`~rigidfold.cli.structure_specs.read_structure_options` reads them)
 
 def length(what: str):
     """argparse type: a length in metres, or with a unit (``18mm``)."""
-
-    def parse(text: str) -> float:
-        from rigidfold.fabricate.build import parse_length
-
-        try:
-            return parse_length(text, what)
-        except ValueError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-
-    return parse
+    return argument_type(lambda text: parse_length(text, what))
 
 
 def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
@@ -72,7 +64,7 @@ def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
             exclude=("thickness",),
             prefix="with --thickness: ",
             shown={
-                "density": f"that of --material, or of {STRUCTURE.material.name}; it does not "
+                "density": f"that of --material, or of {STRUCTURE.material.key}; it does not "
                 "change the structure's self-weight"
             },
         )
@@ -111,12 +103,13 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--material",
+        type=argument_type(parse_material),
         default=None,
         metavar="NAME|E,nu,density",
         help=docs(StructureOptions)["material"] + "; Step 9's frame is then of strips of these "
         f"panels (of --thickness, or {STRUCTURE.thickness * 1e3:g} mm), and --structure and "
         "the thick panels' masses use it (default: the paper's steel tubes for Step 9, "
-        f"{STRUCTURE.material.name} for the others)",
+        f"{STRUCTURE.material.key} for the others)",
     )
     add_options(
         p,

@@ -69,11 +69,12 @@ def _case(args: argparse.Namespace):
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
+    from rigidfold.cli.units import parse_fixed
     from rigidfold.pipeline.workflows import optimize_case
 
-    out = optimize_case(
-        _case(args), args.out, fixed=args.fixed, solver=args.solver, overwrite=args.overwrite
-    )
+    case = _case(args)
+    fixed = () if args.fixed is None else parse_fixed(args.fixed)
+    out = optimize_case(case, args.out, fixed=fixed, solver=args.solver, overwrite=args.overwrite)
     result = out.result
     print(
         f"{result.status.value}: F = {result.F:.3e} (F1 = {result.F1:.2e}, F2 = {result.F2:.2e}), "
@@ -256,11 +257,18 @@ def _cmd_develop(args: argparse.Namespace) -> int:
 
 
 def _cmd_deform(args: argparse.Namespace) -> int:
+    from rigidfold.config import DEFAULTS
+    from rigidfold.material import Panel, material_named
     from rigidfold.pipeline.workflows import deform_file
 
-    checked = deform_file(
-        args.file, args.out, up=args.up, material=args.material, thickness=args.thickness
-    )
+    panel = None  # either given, the other is the default of Settings.structure
+    if args.material is not None or args.thickness is not None:
+        structure = DEFAULTS.structure
+        panel = Panel(
+            material_named(structure.material) if args.material is None else args.material,
+            structure.thickness if args.thickness is None else args.thickness,
+        )
+    checked = deform_file(args.file, args.out, up=args.up, panel=panel)
     d, m = checked.verification.deformation, checked.verification.motion
     assert d is not None  # deform_file runs the analysis
     if args.json:
@@ -291,9 +299,11 @@ def _cmd_deform(args: argparse.Namespace) -> int:
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
+    from rigidfold.cli.units import parse_formats
     from rigidfold.pipeline.workflows import export_file
 
-    done = export_file(args.file, args.out, formats=args.to, convention=args.convention, up=args.up)
+    formats = parse_formats(args.to)
+    done = export_file(args.file, args.out, formats=formats, convention=args.convention, up=args.up)
     if args.json:
         print(json.dumps(jsonable(done.to_dict())))
     else:

@@ -17,9 +17,10 @@ import math
 import re
 from typing import Any
 
+from rigidfold.cli.units import parse_material
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
-from rigidfold.material import parse_material
+from rigidfold.material import Material
 from rigidfold.structure.choices import (
     CANDIDATE_WORDS,
     CHOSEN_SUPPORTS,
@@ -72,8 +73,8 @@ def read_structure_options(
         "loads": tuple(parse_load(text) for text in loads),
         "limit": parse_limit(limit),
     }
-    if material is not None:
-        texts["material"] = parse_material(material)
+    if material is not None:  # parsed by argparse already, or a text
+        texts["material"] = material if isinstance(material, Material) else parse_material(material)
     return StructureOptions(
         **texts,
         clamped=parse_index_list(clamped, "clamped vertices"),

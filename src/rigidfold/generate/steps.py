@@ -70,7 +70,7 @@ from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.second_order import ChildForecast, Obstruction, obstruction
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.mesh import CreasePattern
-from rigidfold.optimize import OptimizeResult
+from rigidfold.optimize import OptimizeResult, SolverName
 from rigidfold.runtime.numerics import numeric_environment
 from rigidfold.selection import (
     Choice,
@@ -146,7 +146,7 @@ class _Steps:
         )
         t0 = time.perf_counter()
         self.started = time.monotonic() if started is None else started
-        self.problem = case.problem(build_ipopt=options.solver == "ipopt")
+        self.problem = case.problem(build_ipopt=options.solver == SolverName.IPOPT)
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
             crease_groups(case.pattern, case.planes, self.settings) if case.planes else None
@@ -571,7 +571,7 @@ class _Steps:
         self.shapes.clear()
         self.fold_limit = limit
         t0 = time.perf_counter()
-        self.problem = case.problem(build_ipopt=self.options.solver == "ipopt")
+        self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
         run.build_time += time.perf_counter() - t0
         self.backtracks = self.rejected = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own

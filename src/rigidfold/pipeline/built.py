@@ -26,7 +26,6 @@ from rigidfold.fabricate.build import check_thickness
 from rigidfold.fabricate.motion import design_motion
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import prepare_output_dir
-from rigidfold.material import parse_material
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
 from rigidfold.rundir.layout import FINAL_DIR
@@ -92,7 +91,7 @@ def thick_panels(
     fab = fabricate.fabricate(
         panels,
         motion,
-        density=parse_material(options.panel_material).density,
+        density=options.panel_material.density,
         motion_message=message,
         settings=settings,
     )
@@ -207,7 +206,6 @@ def deployment_drive(
     :func:`rigidfold.drive.deploy_design` on ``solutions/NAME.fold``, its files in
     ``run_dir/final/deploy/``. Returns (the record's figures, the result)."""
     from rigidfold.drive import deploy_design
-    from rigidfold.material import parse_material
 
     drive = options.drive
     assert drive is not None
@@ -216,7 +214,7 @@ def deployment_drive(
             thickness=options.panel_thickness, thickness_from="the run's --thickness"
         )
     if options.material is not None:
-        drive = drive.replace(material=parse_material(options.material))
+        drive = drive.replace(material=options.material)
     t0 = time.perf_counter()
     design = run_dir / "solutions" / f"{name}.fold"
     result = deploy_design(

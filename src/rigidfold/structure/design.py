@@ -27,7 +27,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
 from rigidfold.io.files import jsonable, write_together
-from rigidfold.material import MATERIALS, Material, presets_help
+from rigidfold.material import Material, material_named, presets_help
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
     StructureCheck,
@@ -213,8 +213,10 @@ class StructureOptions:
     :data:`~rigidfold.structure.choices.Candidates` (None is ``"boundary"``); ``clamped``
     and ``actuators`` tuples of indices; ``loads`` a tuple of
     :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`, :class:`Pressure`,
-    :class:`Point`; a :class:`SelfWeight` among them is ``self_weight``); ``limit`` the
-    deflection limit's divisor (250.0 for ``L/250``).
+    :class:`Point`; a :class:`SelfWeight` among them is ``self_weight``); ``limit`` a
+    :class:`Limit`; ``candidates`` None is ``"boundary"``; ``material`` a
+    :class:`~rigidfold.material.Material` (the command line: a preset of
+    :data:`~rigidfold.structure.MATERIALS` or ``"E,nu,density"``).
 
     The command line's texts are read by :mod:`rigidfold.cli.structure_specs`. Defaults
     from ``Settings.structure``. Every value is checked when the options are made
@@ -223,12 +225,16 @@ class StructureOptions:
     """
 
     thickness: float = option(
-        _S.thickness, "panel thickness in metres, or with a unit: 18mm, 1.8cm", metavar="T"
+        _S.thickness,
+        "panel thickness in metres, or with a unit: 18mm, 1.8cm",
+        parse="thickness",
+        metavar="T",
     )
     material: Material = option(  # noqa: RUF009 (frozen)
-        MATERIALS[_S.material],
+        material_named(_S.material),
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
         "-, kg/m^3), e.g. 10e9,0.3,700",
+        parse="material",
         metavar="NAME|E,nu,density",
         shown=_S.material,
     )
@@ -381,8 +387,8 @@ class StructureOptions:
     def texts(self) -> dict:
         """``supports``, ``loads``, ``limit``, ``candidates``, ``clamped``, ``actuators`` and
         ``material`` as the options' record holds them: ``"auto"``, ``["uniform=0.5"]``
-        (kPa), the divisor, ``"0,6"``, a preset's name (a custom material as its
-        :meth:`~rigidfold.material.Material.to_dict`)."""
+        (kPa), the divisor, ``"0,6"``, a material's :attr:`~rigidfold.material.Material.key`
+        (a preset's name, or ``"E,nu,density"``)."""
         mat = self.material
         candidates = self.candidates
         return {
@@ -392,7 +398,7 @@ class StructureOptions:
             "candidates": indices_text(candidates) if isinstance(candidates, tuple) else candidates,
             "clamped": indices_text(self.clamped),
             "actuators": indices_text(self.actuators),
-            "material": mat.name if MATERIALS.get(mat.name) == mat else mat.to_dict(),
+            "material": mat.key,
         }
 
     def to_dict(self) -> dict:
@@ -442,7 +448,7 @@ def _record_load(text: str) -> Load:
 
 
 def _record_material(value: str | dict) -> Material:
-    return MATERIALS[value] if isinstance(value, str) else Material.from_dict(value)
+    return Material.from_key(value) if isinstance(value, str) else Material.from_dict(value)
 
 
 _RECORD_READERS: dict[str, Callable] = {

@@ -18,7 +18,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, Check, Settings, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
@@ -33,7 +33,7 @@ PRESETS = {
 }
 
 
-STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check="all")
+STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check=Check.ALL)
 """The generate options of a study by default: the paper's Step 5 (no deployability check;
 the final design's path is traced after the run), no Step 9."""
 
