@@ -23,7 +23,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
-from rigidfold.study.rows import ERROR_PREFIX, Key
+from rigidfold.study.rows import ERROR_PREFIX, Key, RunRow
 from rigidfold.study.store import Store
 
 PRESETS = {
@@ -138,7 +138,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
     from rigidfold.generate.case import make_case
     from rigidfold.mechanism.path import trace_path
     from rigidfold.pipeline.checks import check_solution
-    from rigidfold.rundir import SolutionRecord, aggregate
+    from rigidfold.rundir import RunSummary, SolutionRecord
     from rigidfold.runtime.numerics import numeric_environment
 
     settings, options = config.settings, config.options
@@ -186,40 +186,9 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
         )
         return key, row, []
-    s = run.to_dict()
-    row.update(
-        stop=s["stop"],
-        status=s["stop_reason"],
-        n_reduce=s["N_reduce"],
-        n_lock=s["N_lock"],
-        n_exceed=s["N_exceed"],
-        mean_f=s["mean_F_accepted"],
-        initial_dof=s["initial_dof"],
-        final_dof=s["final_dof"],
-        n_solutions=s["n_solutions"],
-        n_solves=s["n_solves"],
-        time_build=s["time_s"]["build"],
-        time_solve=s["time_s"]["solve"],
-        time_analysis=s["time_s"]["analysis"],
-        time_selection=s["time_s"]["selection"],
-        n_path=s["N_path"],
-        n_backtrack=s["N_backtrack"],
-        n_rigid=s["N_rigid"],
-        lowest_dof=s["lowest_dof"],
-        final_deploys=None if final is None or final.path is None else int(final.path.deploys),
-        time_path=s["time_s"]["path"] + row.pop("time_path_final", 0.0),
-    )
-    if records:
-        figures = aggregate(records)
-        row.update(
-            mean_d=figures["development"]["mean_D"],
-            mean_dl_mm=figures["deformation"]["mean_dl_mm"],
-            mean_drho_fix_deg=figures["deformation"]["mean_drho_fix_deg"],
-            reached_plane=int(figures["deformation"]["reached_plane"] == len(records)),
-            time_develop=sum(r.time_s.get("develop", 0.0) for r in records),
-            time_deform=sum(r.time_s.get("deform", 0.0) for r in records),
-        )
-    row["time_total"] = time.perf_counter() - t0
+    run.final_path_time += row.pop("time_path_final", 0.0)  # the final trace's, time_s.path
+    summary = RunSummary.from_run(run, records, stage_times={}, case={}, solutions=())
+    row = RunRow.from_summary(key, summary, **row, time_total=time.perf_counter() - t0).columns()
     return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in run.attempts]
 
 
