@@ -21,8 +21,8 @@ COMMAND = [
     "generate", "--surface", "bezier", "--seed", "1", "--pattern", "1", "--criterion", "shat",
     "--no-deform",
 ]  # fmt: skip
-COMPARED = ("N_reduce", "N_lock", "N_exceed", "N_path", "N_backtrack", "n_solves",
-            "final_dof", "mean_F_accepted", "mean_F_all_solves", "final_deploys")  # fmt: skip
+COMPARED = ("n_reduce", "n_lock", "n_exceed", "n_path", "n_backtrack", "n_solves",
+            "final_dof", "mean_f_accepted", "mean_f_all_solves", "final_deploys")  # fmt: skip
 PINS = ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "NPY_ENABLE_CPU_FEATURES",
         "NPY_DISABLE_CPU_FEATURES", "GLIBC_TUNABLES", "RIGIDFOLD_NUMERICS",
         "RIGIDFOLD_NUMERICS_RESTARTED")  # fmt: skip
@@ -66,8 +66,9 @@ def main() -> int:
             name = kernel or "(own)"
             results[name] = run(kernel, Path(tmp) / name)
             r = results[name]
-            print(f"{name:10s} N_lock {r['N_lock']}  solves {r['n_solves']}  "
-                  f"mean F {r['mean_F_accepted']!r}  numerics {r['numerics']}", flush=True)  # fmt: skip
+            print(f"{name:10s} N_lock {r['n_lock']}  solves {r['n_solves']}  "
+                  f"mean F {r['mean_f_accepted']!r}  numerics {r['numerics']}",
+                  flush=True)  # fmt: skip
     first = next(iter(results.values()))
     differ = [name for name, r in results.items() if r != first]
     if differ:

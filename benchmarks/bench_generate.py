@@ -51,7 +51,7 @@ def bench_generate(seeds: int) -> None:
         s = run.to_dict()
         print(
             f"  seed {seed}: {walls[-1]:6.2f} s, DOF {s['initial_dof']} -> {s['final_dof']}, "
-            f"{s['n_solves']} solves, N_lock {s['N_lock']}, N_exceed {s['N_exceed']}",
+            f"{s['n_solves']} solves, N_lock {s['n_lock']}, N_exceed {s['n_exceed']}",
             flush=True,
         )
     print(

@@ -90,7 +90,7 @@ def bench_generate(seeds: int) -> None:
             s = run.to_dict()
             print(
                 f"  look-ahead {'on ' if lookahead else 'off'} seed {seed}: {rows[-1][1]:6.2f} s, "
-                f"N_reduce {s['N_reduce']}, N_lock {s['N_lock']}, N_exceed {s['N_exceed']}, "
+                f"N_reduce {s['n_reduce']}, N_lock {s['n_lock']}, N_exceed {s['n_exceed']}, "
                 f"{s['n_solves']} solves, {s['n_skipped']} skipped",
                 flush=True,
             )

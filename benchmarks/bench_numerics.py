@@ -98,7 +98,7 @@ def child(args: argparse.Namespace) -> None:
             row["per_solve_s"] = row["generate_s"] / max(s["n_solves"], 1)
             row["gen_solve_s"] = s["time_s"]["solve"] / max(s["n_solves"], 1)
             row["gen_iterations"] = sum(a.iterations for a in run.attempts) / max(s["n_solves"], 1)
-            row["path"] = f"DOF {s['initial_dof']} -> {s['final_dof']}, N_lock {s['N_lock']}"
+            row["path"] = f"DOF {s['initial_dof']} -> {s['final_dof']}, N_lock {s['n_lock']}"
         shape = make_case("dome", "grid:41x41", size="3x3").pattern
         row["analysis_41_s"], mech = median_time(
             lambda: analyze(shape.with_coords(shape.coords)), args.inner

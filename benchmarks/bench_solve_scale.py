@@ -30,6 +30,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS
 from rigidfold.generate.case import make_case
+from rigidfold.optimize import SolverName
 
 IPOPT_ALONE = DEFAULTS.with_(projection_vertices=10**9)
 
@@ -53,7 +54,7 @@ def measure(case, repeat: int) -> dict:
         fixed[folded[np.argmin(rho[folded])]] = True
         step, step_wall, _ = timed(lambda: problem.solve(fixed=fixed, start=result.coords))  # noqa: B023
         rows.append((build_wall, build_cpu, solve_wall, solve_cpu, step_wall))
-    nlpsol = problem.solver("ipopt").nlpsol
+    nlpsol = problem.solver(SolverName.IPOPT).nlpsol
     medians = [statistics.median(column) for column in zip(*rows, strict=True)]
     return {
         "V": case.pattern.n_vertices,

@@ -36,6 +36,7 @@ from rigidfold.structure import (
     Service,
     StructureOptions,
     Supports,
+    Uniform,
     auto_supports,
     check_supports,
     support_candidates,
@@ -70,8 +71,8 @@ def main() -> None:
                 lambda k=k, nonlinear=nonlinear: structure(
                     DESIGN,
                     Path(tmp) / "out",
-                    StructureOptions.from_strings(
-                        loads=("uniform=0.5",),
+                    StructureOptions(
+                        loads=(Uniform(0.5),),
                         hinge_stiffness=k,
                         nonlinear=nonlinear,
                         modes=0 if nonlinear else 3,

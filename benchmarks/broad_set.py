@@ -191,9 +191,9 @@ def _read_summary(path: Path) -> dict:
         "deploys": data.get("final_deploys"),
         "solves": solves,
         "solves_per_dof": solves / removed if removed and solves is not None else None,
-        "N_lock": data.get("N_lock"),
-        "N_path": data.get("N_path"),
-        "N_backtrack": data.get("N_backtrack"),
+        "N_lock": data.get("n_lock"),
+        "N_path": data.get("n_path"),
+        "N_backtrack": data.get("n_backtrack"),
         "time_s": data.get("time_s") or {},
     }
 

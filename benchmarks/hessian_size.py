@@ -16,6 +16,7 @@ import statistics
 
 from rigidfold.config import DEFAULTS
 from rigidfold.generate.case import make_case
+from rigidfold.optimize import SolverName
 
 BACKENDS = ("casadi", "closed-form")
 
@@ -43,10 +44,10 @@ def main() -> None:
         for _ in range(args.repeats):
             for backend, problem in problems.items():
                 result = problem.solve()
-                stats = problem.solver("ipopt").nlpsol.stats()
+                stats = problem.solver(SolverName.IPOPT).nlpsol.stats()
                 solve[backend].append(result.wall_time)
                 per_call[backend].append(stats["t_wall_nlp_hess_l"] / stats["n_call_nlp_hess_l"])
-        symbolic = problems["casadi"].solver("ipopt").nlpsol.get_function("nlp_hess_l")
+        symbolic = problems["casadi"].solver(SolverName.IPOPT).nlpsol.get_function("nlp_hess_l")
         print(
             f"pattern {name:<3} n={problems['casadi'].n_variables}  Hessian nnz "
             f"{symbolic.sparsity_out(0).nnz()}, {symbolic.n_instructions()} SX instructions; "

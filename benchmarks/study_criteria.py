@@ -39,7 +39,7 @@ def support_face(case, corner: str) -> int | None:
     return int(np.argmin(np.linalg.norm(bary - point, axis=1)))
 
 
-COUNTS = ("N_reduce", "N_lock", "N_exceed")
+COUNTS = ("n_reduce", "n_lock", "n_exceed")
 
 
 def standard_error(values: list[float]) -> float:
@@ -94,7 +94,7 @@ def main() -> None:
                 means = {k: statistics.mean(r[k] for r in runs) for k in COUNTS}
                 errors = {k: standard_error([r[k] for r in runs]) for k in COUNTS}
                 wall = statistics.median(r["wall_s"] for r in runs)
-                fs = [r["mean_F_accepted"] for r in runs if r["mean_F_accepted"] is not None]
+                fs = [r["mean_f_accepted"] for r in runs if r["mean_f_accepted"] is not None]
                 reached = sum(r["final_dof"] == 1 for r in runs)
                 p = PAPER.get((pattern, criterion))
                 paper = f"{p[0]:.2f} {p[1]:.2f} {p[2]:.2f} {p[3]:.2e}" if p else ""

@@ -55,14 +55,14 @@ def test_a_backtracking_run_ends_with_a_chain(backtracked):
     for attempt in run.attempts:
         if attempt.outcome is AttemptOutcome.DEAD_END:
             assert attempt.dof is not None and attempt.dof >= 1
-    assert run.to_dict()["N_backtrack"] == run.n_backtrack
+    assert run.to_dict()["n_backtrack"] == run.n_backtrack
 
 
 def test_the_run_directory_holds_only_the_chain(backtracked):
     out, run = backtracked
     summary = json.loads((out / "summary.json").read_text())
     log = read_log(out / "log.jsonl")  # the last line of each attempt
-    assert summary["N_backtrack"] == run.n_backtrack
+    assert summary["n_backtrack"] == run.n_backtrack
     assert sum(a.outcome == "dead_end" for a in log) == run.n_backtrack
     assert [a.outcome for a in log] == [a.outcome.value for a in run.attempts]
     names = [f"step_{s.step:02d}_dof_{s.mechanism.dof:02d}" for s in run.solutions]

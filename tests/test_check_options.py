@@ -13,11 +13,14 @@ from pathlib import Path
 import pytest
 
 from conftest import main_code
+from rigidfold.cli.structure_specs import read_structure_options
+from rigidfold.cli.units import parse_length, parse_sheet
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricateOptions
 from rigidfold.generate import GenerateOptions
 from rigidfold.io import read_fold
-from rigidfold.structure import Limit, Pins, StructureOptions, Uniform
+from rigidfold.material import MATERIALS, Material
+from rigidfold.structure import Pins, Point, Pressure, Service, StructureOptions, Uniform
 from test_generate_integration import FAST as INTEGRATION_FAST
 
 FAST = [*INTEGRATION_FAST, "--no-report"]
@@ -69,46 +72,99 @@ def test_fabricate_options_refuse_bad_values_in_one_line(changes):
     ],
 )
 def test_structure_options_refuse_bad_values_in_one_line(changes):
+    """The command line's texts (read by rigidfold.cli.structure_specs) and the typed
+    values, each refused in one line."""
     with pytest.raises(RigidfoldError) as info:
-        StructureOptions.from_strings(**changes)
+        read_structure_options(**changes)
     message = str(info.value)
     assert "\n" not in message and message
 
 
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {"supports": "auto"},
+        {"loads": ("uniform=1",)},
+        {"limit": "L/250"},
+        {"clamped": "0,6"},
+        {"candidates": "0,1"},
+        {"candidates": "Ground"},
+        {"actuators": "1"},
+        {"material": "steel"},
+        {"thickness": "18mm"},
+    ],
+)
+def test_the_record_takes_typed_values_not_texts(changes):
+    """StructureOptions holds typed values: a text where one is due is refused in one line,
+    naming it (the command line reads its texts first)."""
+    with pytest.raises(RigidfoldError) as info:
+        StructureOptions(**changes)
+    message = str(info.value)
+    (value,) = changes.values()
+    shown = repr(value[0] if isinstance(value, tuple) else value)
+    assert "\n" not in message and f"got {shown}" in message
+
+
 def test_options_keep_what_the_user_gave():
-    fab = FabricateOptions("18mm", sheet="3050x1525", min_thickness="5mm")
+    fab = FabricateOptions(
+        parse_length("18mm"), sheet=parse_sheet("3050x1525"), min_thickness=parse_length("5mm")
+    )
     assert fab.thickness == pytest.approx(0.018) and fab.sheet == (3050.0, 1525.0)
     assert fab.min_thickness == pytest.approx(0.005)
     assert FabricateOptions.from_dict(json.loads(json.dumps(fab.to_dict()))) == fab
-    assert StructureOptions.from_strings(supports="", clamped="0,6").clamped == "0,6"
-    st = StructureOptions.from_strings(supports="0, 4,9", loads=["uniform=0.5"], limit="L/300")
-    assert st.loads == (Uniform(0.5),) and st.limit == Limit(300.0)
+    assert read_structure_options(supports="", clamped="0,6").clamped == (0, 6)
+    st = read_structure_options(supports="0, 4,9", loads=["uniform=0.5"], limit="L/300")
+    assert st.loads == (Uniform(0.5),) and st.limit == 300.0
     assert st.supports == Pins((0, 4, 9))
     assert StructureOptions.from_dict(json.loads(json.dumps(st.to_dict()))) == st
+    other = read_structure_options(
+        supports="service",
+        candidates=" Ground",
+        actuators="3, 1",
+        loads=["pressure=-500Pa", "point=2:0,0,-2kN", "self_weight"],
+        material="10e9,0.3,700",
+        limit=300,
+    )
+    assert other.candidates == "ground" and other.actuators == (3, 1)
+    assert other.loads == (Pressure(-0.5), Point(2, (0.0, 0.0, -2000.0)))
+    assert other.material == Material(10e9, 0.3, 700.0) and other.supports == Service()
+    data = json.loads(json.dumps(other.to_dict()))
+    assert data["supports"] == "service" and data["actuators"] == "3,1"
+    assert data["loads"] == ["pressure=-0.5", "point=2:0.0,0.0,-2000.0"]
+    assert StructureOptions.from_dict(data) == other
+    candidates = StructureOptions(candidates=(1, 5), material=MATERIALS["steel"])
+    data = json.loads(json.dumps(candidates.to_dict()))
+    assert data["candidates"] == "1,5" and data["material"] == "steel"
+    assert StructureOptions.from_dict(data) == candidates
+    with pytest.raises(RigidfoldError, match="cannot read"):
+        StructureOptions.from_dict({"loads": ["snow=1"]})
     with pytest.raises(RigidfoldError, match="clamped vertices: 9 is out of range"):
-        StructureOptions(clamped="9").check_indices(n_vertices=9, n_edges=20)
+        StructureOptions(clamped=(9,)).check_indices(n_vertices=9, n_edges=20)
     with pytest.raises(RigidfoldError, match="actuators: 20 is out of range"):
-        StructureOptions(actuators="20").check_indices(n_vertices=9, n_edges=20)
+        StructureOptions(actuators=(20,)).check_indices(n_vertices=9, n_edges=20)
 
 
 def test_generate_options_hold_the_checks():
     fab = FabricateOptions(0.02, clearance_angle_deg=3.0)
-    st = StructureOptions(thickness=0.02, nonlinear=True, clamped="0")
-    opts = GenerateOptions(fabricate=fab, structure=st, material="plywood")
+    st = StructureOptions(thickness=0.02, nonlinear=True, clamped=(0,))
+    opts = GenerateOptions(fabricate=fab, structure=st, material=MATERIALS["plywood"])
     assert opts.panel_thickness == 0.02
     data = json.loads(json.dumps(opts.to_dict()))
     assert data["fabricate"]["thickness"] == 0.02 and data["structure"]["nonlinear"] is True
     assert GenerateOptions.from_dict(data) == opts
     assert pickle.loads(pickle.dumps(opts)) == opts  # a study hands it to its workers
     assert GenerateOptions.from_dict({"structure": None, "fabricate": None}) == GenerateOptions()
-    moved = opts.replace(material="steel")  # a new material is the structure's too
-    assert moved.structure.material == "steel" and moved.structure.nonlinear
+    moved = opts.replace(material=MATERIALS["steel"])  # a new material is the structure's too
+    assert moved.structure.material == MATERIALS["steel"] and moved.structure.nonlinear
 
 
 @pytest.mark.parametrize(
     "options",
     [
-        {"material": "steel", "structure": StructureOptions(material="plywood")},
+        {
+            "material": MATERIALS["steel"],
+            "structure": StructureOptions(material=MATERIALS["plywood"]),
+        },
         {"fabricate": FabricateOptions(0.02), "structure": StructureOptions(thickness=0.018)},
         {"structure": "yes"},
     ],

@@ -53,8 +53,8 @@ def test_generate_writes_solutions_log_and_summary(generated):
     # the search's path); the other solutions' records say it was not computed
     assert [p.name for p in (generated / "solutions").glob("*.svg")] == ["step_03_dof_18.svg"]
     summary = json.loads((generated / "summary.json").read_text())
-    assert (summary["initial_dof"], summary["final_dof"], summary["N_reduce"]) == (21, 18, 3)
-    assert summary["N_lock"] == 0 and summary["N_exceed"] == 0
+    assert (summary["initial_dof"], summary["final_dof"], summary["n_reduce"]) == (21, 18, 3)
+    assert summary["n_lock"] == 0 and summary["n_exceed"] == 0
     assert set(summary["time_s"]) == {
         "build",
         "solve",
@@ -80,7 +80,7 @@ def test_generate_writes_solutions_log_and_summary(generated):
     assert summary["deformation"]["checked"] == 0 and summary["time_s"]["deform"] == 0.0
     assert summary["motion"]["traced"] == 1 and summary["motion"]["max_length_error"] < 1e-8
     assert [s["motion"] is None for s in summary["per_solution"]] == [True] * 3 + [False]
-    assert summary["N_path"] == 0 and summary["final_deploys"] is True
+    assert summary["n_path"] == 0 and summary["final_deploys"] is True
     assert summary["per_solution"][-1]["deployability"]["deploys"] is True
     assert summary["verdict"] == {
         "outcome": "passed",

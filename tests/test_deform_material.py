@@ -67,6 +67,12 @@ def test_deform_cli_material_and_thickness(shape, tmp_path, capsys):
     assert report["frame_section"]["material"]["name"] == "plywood"
     saved = json.loads((out / "miura_deform.json").read_text())
     assert saved["frame_section"]["thickness_m"] == 0.018
-    assert main(["deform", str(src), "--out", str(tmp_path / "x"), "--thickness", "-1"]) == 2
-    assert main(["deform", str(src), "--out", str(tmp_path / "y"), "--material", "cheese"]) == 2
+    for flag, bad, name in (("--thickness", "-1", "x"), ("--material", "cheese", "y")):
+        with pytest.raises(SystemExit) as refused:  # refused by the parser, in one line
+            main(["deform", str(src), "--out", str(tmp_path / name), flag, bad])
+        assert refused.value.code == 2 and f"argument {flag}" in capsys.readouterr().err
+    args = ["--thickness", "18mm", "--json"]  # a unit, as the other commands take it
+    assert main(["deform", str(src), "--out", str(tmp_path / "mm"), *args]) == 0
+    section = json.loads(capsys.readouterr().out)["frame_section"]
+    assert section["thickness_m"] == pytest.approx(0.018)
     assert not (tmp_path / "x").exists() or not any((tmp_path / "x").iterdir())

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rigidfold.cli.units import parse_base, parse_cable, parse_point_mass
 from rigidfold.config import DEFAULTS
 from rigidfold.drive import DEPLOY_FILES, DriveOptions, DriveStatus, deploy_design
 from rigidfold.drive import actuators as act
@@ -18,7 +19,6 @@ from rigidfold.drive.energy import energy
 from rigidfold.drive.equilibria import equilibria, released
 from rigidfold.drive.mass import design_masses
 from rigidfold.drive.motion import DriveMotion, drive_motion
-from rigidfold.drive.options import parse_base, parse_cable, parse_point_mass
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports import read_design
 from rigidfold.fabricate.motion import PanelMotion

@@ -13,8 +13,8 @@ import pytest
 import rigidfold
 from rigidfold import RigidfoldError
 from rigidfold.config import DEFAULTS
-from rigidfold.exports import parse_formats
-from rigidfold.generate.case import make_case, parse_fixed
+from rigidfold.exports import check_formats
+from rigidfold.generate.case import fixed_mask, make_case
 from rigidfold.io import read_fold
 from rigidfold.patterns import parse_pattern
 from rigidfold.pipeline.workflows import analyze_file, report_run
@@ -48,14 +48,14 @@ def test_rigidfold_error_is_a_value_error_exported_lightly():
         lambda tmp: make_case("nosuch", "1"),
         lambda tmp: make_case("dome", "grid:1500x900"),
         lambda tmp: make_case("dome", "grid:3x3", size="axb"),
-        lambda tmp: make_case("dome", "1", symmetric=True, seed=-1),
+        lambda tmp: make_case("bezier", "1", seed=-1),
         lambda tmp: parse_pattern("mesh:0,0;1,0"),
         lambda tmp: get_surface("expr", expr="__import__('os')"),
         lambda tmp: parse_expression("x +* y"),
         lambda tmp: mesh_surface(tmp / "none.obj"),
         lambda tmp: read_fold(tmp / "none.fold"),
-        lambda tmp: parse_fixed("a,b", make_case("dome", "grid:3x3").pattern),
-        lambda tmp: parse_formats("obj,docx"),
+        lambda tmp: fixed_mask((0, 99), make_case("dome", "grid:3x3").pattern),
+        lambda tmp: check_formats(["obj", "docx"]),
         lambda tmp: DEFAULTS.with_(dz=-1.0),
         lambda tmp: DEFAULTS.with_(theta_min=2.0, theta_max=1.0),
         lambda tmp: analyze_file(tmp / "none.fold"),

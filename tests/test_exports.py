@@ -19,10 +19,10 @@ from rigidfold.cli.commands import main
 from rigidfold.develop import develop
 from rigidfold.exports import (
     EXPORT_FORMATS,
+    check_formats,
     export_design,
     layout_sheet,
     panel_loops,
-    parse_formats,
     read_design,
 )
 from rigidfold.exports.mesh3d import Y_UP
@@ -224,7 +224,7 @@ def test_svg_cut_sheet_measures_in_mm_and_keeps_the_boundary_length(design, expo
 def test_origami_simulator_svg_uses_its_colours_and_opacities(design, tmp_path):
     shape, coords2d = design
     (path,) = export_design(
-        shape, coords2d, tmp_path, "svg", name="os", convention="origami-simulator"
+        shape, coords2d, tmp_path, ("svg",), name="os", convention="origami-simulator"
     )
     root = ET.parse(path).getroot()
     assert root.get("width").endswith("mm")
@@ -355,9 +355,13 @@ def test_origami_simulator_fold_reads_back_as_the_same_design(design, exported):
 
 # ------------------------------------------------------------------------------ API
 def test_parse_formats():
+    from rigidfold.cli.units import parse_formats
+
     assert parse_formats("SVG, obj,obj") == ("obj", "svg")
-    assert parse_formats(["csv", "dxf"]) == ("dxf", "csv")
+    assert check_formats(["csv", "dxf"]) == ("dxf", "csv")
     assert parse_formats(",".join(EXPORT_FORMATS)) == EXPORT_FORMATS
+    with pytest.raises(ValueError, match="sequence of format names"):
+        check_formats("obj")
     with pytest.raises(ValueError, match="unknown export format 'xyz'"):
         parse_formats("obj,xyz")
     with pytest.raises(ValueError, match="no export format"):
@@ -382,7 +386,7 @@ def test_an_existing_link_is_replaced_not_followed(design, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     (out / "design.obj").symlink_to(target)
-    export_design(shape, coords2d, out, "obj")
+    export_design(shape, coords2d, out, ("obj",))
     assert target.read_text() == "keep"
     assert not (out / "design.obj").is_symlink()
 

@@ -305,7 +305,7 @@ def test_missing_file_exits_2(tmp_path, capsys):
 
 
 def test_parse_length():
-    from rigidfold.fabricate.build import parse_length, parse_sheet
+    from rigidfold.cli.units import parse_length, parse_sheet
 
     assert parse_length("18mm") == pytest.approx(0.018)
     assert parse_length("1.8cm") == pytest.approx(0.018)
@@ -313,6 +313,10 @@ def test_parse_length():
     assert parse_sheet("2440x1220") == (2440.0, 1220.0)
     with pytest.raises(ValueError, match="thickness"):
         parse_length("0")
+    with pytest.raises(ValueError, match="at most"):
+        parse_sheet("1e308x10")
+    with pytest.raises(ValueError, match="thickness must be a positive length"):
+        FabricateOptions("18mm")  # the library takes metres; the command line reads text
 
 
 def test_earlier_fabricate_refused_unless_overwrite(design, tmp_path, capsys):

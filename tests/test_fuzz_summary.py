@@ -92,7 +92,7 @@ MUTATIONS = [
         [6],
         "'final_dof' is [6], expected a whole number (64 bits) or null",
     ),
-    ("summary.json", ("N_lock",), "$\\frac$", "'N_lock' is \"$\\\\frac$\""),
+    ("summary.json", ("n_lock",), "$\\frac$", "'n_lock' is \"$\\\\frac$\""),
     ("summary.json", ("stop",), None, "'stop' is null, expected text"),
     ("summary.json", ("solutions",), "solutions/x.fold", "'solutions' is \"solutions/x.fold\""),
     ("summary.json", ("solutions", 0), "/etc/passwd", "'solutions[0]' is \"/etc/passwd\""),

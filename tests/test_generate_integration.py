@@ -16,7 +16,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.generate import GenerateOptions
 from rigidfold.rundir import Stage, load_run
-from rigidfold.structure import StructureOptions
+from rigidfold.structure import StructureOptions, Uniform
 from rigidfold.study import STUDY_OPTIONS, StudyConfig
 
 FAST = [
@@ -148,11 +148,9 @@ def test_options_are_validated(changes):
 
 
 def test_options_round_trip_and_studies_do_not_store_them():
-    structure = StructureOptions.from_strings(
-        thickness=0.018, loads=("uniform=0.5",), limit="L/300"
-    )
+    structure = StructureOptions(thickness=0.018, loads=(Uniform(0.5),), limit=300.0)
     opts = GenerateOptions(fabricate=FabricateOptions(0.018), structure=structure)
-    assert len(opts.structure.loads) == 1 and opts.structure.limit.divisor == 300.0
+    assert len(opts.structure.loads) == 1 and opts.structure.limit == 300.0
     assert GenerateOptions.from_dict(json.loads(json.dumps(opts.to_dict()))) == opts
     stored = StudyConfig(STUDY_OPTIONS).as_dict()
     assert set(stored) == {
@@ -199,9 +197,10 @@ def test_step9_takes_the_users_material(tmp_path):
         figures[name] = deformed["max_dl_mm"]
     assert figures["tubes"] != pytest.approx(figures["plywood"], rel=1e-3)
     from rigidfold.config import DEFAULTS
+    from rigidfold.material import MATERIALS
 
-    assert GenerateOptions().panel_material == DEFAULTS.structure.material
-    assert GenerateOptions(material="steel").panel_material == "steel"
+    assert GenerateOptions().panel_material == MATERIALS[DEFAULTS.structure.material]
+    assert GenerateOptions(material=MATERIALS["steel"]).panel_material == MATERIALS["steel"]
 
 
 def test_a_check_that_cannot_run_is_a_failed_stage_not_a_lost_run(tmp_path, monkeypatch):

@@ -15,7 +15,7 @@ import pytest
 
 from rigidfold.config import DEFAULTS
 from rigidfold.generate.case import make_case
-from rigidfold.optimize import Status
+from rigidfold.optimize import SolverName, Status
 from rigidfold.optimize.jacobian import (
     ClosedFormGradient,
     ClosedFormJacobian,
@@ -91,7 +91,7 @@ def test_callbacks_evaluate_as_casadi_functions():
 def test_large_pattern_solver_uses_the_closed_form_derivatives():
     settings = DEFAULTS.with_(projection_vertices=40)  # 7 x 7 = 49 vertices takes the path
     problem = make_case("dome", "grid:7x7", size="3x3", settings=settings).problem()
-    nlpsol = problem.solver("ipopt").nlpsol
+    nlpsol = problem.solver(SolverName.IPOPT).nlpsol
     assert "constraint_jacobian" not in problem.__dict__  # CasADi's was never built
     assert "objective_gradient" not in problem.__dict__
     assert nlpsol.get_function("nlp_jac_g").class_name() == "CallbackInternal"

@@ -23,11 +23,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("cli",),
 )
 ENTRIES = ("__init__", "__main__", "pinned")  # the package and its process entries
-KNOWN_UPWARD = {
-    # structure/design.py reads the thickness that fabricate recorded beside a design
-    ("rigidfold.structure.design", "rigidfold.fabricate.build"),
-    ("rigidfold.structure.design", "rigidfold.fabricate.files"),
-}
+KNOWN_UPWARD: set[tuple[str, str]] = set()
+"""Imports allowed to go up a layer: none."""
 LAYER_OF = {name: i for i, names in enumerate(LAYERS) for name in names}
 
 

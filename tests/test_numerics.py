@@ -165,8 +165,9 @@ def test_pinned_environ_merges_and_replaces():
 NUMERICS_A = {"key": "aaaa numpy=1", "status": "pinned"}
 NUMERICS_B = {"key": "bbbb numpy=1", "status": "pinned"}
 ROW = {
-    "status": "target DOF 1 reached", "n_reduce": 3, "n_lock": 1, "n_exceed": 0, "mean_f": 1e-13,
-    "initial_dof": 4, "final_dof": 1, "n_solutions": 4, "n_solves": 5, "time_build": 0.1,
+    "status": "target DOF 1 reached", "n_reduce": 3, "n_lock": 1, "n_exceed": 0,
+    "mean_f_accepted": 1e-13, "initial_dof": 4, "final_dof": 1, "n_solutions": 4, "n_solves": 5,
+    "time_build": 0.1,
     "time_solve": 1.0, "time_analysis": 0.1, "time_selection": 0.0, "time_total": 1.3,
     "version": "t", "numerics": "aaaa",
 }  # fmt: skip

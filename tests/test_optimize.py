@@ -7,7 +7,7 @@ import pytest
 
 from rigidfold.config import DEFAULTS
 from rigidfold.generate.case import make_case
-from rigidfold.optimize import FormFindingProblem, Status, build_linear_map
+from rigidfold.optimize import FormFindingProblem, SolverName, Status, build_linear_map
 from rigidfold.surfaces import get_surface
 
 
@@ -85,7 +85,7 @@ def test_derivatives_handed_to_ipopt_have_o_of_e_nonzeros():
     per_edge = []
     for n in (7, 11, 21):
         case = make_case("dome", f"grid:{n}x{n}", size="3x3")
-        nlpsol = case.problem().solver("ipopt").nlpsol
+        nlpsol = case.problem().solver(SolverName.IPOPT).nlpsol
         jac = nlpsol.get_function("nlp_jac_g").sparsity_out(1)
         hess = nlpsol.get_function("nlp_hess_l").sparsity_out(0)  # upper triangle
         assert max(np.diff(jac.T.colind())) <= 9  # an angle: three vertices
@@ -214,7 +214,7 @@ def test_pattern2_infeasible_start_is_repaired():
     assert result.pattern.corner_angles.min() >= DEFAULTS.design.theta_min - 1e-8
 
 
-@pytest.mark.parametrize("solver", ["slsqp", "slsqp-fd"])
+@pytest.mark.parametrize("solver", [SolverName.SLSQP, SolverName.SLSQP_FD])
 def test_slsqp_reference_solvers_return_a_result(solver):
     """SLSQP runs on the same model and reports through the same result type."""
     case = make_case("bezier", "1", seed=1, settings=DEFAULTS.with_(slsqp_max_iter=15))

@@ -180,7 +180,7 @@ def test_a_deployable_design_is_accepted_and_delivered(seed_103):
     assert_rigid(final.path, final.result.pattern)
     assert final.result.F <= DEFAULTS.solver.polish_tol * 10  # polished to F = 0
     record = checked.to_dict()
-    assert record["N_path"] == checked.n_path and record["final_deploys"] is True
+    assert record["n_path"] == checked.n_path and record["final_deploys"] is True
     assert record["time_s"]["path"] > 0
 
 
@@ -201,10 +201,10 @@ def test_the_counters_are_stored_and_reported(tmp_path, capsys):
     assert main([*args, "--lookahead", "--no-deform", "--quiet", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
-    assert f"N_path={summary['N_path']}" in printed and summary["N_path"] >= 1
+    assert f"N_path={summary['n_path']}" in printed and summary["n_path"] >= 1
     assert summary["final_deploys"] is True and summary["options"]["deploy_check"] is True
     log = read_log(out / "log.jsonl")
-    assert sum(a.outcome == "path" for a in log) == summary["N_path"]
+    assert sum(a.outcome == "path" for a in log) == summary["n_path"]
     # the report's slider shows the traced path of the final design, flat to folded
     final = json.loads((out / summary["verdict"]["final_design"]).read_text())
     motion = [f for f in final["file_frames"] if "folding motion" in f.get("frame_title", "")]

@@ -73,7 +73,7 @@ def test_report_writes_one_page_and_the_figures(reported, run_dir):
     info = reported.to_dict()
     summary = json.loads((run_dir / "summary.json").read_text())
     assert info["final_design"] == summary["solutions"][-1] == "solutions/step_03_dof_06.fold"
-    assert (info["final_dof"], info["N_lock"]) == (6, summary["N_lock"])
+    assert (info["final_dof"], info["n_lock"]) == (6, summary["n_lock"])
     assert info["checks"] == {
         "development": "passed",
         "folding motion": "passed",

@@ -128,7 +128,7 @@ def test_summary_json_is_written_when_it_changes_and_exact_at_the_end(logged):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["schema_version"] == SCHEMA_VERSION
     exact = run.to_dict()
-    for key in ("n_solves", "N_lock", "N_exceed", "N_path", "N_backtrack", "N_rigid", "stop"):
+    for key in ("n_solves", "n_lock", "n_exceed", "n_path", "n_backtrack", "n_rigid", "stop"):
         assert summary[key] == exact[key], key
 
 

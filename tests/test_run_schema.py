@@ -85,7 +85,7 @@ def test_summary_is_written_and_read_through_one_record():
     )
     data = summary.to_dict()
     assert set(Generation().to_dict()) <= set(data)
-    assert data["time_s"]["develop"] == 1.5 and data["N_lock"] == 0
+    assert data["time_s"]["develop"] == 1.5 and data["n_lock"] == 0
     keys = list(data)
     assert keys[0] == "schema_version"
     assert keys.index("structure") + 1 == keys.index("per_solution")
@@ -119,8 +119,8 @@ def test_generate_options_validate_and_round_trip():
         GenerateOptions(criterion="x")
     with pytest.raises(ValueError, match="target DOF must be an integer >= 0, got -1"):
         GenerateOptions(target_dof=-1)
-    with pytest.raises(ValueError, match="unknown check 'some'"):
-        GenerateOptions(check="some")
+    with pytest.raises(ValueError, match="check must be a Check \\(final, all\\), got 'all'"):
+        GenerateOptions(check="all")  # the command line's text is read by rigidfold.cli
 
 
 def test_settings_hold_no_run_options():
@@ -188,3 +188,74 @@ def test_a_design_beyond_dz_fails_the_fit_check(tmp_path):
     files = [tmp_path / f"step_{k}.fold" for k in range(len(records))]
     verdict = run_verdict(run, records, files, options.target_dof)
     assert f"{Stage.FIT.message} for the final design (max |z - target|" in verdict.shortfalls[0]
+
+
+# ------------------------------------------------- the records once (issue 46, item 3)
+
+
+def test_summary_shape_follows_run_summary_fields():
+    """SUMMARY_SHAPE is made from RunSummary: every field is a key of it (the fields without
+    a default required), and a field added to RunSummary is a key of the shape so made."""
+    from dataclasses import MISSING, fields, make_dataclass
+
+    from rigidfold.rundir.json_shapes import Nullable, record_shape
+    from rigidfold.rundir.schema import SOLUTION_SHAPE, SUMMARY_SHAPE
+
+    assert list(SUMMARY_SHAPE.keys) == [f.name for f in fields(RunSummary)]
+    required = {
+        f.name for f in fields(RunSummary) if f.default is MISSING and f.default_factory is MISSING
+    }
+    assert set(SUMMARY_SHAPE.required) == required
+    assert required == {
+        "stop", "stop_reason", "final_dof", "n_lock", "per_solution", "case", "solutions",
+    }  # fmt: skip
+    assert SUMMARY_SHAPE.keys["per_solution"] == [SOLUTION_SHAPE]
+    assert list(SOLUTION_SHAPE.keys) == [f.name for f in fields(SolutionRecord)]
+    assert SUMMARY_SHAPE.keys["n_lock"] == Nullable(int)
+    added = make_dataclass(
+        "Later", [("n_flips", int | None, None)], bases=(RunSummary,), frozen=True, kw_only=True
+    )
+    assert record_shape(added, null_is_default=True).keys["n_flips"] == Nullable(int)
+
+
+def test_stage_figures_are_declared_once():
+    """A key read of a stage's figures is declared in its TypedDict, which makes its shape;
+    one added there is checked in summary.json."""
+    from typing import Annotated, get_type_hints
+
+    from rigidfold.rundir.json_shapes import Nullable, record_shape, shape_of
+    from rigidfold.rundir.schema import SOLUTION_SHAPE, DevelopmentFigures
+
+    development = SOLUTION_SHAPE.keys["development"]
+    assert development == Nullable(record_shape(DevelopmentFigures))
+    assert set(development.shape.keys) == set(get_type_hints(DevelopmentFigures))
+
+    class Later(DevelopmentFigures, total=False):
+        wrinkles: int | None
+
+    later = shape_of(Annotated[dict | None, Later])
+    assert later.shape.keys["wrinkles"] == Nullable(int)
+    summary = RunSummary.from_run(
+        Generation(), [_record()], stage_times={}, options={}, case={}, solutions=("a",)
+    )
+    data = json.loads(json.dumps(summary.to_dict()))
+    data["per_solution"][0]["development"]["D"] = "small"
+    with pytest.raises(RigidfoldError, match=r"'per_solution\[0\]\.development\.D' is \"small\""):
+        RunSummary.from_dict(data, "summary.json")
+
+
+def test_each_counter_has_one_name_from_the_run_to_the_summary():
+    """Generation.to_dict's keys are RunSummary's fields and summary.json's keys under the
+    same names (no renaming: ``n_lock`` everywhere, never ``N_lock``)."""
+    from dataclasses import fields
+
+    run = Generation(n_lock=2, n_exceed=1, n_path=3, n_backtrack=4, n_rigid=5)
+    produced = run.to_dict()
+    names = {f.name for f in fields(RunSummary)}
+    assert set(produced) <= names
+    summary = RunSummary.from_run(run, [], stage_times={}, case={}, solutions=())
+    data = summary.to_dict()
+    for key, value in produced.items():
+        assert data[key] == value and getattr(summary, key) == value
+    assert not [k for k in data if k.startswith("N_") or "_F_" in k]
+    assert (summary.n_lock, summary.n_exceed, summary.n_rigid) == (2, 1, 5)

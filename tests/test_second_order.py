@@ -131,7 +131,7 @@ def test_a_dense_step_passes_the_bifurcation_point_of_a_flat_vertex_on_its_branc
     """The flat state of a degree-4 vertex is a bifurcation point (two flexes: a fold about
     either diagonal). Arriving along the fold about 0-2, the dense step continues on that
     branch, onto the constraints to the tracer's tolerance."""
-    from rigidfold.mechanism.path import _escape
+    from rigidfold.mechanism.recovery import escape
     from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints
 
     flat = CreasePattern.from_faces(STRAIGHT4, FACES4)
@@ -139,7 +139,7 @@ def test_a_dense_step_passes_the_bifurcation_point_of_a_flat_vertex_on_its_branc
     t = np.zeros(cons.n)
     t[3 * 3 + 2] = 1.0  # vertex 3 leaves the plane: the fold about 0-2
     x0 = cons.x0
-    out = _escape(cons, x0, t, cons.free_angles(x0), 0.05, "projection", DEFAULTS)
+    out = escape(cons, x0, t, cons.free_angles(x0), 0.05, "projection", DEFAULTS)
     assert out is not None
     y, _, _, _ = out
     assert np.abs(cons.residual(y)).max() <= DEFAULTS.path.tol

@@ -16,13 +16,13 @@ from pathlib import Path
 import pytest
 
 from conftest import main_code
+from rigidfold.cli.structure_specs import parse_index_list
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions, Stop, best_so_far, generate
 from rigidfold.generate.case import make_case
 from rigidfold.pipeline.verdict import run_verdict
 from rigidfold.reporting import render_figures
 from rigidfold.rundir import SolutionRecord, load_run, read_log
-from rigidfold.structure.supports import index_list
 
 SMALL = ["generate", "--surface", "bezier", "--seed", "1", "--pattern", "grid:3x3"]
 SMALL += ["--size", "1x1", "--no-deform", "--no-report", "--quiet"]
@@ -110,7 +110,7 @@ def test_target_dof_0_with_the_deploy_check_is_refused_before_the_run(tmp_path, 
 @pytest.mark.parametrize("text", ["0,,1", "0,1,", ",0", " , "])
 def test_an_empty_index_is_refused_naming_the_text(text):
     with pytest.raises(RigidfoldError, match=f"got {text!r}"):
-        index_list(text, "supports")
+        parse_index_list(text, "supports")
 
 
 def test_supports_with_an_empty_item_exit_2(tmp_path, capsys):
@@ -118,7 +118,8 @@ def test_supports_with_an_empty_item_exit_2(tmp_path, capsys):
     code = main_code(["structure", str(aframe), "--supports", "0,,1", "--out", str(tmp_path)])
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and "'0,,1'" in line and "item 2 is empty" in line
-    assert index_list("", "supports") == [] and index_list(" 3, 7 ", "supports") == [3, 7]
+    assert parse_index_list("", "supports") == ()
+    assert parse_index_list(" 3, 7 ", "supports") == (3, 7)
 
 
 # ---------------------------------------------------- the design an interrupted run names

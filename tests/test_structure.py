@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from conftest import files_of, folded_grid, run_cli, run_cli_size_limited
+from rigidfold.cli.structure_specs import parse_limit, parse_load
 from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
 from rigidfold.io import read_fold, write_fold
@@ -26,9 +27,6 @@ from rigidfold.structure import (
     auto_supports,
     check_structure,
     check_supports,
-    parse_limit,
-    parse_load,
-    parse_material,
 )
 
 DATA = Path(__file__).parent / "data"
@@ -229,6 +227,8 @@ def test_stiffer_hinges_deflect_less(design, chosen):
 
 # ------------------------------------------------------------------ inputs
 def test_material_presets_and_custom():
+    from rigidfold.cli.units import parse_material
+
     assert parse_material("steel").E == 210e9
     assert parse_material("Aluminium").density == 2700
     custom = parse_material("10e9, 0.3, 700")
@@ -236,6 +236,9 @@ def test_material_presets_and_custom():
     for bad in ("wood", "1,2", "1e9,0.6,700", "-1,0.3,7", "a,b,c", "1e9,0.3,nan"):
         with pytest.raises(ValueError):
             parse_material(bad)
+    for material in (*MATERIALS.values(), custom, Material(2.1e11, 0.3, 7850.5)):
+        assert Material.from_key(material.key) == material  # a record's one word
+    assert MATERIALS["steel"].key == "steel" and custom.key == "10000000000,0.3,700"
 
 
 def test_limit_and_load_parsing():

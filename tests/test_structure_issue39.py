@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from conftest import folded_grid, run_cli
+from rigidfold.cli.structure_specs import parse_load, read_structure_options
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate.options import GenerateOptions
@@ -27,10 +28,10 @@ from rigidfold.structure import (
     StructureOptions,
     StructureStatus,
     Supports,
+    Uniform,
     auto_supports,
     check_structure,
     check_supports,
-    parse_load,
     write_structure,
 )
 from rigidfold.structure.design import plan_design
@@ -80,7 +81,7 @@ def test_more_modes_than_the_model_has_gives_all_it_has():
 )
 def test_numbers_that_overflow_are_refused_when_the_options_are_made(changes):
     with pytest.raises(RigidfoldError, match="max_structure_value") as err:
-        StructureOptions.from_strings(**changes)
+        read_structure_options(**changes)
     assert "\n" not in str(err.value)
 
 
@@ -94,7 +95,7 @@ def test_the_library_refuses_them_too():
 
 def test_generate_refuses_them_before_the_run():
     with pytest.raises(RigidfoldError, match="max_structure_value"):
-        GenerateOptions(structure=StructureOptions.from_strings(loads=("uniform=1e300",)))
+        GenerateOptions(structure=StructureOptions(loads=(Uniform(1e300),)))
 
 
 @pytest.mark.parametrize(

@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from conftest import folded_grid, run_cli
+from rigidfold.cli.structure_specs import read_structure_options
 from rigidfold.config import DEFAULTS
 from rigidfold.io import read_fold, write_fold
-from rigidfold.structure import StructureStatus, Supports, check_supports
+from rigidfold.structure import Auto, Pins, Service, StructureStatus, Supports, check_supports
 from rigidfold.structure.design import StructureOptions, plan_design
 from test_structure import independent_kernel
 
@@ -29,10 +30,10 @@ def test_service_supports_meet_the_limit_that_auto_misses(roof):
     """The roof on free hinges: auto's pins hold the mechanism but let it sag far past
     L/250; service keeps them, adds boundary pins, meets the limit, and each added pin is
     needed (without any one of them the same analysis misses the limit)."""
-    auto = plan_design(roof, StructureOptions.from_strings(supports="auto", modes=0)).check()
+    auto = plan_design(roof, StructureOptions(supports=Auto(), modes=0)).check()
     assert auto.rigidity.rigid and auto.status is StructureStatus.DEFLECTION
     assert "--supports service pins more vertices" in auto.message  # what may meet it
-    plan = plan_design(roof, StructureOptions.from_strings(supports="service", modes=0))
+    plan = plan_design(roof, StructureOptions(supports=Service(), modes=0))
     check = plan.check()
     assert check.status is StructureStatus.PASSED and check.chosen == "service"
     growth = check.growth
@@ -67,9 +68,7 @@ def test_a_search_that_cannot_meet_the_limit_says_how_far_it_went():
     service_max_pins), keeps them all (none can be taken away) and fails the limit."""
     design = folded_grid(4, 0.3)
     boundary = design.boundary_vertices
-    check = plan_design(
-        design, StructureOptions.from_strings(supports="service", limit="L/1e9", modes=0)
-    ).check()
+    check = plan_design(design, StructureOptions(supports=Service(), limit=1e9, modes=0)).check()
     assert check.status is StructureStatus.DEFLECTION and not check.growth.passed
     assert f"pins alone did not meet it ({len(boundary)} pinned of {len(boundary)}" in check.message
     np.testing.assert_array_equal(check.rigidity.supports.pinned, boundary)
@@ -79,7 +78,7 @@ def test_a_search_that_cannot_meet_the_limit_says_how_far_it_went():
     capped = DEFAULTS.with_(structure_service_max_pins=2)
     few = plan_design(
         design,
-        StructureOptions.from_strings(supports="service", limit="L/1e9", modes=0),
+        StructureOptions(supports=Service(), limit=1e9, modes=0),
         settings=capped,
     ).check()
     assert len(few.growth.added) == 2 and len(few.growth.trail) == 3
@@ -120,7 +119,7 @@ def test_cli_service_reports_the_added_pins(tmp_path):
 )
 def test_a_misspelt_support_word_is_one_line_naming_the_choices(text, words):
     with pytest.raises(ValueError) as err:
-        StructureOptions.from_strings(supports=text)
+        read_structure_options(supports=text)
     message = str(err.value)
     assert message.startswith("supports must be auto, service or comma-separated vertex indices")
     assert words in message and "\n" not in message
@@ -131,23 +130,19 @@ def test_where_pins_alone_miss_the_limit_the_hinge_stiffness_that_meets_it_is_na
     stiffness that meets it (checked again with the supports given), close to the least
     (20 % less does not), and an unreachable limit is said to be out of reach of hinges."""
     design = folded_grid(4, 0.3)
-    pins = ",".join(map(str, plan_design(design).rigidity.supports.pinned))
-    options = StructureOptions.from_strings(
-        supports="service", candidates=pins, limit="L/1000", modes=0
-    )
+    pins = tuple(plan_design(design).rigidity.supports.pinned.tolist())
+    options = StructureOptions(supports=Service(), candidates=pins, limit=1000.0, modes=0)
     check = plan_design(design, options).check()
     assert check.status is StructureStatus.DEFLECTION and check.growth.searched_hinges
     k, largest = check.growth.hinge_hint
     assert largest <= check.allowed_displacement
     assert "N m/rad per m would" in check.message
-    given = StructureOptions.from_strings(supports=pins, limit="L/1000", modes=0)
+    given = StructureOptions(supports=Pins(pins), limit=1000.0, modes=0)
     assert plan_design(design, given.replace(hinge_stiffness=k)).check().passed
     softer = plan_design(design, given.replace(hinge_stiffness=k / 1.2)).check()
     assert softer.status is StructureStatus.DEFLECTION
     data = check.to_dict()["supports"]["service"]["hinge_stiffness_that_meets_the_limit"]
     assert data == {"Nm_per_rad_per_m": k, "max_displacement_m": largest}
-    never = StructureOptions.from_strings(
-        supports="service", candidates=pins, limit="L/1e9", modes=0
-    )
+    never = StructureOptions(supports=Service(), candidates=pins, limit=1e9, modes=0)
     out = plan_design(design, never).check()
     assert out.growth.hinge_hint is None and "nor would stiffer hinges" in out.message

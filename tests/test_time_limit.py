@@ -12,6 +12,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop, generate
 from rigidfold.generate.case import make_case
 from rigidfold.generate.options import GenerateOptions
+from rigidfold.optimize import SolverName
 
 
 def test_a_time_limit_ends_the_run_with_a_named_design_and_exit_1(tmp_path, capsys):
@@ -136,9 +137,10 @@ def test_the_candidates_paths_are_traced_to_the_runs_deadline(monkeypatch):
 @pytest.mark.parametrize(
     ("solver", "settings"),
     [
-        ("ipopt", {}),
-        ("ipopt", {"projection_vertices": 10}),  # the composite: projection, IPOPT, projection
-        ("slsqp", {}),
+        (SolverName.IPOPT, {}),
+        # the composite: projection, IPOPT, projection
+        (SolverName.IPOPT, {"projection_vertices": 10}),
+        (SolverName.SLSQP, {}),
     ],
 )
 def test_a_solve_past_its_deadline_ends_at_its_iterate(solver, settings):
@@ -151,7 +153,7 @@ def test_a_solve_past_its_deadline_ends_at_its_iterate(solver, settings):
     from rigidfold.optimize import Status
 
     case = make_case("dome", "grid:5x5", size="3x3", settings=DEFAULTS.with_(**settings))
-    problem = case.problem(build_ipopt=solver == "ipopt")
+    problem = case.problem(build_ipopt=solver is SolverName.IPOPT)
     plain = problem.solve(solver=solver)
     assert plain.status is Status.CONVERGED
     far = problem.solve(solver=solver, deadline=time.monotonic() + 3600.0)
@@ -253,3 +255,62 @@ def test_a_time_limited_run_ends_within_its_grace():
     assert run.stop is Stop.TIME_LIMIT
     g = DEFAULTS.generation
     assert wall < 2.0 + max(g.time_limit_grace_min, 2.0 * g.time_limit_grace) + 3.0
+
+
+def test_a_first_solve_cut_by_the_time_limit_ends_the_run_at_the_limit(monkeypatch):
+    """The first solve that the limit ends says so: the stop is ``time_limit`` (no
+    "no developable polyhedron", whose hints (a larger dz, other bounds) would mislead), its
+    attempt's outcome ``time_limit``, no solution."""
+    import time
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.generate import AttemptOutcome
+
+    monkeypatch.setattr(
+        generation._Steps, "final_deadline", property(lambda self: time.monotonic() - 1.0)
+    )
+    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False), time_limit=5)
+    assert run.stop is Stop.TIME_LIMIT and run.stop_reason == "time limit of 5 s reached"
+    assert [a.outcome for a in run.attempts] == [AttemptOutcome.TIME_LIMIT]
+    assert run.solutions == [] and run.final is None
+
+
+def test_a_motion_cut_by_its_deadline_says_so_and_not_that_the_shape_is_stuck():
+    """The final design's folding motion traced after a run's time limit ends at the run's
+    deadline: its status is ``cut`` (the motion stage fails with that message), and the shape
+    is not said to have no path to the plane."""
+    import time
+
+    from rigidfold.deform import MotionStatus, folding_motion
+    from rigidfold.develop import develop
+
+    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False))
+    pattern = run.final.result.pattern
+    flat = develop(pattern).coords2d
+    cut = folding_motion(pattern, flat, dof=run.final_dof, deadline=time.monotonic() - 1.0)
+    assert cut.status is MotionStatus.CUT and "time limit" in cut.message
+    whole = folding_motion(pattern, flat, dof=run.final_dof, deadline=time.monotonic() + 3600)
+    assert whole.status is MotionStatus.OK
+
+
+def test_the_process_age_counts_from_the_start_of_the_process():
+    """``--time-limit`` counts from the command's start: the age of this process is
+    positive and grows with the clock (0.0 only where /proc cannot be read)."""
+    import time
+
+    from rigidfold.runtime.clock import process_age
+
+    first = process_age()
+    time.sleep(0.05)
+    second = process_age()
+    assert first > 0.0 and second >= first + 0.04
+
+
+def test_the_graces_after_a_time_limit():
+    """Naming the final design ends a grace after T, the whole run by two graces:
+    T + max(10 s, 5 % of T) with the defaults."""
+    from rigidfold.generate.steps import past_time_limit
+
+    assert past_time_limit(100.0, None, DEFAULTS) is None
+    assert past_time_limit(100.0, 180.0, DEFAULTS, 2.0) == 100.0 + 180.0 + 10.0
+    assert past_time_limit(100.0, 600.0, DEFAULTS, 2.0) == 100.0 + 600.0 + 30.0

@@ -12,12 +12,8 @@ record.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable
 from typing import Any
-
-from rigidfold.config import check_seed
-from rigidfold.errors import RigidfoldError
 
 
 @dataclasses.dataclass(frozen=True)
@@ -26,19 +22,22 @@ class Flag:
 
     name : the flag (default: ``--`` and the field's name with dashes; a bool whose default
         is True is turned off by ``--no-`` and that name).
-    parse : the text to the value (an argparse ``type``; default: the text).
+    parse : how the command line reads the text: the name of one of its parsers (a key of
+        ``rigidfold.cli.units.PARSERS``: ``"thickness"``, ``"material"``, ``"seed"``, ...),
+        or ``int`` / ``float``; default: the text. The record itself holds typed values.
+        A field whose default is a member of an ``enum.Enum`` is read as one of its values.
     metavar, choices : as argparse's.
     shown : the default as the help says it, where that is not the value itself: for a
         default of None what None means, else the default as text (``""`` is ``"none"``);
-        one that is not text or a number, as text that ``parse`` (or the record's
-        ``from_strings``) reads back (a pair ``(2440.0, 1220.0)`` is ``"2440x1220"``).
+        one that is not text or a number, as text that ``parse`` reads back (a pair
+        ``(2440.0, 1220.0)`` is ``"2440x1220"``).
     switch : a bool's help before its doc, where that is not "turn on" (or "turn off" for a
         bool on by default): ``"leave out"``, or ``""`` for a doc that reads as the help.
     repeat : the flag may be given more than once, its values a list (none by default).
     """
 
     name: str | None = None
-    parse: Callable[[str], Any] | None = None
+    parse: str | Callable[[str], Any] | None = None
     metavar: str | None = None
     choices: tuple[str, ...] | None = None
     shown: str | None = None
@@ -60,49 +59,3 @@ def option(default: Any, doc: str, *, flag: bool = True, **how: Any) -> Any:
 def docs(record: type) -> dict[str, str]:
     """What every field of an options record means, by field name."""
     return {f.name: f.metadata.get("doc", "") for f in dataclasses.fields(record)}
-
-
-# ---- the text of a flag to its value: a RigidfoldError names what was received ----------
-
-
-def count(text: str) -> int:
-    """An integer >= 0."""
-    value = _integer(text)
-    if value < 0:
-        raise RigidfoldError(f"must be an integer >= 0, got {text!r}")
-    return value
-
-
-def seed(text: str) -> int:
-    """A seed: an integer from 0 to below 2**63."""
-    return check_seed(_integer(text))
-
-
-def positive(text: str) -> float:
-    """A finite number > 0."""
-    value = _number(text)
-    if not (math.isfinite(value) and value > 0):
-        raise RigidfoldError(f"must be a positive number, got {text!r}")
-    return value
-
-
-def fraction(text: str) -> float:
-    """A number from 0 to below 1."""
-    value = _number(text)
-    if not 0 <= value < 1:
-        raise RigidfoldError(f"must be a number from 0 to below 1, got {text!r}")
-    return value
-
-
-def _integer(text: str) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise RigidfoldError(f"invalid int value: {text!r}") from None
-
-
-def _number(text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        return math.nan

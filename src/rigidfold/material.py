@@ -1,5 +1,7 @@
 """The panels' material: an isotropic elastic plate of Young's modulus, Poisson's ratio and
-density, given by name (a preset) or as ``E,nu,density`` in SI units.
+density (:class:`Material`), a preset of :data:`MATERIALS` or any other; the panels of a built
+design, a material and a thickness (:class:`Panel`). The command line reads a preset's name or
+``E,nu,density`` in SI units (:mod:`rigidfold.cli.units`).
 
 The presets are typical values, for a first design; a structural check uses the values of
 the product that will be built (its data sheet or the relevant code):
@@ -66,9 +68,37 @@ class Material:
         """The material of :meth:`to_dict`."""
         return cls(data["E_Pa"], data["nu"], data["density_kg_m3"], data["name"])
 
+    @property
+    def key(self) -> str:
+        """The material as a record holds it in one word: a preset's name, else
+        ``"E,nu,density"`` (SI units; :meth:`from_key` reads it back)."""
+        if MATERIALS.get(self.name) == self:
+            return self.name
+        return ",".join(_number(x) for x in (self.E, self.nu, self.density))
+
+    @classmethod
+    def from_key(cls, key: str) -> Material:
+        """The material of :attr:`key` (as a record wrote it); RigidfoldError for another
+        text."""
+        if key in MATERIALS:
+            return MATERIALS[key]
+        try:
+            E, nu, density = (float(x) for x in str(key).split(","))
+        except ValueError:
+            raise RigidfoldError(
+                f"a recorded material is a preset's name or 'E,nu,density', got {key!r}"
+            ) from None
+        return cls(E, nu, density)
+
     def describe(self) -> str:
         """``plywood (E = 10 GPa, nu = 0.3, 700 kg/m^3)``."""
         return f"{self.name} (E = {self.E / 1e9:g} GPa, nu = {self.nu:g}, {self.density:g} kg/m^3)"
+
+
+def _number(x: float) -> str:
+    """``x`` in the fewest digits that read back as it (``10000000000``, ``0.3``)."""
+    text = repr(float(x))
+    return text.removesuffix(".0")
 
 
 MATERIALS: dict[str, Material] = {
@@ -88,33 +118,28 @@ MATERIAL_SOURCES = {
 """Where each preset's values come from, in a few words (for ``--help`` and the JSON)."""
 
 
-def parse_material(text: str | Material) -> Material:
-    """A preset's name (:data:`MATERIALS`) or ``"E,nu,density"`` in SI units (Pa, -, kg/m^3).
+def material_named(name: str) -> Material:
+    """The preset ``name`` (a key of :data:`MATERIALS`, as ``Settings.structure.material``
+    holds it); RigidfoldError naming it for another name."""
+    if name not in MATERIALS:
+        raise RigidfoldError(f"no material preset {name!r} (the presets: {', '.join(MATERIALS)})")
+    return MATERIALS[name]
 
-    ValueError (one line, naming what was received) for anything else.
-    """
-    if isinstance(text, Material):
-        return text
-    if not isinstance(text, str):
-        raise RigidfoldError(f"material must be a name or 'E,nu,density', got {text!r}")
-    key = text.strip().lower()
-    if key in MATERIALS:
-        return MATERIALS[key]
-    if key == "aluminum":
-        return MATERIALS["aluminium"]
-    parts = [p.strip() for p in text.split(",")]
-    if len(parts) != 3:
-        raise RigidfoldError(
-            f"material must be one of {', '.join(MATERIALS)} or 'E,nu,density' in SI units "
-            f"(e.g. 10e9,0.3,700), got {text!r}"
-        )
-    try:
-        E, nu, density = (float(p) for p in parts)
-    except ValueError:
-        raise RigidfoldError(
-            f"material 'E,nu,density' must be three numbers, got {text!r}"
-        ) from None
-    return Material(E, nu, density)
+
+@dataclass(frozen=True)
+class Panel:
+    """The panels of a built design: their material and their thickness, metres (> 0)."""
+
+    material: Material
+    thickness: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.material, Material):
+            raise RigidfoldError(f"panel material must be a Material, got {self.material!r}")
+        t = self.thickness
+        if isinstance(t, bool) or not (isinstance(t, int | float) and math.isfinite(t) and t > 0):
+            raise RigidfoldError(f"thickness must be a positive number of metres, got {t!r}")
+        object.__setattr__(self, "thickness", float(t))
 
 
 def presets_help() -> str:

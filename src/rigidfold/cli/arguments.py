@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from rigidfold.cli.checks import fabricate_arguments, structure_arguments
+from rigidfold.cli.checks import fabricate_arguments, length, structure_arguments
 from rigidfold.cli.parser import Parser, add_options, argument_type, directory
+from rigidfold.cli.units import parse_material, seed
 from rigidfold.config import DEFAULTS
 from rigidfold.drive import DriveOptions
 from rigidfold.exports import CONVENTIONS, EXPORT_FORMATS
-from rigidfold.flags import seed
 from rigidfold.generate import GenerateOptions
 from rigidfold.generate.case_options import CaseOptions, SettingsOptions
 from rigidfold.io import UP_AXES
@@ -117,6 +117,7 @@ def _deform(p: Parser) -> None:
     _file(p)
     p.add_argument(
         "--material",
+        type=argument_type(parse_material),
         default=None,
         metavar="NAME|E,nu,density",
         help="build the frame's members as strips of these panels instead of the paper's "
@@ -126,11 +127,11 @@ def _deform(p: Parser) -> None:
     )
     p.add_argument(
         "--thickness",
-        type=float,
+        type=length("thickness"),
         default=None,
         metavar="T",
-        help="panel thickness in metres for --material (default with --material: "
-        f"{DEFAULTS.structure.thickness:g})",
+        help="panel thickness for --material, in metres or with a unit: 18mm, 1.8cm (default "
+        f"with --material: {DEFAULTS.structure.thickness:g})",
     )
 
 

@@ -19,7 +19,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rigidfold.cli.parser import add_options, options_of
+from rigidfold.cli.parser import add_options, argument_type, options_of
+from rigidfold.cli.structure_specs import read_structure_options
+from rigidfold.cli.units import parse_length, parse_material
 from rigidfold.fabricate.options import FabricateOptions
 from rigidfold.flags import docs
 from rigidfold.structure import StructureOptions
@@ -27,19 +29,14 @@ from rigidfold.structure import StructureOptions
 STRUCTURE = StructureOptions()
 """The structure check's defaults (``Settings.structure``)."""
 
+TEXT_DEFAULTS = {"clamped": "", "actuators": ""}
+"""The defaults of the structure's flags that are lists of indices, as the command line's
+texts (:func:`~rigidfold.cli.structure_specs.read_structure_options` reads them)."""
+
 
 def length(what: str):
     """argparse type: a length in metres, or with a unit (``18mm``)."""
-
-    def parse(text: str) -> float:
-        from rigidfold.fabricate.build import parse_length
-
-        try:
-            return parse_length(text, what)
-        except ValueError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-
-    return parse
+    return argument_type(lambda text: parse_length(text, what))
 
 
 def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
@@ -67,7 +64,7 @@ def fabricate_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
             exclude=("thickness",),
             prefix="with --thickness: ",
             shown={
-                "density": f"that of --material, or of {STRUCTURE.material}; it does not "
+                "density": f"that of --material, or of {STRUCTURE.material.key}; it does not "
                 "change the structure's self-weight"
             },
         )
@@ -84,17 +81,18 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     Step 9's and the thick panels', and the thickness is ``--thickness``
     (:func:`fabricate_arguments`)."""
     if not generate:
-        add_options(
-            p,
-            StructureOptions,
-            defaults={"thickness": None},
-            shown={
-                "thickness": "the thickness rigidfold fabricate made this design's panels, "
-                "read from NAME_fabricate.json beside the design or, for a run's "
-                f"solutions/NAME.fold, in the run's final/thick/; else {STRUCTURE.thickness:g}; "
-                "structure.json's thickness_from says which"
-            },
+        # the thickness first, as the record's first field: a length the command line reads
+        p.add_argument(
+            "--thickness",
+            type=length("thickness"),
+            default=None,
+            metavar="T",
+            help=docs(StructureOptions)["thickness"] + " (default: the thickness rigidfold "
+            "fabricate made this design's panels, read from NAME_fabricate.json beside the "
+            "design or, for a run's solutions/NAME.fold, in the run's final/thick/; else "
+            f"{STRUCTURE.thickness:g}; structure.json's thickness_from says which)",
         )
+        add_options(p, StructureOptions, exclude=("thickness",), defaults=TEXT_DEFAULTS)
         return
     p.add_argument(
         "--structure",
@@ -105,14 +103,21 @@ def structure_arguments(p: argparse.ArgumentParser, *, generate: bool) -> None:
     )
     p.add_argument(
         "--material",
+        type=argument_type(parse_material),
         default=None,
         metavar="NAME|E,nu,density",
         help=docs(StructureOptions)["material"] + "; Step 9's frame is then of strips of these "
         f"panels (of --thickness, or {STRUCTURE.thickness * 1e3:g} mm), and --structure and "
         "the thick panels' masses use it (default: the paper's steel tubes for Step 9, "
-        f"{STRUCTURE.material} for the others)",
+        f"{STRUCTURE.material.key} for the others)",
     )
-    add_options(p, StructureOptions, exclude=("thickness", "material"), prefix="--structure: ")
+    add_options(
+        p,
+        StructureOptions,
+        exclude=("thickness", "material"),
+        prefix="--structure: ",
+        defaults=TEXT_DEFAULTS,
+    )
 
 
 def fabricate_options(args: argparse.Namespace) -> FabricateOptions | None:
@@ -130,10 +135,10 @@ def structure_options(args: argparse.Namespace) -> StructureOptions:
     """The structure check's options of the parsed arguments (checked); generate's
     ``--thickness`` and ``--material`` where not given: the check's defaults.
     ``rigidfold structure FILE`` without ``--thickness``: the thickness fabricate recorded
-    for the design (:func:`~rigidfold.structure.design.recorded_thickness`, said on stderr
+    for the design (:func:`~rigidfold.fabricate.files.recorded_thickness`, said on stderr
     and as ``thickness_from``), else the default."""
+    from rigidfold.fabricate.files import recorded_thickness
     from rigidfold.pipeline.built import thick_dir_of
-    from rigidfold.structure.design import recorded_thickness
 
     thickness, source = args.thickness, ""
     design = getattr(args, "file", None)
@@ -152,8 +157,8 @@ def structure_options(args: argparse.Namespace) -> StructureOptions:
     return options_of(
         StructureOptions,
         args,
-        make=StructureOptions.from_strings,
+        make=read_structure_options,
         thickness=STRUCTURE.thickness if thickness is None else thickness,
         thickness_from=source,
-        material=STRUCTURE.material if args.material is None else args.material,
+        material=args.material,
     )

@@ -17,6 +17,7 @@ import math
 import os
 import sys
 import tempfile
+import time
 import traceback
 from collections.abc import Sequence
 
@@ -69,11 +70,12 @@ def _case(args: argparse.Namespace):
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
+    from rigidfold.cli.units import parse_fixed
     from rigidfold.pipeline.workflows import optimize_case
 
-    out = optimize_case(
-        _case(args), args.out, fixed=args.fixed, solver=args.solver, overwrite=args.overwrite
-    )
+    case = _case(args)
+    fixed = () if args.fixed is None else parse_fixed(args.fixed)
+    out = optimize_case(case, args.out, fixed=fixed, solver=args.solver, overwrite=args.overwrite)
     result = out.result
     print(
         f"{result.status.value}: F = {result.F:.3e} (F1 = {result.F1:.2e}, F2 = {result.F2:.2e}), "
@@ -91,12 +93,12 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 def _counters(summary: dict, stop_reason: str) -> str:
     """The line of a finished run's counters: the DOF reduced, N_*, the solves, and the
     final design's DOF where it is not the lowest reached."""
-    rigid = f" N_rigid={summary['N_rigid']}" if summary["N_rigid"] else ""
+    rigid = f" N_rigid={summary['n_rigid']}" if summary["n_rigid"] else ""
     final = summary["final_dof"]
     return (
         f"{stop_reason}: DOF {summary['initial_dof']} -> {summary['lowest_dof']}, "
-        f"N_reduce={summary['N_reduce']} N_lock={summary['N_lock']} "
-        f"N_exceed={summary['N_exceed']} N_path={summary['N_path']}{rigid}, "
+        f"N_reduce={summary['n_reduce']} N_lock={summary['n_lock']} "
+        f"N_exceed={summary['n_exceed']} N_path={summary['n_path']}{rigid}, "
         f"{summary['n_solves']} solves"
         + ("" if final == summary["lowest_dof"] else f"; final design DOF {final}")
     )
@@ -106,6 +108,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.cli.progress import GenerateProgress
     from rigidfold.drive import DriveOptions
     from rigidfold.pipeline import Interrupted, RunWriter, run
+    from rigidfold.runtime.clock import process_age
 
     structure = structure_options(args)  # checked even without --structure
     options = options_of(
@@ -124,7 +127,9 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         args.out, case, options, overwrite=args.overwrite, report=not args.no_report
     ) as writer:
         try:
-            result = run(case, options, (writer, progress))
+            # --time-limit counts from the command's start, imports and the case too
+            started = time.monotonic() - process_age()
+            result = run(case, options, (writer, progress), started=started)
         except Interrupted as stop:
             return _interrupted(stop.result, writer, progress)
         except KeyboardInterrupt:  # before the run began, or as it returned
@@ -259,11 +264,18 @@ def _cmd_develop(args: argparse.Namespace) -> int:
 
 
 def _cmd_deform(args: argparse.Namespace) -> int:
+    from rigidfold.config import DEFAULTS
+    from rigidfold.material import Panel, material_named
     from rigidfold.pipeline.workflows import deform_file
 
-    checked = deform_file(
-        args.file, args.out, up=args.up, material=args.material, thickness=args.thickness
-    )
+    panel = None  # either given, the other is the default of Settings.structure
+    if args.material is not None or args.thickness is not None:
+        structure = DEFAULTS.structure
+        panel = Panel(
+            material_named(structure.material) if args.material is None else args.material,
+            structure.thickness if args.thickness is None else args.thickness,
+        )
+    checked = deform_file(args.file, args.out, up=args.up, panel=panel)
     d, m = checked.verification.deformation, checked.verification.motion
     assert d is not None  # deform_file runs the analysis
     if args.json:
@@ -294,9 +306,11 @@ def _cmd_deform(args: argparse.Namespace) -> int:
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
+    from rigidfold.cli.units import parse_formats
     from rigidfold.pipeline.workflows import export_file
 
-    done = export_file(args.file, args.out, formats=args.to, convention=args.convention, up=args.up)
+    formats = parse_formats(args.to)
+    done = export_file(args.file, args.out, formats=formats, convention=args.convention, up=args.up)
     if args.json:
         print(json.dumps(jsonable(done.to_dict())))
     else:

@@ -12,11 +12,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import difflib
+import enum
 import re
 import unicodedata
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from rigidfold.cli.units import parser_of
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import Flag
 
@@ -44,7 +46,9 @@ def add_options(
     default: ``shown[name]`` where given, else its flag's ``shown``, else the value unless
     None or a repeat flag's. A shown default that is not text or a number (a pair, a typed
     choice) is given to argparse as its shown text (``2440x1220``, ``auto``), which the
-    flag's ``parse`` (or the record's ``from_strings``) reads as the command line's."""
+    flag's ``parse`` reads as the command line's. ``parse`` names a parser of
+    :mod:`rigidfold.cli.units`; a field whose default is an enum's member is read as one of
+    its values (the flag's ``choices``)."""
     for f in dataclasses.fields(record):
         flag: Flag | None = f.metadata.get("flag")
         if flag is None or (only is not None and f.name not in only) or f.name in exclude:
@@ -79,7 +83,9 @@ def add_options(
         if flag.repeat:
             how |= {"action": "append", "default": None}  # None: the record's default
         if flag.parse is not None:
-            how["type"] = argument_type(flag.parse)
+            how["type"] = argument_type(parser_of(flag.parse))
+        elif isinstance(default, enum.Enum):
+            how["type"] = _member(type(default))
         parser.add_argument(
             flag.name or "--" + dashed,
             dest=f.name,
@@ -99,8 +105,9 @@ def options_of(
 ) -> Any:
     """The options record ``record`` of the parsed ``args`` (the fields that have a flag
     there; None where the record's default is not: not given, the record's default) and
-    ``given``, made by ``make`` (default: the record; a record's ``from_strings`` where that
-    reads some of the texts); checked by the record."""
+    ``given``, made by ``make`` (default: the record; a reader of the command line's texts
+    where some are not yet typed, such as
+    :func:`rigidfold.cli.structure_specs.read_structure_options`); checked by the record."""
     flagged = {
         f.name: getattr(args, f.name)
         for f in dataclasses.fields(record)
@@ -122,6 +129,17 @@ def argument_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
             return parse(text)
         except RigidfoldError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
+
+    return convert
+
+
+def _member(kind: type[enum.Enum]) -> Callable[[str], Any]:
+    """argparse type of a field whose values are an enum's: the member of the text's value,
+    other text as it is (for argparse's "invalid choice" of the flag's choices)."""
+    values = {m.value: m for m in kind}
+
+    def convert(text: str) -> Any:
+        return values.get(text, text)
 
     return convert
 

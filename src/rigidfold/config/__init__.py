@@ -12,6 +12,8 @@ checks of a design), ``inputs`` (reading, and bounds on any input), ``settings``
 record), ``seeds``, ``blas`` (one BLAS thread).
 """
 
+from enum import StrEnum
+
 from rigidfold.config.blas import one_blas_thread
 from rigidfold.config.checks import (
     SIDES,
@@ -33,9 +35,18 @@ from rigidfold.config.inputs import InputSettings, LimitSettings
 from rigidfold.config.seeds import DEFAULT_SEED, SEED_LIMIT, check_seed
 from rigidfold.config.settings import DEFAULTS, FLAT_NAMES, GROUPS, Settings
 
-CHECKS = ("final", "all")
-"""Which solutions of a generation run get the folding motion and Step 9 (``generate
---check``): the final design only (the default), or every solution."""
+
+class Check(StrEnum):
+    """Which solutions of a generation run get the folding motion and Step 9 (``generate
+    --check``): the final design only (the default), or every solution. A ``str``: files
+    and databases hold the plain value."""
+
+    FINAL = "final"
+    ALL = "all"
+
+
+CHECKS = tuple(c.value for c in Check)
+"""The values of :class:`Check`, the default first (``generate --check``'s choices)."""
 
 __all__ = [
     "CHECKS",
@@ -46,6 +57,7 @@ __all__ = [
     "HESSIANS",
     "SEED_LIMIT",
     "SIDES",
+    "Check",
     "DeformationSettings",
     "DesignSettings",
     "DriveSettings",

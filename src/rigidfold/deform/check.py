@@ -27,7 +27,7 @@ from rigidfold.mesh import CreasePattern
 from rigidfold.outcomes import Outcome
 
 if TYPE_CHECKING:
-    from rigidfold.material import Material
+    from rigidfold.material import Panel
 
 
 class Agreement(Outcome):
@@ -119,6 +119,8 @@ def _not_traced(development: Development, motion: Motion, settings: Settings) ->
             "reaches the plane",
             "",
         )
+    if motion.status is MotionStatus.CUT:
+        return "the run's time limit ended the motion's trace before the plane", ""
     if motion.dof == 0:
         return (
             "the shape has no mechanism (DOF 0 with its fixed creases), so no rigid-folding "
@@ -183,16 +185,17 @@ def verify(
     support_face: int | None = None,
     dof: int | None = None,
     path: FoldingPath | None = None,
-    material: Material | None = None,
-    thickness: float | None = None,
+    panel: Panel | None = None,
+    deadline: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> Verification:
     """Development (Step 8), large-deformation check (Step 9) and motion of one shape.
 
     ``dof``, ``path``: the shape's DOF and traced folding path where they are known
-    (:func:`rigidfold.deform.folding_motion` traces the path otherwise). ``material``,
-    ``thickness``: Step 9's frame as strips of the panels
-    (:func:`rigidfold.deform.analysis.panel_section`) instead of the paper's tubes."""
+    (:func:`rigidfold.deform.folding_motion` traces the path otherwise). ``panel``: Step 9's
+    frame as strips of these panels (:func:`rigidfold.deform.analysis.panel_section`)
+    instead of the paper's tubes. ``deadline`` (of ``time.monotonic()``): the motion's trace
+    ends there (:attr:`rigidfold.deform.MotionStatus.CUT`)."""
     times = {}
     t0 = time.perf_counter()
     development = develop(pattern, settings=settings)
@@ -203,8 +206,8 @@ def verify(
         deformation = deform(
             pattern,
             support_face=support_face,
-            material=material,
-            thickness=thickness,
+            material=None if panel is None else panel.material,
+            thickness=None if panel is None else panel.thickness,
             settings=settings,
         )
         times["deform"] = time.perf_counter() - t0
@@ -217,6 +220,7 @@ def verify(
             support_face=support_face,
             dof=dof,
             path=path,
+            deadline=deadline,
             settings=settings,
         )
         times["motion"] = time.perf_counter() - t0

@@ -33,6 +33,7 @@ class MotionStatus(Outcome):
 
     OK = "ok", "the motion is traced from the plane to the designed shape"
     FAILED = "failed", "no rigid-folding path to the plane was found"
+    CUT = "cut", "the run's time limit ended the trace before the plane"
 
 
 @dataclass
@@ -91,6 +92,7 @@ def folding_motion(
     support_face: int | None = None,
     dof: int | None = None,
     path: FoldingPath | None = None,
+    deadline: float | None = None,
     settings: Settings = DEFAULTS,
 ) -> Motion:
     """The folding motion of ``pattern`` down to its development ``flat`` (V, 2).
@@ -101,13 +103,17 @@ def folding_motion(
     :func:`rigidfold.frame.model.default_support_face`). Returns up to
     ``settings.deformation.motion_frames`` frames from the plane to the designed shape, the
     support panel held still, when the path reaches the flat state; otherwise the part that was
-    traced.
+    traced. ``deadline`` (a time of ``time.monotonic()``, a run's time limit): the trace here
+    ends there; a motion it cuts says so (:attr:`MotionStatus.CUT`), not that the shape does
+    not deploy.
     """
     if support_face is None:
         support_face = default_support_face(pattern)
     panel = np.flatnonzero(pattern.facets == pattern.facets[support_face])
     if path is None:
-        path = trace_path(pattern, dof=dof, support_face=support_face, settings=settings)
+        path = trace_path(
+            pattern, dof=dof, support_face=support_face, settings=settings, deadline=deadline
+        )
     n = max(int(settings.deformation.motion_frames), 2)
     if path.deploys:
         folded, fraction = path.frames(pattern, n, support_face=support_face, settings=settings)
@@ -118,7 +124,8 @@ def folding_motion(
     else:
         frames = path.frames(pattern, n, support_face=support_face, settings=settings)[0]
         parameter = np.full(len(frames), np.nan)
-        status, message = MotionStatus.FAILED, f"{path.status.message}: {path.message}"
+        status = MotionStatus.CUT if path.cut else MotionStatus.FAILED
+        message = f"{path.status.message}: {path.message}"
     L0 = pattern.edge_lengths
     err = max(float(np.max(np.abs(edge_lengths(f, pattern.edges) - L0) / L0)) for f in frames)
     return Motion(

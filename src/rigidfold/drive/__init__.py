@@ -17,7 +17,7 @@ are imported only when used.
 
 from rigidfold.drive.deploy import deploy_design
 from rigidfold.drive.files import DEPLOY_FILES, write_drive
-from rigidfold.drive.options import AUTO, Base, DriveOptions, parse_base, parse_cable
+from rigidfold.drive.options import AUTO, Base, DriveOptions
 from rigidfold.drive.result import DriveResult, DriveStatus
 
 __all__ = [
@@ -28,7 +28,5 @@ __all__ = [
     "DriveResult",
     "DriveStatus",
     "deploy_design",
-    "parse_base",
-    "parse_cable",
     "write_drive",
 ]

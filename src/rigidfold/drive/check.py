@@ -47,7 +47,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.material import Material
 from rigidfold.outcomes import Outcome
 from rigidfold.runtime.quiet import native_quiet
-from rigidfold.structure.model import ShellMesh, shell_mesh
+from rigidfold.structure.model import ShellMesh, build_shells, build_spring, shell_mesh
 
 
 class CheckStatus(Outcome):
@@ -254,20 +254,7 @@ def held_moment(
     on_base = np.isin(mesh.triangle_face, model.base_faces)
     fixed[np.unique(mesh.triangles[on_base])] = True
     ties = _ties(mesh, fixed)
-    ops.wipe()
-    ops.model("basic", "-ndm", 3, "-ndf", 6)
-    for i, c in enumerate(mesh.coords):
-        ops.node(i + 1, *map(float, c))
-    ops.section(
-        "ElasticMembranePlateSection",
-        1,
-        float(material.E),
-        float(material.nu),
-        float(thickness),
-        float(density),
-    )
-    for t, (a, b, c) in enumerate(mesh.triangles):
-        ops.element("ASDShellT3", t + 1, int(a) + 1, int(b) + 1, int(c) + 1, 1)
+    build_shells(ops, mesh, material, thickness, density)
     rigidity = material.plate_rigidity(thickness)
     hold = stiffer * settings.drive.check_hold * rigidity / float(np.mean(shape.edge_lengths))
     moment_of = dict(zip(model.hinge_edges.tolist(), model.spring_moment.tolist(), strict=True))
@@ -285,22 +272,8 @@ def held_moment(
         if e != model.edge:  # a spring's moment, not its stiffness (see the module's text)
             continue
         k = hold * share
-        ops.uniaxialMaterial("Elastic", s_ + 1, float(k))
-        ref = np.eye(3)[int(np.argmin(np.abs(axis)))]
         tag += 1
-        ops.element(
-            "zeroLength",
-            tag,
-            int(a) + 1,
-            int(b) + 1,
-            "-mat",
-            s_ + 1,
-            "-dir",
-            4,
-            "-orient",
-            *map(float, axis),
-            *map(float, np.cross(ref, axis)),
-        )
+        build_spring(ops, tag, s_ + 1, a, b, axis, k)
         if e == model.edge:
             held.append((int(a), int(b), axis, k))
     for node in np.flatnonzero(fixed).tolist():

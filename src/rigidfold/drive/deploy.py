@@ -50,7 +50,7 @@ def _read(
 ) -> tuple[Design, str, float, str]:
     """(the design, its source in words, the panels' thickness, where it came from)."""
     from rigidfold.exports import read_design
-    from rigidfold.structure.design import recorded_thickness
+    from rigidfold.fabricate.files import recorded_thickness
 
     if isinstance(design, Design):
         source = "the design given"

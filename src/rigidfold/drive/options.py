@@ -1,10 +1,11 @@
 """The options of the drive as the user gives them: ``rigidfold deploy`` and ``rigidfold
 generate --deploy`` build one :class:`DriveOptions`.
 
-Every field is a typed value (a thickness in metres, a :class:`~rigidfold.structure.
-material.Material`, a base that is a panel's index or :data:`AUTO`, cables as pairs of
-vertices), made by :func:`rigidfold.flags.option` whose doc is also its flag's help and
-whose ``parse`` reads the command line's text; defaults from ``Settings.drive`` (the
+Every field is a typed value (a thickness in metres, a :class:`~rigidfold.material.Material`,
+a base that is a panel's index or :data:`AUTO`, cables as pairs of vertices), made by
+:func:`rigidfold.flags.option` whose doc is also its flag's help and whose ``parse`` names the
+parser of the command line's text (:mod:`rigidfold.cli.units`: ``18mm``, ``panel:3``,
+``V,W``, ``V:KG``); defaults from ``Settings.drive`` (the
 hinges, the hardware) and ``Settings.structure`` (the panels' thickness and material, as
 ``rigidfold structure`` has them). Every value is checked once, when the options are made
 (:class:`rigidfold.errors.RigidfoldError`, one line naming what was received); the indices
@@ -19,9 +20,8 @@ from typing import Literal
 
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
-from rigidfold.fabricate.build import parse_length
 from rigidfold.flags import option
-from rigidfold.material import Material, parse_material, presets_help
+from rigidfold.material import Material, material_named, presets_help
 
 AUTO: Literal["auto"] = "auto"
 """The base chosen by the drive (``--base auto``)."""
@@ -38,68 +38,42 @@ _D = DEFAULTS.drive
 _S = DEFAULTS.structure
 
 
-def parse_base(text: str | int) -> Base:
-    """``"auto"``, ``"panel:P"`` or ``"P"`` (a panel's index, >= 0) as a :data:`Base`."""
-    if isinstance(text, bool):
-        raise RigidfoldError(f"base must be auto or panel:P, got {text!r}")
-    if isinstance(text, int):
-        if text < 0:
-            raise RigidfoldError(f"base must be auto or panel:P with P >= 0, got {text!r}")
-        return text
-    if not isinstance(text, str):
-        raise RigidfoldError(f"base must be auto or panel:P, got {text!r}")
-    raw = text.strip().lower()
-    if raw == AUTO:
+def _base(base: object) -> Base:
+    """A :data:`Base`: :data:`AUTO` or a panel's index >= 0."""
+    if base == AUTO and isinstance(base, str):
         return AUTO
-    number = raw.removeprefix("panel:").strip()
-    try:
-        value = int(number)
-    except ValueError:
-        raise RigidfoldError(f"base must be auto or panel:P, got {text!r}") from None
-    if value < 0:
-        raise RigidfoldError(f"base must be auto or panel:P with P >= 0, got {text!r}")
-    return value
+    if isinstance(base, bool) or not isinstance(base, int):
+        raise RigidfoldError(f"base must be auto or a panel's index, got {base!r}")
+    if base < 0:
+        raise RigidfoldError(f"base must be auto or panel:P with P >= 0, got {base!r}")
+    return base
 
 
-def parse_cable(text: str | tuple[int, int]) -> tuple[int, int]:
-    """``"V,W"`` (or a pair) as a cable between two different vertices ``(V, W)``."""
-    parts: list
-    if isinstance(text, str):
-        parts = [p.strip() for p in text.replace("-", ",").split(",")]
-    elif isinstance(text, tuple | list):
-        parts = list(text)
-    else:
-        raise RigidfoldError(f"a cable is V,W (two vertices), got {text!r}")
-    try:
-        if len(parts) != 2 or any(isinstance(p, bool | float) for p in parts):
-            raise ValueError
-        v, w = (int(p) for p in parts)
-    except (TypeError, ValueError):
-        raise RigidfoldError(f"a cable is V,W (two vertices), got {text!r}") from None
+def _cable(cable: object) -> tuple[int, int]:
+    """A cable: a pair of two different vertices >= 0."""
+    pair = tuple(cable) if isinstance(cable, tuple | list) else ()
+    if len(pair) != 2 or any(isinstance(v, bool) or not isinstance(v, int) for v in pair):
+        raise RigidfoldError(f"a cable is a pair of vertices (V, W), got {cable!r}")
+    v, w = pair
     if v < 0 or w < 0 or v == w:
-        raise RigidfoldError(f"a cable joins two different vertices >= 0, got {text!r}")
+        raise RigidfoldError(f"a cable joins two different vertices >= 0, got {cable!r}")
     return v, w
 
 
-def parse_point_mass(text: str | tuple[int, float]) -> tuple[int, float]:
-    """``"V:KG"`` (or a pair) as a point mass ``(vertex, kg)``, kg finite and >= 0."""
-    if isinstance(text, str):
-        vertex, sep, kg = text.partition(":")
-        if not sep:
-            raise RigidfoldError(f"a point mass is V:KG, got {text!r}")
-        parts: list = [vertex.strip(), kg.strip()]
-    elif isinstance(text, tuple | list) and len(text) == 2:
-        parts = list(text)
-    else:
-        raise RigidfoldError(f"a point mass is V:KG, got {text!r}")
-    try:
-        if isinstance(parts[0], bool | float):
-            raise ValueError
-        v, m = int(parts[0]), float(parts[1])
-    except (TypeError, ValueError):
-        raise RigidfoldError(f"a point mass is V:KG, got {text!r}") from None
+def _point_mass(mass: object) -> tuple[int, float]:
+    """A point mass: (a vertex >= 0, kg finite and >= 0)."""
+    pair = tuple(mass) if isinstance(mass, tuple | list) else ()
+    if (
+        len(pair) != 2
+        or isinstance(pair[0], bool)
+        or not isinstance(pair[0], int)
+        or isinstance(pair[1], bool)
+        or not isinstance(pair[1], int | float)
+    ):
+        raise RigidfoldError(f"a point mass is a pair (vertex, kg), got {mass!r}")
+    v, m = pair[0], float(pair[1])
     if v < 0 or not (math.isfinite(m) and m >= 0):
-        raise RigidfoldError(f"a point mass is V:KG with V >= 0 and KG >= 0, got {text!r}")
+        raise RigidfoldError(f"a point mass is (V, KG) with V >= 0 and KG >= 0, got {mass!r}")
     return v, m
 
 
@@ -109,37 +83,6 @@ def _non_negative(value: object, what: str, unit: str) -> float:
     if not (math.isfinite(value) and value >= 0):
         raise RigidfoldError(f"{what} must be a finite number >= 0 ({unit}), got {value!r}")
     return float(value)
-
-
-def _number_text(what: str, unit: str):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except (TypeError, ValueError):
-            raise RigidfoldError(f"{what} must be a number ({unit}), got {text!r}") from None
-        return _non_negative(value, what, unit)
-
-    return parse
-
-
-def _positive_text(what: str, unit: str):
-    def parse(text: str) -> float:
-        value = _number_text(what, unit)(text)
-        if value <= 0:
-            raise RigidfoldError(f"{what} must be positive ({unit}), got {text!r}")
-        return value
-
-    return parse
-
-
-def _ground(text: str) -> float:
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise RigidfoldError(f"ground must be a height in metres, got {text!r}") from None
-    if not math.isfinite(value):
-        raise RigidfoldError(f"ground must be a finite height in metres, got {text!r}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -157,22 +100,22 @@ class DriveOptions:
     thickness: float | None = option(
         None,
         "panel thickness in metres, or with a unit: 18mm, 1.8cm",
-        parse=lambda text: parse_length(text, "thickness"),
+        parse="thickness",
         metavar="T",
         shown=f"the thickness fabricate recorded beside the design, else {_S.thickness:g}",
     )
     material: Material = option(  # noqa: RUF009 (frozen)
-        parse_material(_S.material),
+        material_named(_S.material),
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
         "-, kg/m^3); its density gives the masses",
-        parse=parse_material,
+        parse="material",
         metavar="NAME|E,nu,density",
         shown=_S.material,
     )
     density: float | None = option(
         None,
         "density of the panels, kg/m^3, instead of the material's",
-        parse=_positive_text("density", "kg/m^3"),
+        parse="density",
         metavar="KG/M3",
         shown="the material's",
     )
@@ -180,7 +123,7 @@ class DriveOptions:
         _D.hinge_stiffness,
         "rotational stiffness of every hinge, N m/rad per metre of crease (as structure "
         "--hinge-stiffness)",
-        parse=_number_text("hinge stiffness", "N m/rad per m"),
+        parse="hinge-stiffness",
         metavar="K",
     )
     spring_rest: str = option(
@@ -192,20 +135,20 @@ class DriveOptions:
         _D.friction,
         "Coulomb friction torque of every hinge, N m per metre of crease; it resists the "
         "motion, in both directions",
-        parse=_number_text("friction", "N m per m"),
+        parse="friction",
         metavar="NM/M",
     )
     hardware: float = option(
         _D.hardware,
         "mass of the hinge hardware, kg per metre of hinge",
-        parse=_number_text("hardware", "kg/m"),
+        parse="hardware",
         metavar="KG/M",
     )
     point_masses: tuple[tuple[int, float], ...] = option(
         (),
         "a mass at a vertex, kg, repeatable",
         name="--point-mass",
-        parse=parse_point_mass,
+        parse="point-mass",
         metavar="V:KG",
         repeat=True,
     )
@@ -214,13 +157,13 @@ class DriveOptions:
         "how the structure is held during the motion: panel:P clamps panel P in its built "
         "pose; auto chooses the panel of the smallest peak effort among those whose motion "
         "keeps every vertex above the ground",
-        parse=parse_base,
+        parse="base",
         metavar="panel:P|auto",
     )
     ground: float | None = option(
         None,
         "height of the ground, metres: a state in which a vertex passes below it is reported",
-        parse=_ground,
+        parse="ground",
         metavar="Z",
         shown="the lowest point of the built design",
     )
@@ -228,7 +171,7 @@ class DriveOptions:
         (),
         "a cable between two vertices, repeatable: its tension along the motion",
         name="--cable",
-        parse=parse_cable,
+        parse="cable",
         metavar="V,W",
         repeat=True,
     )
@@ -238,14 +181,14 @@ class DriveOptions:
     max_torque: float | None = option(
         None,
         "the largest torque a crease drive may need, N m",
-        parse=_positive_text("max torque", "N m"),
+        parse="max-torque",
         metavar="NM",
         shown="no limit",
     )
     max_tension: float | None = option(
         None,
         "the largest tension a cable may need, N",
-        parse=_positive_text("max tension", "N"),
+        parse="max-tension",
         metavar="N",
         shown="no limit",
     )
@@ -263,14 +206,13 @@ class DriveOptions:
     def __post_init__(self) -> None:
         t = self.thickness
         if t is not None:
-            if isinstance(t, str):
-                t = parse_length(t, "thickness")
             if isinstance(t, bool) or not isinstance(t, int | float):
                 raise RigidfoldError(f"thickness must be a positive length in metres, got {t!r}")
             if not (math.isfinite(t) and t > 0):
                 raise RigidfoldError(f"thickness must be a positive length in metres, got {t!r}")
             object.__setattr__(self, "thickness", float(t))
-        object.__setattr__(self, "material", parse_material(self.material))
+        if not isinstance(self.material, Material):
+            raise RigidfoldError(f"material must be a Material, got {self.material!r}")
         if self.density is not None:
             d = _non_negative(self.density, "density", "kg/m^3")
             object.__setattr__(self, "density", d)
@@ -286,10 +228,8 @@ class DriveOptions:
             )
         if isinstance(self.point_masses, str) or not isinstance(self.point_masses, tuple | list):
             raise RigidfoldError(f"point masses must be V:KG pairs, got {self.point_masses!r}")
-        object.__setattr__(
-            self, "point_masses", tuple(parse_point_mass(p) for p in self.point_masses)
-        )
-        object.__setattr__(self, "base", parse_base(self.base))
+        object.__setattr__(self, "point_masses", tuple(_point_mass(p) for p in self.point_masses))
+        object.__setattr__(self, "base", _base(self.base))
         if self.ground is not None:
             if isinstance(self.ground, bool) or not isinstance(self.ground, int | float):
                 raise RigidfoldError(f"ground must be a height in metres, got {self.ground!r}")
@@ -298,7 +238,7 @@ class DriveOptions:
             object.__setattr__(self, "ground", float(self.ground))
         if isinstance(self.cables, str) or not isinstance(self.cables, tuple | list):
             raise RigidfoldError(f"cables must be V,W pairs, got {self.cables!r}")
-        object.__setattr__(self, "cables", tuple(parse_cable(c) for c in self.cables))
+        object.__setattr__(self, "cables", tuple(_cable(c) for c in self.cables))
         for name, unit in (("max_torque", "N m"), ("max_tension", "N")):
             value = getattr(self, name)
             if value is None:

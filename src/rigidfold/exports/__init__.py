@@ -20,9 +20,9 @@ from rigidfold.exports.cutsheet import (
 from rigidfold.exports.design import (
     EXPORT_FORMATS,
     Design,
+    check_formats,
     export_design,
     export_paths,
-    parse_formats,
     read_design,
 )
 from rigidfold.exports.fold_os import origami_simulator_fold, write_origami_simulator_fold
@@ -38,6 +38,7 @@ __all__ = [
     "Design",
     "Sheet",
     "check_convention",
+    "check_formats",
     "crease_rows",
     "dxf_text",
     "export_design",
@@ -47,7 +48,6 @@ __all__ = [
     "origami_simulator_fold",
     "panel_loops",
     "panel_rows",
-    "parse_formats",
     "read_design",
     "sheet_svg_text",
     "write_dxf",

@@ -51,14 +51,14 @@ _FILES = {
 }
 
 
-def parse_formats(formats: str | Sequence[str]) -> tuple[str, ...]:
-    """The formats asked for, checked, in :data:`EXPORT_FORMATS` order without repeats.
-
-    formats : comma-separated text (``"obj,dxf"``, case and blanks ignored) or a sequence
-    of names. Raises ValueError naming an unknown format, or when none is given.
-    """
-    names = formats.split(",") if isinstance(formats, str) else list(formats)
-    wanted = {str(name).strip().lower() for name in names} - {""}
+def check_formats(formats: Sequence[str]) -> tuple[str, ...]:
+    """The formats asked for (names of :data:`EXPORT_FORMATS`; blanks are none), checked, in
+    :data:`EXPORT_FORMATS` order without repeats. Raises RigidfoldError naming an unknown
+    format, or when none is given (the command line reads ``--to obj,dxf`` into names:
+    :func:`rigidfold.cli.units.parse_formats`)."""
+    if isinstance(formats, str):
+        raise RigidfoldError(f"formats must be a sequence of format names, got {formats!r}")
+    wanted = {str(name) for name in formats} - {""}
     unknown = sorted(wanted - set(EXPORT_FORMATS))
     if unknown:
         raise RigidfoldError(
@@ -70,13 +70,13 @@ def parse_formats(formats: str | Sequence[str]) -> tuple[str, ...]:
 
 
 def export_paths(
-    out_dir: str | os.PathLike, formats: str | Sequence[str] = EXPORT_FORMATS, *, name: str
+    out_dir: str | os.PathLike, formats: Sequence[str] = EXPORT_FORMATS, *, name: str
 ) -> list[Path]:
     """The files :func:`export_design` writes into ``out_dir`` for ``formats`` (see
-    :func:`parse_formats`) and the stem ``name``, in :data:`EXPORT_FORMATS` order."""
+    :func:`check_formats`) and the stem ``name``, in :data:`EXPORT_FORMATS` order."""
     out = Path(out_dir)
     return [
-        out / template.format(name) for fmt in parse_formats(formats) for template in _files(fmt)
+        out / template.format(name) for fmt in check_formats(formats) for template in _files(fmt)
     ]
 
 
@@ -89,7 +89,7 @@ def export_design(
     pattern: CreasePattern,
     coords2d: np.ndarray,
     out_dir: str | os.PathLike,
-    formats: str | Sequence[str] = EXPORT_FORMATS,
+    formats: Sequence[str] = EXPORT_FORMATS,
     *,
     name: str = "design",
     title: str = "",
@@ -106,8 +106,8 @@ def export_design(
         Its development diagram, metres (e.g. ``rigidfold.develop.develop(pattern)``).
     out_dir : path
         Output directory.
-    formats : str or sequence of str
-        Some of :data:`EXPORT_FORMATS` (see :func:`parse_formats`); default all.
+    formats : sequence of str
+        Some of :data:`EXPORT_FORMATS` (see :func:`check_formats`); default all.
     name : str
         Stem of the files (see the module's table); a plain file name.
     title : str
@@ -128,7 +128,7 @@ def export_design(
         For an unknown format or convention, a ``name`` that is not a plain file name,
         ``coords2d`` that is not a finite (V, 2) array, or a file that cannot be written.
     """
-    chosen = parse_formats(formats)
+    chosen = check_formats(formats)
     check_convention(convention)
     if not name or Path(name).name != name or name in (".", ".."):
         raise RigidfoldError(f"name must be a plain file name, got {name!r}")

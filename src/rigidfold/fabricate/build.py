@@ -23,7 +23,7 @@ from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
 from rigidfold.fabricate.progress import check_size, step
 from rigidfold.fabricate.solids import Solids, bevel_angles, thicken
-from rigidfold.material import parse_material
+from rigidfold.material import material_named
 from rigidfold.outcomes import Outcome
 
 
@@ -257,7 +257,7 @@ def fabrication_values(
         shown = f"{math.degrees(c):g}" if isinstance(c, int | float | np.number) else repr(c)
         raise RigidfoldError(f"clearance angle must lie in [0, 90) degrees, got {shown}")
     # one density per material: the default is that of the default panels' material
-    rho = density if density is not None else parse_material(settings.structure.material).density
+    rho = density if density is not None else material_named(settings.structure.material).density
     if (
         isinstance(rho, bool)
         or not isinstance(rho, int | float | np.number)
@@ -398,47 +398,25 @@ def _verdict(
     )
 
 
-_UNITS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
-
-
-def parse_length(text: str, what: str = "thickness") -> float:
-    """A length in metres from ``"0.018"``, ``"18mm"``, ``"1.8cm"`` or ``"0.018m"``. Raises
-    ValueError naming ``what`` and the text for anything else, or a length that is not
-    positive and finite."""
-    raw = str(text).strip().lower()
-    scale = 1.0
-    for unit in ("mm", "cm", "m"):
-        if raw.endswith(unit):
-            raw, scale = raw[: -len(unit)].strip(), _UNITS[unit]
-            break
-    try:
-        value = float(raw) * scale
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise RigidfoldError(
-            f"{what} must be a positive length in metres or with a unit (18mm, 1.8cm, "
-            f"0.018), got {text!r}"
-        )
-    return value
-
-
-def parse_sheet(
-    text: str | tuple[float, float], *, settings: Settings = DEFAULTS
+def check_sheet(
+    sheet: tuple[float, float], *, settings: Settings = DEFAULTS, shown: object = None
 ) -> tuple[float, float]:
-    """(width, height) in mm from ``"2440x1220"`` or a (width, height) pair, each at most
-    ``settings.limits.max_sheet_size``. Raises ValueError naming what was received."""
-    parts = str(text).lower().replace(" ", "").split("x") if isinstance(text, str) else text
+    """A stock sheet ``(width, height)`` in mm as floats, each positive, finite and at most
+    ``settings.limits.max_sheet_size``. Raises RigidfoldError naming what was received
+    (``shown``, where given: the text it was read from)."""
+    said = sheet if shown is None else shown
     try:
-        w, h = (float(x) for x in parts)
+        w, h = (float(x) for x in sheet)
+        if any(isinstance(x, bool | str) for x in sheet):
+            raise TypeError
     except (TypeError, ValueError):
         w = h = math.nan
     if not all(math.isfinite(x) and x > 0 for x in (w, h)):
-        raise RigidfoldError(f"sheet must be WIDTHxHEIGHT in millimetres (2440x1220), got {text!r}")
+        raise RigidfoldError(f"sheet must be (width, height) in millimetres, got {said!r}")
     most = settings.limits.max_sheet_size
     if max(w, h) > most:
         raise RigidfoldError(
             f"sheet must be at most {most:g} mm each way (Settings.limits.max_sheet_size), "
-            f"got {text!r}"
+            f"got {said!r}"
         )
     return w, h

@@ -23,6 +23,7 @@ import json
 import math
 import os
 import re
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +32,7 @@ from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.exports.mesh3d import Y_UP, panel_colours, panel_names
 from rigidfold.fabricate.build import Fabrication
-from rigidfold.io.files import text_bytes, write_together
+from rigidfold.io.files import parse_json, text_bytes, write_together
 
 HINGE_COLUMNS = (
     "hinge",
@@ -334,6 +335,28 @@ def write_fabrication(
 
 FABRICATE_JSON = "{}_fabricate.json"
 """The summary file :func:`write_fabrication` writes, ``{}`` for the design's name."""
+
+
+def recorded_thickness(path: str | Path, also: Sequence[Path] = ()) -> tuple[float, Path] | None:
+    """(the thickness, metres, that ``rigidfold fabricate`` made the panels of the design in
+    FOLD file ``path``, the file that records it) or None: fabricate writes it as
+    ``thickness_m`` of ``NAME_fabricate.json`` (:data:`FABRICATE_JSON`)
+    in its output directory, looked for beside the design (``fabricate DESIGN.fold --out``
+    the design's directory), then in the directories ``also`` (for a run's solution, the
+    run's thick panels: :func:`rigidfold.pipeline.built.thick_dir_of`)."""
+    path = Path(path)
+    name = FABRICATE_JSON.format(path.stem)
+    places = [path.parent / name, *(where / name for where in also)]
+    for place in places:
+        try:
+            data = parse_json(place.read_bytes())
+        except (OSError, ValueError):
+            continue
+        t = data.get("thickness_m") if isinstance(data, dict) else None
+        if isinstance(t, int | float) and not isinstance(t, bool) and 0 < t < float("inf"):
+            return float(t), place
+    return None
+
 
 SOLID_FILES = (
     "{}_solids.glb",

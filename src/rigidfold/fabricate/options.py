@@ -5,8 +5,9 @@ It holds every option of the command (the thickness, the side, the clearance ang
 degrees, the density, the stock sheet, the minimum thickness), each a field made by
 :func:`rigidfold.flags.option` whose doc is also its flag's help, each default from
 ``Settings.fabricate``, checked once when it is made (:func:`rigidfold.fabricate.build.
-fabrication_values`, :func:`~rigidfold.fabricate.build.parse_length`,
-:func:`~rigidfold.fabricate.build.parse_sheet`); :meth:`FabricateOptions.fabricate` runs
+fabrication_values`, :func:`~rigidfold.fabricate.build.check_sheet`); the command line reads
+their texts (:mod:`rigidfold.cli.units`: ``18mm``, ``2440x1220``);
+:meth:`FabricateOptions.fabricate` runs
 :func:`rigidfold.fabricate.fabricate_panels` with them.
 """
 
@@ -14,7 +15,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import MISSING, dataclass, fields
-from functools import partial
 
 import numpy as np
 
@@ -22,15 +22,14 @@ from rigidfold.config import DEFAULTS, SIDES, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.build import (
     Fabrication,
+    check_sheet,
     fabricate_panels,
     fabrication_values,
-    parse_length,
-    parse_sheet,
 )
 from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.panels import Panels
-from rigidfold.flags import option, positive
-from rigidfold.material import parse_material
+from rigidfold.flags import option
+from rigidfold.material import material_named
 
 _SHEET = (DEFAULTS.fabricate.sheet_width, DEFAULTS.fabricate.sheet_height)
 _MATERIAL = DEFAULTS.structure.material
@@ -42,9 +41,9 @@ class FabricateOptions:
 
     Each field is made by :func:`rigidfold.flags.option` with what it means, also the help of
     its flag (:func:`rigidfold.cli.parser.add_options`: ``rigidfold fabricate``'s, and
-    ``generate``'s with ``--thickness``): a new option is a new field here. Besides the
-    command line's texts, ``thickness`` and ``min_thickness`` take a number of metres (kept
-    as a float), ``sheet`` a ``(width, height)`` pair (kept as one); ``density`` None: the
+    ``generate``'s with ``--thickness``): a new option is a new field here. ``thickness``
+    and ``min_thickness`` are metres, ``sheet`` a ``(width, height)`` pair in millimetres
+    (the command line reads ``18mm`` and ``2440x1220``); ``density`` None: the
     density of the panels' material (``rigidfold generate``: its ``--material``; else
     ``Settings.structure.material``'s); ``min_thickness`` None:
     ``Settings.fabricate.min_depth`` times the thickness.
@@ -56,7 +55,7 @@ class FabricateOptions:
     thickness: float = option(
         MISSING,
         "panel thickness in metres, or with a unit: 18mm, 1.8cm",
-        parse=partial(parse_length, what="thickness"),
+        parse="thickness",
         metavar="T",
     )
     side: str = option(
@@ -75,32 +74,34 @@ class FabricateOptions:
     density: float | None = option(
         None,
         "density of the panel material for the masses",
-        parse=positive,
+        parse="positive",
         metavar="KG/M3",
-        shown=f"that of {_MATERIAL}, {parse_material(_MATERIAL).density:g}",
+        shown=f"that of {_MATERIAL}, {material_named(_MATERIAL).density:g}",
     )
     sheet: tuple[float, float] = option(
         _SHEET,
         "stock sheet size in millimetres that the cut sheets are nested onto",
-        parse=parse_sheet,
+        parse="sheet",
         metavar="WxH",
         shown="{:g}x{:g}".format(*_SHEET),
     )
     min_thickness: float | None = option(
         None,
         "a panel whose solid is nowhere this deep once bevelled fails",
-        parse=partial(parse_length, what="min-thickness"),
+        parse="min-thickness",
         metavar="T",
         shown=f"{DEFAULTS.fabricate.min_depth:g} x the thickness",
     )
 
     def __post_init__(self) -> None:
-        for name, what in (("thickness", "thickness"), ("min_thickness", "min-thickness")):
-            value = getattr(self, name)
-            if isinstance(value, str) or (name == "thickness" and value is not None):
-                if isinstance(value, bool):
-                    raise RigidfoldError(f"{what} must be a positive length, got {value!r}")
-                object.__setattr__(self, name, parse_length(value, what))
+        t = self.thickness
+        if (
+            isinstance(t, bool)
+            or not isinstance(t, int | float | np.number)
+            or not (math.isfinite(t) and t > 0)
+        ):
+            raise RigidfoldError(f"thickness must be a positive length in metres, got {t!r}")
+        object.__setattr__(self, "thickness", float(t))
         if self.side not in SIDES:
             raise RigidfoldError(f"side must be one of {', '.join(SIDES)}, got {self.side!r}")
         angle = self.clearance_angle_deg
@@ -111,7 +112,7 @@ class FabricateOptions:
         for name in ("density", "min_thickness"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, float(getattr(self, name)))
-        object.__setattr__(self, "sheet", parse_sheet(self.sheet))  # within the limits
+        object.__setattr__(self, "sheet", check_sheet(self.sheet))  # within the limits
 
     def values(self, settings: Settings = DEFAULTS) -> tuple[float, float, float]:
         """(clearance angle in radians, minimum thickness in metres, density in kg/m^3),

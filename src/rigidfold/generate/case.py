@@ -6,6 +6,7 @@ This is the entry point that validates user choices once; the CLI and the benchm
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Unpack
@@ -13,7 +14,7 @@ from typing import Unpack
 import numpy as np
 
 from rigidfold import patterns
-from rigidfold.config import DEFAULTS, Settings, check_seed
+from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.io.fold import read_fold
 from rigidfold.mesh import CreasePattern
@@ -115,10 +116,9 @@ def make_case(
         (:class:`rigidfold.patterns.PatternKeywords`: ``size``, ``diagonals``,
         ``edge_length``, ``scale``, ``up``, ``rigid_panels``); ``up``, the up axis (``"z"``
         or ``"y"``) of a FOLD pattern, is also that of a mesh or FOLD surface.
-    ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is refused.
+    ``seed`` draws a Bezier surface (which checks it). ``symmetric`` imposes the surface's
+    own mirror planes (9); a surface without any is refused.
     """
-    if seed is not None:
-        check_seed(seed)
     up = pattern_options.get("up", "z")
     plan = patterns.parse_pattern(pattern, settings=settings, **pattern_options)
     if isinstance(surface, Surface):
@@ -185,21 +185,13 @@ def _input_files(pattern: str, surface: str | Surface) -> tuple[Path, ...]:
     return tuple(files)
 
 
-def parse_fixed(text: str | None, pattern: CreasePattern) -> np.ndarray:
-    """Parse "I,J,..." crease indices into an (E,) bool mask, checking every index."""
+def fixed_mask(fixed: Sequence[int], pattern: CreasePattern) -> np.ndarray:
+    """The (E,) bool mask of the crease lines ``fixed`` (indices into the pattern's edges,
+    ``optimize --fixed``), every index checked."""
     mask = np.zeros(pattern.n_edges, dtype=bool)
-    if not text:
-        return mask
-    for token in text.split(","):
-        token = token.strip()
-        if not token:
-            continue
-        try:
-            e = int(token)
-        except ValueError:
-            raise RigidfoldError(
-                f"--fixed expects comma-separated edge indices, got {token!r}"
-            ) from None
+    for e in fixed:
+        if isinstance(e, bool) or not isinstance(e, int | np.integer):
+            raise RigidfoldError(f"--fixed expects edge indices, got {e!r}")
         if not 0 <= e < pattern.n_edges:
             raise RigidfoldError(f"--fixed edge {e} out of range 0..{pattern.n_edges - 1}")
         if pattern.is_boundary_edge[e]:

@@ -12,7 +12,7 @@ from dataclasses import MISSING, dataclass
 
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, Settings
 from rigidfold.errors import RigidfoldError
-from rigidfold.flags import fraction, option, positive, seed
+from rigidfold.flags import option
 from rigidfold.generate.case import Case, make_case
 from rigidfold.io import UP_AXES
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
@@ -50,7 +50,7 @@ class CaseOptions:
         f"{DEFAULTS.generation.hinge_stiffness:g} +/- "
         f"{DEFAULTS.generation.hinge_stiffness_spread:g} Nm, Section 6.1) that the s and shat "
         "criteria rank by, and the order of the random criterion",
-        parse=seed,
+        parse="seed",
     )
     expr: str | None = option(
         None,
@@ -66,7 +66,7 @@ class CaseOptions:
     scale: float | None = option(
         None,
         "metres per unit of a FOLD or SVG file drawn without units (instead of --size)",
-        parse=positive,
+        parse="positive",
         metavar="M_PER_UNIT",
     )
     rigid_panels: bool = option(
@@ -89,7 +89,7 @@ class CaseOptions:
         None,
         "target edge length in metres of a mesh: pattern (default: sqrt(footprint area) / "
         f"{DEFAULTS.inputs.mesh_divisions:g})",
-        parse=positive,
+        parse="positive",
         metavar="L",
     )
     symmetric: bool = option(
@@ -120,21 +120,6 @@ class CaseOptions:
             rigid_panels=self.rigid_panels,
             settings=settings,
         )
-
-
-def _angles(text: str) -> tuple[float, ...]:
-    """Comma-separated angles in degrees, each in (0, 180); "0": none."""
-    if text.strip() == "0":
-        return ()
-    try:
-        angles = tuple(float(part) for part in text.split(","))
-    except ValueError:
-        raise RigidfoldError(
-            f"must be angles in degrees separated by commas, got {text!r}"
-        ) from None
-    if not all(0 < a < 180 for a in angles):
-        raise RigidfoldError(f"each angle must lie in (0, 180) degrees, got {text!r}")
-    return angles
 
 
 def _degrees(name: str) -> float:
@@ -170,7 +155,7 @@ class SettingsOptions:
         None,
         "bound (12) on the fold angle of every free crease, |rho| <= this, degrees (default: "
         "no bound)",
-        parse=positive,
+        parse="positive",
         metavar="DEG",
     )
     fold_limit: tuple[float, ...] | None = option(
@@ -180,7 +165,7 @@ class SettingsOptions:
         "at the next of these angles, degrees (default: "
         f"{','.join(f'{math.degrees(a):g}' for a in DEFAULTS.generation.fold_limits)}; 0: no "
         "restart)",
-        parse=_angles,
+        parse="angles",
         metavar="DEG[,DEG...]",
     )
     hessian: str = option(
@@ -194,7 +179,7 @@ class SettingsOptions:
         "slips of the pen in an SVG pattern mended, as a fraction of the drawing's diagonal: "
         "a crease overshooting the line it ends on, or ending short of one, by up to this much "
         "is cut or extended to it; 0 mends nothing (Settings.inputs.svg_snap_tol)",
-        parse=fraction,
+        parse="fraction",
         metavar="FRACTION",
     )
     backtrack: int | None = option(

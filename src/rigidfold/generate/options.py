@@ -20,13 +20,13 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, check_seed
+from rigidfold.config import CHECKS, DEFAULT_SEED, DEFAULTS, Check, Settings, check_seed
 from rigidfold.drive.options import DriveOptions
 from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate.options import FabricateOptions
-from rigidfold.flags import count, option, positive
-from rigidfold.material import parse_material
-from rigidfold.optimize import SOLVERS
+from rigidfold.flags import option
+from rigidfold.material import Material, Panel, material_named
+from rigidfold.optimize import SOLVERS, SolverName
 from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
 
@@ -53,7 +53,7 @@ class GenerateOptions:
         "stop at a shape with this many degrees of freedom (DOF: independent rigid folding "
         "motions; 1 = folds along one path, stabilised by one support or actuator; 0, a "
         "rigid design, only without the deployability check)",
-        parse=count,
+        parse="count",
     )
     seed: int = option(
         DEFAULT_SEED,
@@ -61,7 +61,9 @@ class GenerateOptions:
         "command line's --seed, which also draws the Bezier surface)",
         flag=False,
     )
-    solver: str = option(SOLVERS[0], "solver of problem (6)", choices=SOLVERS)
+    solver: SolverName = option(  # noqa: RUF009 (a str)
+        SolverName.IPOPT, "solver of problem (6)", choices=SOLVERS
+    )
     lookahead: bool = option(
         False,
         "the look-ahead: skip the candidate creases whose fix would lock another crease at "
@@ -88,15 +90,15 @@ class GenerateOptions:
         "Step 9, the large-deformation check (OpenSees), on the solutions that --check names "
         "(the development diagram, Step 8, and the folding motion run without it)",
     )
-    check: str = option(
-        CHECKS[0],
+    check: Check = option(  # noqa: RUF009 (a str)
+        Check.FINAL,
         "which solutions get the folding motion and the large-deformation check: the final "
         "design only, or all (the development diagram is drawn for every solution)",
         choices=CHECKS,
     )
-    material: str | None = option(
+    material: Material | None = option(  # noqa: RUF009 (frozen)
         None,
-        "the panels' material (a preset or 'E,nu,density'): Step 9's frame of strips of the "
+        "the panels' material: Step 9's frame of strips of the "
         "panels, the structure's material and the thick panels' density unless theirs is "
         "given (None: Step 9 with the paper's steel tubes; the command line's --material)",
         flag=False,
@@ -132,7 +134,7 @@ class GenerateOptions:
         "solve no further candidate after this many seconds (a candidate's path trace under "
         "way ends there too): the run ends with the lowest-DOF design that deploys as its "
         "final design, checked as usual, and exits 1 (None: no limit)",
-        parse=positive,
+        parse="positive",
         metavar="SECONDS",
     )
 
@@ -142,15 +144,16 @@ class GenerateOptions:
 
     def _check_run(self) -> None:
         """Validate the options of Steps 2-9."""
-        for name, choices in (
-            ("criterion", CRITERIA),
-            ("solver", SOLVERS),
-            ("check", CHECKS),
-            ("batch", BATCH_CHOICES),
-        ):
+        for name, choices in (("criterion", CRITERIA), ("batch", BATCH_CHOICES)):
             value = getattr(self, name)
             if value not in choices:
                 raise RigidfoldError(f"unknown {name} {value!r} (choose from {', '.join(choices)})")
+        for name, kind, values in (("solver", SolverName, SOLVERS), ("check", Check, CHECKS)):
+            value = getattr(self, name)
+            if not isinstance(value, kind):
+                raise RigidfoldError(
+                    f"{name} must be a {kind.__name__} ({', '.join(values)}), got {value!r}"
+                )
         target = self.target_dof
         if isinstance(target, bool) or not isinstance(target, int | np.integer) or target < 0:
             raise RigidfoldError(f"target DOF must be an integer >= 0, got {target!r}")
@@ -172,8 +175,8 @@ class GenerateOptions:
             or not 0 < limit < float("inf")
         ):
             raise RigidfoldError(f"time limit must be a number of seconds > 0, got {limit!r}")
-        if self.material is not None:
-            parse_material(self.material)
+        if self.material is not None and not isinstance(self.material, Material):
+            raise RigidfoldError(f"material must be a Material or None, got {self.material!r}")
 
     def _check_checks(self) -> None:
         """The thick panels and the structure: of their types, one material and one
@@ -189,8 +192,8 @@ class GenerateOptions:
             return
         if self.material is not None and st.material != self.material:
             raise RigidfoldError(
-                f"the structure's material {st.material!r} is not the panels' material "
-                f"{self.material!r}"
+                f"the structure's material {st.material.key!r} is not the panels' material "
+                f"{self.material.key!r}"
             )
         if fab is not None and st.thickness != fab.thickness:
             raise RigidfoldError(
@@ -199,11 +202,14 @@ class GenerateOptions:
             )
 
     @property
-    def panel_material(self) -> str:
-        """The material of the structure check and of the thick panels' masses."""
+    def panel_material(self) -> Material:
+        """The material of the structure check and of the thick panels' masses: ``material``,
+        else the structure's, else the preset ``Settings.structure.material`` names."""
         if self.material is not None:
             return self.material
-        return DEFAULTS.structure.material if self.structure is None else self.structure.material
+        if self.structure is not None:
+            return self.structure.material
+        return material_named(DEFAULTS.structure.material)
 
     @property
     def panel_thickness(self) -> float | None:
@@ -212,6 +218,14 @@ class GenerateOptions:
         if self.fabricate is not None:
             return self.fabricate.thickness
         return None if self.structure is None else self.structure.thickness
+
+    def frame_panel(self, settings: Settings = DEFAULTS) -> Panel | None:
+        """The panels whose strips make Step 9's frame: ``material``, of
+        :attr:`panel_thickness` (else ``settings.structure.thickness``); None without a
+        ``material``: the paper's tubes."""
+        if self.material is None:
+            return None
+        return Panel(self.material, self.panel_thickness or settings.structure.thickness)
 
     def replace(self, **changes) -> GenerateOptions:
         """These options with ``changes`` (field names), validated; unknown names are a
@@ -229,6 +243,8 @@ class GenerateOptions:
         options as theirs (None: not run)."""
         data = {f.name: getattr(self, f.name) for f in fields(self)}
         fab, st, dr = data.pop("fabricate"), data.pop("structure"), data.pop("drive")
+        data["solver"], data["check"] = self.solver.value, self.check.value
+        data["material"] = None if self.material is None else self.material.key
         return data | {
             "fabricate": None if fab is None else fab.to_dict(),
             "structure": None if st is None else st.to_dict(),
@@ -242,6 +258,12 @@ class GenerateOptions:
         given = {f.name: data[f.name] for f in fields(cls) if f.name in data}
         fab, st = given.pop("fabricate", None), given.pop("structure", None)
         dr = given.pop("drive", None)
+        if "solver" in given:
+            given["solver"] = SolverName(given["solver"])
+        if "check" in given:
+            given["check"] = Check(given["check"])
+        if given.get("material") is not None:
+            given["material"] = Material.from_key(given["material"])
         return cls(
             **given,
             fabricate=None if fab is None else FabricateOptions.from_dict(fab),

@@ -272,7 +272,9 @@ class Generation:
         return self.initial_dof - self.solutions[-1].mechanism.dof
 
     def to_dict(self) -> dict:
-        """JSON-serialisable counters, stop and times of the run."""
+        """JSON-serialisable counters, stop and times of the run, each under its attribute's
+        name (``n_lock``: the paper's N_lock), the key of summary.json
+        (:class:`rigidfold.rundir.RunSummary`) and the study's column."""
         accepted_F = [s.result.F for s in self.solutions]
         all_F = [a.F for a in self.attempts if np.isfinite(a.F)]
         return {
@@ -281,12 +283,12 @@ class Generation:
             "initial_dof": self.initial_dof,
             "final_dof": self.final_dof,
             "lowest_dof": self.lowest_dof,
-            "N_reduce": self.n_reduce,
-            "N_lock": self.n_lock,
-            "N_exceed": self.n_exceed,
-            "N_path": self.n_path,
-            "N_backtrack": self.n_backtrack,
-            "N_rigid": self.n_rigid,
+            "n_reduce": self.n_reduce,
+            "n_lock": self.n_lock,
+            "n_exceed": self.n_exceed,
+            "n_path": self.n_path,
+            "n_backtrack": self.n_backtrack,
+            "n_rigid": self.n_rigid,
             "deploy_check": self.deploy_check,
             "final_step": None if self.final is None else self.final.step,
             "final_deploys": (
@@ -296,8 +298,8 @@ class Generation:
             "n_solutions": len(self.solutions),
             "n_solves": len(self.attempts),
             "n_skipped": self.n_skipped,
-            "mean_F_accepted": float(np.mean(accepted_F)) if accepted_F else None,
-            "mean_F_all_solves": float(np.mean(all_F)) if all_F else None,
+            "mean_f_accepted": float(np.mean(accepted_F)) if accepted_F else None,
+            "mean_f_all_solves": float(np.mean(all_F)) if all_F else None,
             "numerics": self.numerics,
             "time_s": {
                 "build": self.build_time,

@@ -70,7 +70,7 @@ from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.second_order import ChildForecast, Obstruction, obstruction
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.mesh import CreasePattern
-from rigidfold.optimize import OptimizeResult
+from rigidfold.optimize import OptimizeResult, SolverName
 from rigidfold.runtime.numerics import numeric_environment
 from rigidfold.selection import (
     Choice,
@@ -136,6 +136,7 @@ class _Steps:
         on_attempt: Callable[[Generation, Attempt], None] | None,
         on_solution: Callable[[Generation, Solution], None] | None,
         on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None = None,
+        started: float | None = None,
     ) -> None:
         self.case, self.options, self.settings = case, options, case.settings
         self.on_attempt, self.on_solution, self.on_retract = on_attempt, on_solution, on_retract
@@ -144,8 +145,8 @@ class _Steps:
             numerics=numeric_environment().to_dict(), deploy_check=options.deploy_check
         )
         t0 = time.perf_counter()
-        self.started = time.monotonic()
-        self.problem = case.problem(build_ipopt=options.solver == "ipopt")
+        self.started = time.monotonic() if started is None else started
+        self.problem = case.problem(build_ipopt=options.solver == SolverName.IPOPT)
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
             crease_groups(case.pattern, case.planes, self.settings) if case.planes else None
@@ -191,7 +192,7 @@ class _Steps:
         opts, settings = self.options, self.settings
         deadline = self.deadline if start is not None else self.final_deadline
         result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
-        cut = deadline is not None and start is not None and time.monotonic() > deadline
+        cut = deadline is not None and time.monotonic() > deadline
         if opts.deploy_check:
             result = self.problem.polish(result, deadline)
         t1 = time.perf_counter()
@@ -294,11 +295,7 @@ class _Steps:
     def final_deadline(self) -> float | None:
         """The end of naming the final design after the time limit T: T + max(
         ``time_limit_grace_min``, ``time_limit_grace`` T) (None without a limit)."""
-        limit = self.options.time_limit
-        if limit is None:
-            return None
-        g = self.settings.generation
-        return self.started + limit + max(g.time_limit_grace_min, g.time_limit_grace * limit)
+        return past_time_limit(self.started, self.options.time_limit, self.settings)
 
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
@@ -574,7 +571,7 @@ class _Steps:
         self.shapes.clear()
         self.fold_limit = limit
         t0 = time.perf_counter()
-        self.problem = case.problem(build_ipopt=self.options.solver == "ipopt")
+        self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
         run.build_time += time.perf_counter() - t0
         self.backtracks = self.rejected = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
@@ -630,6 +627,7 @@ def generate(
     on_attempt: Callable[[Generation, Attempt], None] | None = None,
     on_solution: Callable[[Generation, Solution], None] | None = None,
     on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None = None,
+    started: float | None = None,
     **changes,
 ) -> Generation:
     """Run Steps 2-7 on a case; callbacks see every attempt, every accepted solution and
@@ -643,14 +641,20 @@ def generate(
     planes in the case, creases are fixed in mirror groups (2 or 4 at once). With
     ``target_dof=0`` the DOF-0 shape that ends the run is its last solution (its attempt's
     outcome stays ZERO_DOF) and the stop is TARGET_REACHED. A KeyboardInterrupt propagates
-    after the callbacks of everything finished so far.
+    after the callbacks of everything finished so far. ``started``: the time of
+    ``time.monotonic()`` that the time limit counts from (default: the call; the command
+    line gives its process's start, :func:`rigidfold.runtime.clock.process_age`).
     """
     opts = (options or GenerateOptions()).replace(**changes)
     check_analysis_size(case.pattern, case.settings)  # before the first solve, not after it
-    steps = _Steps(case, opts, on_attempt, on_solution, on_retract)
+    steps = _Steps(case, opts, on_attempt, on_solution, on_retract, started)
     run = steps.run
     # Steps 2-5 for the triangulated target surface
     rec, trial = steps.solve(case.pattern.fixed.copy(), None, (), None)
+    if rec.outcome is AttemptOutcome.TIME_LIMIT:  # the limit ended the first solve
+        run.stop, run.stop_detail = Stop.TIME_LIMIT, f"{opts.time_limit:g}"
+        steps.record(rec, trial)
+        return run
     if not steps.is_solution(rec):
         run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
         rec.outcome = AttemptOutcome.INITIAL_FAILED
@@ -688,6 +692,21 @@ def generate(
             counted=final.mechanism.dof,
         ).to_dict()
     return run
+
+
+def past_time_limit(
+    started: float, limit: float | None, settings: Settings, graces: float = 1.0
+) -> float | None:
+    """The time of ``time.monotonic()`` ``graces`` graces after a run's time limit ``limit``
+    (seconds from ``started``; None: no limit, no time). The grace is max(
+    ``time_limit_grace_min``, ``time_limit_grace`` x limit): naming the final design ends
+    one grace after the limit, the final design's folding motion one and a half, and the
+    whole run (its exports, summary and report) by two: T + max(10 s, 5 % of T) with the
+    defaults."""
+    if limit is None:
+        return None
+    g = settings.generation
+    return started + limit + graces * max(g.time_limit_grace_min, g.time_limit_grace * limit)
 
 
 def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:

@@ -45,6 +45,12 @@ flat state is cut to the linear prediction of the closest approach, so the flat 
 rather than passed. Lengths are kept to ``path_tol`` at every point. A trace given a
 ``deadline`` (the time limit of the run that asks for it) ends there, out of budget
 (``max_steps``).
+
+In the code, each direction of a trace is a ``_Tracer`` whose :class:`Mode` (augmented,
+projection, descent) says which system it steps by; its steps are *predict*, *correct*,
+*accept* with *end* (has the path ended at the new point?), and, where the step has
+fallen below ``path_min_step``, *recover* (:mod:`rigidfold.mechanism.recovery`: rows
+dropped, near flexes held, a dense step past the point).
 """
 
 from __future__ import annotations
@@ -52,6 +58,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from enum import StrEnum
 from functools import cached_property
 
 import numpy as np
@@ -60,15 +67,9 @@ import scipy.sparse as sp
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.frame.model import default_support_face
-from rigidfold.mechanism import rigid_folding
 from rigidfold.mechanism.analysis import analyze
-from rigidfold.mechanism.rigid_folding import (
-    RigidFoldingConstraints,
-    System,
-    correct,
-    independent_rows,
-    rows_without_stresses,
-)
+from rigidfold.mechanism.recovery import escape, hold_near_flexes, may_reduce, reduce_rows
+from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System, correct
 from rigidfold.mesh import CreasePattern
 from rigidfold.outcomes import Outcome
 
@@ -214,6 +215,20 @@ class FoldingPath:
         }
 
 
+class Mode(StrEnum):
+    """How the tracer predicts and corrects a step (see the module's text)."""
+
+    AUGMENTED = "augmented"
+    """DOF 1: the tangent and the pseudo-arclength corrector of the square ``[J; t^T]`` (or
+    ``[J_rows; t^T]`` of the independent rows, once the redundant ones are dropped)."""
+    PROJECTION = "projection"
+    """DOF 1 with self-stressed constraints: the tangent and the corrector in the
+    regularised projection form."""
+    DESCENT = "descent"
+    """DOF > 1: the Gauss-Newton direction towards flat within the mechanism, and the
+    minimum-norm corrector."""
+
+
 @dataclass
 class _Trace:
     """The points of one direction of the trace, as it grows."""
@@ -231,396 +246,328 @@ class _Trace:
     dropped_rows: int = 0
     cut: bool = False
 
+    @classmethod
+    def start(cls, x: np.ndarray, rho: np.ndarray) -> _Trace:
+        """The trace of the one point x (n,), the design, with free fold angles rho."""
+        return cls([x.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
 
-def _trace_direction(
-    cons: RigidFoldingConstraints,
-    x0: np.ndarray,
-    t0: np.ndarray | None,
-    mode: str,
-    m0: float,
-    settings: Settings,
-    deadline: float | None = None,
-) -> tuple[_Trace, PathStatus, str]:
-    """Continue from the design x0 (mode "augmented"/"projection": along t0; "descent": the
-    Gauss-Newton direction) until the path ends (see the module's text), or until the time
-    ``deadline`` (of ``time.monotonic()``) has passed."""
-    J, J_rho = cons.jacobian(x0)
-    rho = cons.free_angles(x0)
-    tr = _Trace([x0.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
-    flat_tol, limit = settings.path.flat_tol, settings.path.fold_limit
-    system = System(J, J_rho, mode, t0, settings)
-    tr.factorizations += 1
-    t = t0 if mode == "descent" else system.direction(t0, rho)
-    det_sign = system.factors.det_sign if mode == "augmented" else 0
-    # step lengths are root-mean-square vertex displacements, in mean edge lengths
-    rms = math.sqrt(cons.pattern.n_vertices)
-    first, largest, least = (
-        rms * v for v in (settings.path.step, settings.path.max_step, settings.path.min_step)
-    )
-    x, h, travelled, slope_sign, slow, escapes = x0.copy(), first, 0.0, 0, 0, 0
-    rows: np.ndarray | None = None  # the independent rows, once the redundant ones are dropped
-    frozen: np.ndarray | None = None  # near flexes held, once their near stresses are dropped
-    near_stress = (0.0, 0.0)  # then J's near singular values over its largest (least, most)
-    strained: tuple[float, float] | None = None  # the largest step since x that strains
-    best = 1.0  # the smallest measure so far
-    lowest = np.inf  # DOF 1: the smallest measure since m first fell
-    while True:
-        if tr.steps >= settings.path.max_steps:
-            return tr, PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps"
-        if deadline is not None and time.monotonic() > deadline:
+
+@dataclass(frozen=True)
+class _End:
+    """How and why the trace of a direction ended."""
+
+    status: PathStatus
+    message: str
+
+
+@dataclass(frozen=True)
+class _Step:
+    """A step tried from the tracer's point x.
+
+    y : (n,) the corrected point; ok : it is on the constraints to ``path_tol`` (and, DOF 1,
+    its chord within ``path_max_turn`` of the tangent); length : the step predicted (rms
+    vertex displacement); factorizations : those the corrector made (1: an easy step, the
+    next may grow); system : the corrector's last factored system (at y where ok);
+    beyond : where the corrector failed with the independent rows because the constraints
+    have no solution within ``path_tol`` there, the least-squares residual left, else None.
+    """
+
+    y: np.ndarray
+    ok: bool
+    length: float
+    factorizations: int
+    system: System | None
+    beyond: float | None = None
+
+
+class _Tracer:
+    """One direction of the trace from the design x0: the continuation's state and its steps.
+
+    :meth:`run` repeats :meth:`predict` (the step along the tangent t, or along the descent
+    direction), :meth:`correct` (back onto c = 0) and :meth:`accept` (the new point, and
+    :meth:`end`: has the path ended there?); a step that fails is halved, and where it falls
+    below ``path_min_step``, :meth:`recover` changes the system (rows dropped, near flexes
+    held: :mod:`rigidfold.mechanism.recovery`), takes a dense step past the point, or ends
+    the trace. Lengths are in the constraints' scale (``cons.scale``); step lengths are
+    root-mean-square vertex displacements (``rms``: one mean edge length of them).
+    """
+
+    def __init__(
+        self,
+        cons: RigidFoldingConstraints,
+        x0: np.ndarray,
+        t0: np.ndarray | None,
+        mode: Mode,
+        m0: float,
+        settings: Settings,
+        deadline: float | None,
+    ) -> None:
+        self.cons, self.m0, self.settings, self.deadline = cons, m0, settings, deadline
+        self.mode = mode
+        J, J_rho = cons.jacobian(x0)
+        self.rho = cons.free_angles(x0)  # the free fold angles at x
+        self.trace = _Trace.start(x0, self.rho)
+        self.system = System(J, J_rho, mode.value, t0, settings)  # factored at x
+        self.trace.factorizations += 1
+        self.t = t0 if mode is Mode.DESCENT else self.system.direction(t0, self.rho)
+        self.det_sign = self.system.factors.det_sign if mode is Mode.AUGMENTED else 0
+        self.rms = math.sqrt(cons.pattern.n_vertices)
+        self.first, self.largest, self.least = (
+            self.rms * v
+            for v in (settings.path.step, settings.path.max_step, settings.path.min_step)
+        )
+        self.x, self.h, self.travelled = x0.copy(), self.first, 0.0  # point, step, arclength
+        self.slope_sign = 0  # the sign of dm/ds, last it was not 0
+        self.slow = 0  # steps since m last fell by path_stall_ratio below its best
+        self.rows: np.ndarray | None = None  # the independent rows, once the others dropped
+        self.frozen: np.ndarray | None = None  # near flexes held, once their stresses dropped
+        self.near_stress = (0.0, 0.0)  # then J's near singular values over its largest
+        self.strained: tuple[float, float] | None = None  # the largest step since x (step,
+        # residual) that left a least-squares residual above path_tol
+        self.best = 1.0  # the smallest measure so far
+        self.lowest = np.inf  # DOF 1: the smallest measure since m first fell
+
+    def run(self) -> tuple[_Trace, PathStatus, str]:
+        """Step until the path ends: (its points, how it ended, why in words)."""
+        while True:
+            prediction = self.out_of_budget() or self.predict()
+            if isinstance(prediction, _End):
+                return self.trace, prediction.status, prediction.message
+            step = self.correct(*prediction)
+            if not step.ok:
+                self.h = step.length / 2
+                if self.h >= self.least:
+                    continue  # a shorter step from x
+                recovered = self.recover(step)
+                if recovered is None:
+                    continue  # a new system at x: a step of ``first`` from there
+                if isinstance(recovered, _End):
+                    return self.trace, recovered.status, recovered.message
+                step = recovered
+            end = self.accept(step)
+            if end is not None:
+                return self.trace, end.status, end.message
+            self.h = min(2 * step.length, self.largest) if step.factorizations == 1 else step.length
+
+    def out_of_budget(self) -> _End | None:
+        """The end of a trace that has taken ``path_max_steps`` steps or passed its deadline."""
+        tr = self.trace
+        if tr.steps >= self.settings.path.max_steps:
+            return _End(PathStatus.MAX_STEPS, f"no flat state after {tr.steps} steps")
+        if self.deadline is not None and time.monotonic() > self.deadline:
             tr.cut = True
-            return (
-                tr,
+            return _End(
                 PathStatus.MAX_STEPS,
                 f"the run's time limit passed after {tr.steps} steps, short of the flat state",
             )
-        if mode == "descent":
-            d = system.direction(None, rho)
+        return None
+
+    def predict(self) -> tuple[np.ndarray, float] | _End:
+        """(the unit direction (n,), the step length) of the next step from x: along the
+        tangent (DOF 1) or the descent direction, h long at most; no crease turns by more than
+        ``path_max_fold_step`` in it, and it is cut at the linear prediction of the closest
+        approach to the flat state. A descent that no longer lowers m ends the trace."""
+        settings, rho = self.settings.path, self.rho
+        if self.mode is Mode.DESCENT:
+            d = self.system.direction(None, rho)
             size = float(np.linalg.norm(d))
-            if not size > least:
-                return (
-                    tr,
+            if not size > self.least:
+                return _End(
                     PathStatus.STOPS_SHORT,
-                    (
-                        "no rigid folding lowers the folding measure below "
-                        f"{tr.measure[-1]:.3g} of the design's"
-                    ),
+                    "no rigid folding lowers the folding measure below "
+                    f"{self.trace.measure[-1]:.3g} of the design's",
                 )
-            unit, step = d / size, min(h, size)
+            unit, step = d / size, min(self.h, size)
         else:
-            assert t is not None
-            unit, step = t, h
-        # no crease turns by more than path_max_fold_step in one step; and the step is cut at
-        # the linear prediction of the closest approach to the flat state
-        rate = system.J_rho @ unit
+            assert self.t is not None
+            unit, step = self.t, self.h
+        rate = self.system.J_rho @ unit
         fastest = float(np.abs(rate).max(initial=0.0))
-        if fastest * step > settings.path.max_fold_step:
-            step = settings.path.max_fold_step / fastest
+        if fastest * step > settings.max_fold_step:
+            step = settings.max_fold_step / fastest
         rr = float(rate @ rate)
         if rr > 0:
             s_star = -float(rho @ rate) / rr
-            if 0 < s_star < step and np.abs(rho + s_star * rate).max() < 2 * flat_tol:
-                step = max(s_star, least)
-        y, ok, nf, new = correct(cons, x + step * unit, mode, t, settings, rows, frozen)
-        tr.factorizations += nf
-        beyond = None if ok else _beyond_tolerance(cons, y, new, settings)
-        if beyond is not None and strained is None:
-            strained = (step, beyond)
-        if ok and mode != "descent":  # the tangent must not turn too far in one step
-            chord = y - x
-            ok = float(chord @ unit) > np.cos(settings.path.max_turn) * np.linalg.norm(chord)
-        if not ok:
-            h = step / 2
-            if h >= least:
-                continue
-            if mode == "projection" and rows is None and _may_reduce(cons, settings):
-                assert t is not None
-                reduced = _reduce(cons, x, t, settings)
-                tr.factorizations += 1
-                if reduced is not None:  # go on by the square system of the independent rows
-                    rows, system, sigma = reduced
-                    near_stress = (sigma, sigma)
-                    mode, t, h = "augmented", system.direction(t, rho), first
-                    det_sign = system.factors.det_sign
-                    tr.dropped_rows = cons.n_rows - len(rows)
-                    continue
-            if mode == "augmented" and rows is not None and frozen is None and beyond is None:
-                assert t is not None
-                held = _hold_near_flexes(cons, x, t, settings)
-                tr.factorizations += 1
-                if held is not None:  # go on with the near self-stresses' rows dropped too
-                    rows, frozen, system, near_stress = held
-                    t, h = system.direction(t, rho), first
-                    det_sign = system.factors.det_sign
-                    tr.dropped_rows = cons.n_rows - len(rows)
-                    continue
-            if beyond is not None:  # the constraints have no solution within path_tol here
-                assert strained is not None
-                residual = float(np.abs(cons.residual(x)).max())
-                return (
-                    tr,
-                    PathStatus.STOPS_SHORT,
-                    _strained(tr, strained, (step, beyond), near_stress, residual, rms, settings),
-                )
-            escaped = (
-                _escape(cons, x, t, rho, first, mode, settings, rows, frozen)
-                if escapes < settings.path.max_escapes
-                else None
+            if 0 < s_star < step and np.abs(rho + s_star * rate).max() < 2 * settings.flat_tol:
+                step = max(s_star, self.least)
+        return unit, step
+
+    def correct(self, unit: np.ndarray, length: float) -> _Step:
+        """The prediction x + length * unit corrected onto the constraints (the module's
+        ``correct``: chord steps on the current mode's system)."""
+        y, ok, nf, system = correct(
+            self.cons,
+            self.x + length * unit,
+            self.mode.value,
+            self.t,
+            self.settings,
+            self.rows,
+            self.frozen,
+        )
+        self.trace.factorizations += nf
+        beyond = None if ok else _beyond_tolerance(self.cons, y, system, self.settings)
+        if beyond is not None and self.strained is None:
+            self.strained = (length, beyond)
+        if ok and self.mode is not Mode.DESCENT:  # the tangent must not turn too far in one step
+            chord = y - self.x
+            ok = float(chord @ unit) > np.cos(self.settings.path.max_turn) * np.linalg.norm(chord)
+        return _Step(y, ok, length, nf, system, beyond)
+
+    def recover(self, failed: _Step) -> _Step | _End | None:
+        """Where the step has fallen below ``path_min_step`` at x (``failed`` the last one
+        tried): None where the trace goes on from x with a new system (a 1-DOF projection
+        trace with the redundant rows dropped; a trace of the independent rows with J's near
+        flexes held as well); the point of a dense step past x; or the end of the trace,
+        where the constraints have no solution within ``path_tol`` (stops short) or nothing
+        goes on (stalled)."""
+        cons, settings, tr = self.cons, self.settings, self.trace
+        if self.mode is Mode.PROJECTION and self.rows is None and may_reduce(cons, settings):
+            assert self.t is not None
+            reduced = reduce_rows(cons, self.x, self.t, settings)
+            tr.factorizations += 1
+            if reduced is not None:  # go on by the square system of the independent rows
+                rows, system, sigma = reduced
+                self.near_stress = (sigma, sigma)
+                self.mode = Mode.AUGMENTED
+                self._go_on(rows, system)
+                return None
+        held = self.mode is Mode.AUGMENTED and self.rows is not None and self.frozen is None
+        if held and failed.beyond is None and self._hold_near_flexes():
+            return None  # go on with the near self-stresses' rows dropped too
+        if failed.beyond is not None:  # the constraints have no solution within path_tol here
+            assert self.strained is not None
+            residual = float(np.abs(cons.residual(self.x)).max())
+            last = (failed.length, failed.beyond)
+            return _End(
+                PathStatus.STOPS_SHORT,
+                _strained(tr, self.strained, last, self.near_stress, residual, self.rms, settings),
             )
-            if escaped is None and mode == "augmented" and rows is None and frozen is None:
+        escaped = (
+            escape(
+                cons,
+                self.x,
+                self.t,
+                self.rho,
+                self.first,
+                self.mode.value,
+                settings,
+                self.rows,
+                self.frozen,
+            )
+            if tr.escapes < settings.path.max_escapes
+            else None
+        )
+        if escaped is None:
+            if self.mode is Mode.AUGMENTED and self.rows is None and self.frozen is None:
                 # a trace of n - 1 rows (none redundant) past its dense steps: J's near
                 # flexes are held and their near self-stresses' rows dropped, as above
-                assert t is not None
-                held = _hold_near_flexes(cons, x, t, settings)
-                tr.factorizations += 1
-                if held is not None:
-                    rows, frozen, system, near_stress = held
-                    t, h = system.direction(t, rho), first
-                    det_sign = system.factors.det_sign
-                    tr.dropped_rows = cons.n_rows - len(rows)
-                    continue
-            if escaped is None:
-                return (
-                    tr,
-                    PathStatus.STALLED,
-                    (
-                        f"the step fell below {settings.path.min_step:g} mean edge lengths at "
-                        f"m = {tr.measure[-1]:.3g} of the design's"
-                        + (f" ({escapes} dense steps past stalls)" if escapes else "")
-                        + _stall_reason(cons, y, new, mode, settings)
-                    ),
-                )
-            y, t, new, mode = escaped
-            if new.rows is not None and rows is None:
-                rows, tr.dropped_rows = new.rows, cons.n_rows - len(new.rows)
-            escapes, step, nf = escapes + 1, first, 1
-            tr.escapes += 1
-        assert new is not None
-        rho_y = cons.free_angles(y)
-        fold_max = float(np.abs(rho_y).max(initial=0.0))
-        if fold_max >= limit:
-            return (
-                tr,
-                PathStatus.COLLISION,
-                (
-                    f"crease {int(cons.free[np.argmax(np.abs(rho_y))])} folds to "
-                    f"{np.degrees(fold_max):.1f} degrees at m = "
-                    f"{np.linalg.norm(rho_y) / m0:.3g} of the design's"
-                ),
+                if self._hold_near_flexes():
+                    return None
+            return _End(
+                PathStatus.STALLED,
+                f"the step fell below {settings.path.min_step:g} mean edge lengths at "
+                f"m = {tr.measure[-1]:.3g} of the design's"
+                + (f" ({tr.escapes} dense steps past stalls)" if tr.escapes else "")
+                + _stall_reason(cons, failed.y, failed.system, self.mode.value, settings),
             )
-        travelled += float(np.linalg.norm(y - x))
-        strained = None
-        x, rho, system = y, rho_y, new
-        if mode != "descent":
-            t = system.direction(t, rho)
+        y, self.t, system, mode = escaped
+        self.mode = Mode(mode)
+        if system.rows is not None and self.rows is None:
+            self.rows, tr.dropped_rows = system.rows, cons.n_rows - len(system.rows)
+        tr.escapes += 1
+        return _Step(y, True, self.first, 1, system)
+
+    def _hold_near_flexes(self) -> bool:
+        """Hold J's near flexes at x and drop their near self-stresses' rows
+        (:func:`rigidfold.mechanism.recovery.hold_near_flexes`); False where there are none."""
+        assert self.t is not None
+        held = hold_near_flexes(self.cons, self.x, self.t, self.settings)
+        self.trace.factorizations += 1
+        if held is None:
+            return False
+        rows, self.frozen, system, self.near_stress = held
+        self._go_on(rows, system)
+        return True
+
+    def _go_on(self, rows: np.ndarray, system: System) -> None:
+        """Continue from x by ``system``, the square system of the constraints' ``rows``:
+        its tangent, its determinant's sign, and a first step again."""
+        self.rows, self.system = rows, system
+        self.t, self.h = system.direction(self.t, self.rho), self.first
+        self.det_sign = system.factors.det_sign
+        self.trace.dropped_rows = self.cons.n_rows - len(rows)
+
+    def accept(self, step: _Step) -> _End | None:
+        """Move to the corrected point of ``step`` and record it (limit points where dm/ds
+        changed sign, bifurcations where det [J; t^T] did), then :meth:`end`; a point where a
+        crease folds to ``path_fold_limit`` (its panels meet) ends the trace unrecorded."""
+        cons, tr = self.cons, self.trace
+        assert step.system is not None
+        rho = cons.free_angles(step.y)
+        fold_max = float(np.abs(rho).max(initial=0.0))
+        if fold_max >= self.settings.path.fold_limit:
+            return _End(
+                PathStatus.COLLISION,
+                f"crease {int(cons.free[np.argmax(np.abs(rho))])} folds to "
+                f"{np.degrees(fold_max):.1f} degrees at m = "
+                f"{np.linalg.norm(rho) / self.m0:.3g} of the design's",
+            )
+        self.travelled += float(np.linalg.norm(step.y - self.x))
+        self.strained = None
+        self.x, self.rho, self.system = step.y, rho, step.system
+        if self.mode is not Mode.DESCENT:
+            self.t = self.system.direction(self.t, self.rho)
         tr.steps += 1
-        m = float(np.linalg.norm(rho)) / m0
+        m = float(np.linalg.norm(self.rho)) / self.m0
         slope = int(np.sign(m - tr.measure[-1]))
-        if slope_sign and slope and slope != slope_sign:
+        if self.slope_sign and slope and slope != self.slope_sign:
             tr.limit_points.append(len(tr.points) - 1)
-        slope_sign = slope or slope_sign
-        if mode == "augmented":
-            sign = system.factors.det_sign
-            if sign != det_sign:
+        self.slope_sign = slope or self.slope_sign
+        if self.mode is Mode.AUGMENTED:
+            sign = self.system.factors.det_sign
+            if sign != self.det_sign:
                 tr.bifurcations.append(len(tr.points))
-                det_sign = sign
-        slow = slow + 1 if m > best * (1 - settings.path.stall_ratio) else 0
-        best = min(best, m)
-        tr.points.append(x.copy())
-        tr.arclength.append(travelled)
+                self.det_sign = sign
+        self.slow = self.slow + 1 if m > self.best * (1 - self.settings.path.stall_ratio) else 0
+        self.best = min(self.best, m)
+        tr.points.append(self.x.copy())
+        tr.arclength.append(self.travelled)
         tr.measure.append(m)
         tr.max_fold.append(fold_max)
-        tr.folds.append(rho)
-        if fold_max <= flat_tol:
-            return (
-                tr,
+        tr.folds.append(self.rho)
+        return self.end(slope)
+
+    def end(self, slope: int) -> _End | None:
+        """Whether the path ends at the point just recorded (``slope`` the sign of dm/ds on
+        the way to it): flat; stops short (m came no lower for ``path_wander_steps``, for a
+        descent ``path_stall_steps``, steps); or turned back (DOF 1: m, having fallen, rose
+        ``path_turn_back`` above its lowest)."""
+        settings, tr = self.settings.path, self.trace
+        m, fold_max = tr.measure[-1], tr.max_fold[-1]
+        if fold_max <= settings.flat_tol:
+            return _End(
                 PathStatus.FLAT,
-                (
-                    f"every fold angle below {np.degrees(flat_tol):.2g} degrees after {tr.steps} "
-                    f"steps ({travelled * cons.scale:.3g} m of path)"
-                ),
+                f"every fold angle below {np.degrees(settings.flat_tol):.2g} degrees after "
+                f"{tr.steps} steps ({self.travelled * self.cons.scale:.3g} m of path)",
             )
-        if slow >= (settings.path.stall_steps if mode == "descent" else settings.path.wander_steps):
-            return (
-                tr,
+        patience = settings.stall_steps if self.mode is Mode.DESCENT else settings.wander_steps
+        if self.slow >= patience:
+            return _End(
                 PathStatus.STOPS_SHORT,
-                (
-                    f"no rigid folding lowers the folding measure below {best:.3g} of the "
-                    f"design's (none in the last {slow} steps)"
-                ),
+                f"no rigid folding lowers the folding measure below {self.best:.3g} of the "
+                f"design's (none in the last {self.slow} steps)",
             )
-        if mode != "descent":
+        if self.mode is not Mode.DESCENT:
             if slope < 0:  # m falls: from here on a rise of path_turn_back is a turn back
-                lowest = min(lowest, m)
-            elif m > lowest + settings.path.turn_back:
+                self.lowest = min(self.lowest, m)
+            elif m > self.lowest + settings.turn_back:
                 k = int(np.argmin(tr.measure))
-                return (
-                    tr,
+                return _End(
                     PathStatus.TURNED_BACK,
-                    (
-                        f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest "
-                        f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees)"
-                    ),
+                    f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest "
+                    f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees)",
                 )
-        h = min(2 * step, largest) if nf == 1 else step
-
-
-def _escape(
-    cons: RigidFoldingConstraints,
-    x: np.ndarray,
-    t: np.ndarray | None,
-    rho: np.ndarray,
-    first: float,
-    mode: str,
-    settings: Settings,
-    rows: np.ndarray | None = None,
-    frozen: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, System, str] | None:
-    """One step past the point x where the sparse continuation stalled (see
-    ``Settings.path.escape_tol``): the null space N of J at x from a dense SVD; the
-    directions tried are the last tangent's part in N (the branch continued), where N has
-    two or more columns the branches of the bifurcation equation in the plane of J's two
-    smallest singular vectors, the path's and its nearest flex (see :func:`_branches`:
-    branch switching), and the part of the steepest descent of the folding measure (a branch
-    towards flat); each step of ``first``, a quarter, a sixteenth. A 1-DOF trace corrects it
-    by the square system ``[J_rows; d^T]`` of the independent rows (dropped here if the
-    constraints are self-stressed and ``rows`` is None) with the Gauss-Newton corrector of
-    :func:`rigidfold.mechanism.rigid_folding.correct`; a trace of more DOF by Gauss-Newton
-    with the pseudo-inverse truncated at ``mechanism_rank_tol``; until every constraint
-    holds to ``path_tol``. Returns (the point, its direction, the factored system there, the
-    mode: "projection" where the augmented matrix is singular), or None (no step converged,
-    or more than ``mechanism_second_order_vertices`` vertices)."""
-    if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
         return None
-    J, J_rho = cons.jacobian(x)
-    U, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
-    values = np.zeros(cons.n)
-    values[: len(s)] = s
-    small = values <= settings.path.escape_tol * values[0]
-    N = vt[small].T
-    if not N.shape[1]:
-        return None
-    square = mode != "descent"
-    tries = [] if t is None else [N @ (N.T @ t)]
-    if square and N.shape[1] >= 2:
-        # the plane of the two smallest singular values (the path's and a near flex)
-        plane = vt[cons.n - 2 :].T
-        stresses = np.hstack([U[:, : len(s)][:, small[: len(s)]], U[:, len(s) :]])
-        tries += _branches(cons, x, plane, stresses, rho, settings)
-    tries.append(N @ (N.T @ -(J_rho.T @ rho)))
-    if square and rows is None and cons.n_rows > cons.n - 1:
-        rows = rows_without_stresses(U, cons.n, 1)
-    wide = settings.with_(path_corrector_iter=3 * settings.path.corrector_iter)
-    done: list[np.ndarray] = []
-    for d in tries:
-        size = float(np.linalg.norm(d))
-        if not size > 0:
-            continue
-        d = d / size
-        if any(float(d @ e) > math.cos(settings.path.max_turn) for e in done):
-            continue  # tried already
-        done.append(d)
-        for h in (first, first / 4, first / 16):
-            if square:
-                # the module's corrector (the continuation's, ``correct``, may be swapped)
-                y, ok, _, system = rigid_folding.correct(
-                    cons, x + h * d, "augmented", d, wide, rows, frozen
-                )
-                if ok and system is not None and float((y - x) @ d) > 0.5 * h:
-                    return y, d, system, "augmented"
-                continue
-            y = x + h * d
-            for _ in range(3 * settings.path.corrector_iter):
-                c = cons.residual(y)
-                if not np.isfinite(c).all():
-                    break
-                if float(np.abs(c).max()) <= settings.path.tol:
-                    chord = y - x
-                    if float(chord @ d) <= 0.5 * h:  # slid back towards x
-                        break
-                    Jy, Jy_rho = cons.jacobian(y)
-                    for kind in (mode, "projection"):
-                        try:
-                            return y, d, System(Jy, Jy_rho, kind, d, settings, rows), kind
-                        except RuntimeError:  # an exactly singular augmented matrix
-                            continue
-                    return None
-                A = np.vstack([cons.jacobian(y)[0].toarray(), d])
-                dy = np.linalg.lstsq(A, np.r_[-c, 0.0], rcond=settings.mechanism.rank_tol)[0]
-                y = y + dy
-    return None
-
-
-def _branches(
-    cons: RigidFoldingConstraints,
-    x: np.ndarray,
-    N: np.ndarray,
-    W: np.ndarray,
-    rho: np.ndarray,
-    settings: Settings,
-) -> list[np.ndarray]:
-    """Branch directions (n,) at a simple bifurcation point x: N (n, 2) spans the null space
-    of J there, W (m, k) its (near) self-stresses; a branch leaves x along d in N with
-    ``w^T c''(d, d) = 0`` for every stress w (the algebraic bifurcation equation, Allgower &
-    Georg ch. 8), c'' by central differences of J along N (step sqrt(``path_tol``), so that
-    its error is of the order of the tolerance). The roots are the deepest minima of the sum
-    of squares over half a circle of directions (a degree apart); each is returned with both
-    signs, those that lower the folding measure first."""
-    eps = math.sqrt(settings.path.tol)
-    D = []
-    for j in range(2):
-        Jp = cons.jacobian(x + eps * N[:, j])[0]
-        Jm = cons.jacobian(x - eps * N[:, j])[0]
-        D.append(W.T @ ((Jp - Jm) @ N) / (2 * eps))  # (k, 2): w^T c''(n_i, n_j)
-    Q = np.stack([np.column_stack([D[0][:, i], D[1][:, i]]) for i in range(2)], axis=1)
-    Q = (Q + Q.transpose(0, 2, 1)) / 2  # (k, 2, 2)
-    theta = np.radians(np.arange(180.0))
-    a = np.stack([np.cos(theta), np.sin(theta)])  # (2, 180)
-    f = (np.einsum("ia,kij,ja->ka", a, Q, a) ** 2).sum(axis=0)
-    minima = np.flatnonzero((f <= np.roll(f, 1)) & (f <= np.roll(f, -1)))
-    best = minima[np.argsort(f[minima])][:2]
-    out = [sign * (N @ a[:, i]) for i in best for sign in (1.0, -1.0)]
-    J_rho = cons.jacobian(x)[1]
-    return sorted(out, key=lambda d: float(rho @ (J_rho @ d)))
-
-
-def _may_reduce(cons: RigidFoldingConstraints, settings: Settings) -> bool:
-    """The redundant rows of a 1-DOF shape are dropped where its projection continuation
-    stalls (``path_reduce``), up to ``mechanism_second_order_vertices`` vertices (one dense
-    SVD)."""
-    return (
-        settings.path.reduce and cons.pattern.n_vertices <= settings.mechanism.second_order_vertices
-    )
-
-
-def _reduce(
-    cons: RigidFoldingConstraints, x: np.ndarray, t: np.ndarray, settings: Settings
-) -> tuple[np.ndarray, System, float] | None:
-    """(rows (n - 1,) int, the factored ``[J_rows; t^T]`` at x, J's smallest singular value
-    over its largest there): the independent rows of the constraints of a 1-DOF shape at x
-    (:func:`rigidfold.mechanism.rigid_folding.independent_rows`) and the square augmented
-    system they make with the tangent t (n,); None where it is exactly singular."""
-    rows, sigma = independent_rows(cons.jacobian(x)[0], 1)
-    try:
-        return rows, System(*cons.jacobian(x), "augmented", t, settings, rows), sigma
-    except RuntimeError:
-        return None
-
-
-def _hold_near_flexes(
-    cons: RigidFoldingConstraints, x: np.ndarray, t: np.ndarray, settings: Settings
-) -> tuple[np.ndarray, np.ndarray, System, tuple[float, float]] | None:
-    """Where the square system of the independent rows stalls too, at x: J's near flexes
-    there (right singular vectors of singular values below ``path_escape_tol`` of the
-    largest, but for the smallest, the path's own) are held, ``frozen`` (n, k), and the rows
-    of their near self-stresses dropped as well (``[J_rows; frozen^T; t^T]`` square): their
-    residual is then left to the Gauss-Newton corrector's least squares and checked
-    against ``path_tol`` like that of the exact self-stresses, rather than removed by
-    moves of residual / sigma along the near flexes, which Newton's method cannot make.
-    Returns (rows, frozen, the factored system at x, (the smallest, the largest) of those
-    singular values over the largest one), or None (no near flex, an exactly singular
-    system, or more than ``mechanism_second_order_vertices`` vertices)."""
-    if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
-        return None
-    J, J_rho = cons.jacobian(x)
-    U, s, vt = np.linalg.svd(J.toarray(), full_matrices=True)
-    values = np.zeros(cons.n)  # J's n singular values: zeros past the m of a J of m < n rows
-    values[: min(len(s), cons.n)] = s[: cons.n]
-    near = np.flatnonzero(values[:-1] <= settings.path.escape_tol * values[0])
-    if not len(near):
-        return None
-    frozen = vt[near].T
-    rows = rows_without_stresses(U, cons.n, 1 + len(near))
-    try:
-        system = System(J, J_rho, "augmented", t, settings, rows, frozen)
-    except RuntimeError:
-        return None
-    return (
-        rows,
-        frozen,
-        system,
-        (float(values[near].min() / s[0]), float(values[near].max() / s[0])),
-    )
 
 
 def _strained(
@@ -717,7 +664,7 @@ def trace_path(
     if dof <= 0:
         return _result(
             cons,
-            [_single(cons, x0, rho)],
+            [_Trace.start(x0, rho)],
             PathStatus.RIGID,
             PathStatus.RIGID.message,
             max(dof, 0),
@@ -726,26 +673,24 @@ def trace_path(
     if m0 == 0 or np.abs(rho).max() <= settings.path.flat_tol:
         return _result(
             cons,
-            [_single(cons, x0, rho)],
+            [_Trace.start(x0, rho)],
             PathStatus.FLAT,
             "the shape is flat already",
             dof,
             m0 or 1.0,
         )
     if dof == 1:
-        mode = "augmented" if cons.n_rows == cons.n - 1 else "projection"
+        mode = Mode.AUGMENTED if cons.n_rows == cons.n - 1 else Mode.PROJECTION
         t = _first_tangent(J, J_rho, rho, settings)
         traces = []
         for sign in (1.0, -1.0):
             try:
-                tr, status, message = _trace_direction(
-                    cons, x0, sign * t, mode, m0, settings, deadline
-                )
+                tracer = _Tracer(cons, x0, sign * t, mode, m0, settings, deadline)
+                tr, status, message = tracer.run()
             except RuntimeError:  # the augmented matrix is singular at the design
-                mode = "projection"
-                tr, status, message = _trace_direction(
-                    cons, x0, sign * t, mode, m0, settings, deadline
-                )
+                mode = Mode.PROJECTION
+                tracer = _Tracer(cons, x0, sign * t, mode, m0, settings, deadline)
+                tr, status, message = tracer.run()
             traces.append((tr, status, message))
             if status is not PathStatus.STALLED:
                 break
@@ -764,7 +709,7 @@ def trace_path(
             )
         factorizations = sum(t[0].factorizations for t in traces)
         return _result(cons, [tr], status, message, 1, m0, factorizations)
-    tr, status, message = _trace_direction(cons, x0, None, "descent", m0, settings, deadline)
+    tr, status, message = _Tracer(cons, x0, None, Mode.DESCENT, m0, settings, deadline).run()
     return _result(cons, [tr], status, message, dof, m0)
 
 
@@ -777,10 +722,6 @@ def _first_tangent(
     if not np.isfinite(t).all():
         raise RigidfoldError("the shape's folding path has no tangent at the design")
     return t
-
-
-def _single(cons: RigidFoldingConstraints, x: np.ndarray, rho: np.ndarray) -> _Trace:
-    return _Trace([x.copy()], [0.0], [1.0], [float(np.abs(rho).max(initial=0.0))], [rho], [], [])
 
 
 def _result(

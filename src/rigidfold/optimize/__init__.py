@@ -2,7 +2,13 @@
 
 from rigidfold.optimize.ipopt import IpoptSolver
 from rigidfold.optimize.nlp import NLP
-from rigidfold.optimize.problem import SOLVER_FACTORIES, SOLVERS, FormFindingProblem, classify
+from rigidfold.optimize.problem import (
+    SOLVER_FACTORIES,
+    SOLVERS,
+    FormFindingProblem,
+    SolverName,
+    classify,
+)
 from rigidfold.optimize.result import OptimizeResult, Status
 from rigidfold.optimize.slsqp import SlsqpSolver
 from rigidfold.optimize.solver import Solver, SolverOutcome, SolverRun
@@ -18,6 +24,7 @@ __all__ = [
     "OptimizeResult",
     "SlsqpSolver",
     "Solver",
+    "SolverName",
     "SolverOutcome",
     "SolverRun",
     "Status",

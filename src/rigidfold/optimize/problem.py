@@ -11,6 +11,7 @@ import dataclasses
 import functools
 import time
 from collections.abc import Callable, Mapping, Sequence
+from enum import StrEnum
 from functools import partial
 from types import MappingProxyType
 
@@ -29,15 +30,26 @@ from rigidfold.optimize.solver import Solver, SolverOutcome, SolverProblem
 from rigidfold.optimize.variables import LinearMap, build_linear_map
 from rigidfold.protocols import SymmetryPlane, TargetSurface
 
-#: name -> solver factory ``(problem) -> Solver``; the one list of solver names
-SOLVER_FACTORIES: Mapping[str, Callable[[SolverProblem], Solver]] = MappingProxyType(
+
+class SolverName(StrEnum):
+    """A solver of problem (6) (``--solver``): IPOPT with the exact Hessian, SLSQP with the
+    exact Jacobian or with finite differences. A ``str``: files hold the plain value."""
+
+    IPOPT = "ipopt"
+    SLSQP = "slsqp"
+    SLSQP_FD = "slsqp-fd"
+
+
+#: name -> solver factory ``(problem) -> Solver``; the one list of solvers
+SOLVER_FACTORIES: Mapping[SolverName, Callable[[SolverProblem], Solver]] = MappingProxyType(
     {
-        "ipopt": ipopt_solver,
-        "slsqp": partial(SlsqpSolver, exact=True),
-        "slsqp-fd": partial(SlsqpSolver, exact=False),
+        SolverName.IPOPT: ipopt_solver,
+        SolverName.SLSQP: partial(SlsqpSolver, exact=True),
+        SolverName.SLSQP_FD: partial(SlsqpSolver, exact=False),
     }
 )
-SOLVERS = tuple(SOLVER_FACTORIES)
+SOLVERS = tuple(s.value for s in SOLVER_FACTORIES)
+"""The solvers' names, the default first (``--solver``'s choices)."""
 
 
 class FormFindingProblem:
@@ -96,10 +108,10 @@ class FormFindingProblem:
         self.objective = ca.Function(
             "F", [xi, w], [nlp.f, nlp.f1, nlp.f2], names, ["F", "F1", "F2"]
         )
-        self._solvers: dict[str, Solver] = {}
+        self._solvers: dict[SolverName, Solver] = {}
         self._projection: Projection | None = None
         if build_ipopt:
-            self.solver("ipopt")
+            self.solver(SolverName.IPOPT)
         self.build_time = time.perf_counter() - t0
 
     @functools.cached_property
@@ -189,7 +201,7 @@ class FormFindingProblem:
         return max(0.0, *parts)
 
     # ------------------------------------------------------------------ solve
-    def solver(self, name: str) -> Solver:
+    def solver(self, name: SolverName) -> Solver:
         """The solver ``name`` (one of ``SOLVERS``) of this problem, built on first use and kept."""
         if name not in SOLVER_FACTORIES:
             raise RigidfoldError(f"unknown solver {name!r} (choose from {', '.join(SOLVERS)})")
@@ -201,12 +213,12 @@ class FormFindingProblem:
         self,
         fixed=None,
         start: np.ndarray | None = None,
-        solver: str = "ipopt",
+        solver: SolverName = SolverName.IPOPT,
         deadline: float | None = None,
     ) -> OptimizeResult:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
-        ``solver`` is one of ``SOLVERS``; the result's ``wall_time`` is that of the solve alone.
+        ``solver`` is a :class:`SolverName`; the result's ``wall_time`` is that of the solve alone.
         ``deadline``: a time of ``time.monotonic()`` (a run's time limit) at which the solve
         ends at its iterate (judged as any other: accepted only at F <= F_tol).
         A solver that ends where a triangle has collapsed (or at non-finite coordinates) has

@@ -29,13 +29,7 @@ from rigidfold.io import prepare_output_dir
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mesh import CreasePattern
 from rigidfold.rundir.layout import FINAL_DIR
-from rigidfold.structure import (
-    StructureCheck,
-    check_design,
-    parse_indices,
-    parse_material,
-    write_structure,
-)
+from rigidfold.structure import StructureCheck, check_design, write_structure
 
 THICK_DIR = Path(FINAL_DIR) / "thick"
 """Where the thick panels' files go in the run's directory."""
@@ -64,7 +58,7 @@ def check_built_options(pattern: CreasePattern, options: GenerateOptions) -> Non
         return
     st.check_indices(pattern.n_vertices, pattern.n_edges)
     free = set(pattern.free_creases.tolist())
-    fixed = [e for e in parse_indices(st.actuators, pattern.n_edges, "actuators") if e not in free]
+    fixed = [e for e in sorted(set(st.actuators)) if e not in free]
     if fixed:
         raise RigidfoldError(f"actuator {fixed[0]} is not a free crease of the crease pattern")
 
@@ -97,7 +91,7 @@ def thick_panels(
     fab = fabricate.fabricate(
         panels,
         motion,
-        density=parse_material(options.panel_material).density,
+        density=options.panel_material.density,
         motion_message=message,
         settings=settings,
     )
@@ -212,7 +206,6 @@ def deployment_drive(
     :func:`rigidfold.drive.deploy_design` on ``solutions/NAME.fold``, its files in
     ``run_dir/final/deploy/``. Returns (the record's figures, the result)."""
     from rigidfold.drive import deploy_design
-    from rigidfold.material import parse_material
 
     drive = options.drive
     assert drive is not None
@@ -221,7 +214,7 @@ def deployment_drive(
             thickness=options.panel_thickness, thickness_from="the run's --thickness"
         )
     if options.material is not None:
-        drive = drive.replace(material=parse_material(options.material))
+        drive = drive.replace(material=options.material)
     t0 = time.perf_counter()
     design = run_dir / "solutions" / f"{name}.fold"
     result = deploy_design(

@@ -27,7 +27,6 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import Fabrication
 from rigidfold.generate import GenerateOptions, Solution
 from rigidfold.generate.case import Case
-from rigidfold.material import parse_material
 from rigidfold.mechanism.path import FoldingPath
 from rigidfold.pipeline.built import deployment_drive, structure_check, thick_panels
 from rigidfold.rundir.schema import NOT_DEVELOPED, FitStatus, SolutionRecord
@@ -106,7 +105,7 @@ def check_solution(
         dof=dof,
         path=solution.path or path,
         support_face=options.support_face,
-        **_frame_material(options, settings.structure.thickness),
+        panel=options.frame_panel(settings),
         settings=settings,
     )
     fit = _fit(case.deviation(pattern.coords), settings)
@@ -148,15 +147,6 @@ def _fit(dz: np.ndarray, settings: Settings) -> dict:
         "status": (FitStatus.WITHIN if within else FitStatus.BEYOND).value,
         "message": f"max |z - target| {worst * 1e3:.4g} mm, bound dz {bound * 1e3:.4g} mm",
     }
-
-
-def _frame_material(options: GenerateOptions, thickness: float) -> dict:
-    """Step 9's frame of strips of the user's panels (``options.material``, of
-    ``options.panel_thickness`` or ``thickness``, the settings'); {} for the paper's tubes."""
-    if options.material is None:
-        return {}
-    t = options.panel_thickness or thickness
-    return {"material": parse_material(options.material), "thickness": t}
 
 
 def check_final(

@@ -48,7 +48,7 @@ class RunReport:
             "figures": [str(p) for p in self.figures],
             "final_design": None if final is None else final.name,
             "final_dof": self.run.summary.final_dof,
-            "N_lock": self.run.summary.n_lock,
+            "n_lock": self.run.summary.n_lock,
             "checks": {c.name: c.word for c in self.run.checks()},
             "seconds": self.seconds,
         }

@@ -54,6 +54,7 @@ from rigidfold.generate import (
     generate,
 )
 from rigidfold.generate.case import Case
+from rigidfold.generate.steps import past_time_limit
 from rigidfold.io import prepare_output_dir
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mesh import CreasePattern
@@ -93,12 +94,20 @@ def run(
     sinks: Iterable[Sink] = (),
     *,
     motion: bool = True,
+    started: float | None = None,
 ) -> RunResult:
     """Run the design ``case`` with ``options``, telling ``sinks`` as it goes; see the
     module's text. ValueError (one line) before anything runs for supports, actuators or
     loads the crease pattern lacks, and for as-built checks without a sink with a
-    ``run_dir`` to write their files into."""
-    return _Run(case, options, tuple(sinks), motion).go()
+    ``run_dir`` to write their files into.
+
+    ``started``: the time of ``time.monotonic()`` that ``options.time_limit`` T counts from
+    (default: now; the command line gives its process's start). The search stops at T,
+    naming the final design ends a grace after it, the final design's folding path a grace
+    and a half (a trace it cuts makes the motion ``cut``), and what is left (exports,
+    summary, report) has the rest of two graces: T + max(10 s, 5 % of T) with the defaults
+    (:func:`rigidfold.generate.steps.past_time_limit`)."""
+    return _Run(case, options, tuple(sinks), motion, started).go()
 
 
 def stopped(result: RunResult) -> RunResult:
@@ -119,9 +128,17 @@ class _Run:
     """The state of one run while it goes; :meth:`result` is its snapshot."""
 
     def __init__(
-        self, case: Case, options: GenerateOptions, sinks: tuple[Sink, ...], motion: bool
+        self,
+        case: Case,
+        options: GenerateOptions,
+        sinks: tuple[Sink, ...],
+        motion: bool,
+        started: float | None = None,
     ) -> None:
         check_built_options(case.pattern, options)
+        self.started = time.monotonic() if started is None else started
+        # the final design's path and motion end here, 1.5 graces after the time limit
+        self.deadline = past_time_limit(self.started, options.time_limit, case.settings, 1.5)
         self.run_dir: Path | None = next(
             (d for s in sinks if (d := getattr(s, "run_dir", None)) is not None), None
         )
@@ -177,6 +194,7 @@ class _Run:
                     on_attempt=self.on_attempt,
                     on_solution=self.on_solution,
                     on_retract=self.on_retract,
+                    started=self.started,
                 )
                 result = self.finish(self.generation)
             self.ended = result  # from here a signal does not make it an interrupted run
@@ -284,6 +302,7 @@ class _Run:
             dof=final.mechanism.dof,
             support_face=self.options.support_face,
             settings=self.case.settings,
+            deadline=self.deadline,
         )
         self.final_path_time = time.perf_counter() - t0
         return path

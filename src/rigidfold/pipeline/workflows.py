@@ -22,7 +22,7 @@ prints. ``rigidfold.cli`` only parses arguments, calls these functions and print
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,13 +38,13 @@ from rigidfold.exports import (
     EXPORT_FORMATS,
     Design,
     check_convention,
+    check_formats,
     export_design,
     export_paths,
-    parse_formats,
     read_design,
 )
 from rigidfold.fabricate import FabricateOptions, Fabrication, Panels, design_motion
-from rigidfold.generate.case import Case, parse_fixed, shape_summary
+from rigidfold.generate.case import Case, fixed_mask, shape_summary
 from rigidfold.io import (
     FoldData,
     prepare_output_dir,
@@ -53,18 +53,14 @@ from rigidfold.io import (
     write_fold,
     write_json,
 )
+from rigidfold.material import Panel
 from rigidfold.mechanism import Mechanism, analyze
-from rigidfold.optimize import OptimizeResult
+from rigidfold.optimize import OptimizeResult, SolverName
 from rigidfold.pipeline.report import RunReport as RunReport  # the command's, kept here
 from rigidfold.pipeline.report import report_run as report_run
 from rigidfold.pipeline.writer import write_checked_shape
 from rigidfold.rundir import clear_earlier_run, earlier_run
-from rigidfold.structure import (
-    Material,
-    StructureCheck,
-    StructureStatus,
-    parse_material,
-)
+from rigidfold.structure import StructureCheck, StructureStatus
 from rigidfold.structure.design import (
     STRUCTURE_FILES,
     StructureOptions,
@@ -196,8 +192,7 @@ def deform_file(
     out: str | os.PathLike,
     *,
     up: str = "z",
-    material: str | Material | None = None,
-    thickness: float | None = None,
+    panel: Panel | None = None,
     settings: Settings = DEFAULTS,
 ) -> ShapeCheck:
     """Steps 8-9 and the folding motion of a FOLD shape (read with ``up``):
@@ -205,17 +200,11 @@ def deform_file(
     frames, folded form and figures), ``OUT/<name>.svg`` and ``OUT/<name>_deform.json``
     (every figure and the load-step history).
 
-    material, thickness : Step 9's frame as strips of these panels
-    (:func:`rigidfold.deform.analysis.panel_section`; a preset's name or ``E,nu,density``,
-    metres); either given, the other defaults to ``Settings.structure.material`` /
-    ``structure_thickness``; neither: the paper's tubes."""
-    mat, t = None, None
-    if material is not None or thickness is not None:
-        mat = parse_material(settings.structure.material if material is None else material)
-        t = settings.structure.thickness if thickness is None else thickness
-        if isinstance(t, bool) or not (isinstance(t, int | float) and np.isfinite(t) and t > 0):
-            raise RigidfoldError(f"thickness must be a positive number of metres, got {t!r}")
-    return _check_file(path, out, deform=True, up=up, settings=settings, material=mat, thickness=t)
+    panel : Step 9's frame as strips of these panels
+    (:func:`rigidfold.deform.analysis.panel_section`); None: the paper's tubes."""
+    if panel is not None and not isinstance(panel, Panel):
+        raise RigidfoldError(f"panel must be a Panel or None, got {panel!r}")
+    return _check_file(path, out, deform=True, up=up, settings=settings, panel=panel)
 
 
 def _check_file(
@@ -225,8 +214,7 @@ def _check_file(
     deform: bool,
     up: str,
     settings: Settings,
-    material: Material | None = None,
-    thickness: float | None = None,
+    panel: Panel | None = None,
 ) -> ShapeCheck:
     """Read, check and write back a FOLD shape. The output FOLD is the input document with
     rigidfold's frames (in metres, ``frame_unit: "m"``, z up) and ``rigidfold:`` keys added:
@@ -244,8 +232,7 @@ def _check_file(
         data.pattern,
         run_deform=deform,
         run_motion=deform,
-        material=material,
-        thickness=thickness,
+        panel=panel,
         settings=settings,
     )
     written = write_checked_shape(
@@ -266,8 +253,12 @@ def _check_file(
             "E_Pa": settings.deformation.youngs_modulus,
             "nu": settings.deformation.poisson_ratio,
         }
-        if material is not None:
-            section = {"kind": "panel", "material": material.to_dict(), "thickness_m": thickness}
+        if panel is not None:
+            section = {
+                "kind": "panel",
+                "material": panel.material.to_dict(),
+                "thickness_m": panel.thickness,
+            }
         written.append(
             write_json(
                 out_dir / f"{stem}_deform.json", {**check.to_dict(), "frame_section": section}
@@ -298,11 +289,11 @@ def optimize_case(
     case: Case,
     out: str | os.PathLike,
     *,
-    fixed: str | None = None,
-    solver: str = "ipopt",
+    fixed: Sequence[int] = (),
+    solver: SolverName = SolverName.IPOPT,
     overwrite: bool = False,
 ) -> OptimizeOutput:
-    """Solve (6) once with the creases ``fixed`` ("I,J,...") fixed; write
+    """Solve (6) once with the creases ``fixed`` (indices into the pattern's edges) fixed; write
     ``OUT/solution.fold`` and ``OUT/summary.json`` whatever the outcome.
 
     Before any work, ValueError when one of the files would replace one of ``case.inputs``,
@@ -311,8 +302,8 @@ def optimize_case(
     refuse_replacing_inputs(case.inputs, [Path(out) / name for name in OPTIMIZE_FILES])
     out_dir = prepare_output_dir(out)
     clear_earlier_run(out_dir, overwrite=overwrite, inputs=case.inputs, names=OPTIMIZE_FILES)
-    mask = parse_fixed(fixed, case.pattern)
-    problem = case.problem(build_ipopt=solver == "ipopt")
+    mask = fixed_mask(fixed, case.pattern)
+    problem = case.problem(build_ipopt=solver == SolverName.IPOPT)
     result = problem.solve(fixed=mask, solver=solver)
     report = shape_summary(case, result, problem.build_time)
     fold = write_fold(
@@ -368,16 +359,16 @@ def export_file(
     path: str | os.PathLike,
     out: str | os.PathLike,
     *,
-    formats: str | tuple[str, ...] = EXPORT_FORMATS,
+    formats: Sequence[str] = EXPORT_FORMATS,
     convention: str = CONVENTIONS[0],
     up: str = "z",
     settings: Settings = DEFAULTS,
 ) -> DesignExport:
     """Export the design in a FOLD file (read with ``up``; its development diagram from its
     ``creasePattern`` frame, or computed: :func:`rigidfold.exports.read_design`) to
-    ``OUT/<name>.*`` in ``formats`` (:func:`rigidfold.exports.parse_formats`), the SVG cut
+    ``OUT/<name>.*`` in ``formats`` (:func:`rigidfold.exports.check_formats`), the SVG cut
     sheet in ``convention`` (:func:`rigidfold.exports.export_design`)."""
-    chosen = parse_formats(formats)
+    chosen = check_formats(formats)
     check_convention(convention)
     stem = Path(path).stem
     refuse_replacing_inputs([path], export_paths(out, chosen, name=stem))

@@ -6,17 +6,21 @@ values, ``object`` anything, a list ``[S]`` a list of S, a tuple a list of that 
 of those shapes, a :class:`Record` an object, :class:`Nullable` also null.
 :func:`check_shape` checks a value against one, so that a damaged file is a one-line error
 naming the file and the key; :func:`shape_of` makes the shape of a record's field from its
-type (:data:`rigidfold.rundir.schema.LOG_SHAPE`).
+type, :func:`record_shape` that of a whole record (a dataclass or a TypedDict) from its
+fields: :data:`rigidfold.rundir.schema.LOG_SHAPE` of an attempt, ``SUMMARY_SHAPE`` of
+summary.json.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
 import types
 import typing
 from dataclasses import dataclass
+from typing import Annotated
 
 from rigidfold.errors import RigidfoldError
 from rigidfold.outcomes import Outcome
@@ -131,17 +135,35 @@ def received(value) -> str:
     return text if len(text) <= 40 else text[:39] + "…"
 
 
+Finite = Annotated[float, float]
+"""The type of a field (or an item of one) that is a finite number, never null: of the shape
+``float`` (:func:`shape_of`), where a plain ``float`` may be null (a NaN is written as
+null). ``Annotated[T, shape]`` gives any type its shape this way."""
+
+
 def shape_of(hint: object) -> object:
     """The shape (see the module's text) of the JSON that a field of type ``hint`` is
     written as: an int, str or bool itself, an :class:`~rigidfold.outcomes.Outcome` enum
-    one of its values, a float a finite number or null (a NaN is written as null), a list
-    or a tuple of one kind a list of its shape, a dict an object, ``X | None`` also null;
-    another type anything."""
+    one of its values, a float a finite number or null (a NaN is written as null;
+    :data:`Finite`: never null), a list or a tuple of one kind a list of its shape, a tuple
+    of fixed length a list of that many items, a dict an object, a dataclass or a TypedDict
+    the object of its fields (:func:`record_shape`), ``X | None`` also null,
+    ``Annotated[X, shape]`` that shape, ``Annotated[dict | None, R]`` (R a TypedDict or a
+    dataclass: what is read of the dict) the object of R's fields, also null; another type
+    anything."""
+    if typing.get_origin(hint) is Annotated:
+        base, given = typing.get_args(hint)[:2]
+        if _is_record(given):  # the record's object for the base type's dict
+            record = record_shape(given)
+            return Nullable(record) if isinstance(shape_of(base), Nullable) else record
+        return given
     origin, args = typing.get_origin(hint), typing.get_args(hint)
     if origin in (typing.Union, types.UnionType):
         kinds = [a for a in args if a is not type(None)]
         inner = shape_of(kinds[0]) if len(kinds) == 1 else object
         return inner if isinstance(inner, Nullable) or inner is object else Nullable(inner)
+    if origin is tuple and args and Ellipsis not in args:
+        return tuple(shape_of(a) for a in args)
     if origin in (list, tuple) and args:
         return [shape_of(args[0])]
     if hint is float:
@@ -150,4 +172,36 @@ def shape_of(hint: object) -> object:
         return Record({})
     if hint in (int, str, bool) or (isinstance(hint, type) and issubclass(hint, Outcome)):
         return hint
+    if _is_record(hint):
+        return record_shape(typing.cast(type, hint))
     return object
+
+
+def _is_record(hint: object) -> bool:
+    """Whether ``hint`` is a dataclass or a TypedDict (a type, not an instance)."""
+    return isinstance(hint, type) and (typing.is_typeddict(hint) or dataclasses.is_dataclass(hint))
+
+
+def record_shape(record: type, *, null_is_default: bool = False) -> Record:
+    """The shape of the JSON object that ``record``, a dataclass or a TypedDict, is written
+    as: each field under its own name, of the shape of its type (:func:`shape_of`; say
+    ``Annotated[T, shape]`` for another); required: a dataclass's fields
+    without a default, a TypedDict's required keys. ``null_is_default``: a field with a
+    default may also be null (the record's reader takes the default for it)."""
+    hints = typing.get_type_hints(record, include_extras=True)
+    if typing.is_typeddict(record):
+        required = record.__required_keys__  # type: ignore[attr-defined]
+        return Record(
+            {k: shape_of(h) for k, h in hints.items()}, tuple(k for k in hints if k in required)
+        )
+    keys: dict = {}
+    needed: list[str] = []
+    missing = dataclasses.MISSING
+    for f in dataclasses.fields(record):
+        shape = shape_of(hints[f.name])
+        if f.default is missing and f.default_factory is missing:
+            needed.append(f.name)
+        elif null_is_default and not isinstance(shape, Nullable) and shape is not object:
+            shape = Nullable(shape)
+        keys[f.name] = shape
+    return Record(keys, tuple(needed))

@@ -19,7 +19,7 @@ import dataclasses
 import os
 import typing
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Annotated, Any, TypedDict
 
 import numpy as np
 
@@ -30,15 +30,24 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.fabricate import FabricationStatus
 from rigidfold.generate import Attempt, Generation, Stop
 from rigidfold.outcomes import Outcome
-from rigidfold.rundir.json_shapes import Nullable, Record, check_shape, received, shape_of
+from rigidfold.rundir.json_shapes import (
+    Finite,
+    Nullable,
+    Record,
+    check_shape,
+    received,
+    record_shape,
+)
 from rigidfold.structure import StructureStatus
 
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 """The version of the files of a run directory this rigidfold writes and reads: summary.json's
-``schema_version`` and the header line of log.jsonl (``{"schema_version": 4}``; 2: a
+``schema_version`` and the header line of log.jsonl (``{"schema_version": 5}``; 2: a
 solution's ``fit`` has its ``status``; 3: a solution's ``development`` may be
 :data:`NOT_COMPUTED`, the diagram drawn for the final design only; 4: a solution's ``drive``,
-``generate --deploy``). A run of another
+``generate --deploy``; 5: the counters under their :class:`RunSummary` names, ``n_lock``
+and ``mean_f_accepted`` where version 4 wrote ``N_lock`` and ``mean_F_accepted``). A run of
+another
 version (0: written before rigidfold recorded one) is refused (:func:`check_version`), not
 read through layers of old formats."""
 
@@ -73,151 +82,6 @@ NOT_DEVELOPED = {
 }
 """The ``development`` figures of a solution whose diagram was not drawn."""
 
-_NUMBERS = Nullable(float)
-SUMMARY_SHAPE = Record(
-    {
-        "stop": str,
-        "stop_reason": str,
-        "final_dof": Nullable(int),
-        "initial_dof": Nullable(int),
-        "N_reduce": Nullable(int),
-        "N_lock": Nullable(int),
-        "N_exceed": Nullable(int),
-        "N_path": Nullable(int),
-        "N_backtrack": Nullable(int),
-        "N_rigid": Nullable(int),
-        "lowest_dof": Nullable(int),
-        "dof_margin": Nullable(Record({"clear": Nullable(bool), "message": Nullable(str)})),
-        "deploy_check": Nullable(bool),
-        "final_step": Nullable(int),
-        "final_deploys": Nullable(bool),
-        "solutions": [str],
-        "per_solution": [
-            Record(
-                {
-                    "step": Nullable(int),
-                    "dof": Nullable(int),
-                    "time_s": Nullable(Record({})),
-                    "development": Nullable(
-                        Record(
-                            {
-                                "status": Nullable(str),
-                                "D": _NUMBERS,
-                                "flipped": Nullable(int),
-                                "overlaps": Nullable(int),
-                            }
-                        )
-                    ),
-                    "motion": Nullable(
-                        Record({"status": Nullable(str), "max_length_error": _NUMBERS})
-                    ),
-                    "deployability": Nullable(
-                        Record({"status": Nullable(str), "deploys": Nullable(bool)})
-                    ),
-                    "deformation": Nullable(
-                        Record(
-                            {
-                                "status": Nullable(str),
-                                "reached_plane": Nullable(bool),
-                                "max_dl_mm": _NUMBERS,
-                                "max_drho_fix_deg": _NUMBERS,
-                            }
-                        )
-                    ),
-                    "verdicts": Nullable(
-                        Record({"agreement": Nullable(str), "reason": Nullable(str)})
-                    ),
-                    "fit": Nullable(
-                        Record(
-                            {
-                                "max_abs_dz_m": _NUMBERS,
-                                "status": Nullable(str),
-                                "message": Nullable(str),
-                            }
-                        )
-                    ),
-                    "fabrication": Nullable(
-                        Record(
-                            {
-                                "status": Nullable(str),
-                                "message": Nullable(str),
-                                "thickness_m": _NUMBERS,
-                                "panels": Nullable(int),
-                                "min_gap_m": _NUMBERS,
-                                "trimming_loss": _NUMBERS,
-                                "closest": Nullable(
-                                    Record(
-                                        {
-                                            "panels": Nullable((int, int)),
-                                            "fraction": _NUMBERS,
-                                            "detail": Nullable(str),
-                                        }
-                                    )
-                                ),
-                                "solids": Nullable(str),
-                            }
-                        )
-                    ),
-                    "structure": Nullable(
-                        Record(
-                            {
-                                "status": Nullable(str),
-                                "message": Nullable(str),
-                                "max_displacement_m": _NUMBERS,
-                                "allowed_displacement_m": _NUMBERS,
-                                "frequencies_Hz": Nullable([float]),
-                                "figure": Nullable(str),
-                            }
-                        )
-                    ),
-                    "drive": Nullable(
-                        Record(
-                            {
-                                "status": Nullable(str),
-                                "message": Nullable(str),
-                                "files": Nullable([str]),
-                            }
-                        )
-                    ),
-                }
-            )
-        ],
-        "case": Record(
-            {
-                "surface": Nullable(
-                    Record(
-                        {
-                            "name": Nullable(str),
-                            "plan_box_m": Nullable((float, float)),
-                            "control_heights": Nullable([[float]]),
-                            "expression": Nullable(str),
-                        }
-                    )
-                ),
-                "F_tol": _NUMBERS,
-                "dz_m": _NUMBERS,
-            }
-        ),
-        "options": Nullable(Record({"target_dof": Nullable(int)})),
-        "verdict": Nullable(Record({"outcome": str, "message": str}, ("outcome", "message"))),
-        "target_surface": Nullable(str),
-        "n_solutions": Nullable(int),
-        "n_solves": Nullable(int),
-        "n_skipped": Nullable(int),
-        "mean_F_accepted": _NUMBERS,
-        "mean_F_all_solves": _NUMBERS,
-        "numerics": Nullable(Record({})),
-        "time_s": Nullable(Record({})),
-        "exports": Nullable([str]),
-    },
-    ("stop", "stop_reason", "final_dof", "N_lock", "solutions", "per_solution", "case"),
-)
-"""What the report reads of ``summary.json`` and the shape it must have (:func:`check_shape`):
-``int`` a whole number, ``float`` a finite number, ``str`` text, ``bool`` true or false, a
-list ``[S]`` a list of S, a tuple a list of that many items of those shapes, a
-:class:`Record` an object, :class:`Nullable` also null."""
-
-
 HISTORY_SHAPE = [
     Record(
         {k: float for k in ("load_factor", "mean_dl_mm", "max_dl_mm", "max_drho_fix_deg")},
@@ -237,22 +101,10 @@ DESIGN_SHAPE = Record(
 """What the report reads of rigidfold's keys in a solution file (see :data:`SUMMARY_SHAPE`)."""
 
 
-def _log_shape() -> Record:
-    """The shape of a line of ``log.jsonl``: each field of
-    :class:`rigidfold.generate.Attempt` (:func:`shape_of` its type), those without a default
-    required."""
-    hints = typing.get_type_hints(Attempt)
-    fields_ = dataclasses.fields(Attempt)
-    missing = dataclasses.MISSING
-    return Record(
-        {f.name: shape_of(hints[f.name]) for f in fields_},
-        tuple(f.name for f in fields_ if f.default is missing and f.default_factory is missing),
-    )
-
-
-LOG_SHAPE = _log_shape()
+LOG_SHAPE = record_shape(Attempt)
 """The shape of each attempt line of ``log.jsonl`` (see :data:`SUMMARY_SHAPE`), made from
-:class:`rigidfold.generate.Attempt`, which the line is read into."""
+:class:`rigidfold.generate.Attempt`, which the line is read into (:func:`record_shape`: each
+field's shape from its type, those without a default required)."""
 
 LOG_NAN_FIELDS = tuple(
     name for name, hint in typing.get_type_hints(Attempt).items() if hint is float
@@ -312,6 +164,99 @@ STAGES: dict[Stage, StageRule] = {
 """Every :class:`Stage`'s rule: the one place that says when a check of a solution passes."""
 
 
+class DevelopmentFigures(TypedDict, total=False):
+    """What is read of a solution's ``development``: Step 8's figures
+    (:meth:`rigidfold.develop.Development.to_dict`), or :data:`NOT_DEVELOPED`."""
+
+    status: str | None
+    D: float | None
+    flipped: int | None
+    overlaps: int | None
+
+
+class MotionFigures(TypedDict, total=False):
+    """What is read of a solution's ``motion`` (:meth:`rigidfold.deform.Motion.to_dict`)."""
+
+    status: str | None
+    max_length_error: float | None
+
+
+class DeployabilityFigures(TypedDict, total=False):
+    """What is read of a solution's ``deployability``, its folding path
+    (:meth:`rigidfold.mechanism.path.FoldingPath.to_dict`)."""
+
+    status: str | None
+    deploys: bool | None
+
+
+class DeformationFigures(TypedDict, total=False):
+    """What is read of a solution's ``deformation``, Step 9's figures
+    (:meth:`rigidfold.deform.DeformResult.to_dict`)."""
+
+    status: str | None
+    reached_plane: bool | None
+    mean_dl_mm: float | None
+    max_dl_mm: float | None
+    mean_drho_fix_deg: float | None
+    max_drho_fix_deg: float | None
+
+
+class VerdictsFigures(TypedDict, total=False):
+    """What is read of a solution's ``verdicts`` (:meth:`rigidfold.deform.Verdicts.to_dict`)."""
+
+    agreement: str | None
+    reason: str | None
+
+
+class FitFigures(TypedDict, total=False):
+    """What is read of a solution's ``fit`` to its target (:data:`Stage.FIT`)."""
+
+    max_abs_dz_m: float | None
+    status: str | None
+    message: str | None
+
+
+class ClosestPair(TypedDict, total=False):
+    """The closest pair of thick panels over the motion (``fabrication.closest``)."""
+
+    panels: tuple[int, int] | None
+    fraction: float | None
+    detail: str | None
+
+
+class FabricationFigures(TypedDict, total=False):
+    """What is read of a solution's ``fabrication``, its thick panels
+    (:func:`rigidfold.pipeline.built.thick_panels`)."""
+
+    status: str | None
+    message: str | None
+    thickness_m: float | None
+    panels: int | None
+    min_gap_m: float | None
+    trimming_loss: float | None
+    closest: ClosestPair | None
+    solids: str | None
+
+
+class StructureFigures(TypedDict, total=False):
+    """What is read of a solution's ``structure``, the check under load."""
+
+    status: str | None
+    message: str | None
+    max_displacement_m: float | None
+    allowed_displacement_m: float | None
+    frequencies_Hz: list[Finite] | None
+    figure: str | None
+
+
+class DriveFigures(TypedDict, total=False):
+    """What is read of a solution's ``drive``, the deployment drive (``generate --deploy``)."""
+
+    status: str | None
+    message: str | None
+    files: list[str] | None
+
+
 @dataclass(frozen=True)
 class SolutionRecord:
     """The checks of one accepted solution: an entry of ``summary.json``'s ``per_solution``.
@@ -321,21 +266,23 @@ class SolutionRecord:
     development, motion, deformation, verdicts : each stage's figures (its ``to_dict()``;
     None where it did not run); deployability : the folding path's
     (:meth:`rigidfold.mechanism.path.FoldingPath.to_dict`), None where it was not traced;
-    time_s : seconds per stage.
+    time_s : seconds per stage. The keys of a stage's figures that are read are declared
+    once, in its TypedDict (``Annotated[dict | None, DevelopmentFigures]``, ...), which
+    makes their shape (:data:`SOLUTION_SHAPE`).
     """
 
-    step: int | None
-    dof: int | None
-    fit: dict | None = None
-    development: dict | None = None
-    deformation: dict | None = None
-    motion: dict | None = None
-    verdicts: dict | None = None
+    step: int | None = None
+    dof: int | None = None
+    fit: Annotated[dict | None, FitFigures] = None
+    development: Annotated[dict | None, DevelopmentFigures] = None
+    deformation: Annotated[dict | None, DeformationFigures] = None
+    motion: Annotated[dict | None, MotionFigures] = None
+    verdicts: Annotated[dict | None, VerdictsFigures] = None
     time_s: dict = field(default_factory=dict)
-    deployability: dict | None = None
-    fabrication: dict | None = None
-    structure: dict | None = None
-    drive: dict | None = None
+    deployability: Annotated[dict | None, DeployabilityFigures] = None
+    fabrication: Annotated[dict | None, FabricationFigures] = None
+    structure: Annotated[dict | None, StructureFigures] = None
+    drive: Annotated[dict | None, DriveFigures] = None
 
     @classmethod
     def from_check(
@@ -365,10 +312,9 @@ class SolutionRecord:
     def from_dict(cls, data: dict) -> SolutionRecord:
         """A record of ``summary.json`` (checked with :data:`SUMMARY_SHAPE`); keys of
         other versions are ignored, missing ones are None."""
-        names = {f.name for f in fields(cls)}
-        known = {k: v for k, v in data.items() if k in names}
-        known["time_s"] = dict(known.get("time_s") or {})
-        return cls(**{"step": None, "dof": None, **known})
+        known = _known_fields(cls, data)
+        known["time_s"] = dict(known.get("time_s", {}))
+        return cls(**known)
 
     def to_dict(self, *, history: bool = True) -> dict:
         """The record as JSON values; ``history=False`` leaves out the large-deformation
@@ -418,6 +364,11 @@ class SolutionRecord:
     def failed_stages(self) -> list[Stage]:
         """The stages that ran on this solution and failed, in :class:`Stage` order."""
         return [stage for stage in Stage if self.passed(stage) is False]
+
+
+SOLUTION_SHAPE = record_shape(SolutionRecord, null_is_default=True)
+"""The shape of an entry of summary.json's ``per_solution`` (:data:`SUMMARY_SHAPE`), made
+from :class:`SolutionRecord`: a null field is read as its default."""
 
 
 def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dict:
@@ -474,32 +425,71 @@ def aggregate(records: list[SolutionRecord] | tuple[SolutionRecord, ...]) -> dic
     }
 
 
-_KEYS = {
-    "n_reduce": "N_reduce",
-    "n_lock": "N_lock",
-    "n_exceed": "N_exceed",
-    "n_path": "N_path",
-    "n_backtrack": "N_backtrack",
-    "n_rigid": "N_rigid",
-    "mean_f_accepted": "mean_F_accepted",
-    "mean_f_all_solves": "mean_F_all_solves",
-}
-"""The keys of ``summary.json`` that are not their :class:`RunSummary` field's name."""
+def _known_fields(record: type, data: dict) -> dict:
+    """The fields of the dataclass ``record`` that ``data`` (JSON checked with its shape)
+    holds, a null one of a field with a default read as that default (:func:`record_shape`
+    with ``null_is_default``); keys of other versions are ignored."""
+    out = {}
+    for f in fields(record):
+        if f.name not in data:
+            continue
+        value = data[f.name]
+        if value is None and f.default is not dataclasses.MISSING:
+            value = f.default
+        elif value is None and f.default_factory is not dataclasses.MISSING:
+            value = f.default_factory()
+        out[f.name] = value
+    return out
 
 
-def _key(name: str) -> str:
-    """The key of ``summary.json`` of the :class:`RunSummary` field ``name``."""
-    return _KEYS.get(name, name)
+class MarginFigures(TypedDict, total=False):
+    """What is read of summary.json's ``dof_margin``
+    (:meth:`rigidfold.mechanism.margin.DofMargin.to_dict`)."""
+
+    clear: bool | None
+    message: str | None
+
+
+class SurfaceMeta(TypedDict, total=False):
+    """What is read of the case's ``surface`` (its target surface, rebuilt by the report)."""
+
+    name: str | None
+    plan_box_m: tuple[Finite, Finite] | None
+    control_heights: list[list[Finite]] | None
+    expression: str | None
+
+
+class CaseMeta(TypedDict, total=False):
+    """What is read of summary.json's ``case`` (:meth:`rigidfold.generate.case.Case.metadata`)."""
+
+    surface: SurfaceMeta | None
+    F_tol: float | None
+    dz_m: float | None
+
+
+class OptionsMeta(TypedDict, total=False):
+    """What is read of summary.json's ``options``."""
+
+    target_dof: int | None
+
+
+class VerdictRecord(TypedDict):
+    """summary.json's ``verdict`` (:meth:`rigidfold.pipeline.verdict.RunVerdict.to_dict`)."""
+
+    outcome: str
+    message: str
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class RunSummary:
     """``summary.json``: made by the run writer (:meth:`from_run`), written by
     :meth:`to_dict`, read back by :meth:`from_dict` (checked with :data:`SUMMARY_SHAPE`
-    first). Its fields in the order of the file, each under its own name but those in
-    ``_KEYS`` (``n_lock``: ``N_lock``); the file's ``schema_version``
-    (:data:`SCHEMA_VERSION`) and the run-wide figures (:func:`aggregate` of
-    ``per_solution``) are written, not held.
+    first). Its fields in the order of the file, each under its own name (the name of
+    :meth:`rigidfold.generate.Generation.to_dict`'s key and of the study's column,
+    :class:`rigidfold.study.RunRow`); the file's ``schema_version`` (:data:`SCHEMA_VERSION`)
+    and the run-wide figures (:func:`aggregate` of ``per_solution``) are written, not held.
+    The fields without a default (``stop``, ``stop_reason``, ``final_dof``, ``n_lock``,
+    ``per_solution``, ``case``, ``solutions``) are the keys a summary must have.
 
     stop, stop_reason : how the run ended (:class:`rigidfold.generate.Stop` value and words);
     initial_dof, final_dof, lowest_dof, n_reduce, n_lock, n_exceed, n_path, n_backtrack,
@@ -520,10 +510,10 @@ class RunSummary:
     stop: str
     stop_reason: str
     initial_dof: int | None = None
-    final_dof: int | None = None
+    final_dof: int | None
     lowest_dof: int | None = None
     n_reduce: int | None = None
-    n_lock: int | None = None
+    n_lock: int | None
     n_exceed: int | None = None
     n_path: int | None = None
     n_backtrack: int | None = None
@@ -531,7 +521,7 @@ class RunSummary:
     deploy_check: bool = False
     final_step: int | None = None
     final_deploys: bool | None = None
-    dof_margin: dict | None = None
+    dof_margin: Annotated[dict | None, MarginFigures] = None
     n_solutions: int | None = None
     n_solves: int | None = None
     n_skipped: int | None = None
@@ -539,11 +529,11 @@ class RunSummary:
     mean_f_all_solves: float | None = None
     numerics: dict | None = None
     time_s: dict = field(default_factory=dict)
-    per_solution: tuple[SolutionRecord, ...] = ()
-    options: dict = field(default_factory=dict)
-    case: dict = field(default_factory=dict)
-    solutions: tuple[str, ...] = ()
-    verdict: dict | None = None
+    per_solution: Annotated[tuple[SolutionRecord, ...], [SOLUTION_SHAPE]]
+    options: Annotated[dict, OptionsMeta] = field(default_factory=dict)
+    case: Annotated[dict, CaseMeta]
+    solutions: tuple[str, ...]
+    verdict: Annotated[dict | None, VerdictRecord] = None
     exports: tuple[str, ...] = ()
     target_surface: str | None = None
 
@@ -563,7 +553,7 @@ class RunSummary:
         produced["time_s"] = produced["time_s"] | stage_times
         names = [f.name for f in fields(cls)]
         return cls(
-            **{n: produced[_key(n)] for n in names if _key(n) in produced},
+            **{n: produced[n] for n in names if n in produced},
             per_solution=tuple(records),
             **given,
         )
@@ -580,7 +570,7 @@ class RunSummary:
                 value = [r.to_dict(history=False) for r in self.per_solution]
             elif isinstance(value, tuple):
                 value = list(value)
-            out[_key(f.name)] = value
+            out[f.name] = value
         return out
 
     @classmethod
@@ -598,16 +588,13 @@ class RunSummary:
             )
         check_version(data.get("schema_version"), file)  # a summary made before versions
         check_shape(data, SUMMARY_SHAPE, file)
-        known = {f.name: data[_key(f.name)] for f in fields(cls) if _key(f.name) in data}
+        known = _known_fields(cls, data)
         return cls(
             **known
             | {
-                "deploy_check": bool(data.get("deploy_check")),
-                "time_s": data.get("time_s") or {},
                 "per_solution": tuple(SolutionRecord.from_dict(r) for r in data["per_solution"]),
-                "options": data.get("options") or {},
-                "solutions": tuple(data["solutions"]),
-                "exports": tuple(data.get("exports") or ()),
+                "solutions": tuple(known["solutions"]),
+                "exports": tuple(known.get("exports", ())),
             }
         )
 
@@ -618,3 +605,11 @@ class RunSummary:
     @property
     def running(self) -> bool:
         return self.stop == Stop.RUNNING
+
+
+SUMMARY_SHAPE = record_shape(RunSummary, null_is_default=True)
+"""What the readers rely on of ``summary.json`` and the shape it must have
+(:func:`check_shape`), made from :class:`RunSummary` (:func:`record_shape`): each field under
+its name, of the shape of its type (a solution's stage figures and the case's keys: of their
+TypedDicts, :class:`DevelopmentFigures`, ..., :class:`CaseMeta`), the fields without a
+default required, the others also null (read as their default)."""

@@ -9,23 +9,23 @@ first order is not enough: prestress stability, or a finite mechanism),
 hinges), :mod:`~rigidfold.structure.loads` (self-weight, snow, wind, point loads),
 :mod:`~rigidfold.structure.analysis` (static and eigen analysis in OpenSees),
 :mod:`~rigidfold.structure.check` (the check and its verdict),
-:mod:`~rigidfold.structure.choices` (the typed supports and limit of the options),
+:mod:`~rigidfold.structure.choices` (the typed supports and indices of the options),
 :mod:`~rigidfold.structure.design` (the options, :class:`StructureOptions`, the check
 from them, and its files) and
 :mod:`~rigidfold.structure.figure` (the deflected shape). OpenSees and matplotlib are
 imported only when an analysis runs or a figure is drawn.
 """
 
-from rigidfold.material import MATERIALS, Material, parse_material, presets_help
+from rigidfold.material import MATERIALS, Material, presets_help
 from rigidfold.mechanism.second_order import SecondOrder, Stability, second_order
 from rigidfold.structure.check import (
     StructureCheck,
     StructureStatus,
     check_inputs,
+    check_limit,
     check_structure,
-    parse_limit,
 )
-from rigidfold.structure.choices import Auto, Limit, Pins, Service, SupportSpec, parse_supports
+from rigidfold.structure.choices import Auto, Candidates, Pins, Service, SupportSpec
 from rigidfold.structure.design import (
     STRUCTURE_FILES,
     StructureOptions,
@@ -40,7 +40,6 @@ from rigidfold.structure.loads import (
     Pressure,
     SelfWeight,
     Uniform,
-    parse_load,
 )
 from rigidfold.structure.supports import (
     CANDIDATE_FORMS,
@@ -49,7 +48,7 @@ from rigidfold.structure.supports import (
     Supports,
     auto_supports,
     check_supports,
-    parse_indices,
+    index_array,
     support_candidates,
 )
 
@@ -59,7 +58,7 @@ __all__ = [
     "MATERIALS",
     "STRUCTURE_FILES",
     "Auto",
-    "Limit",
+    "Candidates",
     "Load",
     "Material",
     "Pins",
@@ -80,14 +79,11 @@ __all__ = [
     "auto_supports",
     "check_design",
     "check_inputs",
+    "check_limit",
     "check_structure",
     "check_supports",
     "design_supports",
-    "parse_indices",
-    "parse_limit",
-    "parse_load",
-    "parse_material",
-    "parse_supports",
+    "index_array",
     "presets_help",
     "second_order",
     "support_candidates",

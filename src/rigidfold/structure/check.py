@@ -12,7 +12,6 @@ is twice the largest plan distance from a support to a vertex (the cantilever co
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
@@ -46,19 +45,18 @@ class StructureStatus(Outcome):
     NOT_CONVERGED = "not_converged", "the static analysis did not carry the whole load"
 
 
-def parse_limit(text: str | float) -> float:
-    """``"L/250"`` (or ``250``) as the divisor 250.0; ValueError naming what was received."""
-    if isinstance(text, int | float) and not isinstance(text, bool):
-        value = float(text)
-    else:
-        match = re.fullmatch(r"\s*(?:[lL]\s*/\s*)?([0-9.eE+-]+)\s*", str(text))
-        try:
-            value = float(match.group(1)) if match else float("nan")
-        except ValueError:
-            value = float("nan")
+def check_limit(divisor: object) -> float:
+    """The deflection limit's divisor (span / ``divisor``: 250.0 for ``L/250``) as a float;
+    ValueError naming what was received for one that is not a finite number > 0."""
+    value = (
+        float(divisor)
+        if isinstance(divisor, int | float | np.integer | np.floating)
+        and not isinstance(divisor, bool)
+        else float("nan")
+    )
     if not (np.isfinite(value) and value > 0):
         raise RigidfoldError(
-            f"the deflection limit must be L/N with N > 0 (e.g. L/250), got {text!r}"
+            f"the deflection limit must be L/N with N > 0 (e.g. L/250), got {divisor!r}"
         )
     return value
 

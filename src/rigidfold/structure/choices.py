@@ -1,25 +1,28 @@
-"""The typed values of the structure check's options that the command line gives as text:
-the supports (:data:`SupportSpec`: :class:`Auto`, :class:`Service` or :class:`Pins`) and the
-deflection limit (:class:`Limit`); the loads are :data:`rigidfold.structure.loads.Load`.
+"""The typed values of the structure check's options: the supports (:data:`SupportSpec`:
+:class:`Auto`, :class:`Service` or :class:`Pins`), the vertices ``auto`` may choose
+(:data:`Candidates`) and lists of indices (:func:`index_tuple`); the loads are
+:data:`rigidfold.structure.loads.Load`.
 
-:func:`parse_supports` and :meth:`Limit.parse` read ``--supports`` and ``--limit`` once
-(ValueError, one line, naming what was received); each value's ``text`` gives the option
-back.
+The command line's texts (``--supports auto``, ``--clamped 0,6``) are read into them by
+:mod:`rigidfold.cli.structure_specs`; each value's ``text`` gives the option back. Here they
+are only checked for their types (ValueError, one line, naming what was received); the
+indices against a design by :func:`rigidfold.structure.supports.index_array`.
 """
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
 from rigidfold.errors import RigidfoldError
-from rigidfold.structure.check import parse_limit
-from rigidfold.structure.supports import index_list
 
 CHOSEN_SUPPORTS = ("auto", "service")
 """The words ``--supports`` takes besides a list of vertices."""
+
+CANDIDATE_WORDS = ("boundary", "ground")
+"""The words ``--support-candidates`` takes besides a list of vertices."""
 
 
 @dataclass(frozen=True)
@@ -69,46 +72,33 @@ SupportSpec = Auto | Service | Pins
 
 SUPPORT_TYPES = (Auto, Service, Pins)
 
+Candidates = Literal["boundary", "ground"] | tuple[int, ...] | None
+"""The vertices ``auto`` may choose: None or ``"boundary"`` (every boundary vertex),
+``"ground"`` (the boundary vertices at the lowest height) or the vertices' indices."""
 
-def parse_supports(text: str) -> SupportSpec:
-    """``auto``, ``service`` or ``V,V,...`` (``""``: no pins) as its typed value; ValueError
-    (one line, with the closest word for a misspelling) for anything else."""
-    if not isinstance(text, str):
+
+def index_tuple(values: object, what: str) -> tuple[int, ...]:
+    """``values``, a sequence of integers (indices, not yet checked against a design), as a
+    tuple of ints; ValueError naming ``what`` and the value for anything else."""
+    if isinstance(values, str | bytes) or not isinstance(values, tuple | list | np.ndarray):
+        raise RigidfoldError(f"{what} must be a tuple of integer indices, got {values!r}")
+    if not all(isinstance(v, int | np.integer) and not isinstance(v, bool) for v in values):
+        raise RigidfoldError(f"{what} must be integer indices, got {values!r}")
+    return tuple(int(v) for v in values)
+
+
+def check_candidates(value: object) -> Candidates:
+    """``value`` as :data:`Candidates`; ValueError naming it for anything else."""
+    if value is None or value in CANDIDATE_WORDS:
+        return value  # type: ignore[return-value]
+    if isinstance(value, str):
         raise RigidfoldError(
-            f"supports must be auto, service or comma-separated vertex indices, got {text!r}"
+            f"support candidates must be {' or '.join(CANDIDATE_WORDS)} or a tuple of vertex "
+            f"indices, got {value!r}"
         )
-    word = text.strip().lower()
-    if word == "auto":
-        return Auto()
-    if word == "service":
-        return Service()
-    if any(c.isalpha() for c in text):
-        close = difflib.get_close_matches(word, CHOSEN_SUPPORTS, n=1)
-        raise RigidfoldError(
-            "supports must be auto, service or comma-separated vertex indices, got "
-            f"{text!r}" + (f" (did you mean {close[0]}?)" if close else "")
-        )
-    values = index_list(text, "supports")
-    bad = [v for v in values if v < 0]
-    if bad:
-        raise RigidfoldError(f"supports: {bad[0]} is not a vertex index (got {text!r})")
-    return Pins(tuple(values))
+    return index_tuple(value, "support candidates")
 
 
-@dataclass(frozen=True)
-class Limit:
-    """The serviceability limit: the largest displacement at most span / ``divisor``."""
-
-    divisor: float
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "divisor", parse_limit(self.divisor))
-
-    @classmethod
-    def parse(cls, text: str | float) -> Limit:
-        """``"L/250"`` (or ``250``); ValueError naming what was received."""
-        return cls(parse_limit(text))
-
-    @property
-    def text(self) -> str:
-        return f"L/{self.divisor:g}"
+def indices_text(values: tuple[int, ...]) -> str:
+    """``(3, 7, 12)`` as the command line gives it, ``"3,7,12"`` (``""``: none)."""
+    return ",".join(map(str, values))

@@ -1,10 +1,11 @@
 """The structure check of a design from its options, and its files.
 
 :class:`StructureOptions` holds the options of ``rigidfold structure`` (which ``rigidfold
-generate --structure`` shares), typed and checked once when made; the command line's texts
-(``--supports auto``, ``--load uniform=0.5kPa``, ``--limit L/250``) are read once by
-:meth:`StructureOptions.from_strings` into :mod:`rigidfold.structure.choices` and
-:mod:`rigidfold.structure.loads` values. :func:`plan_design` reads them against a design:
+generate --structure`` shares), typed and checked once when made: the supports and indices
+:mod:`rigidfold.structure.choices` values, the loads :mod:`rigidfold.structure.loads` values,
+the material a :class:`~rigidfold.material.Material`, lengths in metres. The command line's
+texts (``--supports auto``, ``--load uniform=0.5kPa``, ``--limit L/250``) are read into them
+by :mod:`rigidfold.cli.structure_specs`. :func:`plan_design` reads them against a design:
 it chooses or checks the supports (a :class:`DesignPlan`), whose ``check`` runs
 :func:`rigidfold.structure.check.check_structure` (:func:`check_design` does both);
 :func:`write_structure` writes ``structure.json`` and ``structure.png``
@@ -16,7 +17,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -25,32 +26,42 @@ import numpy as np
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
-from rigidfold.io.files import jsonable, parse_json, write_together
-from rigidfold.material import Material, parse_material, presets_help
+from rigidfold.io.files import jsonable, write_together
+from rigidfold.material import Material, material_named, presets_help
 from rigidfold.mesh import CreasePattern
 from rigidfold.structure.check import (
     StructureCheck,
     check_inputs,
+    check_limit,
     check_numbers,
     check_structure,
 )
 from rigidfold.structure.choices import (
     SUPPORT_TYPES,
     Auto,
-    Limit,
+    Candidates,
     Pins,
     Service,
     SupportSpec,
-    parse_supports,
+    check_candidates,
+    index_tuple,
+    indices_text,
 )
-from rigidfold.structure.loads import LOAD_TYPES, Load, SelfWeight, check_loads, parse_load
+from rigidfold.structure.loads import (
+    LOAD_TYPES,
+    Load,
+    Point,
+    Pressure,
+    SelfWeight,
+    Uniform,
+    check_loads,
+)
 from rigidfold.structure.supports import (
     Rigidity,
     Supports,
     auto_supports,
     check_supports,
-    index_list,
-    parse_indices,
+    index_array,
     support_candidates,
 )
 
@@ -82,26 +93,26 @@ def design_supports(
     pattern: CreasePattern,
     supports: SupportSpec = Auto(),  # noqa: B008 (frozen)
     *,
-    candidates: str | None = None,
-    clamped: str = "",
-    actuators: str = "",
+    candidates: Candidates = None,
+    clamped: tuple[int, ...] = (),
+    actuators: tuple[int, ...] = (),
     settings: Settings = DEFAULTS,
 ) -> tuple[Rigidity, np.ndarray | None]:
     """(the supports' first-order rigidity, the candidates they were chosen from or None
     where they were given): ``supports`` :class:`Auto` (the fewest pinned ``candidates``:
-    ``"boundary"``, ``"ground"`` or ``"V,V,..."``; :class:`Service` starts from the same
+    :data:`~rigidfold.structure.choices.Candidates`; :class:`Service` starts from the same
     set) or :class:`Pins`, with ``clamped`` vertices and ``actuators`` (free creases held).
     ValueError (one line) for an index the design lacks."""
     V = pattern.n_vertices
-    clamp = parse_indices(clamped, V, "clamped vertices")
-    held = parse_indices(actuators, pattern.n_edges, "actuators")
+    clamp = index_array(clamped, V, "clamped vertices")
+    held = index_array(actuators, pattern.n_edges, "actuators")
     if isinstance(supports, Auto | Service):
         pool = support_candidates(pattern, candidates, settings)
         rigidity = auto_supports(pattern, pool, clamped=clamp, actuated=held, settings=settings)
         return rigidity, pool
     if not isinstance(supports, Pins):
         raise RigidfoldError(f"supports must be Auto, Service or Pins, got {supports!r}")
-    pins = parse_indices(supports.text, V, "supports")
+    pins = index_array(supports.vertices, V, "supports")
     if not len(pins) and not len(clamp):
         raise RigidfoldError("give --supports V,V,..., auto or service, or --clamped vertices")
     return check_supports(pattern, Supports(pins, clamp, held), settings), None
@@ -186,34 +197,6 @@ class DesignPlan:
             self.steps(words)
 
 
-def check_options(
-    *,
-    material: str | Material = DEFAULTS.structure.material,
-    loads: tuple[Load, ...] = (),
-    limit: Limit = Limit(DEFAULTS.structure.limit),  # noqa: B008 (frozen)
-    modes: int = DEFAULTS.structure.modes,
-) -> tuple[Material, tuple[Load, ...], float]:
-    """(material, loads, limit divisor) of the options; ValueError (one line) for any that
-    is not valid, before the design is read."""
-    mat = parse_material(material)
-    if not isinstance(limit, Limit):
-        raise RigidfoldError(f"limit must be a Limit (Limit.parse('L/250')), got {limit!r}")
-    if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
-        raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
-    return mat, tuple(loads), limit.divisor
-
-
-_TEXT_FIELDS = ("supports", "loads", "limit")
-"""The fields the command line gives as text (:meth:`StructureOptions.from_strings`)."""
-
-
-def _thickness(text: str) -> float:
-    """``--thickness``: a length in metres, or with a unit (``18mm``)."""
-    from rigidfold.fabricate.build import parse_length
-
-    return parse_length(text, "thickness")
-
-
 _S = DEFAULTS.structure
 
 
@@ -224,30 +207,36 @@ class StructureOptions:
 
     Each field is made by :func:`rigidfold.flags.option` with what it means, also the help of
     its flag (:func:`rigidfold.cli.parser.add_options`: ``rigidfold structure``'s, and
-    ``generate``'s prefixed "--structure: "): a new option is a new field here. ``supports``
-    is :class:`Auto`, :class:`Service` or :class:`Pins`; ``loads`` a tuple of
+    ``generate``'s prefixed "--structure: "): a new option is a new field here. ``thickness``
+    in metres; ``material`` a :class:`~rigidfold.material.Material`; ``supports`` is
+    :class:`Auto`, :class:`Service` or :class:`Pins`; ``candidates`` a
+    :data:`~rigidfold.structure.choices.Candidates` (None is ``"boundary"``); ``clamped``
+    and ``actuators`` tuples of indices; ``loads`` a tuple of
     :data:`~rigidfold.structure.loads.Load` terms (:class:`Uniform`, :class:`Pressure`,
     :class:`Point`; a :class:`SelfWeight` among them is ``self_weight``); ``limit`` a
-    :class:`Limit`; ``candidates`` None is ``"boundary"``; ``material`` a preset name
-    (:data:`~rigidfold.structure.MATERIALS`) or ``"E,nu,density"``.
+    :class:`Limit`; ``candidates`` None is ``"boundary"``; ``material`` a
+    :class:`~rigidfold.material.Material` (the command line: a preset of
+    :data:`~rigidfold.structure.MATERIALS` or ``"E,nu,density"``).
 
-    :meth:`from_strings` reads the command line's texts (``"auto"``, ``"uniform=0.5kPa"``,
-    ``"L/250"``). Defaults from ``Settings.structure``. Every value is checked when the
-    options are made (ValueError, one line, naming what was received); the indices against
-    a design by :meth:`check_indices` and :func:`plan_design`.
+    The command line's texts are read by :mod:`rigidfold.cli.structure_specs`. Defaults
+    from ``Settings.structure``. Every value is checked when the options are made
+    (ValueError, one line, naming what was received); the indices against a design by
+    :meth:`check_indices` and :func:`plan_design`.
     """
 
     thickness: float = option(
         _S.thickness,
         "panel thickness in metres, or with a unit: 18mm, 1.8cm",
-        parse=_thickness,
+        parse="thickness",
         metavar="T",
     )
-    material: str = option(
-        _S.material,
+    material: Material = option(  # noqa: RUF009 (frozen)
+        material_named(_S.material),
         f"the panels' material: a preset ({presets_help()}) or E,nu,density in SI units (Pa, "
         "-, kg/m^3), e.g. 10e9,0.3,700",
+        parse="material",
         metavar="NAME|E,nu,density",
+        shown=_S.material,
     )
     supports: SupportSpec = option(  # noqa: RUF009 (frozen)
         Auto(),
@@ -260,7 +249,7 @@ class StructureOptions:
         metavar="V,V,...|auto|service",
         shown=Auto().text,
     )
-    candidates: str | None = option(
+    candidates: Candidates = option(  # noqa: RUF009 (a field)
         None,
         "the vertices auto may choose: every boundary vertex, the boundary vertices at the "
         f"lowest height (within {_S.ground_tol:g} m), or a list",
@@ -268,14 +257,14 @@ class StructureOptions:
         metavar="boundary|ground|V,V,...",
         shown="boundary",
     )
-    clamped: str = option(
-        "",
+    clamped: tuple[int, ...] = option(
+        (),
         "clamped vertices: translations and the rotations of the panels there held",
         metavar="V,V,...",
         shown="none",
     )
-    actuators: str = option(
-        "",
+    actuators: tuple[int, ...] = option(
+        (),
         "free creases (indices into the design's edges_vertices) held at their angle by "
         "actuators: supports of a hinge",
         metavar="I,J,...",
@@ -302,12 +291,12 @@ class StructureOptions:
     self_weight: bool = option(
         True, "the panels' weight (density x g x thickness)", switch="leave out"
     )
-    limit: Limit = option(  # noqa: RUF009 (frozen)
-        Limit(_S.limit),
+    limit: float = option(
+        _S.limit,
         "serviceability: the largest displacement may be at most the span over N; the span is "
         "the largest plan distance between supports (twice the reach of a cantilever)",
         metavar="L/N",
-        shown=Limit(_S.limit).text,
+        shown=f"L/{_S.limit:g}",
     )
     nonlinear: bool = option(
         False,
@@ -326,76 +315,49 @@ class StructureOptions:
     )
 
     def __post_init__(self) -> None:
-        if not isinstance(self.material, str):
+        if not isinstance(self.material, Material):
             raise RigidfoldError(
-                f"material must be a preset name or E,nu,density, got {self.material!r}"
+                f"material must be a Material (rigidfold.material.MATERIALS), got {self.material!r}"
             )
         if not isinstance(self.supports, SUPPORT_TYPES):
             raise RigidfoldError(
-                "supports must be Auto(), Service() or Pins(...) (from_strings reads "
-                f"'auto', 'service', 'V,V,...'), got {self.supports!r}"
+                f"supports must be Auto(), Service() or Pins(...), got {self.supports!r}"
             )
         if isinstance(self.loads, str) or not isinstance(self.loads, tuple | list):
             raise RigidfoldError(f"loads must be a tuple of loads, got {self.loads!r}")
         bad = [x for x in self.loads if not isinstance(x, LOAD_TYPES)]
         if bad:
             raise RigidfoldError(
-                "loads must be Uniform, Pressure, Point or SelfWeight (from_strings reads "
-                f"'uniform=0.5kPa'), got {bad[0]!r}"
+                f"loads must be Uniform, Pressure, Point or SelfWeight, got {bad[0]!r}"
             )
         if any(isinstance(x, SelfWeight) for x in self.loads):
             object.__setattr__(self, "self_weight", True)
         object.__setattr__(
             self, "loads", tuple(x for x in self.loads if not isinstance(x, SelfWeight))
         )
-        mat, parsed, _ = check_options(
-            material=self.material, loads=self.loads, limit=self.limit, modes=self.modes
-        )
+        object.__setattr__(self, "limit", check_limit(self.limit))
+        modes = self.modes
+        if isinstance(modes, bool) or not isinstance(modes, int) or modes < 0:
+            raise RigidfoldError(f"modes must be an integer >= 0, got {modes!r}")
         check_numbers(
             thickness=self.thickness,
             hinge_stiffness=self.hinge_stiffness,
-            loads=parsed,
-            material=mat,
+            loads=self.loads,
+            material=self.material,
         )
         object.__setattr__(self, "thickness", float(self.thickness))
         object.__setattr__(self, "hinge_stiffness", float(self.hinge_stiffness))
-        clamped = index_list(self.clamped, "clamped vertices")
+        clamped = index_tuple(self.clamped, "clamped vertices")
+        object.__setattr__(self, "clamped", clamped)
         if isinstance(self.supports, Pins) and not self.supports.vertices and not clamped:
             raise RigidfoldError("give --supports V,V,..., auto or service, or --clamped vertices")
-        candidates = self.candidates
-        if candidates is not None and (
-            not isinstance(candidates, str)
-            or candidates.strip().lower() not in ("boundary", "ground")
-        ):
-            index_list(candidates, "support candidates")
-        index_list(self.actuators, "actuators")
+        object.__setattr__(self, "candidates", check_candidates(self.candidates))
+        object.__setattr__(self, "actuators", index_tuple(self.actuators, "actuators"))
         if not isinstance(self.thickness_from, str):
             raise RigidfoldError(f"thickness_from must be text, got {self.thickness_from!r}")
         for name in ("self_weight", "nonlinear"):
             if not isinstance(getattr(self, name), bool):
                 raise RigidfoldError(f"{name} must be true or false, got {getattr(self, name)!r}")
-
-    @classmethod
-    def from_strings(
-        cls,
-        *,
-        supports: str = "auto",
-        loads: tuple[str, ...] | list[str] = (),
-        limit: str | float = DEFAULTS.structure.limit,
-        **others,
-    ) -> StructureOptions:
-        """The options of the command line's texts: ``supports`` ``"auto"``, ``"service"`` or
-        ``"V,V,..."``; ``loads`` ``--load`` texts (:func:`~rigidfold.structure.parse_load`:
-        ``"uniform=0.5kPa"``, a bare number in kPa; ``"point=12:0,0,-2kN"``, a bare number
-        in newtons); ``limit`` ``"L/250"`` or 250; the other fields as typed."""
-        if isinstance(loads, str) or not isinstance(loads, tuple | list):
-            raise RigidfoldError(f"loads must be a list of load texts, got {loads!r}")
-        return cls(
-            supports=parse_supports(supports),
-            loads=tuple(parse_load(text) for text in loads),
-            limit=Limit.parse(limit),
-            **others,
-        )
 
     @property
     def auto(self) -> bool:
@@ -411,54 +373,94 @@ class StructureOptions:
         """ValueError (one line) for a support, candidate, clamped vertex, actuator or point
         load that a design of ``n_vertices`` vertices and ``n_edges`` edges lacks."""
         if isinstance(self.supports, Pins):
-            parse_indices(self.supports.text, n_vertices, "supports")
-        if self.candidates is not None and self.candidates.strip().lower() not in (
-            "boundary",
-            "ground",
-        ):
-            parse_indices(self.candidates, n_vertices, "support candidates")
-        parse_indices(self.clamped, n_vertices, "clamped vertices")
-        parse_indices(self.actuators, n_edges, "actuators")
+            index_array(self.supports.vertices, n_vertices, "supports")
+        if isinstance(self.candidates, tuple):
+            index_array(self.candidates, n_vertices, "support candidates")
+        index_array(self.clamped, n_vertices, "clamped vertices")
+        index_array(self.actuators, n_edges, "actuators")
         check_loads(self.loads, n_vertices)
 
     def replace(self, **changes) -> StructureOptions:
-        """These options with ``changes`` (field names), checked; ``supports``, ``loads`` and
-        ``limit`` may also be given as the texts of :meth:`from_strings` (the keywords of
-        :class:`~rigidfold.generate.GenerateOptions` of earlier versions)."""
-        if not changes:
-            return self
-        if isinstance(changes.get("supports"), str):
-            changes["supports"] = parse_supports(changes["supports"])
-        loads = changes.get("loads")
-        if isinstance(loads, tuple | list) and any(isinstance(x, str) for x in loads):
-            changes["loads"] = tuple(parse_load(x) if isinstance(x, str) else x for x in loads)
-        if "limit" in changes and not isinstance(changes["limit"], Limit):
-            changes["limit"] = Limit.parse(changes["limit"])
-        return replace(self, **changes)
+        """These options with ``changes`` (field names, typed values), checked."""
+        return replace(self, **changes) if changes else self
 
     def texts(self) -> dict:
-        """``supports``, ``loads`` and ``limit`` as the command line's texts (and
-        :meth:`from_strings`) take them: ``"auto"``, ``["uniform=0.5"]`` (kPa), the divisor."""
+        """``supports``, ``loads``, ``limit``, ``candidates``, ``clamped``, ``actuators`` and
+        ``material`` as the options' record holds them: ``"auto"``, ``["uniform=0.5"]``
+        (kPa), the divisor, ``"0,6"``, a material's :attr:`~rigidfold.material.Material.key`
+        (a preset's name, or ``"E,nu,density"``)."""
+        mat = self.material
+        candidates = self.candidates
         return {
             "supports": self.supports.text,
             "loads": [load.text for load in self.loads],
-            "limit": self.limit.divisor,
+            "limit": self.limit,
+            "candidates": indices_text(candidates) if isinstance(candidates, tuple) else candidates,
+            "clamped": indices_text(self.clamped),
+            "actuators": indices_text(self.actuators),
+            "material": mat.key,
         }
 
     def to_dict(self) -> dict:
-        """The options as JSON values (``supports``, ``loads``, ``limit`` as their texts:
-        :meth:`texts`); :meth:`from_dict` reads them."""
+        """The options as JSON values (the typed ones as :meth:`texts`); :meth:`from_dict`
+        reads them."""
         data = {f.name: getattr(self, f.name) for f in fields(self)}
         return data | self.texts()
 
     @classmethod
     def from_dict(cls, data: dict) -> StructureOptions:
-        """The options of :meth:`to_dict` (``loads`` a list of texts); unknown keys are
-        ignored, missing ones take their defaults."""
+        """The options of :meth:`to_dict`; unknown keys are ignored, missing ones take their
+        defaults. Reads the record's own forms only (those :meth:`texts` writes), not the
+        command line's (:mod:`rigidfold.cli.structure_specs`); RigidfoldError naming a value
+        it cannot read."""
         names = {f.name for f in fields(cls)}
         given = {k: v for k, v in data.items() if k in names}
-        texts = {k: given.pop(k) for k in _TEXT_FIELDS if k in given}
-        return cls.from_strings(**texts, **given)
+        try:
+            readers = _RECORD_READERS
+            typed = {k: readers[k](v) if k in readers else v for k, v in given.items()}
+        except (TypeError, ValueError, KeyError, AttributeError) as exc:
+            raise RigidfoldError(f"structure options of a record: cannot read {exc}") from None
+        return cls(**typed)
+
+
+def _record_indices(text: str) -> tuple[int, ...]:
+    return tuple(int(t) for t in text.split(",")) if text else ()
+
+
+def _record_supports(text: str) -> SupportSpec:
+    chosen: dict[str, SupportSpec] = {"auto": Auto(), "service": Service()}
+    return chosen[text] if text in chosen else Pins(_record_indices(text))
+
+
+def _record_load(text: str) -> Load:
+    kind, _, value = text.partition("=")
+    if kind == "point":
+        vertex, _, force = value.partition(":")
+        fx, fy, fz = (float(f) for f in force.split(","))
+        return Point(int(vertex), (fx, fy, fz))
+    if kind == "uniform":
+        return Uniform(float(value))
+    if kind == "pressure":
+        return Pressure(float(value))
+    if kind == SelfWeight.kind:
+        return SelfWeight()
+    raise ValueError(f"the load {text!r}")
+
+
+def _record_material(value: str | dict) -> Material:
+    return Material.from_key(value) if isinstance(value, str) else Material.from_dict(value)
+
+
+_RECORD_READERS: dict[str, Callable] = {
+    "supports": _record_supports,
+    "loads": lambda texts: tuple(_record_load(t) for t in texts),
+    "candidates": lambda v: v if v is None or v in ("boundary", "ground") else _record_indices(v),
+    "clamped": _record_indices,
+    "actuators": _record_indices,
+    "material": _record_material,
+}
+"""How :meth:`StructureOptions.from_dict` reads each value that :meth:`~StructureOptions.
+texts` wrote in the record's own form (the others are JSON values already)."""
 
 
 def plan_design(
@@ -472,13 +474,12 @@ def plan_design(
     :func:`design_supports`); the indices and loads are checked against the design
     (ValueError, one line). ``progress`` is handed a line as each long step starts
     (:class:`Steps`)."""
-    mat, parsed, _ = check_options(material=options.material, loads=options.loads)
     check_inputs(
         pattern,
         thickness=options.thickness,
         hinge_stiffness=options.hinge_stiffness,
-        loads=parsed,
-        material=mat,
+        loads=options.loads,
+        material=options.material,
         settings=settings,
     )
     options.check_indices(pattern.n_vertices, pattern.n_edges)
@@ -499,13 +500,13 @@ def plan_design(
         pattern,
         rigidity,
         pool is not None,
-        mat,
+        options.material,
         options.thickness,
-        parsed,
+        options.loads,
         options.self_weight,
         options.hinge_stiffness,
         options.nonlinear,
-        options.limit.divisor,
+        options.limit,
         options.modes,
         settings,
         pool if options.service else None,
@@ -524,29 +525,6 @@ def check_design(
     """The structure check of ``pattern`` with ``options``: every input checked first
     (ValueError, one line), then the analysis (``progress``: :func:`plan_design`)."""
     return plan_design(pattern, options, settings=settings, progress=progress).check()
-
-
-def recorded_thickness(path: str | Path, also: Sequence[Path] = ()) -> tuple[float, Path] | None:
-    """(the thickness, metres, that ``rigidfold fabricate`` made the panels of the design in
-    FOLD file ``path``, the file that records it) or None: fabricate writes it as
-    ``thickness_m`` of ``NAME_fabricate.json`` (:data:`rigidfold.fabricate.files.FABRICATE_JSON`)
-    in its output directory, looked for beside the design (``fabricate DESIGN.fold --out``
-    the design's directory), then in the directories ``also`` (for a run's solution, the
-    run's thick panels: :func:`rigidfold.pipeline.built.thick_dir_of`)."""
-    from rigidfold.fabricate.files import FABRICATE_JSON
-
-    path = Path(path)
-    name = FABRICATE_JSON.format(path.stem)
-    places = [path.parent / name, *(where / name for where in also)]
-    for place in places:
-        try:
-            data = parse_json(place.read_bytes())
-        except (OSError, ValueError):
-            continue
-        t = data.get("thickness_m") if isinstance(data, dict) else None
-        if isinstance(t, int | float) and not isinstance(t, bool) and 0 < t < float("inf"):
-            return float(t), place
-    return None
 
 
 def write_structure(check: StructureCheck, out: Path, source: str) -> list[Path]:

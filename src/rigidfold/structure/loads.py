@@ -11,8 +11,9 @@ point loads, as nodal forces of the shell mesh.
 
 Units: a pressure or uniform load in ``Pa``, ``kPa`` (= ``kN/m2``) or ``MPa``, a bare number
 in kPa (``uniform=0.5``, ``0.5kPa`` and ``500Pa`` are the same load); a point load's
-components in ``N``, ``kN`` or ``MN``, a bare number in newtons. :data:`PRESSURE_UNITS`,
-:data:`FORCE_UNITS`.
+components in ``N``, ``kN`` or ``MN``, a bare number in newtons. The command line reads them
+(:func:`rigidfold.cli.structure_specs.parse_load`) into the typed loads here: a
+:class:`Uniform` or :class:`Pressure` in kPa, a :class:`Point` in newtons.
 
 Self-weight (on unless ``--no-self-weight``) is density x g x thickness per panel area. An
 element's load goes to its three nodes in equal shares (the consistent load of a uniform
@@ -21,8 +22,6 @@ load on a linear triangle's translations).
 
 from __future__ import annotations
 
-import math
-import re
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -50,8 +49,8 @@ class _AreaLoad:
 
     @property
     def text(self) -> str:
-        """The ``--load`` text of this load, its number in kPa, bare (:func:`parse_load`
-        reads it back)."""
+        """The ``--load`` text of this load, its number in kPa, bare
+        (:func:`rigidfold.cli.structure_specs.parse_load` reads it back)."""
         return f"{self.kind}={self.kpa!r}"
 
 
@@ -86,7 +85,8 @@ class Point:
 
     @property
     def text(self) -> str:
-        """The ``--load`` text of this load (:func:`parse_load` reads it back)."""
+        """The ``--load`` text of this load (:func:`rigidfold.cli.structure_specs.parse_load`
+        reads it back)."""
         return f"point={self.vertex}:" + ",".join(repr(f) for f in self.force)
 
 
@@ -113,73 +113,6 @@ Load = Uniform | Pressure | Point | SelfWeight
 
 LOAD_TYPES = (Uniform, Pressure, Point, SelfWeight)
 """The classes of :data:`Load`, for ``isinstance``."""
-
-PRESSURE_UNITS = {"Pa": 1e-3, "kPa": 1.0, "kN/m2": 1.0, "MPa": 1e3}
-"""A uniform load's or pressure's units in kPa (any case; ``kN/m^2`` too); a bare number is
-kPa."""
-
-FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
-"""A point load's units in newtons (any case); a bare number is newtons."""
-
-_UNIT = re.compile(r"\s*([-+0-9.eE]+(?:[eE][-+]?\d+)?)\s*([a-zA-Z][a-zA-Z/^0-9]*)?\s*")
-
-
-def parse_load(text: str) -> Load:
-    """``uniform=Q``, ``pressure=Q`` (kPa, or with a unit: ``0.5kPa``, ``500Pa``) or
-    ``point=V:FX,FY,FZ`` (newtons, or ``2kN``) (see the module's text); ValueError naming
-    what was received for anything else."""
-    if isinstance(text, str) and text.strip().lower() in ("self_weight", "self-weight"):
-        return SelfWeight()
-    if not isinstance(text, str) or "=" not in text:
-        raise RigidfoldError(
-            f"a load is uniform=KPA, pressure=KPA or point=V:FX,FY,FZ, got {text!r}"
-        )
-    kind, _, value = (s.strip() for s in text.partition("="))
-    kind = kind.lower()
-    if kind in ("uniform", "pressure"):
-        kpa = _number(value, text, PRESSURE_UNITS)
-        return Uniform(kpa) if kind == "uniform" else Pressure(kpa)
-    if kind in ("self_weight", "self-weight"):
-        if value:
-            raise RigidfoldError(f"self-weight takes no value, got {text!r}")
-        return SelfWeight()
-    if kind == "point":
-        vertex, sep, force = value.partition(":")
-        parts = force.split(",")
-        if not sep or len(parts) != 3:
-            raise RigidfoldError(f"a point load is point=V:FX,FY,FZ (newtons), got {text!r}")
-        try:
-            v = int(vertex.strip())
-        except ValueError:
-            raise RigidfoldError(
-                f"a point load's vertex must be an integer, got {text!r}"
-            ) from None
-        if v < 0:
-            raise RigidfoldError(f"a point load's vertex must be >= 0, got {text!r}")
-        fx, fy, fz = (_number(p, text, FORCE_UNITS) for p in parts)
-        return Point(v, (fx, fy, fz))
-    raise RigidfoldError(
-        f"unknown load kind {kind!r} in {text!r} (choose from {', '.join(LOAD_KINDS)})"
-    )
-
-
-def _number(value: str, text: str, units: dict[str, float]) -> float:
-    """``value``, a number with an optional unit of ``units``, in the units' base."""
-    match = _UNIT.fullmatch(value)
-    known = {u.lower(): f for u, f in units.items()} | {"kn/m^2": units.get("kN/m2", 1.0)}
-    unit = (match.group(2) or "").lower() if match else ""
-    if match and unit and unit not in known:
-        raise RigidfoldError(
-            f"unknown unit {match.group(2)!r} in the load {text!r} (use "
-            f"{', '.join(units)}, or a bare number)"
-        )
-    try:
-        x = float(match.group(1)) * known.get(unit, 1.0) if match else math.nan
-    except (ValueError, OverflowError):
-        x = math.nan
-    if not math.isfinite(x):
-        raise RigidfoldError(f"a load's value must be a finite number, got {text!r}")
-    return x
 
 
 def check_magnitudes(loads: tuple[Load, ...], largest: float) -> None:

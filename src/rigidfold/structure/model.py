@@ -277,6 +277,59 @@ def _vertex_groups(pat: CreasePattern) -> dict[tuple[int, int], int]:
     return {key: find(key)[1] for key in parent}
 
 
+def build_shells(
+    ops: Any,
+    mesh: ShellMesh,
+    material: Material,
+    thickness: float,
+    density: float,
+    *,
+    nonlinear: bool = False,
+) -> None:
+    """Start the OpenSees model of ``mesh`` in ``ops`` (openseespy.opensees, wiped first):
+    node tag i + 1 is node i, and element tag t + 1 the shell (ASDShellT3) of triangle t,
+    of one elastic membrane-plate section of ``material``, ``thickness`` (m) and ``density``
+    (kg/m^3); corotational where ``nonlinear``."""
+    ops.wipe()
+    ops.model("basic", "-ndm", 3, "-ndf", 6)
+    for i, c in enumerate(mesh.coords):
+        ops.node(i + 1, *map(float, c))
+    ops.section(
+        "ElasticMembranePlateSection",
+        1,
+        float(material.E),
+        float(material.nu),
+        float(thickness),
+        float(density),
+    )
+    extra = ["-corotational"] if nonlinear else []
+    for t, (a, b, c) in enumerate(mesh.triangles):
+        ops.element("ASDShellT3", t + 1, int(a) + 1, int(b) + 1, int(c) + 1, 1, *extra)
+
+
+def build_spring(
+    ops: Any, tag: int, material_tag: int, a: int, b: int, axis: np.ndarray, stiffness: float
+) -> None:
+    """A rotational spring of ``stiffness`` (N m/rad) about ``axis`` (3,) between nodes a
+    and b, in ``ops``: uniaxial material ``material_tag`` and zeroLength element ``tag``,
+    its local x along the axis."""
+    ops.uniaxialMaterial("Elastic", material_tag, float(stiffness))
+    ref = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    ops.element(
+        "zeroLength",
+        tag,
+        int(a) + 1,
+        int(b) + 1,
+        "-mat",
+        material_tag,
+        "-dir",
+        4,
+        "-orient",
+        *map(float, axis),
+        *map(float, np.cross(ref, axis)),
+    )
+
+
 def build_model(
     ops: Any,
     mesh: ShellMesh,
@@ -294,41 +347,12 @@ def build_model(
     (K, 2) ties (:meth:`ShellMesh.ties`): the constrained node of each follows the retained
     one's translations.
     """
-    ops.wipe()
-    ops.model("basic", "-ndm", 3, "-ndf", 6)
-    for i, c in enumerate(mesh.coords):
-        ops.node(i + 1, *map(float, c))
-    ops.section(
-        "ElasticMembranePlateSection",
-        1,
-        float(material.E),
-        float(material.nu),
-        float(thickness),
-        float(material.density),
-    )
-    extra = ["-corotational"] if nonlinear else []
-    for t, (a, b, c) in enumerate(mesh.triangles):
-        ops.element("ASDShellT3", t + 1, int(a) + 1, int(b) + 1, int(c) + 1, 1, *extra)
+    build_shells(ops, mesh, material, thickness, material.density, nonlinear=nonlinear)
     if hinge_stiffness > 0:
         tag = mesh.n_elements
         for s, ((a, b), axis) in enumerate(zip(mesh.springs, mesh.spring_axis, strict=True)):
-            ops.uniaxialMaterial("Elastic", s + 1, float(hinge_stiffness * mesh.spring_length[s]))
-            ref = np.eye(3)[int(np.argmin(np.abs(axis)))]
-            yp = np.cross(ref, axis)
             tag += 1
-            ops.element(
-                "zeroLength",
-                tag,
-                int(a) + 1,
-                int(b) + 1,
-                "-mat",
-                s + 1,
-                "-dir",
-                4,
-                "-orient",
-                *map(float, axis),
-                *map(float, yp),
-            )
+            build_spring(ops, tag, s + 1, a, b, axis, hinge_stiffness * mesh.spring_length[s])
     nodes, clamp, _ = mesh.supported_nodes(pinned, clamped)
     for i, c in zip(nodes, clamp, strict=True):
         rot = 1 if c else 0

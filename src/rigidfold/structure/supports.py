@@ -63,53 +63,35 @@ from rigidfold.mechanism.kinematics import (
 from rigidfold.mechanism.second_order import SecondOrder, Stability, held_vertices, second_order
 from rigidfold.mechanism.stiffness import PseudoStiffness
 from rigidfold.mesh import CreasePattern
+from rigidfold.structure.choices import Candidates, indices_text
 
 CANDIDATE_FORMS = ("boundary", "ground", "V,V,...")
 
 
-def index_list(text: str, what: str) -> list[int]:
-    """The integers of ``"3,7,12"`` (``""``: none), not yet checked against a design;
-    ValueError naming ``what`` and the text for anything else, an empty item included
-    (``"0,,1"``, ``"0,1,"``: a number left out is a slip, not nothing)."""
-    if not isinstance(text, str):
-        raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}")
-    if not text.strip():
-        return []
-    items = [t.strip() for t in text.split(",")]
-    if not all(items):
-        raise RigidfoldError(
-            f"{what} must be comma-separated integers, got {text!r}: item "
-            f"{items.index('') + 1} is empty"
-        )
-    try:
-        return [int(t) for t in items]
-    except ValueError:
-        raise RigidfoldError(f"{what} must be comma-separated integers, got {text!r}") from None
-
-
-def parse_indices(text: str, count: int, what: str) -> np.ndarray:
-    """``"3,7,12"`` as a sorted (k,) int64 array of distinct indices below ``count``;
-    ``""`` is none. ValueError naming ``what`` and the text for anything else."""
-    values = index_list(text, what)
+def index_array(values: tuple[int, ...], count: int, what: str) -> np.ndarray:
+    """The indices ``values`` as a sorted (k,) int64 array of distinct indices below
+    ``count``; ValueError naming ``what`` and the indices for one out of range."""
     bad = [v for v in values if not 0 <= v < count]
     if bad:
-        raise RigidfoldError(f"{what}: {bad[0]} is out of range 0..{count - 1} (got {text!r})")
+        raise RigidfoldError(
+            f"{what}: {bad[0]} is out of range 0..{count - 1} (got {indices_text(values)!r})"
+        )
     return np.array(sorted(set(values)), dtype=np.int64)
 
 
 def support_candidates(
-    pattern: CreasePattern, spec: str | None = None, settings: Settings = DEFAULTS
+    pattern: CreasePattern, spec: Candidates = None, settings: Settings = DEFAULTS
 ) -> np.ndarray:
     """The vertices ``auto`` may choose (sorted, int64): ``None`` or ``"boundary"``: the
     boundary vertices; ``"ground"``: those within ``settings.structure.ground_tol`` of the
-    lowest boundary vertex's height; ``"V,V,..."``: these vertices."""
+    lowest boundary vertex's height; a tuple of indices: these vertices."""
     boundary = pattern.boundary_vertices
-    if spec is None or spec.strip().lower() == "boundary":
+    if spec is None or spec == "boundary":
         return boundary
-    if spec.strip().lower() == "ground":
+    if spec == "ground":
         z = pattern.coords[boundary, 2]
         return boundary[z <= z.min() + settings.structure.ground_tol]
-    return parse_indices(spec, pattern.n_vertices, "support candidates")
+    return index_array(spec, pattern.n_vertices, "support candidates")
 
 
 @dataclass(frozen=True, eq=False)

@@ -160,7 +160,7 @@ def _store_lines(store: Store, figures: dict[str, str]) -> list[str]:
             lines.append(
                 f"| {LABEL[r['criterion']]} | {r['n']} | {_fmt(r['n_reduce'], r['n_reduce_se'])} "
                 f"| {_fmt(r['n_lock'], r['n_lock_se'])} | {_fmt(r['n_exceed'], r['n_exceed_se'])} "
-                f"| {_fmt(r['mean_f'])} | {r['reached_target']}/{r['n']} "
+                f"| {_fmt(r['mean_f_accepted'])} | {r['reached_target']}/{r['n']} "
                 f"| {_fmt(p[0])} | {_fmt(p[1])} | {_fmt(p[2])} | {_fmt(p[3])} |"
             )
         if pattern in figures:
@@ -356,7 +356,7 @@ def _summary_lines(rows: list[dict]) -> list[str]:
             + [_fmt(r[k]) for k in ("n_reduce", "n_lock", "n_exceed", "n_path")]
             + [
                 "-" if r["deploys_share"] is None else f"{100 * r['deploys_share']:.0f} %",
-                _fmt(r["mean_f"]),
+                _fmt(r["mean_f_accepted"]),
             ]
             + [_fmt(r["n_solves"], digits=1), _fmt(r["skipped_per_run"])]
             + [_fmt(r["groups_per_run"])]

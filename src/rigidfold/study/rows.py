@@ -15,8 +15,12 @@ import sqlite3
 import types
 import typing
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any
 
 from rigidfold.generate import Attempt, Stop
+
+if TYPE_CHECKING:
+    from rigidfold.rundir import RunSummary
 
 
 @dataclass(frozen=True)
@@ -93,10 +97,12 @@ class RunRow:
     (None: it could not run, ``status`` then "error: <message>"); status : the words; the
     paper's counters (``n_reduce``, ``n_lock``, ``n_exceed``), ``n_path``, ``n_rigid``,
     ``n_backtrack``, the lowest DOF reached (``lowest_dof``), the final design's
-    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f``, the Step 8-9 figures
-    (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the times in
-    seconds (``time_*``), and where it was computed (``version``, ``worker``,
-    ``numerics``); a figure the run (or its version) did not record is None.
+    ``final_dof`` and ``final_deploys`` (1, 0 or None), ``mean_f_accepted``, the Step 8-9
+    figures (``mean_d``, ``mean_dl_mm``, ``mean_drho_fix_deg``, ``reached_plane``), the
+    times in seconds (``time_*``), and where it was computed (``version``, ``worker``,
+    ``numerics``: the numeric environment's key); a figure the run (or its version) did not
+    record is None. The counters and figures of the run's summary have its names
+    (:data:`SUMMARY_COLUMNS`, :meth:`from_summary`).
     """
 
     study: str
@@ -108,7 +114,7 @@ class RunRow:
     n_reduce: int | None = None
     n_lock: int | None = None
     n_exceed: int | None = None
-    mean_f: float | None = None
+    mean_f_accepted: float | None = None
     initial_dof: int | None = None
     final_dof: int | None = None
     n_solutions: int | None = None
@@ -145,6 +151,39 @@ class RunRow:
         return self.status.removeprefix(ERROR_PREFIX) if self.stop is None else None
 
     @classmethod
+    def from_summary(cls, key: Key, summary: RunSummary, **given: Any) -> RunRow:
+        """The row of the run ``key`` whose summary is ``summary``
+        (:class:`rigidfold.rundir.RunSummary`): its status the stop reason, the columns of
+        :data:`SUMMARY_COLUMNS` the summary's fields of the same name, the generation's
+        times (``time_build``, ... ``time_path``) its ``time_s``, and where solutions were
+        checked (``summary.per_solution``) the Step 8-9 figures of them
+        (:func:`rigidfold.rundir.aggregate`) and their times; ``given``: the other columns
+        (``version``, ``worker``, ``numerics``, ``time_total``)."""
+        data = summary.to_dict()
+        row: dict[str, Any] = {name: data[name] for name in SUMMARY_COLUMNS}
+        row["stop"] = Stop(summary.stop)
+        row["status"] = summary.stop_reason
+        if summary.final_deploys is not None:
+            row["final_deploys"] = int(summary.final_deploys)
+        row |= {f"time_{k}": summary.time_s[k] for k in GENERATION_TIMES}
+        records = summary.per_solution
+        if records:
+            row |= {
+                "mean_d": data["development"]["mean_D"],
+                "mean_dl_mm": data["deformation"]["mean_dl_mm"],
+                "mean_drho_fix_deg": data["deformation"]["mean_drho_fix_deg"],
+                "reached_plane": int(data["deformation"]["reached_plane"] == len(records)),
+                "time_develop": sum(r.time_s.get("develop", 0.0) for r in records),
+                "time_deform": sum(r.time_s.get("deform", 0.0) for r in records),
+            }
+        return cls(**{f.name: getattr(key, f.name) for f in fields(Key)} | row | given)
+
+    def columns(self) -> dict:
+        """The row's ``runs`` columns besides its key, by name (what
+        :meth:`rigidfold.study.store.Store.add` stores)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in KEY_COLUMNS}
+
+    @classmethod
     def from_columns(cls, values: dict) -> RunRow:
         """The row of the ``runs`` columns ``values``."""
         names = {f.name for f in fields(cls)}
@@ -153,6 +192,28 @@ class RunRow:
         known["symmetric"] = bool(known["symmetric"])
         return cls(stop=None if stop is None else Stop(stop), **known)
 
+
+SUMMARY_COLUMNS = (
+    "initial_dof",
+    "final_dof",
+    "lowest_dof",
+    "n_reduce",
+    "n_lock",
+    "n_exceed",
+    "n_path",
+    "n_backtrack",
+    "n_rigid",
+    "final_deploys",
+    "n_solutions",
+    "n_solves",
+    "mean_f_accepted",
+)
+"""The columns of ``runs`` that are :class:`rigidfold.rundir.RunSummary` fields (and keys of
+summary.json and of :meth:`rigidfold.generate.Generation.to_dict`) of the same name: the
+counters, the DOFs and the mean F, one name from the run to the database."""
+
+GENERATION_TIMES = ("build", "solve", "analysis", "selection", "path")
+"""The generation's times in a summary's ``time_s`` that are the columns ``time_<name>``."""
 
 SCHEMA = (
     """

@@ -19,12 +19,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from rigidfold.config import DEFAULT_SEED, DEFAULTS, Settings, check_seed
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, Check, Settings, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.patterns import parse_pattern
 from rigidfold.selection import CRITERIA
-from rigidfold.study.rows import ERROR_PREFIX, Key
+from rigidfold.study.rows import ERROR_PREFIX, Key, RunRow
 from rigidfold.study.store import Store
 
 if TYPE_CHECKING:  # the pipeline is imported in the worker
@@ -37,7 +37,7 @@ PRESETS = {
 }
 
 
-STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check="all")
+STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check=Check.ALL)
 """The generate options of a study by default: the paper's Step 5 (no deployability check;
 the final design's path is traced after the run), no Step 9."""
 
@@ -165,53 +165,26 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
             status=ERROR_PREFIX + str(exc), error=str(exc), time_total=time.perf_counter() - t0
         )
         return key, row, []
-    row.update(run_row(result))
-    row["time_total"] = time.perf_counter() - t0
+    row = run_row(key, result, **row, time_total=time.perf_counter() - t0)
     return key, row, [a.to_dict() | {"idx": a.index, "f": a.F} for a in result.generation.attempts]
 
 
-def run_row(result: RunResult) -> dict:
-    """The ``runs`` columns of a finished run (:class:`rigidfold.pipeline.RunResult`): its
-    counters and times, whether its final design deploys (its path, traced after the search
-    where the search did not), and the figures of the solutions whose checks ran."""
-    from rigidfold.rundir import aggregate
+def run_row(key: Key, result: RunResult, **given) -> dict:
+    """The ``runs`` columns of the finished run ``key`` (:class:`rigidfold.pipeline.RunResult`):
+    :meth:`RunRow.from_summary` of its summary, with the final design's path traced after
+    the search where the search did not (whether it deploys, and its seconds in
+    ``time_path``), and the figures of the solutions whose checks ran; ``given``: the other
+    columns (``version``, ``worker``, ``numerics``, ``time_total``)."""
+    from rigidfold.rundir import RunSummary
 
-    s = result.generation.to_dict()
-    path = result.final_path
-    row = dict(
-        stop=s["stop"],
-        status=s["stop_reason"],
-        n_reduce=s["N_reduce"],
-        n_lock=s["N_lock"],
-        n_exceed=s["N_exceed"],
-        mean_f=s["mean_F_accepted"],
-        initial_dof=s["initial_dof"],
-        final_dof=s["final_dof"],
-        n_solutions=s["n_solutions"],
-        n_solves=s["n_solves"],
-        time_build=s["time_s"]["build"],
-        time_solve=s["time_s"]["solve"],
-        time_analysis=s["time_s"]["analysis"],
-        time_selection=s["time_s"]["selection"],
-        n_path=s["N_path"],
-        n_backtrack=s["N_backtrack"],
-        n_rigid=s["N_rigid"],
-        lowest_dof=s["lowest_dof"],
-        final_deploys=None if result.final is None or path is None else int(path.deploys),
-        time_path=s["time_s"]["path"] + result.final_path_time,
-    )
     records = [result.checked[step].record for step in sorted(result.checked)]
-    if records:
-        figures = aggregate(records)
-        row.update(
-            mean_d=figures["development"]["mean_D"],
-            mean_dl_mm=figures["deformation"]["mean_dl_mm"],
-            mean_drho_fix_deg=figures["deformation"]["mean_drho_fix_deg"],
-            reached_plane=int(figures["deformation"]["reached_plane"] == len(records)),
-            time_develop=sum(r.time_s.get("develop", 0.0) for r in records),
-            time_deform=sum(r.time_s.get("deform", 0.0) for r in records),
-        )
-    return row
+    summary = RunSummary.from_run(result.generation, records, stage_times={}, case={}, solutions=())
+    path = result.final_path
+    deploys = None if result.final is None or path is None else int(path.deploys)
+    given["time_path"] = summary.time_s["path"] + result.final_path_time
+    if deploys is not None:
+        given["final_deploys"] = deploys
+    return RunRow.from_summary(key, summary, **given).columns()
 
 
 def lost_run(exc: Exception) -> dict:

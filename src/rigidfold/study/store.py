@@ -108,9 +108,10 @@ def sqlite_uri(path: str | Path, mode: str) -> str:
     return f"file:{quote(absolute, safe='/')}?mode={mode}"
 
 
-STUDY_SCHEMA_VERSION = 2
+STUDY_SCHEMA_VERSION = 3
 """The version of the tables of :data:`SCHEMA`, the database's ``PRAGMA user_version``; raise
-it with any change to them that an older rigidfold cannot read."""
+it with any change to them that an older rigidfold cannot read (3: the column ``mean_f`` of
+``runs`` is ``mean_f_accepted``, the name of summary.json's key)."""
 
 READONLY_COPY_TRIES = 3
 """Times a database opened read-only is copied into memory before it is read in place

@@ -44,7 +44,7 @@ def tables_5_6(store: Store) -> list[dict]:
         for crit in [c for c in ORDER if any(r.criterion == c for r in runs)]:
             sel = [r for r in runs if r.pattern == pattern and r.criterion == crit]
             row = {"pattern": pattern, "criterion": crit, "n": len(sel)}
-            for name in ("n_reduce", "n_lock", "n_exceed", "mean_f"):
+            for name in ("n_reduce", "n_lock", "n_exceed", "mean_f_accepted"):
                 row[name], row[name + "_se"] = _mean_se([getattr(r, name) for r in sel])
             row["reached_target"] = sum(r.stop is Stop.TARGET_REACHED for r in sel)
             row["seeds"] = (min(r.seed for r in sel), max(r.seed for r in sel))
@@ -231,7 +231,7 @@ def criterion_summary(store: Store) -> list[dict]:
     for pattern, crit in sorted({(r.pattern, r.criterion) for r in runs}):
         sel = [r for r in runs if (r.pattern, r.criterion) == (pattern, crit)]
         row: dict = {"pattern": pattern, "criterion": crit, "runs": len(sel)}
-        for name in ("n_reduce", "n_lock", "n_exceed", "mean_f", "n_solves"):
+        for name in ("n_reduce", "n_lock", "n_exceed", "mean_f_accepted", "n_solves"):
             row[name] = _mean_se([getattr(r, name) for r in sel])[0]
         for name, counts in (("skipped_per_run", skipped), ("groups_per_run", carried)):
             done = counts.get((pattern, crit))
@@ -354,7 +354,7 @@ def tables_7_8(store: Store) -> list[dict]:
             r.n_exceed,
             r.final_dof,
             r.n_solves,
-            r.mean_f,
+            r.mean_f_accepted,
             r.mean_d,
             r.mean_dl_mm,
             r.mean_drho_fix_deg,
