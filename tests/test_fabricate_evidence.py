@@ -240,7 +240,7 @@ def test_sheet_too_large_refused(tmp_path, capsys):
     from rigidfold.fabricate import FabricateOptions
 
     with pytest.raises(RigidfoldError, match="max_sheet_size"):
-        FabricateOptions(thickness=0.02, sheet="1e308x1e308")
+        FabricateOptions(thickness=0.02, sheet=(1e308, 1e308))
     args = ["fabricate", str(AFRAME), "--thickness", "18mm", "--sheet", "1e308x1e308"]
     assert main_code([*args, "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip()

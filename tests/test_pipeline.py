@@ -110,7 +110,7 @@ def test_the_result_is_frozen_and_has_one_to_dict(recorded):
     data = json.loads(json.dumps(result.to_dict()))
     generation = result.generation
     assert data["stop"] == generation.stop.value == Stop.NO_CANDIDATE.value
-    assert data["N_backtrack"] == generation.n_backtrack
+    assert data["n_backtrack"] == generation.n_backtrack
     assert data["verdict"]["outcome"] == result.verdict.outcome.value == "fell_short"
     assert data["solutions"] == [
         f"solutions/step_{s.step:02d}_dof_{s.mechanism.dof:02d}.fold" for s in generation.solutions

@@ -314,3 +314,24 @@ def test_the_graces_after_a_time_limit():
     assert past_time_limit(100.0, None, DEFAULTS) is None
     assert past_time_limit(100.0, 180.0, DEFAULTS, 2.0) == 100.0 + 180.0 + 10.0
     assert past_time_limit(100.0, 600.0, DEFAULTS, 2.0) == 100.0 + 600.0 + 30.0
+
+
+def test_a_limit_counts_from_the_commands_start_only_in_the_command():
+    """In the ``rigidfold`` command (marked at its entry) a time limit counts from the
+    process's start; a program calling the command line in its own process (these tests)
+    counts from the run's start."""
+    import subprocess
+    import sys
+    import time
+
+    from rigidfold.runtime.clock import command_started
+
+    assert command_started() is None  # pytest's process is not the command
+    code = (
+        "import time, rigidfold.runtime.clock as c; time.sleep(0.3); c.mark_command(); "
+        "print(time.monotonic() - c.command_started())"
+    )
+    t0 = time.monotonic()
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    age = float(out.stdout)
+    assert 0.3 <= age <= time.monotonic() - t0

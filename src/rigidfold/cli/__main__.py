@@ -2,10 +2,12 @@
 
 import sys
 
+from rigidfold.runtime.clock import mark_command
 from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, command_ended, terminate_interrupts
 
 if __name__ == "__main__":
     terminate_interrupts()  # before the command line's modules load: SIGTERM then exits 130
+    mark_command()  # a time limit counts from the process's start
     code = None
     try:
         from rigidfold.cli.commands import main

@@ -17,7 +17,6 @@ import math
 import os
 import sys
 import tempfile
-import time
 import traceback
 from collections.abc import Sequence
 
@@ -108,7 +107,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     from rigidfold.cli.progress import GenerateProgress
     from rigidfold.drive import DriveOptions
     from rigidfold.pipeline import Interrupted, RunWriter, run
-    from rigidfold.runtime.clock import process_age
+    from rigidfold.runtime.clock import command_started
 
     structure = structure_options(args)  # checked even without --structure
     options = options_of(
@@ -128,8 +127,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     ) as writer:
         try:
             # --time-limit counts from the command's start, imports and the case too
-            started = time.monotonic() - process_age()
-            result = run(case, options, (writer, progress), started=started)
+            result = run(case, options, (writer, progress), started=command_started())
         except Interrupted as stop:
             return _interrupted(stop.result, writer, progress)
         except KeyboardInterrupt:  # before the run began, or as it returned

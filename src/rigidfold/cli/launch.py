@@ -11,6 +11,7 @@ import sysconfig
 from collections.abc import Sequence
 from pathlib import Path
 
+from rigidfold.runtime.clock import mark_command
 from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, command_ended, terminate_interrupts
 
 
@@ -30,6 +31,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         if entry:
             restart_pinned()
+            mark_command()  # a time limit counts from the process's start
         from rigidfold.cli.commands import main as cli_main
 
         code = cli_main(argv)

@@ -28,3 +28,23 @@ def process_age() -> float:
     except (OSError, ValueError, IndexError, AttributeError):
         return 0.0
     return max(0.0, now - started)
+
+
+_command_started: float | None = None
+"""The time of ``time.monotonic()`` at which this process, the ``rigidfold`` command, was
+started (:func:`mark_command`); None where the command line is called from a program."""
+
+
+def mark_command() -> None:
+    """Note that this process is the ``rigidfold`` command (``python -m rigidfold``,
+    ``python -m rigidfold.cli``, the installed script), started :func:`process_age` seconds
+    ago: its time limit counts from then (:func:`command_started`)."""
+    global _command_started
+    _command_started = time.monotonic() - process_age()
+
+
+def command_started() -> float | None:
+    """When this process, the ``rigidfold`` command, was started (of ``time.monotonic()``);
+    None when the command line runs inside another program (a test, a script calling
+    ``rigidfold.cli.commands.main``): its limit then counts from the run's start."""
+    return _command_started
