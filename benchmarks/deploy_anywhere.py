@@ -58,7 +58,7 @@ MODES: dict[str, dict] = {
     "after": {},
     "before": {"fold_limits": ()},
     "no-second-order": {"second_order": False},
-    "bounded": {"rho_bar": math.radians(120.0)},
+    "bounded": {"rho_max": math.radians(120.0)},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the

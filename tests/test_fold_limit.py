@@ -33,11 +33,11 @@ def test_the_restart_case_has_bound_12_at_the_limit():
     case = make_case("dome", "1", seed=1)
     limit = math.radians(100)
     bounded = with_fold_limit(case, GenerateOptions(), limit)
-    assert bounded.settings.design.rho_bar == limit
+    assert bounded.settings.design.rho_max == limit
     assert bounded.pattern is case.pattern and bounded.surface is case.surface
     # the paper's Step 5 (no check), the user's own bound (12): no restart
     assert with_fold_limit(case, GenerateOptions(deploy_check=False), limit) is case
-    own = make_case("dome", "1", seed=1, settings=DEFAULTS.with_(rho_bar=math.radians(90)))
+    own = make_case("dome", "1", seed=1, settings=DEFAULTS.with_(rho_max=math.radians(90)))
     assert with_fold_limit(own, GenerateOptions(), limit) is own
     assert all(0 < a < math.pi for a in DEFAULTS.generation.fold_limits)
     with pytest.raises(RigidfoldError, match="fold limit must lie in"):

@@ -212,7 +212,7 @@ def test_zero_dof_on_the_way_ends_or_counts_as_lock(monkeypatch, ends):
         return real(pattern, **kw)
 
     monkeypatch.setattr(gen, "analyze", analyze)
-    settings = DEFAULTS.with_(zero_dof_ends=ends)
+    settings = DEFAULTS.with_(retry_zero_dof=not ends)
     run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="shat", seed=1)
     fourth = run.attempts[3]
     assert fourth.dof == 0

@@ -23,7 +23,7 @@ from rigidfold.optimize.jacobian import (
 )
 from rigidfold.optimize.residuals import Residuals
 
-WITH_RHO = DEFAULTS.with_(rho_bar=math.radians(160))
+WITH_RHO = DEFAULTS.with_(rho_max=math.radians(160))
 CASES = [
     ("bezier", "1", {"seed": 3}),
     ("bezier", "2", {"seed": 5, "settings": WITH_RHO}),

@@ -199,7 +199,7 @@ def test_fixed_creases_become_flat():
 
 
 def test_fold_angle_bound():
-    settings = DEFAULTS.with_(rho_bar=np.radians(25.0))
+    settings = DEFAULTS.with_(rho_max=np.radians(25.0))
     case = make_case("bezier", "1", seed=6, settings=settings)
     result = case.problem().solve()
     free = result.pattern.free_creases
@@ -255,7 +255,7 @@ def test_bad_fixed_selection(bezier_problem):
 
 # ---------------------------------------------------------------- closed-form Hessian
 @pytest.mark.parametrize(
-    ("surface", "pattern", "symmetric", "rho_bar"),
+    ("surface", "pattern", "symmetric", "rho_max"),
     [
         ("bezier", "1", False, None),
         ("bezier", "2", False, None),
@@ -264,9 +264,9 @@ def test_bad_fixed_selection(bezier_problem):
         ("hp", "11", True, 0.5),
     ],
 )
-def test_closed_form_hessian_equals_casadi(surface, pattern, symmetric, rho_bar):
+def test_closed_form_hessian_equals_casadi(surface, pattern, symmetric, rho_max):
     """The element-assembled Hessian of the Lagrangian is CasADi's exact one, to round-off."""
-    settings = DEFAULTS.with_(rho_bar=rho_bar)
+    settings = DEFAULTS.with_(rho_max=rho_max)
     case = make_case(surface, pattern, seed=7, symmetric=symmetric, settings=settings)
     _assert_closed_form_hessian_is_exact(case.problem(build_ipopt=False))
 

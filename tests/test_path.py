@@ -126,7 +126,7 @@ def test_path_settings_take_effect():
     shape = miura(3, 3, height=0.5)
     budget = trace_path(shape, settings=DEFAULTS.with_(path_max_steps=1))
     assert budget.status is PathStatus.MAX_STEPS and budget.steps <= 2 * 1
-    collide = trace_path(shape, settings=DEFAULTS.with_(path_fold_limit=math.radians(1.0)))
+    collide = trace_path(shape, settings=DEFAULTS.with_(path_collision_angle=math.radians(1.0)))
     assert collide.status in (PathStatus.COLLISION, PathStatus.TURNED_BACK)
     loose = trace_path(shape, settings=DEFAULTS.with_(path_flat_tol=math.radians(170.0)))
     assert loose.deploys and loose.steps == 0 and "flat already" in loose.message

@@ -88,11 +88,11 @@ def test_a_flat_name_read_as_an_attribute_says_where_it_lives():
 
 def test_from_degrees_keeps_the_defaults_exactly():
     assert Settings.from_degrees() == DEFAULTS
-    s = Settings.from_degrees(theta_min_deg=20, rho_bar_deg=150, dz=0.25, svg_snap_tol=0.0)
+    s = Settings.from_degrees(theta_min_deg=20, rho_max_deg=150, dz=0.25, svg_snap_tol=0.0)
     assert (
         s.design.theta_min == math.radians(20) and s.design.theta_max == DEFAULTS.design.theta_max
     )
-    assert s.design.rho_bar == math.radians(150) and s.design.dz == 0.25
+    assert s.design.rho_max == math.radians(150) and s.design.dz == 0.25
     assert s.inputs.svg_snap_tol == 0.0
 
 

@@ -26,7 +26,7 @@ class PathSettings(Group):
         "The path reaches the flat state when every free crease's fold angle is within this "
         "of 0, radians (0.5 degrees).",
     )
-    fold_limit: float = setting(
+    collision_angle: float = setting(
         math.radians(179.0),
         "The path ends where a crease folds to this, radians (179 degrees): its panels meet.",
     )

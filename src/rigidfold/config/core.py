@@ -26,7 +26,7 @@ class DesignSettings(Group):
     theta_max: float = setting(
         2 * math.pi / 3, "Upper bound on every sector angle, radians (paper: 2 pi/3)."
     )
-    rho_bar: float | None = setting(
+    rho_max: float | None = setting(
         None, "Optional bound on |rho_j| of free creases, constraint (12), radians."
     )
     f_tol: float = setting(1e-7, "A solution of (6) is accepted when F <= f_tol (paper: 1e-7).")
@@ -47,9 +47,9 @@ class DesignSettings(Group):
                 f"theta_min={math.degrees(self.theta_min):g}, "
                 f"theta_max={math.degrees(self.theta_max):g} degrees"
             )
-        if self.rho_bar is not None and not (0 < self.rho_bar < math.pi):
+        if self.rho_max is not None and not (0 < self.rho_max < math.pi):
             raise RigidfoldError(
-                f"rho_bar must lie in (0, 180) degrees, got {math.degrees(self.rho_bar):g}"
+                f"rho_max must lie in (0, 180) degrees, got {math.degrees(self.rho_max):g}"
             )
         if not self.f_tol > 0:
             raise RigidfoldError(f"f_tol must be positive, got {self.f_tol!r}")
@@ -60,12 +60,13 @@ class GenerationSettings(Group):
     """The generation procedure (Steps 4-7): the fictitious hinge stiffnesses of the
     criteria, lock prediction, the look-ahead and the deployability check."""
 
-    zero_dof_ends: bool = setting(
-        True,
-        "Step 5 of the paper: a solution of (6) whose mechanism has DOF 0 ends generation (it "
-        "goes to Step 8; not counted in N_reduce, N_lock or N_exceed). ``False``: while the "
-        "target DOF is >= 1, count it as a lock and try the next candidate (Step 7) instead, "
-        "which reaches the target more often at the price of more solves.",
+    retry_zero_dof: bool = setting(
+        False,
+        "``False``, Step 5 of the paper: a solution of (6) whose mechanism has DOF 0 ends "
+        "generation (it goes to Step 8; not counted in N_reduce, N_lock or N_exceed). "
+        "``True`` (``--retry-zero-dof``): while the target DOF is >= 1, count it as a lock and "
+        "try the next candidate (Step 7) instead, which reaches the target more often at the "
+        "price of more solves.",
     )
     hinge_stiffness: float = setting(
         1e-3, "Mean of the fictitious hinge stiffnesses K_j, N m (Section 6.1)."
@@ -142,7 +143,7 @@ class GenerationSettings(Group):
     )
     fold_limits: tuple[float, ...] = setting(
         (math.radians(120.0), math.radians(90.0)),
-        "With the deployability check (and no ``design.rho_bar`` of the user's): where the "
+        "With the deployability check (and no ``design.rho_max`` of the user's): where the "
         "run's chain dead-ends, it starts again from the initial shape with bound (12) at "
         "the next of these angles, radians, on every solve: each fix flattens a crease and "
         "the solve folds the creases left free further, and the paths of shapes with creases "

@@ -46,7 +46,7 @@ class Settings:
     :meth:`Settings.docs`)."""
 
     design: DesignSettings = field(default_factory=DesignSettings)
-    """Problem (6): dz, sector-angle bounds, rho_bar, F's tolerance (paper, Section 6.1)."""
+    """Problem (6): dz, sector-angle bounds, rho_max, F's tolerance (paper, Section 6.1)."""
     generation: GenerationSettings = field(default_factory=GenerationSettings)
     """Steps 4-7: hinge stiffnesses, lock prediction, look-ahead, deployability check."""
     solver: SolverSettings = field(default_factory=SolverSettings)
@@ -124,7 +124,7 @@ class Settings:
         *,
         theta_min_deg: float | None = None,
         theta_max_deg: float | None = None,
-        rho_bar_deg: float | None = None,
+        rho_max_deg: float | None = None,
         **kwargs: Any,
     ) -> Settings:
         """Build settings with angles given in degrees (as on the command line) and any other
@@ -134,8 +134,8 @@ class Settings:
         for name, degrees in angles.items():
             if degrees is not None:
                 kwargs[name] = math.radians(degrees)
-        rho_bar = None if rho_bar_deg is None else math.radians(rho_bar_deg)
-        return cls().with_(rho_bar=rho_bar, **kwargs)
+        rho_max = None if rho_max_deg is None else math.radians(rho_max_deg)
+        return cls().with_(rho_max=rho_max, **kwargs)
 
 
 GROUPS: dict[str, type[Group]] = {f.name: f.default_factory for f in fields(Settings)}  # type: ignore[misc]

@@ -88,7 +88,7 @@ class Case:
             "dz_m": s.design.dz,
             "theta_min_deg": math.degrees(s.design.theta_min),
             "theta_max_deg": math.degrees(s.design.theta_max),
-            "rho_bar_deg": None if s.design.rho_bar is None else math.degrees(s.design.rho_bar),
+            "rho_max_deg": None if s.design.rho_max is None else math.degrees(s.design.rho_max),
             "F_tol": s.design.f_tol,
         }
 

@@ -9,7 +9,7 @@
               DOF >= 1, no locked crease   -> accept, Step 6
               DOF >= 1, a locked crease    -> Step 7                       (N_lock += 1)
               DOF = 0                      -> end, to Step 8 (not counted, Section 6.3);
-                                              with ``zero_dof_ends=False`` and a target DOF
+                                              with ``retry_zero_dof=True`` and a target DOF
                                               >= 1: a lock, Step 7
     Step 6  rank the free creases of the last accepted shape by the criterion; fix the best
     Step 7  E_fix = {} -> no developable polyhedron; otherwise replace the last fixed crease
@@ -94,7 +94,7 @@ class _Trial:
 
 
 @dataclass
-class _Shape:
+class _Frame:
     """Step 6 at one accepted shape, kept while the shape may be reduced again: the ranked
     crease groups with their scores, the candidates not yet tried (an iterator, lazy with
     look-ahead), the candidates whose paths did not reach the flat state, the candidates
@@ -152,7 +152,7 @@ class _Steps:
             crease_groups(case.pattern, case.planes, self.settings) if case.planes else None
         )
         # a DOF-0 shape cannot deploy: with the deployability check and a target >= 1 it is
-        # over-reduction, retried like a lock (as with zero_dof_ends=False)
+        # over-reduction, retried like a lock (as with retry_zero_dof=True)
         # the DOF the search counts (Settings.mechanism.dof_count): with "gap", the analysis
         # counts the singular values below dof_gap times rank_tol (near-mechanisms are DOF)
         self.count = _dof_count(self.settings, options)
@@ -165,10 +165,10 @@ class _Steps:
         self.batch = options.batch == "on" or (options.batch == "auto" and options.deploy_check)
         self.batch_size = self.settings.generation.batch_first  # the next set's size
         self.zero_ends = (
-            self.settings.generation.zero_dof_ends and not options.deploy_check
+            not self.settings.generation.retry_zero_dof and not options.deploy_check
         ) or options.target_dof == 0
         self.locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
-        self.shapes: list[_Shape] = []  # Step 6 at each solution being reduced, the last on top
+        self.shapes: list[_Frame] = []  # Step 6 at each solution being reduced, the last on top
         self.accepted: list[Attempt] = []  # the attempt of each solution
         self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
         self.backtracks = 0  # retractions by backtracking in the chain being built
@@ -351,7 +351,7 @@ class _Steps:
         )
         return ranked, order, forecast, time.perf_counter() - t1
 
-    def annotate(self, rec: Attempt, choice: Choice, shape: _Shape, current: Solution) -> None:
+    def annotate(self, rec: Attempt, choice: Choice, shape: _Frame, current: Solution) -> None:
         """The look-ahead's record of a candidate's attempt (what it skipped, what it was
         predicted to lock, what it carried, whether it was forecast second-order rigid) and
         the forecast's view of the creases it locked."""
@@ -388,7 +388,7 @@ class _Steps:
                 self.run.stop_detail = f"{self.options.time_limit:g}"
                 return Stop.TIME_LIMIT
             ranked, order, forecast, t_sel = self.rank(current)
-            self.shapes.append(_Shape(current, ranked, order, forecast, t_sel=t_sel))
+            self.shapes.append(_Frame(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
         if self.batch and not shape.batched:
@@ -450,7 +450,7 @@ class _Steps:
                 self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
 
-    def fix_set(self, current: Solution, shape: _Shape) -> Stop | bool:
+    def fix_set(self, current: Solution, shape: _Frame) -> Stop | bool:
         """Several creases in one solve (``GenerateOptions.batch``; :mod:`rigidfold.selection.
         batch`): at a shape more than ``batch_single_dof`` DOF above the target, the largest
         compatible set of its ranked candidates, of at most the next set's size and never
@@ -498,7 +498,7 @@ class _Steps:
             self.batch_size = max(2, len(chosen))
         return False
 
-    def worth_more(self, shape: _Shape) -> bool:
+    def worth_more(self, shape: _Frame) -> bool:
         """Whether the first chain keeps trying candidates at ``shape`` past
         ``restart_after`` rejected paths instead of restarting: while its next candidates
         are still forecast to deploy (the last one tried was not put off by the look-ahead
@@ -712,7 +712,7 @@ def past_time_limit(
 def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
     """The case of a run's restart at the fold limit ``limit`` (radians;
     :meth:`_Steps.restart`): with the deployability check and no bound (12) of the user's
-    (``Settings.design.rho_bar``), (12) at ``limit``; otherwise ``case`` itself (no
+    (``Settings.design.rho_max``), (12) at ``limit``; otherwise ``case`` itself (no
     restart).
 
     Each fix flattens a crease, and the solve makes up for it by folding the creases left
@@ -722,9 +722,9 @@ def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
     away from that, and IPOPT's barrier on it favours the less folded of the shapes that
     solve (6)."""
     s = case.settings
-    if not options.deploy_check or s.design.rho_bar is not None:
+    if not options.deploy_check or s.design.rho_max is not None:
         return case
-    return replace(case, settings=s.with_(rho_bar=limit))
+    return replace(case, settings=s.with_(rho_max=limit))
 
 
 def best_so_far(run: Generation) -> None:

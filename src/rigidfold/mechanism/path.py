@@ -16,7 +16,7 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
   starts in the direction that lowers the folding measure ``m = |rho_free|`` and passes the
   points where m stops falling only on its way down: it ends at the flat state; where m,
   having fallen, rises ``path_turn_back`` above its lowest (the path *turns back*: the
-  shape does not deploy along it); where a crease folds to ``path_fold_limit`` (its panels
+  shape does not deploy along it); where a crease folds to ``path_collision_angle`` (its panels
   meet); where m comes no lower for ``path_wander_steps`` steps (the path *stops short*); when
   the budget runs out; or when the step does, and then the other direction from the design is
   traced too. A sign change of ``det [J; t^T]`` is a bifurcation point, which the
@@ -500,12 +500,12 @@ class _Tracer:
     def accept(self, step: _Step) -> _End | None:
         """Move to the corrected point of ``step`` and record it (limit points where dm/ds
         changed sign, bifurcations where det [J; t^T] did), then :meth:`end`; a point where a
-        crease folds to ``path_fold_limit`` (its panels meet) ends the trace unrecorded."""
+        crease folds to ``path_collision_angle`` (its panels meet) ends the trace unrecorded."""
         cons, tr = self.cons, self.trace
         assert step.system is not None
         rho = cons.free_angles(step.y)
         fold_max = float(np.abs(rho).max(initial=0.0))
-        if fold_max >= self.settings.path.fold_limit:
+        if fold_max >= self.settings.path.collision_angle:
             return _End(
                 PathStatus.COLLISION,
                 f"crease {int(cons.free[np.argmax(np.abs(rho))])} folds to "

@@ -12,7 +12,7 @@ each has a short closed-form Hessian, so this module evaluates it directly with 
   v = c - a: Hessian in (u, v) from q = |u|^2 |v|^2 - (u . v)^2 (below), 9 x 9 per angle;
 * F1 = sum_v d_v^2, d_v = 2 pi - sum_k theta_k: a Gauss-Newton part
   2 s sum_v (grad d_v)(grad d_v)^T plus the angle Hessians weighted by -2 s d_v;
-* F2 = sum_j w_j |n_a x n_b|^2 = sum_j w_j (1 - c_j^2) and (12) rho_j = (1 - w_j)(cos rho_bar
+* F2 = sum_j w_j |n_a x n_b|^2 = sum_j w_j (1 - c_j^2) and (12) rho_j = (1 - w_j)(cos rho_max
   - c_j), with c = n_a . n_b of the unit normals of the two triangles at crease j:
   Hessian of c in (m_a, m_b) = (e1 x e2) of each triangle, chained through the bilinear m;
 * dz: the 2 x 2 Hessian of the surface per vertex (``Surface.hessian``).
@@ -225,7 +225,7 @@ class ClosedFormHessian:
         self.V, self.n, self.T, self.t = V, n, lin.T.tocsr(), lin.t
         faces = pat.faces
         F = len(faces)
-        self.rho = problem.settings.design.rho_bar
+        self.rho = problem.settings.design.rho_max
         self.angle_vertices = angle_corners(faces)  # (3F, 3): a, b, c
         inner = pat.interior_vertices
         row_of = np.full(V, -1)

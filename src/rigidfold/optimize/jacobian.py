@@ -9,13 +9,13 @@ derivatives that are short sums of element gradients:
     grad F = 2 J_r^T r                       (r, J_r: rigidfold.optimize.residuals)
     d(z_v - f(x_v, y_v))        = (-f_x, -f_y, 1)                  in (x_v, y_v, z_v)
     d theta                     = angle_gradients                  in the triangle's corners
-    d((1 - w)(cos rho_bar - cos rho)) = (1 - w) sin rho d rho      in the crease's stencil
+    d((1 - w)(cos rho_max - cos rho)) = (1 - w) sin rho d rho      in the crease's stencil
 
 This module evaluates them with NumPy and hands them to IPOPT as CasADi callbacks, with the
 Jacobian's sparsity in the independent variables xi (``P = T xi + t``) fixed per problem:
 each element entry is mapped to its nonzeros by one sparse matrix built once, as
 ``rigidfold.optimize.hessian`` does for the Hessian. The rows and their order are those of
-``NLP.g`` (dz, sector angles, then (12) when ``rho_bar`` is set); ``tests/test_jacobian.py``
+``NLP.g`` (dz, sector angles, then (12) when ``rho_max`` is set); ``tests/test_jacobian.py``
 checks both against CasADi's derivatives.
 """
 
@@ -52,14 +52,14 @@ class ClosedFormJacobian:
         self.surface = problem.surface
         self.angle_vertices = angle_corners(pat.faces)  # (3F, 3): a, b, c
         self.dz_vertices = problem.nlp.dz_vertices
-        self.rho_bar = problem.settings.design.rho_bar
+        self.rho_max = problem.settings.design.rho_max
         self.interior = pat.interior_edges
         self.stencils = pat.crease_stencils(self.interior)  # (Ei, 4): u, v, a, b
         n_dz, n_theta = len(self.dz_vertices), len(self.angle_vertices)
         blocks = [self.dz_vertices[:, None], self.angle_vertices]
-        if self.rho_bar is not None:
+        if self.rho_max is not None:
             blocks.append(self.stencils)
-        self.m = n_dz + n_theta + (len(self.stencils) if self.rho_bar is not None else 0)
+        self.m = n_dz + n_theta + (len(self.stencils) if self.rho_max is not None else 0)
         if self.m != problem.nlp.g.shape[0]:
             raise RigidfoldError(f"{self.m} constraint rows, the NLP has {problem.nlp.g.shape[0]}")
         # every element entry: its row of g and its row of P (vertex-major, then x, y, z)
@@ -87,10 +87,10 @@ class ClosedFormJacobian:
         e_dz = np.stack([-fx, -fy, np.ones(len(v))], axis=1)
         theta, e_theta = angle_gradients(X[self.angle_vertices])
         g, e = [g_dz, theta], [e_dz.ravel(), e_theta.ravel()]
-        if self.rho_bar is not None:
+        if self.rho_max is not None:
             free = 1.0 - np.asarray(w, dtype=float)[self.interior]
             rho, e_rho = fold_angle_gradients(X[self.stencils])
-            g.append(free * (np.cos(self.rho_bar) - np.cos(rho)))
+            g.append(free * (np.cos(self.rho_max) - np.cos(rho)))
             e.append(((free * np.sin(rho))[:, None] * e_rho).ravel())
         return np.concatenate(g), self.R @ np.concatenate(e)
 

@@ -7,13 +7,13 @@
     F2 = sum_{j in E_fix} |n_j1 x n_j2|^2
     s.t.     |z_i - f(x_i, y_i)| <= dz                  (every vertex that can move)
              theta_min <= theta_ik <= theta_max          (every sector angle)
-             |rho_j| <= rho_bar                          (free creases, optional, Eq. 12)
+             |rho_j| <= rho_max                          (free creases, optional, Eq. 12)
              P = T xi + t                                (Eqs. 7-11, eliminated)
 
 The model is built once per pattern, surface, symmetry and settings as CasADi SX
 expressions; the fixed-crease mask is a *parameter* ``w`` (E,), so fixing another crease
 needs no rebuild. Angles are ``atan2(|a x b|, a . b)``. Constraint (12) is imposed in the
-equivalent smooth form ``n_j1 . n_j2 >= cos(rho_bar)``.
+equivalent smooth form ``n_j1 . n_j2 >= cos(rho_max)``.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ class NLP:
         The sector angles; entry k*F + f is the angle at ``faces[f, k]``.
     g : ca.SX (m, 1)
         The constraints, in this order: ``z - f(x, y)`` at ``dz_vertices`` (k,), the sector
-        angles theta (3F,) and, when ``rho_bar`` is set, ``(1 - w_j)(cos rho_bar - n_j1 . n_j2)``
+        angles theta (3F,) and, when ``rho_max`` is set, ``(1 - w_j)(cos rho_max - n_j1 . n_j2)``
         per interior edge.
     lbg, ubg : (m,) float64
         Bounds of g (-inf where a constraint has no lower bound).
@@ -153,8 +153,8 @@ def build_nlp(
     g = [z[mv] - height, theta]
     lbg = [np.full(len(mv), -s.design.dz), np.full(theta.shape[0], s.design.theta_min)]
     ubg = [np.full(len(mv), s.design.dz), np.full(theta.shape[0], s.design.theta_max)]
-    if s.design.rho_bar is not None:
-        g.append((1 - w_int) * (np.cos(s.design.rho_bar) - _dot(na, nb)))
+    if s.design.rho_max is not None:
+        g.append((1 - w_int) * (np.cos(s.design.rho_max) - _dot(na, nb)))
         lbg.append(np.full(len(interior), -np.inf))
         ubg.append(np.zeros(len(interior)))
     return NLP(

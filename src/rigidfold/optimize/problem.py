@@ -66,7 +66,7 @@ class FormFindingProblem:
     planes : sequence of SymmetryPlane
         Vertical planes of symmetry (9); each has ``a, b, c`` and ``reflect``.
     settings : Settings
-        Design parameters (dz, theta bounds, rho_bar, F_tol) and tolerances.
+        Design parameters (dz, theta bounds, rho_max, F_tol) and tolerances.
     build_ipopt : bool
         Build the IPOPT solver (exact Hessian of the Lagrangian) now, so that ``build_time``
         covers it; otherwise it is built on the first IPOPT solve.
@@ -195,9 +195,9 @@ class FormFindingProblem:
             theta.max() - s.design.theta_max,
             self.map.residual(coords),
         ]
-        if s.design.rho_bar is not None:
+        if s.design.rho_max is not None:
             free = ~fixed & ~shape.is_boundary_edge
-            parts.append(np.abs(shape.fold_angles[free]).max(initial=0.0) - s.design.rho_bar)
+            parts.append(np.abs(shape.fold_angles[free]).max(initial=0.0) - s.design.rho_max)
         return max(0.0, *parts)
 
     # ------------------------------------------------------------------ solve

@@ -357,7 +357,7 @@ def lookahead_order(
     """The order to try ranked candidates with look-ahead: put off those predicted to lock.
 
     candidates : in the criterion's order (best first); dof0_ends : a fix that leaves DOF 0
-    ends generation (``Settings.generation.zero_dof_ends``, or a target DOF 0), so such a
+    ends generation (unless ``Settings.generation.retry_zero_dof``, or a target DOF 0), so such a
     candidate is not put off although every crease locks at DOF 0. locked_before : {candidate
     (its edges, as ranked): the creases its fix locked at an earlier shape of the run}; such a
     candidate is put off too. rigid : whether a candidate's fix (its edges) is forecast to
