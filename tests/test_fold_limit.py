@@ -111,11 +111,14 @@ def test_the_command_line_limits_in_degrees():
     assert SettingsOptions(fold_limit=()).settings().generation.fold_limits == ()
     limits = SettingsOptions(fold_limit=(150.0, 90.0)).settings().generation.fold_limits
     assert limits == pytest.approx((math.radians(150), math.radians(90)))
+    from rigidfold.cli.units import parser_of
+
     flag = fields_by_name(SettingsOptions)["fold_limit"].metadata["flag"]
-    assert flag.parse("0") == () and flag.parse("120,90") == (120.0, 90.0)
+    parse = parser_of(flag.parse)  # the command line reads the text (issue 46, item 2)
+    assert parse("0") == () and parse("120,90") == (120.0, 90.0)
     for bad in ("200", "abc", "90,"):
         with pytest.raises(RigidfoldError):
-            flag.parse(bad)
+            parse(bad)
 
 
 def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypatch):

@@ -57,7 +57,7 @@ VALUES = {
     ],
     DevelopStatus: ["converged", "flipped", "overlap", "failed"],
     DeformStatus: ["reached_plane", "failed"],
-    MotionStatus: ["ok", "failed"],
+    MotionStatus: ["ok", "failed", "cut"],
 }
 
 
