@@ -223,14 +223,7 @@ class _Run:
         self.generation = generation
         checked = None
         if self.every:
-            checked = check_solution(
-                solution,
-                self.case,
-                self.options,
-                motion=self.motion,
-                deform=self.options.deform,
-            )
-            self.add_times(checked)
+            checked = self.check(solution)
         record = solution_record(solution, self.case) if checked is None else checked.record
         self.emit(SolutionAccepted(self.result(records=(*self.records, record)), solution, checked))
         with held_interrupts():  # the record and its checks go together
@@ -249,6 +242,21 @@ class _Run:
                 self.checked.pop(solution.step, None)
         self.emit(SolutionsRetracted(self.result(), tuple(taken)))
 
+    def check(self, solution: Solution, path: FoldingPath | None = None) -> Checked:
+        """The checks of ``solution`` as the run asks (:func:`check_solution`: the motion
+        with ``motion``, Step 9 with ``options.deform``; ``path`` its traced folding path),
+        their seconds added to the stage times."""
+        checked = check_solution(
+            solution,
+            self.case,
+            self.options,
+            motion=self.motion,
+            deform=self.options.deform,
+            path=path,
+        )
+        self.add_times(checked)
+        return checked
+
     def add_times(self, checked: Checked) -> None:
         for stage, t in checked.record.time_s.items():
             self.stage_times[stage] = self.stage_times.get(stage, 0.0) + t
@@ -265,15 +273,7 @@ class _Run:
             if not self.motion or (again and final.mechanism.dof > 0):
                 self.final_path = self.trace_final(final)
             if again:
-                checked = check_solution(
-                    final,
-                    self.case,
-                    self.options,
-                    motion=self.motion,
-                    deform=self.options.deform,
-                    path=self.final_path,
-                )
-                self.add_times(checked)
+                checked = self.check(final, self.final_path)
                 if self.motion:  # the trace is the motion's
                     self.stage_times["motion"] += self.final_path_time
                 self.emit(FinalChecked(self.result(), final, checked))
