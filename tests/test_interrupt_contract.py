@@ -226,6 +226,55 @@ def test_the_exit_code_is_the_commands_once_it_has_ended(tmp_path):
     assert runs[()].returncode in (-signal.SIGINT, 130), runs[()].stderr
 
 
+def test_a_signal_a_library_swallowed_while_imported_stops_the_run(tmp_path):
+    """The moment CI found (session 23): SIGTERM 0.4 s after the start of a run on a loaded
+    machine landed while CasADi was imported, whose module runs ``try: from numpy import pi
+    ... except: pass``; the KeyboardInterrupt was swallowed there and the run went on to its
+    end (exit 0, its report written 5 s after the signal). The signal is noted, and the next
+    ``kept_interrupts`` block (the pipeline's, every solve's) raises it; once the command has
+    acted on it (:func:`interrupt_handled`), it is not raised again."""
+    module = tmp_path / "swallowed.py"
+    module.write_text(
+        "import os, signal, sys, time\n"
+        "from rigidfold.runtime.interrupts import (\n"
+        "    interrupt_handled, kept_interrupts, terminate_interrupts)\n"
+        "terminate_interrupts()\n"
+        "for name in ('SIGTERM', 'SIGINT'):\n"
+        "    try:  # as a library's import does\n"
+        "        os.kill(os.getpid(), getattr(signal, name))\n"
+        "        time.sleep(5)\n"
+        "    except:  # noqa: E722\n"
+        "        pass\n"
+        "    try:\n"
+        "        with kept_interrupts():\n"
+        "            print(name, 'lost')\n"
+        "    except KeyboardInterrupt:\n"
+        "        print(name, 'raised')\n"
+        "    with kept_interrupts():  # raised once only\n"
+        "        print(name, 'then none')\n"
+        "try:\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(5)\n"
+        "except KeyboardInterrupt:\n"
+        "    interrupt_handled()  # the command acted on it\n"
+        "with kept_interrupts():\n"
+        "    print('handled: none')\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    done = subprocess.run(
+        [sys.executable, str(module)], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n") == [
+        "SIGTERM raised",
+        "SIGTERM then none",
+        "SIGINT raised",
+        "SIGINT then none",
+        "handled: none",
+        "",
+    ]
+
+
 @pytest.fixture
 def ctrl_c():
     """SIGINT raises KeyboardInterrupt in this process, as at a terminal: a process started

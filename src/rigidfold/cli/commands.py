@@ -29,7 +29,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.generate.case_options import CaseOptions, SettingsOptions
 from rigidfold.io import jsonable
-from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, held_interrupts
+from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, held_interrupts, interrupt_handled
 from rigidfold.runtime.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.study import STUDY_OPTIONS
 
@@ -131,6 +131,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         except Interrupted as stop:
             return _interrupted(stop.result, writer, progress)
         except KeyboardInterrupt:  # before the run began, or as it returned
+            interrupt_handled()
             result = writer.interrupted()  # its end, or summary.json saying interrupted
             if result.interrupted:
                 return _interrupted(result, writer, progress)
@@ -506,6 +507,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.refuse_unknown_options(argv)
         args = parser.parse_args(argv)
     except KeyboardInterrupt:
+        interrupt_handled()
         print("rigidfold: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     if not (args.verbose or native_output_shown()):
@@ -527,6 +529,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _error(str(exc))
         return EXIT_USAGE
     except KeyboardInterrupt:
+        interrupt_handled()
         print("rigidfold: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:

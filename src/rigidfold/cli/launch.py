@@ -12,7 +12,12 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from rigidfold.runtime.clock import mark_command
-from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, command_ended, terminate_interrupts
+from rigidfold.runtime.interrupts import (
+    EXIT_INTERRUPTED,
+    command_ended,
+    interrupt_handled,
+    terminate_interrupts,
+)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -39,6 +44,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if code is None:
             print("rigidfold: interrupted", file=sys.stderr)
             code = EXIT_INTERRUPTED
+    interrupt_handled()  # the command has ended: called again in-process, it starts afresh
     if entry:
         command_ended()  # a signal from now on changes nothing, the exit code included
     return code

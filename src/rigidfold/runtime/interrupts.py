@@ -26,8 +26,15 @@ EXIT_INTERRUPTED = 130
 """The exit code of an interrupted command (128 + SIGINT), after SIGTERM too."""
 
 
+_PENDING: list[int] = []
+"""The signals :func:`_interrupt` raised outside every :func:`kept_interrupts` block and no
+command has yet acted on (:func:`interrupt_handled`)."""
+
+
 def _interrupt(signum: int, frame: FrameType | None) -> None:
-    """The handler of SIGTERM set by :func:`terminate_interrupts`: as Ctrl-C."""
+    """The handler of SIGINT and SIGTERM set by :func:`terminate_interrupts`: noted, then
+    raised as Ctrl-C."""
+    _PENDING.append(signum)
     raise KeyboardInterrupt
 
 
@@ -36,11 +43,24 @@ def terminate_interrupts() -> None:
     run stopped by ``kill`` (or a batch system) ends like an interrupted one: its files
     written, its lock released, summary.json saying "interrupted", exit 130. Only while
     SIGTERM has its default action (a program's own handler is kept), and only from the main
-    thread."""
+    thread.
+
+    Both signals are also noted: a library may swallow the KeyboardInterrupt (CasADi's
+    module runs ``try: from numpy import pi ... except: pass`` while it is imported, so a
+    SIGTERM landing there was lost and the run went on to its end, exit 0); the next
+    :func:`kept_interrupts` block (every solve, the whole pipeline) raises it again."""
     if threading.current_thread() is not threading.main_thread():
         return
     if signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
         signal.signal(signal.SIGTERM, _interrupt)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _interrupt)
+
+
+def interrupt_handled() -> None:
+    """The command has acted on a KeyboardInterrupt (it stops, or the run had ended): a
+    signal noted before it is not raised again."""
+    _PENDING.clear()
 
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -85,10 +105,15 @@ def kept_interrupts() -> Iterator[list[int]]:
     then fails as a TypeError) becomes the KeyboardInterrupt. The block is given the list
     of the signals received, for a long block to check between its steps. Nested uses share
     the outermost's handler and list, and raise again at their own end for a signal
-    received while they ran."""
+    received while they ran. The outermost raises at once a signal noted before it that
+    was not acted on (a library swallowed its KeyboardInterrupt: see
+    :func:`terminate_interrupts`)."""
     if threading.current_thread() is not threading.main_thread():
         yield []
         return
+    if _PENDING and not _ACTIVE:
+        _PENDING.clear()
+        raise KeyboardInterrupt  # one that a library swallowed before this block
     if _ACTIVE:
         shared = _ACTIVE[0]
         before = len(shared)
