@@ -183,7 +183,8 @@ def _attempts(plt, run: RunData):
 
 
 def _fit(plt, run: RunData, fit: np.ndarray):
-    steps = [d.step for d in run.designs]
+    rows = run.summary.per_solution[: len(fit)]
+    steps = [r.step for r in rows]
     fig, ax = plt.subplots(figsize=(6.4, 3.6), dpi=120)
     ax.plot(steps, fit[:, 0] * 1e3, "o-", ms=3, label="max |z - target|")
     ax.plot(steps, fit[:, 1] * 1e3, "s-", ms=3, label="RMS |z - target|")
@@ -195,7 +196,7 @@ def _fit(plt, run: RunData, fit: np.ndarray):
     ax.set_ylabel("mm")
     top = ax.secondary_xaxis("top")
     every = max(1, math.ceil(len(steps) / 12))
-    top.set_xticks(steps[::every], [str(d.dof) for d in run.designs][::every])
+    top.set_xticks(steps[::every], [str(r.dof) for r in rows][::every])
     top.set_xlabel("DOF")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

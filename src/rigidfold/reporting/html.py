@@ -457,7 +457,7 @@ def _solutions(run: RunData) -> str:
     rows = []
     for k, r in enumerate(run.summary.per_solution):
         dev, mot, dfm = r.development or {}, r.motion or {}, r.deformation
-        name = run.designs[k].name if k < len(run.designs) else ""
+        name = run.names[k] if k < len(run.names) else ""
         rows.append(
             [
                 r.step,

@@ -2,7 +2,7 @@
 
 :func:`load_run` reads ``DIR/summary.json`` (:class:`~rigidfold.rundir.RunSummary`),
 ``DIR/log.jsonl`` (:class:`rigidfold.generate.Attempt` each, :func:`read_log`) and every
-solution's FOLD file (``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its
+final design's FOLD file (``DIR/solutions/step_XX_dof_YY.fold``: the folded form, its
 development diagram and folding motion as frames (:func:`rigidfold.io.read_frames`), and
 the figures of Steps 8-9 with the large-deformation history under
 ``rigidfold:deformation``), and rebuilds the target surface from the case's metadata where
@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -211,28 +212,32 @@ class RunData:
     """Everything the report shows of one generate run.
 
     directory : Path; summary : ``summary.json``; attempts : ``log.jsonl``'s attempts, by index;
-    designs : every solution in order (the last is the final design); surface : the target
-    surface, or None with ``surface_note`` saying why.
+    names : the solutions' files in order (relative to ``directory``, each checked to be
+    there); final : the final design read from its file (the last solution, or the one
+    ``final_step`` of summary.json names: the lowest-DOF solution that deploys of a run that
+    fell short), None when the run has no solution; surface : the target surface, or None
+    with ``surface_note`` saying why. The other solutions' files are read only when asked
+    for (:attr:`designs`): the report needs their figures only, which summary.json holds.
     """
 
     directory: Path
     summary: RunSummary
     attempts: tuple[Attempt, ...]
-    designs: tuple[SolutionFile, ...]
+    names: tuple[str, ...]
+    final: SolutionFile | None
     surface: TargetSurface | None
     surface_note: str
 
-    @property
-    def final(self) -> SolutionFile | None:
-        """The final design (the last solution, or the one ``final_step`` of summary.json
-        names: the lowest-DOF solution that deploys of a run that fell short), None when the
-        run has no solution."""
-        if not self.designs:
-            return None
-        step = self.summary.final_step
-        if step is not None and 0 <= step < len(self.designs):
-            return self.designs[step]
-        return self.designs[-1]
+    @cached_property
+    def designs(self) -> tuple[SolutionFile, ...]:
+        """Every solution in order, read from its file (the final design's as read)."""
+        k = final_index(self.summary, len(self.names))
+        return tuple(
+            self.final
+            if i == k and self.final is not None
+            else read_solution(self.directory / name, name)
+            for i, name in enumerate(self.names)
+        )
 
     @property
     def at_dz_bound(self) -> float | None:
@@ -252,13 +257,13 @@ class RunData:
         return self.summary.target_dof
 
     def fit(self) -> np.ndarray:
-        """(S, 2) float64: max and RMS of |z - target| per solution, metres (NaN without a
-        surface)."""
-        out = np.full((len(self.designs), 2), np.nan)
+        """(S, 2) float64: max and RMS of |z - target| per solution, metres, as the run
+        measured them (summary.json's ``fit``; NaN without a target surface or a figure)."""
+        out = np.full((len(self.names), 2), np.nan)
         if self.surface is not None:
-            for k, design in enumerate(self.designs):
-                dz = np.abs(design.dz(self.surface))
-                out[k] = dz.max(), np.sqrt(np.mean(dz**2))
+            for k, row in enumerate(self.summary.per_solution[: len(self.names)]):
+                fit = row.fit or {}
+                out[k] = fit.get("max_abs_dz_m", np.nan), fit.get("rms_dz_m", np.nan)
         return out
 
     @property
@@ -454,7 +459,6 @@ def load_run(directory: str | os.PathLike) -> RunData:
     summary = RunSummary.from_dict(_json_object(root, "summary.json"), root / "summary.json")
     attempts = read_log(inside_dir(root, root / LOG_FILE))
     names = summary.solutions
-    designs = []
     seen: dict[str, int] = {}
     for k, name in enumerate(names):
         if name in seen:  # each solution once: a repeated name is a damaged summary
@@ -472,17 +476,31 @@ def load_run(directory: str | os.PathLike) -> RunData:
         path = inside_dir(root, root / name)
         if not path.is_file():
             raise RigidfoldError(f"solution file {str(path)!r} listed in summary.json is missing")
-        designs.append(read_solution(path, name))
+    index = final_index(summary, len(names))
+    final = (
+        None
+        if index is None
+        else read_solution(inside_dir(root, root / names[index]), names[index])
+    )
     surface, note = target_surface(summary.case.get("surface") or {})
     if surface is None and summary.target_surface is not None:
         surface, note = _stored_surface(root, summary.target_surface)
-    if surface is not None and not all(_measurable(d, surface) for d in designs):
+    if surface is not None and final is not None and not _measurable(final, surface):
         source = "" if summary.target_surface is None else f" (from {summary.target_surface})"
         surface, note = (
             None,
             f"the target surface could not be rebuilt{source}: its heights are too large",
         )
-    return RunData(root, summary, attempts, tuple(designs), surface, note)
+    return RunData(root, summary, attempts, tuple(names), final, surface, note)
+
+
+def final_index(summary: RunSummary, count: int) -> int | None:
+    """The index of the final design among ``count`` solutions: summary.json's
+    ``final_step`` where it is one of them, else the last; None without a solution."""
+    if count == 0:
+        return None
+    step = summary.final_step
+    return step if step is not None and 0 <= step < count else count - 1
 
 
 def _measurable(design: SolutionFile, surface: TargetSurface) -> bool:
