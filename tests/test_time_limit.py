@@ -212,8 +212,9 @@ def test_a_trace_cut_by_the_time_limit_is_no_rejected_path(monkeypatch):
 
 
 def test_the_traces_naming_the_final_design_have_a_deadline_and_are_counted(monkeypatch):
-    """After the limit T, the bisection's traces end by T + max(time_limit_grace_min,
-    time_limit_grace T), and their seconds are in time_s.path."""
+    """After the search, the bisection's traces end a grace after the search's end (the
+    limit T less the reserve for the final stages, :mod:`rigidfold.generate.budget`), and
+    their seconds are in time_s.path."""
     import time
 
     import rigidfold.generate.steps as generation
@@ -231,9 +232,10 @@ def test_the_traces_naming_the_final_design_have_a_deadline_and_are_counted(monk
     t0 = time.monotonic()
     run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False, time_limit=100))
     assert run.stop is Stop.TIME_LIMIT and seen
-    g = DEFAULTS.generation
-    grace = max(g.time_limit_grace_min, g.time_limit_grace * 100)
-    assert all(d is not None and t0 + 100 + grace - 1 < d < t0 + 100 + grace + 1 for d in seen)
+    from rigidfold.generate.budget import time_budget
+
+    naming = time_budget(t0, 100, make_case("bezier", "1").pattern.n_vertices, DEFAULTS).naming
+    assert all(d is not None and naming - 1 < d < naming + 1 for d in seen)
     assert run.final_path_time >= 0.01 * len(seen)
     assert run.to_dict()["time_s"]["path"] >= run.final_path_time
 
@@ -306,14 +308,28 @@ def test_the_process_age_counts_from_the_start_of_the_process():
     assert first > 0.0 and second >= first + 0.04
 
 
-def test_the_graces_after_a_time_limit():
-    """Naming the final design ends a grace after T, the whole run by two graces:
-    T + max(10 s, 5 % of T) with the defaults."""
-    from rigidfold.generate.steps import past_time_limit
+def test_the_time_budget_of_a_run():
+    """A run ends by T + max(10 s, 5 % of T) with the defaults; the search stops before T by
+    the reserve for the final design's stages (grown with the pattern, at most a share of
+    T) less half a grace; naming the final design ends a grace after the search, its path a
+    grace and a half; the reserve fits between the path's end and the run's."""
+    from rigidfold.generate.budget import time_budget
 
-    assert past_time_limit(100.0, None, DEFAULTS) is None
-    assert past_time_limit(100.0, 180.0, DEFAULTS, 2.0) == 100.0 + 180.0 + 10.0
-    assert past_time_limit(100.0, 600.0, DEFAULTS, 2.0) == 100.0 + 600.0 + 30.0
+    g = DEFAULTS.generation
+    assert time_budget(100.0, None, 50, DEFAULTS) is None
+    for limit, vertices in [(180.0, 49), (180.0, 684), (600.0, 1681), (30.0, 1681), (4.0, 10)]:
+        b = time_budget(100.0, limit, vertices, DEFAULTS)
+        grace = max(10.0, 0.05 * limit) / 2
+        assert b.grace == grace and b.end == 100.0 + limit + 2 * grace
+        assert b.reserve <= g.time_limit_reserve_share * limit + 1e-12
+        assert b.search <= 100.0 + limit
+        assert b.naming == b.search + grace and b.path == b.search + 1.5 * grace
+        assert b.path + b.reserve <= b.end + 1e-9
+    small, large = (time_budget(0.0, 180.0, v, DEFAULTS) for v in (49, 684))
+    assert small.search >= 178.0  # a small pattern's stages take a few seconds
+    assert large.reserve > small.reserve and large.search < small.search
+    # a short limit keeps most of T for the search
+    assert time_budget(0.0, 30.0, 1681, DEFAULTS).search >= 0.75 * 30.0
 
 
 def test_a_limit_counts_from_the_commands_start_only_in_the_command():

@@ -193,6 +193,25 @@ class GenerationSettings(Group):
     time_limit_grace_min: float = setting(
         5.0, "Seconds: the least of the grace after a time limit (``time_limit_grace``)."
     )
+    time_limit_reserve: float = setting(
+        3.0,
+        "Seconds a run with a time limit keeps for what follows the final design's path (its "
+        "DOF margin, checks, exports, summary and report), plus "
+        "``time_limit_reserve_per_vertex`` per vertex, at most ``time_limit_reserve_share`` "
+        "of T: the search stops that much (less half a grace) before T "
+        "(:mod:`rigidfold.generate.budget`).",
+    )
+    time_limit_reserve_per_vertex: float = setting(
+        0.02,
+        "Seconds per vertex of the reserve for the final design's stages "
+        "(``time_limit_reserve``): 17 s on a 684-vertex drawn pattern, measured "
+        "(docs/broad_set.md, Session 23).",
+    )
+    time_limit_reserve_share: float = setting(
+        0.25,
+        "The most of a time limit T that the reserve for the final design's stages "
+        "(``time_limit_reserve``) may take: the search keeps at least the rest.",
+    )
     summary_interval: float = setting(
         2.0,
         "Seconds between writes of a run's summary.json after attempts that are rejected "
@@ -216,8 +235,18 @@ class GenerationSettings(Group):
                 f"restart_after must be a whole number >= 1, got {self.restart_after!r}"
             )
         self._non_negative(
-            "summary_interval", "time_limit_grace", "time_limit_grace_min", "batch_tol"
+            "summary_interval",
+            "time_limit_grace",
+            "time_limit_grace_min",
+            "time_limit_reserve",
+            "time_limit_reserve_per_vertex",
+            "batch_tol",
         )
+        if not 0 <= self.time_limit_reserve_share < 1:
+            raise RigidfoldError(
+                "time_limit_reserve_share must lie in [0, 1), got "
+                f"{self.time_limit_reserve_share!r}"
+            )
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):

@@ -55,6 +55,7 @@ from rigidfold.config import (
     one_blas_thread,
 )
 from rigidfold.frame.model import default_support_face
+from rigidfold.generate.budget import time_budget
 from rigidfold.generate.case import Case
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import (
@@ -146,6 +147,9 @@ class _Steps:
         )
         t0 = time.perf_counter()
         self.started = time.monotonic() if started is None else started
+        self.budget = time_budget(
+            self.started, options.time_limit, case.pattern.n_vertices, case.settings
+        )
         self.problem = case.problem(build_ipopt=options.solver == SolverName.IPOPT)
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
@@ -285,17 +289,16 @@ class _Steps:
 
     @property
     def deadline(self) -> float | None:
-        """The end of the run's time limit (``GenerateOptions.time_limit``), a time of
-        ``time.monotonic()``; None without a limit. The solve under way and a candidate's
-        path trace end there."""
-        limit = self.options.time_limit
-        return None if limit is None else self.started + limit
+        """The end of the search (:attr:`TimeBudget.search`: the time limit less the
+        reserve for the final design's stages), a time of ``time.monotonic()``; None
+        without a limit. The solve under way and a candidate's path trace end there."""
+        return None if self.budget is None else self.budget.search
 
     @property
     def final_deadline(self) -> float | None:
-        """The end of naming the final design after the time limit T: T + max(
-        ``time_limit_grace_min``, ``time_limit_grace`` T) (None without a limit)."""
-        return past_time_limit(self.started, self.options.time_limit, self.settings)
+        """The end of naming the final design (:attr:`TimeBudget.naming`, a grace after the
+        search's end; None without a limit)."""
+        return None if self.budget is None else self.budget.naming
 
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
@@ -692,21 +695,6 @@ def generate(
             counted=final.mechanism.dof,
         ).to_dict()
     return run
-
-
-def past_time_limit(
-    started: float, limit: float | None, settings: Settings, graces: float = 1.0
-) -> float | None:
-    """The time of ``time.monotonic()`` ``graces`` graces after a run's time limit ``limit``
-    (seconds from ``started``; None: no limit, no time). The grace is max(
-    ``time_limit_grace_min``, ``time_limit_grace`` x limit): naming the final design ends
-    one grace after the limit, the final design's folding motion one and a half, and the
-    whole run (its exports, summary and report) by two: T + max(10 s, 5 % of T) with the
-    defaults."""
-    if limit is None:
-        return None
-    g = settings.generation
-    return started + limit + graces * max(g.time_limit_grace_min, g.time_limit_grace * limit)
 
 
 def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:

@@ -53,8 +53,8 @@ from rigidfold.generate import (
     best_so_far,
     generate,
 )
+from rigidfold.generate.budget import time_budget
 from rigidfold.generate.case import Case
-from rigidfold.generate.steps import past_time_limit
 from rigidfold.io import prepare_output_dir
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mesh import CreasePattern
@@ -102,11 +102,12 @@ def run(
     ``run_dir`` to write their files into.
 
     ``started``: the time of ``time.monotonic()`` that ``options.time_limit`` T counts from
-    (default: now; the command line gives its process's start). The search stops at T,
-    naming the final design ends a grace after it, the final design's folding path a grace
-    and a half (a trace it cuts makes the motion ``cut``), and what is left (exports,
-    summary, report) has the rest of two graces: T + max(10 s, 5 % of T) with the defaults
-    (:func:`rigidfold.generate.steps.past_time_limit`)."""
+    (default: now; the command line gives its process's start). The run ends by T + two
+    graces, T + max(10 s, 5 % of T) with the defaults: the search stops before T by what
+    the final design's margin, checks, exports and report are estimated to take beyond
+    half a grace (from the pattern's size), naming the final design ends a grace after the
+    search, the final design's folding path a grace and a half (a trace it cuts makes the
+    motion ``cut``) (:mod:`rigidfold.generate.budget`)."""
     return _Run(case, options, tuple(sinks), motion, started).go()
 
 
@@ -137,8 +138,11 @@ class _Run:
     ) -> None:
         check_built_options(case.pattern, options)
         self.started = time.monotonic() if started is None else started
-        # the final design's path and motion end here, 1.5 graces after the time limit
-        self.deadline = past_time_limit(self.started, options.time_limit, case.settings, 1.5)
+        # the final design's path and motion end here, 1.5 graces after the search's end
+        budget = time_budget(
+            self.started, options.time_limit, case.pattern.n_vertices, case.settings
+        )
+        self.deadline = None if budget is None else budget.path
         self.run_dir: Path | None = next(
             (d for s in sinks if (d := getattr(s, "run_dir", None)) is not None), None
         )
