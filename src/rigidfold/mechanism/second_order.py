@@ -70,6 +70,8 @@ from functools import cached_property, lru_cache
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
@@ -177,23 +179,33 @@ class Constraints:
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """(n_c, 3V) dense dg/dx at x (V, 3)."""
+        return self.sparse_jacobian(x).toarray()
+
+    def sparse_jacobian(self, x: np.ndarray) -> sp.csr_matrix:
+        """(n_c, 3V) dg/dx at x (V, 3), sparse: 6 entries per edge, 12 per fixed crease, 1
+        per held coordinate."""
         pat = self.pattern
         E, V = pat.n_edges, pat.n_vertices
-        A = np.zeros((self.n_rows, 3 * V))
         e = pat.edges
         d = x[e[:, 1]] - x[e[:, 0]]
         d /= np.linalg.norm(d, axis=1, keepdims=True)
-        rows = np.arange(E)[:, None]
-        A[rows, 3 * e[:, :1] + np.arange(3)] = -d
-        A[rows, 3 * e[:, 1:] + np.arange(3)] = d
+        xyz = np.arange(3)
+        rows = [np.repeat(np.arange(E), 6)]
+        cols = [np.concatenate([3 * e[:, :1] + xyz, 3 * e[:, 1:] + xyz], axis=1).ravel()]
+        vals = [np.concatenate([-d, d], axis=1).ravel()]
         if len(self.creases):
-            _, grad, cols = fold_angles_and_gradients(x, self.stencils)
-            r = E + np.arange(len(self.creases))[:, None]
-            np.add.at(A, (np.broadcast_to(r, cols.shape), cols), grad / self.scale[:, None])
+            _, grad, at = fold_angles_and_gradients(x, self.stencils)
+            rows.append(np.repeat(E + np.arange(len(self.creases)), at.shape[1]))
+            cols.append(at.ravel())
+            vals.append((grad / self.scale[:, None]).ravel())
         base = E + len(self.creases)
-        for k, v in enumerate(self.held):
-            A[base + 3 * k + np.arange(3), 3 * v + np.arange(3)] = 1.0
-        return A
+        rows.append(base + np.arange(3 * len(self.held)))
+        cols.append((3 * self.held[:, None] + xyz).ravel())
+        vals.append(np.ones(3 * len(self.held)))
+        return sp.csr_matrix(
+            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+            shape=(self.n_rows, 3 * V),
+        )
 
     def stress_forms(self, Z: np.ndarray) -> np.ndarray:
         """(n_c, k, k) z^T Hess g_i z of every constraint on the flexes Z (3V, k), at the
@@ -332,22 +344,32 @@ def _finite_motion(
     """The design moved ``step`` mean edge lengths along the flex z (3V,), corrected at
     right angles to z by Gauss-Newton until every constraint holds to ``tol`` (of the mean
     edge length): that displacement (3V,) when it does within a correction smaller than
-    the step, else None."""
+    the step, else None. Each correction is the least-norm solution of the linearised
+    constraints and z . dx = 0, from the sparse system ``[[I, A^T], [A, -delta I]]``
+    (``delta`` = ``Settings.path.regularization``'s default: redundant rows, self-stresses,
+    are allowed): a dense least-squares solve took 1.5 s at 500 vertices."""
     scale = float(np.mean(cons.lengths))
     t = step * scale
     zn = z / np.linalg.norm(z)
     x0 = cons.x0.ravel()
     x = x0 + t * z
+    n = len(x0)
+    delta = DEFAULTS.path.regularization
     for _ in range(iterations):
         g = cons.values(x.reshape(-1, 3))
         if np.linalg.norm(g) <= tol * scale:
             moved = x - x0
             corr = moved - (moved @ zn) * zn
             return moved if np.linalg.norm(corr) < t else None
-        A = np.vstack([cons.jacobian(x.reshape(-1, 3)), zn])
-        dx = np.linalg.lstsq(A, np.r_[-g, 0.0], rcond=None)[0]
-        x = x + dx
-        if np.linalg.norm(x - x0 - (x - x0) @ zn * zn) >= t:
+        A = sp.vstack([cons.sparse_jacobian(x.reshape(-1, 3)), sp.csr_matrix(zn[None])])
+        m = A.shape[0]
+        K = sp.bmat([[sp.identity(n), A.T], [A, -delta * sp.identity(m)]], format="csc")
+        try:
+            solution = spla.splu(K, permc_spec="COLAMD").solve(np.r_[np.zeros(n), -g, 0.0])
+        except RuntimeError:  # an exactly singular factor: no correction
+            return None
+        x = x + solution[:n]
+        if not np.all(np.isfinite(x)) or np.linalg.norm(x - x0 - (x - x0) @ zn * zn) >= t:
             return None
     return None
 
