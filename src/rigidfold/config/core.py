@@ -207,6 +207,12 @@ class GenerationSettings(Group):
         "(``time_limit_reserve``): 17 s on a 684-vertex drawn pattern, measured "
         "(docs/broad_set.md, Session 23).",
     )
+    time_limit_load_max: float = setting(
+        3.0,
+        "The most that the machine's load (wall time over the process's CPU time during the "
+        "run) may stretch the reserve for the final design's stages "
+        "(``time_limit_reserve``); at most half of T is kept whatever the load.",
+    )
     time_limit_reserve_share: float = setting(
         0.25,
         "The most of a time limit T that the reserve for the final design's stages "
@@ -242,6 +248,10 @@ class GenerationSettings(Group):
             "time_limit_reserve_per_vertex",
             "batch_tol",
         )
+        if not self.time_limit_load_max >= 1:
+            raise RigidfoldError(
+                f"time_limit_load_max must be at least 1, got {self.time_limit_load_max!r}"
+            )
         if not 0 <= self.time_limit_reserve_share < 1:
             raise RigidfoldError(
                 "time_limit_reserve_share must lie in [0, 1), got "

@@ -192,9 +192,13 @@ class _Steps:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
         (with the deployability check), analyse the mechanism, classify, trace the path.
         With a time limit the solve ends at the run's deadline, the initial solve (``start``
-        None: without it the run has no design) at :attr:`final_deadline`."""
+        None: without it the run has no design) a grace after T
+        (:attr:`TimeBudget.first_solve`)."""
         opts, settings = self.options, self.settings
-        deadline = self.deadline if start is not None else self.final_deadline
+        if start is not None or self.budget is None:
+            deadline = self.deadline
+        else:
+            deadline = self.budget.first_solve
         result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
         cut = deadline is not None and time.monotonic() > deadline
         if opts.deploy_check:

@@ -138,11 +138,10 @@ class _Run:
     ) -> None:
         check_built_options(case.pattern, options)
         self.started = time.monotonic() if started is None else started
-        # the final design's path and motion end here, 1.5 graces after the search's end
-        budget = time_budget(
+        # the final design's path and motion end 1.5 graces after the search's end
+        self.budget = time_budget(
             self.started, options.time_limit, case.pattern.n_vertices, case.settings
         )
-        self.deadline = None if budget is None else budget.path
         self.run_dir: Path | None = next(
             (d for s in sinks if (d := getattr(s, "run_dir", None)) is not None), None
         )
@@ -306,7 +305,7 @@ class _Run:
             dof=final.mechanism.dof,
             support_face=self.options.support_face,
             settings=self.case.settings,
-            deadline=self.deadline,
+            deadline=None if self.budget is None else self.budget.path,
         )
         self.final_path_time = time.perf_counter() - t0
         return path
