@@ -19,7 +19,8 @@ machine, 2 where another program takes half the core; at most
 ``time_limit_load_max``): the parts after the search take that much longer too. The search
 then stops ``max(0, reserve - grace / 2)`` before T, naming the final design ends a grace
 after the search, the final design's path a grace and a half after it, and the reserve
-follows.
+follows. The first solve alone ends half a grace after T whatever the reserve: without it
+there is no design.
 """
 
 from __future__ import annotations
@@ -65,9 +66,10 @@ class TimeBudget:
 
     @property
     def first_solve(self) -> float:
-        """The first solve ends here, a grace after T, whatever the reserve: without it the
-        run has no design, and a run without one has no final stages to keep time for."""
-        return self.started + self.limit + self.grace
+        """The first solve ends here, half a grace after T, whatever the reserve: without it
+        the run has no design, and a run without one has no final stages to keep time for
+        (its summary and report take a few seconds)."""
+        return self.started + self.limit + self.grace / 2
 
     @property
     def naming(self) -> float:

@@ -192,7 +192,7 @@ class _Steps:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
         (with the deployability check), analyse the mechanism, classify, trace the path.
         With a time limit the solve ends at the run's deadline, the initial solve (``start``
-        None: without it the run has no design) a grace after T
+        None: without it the run has no design) half a grace after T
         (:attr:`TimeBudget.first_solve`)."""
         opts, settings = self.options, self.settings
         if start is not None or self.budget is None:
