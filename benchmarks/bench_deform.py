@@ -18,7 +18,7 @@ import time
 from rigidfold.deform import deform, folding_motion
 from rigidfold.develop import develop
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 
 def main() -> None:
@@ -28,7 +28,7 @@ def main() -> None:
     args = parser.parse_args()
     deform_times = []
     for seed in range(args.seeds):
-        run = generate(make_case("bezier", "1", seed=seed), criterion="shat", seed=seed)
+        run = generate(case_from_specs("bezier", "1", seed=seed), criterion="shat", seed=seed)
         shape = run.solutions[-1].result.pattern
         dev = develop(shape)
         times, mtimes = [], []

@@ -15,7 +15,7 @@ import statistics
 import time
 
 from rigidfold.develop import develop
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 
 def bench(label: str, case, paper: float, repeat: int) -> None:
@@ -38,8 +38,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
-    bench("pattern 1 (Bezier 1)", make_case("bezier", "1", seed=1), 3.31, args.repeat)
-    bench("11 x 11 (dome, asym)", make_case("dome", "11"), 20.3, args.repeat)
+    bench("pattern 1 (Bezier 1)", case_from_specs("bezier", "1", seed=1), 3.31, args.repeat)
+    bench("11 x 11 (dome, asym)", case_from_specs("dome", "11"), 20.3, args.repeat)
 
 
 if __name__ == "__main__":

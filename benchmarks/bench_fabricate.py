@@ -39,7 +39,7 @@ from rigidfold.fabricate.cutsheets import (
     sheets_summary,
 )
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 ROOF_EXPR = "0.06*x*(12-x)/6 + 0.05*y*(8-y)"
 """The README's 12 m x 8 m barrel roof."""
@@ -52,9 +52,11 @@ GAP = DEFAULTS.fabricate.sheet_gap
 def design(name: str):
     """The final pattern of design ``name`` (see the module's text)."""
     if name == "11":
-        run = generate(make_case("bezier", "11", seed=1), criterion="shat", seed=1, lookahead=True)
+        run = generate(
+            case_from_specs("bezier", "11", seed=1), criterion="shat", seed=1, lookahead=True
+        )
     else:
-        case = make_case("expr", "grid:9x6", size="12x8", expr=ROOF_EXPR)
+        case = case_from_specs("expr", "grid:9x6", size="12x8", expr=ROOF_EXPR)
         run = generate(case, criterion="shat", lookahead=False)
     assert run.final is not None, name
     return run.final.result.pattern

@@ -18,7 +18,7 @@ import time
 
 from rigidfold.config import one_blas_thread
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.selection import rank_candidates, score_creases
 
@@ -45,7 +45,7 @@ def bench_generate(seeds: int) -> None:
     walls, solves = [], []
     for seed in range(seeds):
         t0 = time.perf_counter()
-        run = generate(make_case("bezier", "1", seed=seed), criterion="shat", seed=seed)
+        run = generate(case_from_specs("bezier", "1", seed=seed), criterion="shat", seed=seed)
         walls.append(time.perf_counter() - t0)
         solves.append(len(run.attempts))
         s = run.to_dict()
@@ -64,8 +64,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=5)
     args = parser.parse_args()
-    bench_analysis("pattern 1 (Bezier 0)", make_case("bezier", "1", seed=0), 0.0113)
-    bench_analysis("11 x 11 (dome, asym)", make_case("dome", "11"), 0.882)
+    bench_analysis("pattern 1 (Bezier 0)", case_from_specs("bezier", "1", seed=0), 0.0113)
+    bench_analysis("11 x 11 (dome, asym)", case_from_specs("dome", "11"), 0.882)
     bench_generate(args.seeds)
 
 

@@ -20,7 +20,7 @@ import time
 
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 
 def main() -> None:
@@ -31,7 +31,7 @@ def main() -> None:
     parser.add_argument("--ipopt-alone", action="store_true")
     args = parser.parse_args()
     settings = DEFAULTS.with_(projection_vertices=10**9) if args.ipopt_alone else DEFAULTS
-    case = make_case("dome", f"grid:{args.grid}x{args.grid}", size="3x3", settings=settings)
+    case = case_from_specs("dome", f"grid:{args.grid}x{args.grid}", size="3x3", settings=settings)
     messages: list[tuple[float, str]] = []  # (seconds, the solver's words) of every solve
     build = case.problem
 

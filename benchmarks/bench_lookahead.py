@@ -26,7 +26,7 @@ import numpy as np
 
 from rigidfold.config import one_blas_thread
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.selection import lock_forecast, lookahead_order, rank_candidates, score_creases
 
@@ -81,7 +81,7 @@ def bench_generate(seeds: int) -> None:
         for seed in range(seeds):
             t0 = time.perf_counter()
             run = generate(
-                make_case("bezier", "1", seed=seed),
+                case_from_specs("bezier", "1", seed=seed),
                 criterion="shat",
                 seed=seed,
                 lookahead=lookahead,
@@ -111,8 +111,10 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--repeat", type=int, default=30)
     args = parser.parse_args()
-    bench_selection("pattern 1 (Bezier 1)", make_case("bezier", "1", seed=1), "shat", args.repeat)
-    bench_selection("11 x 11 (dome, asym)", make_case("dome", "11"), "s", args.repeat)
+    bench_selection(
+        "pattern 1 (Bezier 1)", case_from_specs("bezier", "1", seed=1), "shat", args.repeat
+    )
+    bench_selection("11 x 11 (dome, asym)", case_from_specs("dome", "11"), "s", args.repeat)
     bench_generate(args.seeds)
 
 

@@ -15,7 +15,7 @@ Each child runs on one BLAS thread (as ``generate``) and reports, as one JSON li
 * solve: one IPOPT solve of (6) on pattern 1 (Bezier seed 0) from the lifted shape with no
   fixed crease (the first solve of ``generate``, as ``bench_optimize.py``), median of
   ``--inner`` solves of the same built problem; the model build is not timed;
-* generate: a whole ``generate`` of the demo case (``make_case("bezier", "1", seed=1)``,
+* generate: a whole ``generate`` of the demo case (``case_from_specs("bezier", "1", seed=1)``,
   criterion S-hat, seed 1, no Step 9), with its number of solves and the time per solve
   (the whole run's and the solves' own) and IPOPT iterations per solve, since the two modes
   may take different paths;
@@ -76,7 +76,7 @@ def child(args: argparse.Namespace) -> None:
     from bench_scale import timed as median_time  # this folder is on sys.path (a script)
     from rigidfold.config import one_blas_thread
     from rigidfold.generate import generate
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.mechanism import analyze
     from rigidfold.runtime.numerics import numeric_environment
 
@@ -84,12 +84,12 @@ def child(args: argparse.Namespace) -> None:
     row: dict = {"mode": args.child, "status": env.status.value, "canary": env.canary}
     row["unpinned"] = list(env.unpinned)
     with one_blas_thread():
-        problem = make_case("bezier", "1", seed=0).problem(build_ipopt=True)
+        problem = case_from_specs("bezier", "1", seed=0).problem(build_ipopt=True)
         row["solve_s"], result = median_time(problem.solve, args.inner)
         row["solve_iterations"] = result.iterations
         row["solve_converged"] = bool(result.converged)
         if not args.skip_generate:
-            case = make_case("bezier", "1", seed=1)
+            case = case_from_specs("bezier", "1", seed=1)
             t0 = time.perf_counter()
             run = generate(case, criterion="shat", seed=1)
             row["generate_s"] = time.perf_counter() - t0
@@ -99,7 +99,7 @@ def child(args: argparse.Namespace) -> None:
             row["gen_solve_s"] = s["time_s"]["solve"] / max(s["n_solves"], 1)
             row["gen_iterations"] = sum(a.iterations for a in run.attempts) / max(s["n_solves"], 1)
             row["path"] = f"DOF {s['initial_dof']} -> {s['final_dof']}, N_lock {s['n_lock']}"
-        shape = make_case("dome", "grid:41x41", size="3x3").pattern
+        shape = case_from_specs("dome", "grid:41x41", size="3x3").pattern
         row["analysis_41_s"], mech = median_time(
             lambda: analyze(shape.with_coords(shape.coords)), args.inner
         )

@@ -19,7 +19,7 @@ import argparse
 import statistics
 import time
 
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 PAPER_SECONDS = {"pattern 1": 72.4, "pattern 2": 79.3, "dome sym": 202, "dome asym": 1015}
 PAPER_SECONDS.update({"hp sym": 218, "hp asym": 1133})
@@ -27,11 +27,11 @@ PAPER_SECONDS.update({"hp sym": 218, "hp asym": 1133})
 
 def cases(seeds: int):
     for name, pattern in (("pattern 1", "1"), ("pattern 2", "2")):
-        yield name, [make_case("bezier", pattern, seed=s) for s in range(seeds)]
+        yield name, [case_from_specs("bezier", pattern, seed=s) for s in range(seeds)]
     for surface in ("dome", "hp"):
         for sym in (True, False):
             label = f"{surface} {'sym' if sym else 'asym'}"
-            yield label, [make_case(surface, "11", symmetric=sym)]
+            yield label, [case_from_specs(surface, "11", symmetric=sym)]
 
 
 def run(args: argparse.Namespace) -> None:

@@ -25,7 +25,7 @@ from legacy_motion import legacy_folding_motion
 from rigidfold.deform import folding_motion
 from rigidfold.develop import develop
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.patterns import miura
 
 RESCH = (
@@ -34,7 +34,7 @@ RESCH = (
 
 
 def shapes():
-    case = make_case("hp", str(RESCH), seed=7)
+    case = case_from_specs("hp", str(RESCH), seed=7)
     run = generate(case, criterion="shat", seed=7, lookahead=True)
     final = run.final
     assert final is not None

@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfold.config import DEFAULTS, Settings, one_blas_thread
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.selection import score_creases
 
@@ -51,7 +51,7 @@ SLOPE_RANGE = (121, 1681)
 
 
 def grid_case(n: int):
-    return make_case("dome", f"grid:{n}x{n}", size="3x3")
+    return case_from_specs("dome", f"grid:{n}x{n}", size="3x3")
 
 
 def peak_mb() -> float:

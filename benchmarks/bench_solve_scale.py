@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import SolverName
 
 IPOPT_ALONE = DEFAULTS.with_(projection_vertices=10**9)
@@ -90,8 +90,10 @@ def main() -> None:
     args = parser.parse_args()
 
     print("paper's size (medians of --repeat; pattern 1: median over seeds)")
-    paper = [measure(make_case("bezier", "1", seed=s), args.repeat) for s in range(args.seeds)]
-    dome11 = measure(make_case("dome", "11"), args.repeat)
+    paper = [
+        measure(case_from_specs("bezier", "1", seed=s), args.repeat) for s in range(args.seeds)
+    ]
+    dome11 = measure(case_from_specs("dome", "11"), args.repeat)
     for label, rows in (("pattern 1", paper), ("dome 11x11", [dome11])):
         med = {k: statistics.median(r[k] for r in rows) for k in rows[0] if k != "status"}
         print(
@@ -110,11 +112,12 @@ def main() -> None:
     print(header)
     rows = []
     for g in (int(text) for text in args.grids.split(",")):
-        r = measure(make_case("dome", f"grid:{g}x{g}", size="3x3"), args.repeat)
+        r = measure(case_from_specs("dome", f"grid:{g}x{g}", size="3x3"), args.repeat)
         ref = {"solve_wall": float("nan"), "step_wall": float("nan")}
         if not args.no_reference:
             ref = measure(
-                make_case("dome", f"grid:{g}x{g}", size="3x3", settings=IPOPT_ALONE), args.repeat
+                case_from_specs("dome", f"grid:{g}x{g}", size="3x3", settings=IPOPT_ALONE),
+                args.repeat,
             )
         rows.append(r)
         print(

@@ -5,7 +5,7 @@ Run with ``python benchmarks/bench_structure_scale.py [--grids 8,12,17,25,33,40]
 [--supports auto,service] [--modes 3] [--timeout 900] [--repeat 1] [--case dome]``.
 
 Cases: ``grid:NxN`` spanning 3 m (every diagonal towards the centre,
-:func:`rigidfold.patterns.grid`) lifted onto the dome (``make_case("dome", "grid:NxN",
+:func:`rigidfold.patterns.grid`) lifted onto the dome (``case_from_specs("dome", "grid:NxN",
 size="3x3")``; ``--case barrel`` and ``flat``: :func:`design`), every interior edge a free
 hinge: 2 (N - 1)^2 triangles, grid:40x40 the issue's 3042. Each is written to a FOLD file
 and checked by the command line (``rigidfold structure FILE --out DIR --supports S --modes
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import write_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.patterns.grids import grid
@@ -44,9 +44,9 @@ def design(case: str, n: int) -> CreasePattern:
     roof's shallow surface (nearly flat: a near-mechanism per inner vertex); ``flat``: the
     plane grid over 3 m x 3 m (a first-order motion per inner vertex)."""
     if case == "dome":
-        return make_case("dome", f"grid:{n}x{n}", size="3x3").pattern
+        return case_from_specs("dome", f"grid:{n}x{n}", size="3x3").pattern
     if case == "barrel":
-        return make_case("expr", f"grid:{n}x{n}", size="12x8", expr=ROOF).pattern
+        return case_from_specs("expr", f"grid:{n}x{n}", size="12x8", expr=ROOF).pattern
     xy, triangles = grid(n, n, 3.0, 3.0)
     return CreasePattern.from_faces(np.column_stack([xy, np.zeros(len(xy))]), triangles)
 

@@ -27,7 +27,7 @@ from threadpoolctl import threadpool_info, threadpool_limits
 from rigidfold.config import DEFAULTS
 from rigidfold.config import blas as config
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 
 @contextlib.contextmanager
@@ -44,7 +44,7 @@ def caller_threads(n: int | None):
 def first_solve(threads: int, hessian: str) -> tuple[np.ndarray, float, int]:
     settings = DEFAULTS.with_(ipopt_hessian=hessian)
     with caller_threads(threads):
-        case = make_case("hp", "11", symmetric=True, settings=settings)
+        case = case_from_specs("hp", "11", symmetric=True, settings=settings)
         result = case.problem().solve()
     return result.coords, result.F, result.iterations
 
@@ -68,7 +68,7 @@ def main() -> None:
             f"{iterations:3d} iterations  max |coordinate - 1-thread closed-form| {diff:.3f} m"
         )
 
-    cases = [make_case("bezier", "2", seed=s) for s in range(args.seeds)]
+    cases = [case_from_specs("bezier", "2", seed=s) for s in range(args.seeds)]
     times: dict[str, list[float]] = {"one thread": [], "default threads": []}
     for _ in range(args.repeat):
         for mode, threads in (("one thread", 1), ("default threads", None)):

@@ -129,8 +129,8 @@ class BroadCase:
         return args
 
     def make_case_kwargs(self, work: Path) -> dict:
-        """The keywords of :func:`rigidfold.generate.case.make_case` that build this case's initial
-        shape as the command line does (no solve)."""
+        """The keywords of :func:`rigidfold.generate.specs.case_from_specs` that build this
+        case's initial shape as the command line does (no solve)."""
         kwargs: dict = {"seed": self.seed, "expr": self.expr}
         if self.size is not None:
             kwargs["size"] = self.size
@@ -284,10 +284,10 @@ def refusal(case: BroadCase, work: Path) -> str | None:
     """Why ``rigidfold generate`` refuses the case's input before solving (the one-line
     message of the reader or of the initial shape's check), or None when it builds."""
     from rigidfold.errors import RigidfoldError
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
 
     try:
-        make_case(**case.make_case_kwargs(work))
+        case_from_specs(**case.make_case_kwargs(work))
     except RigidfoldError as exc:
         return str(exc)
     return None
@@ -319,7 +319,7 @@ def perturbed_plan(base: Path, seed: int) -> tuple[np.ndarray, np.ndarray]:
     [theta_min, theta_max] by more than a tenth of its room toward 0 or 180 degrees
     (:func:`_angle_room`), has its vertices' offsets halved until it does not. Returns the
     vertices (V, 2) and triangles (F, 3)."""
-    from rigidfold.patterns import parse_pattern
+    from rigidfold.generate.specs import parse_pattern
 
     plan = parse_pattern(str(base))
     xy, faces = plan.xy, plan.faces

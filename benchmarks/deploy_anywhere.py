@@ -111,11 +111,11 @@ def run(case: dict, mode: str) -> dict:
     """One run of ``case`` with the settings of ``mode`` (:data:`MODES`)."""
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import Stop, generate
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
 
     settings = DEFAULTS.with_(**MODES[mode])
     t0, cpu0 = time.perf_counter(), time.process_time()
-    built = make_case(
+    built = case_from_specs(
         case["surface"],
         case["pattern"],
         seed=case["seed"],

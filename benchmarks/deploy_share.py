@@ -70,13 +70,13 @@ def run(case: tuple[str, str, int], deploy: bool, backtrack: int | None = None) 
     (None: the default) or with the paper's Step 5."""
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import Stop, generate
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.mechanism.path import trace_path
 
     surface, pattern, seed = case
     settings = DEFAULTS if backtrack is None else DEFAULTS.with_(backtrack_max=backtrack)
     t0 = time.perf_counter()
-    built = make_case(surface, pattern, seed=seed, settings=settings)
+    built = case_from_specs(surface, pattern, seed=seed, settings=settings)
     gen = generate(built, criterion="shat", seed=seed, lookahead=True, deploy_check=deploy)
     final = gen.final
     if final is not None and final.path is None:

@@ -15,7 +15,7 @@ import argparse
 import statistics
 
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import SolverName
 
 BACKENDS = ("casadi", "closed-form")
@@ -33,7 +33,7 @@ def main() -> None:
         problems = {}
         for backend in BACKENDS:
             try:
-                case = make_case(
+                case = case_from_specs(
                     "bezier", name, seed=args.seed, settings=DEFAULTS.with_(ipopt_hessian=backend)
                 )
             except ValueError as exc:

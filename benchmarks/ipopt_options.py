@@ -20,7 +20,7 @@ import statistics
 import numpy as np
 
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import ipopt
 
 _defaults = ipopt.ipopt_options
@@ -44,7 +44,7 @@ def _value(text: str):
 
 
 def _run(pattern: str, criterion: str, seed: int) -> dict:
-    run = generate(make_case("bezier", pattern, seed=seed), criterion=criterion, seed=seed)
+    run = generate(case_from_specs("bezier", pattern, seed=seed), criterion=criterion, seed=seed)
     return {
         "lock": run.n_lock,
         "solves": len(run.attempts),
@@ -55,7 +55,7 @@ def _run(pattern: str, criterion: str, seed: int) -> dict:
 
 def timing(options: dict) -> None:
     with extra_options(options | {"ipopt.print_timing_statistics": "yes", "ipopt.print_level": 3}):
-        problem = make_case("bezier", "2", seed=7).problem()
+        problem = case_from_specs("bezier", "2", seed=7).problem()
         first = problem.solve()
         fixed = first.pattern.fixed.copy()
         free = np.flatnonzero(~fixed & ~first.pattern.is_boundary_edge)

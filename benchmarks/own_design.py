@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.pipeline.workflows import analyze_file
 from rigidfold.surfaces import Dome, sample_mesh
 
@@ -28,9 +28,9 @@ def obj_dome(n: int) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "dome.obj"
         trimesh.Trimesh(*sample_mesh(dome, n), process=False).export(path)
-        case = make_case(f"mesh:{path}", "11")
+        case = case_from_specs(f"mesh:{path}", "11")
     mesh = case.problem().solve()
-    built_in = make_case("dome", "11").problem().solve()
+    built_in = case_from_specs("dome", "11").problem().solve()
     xyz = mesh.pattern.coords
     x, y = np.meshgrid(np.linspace(0, 3, 601), np.linspace(0, 3, 601))
     print(f"OBJ dome, {n} x {n} vertices, optimize --pattern 11:")

@@ -20,7 +20,7 @@ import numpy as np
 
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import kinematics
 
 
@@ -46,7 +46,7 @@ def main() -> None:
         parser.error(f"--rank-tol must be in (0, 1), got {args.rank_tol:g}")
     try:
         settings = DEFAULTS.with_(mechanism_rank_tol=args.rank_tol)
-        case = make_case("bezier", args.pattern, seed=args.seed, settings=settings)
+        case = case_from_specs("bezier", args.pattern, seed=args.seed, settings=settings)
     except ValueError as exc:
         parser.error(str(exc))
     previous: list[int] = []

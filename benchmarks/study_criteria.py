@@ -49,11 +49,11 @@ def standard_error(values: list[float]) -> float:
 
 def one_run(args: tuple[str, str, int, str, str]) -> dict:
     from rigidfold.generate import generate
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
 
     pattern, criterion, seed, solver, support = args
     t0 = time.perf_counter()
-    case = make_case("bezier", pattern, seed=seed)
+    case = case_from_specs("bezier", pattern, seed=seed)
     run = generate(
         case,
         criterion=criterion,

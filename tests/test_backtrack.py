@@ -16,7 +16,7 @@ import pytest
 from conftest import main_code, paper_generate
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop, generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.pipeline import RunWriter, run
 from rigidfold.rundir import load_run, read_log
 
@@ -27,7 +27,7 @@ OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=Fa
 def _case(backtrack_max: int):
     # backtracking alone: no restart with the fold limit (tests/test_fold_limit.py)
     settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max, fold_limits=())
-    return make_case("bezier", "1", seed=SEED, settings=settings)
+    return case_from_specs("bezier", "1", seed=SEED, settings=settings)
 
 
 @pytest.fixture(scope="module")
@@ -108,9 +108,11 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     """A 3 x 3 grid on the dome stops at DOF 3 (no candidate succeeds); backtracking finds no
     lower chain, so the run ends with the one it had, and the chains it tried since leave no
     file."""
-    case = make_case("dome", "grid:3x3")
+    case = case_from_specs("dome", "grid:3x3")
     plain = generate(
-        make_case("dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0, fold_limits=()))
+        case_from_specs(
+            "dome", "grid:3x3", settings=DEFAULTS.with_(backtrack_max=0, fold_limits=())
+        )
     )
     options = GenerateOptions(deform=False)
     writer = RunWriter(tmp_path, case, options, report=False)

@@ -9,7 +9,7 @@ import pytest
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, GenerateOptions, generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.selection import lock_forecast, rank_candidates, score_creases
 from rigidfold.selection.batch import compatible_set
@@ -17,7 +17,7 @@ from rigidfold.selection.batch import compatible_set
 
 @pytest.fixture(scope="module")
 def grid_shape():
-    case = make_case("dome", "grid:9x9", size="3x3")
+    case = case_from_specs("dome", "grid:9x9", size="3x3")
     result = case.problem().solve()
     assert result.converged
     return result.pattern
@@ -63,7 +63,7 @@ def test_several_creases_per_solve_far_from_the_target_one_near_it():
     are fixed in one solve, each removing as many DOF at least as its size forecast allows;
     within batch_single_dof of the target every solve fixes one candidate; fewer solves than
     the one-crease order to the same target."""
-    case = make_case("dome", "grid:11x11", size="3x3")
+    case = case_from_specs("dome", "grid:11x11", size="3x3")
     single = DEFAULTS.generation.batch_single_dof
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch="auto")
     run = generate(case, opts)
@@ -80,6 +80,6 @@ def test_several_creases_per_solve_far_from_the_target_one_near_it():
 
 def test_the_papers_step_5_fixes_one_crease_per_solve():
     run = generate(
-        make_case("bezier", "1", seed=1), deploy_check=False, target_dof=10, batch="auto"
+        case_from_specs("bezier", "1", seed=1), deploy_check=False, target_dof=10, batch="auto"
     )
     assert all(a.batch == 0 and len(a.fixed_added) <= 1 for a in run.attempts)

@@ -76,11 +76,11 @@ def test_seed_out_of_range_is_refused_at_once(tmp_path, seed):
 
 
 def test_seeds_are_checked_by_the_library():
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.study import plan
 
     with pytest.raises(ValueError, match=r"seed must be a non-negative integer below 2\*\*63"):
-        make_case("bezier", "1", seed=2**63)
+        case_from_specs("bezier", "1", seed=2**63)
     with pytest.raises(ValueError, match="--first-seed must be a non-negative integer"):
         plan(["1"], ["s"], 1, first_seed=10**22)
     with pytest.raises(ValueError, match="the last seed"):
@@ -195,9 +195,9 @@ def test_full_disk_leaves_no_temporary_file(tmp_path, monkeypatch):
 def test_analysis_too_large_is_refused_before_allocating():
     import time
 
+    from rigidfold.generate.specs import parse_pattern
     from rigidfold.mechanism import analysis_bytes, analyze, check_analysis_size
     from rigidfold.mesh import CreasePattern
-    from rigidfold.patterns import parse_pattern
 
     xy, faces = grid(300, 300, 30.0, 30.0, "centre")
     big = CreasePattern.from_faces(np.column_stack([xy, np.zeros(len(xy))]), faces)
@@ -300,7 +300,7 @@ def test_large_polygon_faces_are_triangulated(shape, n):
 def test_large_polygon_face_in_3d_and_from_a_file(tmp_path):
     """A 3000-gon tilted in 3D is triangulated in its own plane; as a crease pattern file it
     is read, fitted into 3 m x 3 m, its diagonals free creases (without --rigid-panels)."""
-    from rigidfold.patterns import parse_pattern
+    from rigidfold.generate.specs import parse_pattern
 
     n = 3000
     xy = star_polygon(n, seed=1)

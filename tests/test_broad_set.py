@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io.fold import read_fold
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
@@ -70,7 +70,7 @@ def test_every_case_builds_as_the_command_line_would(listed):
     pattern parses and its initial shape is accepted on its surface."""
     work, every, left = listed
     for case in every:
-        built = make_case(**case.make_case_kwargs(work))
+        built = case_from_specs(**case.make_case_kwargs(work))
         assert built.pattern.n_vertices >= 4, case.name
         assert case.cli_args(work)[:2] == ["--surface", case.surface]
     for name, reason in left:
@@ -78,7 +78,7 @@ def test_every_case_builds_as_the_command_line_would(listed):
 
 
 def test_perturbed_tessellations_move_inner_vertices_only_and_keep_faces_valid(tmp_path):
-    from rigidfold.patterns import parse_pattern
+    from rigidfold.generate.specs import parse_pattern
 
     base = bc.DRAWN_DIR / bc.PERTURBED_BASES[0]
     plan = parse_pattern(str(base))

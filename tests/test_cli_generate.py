@@ -491,7 +491,7 @@ def test_an_ipopt_solve_raises_keyboard_interrupt(monkeypatch):
     instead of returning a failed solve."""
     import signal
 
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.optimize import hessian
 
     real, calls = hessian.ClosedFormHessian.values, []
@@ -503,7 +503,7 @@ def test_an_ipopt_solve_raises_keyboard_interrupt(monkeypatch):
         return real(self, *args)
 
     monkeypatch.setattr(hessian.ClosedFormHessian, "values", values)
-    problem = make_case("dome", "grid:5x5").problem()
+    problem = case_from_specs("dome", "grid:5x5").problem()
     # as in a terminal (a process started in the background may have SIGINT ignored)
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:

@@ -14,7 +14,7 @@ from rigidfold.deform import TubeSection, deform, folding_motion, verify
 from rigidfold.develop import develop
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import read_fold, write_fold
 from rigidfold.mesh.geometry import best_fit, edge_lengths
 from rigidfold.patterns import miura
@@ -95,7 +95,7 @@ def test_symmetric_dome_one_dof_shape_turns_back_before_the_plane():
 
 @pytest.fixture(scope="module")
 def one_dof_solution():
-    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)
+    run = generate(case_from_specs("bezier", "1", seed=1), criterion="shat", seed=1)
     assert run.final_dof == 1
     return run.solutions[-1].result.pattern
 

@@ -11,7 +11,7 @@ from conftest import paper_generate as generate
 from rigidfold.config import DEFAULTS
 from rigidfold.develop import Development, count_flipped, count_overlaps, develop
 from rigidfold.develop import diagram as diagram_module
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.patterns.miura import miura
 
 
@@ -35,7 +35,7 @@ def assert_valid(dev: Development, pattern, D_max: float) -> None:
 
 @pytest.fixture(scope="module")
 def pattern1_shape():
-    result = make_case("bezier", "1", seed=1).problem().solve()
+    result = case_from_specs("bezier", "1", seed=1).problem().solve()
     assert result.F < 1e-10
     return result.pattern
 
@@ -116,7 +116,7 @@ def test_optimised_pattern1_shape(pattern1_shape):
 
 
 def test_shape_with_fixed_creases():
-    run = generate(make_case("bezier", "1", seed=1), target_dof=15)
+    run = generate(case_from_specs("bezier", "1", seed=1), target_dof=15)
     shape = run.solutions[-1].result.pattern
     assert shape.fixed.any()
     dev = develop(shape)

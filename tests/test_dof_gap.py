@@ -12,7 +12,7 @@ from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate import GenerateOptions, generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.mechanism.margin import DofMargin, dof_margin
 from rigidfold.selection import rank_candidates, score_creases
@@ -48,7 +48,7 @@ def test_the_dof_count_setting_is_checked():
 
 @pytest.fixture(scope="module")
 def checked_run():
-    return generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False))
+    return generate(case_from_specs("bezier", "1", seed=1), GenerateOptions(deform=False))
 
 
 def test_one_count_everywhere_with_the_deployability_check(checked_run):
@@ -68,7 +68,7 @@ def test_one_count_everywhere_with_the_deployability_check(checked_run):
 
 
 def test_the_papers_step_5_keeps_the_papers_count():
-    run = generate(make_case("bezier", "1", seed=1), deploy_check=False, target_dof=15)
+    run = generate(case_from_specs("bezier", "1", seed=1), deploy_check=False, target_dof=15)
     assert run.dof_margin is not None and run.dof_margin["count"] == "threshold"
     for solution in run.solutions:
         assert solution.mechanism.dof == analyze(solution.result.pattern).dof
@@ -78,7 +78,7 @@ def test_a_flat_vertex_is_a_mechanism_whose_creases_rank_first():
     """An interior vertex whose free creases are all flat moves out of its plane at first
     order (an infinitesimal mechanism); its creases, flat already, cost no change of shape
     to fix and are the criterion's first candidates."""
-    case = make_case("dome", "grid:4x4", size="3x3")
+    case = case_from_specs("dome", "grid:4x4", size="3x3")
     shape = case.pattern
     coords = shape.coords.copy()
     interior = np.setdiff1d(np.arange(shape.n_vertices), shape.boundary_vertices)

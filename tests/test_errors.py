@@ -14,11 +14,16 @@ import rigidfold
 from rigidfold import RigidfoldError
 from rigidfold.config import DEFAULTS
 from rigidfold.exports import check_formats
-from rigidfold.generate.case import fixed_mask, make_case
+from rigidfold.generate.case import fixed_mask
+from rigidfold.generate.specs import (
+    case_from_specs,
+    parse_expression,
+    parse_pattern,
+    parse_surface_spec,
+)
 from rigidfold.io import read_fold
-from rigidfold.patterns import parse_pattern
 from rigidfold.pipeline.workflows import analyze_file, report_run
-from rigidfold.surfaces import get_surface, mesh_surface, parse_expression
+from rigidfold.surfaces import mesh_surface
 
 
 def test_the_package_docstring_shows_the_generation_function_and_runs():
@@ -45,16 +50,16 @@ def test_rigidfold_error_is_a_value_error_exported_lightly():
 @pytest.mark.parametrize(
     "call",
     [
-        lambda tmp: make_case("nosuch", "1"),
-        lambda tmp: make_case("dome", "grid:1500x900"),
-        lambda tmp: make_case("dome", "grid:3x3", size="axb"),
-        lambda tmp: make_case("bezier", "1", seed=-1),
+        lambda tmp: case_from_specs("nosuch", "1"),
+        lambda tmp: case_from_specs("dome", "grid:1500x900"),
+        lambda tmp: case_from_specs("dome", "grid:3x3", size="axb"),
+        lambda tmp: case_from_specs("bezier", "1", seed=-1),
         lambda tmp: parse_pattern("mesh:0,0;1,0"),
-        lambda tmp: get_surface("expr", expr="__import__('os')"),
+        lambda tmp: parse_surface_spec("expr", expr="__import__('os')"),
         lambda tmp: parse_expression("x +* y"),
         lambda tmp: mesh_surface(tmp / "none.obj"),
         lambda tmp: read_fold(tmp / "none.fold"),
-        lambda tmp: fixed_mask((0, 99), make_case("dome", "grid:3x3").pattern),
+        lambda tmp: fixed_mask((0, 99), case_from_specs("dome", "grid:3x3").pattern),
         lambda tmp: check_formats(["obj", "docx"]),
         lambda tmp: DEFAULTS.with_(dz=-1.0),
         lambda tmp: DEFAULTS.with_(theta_min=2.0, theta_max=1.0),

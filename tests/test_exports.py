@@ -27,7 +27,7 @@ from rigidfold.exports import (
 )
 from rigidfold.exports.mesh3d import Y_UP
 from rigidfold.exports.sheet import polygon_area
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import crease_pattern_frame, read_fold, write_fold
 from rigidfold.io.fold import edge_assignments
 from rigidfold.mesh.geometry import face_areas
@@ -50,7 +50,7 @@ FILES = [
 def design():
     """A solved pattern-1 shape with a three-triangle panel and a two-triangle panel, and
     its development diagram."""
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     pattern = case.pattern
     inner = next(
         f

@@ -14,9 +14,9 @@ import rigidfold.generate.steps as generation
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, Stop, generate, with_fold_limit
-from rigidfold.generate.case import make_case
 from rigidfold.generate.case_options import SettingsOptions
 from rigidfold.generate.options import GenerateOptions
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism.path import PathStatus
 
 
@@ -30,14 +30,14 @@ def _largest_fold_deg(pattern) -> float:
 
 
 def test_the_restart_case_has_bound_12_at_the_limit():
-    case = make_case("dome", "1", seed=1)
+    case = case_from_specs("dome", "1", seed=1)
     limit = math.radians(100)
     bounded = with_fold_limit(case, GenerateOptions(), limit)
     assert bounded.settings.design.rho_max == limit
     assert bounded.pattern is case.pattern and bounded.surface is case.surface
     # the paper's Step 5 (no check), the user's own bound (12): no restart
     assert with_fold_limit(case, GenerateOptions(deploy_check=False), limit) is case
-    own = make_case("dome", "1", seed=1, settings=DEFAULTS.with_(rho_max=math.radians(90)))
+    own = case_from_specs("dome", "1", seed=1, settings=DEFAULTS.with_(rho_max=math.radians(90)))
     assert with_fold_limit(own, GenerateOptions(), limit) is own
     assert all(0 < a < math.pi for a in DEFAULTS.generation.fold_limits)
     with pytest.raises(RigidfoldError, match="fold limit must lie in"):
@@ -67,7 +67,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         deploy_max_candidates=1,
         fold_limits=tuple(math.radians(a) for a in limits),
     )
-    case = make_case("bezier", "1", seed=1, settings=settings)
+    case = case_from_specs("bezier", "1", seed=1, settings=settings)
     taken_at_once: list[int] = []
     run = generate(
         case,
@@ -100,7 +100,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
 
 
 def test_a_chain_that_deploys_is_not_restarted():
-    run = generate(make_case("dome", "1", seed=1), target_dof=12, deform=False)
+    run = generate(case_from_specs("dome", "1", seed=1), target_dof=12, deform=False)
     assert run.final_dof == 12
     assert all(a.fold_limit_deg is None for a in run.attempts)
 
@@ -146,7 +146,7 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
     settings = DEFAULTS.with_(
         restart_after=1, deploy_max_candidates=2, fold_limits=(math.radians(60.0),)
     )
-    run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
+    run = generate(case_from_specs("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
     bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
     assert [a.outcome for a in bounded] == [AttemptOutcome.EXCEED] * 2
     assert run.stop is Stop.NO_DEPLOYABLE  # the first chain's stop, with its chain
@@ -192,7 +192,7 @@ def test_the_ladder_goes_on_whatever_the_bounded_chain_accepted(monkeypatch):
         fold_limits=tuple(math.radians(a) for a in limits),
     )
     monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
-    run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
+    run = generate(case_from_specs("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
     tried = {a.fold_limit_deg for a in run.attempts if a.fold_limit_deg is not None}
     assert sorted(round(t) for t in tried) == sorted(limits)
     assert run.final_dof == run.lowest_dof  # the first chain, the lowest, is the run's
@@ -209,7 +209,7 @@ def test_a_restart_keeps_the_solutions_within_its_bound(monkeypatch):
         settings = DEFAULTS.with_(
             restart_after=1, deploy_max_candidates=3, fold_limits=(math.radians(limit_deg),)
         )
-        case = make_case("bezier", "1", seed=1, settings=settings)
+        case = case_from_specs("bezier", "1", seed=1, settings=settings)
         taken: list[int] = []
         run = generate(
             case,
@@ -239,7 +239,7 @@ def test_the_first_chain_is_not_given_up_while_trying_is_cheaper(monkeypatch):
     settings = DEFAULTS.with_(
         restart_after=1, second_order=False, fold_limits=(math.radians(60.0),)
     )
-    case = make_case("bezier", "1", seed=1, settings=settings)
+    case = case_from_specs("bezier", "1", seed=1, settings=settings)
     _first_turn_back(monkeypatch, 3, then=PathStatus.FLAT)
     monkeypatch.setattr(generation, "_attempt_time", lambda rec: 1.0)
     run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)

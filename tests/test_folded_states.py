@@ -19,7 +19,7 @@ from conftest import main_code
 from rigidfold.deform import verify
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import read_fold
 from rigidfold.mesh import CreasePattern, geometry
 from rigidfold.pipeline.checks import traced_motion
@@ -43,7 +43,7 @@ def _turned_over(coords: np.ndarray) -> np.ndarray:
 
 
 def test_a_state_past_vertical_is_a_state_and_a_sheet_keeps_its_rule():
-    case = make_case("bezier", "grid:3x3", seed=1, size="1x1")
+    case = case_from_specs("bezier", "grid:3x3", seed=1, size="1x1")
     pattern = case.pattern
     state = pattern.with_coords(_turned_over(pattern.coords))
     # a rigid motion: the same fold angles, the same topology and assignment
@@ -73,7 +73,7 @@ def test_a_state_past_vertical_is_a_state_and_a_sheet_keeps_its_rule():
 def test_small_grids_motion_frames_are_written(grid, size, seed):
     """Each grid's final design's motion, traced, is written as FOLD frames (the frames a
     run writes beside its design), those folded past vertical too."""
-    case = make_case("bezier", grid, seed=seed, size=size)
+    case = case_from_specs("bezier", grid, seed=seed, size=size)
     run = generate(case, seed=seed)
     assert run.final is not None and run.final_dof <= 3
     pattern = run.final.result.pattern

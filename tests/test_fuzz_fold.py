@@ -26,9 +26,9 @@ import pytest
 
 from conftest import folded_grid, main_code
 from fuzzing import byte_damage
+from rigidfold.generate.specs import parse_pattern
 from rigidfold.io import write_fold
 from rigidfold.mesh import CreasePattern
-from rigidfold.patterns import parse_pattern
 
 DATA = Path(__file__).parent / "data"
 MUTANTS_PER_BASE = 50  # 8 bases: 400 mutants, about 500 commands

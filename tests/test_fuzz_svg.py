@@ -2,7 +2,7 @@
 Simulator's drawings and of a drawing of every shape rigidfold reads, run through
 ``rigidfold optimize --pattern FILE.svg`` in this process (the small drawings, whose solve
 takes a few hundredths of a second) or through the reader of the command line,
-:func:`rigidfold.patterns.parse_pattern` (the larger ones). Every case must end with exit
+:func:`rigidfold.generate.specs.parse_pattern` (the larger ones). Every case must end with exit
 code 0, 1 or 2 (2: one line ``rigidfold: error: ...`` on stderr; the reader: a result or a
 one-line ValueError), raise nothing else (no traceback, no warning: warnings are errors in
 the test suite), write nothing outside its ``--out`` folder, and end within
@@ -327,7 +327,7 @@ def run_command(argv: list[str], label: str, root: Path, inputs: list[Path], cap
 def read_directly(path: Path, label: str) -> int:
     """The command line's reader of ``--pattern FILE.svg`` (parse_pattern, as make_case
     calls it): 0 with a pattern, 2 for a one-line ValueError; within SECONDS."""
-    from rigidfold.patterns import parse_pattern
+    from rigidfold.generate.specs import parse_pattern
 
     start = time.perf_counter()
     try:

@@ -15,21 +15,21 @@ import pytest
 
 from conftest import paper_generate as generate
 from rigidfold.config import DEFAULTS, one_blas_thread
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.selection import predicted_locks, score_creases
 
 
 @pytest.fixture(scope="module")
 def seven_dof():
-    case = make_case("bezier", "1", seed=2)
+    case = case_from_specs("bezier", "1", seed=2)
     run = generate(case, criterion="shat", target_dof=7, seed=2)
     assert run.final_dof == 7
     return case, run.solutions[-1]
 
 
 def test_generate_pattern1_reaches_one_dof_without_locks():
-    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)
+    run = generate(case_from_specs("bezier", "1", seed=1), criterion="shat", seed=1)
     assert run.stop_reason == "target DOF 1 reached"
     assert run.initial_dof == 21 and run.final_dof == 1
     assert run.n_reduce == 20
@@ -52,7 +52,7 @@ def test_generate_counts_locks_and_retries_the_next_candidate():
     Which seeds lock depends on round-off (seed 2 did with CasADi's Hessian and two BLAS
     threads, not with the closed-form one); seed 1 locks with both Hessians.
     """
-    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1)
+    run = generate(case_from_specs("bezier", "1", seed=1), criterion="shat", seed=1)
     assert run.final_dof == 1
     locks = [a for a in run.attempts if a.outcome == "lock"]
     assert run.n_lock == len(locks) >= 1
@@ -68,7 +68,7 @@ def test_generate_does_not_depend_on_the_callers_blas_threads():
     two BLAS threads led to different first creases before generate ran on one thread."""
     from threadpoolctl import threadpool_info, threadpool_limits
 
-    case = make_case("hp", "11", symmetric=True)
+    case = case_from_specs("hp", "11", symmetric=True)
     runs = []
     for threads in (1, 2):
         with threadpool_limits(limits=threads, user_api="blas"):
@@ -111,7 +111,7 @@ def test_the_first_blas_limit_of_a_process_reaches_ipopts_openblas_too():
 
 
 def test_generate_symmetric_fixes_mirror_groups():
-    case = make_case("hp", "11", symmetric=True)
+    case = case_from_specs("hp", "11", symmetric=True)
     run = generate(case, criterion="s", target_dof=33, seed=0)
     assert run.initial_dof == 37
     for attempt in run.attempts[1:]:
@@ -121,7 +121,7 @@ def test_generate_symmetric_fixes_mirror_groups():
 
 
 def test_generate_bad_options():
-    case = make_case("bezier", "1", seed=0)
+    case = case_from_specs("bezier", "1", seed=0)
     with pytest.raises(ValueError, match="unknown criterion"):
         generate(case, criterion="best")
     with pytest.raises(ValueError, match="target DOF"):
@@ -176,7 +176,7 @@ def test_section_6_2_fixing_max_sf_crease_reduces_dof_without_lock(seven_dof):
 
 
 def test_generate_uses_the_requested_support():
-    run = generate(make_case("bezier", "1", seed=1), target_dof=20, seed=1, support_face=0)
+    run = generate(case_from_specs("bezier", "1", seed=1), target_dof=20, seed=1, support_face=0)
     assert all(sol.mechanism.frame.support_face == 0 for sol in run.solutions)
     assert run.final_dof == 20
 
@@ -185,7 +185,7 @@ def test_zero_dof_solution_ends_generation_as_in_step5():
     """Paper, Step 5: a 0-DOF solution goes to Step 8; it is not a lock (Section 6.3). With
     a target of 0 it is the target: the last solution and the final design (issue 30, item
     20: it was dropped, and the DOF-1 shape named instead)."""
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     run = generate(case, criterion="shat", target_dof=0, seed=1)
     assert run.stop_reason == "target DOF 0 reached"
     assert run.attempts[-1].outcome == "zero_dof" and run.attempts[-1].dof == 0
@@ -213,7 +213,9 @@ def test_zero_dof_on_the_way_ends_or_counts_as_lock(monkeypatch, ends):
 
     monkeypatch.setattr(gen, "analyze", analyze)
     settings = DEFAULTS.with_(retry_zero_dof=not ends)
-    run = generate(make_case("bezier", "1", seed=1, settings=settings), criterion="shat", seed=1)
+    run = generate(
+        case_from_specs("bezier", "1", seed=1, settings=settings), criterion="shat", seed=1
+    )
     fourth = run.attempts[3]
     assert fourth.dof == 0
     if ends:

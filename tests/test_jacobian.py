@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import SolverName, Status
 from rigidfold.optimize.jacobian import (
     ClosedFormGradient,
@@ -45,7 +45,7 @@ def _point(problem, seed: int) -> tuple[np.ndarray, np.ndarray]:
 
 @pytest.mark.parametrize(("surface", "pattern", "kw"), CASES)
 def test_closed_form_jacobian_equals_casadis(surface, pattern, kw):
-    problem = make_case(surface, pattern, **kw).problem(build_ipopt=False)
+    problem = case_from_specs(surface, pattern, **kw).problem(build_ipopt=False)
     xi, w = _point(problem, 1)
     jacobian = ClosedFormJacobian(problem)
     g, nonzeros = jacobian.values(xi, w)
@@ -63,7 +63,7 @@ def test_closed_form_jacobian_equals_casadis(surface, pattern, kw):
 
 @pytest.mark.parametrize(("surface", "pattern", "kw"), CASES)
 def test_closed_form_gradient_equals_casadis(surface, pattern, kw):
-    problem = make_case(surface, pattern, **kw).problem(build_ipopt=False)
+    problem = case_from_specs(surface, pattern, **kw).problem(build_ipopt=False)
     xi, w = _point(problem, 2)
     F, grad = ClosedFormGradient(Residuals(problem.pattern, problem.map)).values(xi, w)
     F_ref, grad_ref = problem.objective_gradient(xi, w)
@@ -73,7 +73,7 @@ def test_closed_form_gradient_equals_casadis(surface, pattern, kw):
 
 
 def test_callbacks_evaluate_as_casadi_functions():
-    problem = make_case("bezier", "1", seed=3, settings=WITH_RHO).problem(build_ipopt=False)
+    problem = case_from_specs("bezier", "1", seed=3, settings=WITH_RHO).problem(build_ipopt=False)
     xi, w = _point(problem, 3)
     grad_f, jac_g = closed_form_first_derivatives(problem)
     f, grad = grad_f(xi, w)
@@ -90,13 +90,13 @@ def test_callbacks_evaluate_as_casadi_functions():
 
 def test_large_pattern_solver_uses_the_closed_form_derivatives():
     settings = DEFAULTS.with_(projection_vertices=40)  # 7 x 7 = 49 vertices takes the path
-    problem = make_case("dome", "grid:7x7", size="3x3", settings=settings).problem()
+    problem = case_from_specs("dome", "grid:7x7", size="3x3", settings=settings).problem()
     nlpsol = problem.solver(SolverName.IPOPT).nlpsol
     assert "constraint_jacobian" not in problem.__dict__  # CasADi's was never built
     assert "objective_gradient" not in problem.__dict__
     assert nlpsol.get_function("nlp_jac_g").class_name() == "CallbackInternal"
     result = problem.solve()
     assert result.status is Status.CONVERGED
-    reference = make_case("dome", "grid:7x7", size="3x3").problem()
+    reference = case_from_specs("dome", "grid:7x7", size="3x3").problem()
     assert "constraint_jacobian" in reference.__dict__  # paper sizes: CasADi's, as before
     assert reference.solve().status is Status.CONVERGED

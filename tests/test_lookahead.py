@@ -14,7 +14,7 @@ import pytest
 from conftest import degree_n_vertex, folded_grid
 from conftest import paper_generate as generate
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.mesh import CreasePattern
 from rigidfold.rundir import read_log
@@ -32,7 +32,7 @@ VERTICES = {  # its four degree-4 vertices (local one-DOF mechanisms), PARALLEL 
 @pytest.fixture(scope="module")
 def demo_dof5():
     """The demo's shape at DOF 5 (pattern 1, Bezier seed 1, S-hat), where it meets 4 locks."""
-    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1, target_dof=5)
+    run = generate(case_from_specs("bezier", "1", seed=1), criterion="shat", seed=1, target_dof=5)
     assert run.final_dof == 5
     return run.solutions[-1].mechanism
 
@@ -83,7 +83,7 @@ def test_groups_count_dependent_rows_once(demo_dof5):
 
 
 def test_mirror_groups_of_a_symmetric_run():
-    case = make_case("hp", "11", symmetric=True)
+    case = case_from_specs("hp", "11", symmetric=True)
     run = generate(case, criterion="s", seed=0, target_dof=11)
     mech = run.solutions[-1].mechanism
     from rigidfold.selection import crease_groups
@@ -273,7 +273,7 @@ def test_pattern2_locks_of_the_lookahead_study_are_gone(seed, criterion, n_lock,
     28: fixing crease 61 locked crease 45 (at 95-100 degrees, missed at first order) at five
     shapes in a row; it locks once and is put off after."""
     run = generate(
-        make_case("bezier", "2", seed=seed), criterion=criterion, seed=seed, lookahead=True
+        case_from_specs("bezier", "2", seed=seed), criterion=criterion, seed=seed, lookahead=True
     )
     assert (run.n_lock, run.n_reduce, run.final_dof) == (n_lock, 20, 1)
     carried = [a for a in run.attempts if a.carried]
@@ -294,7 +294,7 @@ def test_pattern2_locks_of_the_lookahead_study_are_gone(seed, criterion, n_lock,
 
 @pytest.fixture(scope="module")
 def demo_runs():
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     return {la: generate(case, criterion="shat", seed=1, lookahead=la) for la in (False, True)}
 
 
@@ -338,7 +338,7 @@ def test_all_candidates_predicted_falls_back_to_the_criterions_order(monkeypatch
         return dataclasses.replace(forecast, locked=np.ones_like(forecast.locked))
 
     monkeypatch.setattr(module, "lock_forecast", everything_locks)
-    run = generate(make_case("bezier", "1", seed=1), criterion="shat", seed=1, lookahead=True)
+    run = generate(case_from_specs("bezier", "1", seed=1), criterion="shat", seed=1, lookahead=True)
     without = demo_runs[False]
     assert [a.fixed_added for a in run.attempts] == [a.fixed_added for a in without.attempts]
     assert run.n_lock == without.n_lock and run.n_skipped == 0

@@ -7,7 +7,7 @@ import pytest
 
 from conftest import degree_n_vertex, folded_grid
 from rigidfold.frame import FrameModel
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze, kinematics
 from rigidfold.patterns import miura
 
@@ -41,7 +41,7 @@ def test_miura_frame_method_agrees():
 
 @pytest.mark.parametrize(("pattern", "dof"), [("1", 21), ("2", 21), ("11", 37)])
 def test_initial_dof_of_paper_patterns(pattern, dof):
-    case = make_case("bezier", pattern, seed=3)
+    case = case_from_specs("bezier", pattern, seed=3)
     mech = analyze(case.pattern)
     assert mech.dof == dof == case.pattern.generic_dof
     assert not mech.has_lock

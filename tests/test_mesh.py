@@ -163,11 +163,11 @@ def test_error_messages_show_plain_numbers():
 
 def test_settings_decide_corners_of_a_case():
     """DEFAULTS.with_(corner_angle=...) reaches the pattern that make_case builds."""
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
 
-    assert len(make_case("dome", "1").pattern.corners) == 4
+    assert len(case_from_specs("dome", "1").pattern.corners) == 4
     blunt = DEFAULTS.with_(corner_angle=np.radians(100.0))  # the square's corners turn by 90
-    case = make_case("dome", "1", settings=blunt)
+    case = case_from_specs("dome", "1", settings=blunt)
     assert case.pattern.settings is blunt
     assert case.pattern.corners.tolist() == []
     assert case.pattern.boundary_sides == ()

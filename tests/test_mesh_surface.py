@@ -294,7 +294,7 @@ def test_a_coarse_grid_still_has_four_nodes_a_side():
 # ---------------------------------------------------------------- problem (6)
 def test_form_finding_on_the_dome_mesh(fine_dome):
     """Pattern 11 on the dome given as a mesh: converges like on the built-in dome."""
-    pattern = patterns.build("11", fine_dome)
+    pattern = patterns.build(patterns.PaperPattern("11"), fine_dome)
     result = FormFindingProblem(pattern, fine_dome).solve()
     assert result.converged
     assert result.F <= DEFAULTS.design.f_tol  # measured 2e-17

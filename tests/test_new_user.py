@@ -12,7 +12,7 @@ import pytest
 
 from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 HYPAR = Path(__file__).parent / "data" / "origami_simulator" / "hypar.svg"
 
@@ -34,13 +34,13 @@ def test_a_plan_far_outside_the_angle_bounds_is_refused_before_solving():
     degenerate"; it is refused when the case is made, saying what is out of range and which
     options change the bounds."""
     angles = np.degrees(
-        make_case(
+        case_from_specs(
             "hp", str(HYPAR), settings=DEFAULTS.with_(theta_far_share=1.0)
         ).pattern.corner_angles
     )
     below, above = int((angles < 30).sum()), int((angles > 120).sum())
     with pytest.raises(ValueError) as info:
-        make_case("hp", str(HYPAR))
+        case_from_specs("hp", str(HYPAR))
     message = str(info.value)
     assert "\n" not in message
     assert f"{below + above} of {angles.size} sector angles outside" in message
@@ -50,14 +50,14 @@ def test_a_plan_far_outside_the_angle_bounds_is_refused_before_solving():
     assert "--theta-min" in message and "--theta-max" in message
     # the bounds that the options set decide: wide ones let the same plan through
     wide = DEFAULTS.with_(theta_min=math.radians(0.1), theta_max=math.radians(179))
-    assert make_case("hp", str(HYPAR), settings=wide).pattern.n_faces == angles.size // 3
+    assert case_from_specs("hp", str(HYPAR), settings=wide).pattern.n_faces == angles.size // 3
 
 
 @pytest.mark.parametrize("spec", ["1", "2", "11", "grid:9x6"])
 def test_the_paper_patterns_and_grids_pass_the_angle_check(spec):
     """Plans with a few angles somewhat outside the bounds, which the solver brings inside,
     are not refused (pattern 2's smallest is 17 degrees)."""
-    assert make_case("dome", spec).pattern.n_faces > 0
+    assert case_from_specs("dome", spec).pattern.n_faces > 0
 
 
 def test_the_cli_refuses_the_plan_in_one_line(tmp_path, capsys):
@@ -94,7 +94,7 @@ def test_a_solver_point_with_a_collapsed_face_is_a_failed_solve(monkeypatch):
     from rigidfold.optimize.ipopt import IpoptSolver
     from rigidfold.optimize.solver import SolverOutcome, SolverRun
 
-    case = make_case("dome", "grid:3x3")
+    case = case_from_specs("dome", "grid:3x3")
     problem = case.problem()
     coords = case.pattern.coords.copy()
     face = case.pattern.faces[0]

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import FormFindingProblem, SolverName, Status, build_linear_map
-from rigidfold.surfaces import get_surface
+from rigidfold.surfaces import Bezier, Dome
 
 
 @pytest.fixture(scope="module")
 def bezier_problem() -> FormFindingProblem:
-    case = make_case("bezier", "1", seed=3)
+    case = case_from_specs("bezier", "1", seed=3)
     return case.problem(build_ipopt=False)
 
 
@@ -30,14 +30,14 @@ def bezier_problem() -> FormFindingProblem:
     ],
 )
 def test_independent_variables_table4(surface, pattern, symmetric, n):
-    case = make_case(surface, pattern, seed=0, symmetric=symmetric)
+    case = case_from_specs(surface, pattern, seed=0, symmetric=symmetric)
     lmap = build_linear_map(case.pattern, case.planes)
     assert lmap.n_variables == n
 
 
 @pytest.mark.parametrize("surface", ["dome", "hp"])
 def test_linear_map_satisfies_constraints(surface):
-    case = make_case(surface, "11", symmetric=True)
+    case = case_from_specs(surface, "11", symmetric=True)
     lmap = build_linear_map(case.pattern, case.planes)
     rng = np.random.default_rng(0)
     xi = lmap.restrict(case.pattern.coords) + 0.05 * rng.standard_normal(lmap.n_variables)
@@ -68,7 +68,7 @@ def test_linear_map_is_sparse_and_built_block_by_block(monkeypatch):
 
     monkeypatch.setattr(scipy.linalg, "qr", recording_qr)
     for surface in ("dome", "hp"):
-        case = make_case(surface, "grid:21x21", size="3x3", symmetric=True)
+        case = case_from_specs(surface, "grid:21x21", size="3x3", symmetric=True)
         lmap = build_linear_map(case.pattern, case.planes)
         assert sp.issparse(lmap.T) and lmap.T.shape == (3 * 441, lmap.n_variables)
         assert lmap.T.nnz <= 3 * lmap.T.shape[0]
@@ -84,7 +84,7 @@ def test_derivatives_handed_to_ipopt_have_o_of_e_nonzeros():
     sparsity: a bounded number of nonzeros per row, so nnz grows like the number of edges."""
     per_edge = []
     for n in (7, 11, 21):
-        case = make_case("dome", f"grid:{n}x{n}", size="3x3")
+        case = case_from_specs("dome", f"grid:{n}x{n}", size="3x3")
         nlpsol = case.problem().solver(SolverName.IPOPT).nlpsol
         jac = nlpsol.get_function("nlp_jac_g").sparsity_out(1)
         hess = nlpsol.get_function("nlp_hess_l").sparsity_out(0)  # upper triangle
@@ -107,9 +107,9 @@ def test_boundary_vertices_stay_on_their_sides(bezier_problem):
 
 def test_asymmetric_surface_breaks_symmetry_constraints():
     """Mirror planes that the corner heights contradict are reported, not silently used."""
-    bez = get_surface("bezier", seed=2)
-    dome = get_surface("dome")
-    case = make_case(bez, "11")
+    bez = Bezier(2)
+    dome = Dome()
+    case = case_from_specs(bez, "11")
     with pytest.raises(ValueError, match="contradict"):
         build_linear_map(case.pattern, dome.mirror_planes)
 
@@ -174,7 +174,7 @@ def test_objective_matches_mesh_geometry(bezier_problem):
 
 # ---------------------------------------------------------------- solving
 def test_ipopt_solves_pattern1_and_result_is_consistent():
-    case = make_case("bezier", "1", seed=4)
+    case = case_from_specs("bezier", "1", seed=4)
     result = case.problem().solve()
     assert result.status is Status.CONVERGED
     assert result.F <= DEFAULTS.design.f_tol
@@ -186,7 +186,7 @@ def test_ipopt_solves_pattern1_and_result_is_consistent():
 
 
 def test_fixed_creases_become_flat():
-    case = make_case("bezier", "1", seed=5)
+    case = case_from_specs("bezier", "1", seed=5)
     problem = case.problem()
     first = problem.solve()
     fold = np.abs(first.pattern.fold_angles)
@@ -200,14 +200,14 @@ def test_fixed_creases_become_flat():
 
 def test_fold_angle_bound():
     settings = DEFAULTS.with_(rho_max=np.radians(25.0))
-    case = make_case("bezier", "1", seed=6, settings=settings)
+    case = case_from_specs("bezier", "1", seed=6, settings=settings)
     result = case.problem().solve()
     free = result.pattern.free_creases
     assert np.degrees(np.abs(result.pattern.fold_angles[free]).max()) <= 25.0 + 1e-6
 
 
 def test_pattern2_infeasible_start_is_repaired():
-    case = make_case("bezier", "2", seed=0)
+    case = case_from_specs("bezier", "2", seed=0)
     assert case.pattern.corner_angles.min() < DEFAULTS.design.theta_min
     result = case.problem().solve()
     assert result.converged
@@ -217,7 +217,7 @@ def test_pattern2_infeasible_start_is_repaired():
 @pytest.mark.parametrize("solver", [SolverName.SLSQP, SolverName.SLSQP_FD])
 def test_slsqp_reference_solvers_return_a_result(solver):
     """SLSQP runs on the same model and reports through the same result type."""
-    case = make_case("bezier", "1", seed=1, settings=DEFAULTS.with_(slsqp_max_iter=15))
+    case = case_from_specs("bezier", "1", seed=1, settings=DEFAULTS.with_(slsqp_max_iter=15))
     result = case.problem(build_ipopt=False).solve(solver=solver)
     assert result.solver == solver
     assert result.iterations <= 15
@@ -230,7 +230,7 @@ def test_slsqp_reference_solvers_return_a_result(solver):
 
 
 def test_iteration_limit_is_a_status_not_silence():
-    case = make_case("dome", "11", settings=DEFAULTS.with_(ipopt_max_iter=3))
+    case = case_from_specs("dome", "11", settings=DEFAULTS.with_(ipopt_max_iter=3))
     result = case.problem().solve()
     assert result.status is Status.ITERATION_LIMIT
     assert "Maximum_Iterations_Exceeded" in result.message
@@ -238,7 +238,7 @@ def test_iteration_limit_is_a_status_not_silence():
 
 def test_impossible_bounds_are_not_converged():
     """A tight dz bound on a strongly curved dome cannot be met with F <= F_tol."""
-    case = make_case("dome", "11", settings=DEFAULTS.with_(dz=1e-4))
+    case = case_from_specs("dome", "11", settings=DEFAULTS.with_(dz=1e-4))
     result = case.problem().solve()
     assert result.status in (Status.TOLERANCE_NOT_MET, Status.INFEASIBLE, Status.ITERATION_LIMIT)
     assert not result.converged
@@ -267,7 +267,7 @@ def test_bad_fixed_selection(bezier_problem):
 def test_closed_form_hessian_equals_casadi(surface, pattern, symmetric, rho_max):
     """The element-assembled Hessian of the Lagrangian is CasADi's exact one, to round-off."""
     settings = DEFAULTS.with_(rho_max=rho_max)
-    case = make_case(surface, pattern, seed=7, symmetric=symmetric, settings=settings)
+    case = case_from_specs(surface, pattern, seed=7, symmetric=symmetric, settings=settings)
     _assert_closed_form_hessian_is_exact(case.problem(build_ipopt=False))
 
 
@@ -347,7 +347,9 @@ def test_element_derivatives_match_finite_differences():
 def test_both_hessians_reach_the_same_solution():
     results = {}
     for hessian in ("closed-form", "casadi"):
-        case = make_case("bezier", "1", seed=3, settings=DEFAULTS.with_(ipopt_hessian=hessian))
+        case = case_from_specs(
+            "bezier", "1", seed=3, settings=DEFAULTS.with_(ipopt_hessian=hessian)
+        )
         results[hessian] = case.problem().solve()
     a, b = results["closed-form"], results["casadi"]
     assert a.converged and b.converged

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from rigidfold.errors import RigidfoldError
+from rigidfold.generate.specs import parse_pattern
 from rigidfold.mesh import CreasePattern
-from rigidfold.patterns import parse_pattern
 
 DATA = Path(__file__).parent / "data" / "origami_simulator"
 

@@ -12,7 +12,7 @@ import pytest
 from conftest import dome_mesh, main_code
 from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.surfaces import Dome
 
 DATA = Path(__file__).parent / "data"
@@ -46,20 +46,20 @@ def test_obj_dome_works_like_the_built_in_dome(dome_obj, tmp_path, capsys):
     dz = coords[:, 2] - Dome().height(coords[:, 0], coords[:, 1])
     assert np.abs(dz).max() <= DEFAULTS.design.dz + 1e-3
     # the fitted surface against the analytic dome, on a grid finer than the fit's
-    fitted = make_case(f"mesh:{dome_obj}", "11").surface
+    fitted = case_from_specs(f"mesh:{dome_obj}", "11").surface
     x, y = np.meshgrid(np.linspace(0, 3, 201), np.linspace(0, 3, 201))
     assert np.abs(fitted.height(x, y) - Dome().height(x, y)).max() <= 1e-3
 
 
 def test_a_y_up_mesh_and_a_fold_surface(tmp_path):
-    yup = make_case("mesh:" + str(DATA / "dome_yup.obj"), "1", up="y")
+    yup = case_from_specs("mesh:" + str(DATA / "dome_yup.obj"), "1", up="y")
     assert yup.surface.metadata()["source"] == "dome_yup.obj"
     # a coarse 9 x 9 mesh of the dome, drawn y-up: read z-up it is the dome, to its facets
     assert np.allclose(yup.pattern.coords[:, 2], Dome().height(*yup.plan.xy.T), atol=0.1)
     # the 3D shape of a FOLD file as the target: a solution of the built-in dome
     out = tmp_path / "o"
     assert main(["optimize", "--surface", "dome", "--pattern", "11", "--out", str(out)]) == 0
-    target = make_case(f"fold:{out / 'solution.fold'}", "11")
+    target = case_from_specs(f"fold:{out / 'solution.fold'}", "11")
     assert target.surface.metadata()["source"] == "solution.fold"
     assert target.problem().solve().converged
 
@@ -71,7 +71,7 @@ def test_a_mesh_is_placed_at_the_origin_like_the_pattern(dome_obj, tmp_path):
     moved = tmp_path / "moved.stl"
     shifted = vertices + np.array([100.0, -50.0, 7.0])
     trimesh.Trimesh(shifted, triangles, process=False).export(moved)
-    here, there = make_case(f"mesh:{dome_obj}", "1"), make_case(f"mesh:{moved}", "1")
+    here, there = case_from_specs(f"mesh:{dome_obj}", "1"), case_from_specs(f"mesh:{moved}", "1")
     assert np.allclose(there.pattern.coords[:, 2] - 7.0, here.pattern.coords[:, 2], atol=2e-3)
 
 

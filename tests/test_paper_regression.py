@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 
 SEEDS = range(20)
 
@@ -20,7 +20,7 @@ SEEDS = range(20)
 def test_ipopt_accepts_on_20_bezier_surfaces(pattern):
     accepted = []
     for seed in SEEDS:
-        result = make_case("bezier", pattern, seed=seed).problem().solve()
+        result = case_from_specs("bezier", pattern, seed=seed).problem().solve()
         ok = (
             result.F <= DEFAULTS.design.f_tol
             and result.max_violation <= DEFAULTS.solver.constraint_tol
@@ -34,7 +34,7 @@ def test_ipopt_accepts_on_20_bezier_surfaces(pattern):
 @pytest.mark.parametrize("surface", ["dome", "hp"])
 @pytest.mark.parametrize("symmetric", [True, False], ids=["sym", "asym"])
 def test_ipopt_accepts_dome_and_hp(surface, symmetric):
-    case = make_case(surface, "11", symmetric=symmetric)
+    case = case_from_specs(surface, "11", symmetric=symmetric)
     result = case.problem().solve()
     assert result.converged, result.message
     assert result.n_variables == (83 if symmetric else 315)
@@ -48,7 +48,7 @@ def test_generate_shat_reaches_one_dof_on_20_bezier_surfaces():
 
     reached = 0
     for seed in SEEDS:
-        run = generate(make_case("bezier", "1", seed=seed), criterion="shat", seed=seed)
+        run = generate(case_from_specs("bezier", "1", seed=seed), criterion="shat", seed=seed)
         reached += run.final_dof == 1
         for sol in run.solutions:
             assert sol.result.F <= DEFAULTS.design.f_tol

@@ -16,7 +16,7 @@ from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate import AttemptOutcome, generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism.path import PathStatus, trace_path
 from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System
@@ -152,7 +152,7 @@ def test_motion_frames_are_equal_steps_of_the_path_and_keep_lengths():
 def seed_103():
     """Pattern 1 on Bezier seed 103 (S-hat, look-ahead): the paper's Step 5 ends on a DOF-1
     shape whose path does not reach the flat state; the deployability check replaces it."""
-    case = make_case("bezier", "1", seed=103)
+    case = case_from_specs("bezier", "1", seed=103)
     paper = paper_generate(case, criterion="shat", seed=103, lookahead=True)
     checked = generate(case, criterion="shat", seed=103, lookahead=True)
     return case, paper, checked
@@ -185,7 +185,7 @@ def test_a_deployable_design_is_accepted_and_delivered(seed_103):
 
 
 def test_polish_keeps_the_constraints_and_moves_the_shape_little():
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     problem = case.problem()
     result = problem.solve()
     polished = problem.polish(result)

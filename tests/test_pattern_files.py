@@ -12,7 +12,8 @@ import pytest
 from conftest import main_code
 from rigidfold import patterns
 from rigidfold.cli.commands import main
-from rigidfold.generate.case import make_case
+from rigidfold.generate import specs
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import read_fold
 from rigidfold.surfaces import Dome
 
@@ -48,7 +49,7 @@ def pairs(fixed: np.ndarray) -> set:
 # -------------------------------------------------------------------------------- FOLD
 @pytest.mark.parametrize("name", ["diagonal-cp", "squaretwist"])
 def test_unitless_fold_is_fitted_into_the_default_size_at_the_origin(name):
-    plan = patterns.parse_pattern(str(FOLD_EXAMPLES / f"{name}.fold"))
+    plan = specs.parse_pattern(str(FOLD_EXAMPLES / f"{name}.fold"))
     data = read_fold(FOLD_EXAMPLES / f"{name}.fold", rigid_panels=False)
     assert np.allclose(plan.xy.min(axis=0), 0.0)
     assert max(plan.box) == pytest.approx(3.0) and min(plan.box) <= 3.0 + 1e-12
@@ -71,43 +72,43 @@ def test_unitless_fold_is_fitted_into_the_default_size_at_the_origin(name):
 
 def test_size_and_scale_of_a_unitless_file(tmp_path):
     path = write(tmp_path / "cp.fold", square_with_quad())
-    assert patterns.parse_pattern(str(path), size="12x8").box == pytest.approx((12.0, 6.0))
-    assert patterns.parse_pattern(str(path), size="4x8").box == pytest.approx((4.0, 2.0))
-    scaled = patterns.parse_pattern(str(path), scale=2.5)
+    assert specs.parse_pattern(str(path), size="12x8").box == pytest.approx((12.0, 6.0))
+    assert specs.parse_pattern(str(path), size="4x8").box == pytest.approx((4.0, 2.0))
+    scaled = specs.parse_pattern(str(path), scale=2.5)
     assert scaled.box == pytest.approx((5.0, 2.5))
     assert scaled.source["metres_per_unit"] == 2.5 and scaled.source["fitted_into_m"] is None
     with pytest.raises(ValueError, match="give --size or --scale, not both"):
-        patterns.parse_pattern(str(path), size="3x3", scale=1.0)
+        specs.parse_pattern(str(path), size="3x3", scale=1.0)
 
 
 def test_a_file_in_a_physical_unit_keeps_its_size(tmp_path):
-    mm = patterns.parse_pattern(str(write(tmp_path / "mm.fold", square_with_quad("mm", 1000.0))))
-    m = patterns.parse_pattern(str(write(tmp_path / "m.fold", square_with_quad("m"))))
+    mm = specs.parse_pattern(str(write(tmp_path / "mm.fold", square_with_quad("mm", 1000.0))))
+    m = specs.parse_pattern(str(write(tmp_path / "m.fold", square_with_quad("m"))))
     assert np.allclose(mm.xy, m.xy) and mm.box == pytest.approx((2.0, 1.0))
     assert mm.source["unit"] == "mm" and mm.source["metres_per_unit"] == 1e-3
     assert mm.source["fitted_into_m"] is None
     for option in ({"size": "3x3"}, {"scale": 2.0}):
         with pytest.raises(ValueError, match=r"drawn in mm \(2 m x 1 m\): --size and --scale"):
-            patterns.parse_pattern(str(tmp_path / "mm.fold"), **option)
+            specs.parse_pattern(str(tmp_path / "mm.fold"), **option)
 
 
 def test_fixed_creases_joins_marks_and_rigid_panels(tmp_path):
     data = square_with_quad("m")
     path = write(tmp_path / "j.fold", data)
-    plan = patterns.parse_pattern(str(path))
+    plan = specs.parse_pattern(str(path))
     assert pairs(plan.fixed) == {(1, 4)}  # the "J" edge; the diagonals are free creases
     assert len(plan.faces) == 4
-    rigid = patterns.parse_pattern(str(path), rigid_panels=True)
+    rigid = specs.parse_pattern(str(path), rigid_panels=True)
     assert len(pairs(rigid.fixed)) == 3 and (1, 4) in pairs(rigid.fixed)
     # edges_rigidfold:fixed marks a crease fixed whatever its letter
     data["edges_assignment"][6] = "V"
     data["edges_rigidfold:fixed"] = [False] * 6 + [True]
-    marked = patterns.parse_pattern(str(write(tmp_path / "marked.fold", data)))
+    marked = specs.parse_pattern(str(write(tmp_path / "marked.fold", data)))
     assert pairs(marked.fixed) == {(1, 4)}
     # rigid panels: each square one facet; with the middle "J" too, the whole sheet is one
     assert patterns.build(rigid, Dome(box=rigid.box)).n_facets == 1
     data.pop("edges_rigidfold:fixed")
-    panels = patterns.parse_pattern(str(write(tmp_path / "v.fold", data)), rigid_panels=True)
+    panels = specs.parse_pattern(str(write(tmp_path / "v.fold", data)), rigid_panels=True)
     shape = patterns.build(panels, Dome(box=panels.box))
     assert shape.fixed.sum() == 2 and shape.n_facets == 2 and len(shape.free_creases) == 1
 
@@ -120,7 +121,7 @@ def test_a_mm_file_gives_the_same_answers_as_its_metre_copy(tmp_path):
     millimetres = {**twist, "frame_unit": "mm", "vertices_coords": (coords * 3000.0).tolist()}
     results = []
     for name, data in (("m", metres), ("mm", millimetres)):
-        case = make_case("dome", str(write(tmp_path / f"{name}.fold", data)))
+        case = case_from_specs("dome", str(write(tmp_path / f"{name}.fold", data)))
         assert case.plan.source["unit"] == name
         results.append((case, case.problem().solve()))
     (case_m, m), (case_mm, mm) = results
@@ -159,7 +160,7 @@ def test_a_mm_file_gives_the_same_answers_as_its_metre_copy(tmp_path):
 )
 def test_folded_forms_are_refused_as_patterns(name, message):
     with pytest.raises(ValueError, match=message):
-        patterns.parse_pattern(str(FOLD_EXAMPLES / name))
+        specs.parse_pattern(str(FOLD_EXAMPLES / name))
 
 
 def test_upside_down_face_is_refused(tmp_path):
@@ -168,7 +169,7 @@ def test_upside_down_face_is_refused(tmp_path):
     data["vertices_coords"][3] = [0.5, 1.0]
     data["faces_vertices"] = [[0, 1, 4, 5], [1, 2, 3, 4]]
     with pytest.raises(ValueError, match="upside down"):
-        patterns.parse_pattern(str(write(tmp_path / "over.fold", data)))
+        specs.parse_pattern(str(write(tmp_path / "over.fold", data)))
 
 
 @pytest.mark.parametrize(

@@ -11,7 +11,8 @@ import pytest
 from rigidfold import patterns
 from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate import specs
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mesh import CreasePattern
 from rigidfold.pipeline.workflows import analyze_file
 from rigidfold.surfaces import Bezier, Dome, HyperbolicParaboloid
@@ -31,8 +32,8 @@ def triangles(xy: np.ndarray, faces: np.ndarray, mirror=lambda p: p) -> set:
     [("7x7", None, "1"), ("7x7", "parallel", "1p"), ("11x11", "centre", "11")],
 )
 def test_grid_is_the_paper_pattern_exactly(spec, diagonals, name):
-    grid = patterns.parse_pattern(f"grid:{spec}", diagonals=diagonals)
-    paper = patterns.parse_pattern(name)
+    grid = specs.parse_pattern(f"grid:{spec}", diagonals=diagonals)
+    paper = specs.parse_pattern(name)
     assert np.array_equal(grid.xy, paper.xy) and grid.xy.dtype == paper.xy.dtype
     assert np.array_equal(grid.faces, paper.faces) and grid.faces.dtype == paper.faces.dtype
 
@@ -43,8 +44,8 @@ def test_grid_is_the_paper_pattern_exactly(spec, diagonals, name):
     [(15, 9, "12x8"), (8, 7, "6x4"), (7, 8, "3x3"), (8, 8, "5x5"), (2, 3, "1x2.5")],
 )
 def test_grid_sizes_and_diagonals(nx, ny, size, diagonals):
-    plan = patterns.parse_pattern(f"grid:{nx}x{ny}", size=size, diagonals=diagonals)
-    width, height = patterns.parse_size(size)
+    plan = specs.parse_pattern(f"grid:{nx}x{ny}", size=size, diagonals=diagonals)
+    width, height = specs.parse_size(size)
     shape = crease_pattern(plan)
     assert (shape.n_vertices, shape.n_faces) == (nx * ny, 2 * (nx - 1) * (ny - 1))
     assert plan.box == (width, height)
@@ -70,7 +71,7 @@ def test_grid_sizes_and_diagonals(nx, ny, size, diagonals):
 def test_centre_diagonals_mirror_symmetry(nx, ny, mirrors):
     """Mirror-symmetric about x = W/2 with an odd count along x... as the grid docstring says."""
     w, h = 6.0, 4.0
-    plan = patterns.parse_pattern(f"grid:{nx}x{ny}", size=(w, h))
+    plan = specs.parse_pattern(f"grid:{nx}x{ny}", size=(w, h))
     tris = triangles(plan.xy, plan.faces)
     about_x = triangles(plan.xy, plan.faces, lambda p: np.column_stack([w - p[:, 0], p[:, 1]]))
     about_y = triangles(plan.xy, plan.faces, lambda p: np.column_stack([p[:, 0], h - p[:, 1]]))
@@ -93,7 +94,7 @@ MIN_ANGLE = {"rectangle": 31.04, "L-shape": 31.30, "hexagon": 30.42, "trapezoid"
 
 @pytest.mark.parametrize("name", list(FOOTPRINTS))
 def test_mesh_footprints_reach_theta_min(name):
-    plan = patterns.parse_pattern(f"mesh:{FOOTPRINTS[name]}")
+    plan = specs.parse_pattern(f"mesh:{FOOTPRINTS[name]}")
     shape = crease_pattern(plan)
     angles = np.degrees(shape.corner_angles)
     assert angles.min() >= math.degrees(DEFAULTS.design.theta_min)
@@ -117,21 +118,21 @@ def test_mesh_footprints_reach_theta_min(name):
 
 def test_mesh_edge_length_and_angle_cap():
     square = "mesh:0,0;3,0;3,3;0,3"
-    assert patterns.parse_pattern(square).edge_length == 0.5  # sqrt(9) / 6
-    coarse = patterns.parse_pattern(square, edge_length=1.0)
-    fine = patterns.parse_pattern(square, edge_length=0.25)
+    assert specs.parse_pattern(square).edge_length == 0.5  # sqrt(9) / 6
+    coarse = specs.parse_pattern(square, edge_length=1.0)
+    fine = specs.parse_pattern(square, edge_length=0.25)
     assert len(coarse.faces) < len(fine.faces)
-    tiny = patterns.parse_pattern("mesh:0,0;0.03,0;0.03,0.02;0,0.02", edge_length=0.002)
+    tiny = specs.parse_pattern("mesh:0,0;0.03,0;0.03,0.02;0,0.02", edge_length=0.002)
     assert len(tiny.faces) > 0.0006 / (math.sqrt(3) / 4 * 0.002**2)  # an area bound of 1.7e-6
     steep = DEFAULTS.with_(theta_min=math.radians(40), theta_max=math.radians(150))
-    capped = patterns.parse_pattern(square, settings=steep)  # Triangle ends at the 33-degree cap
+    capped = specs.parse_pattern(square, settings=steep)  # Triangle ends at the 33-degree cap
     angles = np.degrees(crease_pattern(capped).corner_angles)
     assert angles.min() >= math.degrees(DEFAULTS.inputs.mesh_angle_cap)
 
 
 def test_mesh_keeps_sharp_input_angles():
     """A footprint corner sharper than theta_min stays (where the geometry does not allow)."""
-    plan = patterns.parse_pattern("mesh:0,0;10,0;0,1")
+    plan = specs.parse_pattern("mesh:0,0;10,0;0,1")
     angles = np.degrees(crease_pattern(plan).corner_angles)
     assert angles.min() == pytest.approx(math.degrees(math.atan(0.1)))
 
@@ -141,8 +142,8 @@ def test_mesh_from_file_clockwise_closed_and_translated(tmp_path):
     path.write_text(
         "# an L, clockwise, closed, offset\n10 20\n10 26\n13 26\n\n13,23\n16,23\n16 20\n10 20\n"
     )
-    plan = patterns.parse_pattern(f"mesh:{path}")
-    inline = patterns.parse_pattern("mesh:0,0;6,0;6,3;3,3;3,6;0,6")
+    plan = specs.parse_pattern(f"mesh:{path}")
+    inline = specs.parse_pattern("mesh:0,0;6,0;6,3;3,3;3,6;0,6")
     assert np.array_equal(plan.footprint, inline.footprint)
     assert np.allclose(plan.xy, inline.xy, atol=1e-12) and np.array_equal(plan.faces, inline.faces)
 
@@ -185,7 +186,7 @@ BAD = [
 @pytest.mark.parametrize(("spec", "options", "message"), BAD)
 def test_bad_specs_one_line(spec, options, message):
     with pytest.raises(ValueError) as info:
-        patterns.parse_pattern(spec, **options)
+        specs.parse_pattern(spec, **options)
     assert message in str(info.value) and "\n" not in str(info.value)
 
 
@@ -233,7 +234,7 @@ def test_builtin_surfaces_scale_to_the_plan_box():
 
 
 def test_make_case_scales_the_surface_and_records_the_pattern():
-    case = make_case("dome", "grid:9x7", size="6x4", symmetric=True)
+    case = case_from_specs("dome", "grid:9x7", size="6x4", symmetric=True)
     assert case.surface.box == (6.0, 4.0)
     corners = case.pattern.coords[case.pattern.corners]
     assert np.allclose(corners[:, 2], 0.0, atol=1e-12)
@@ -242,9 +243,9 @@ def test_make_case_scales_the_surface_and_records_the_pattern():
     assert meta["diagonals"] == "centre" and meta["edge_length_m"] is None
     result = case.problem().solve()
     assert result.converged
-    paper = make_case("dome", "11").metadata()
+    paper = case_from_specs("dome", "11").metadata()
     assert (paper["pattern"], paper["plan_size_m"], paper["diagonals"]) == ("11", [3.0, 3.0], None)
-    mesh = make_case("hp", f"mesh:{HEXAGON}", edge_length=1.0).metadata()
+    mesh = case_from_specs("hp", f"mesh:{HEXAGON}", edge_length=1.0).metadata()
     assert mesh["edge_length_m"] == 1.0 and len(mesh["footprint_m"]) == 6
     assert json.loads(json.dumps(mesh)) == mesh
 
@@ -307,11 +308,11 @@ def test_mesh_pattern_is_checked_on_its_real_triangle_count():
     """Triangle's refinement adds points: the count after it is checked, not only the
     estimate from the area (here 7) and the outline's points (40)."""
     spec = f"mesh:{circle(40)}"
-    plan = patterns.parse_pattern(spec, edge_length=3.0)
+    plan = specs.parse_pattern(spec, edge_length=3.0)
     assert len(plan.faces) == 120
     settings = DEFAULTS.with_(max_pattern_faces=100)
     with pytest.raises(ValueError) as info:
-        patterns.parse_pattern(spec, edge_length=3.0, settings=settings)
+        specs.parse_pattern(spec, edge_length=3.0, settings=settings)
     assert str(info.value) == (
         f"pattern {spec!r} has 120 triangles, more than 100 (Settings.limits.max_pattern_faces)"
     )
@@ -347,10 +348,10 @@ def test_svg_and_fold_files_are_checked_on_their_triangles(tmp_path, capsys):
             }
         )
     )
-    assert len(patterns.parse_pattern(str(fold)).faces) == 128
+    assert len(specs.parse_pattern(str(fold)).faces) == 128
     small = DEFAULTS.with_(max_pattern_faces=100)
     with pytest.raises(ValueError, match=r"has 128 triangles, more than 100 \(Settings"):
-        patterns.parse_pattern(str(fold), settings=small)
+        specs.parse_pattern(str(fold), settings=small)
     with pytest.raises(ValueError, match=r"make 24642 triangles, more than 100 \(Settings"):
-        patterns.parse_pattern(str(svg), settings=small)
+        specs.parse_pattern(str(svg), settings=small)
     assert not (tmp_path / "o").exists()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rigidfold import patterns
+from rigidfold.generate import specs
 from rigidfold.mesh import CreasePattern
 
 # Table 4 (E of pattern 2 corrected from 117 to 129, see patterns.grids.pattern2)
@@ -19,7 +19,7 @@ TABLE4 = {
 
 @pytest.mark.parametrize("name", list(TABLE4))
 def test_table4_sizes_and_initial_dof(name):
-    plan = patterns.parse_pattern(name)
+    plan = specs.parse_pattern(name)
     xy, faces = plan.xy, plan.faces
     shape = CreasePattern.from_faces(xy, faces)
     V, E, F, dof = TABLE4[name]
@@ -36,7 +36,7 @@ def test_table4_sizes_and_initial_dof(name):
 
 
 def test_pattern2_side_angles_below_theta_min():
-    plan = patterns.parse_pattern("2")
+    plan = specs.parse_pattern("2")
     xy, faces = plan.xy, plan.faces
     shape = CreasePattern.from_faces(xy, faces)
     assert np.degrees(shape.corner_angles.min()) == pytest.approx(26.565, abs=1e-3)
@@ -44,7 +44,7 @@ def test_pattern2_side_angles_below_theta_min():
 
 @pytest.mark.parametrize("name", ["1", "11"])
 def test_grid_mirror_symmetric_about_four_planes(name):
-    plan = patterns.parse_pattern(name)
+    plan = specs.parse_pattern(name)
     xy, faces = plan.xy, plan.faces
     tris = {tuple(sorted(map(tuple, np.round(xy[f], 9).tolist()))) for f in faces}
     for mirror in (
@@ -59,13 +59,13 @@ def test_grid_mirror_symmetric_about_four_planes(name):
 
 def test_unknown_pattern():
     with pytest.raises(ValueError, match="unknown pattern '7'"):
-        patterns.parse_pattern("7")
+        specs.parse_pattern("7")
 
 
 @pytest.mark.parametrize(("name", "flaps"), [("1", 0), ("1p", 2), ("2", 0), ("11", 0)])
 def test_corner_flaps(name, flaps):
     """Boundary vertices of degree 2: triangles hinged on one crease (independent flaps)."""
-    plan = patterns.parse_pattern(name)
+    plan = specs.parse_pattern(name)
     xy, faces = plan.xy, plan.faces
     shape = CreasePattern.from_faces(xy, faces)
     degree = np.bincount(shape.edges.ravel(), minlength=shape.n_vertices)

@@ -17,7 +17,7 @@ import pytest
 
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.pipeline import (
     AttemptEnded,
     FinalChecked,
@@ -48,7 +48,7 @@ class Recorder:
 
 
 def _case():
-    return make_case("dome", "grid:3x3")
+    return case_from_specs("dome", "grid:3x3")
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ import pytest
 from conftest import paper_generate as generate
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import GenerateOptions
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
 from rigidfold.optimize import Status
 from rigidfold.optimize.hessian import angle_derivatives
@@ -36,7 +36,7 @@ def _perturbed(problem, seed: int) -> np.ndarray:
 
 @pytest.mark.parametrize(("surface", "pattern", "kw"), CASES)
 def test_residuals_square_to_the_objective_and_differentiate_to_its_jacobian(surface, pattern, kw):
-    problem = make_case(surface, pattern, **kw).problem(build_ipopt=False)
+    problem = case_from_specs(surface, pattern, **kw).problem(build_ipopt=False)
     rng = np.random.default_rng(1)
     xi = _perturbed(problem, 2)
     w = (rng.random(problem.pattern.n_edges) < 0.3).astype(float)
@@ -72,7 +72,7 @@ def test_element_gradients_equal_the_hessian_module_and_the_mechanism_analysis()
 @pytest.fixture(scope="module")
 def solved_grid():
     """A 21 x 21 grid on the dome (441 vertices, the large-pattern path) and its solution."""
-    case = make_case("dome", "grid:21x21", size="3x3")
+    case = case_from_specs("dome", "grid:21x21", size="3x3")
     problem = case.problem()
     return case, problem, problem.solve()
 
@@ -90,7 +90,7 @@ def test_large_pattern_ipopt_hands_over_to_the_projection(solved_grid):
 
 
 def test_paper_size_patterns_run_ipopt_alone():
-    result = make_case("dome", "grid:11x11", size="3x3").problem().solve()
+    result = case_from_specs("dome", "grid:11x11", size="3x3").problem().solve()
     assert result.status is Status.CONVERGED
     assert result.message.startswith("IPOPT: Solve_Succeeded")
     assert "projection" not in result.message
@@ -98,7 +98,7 @@ def test_paper_size_patterns_run_ipopt_alone():
 
 def test_a_larger_threshold_keeps_ipopt_alone_on_a_large_pattern():
     settings = DEFAULTS.with_(projection_vertices=10**6)
-    case = make_case("dome", "grid:15x15", size="3x3", settings=settings)
+    case = case_from_specs("dome", "grid:15x15", size="3x3", settings=settings)
     result = case.problem().solve()
     assert result.status is Status.CONVERGED
     assert "projection" not in result.message
@@ -125,7 +125,7 @@ def tight_grid(solved_grid):
     case, _, result = solved_grid
     coords = result.coords
     dz = np.abs(coords[:, 2] - case.surface.height(coords[:, 0], coords[:, 1])).max()
-    return make_case(
+    return case_from_specs(
         "dome", "grid:21x21", size="3x3", settings=DEFAULTS.with_(dz=float(dz) + 1e-9)
     ).problem(build_ipopt=False)
 
@@ -168,7 +168,7 @@ def test_a_projection_stopped_near_a_zero_is_taken_without_ipopt(solved_grid):
     at once. Here projection_tol is out of reach, so every step stops at its iteration limit."""
     _, _, result = solved_grid
     settings = DEFAULTS.with_(projection_tol=1e-300, projection_max_iter=8, ipopt_stop_f=1e-6)
-    problem = make_case("dome", "grid:21x21", size="3x3", settings=settings).problem()
+    problem = case_from_specs("dome", "grid:21x21", size="3x3", settings=settings).problem()
     rho = np.abs(result.pattern.fold_angles)
     folded = np.flatnonzero(~result.pattern.is_boundary_edge & (rho > 1e-3))
     fixed = result.pattern.fixed.copy()
@@ -181,7 +181,7 @@ def test_a_projection_stopped_near_a_zero_is_taken_without_ipopt(solved_grid):
 
 
 def test_an_infeasible_start_is_not_projected():
-    problem = make_case("dome", "grid:21x21", size="3x3").problem(build_ipopt=False)
+    problem = case_from_specs("dome", "grid:21x21", size="3x3").problem(build_ipopt=False)
     out = Projection(problem)(problem.start_point(), np.zeros(problem.pattern.n_edges))
     assert not out.converged and not out.feasible
     assert out.iterations == 0
@@ -189,7 +189,7 @@ def test_an_infeasible_start_is_not_projected():
 
 
 def test_generate_on_a_large_grid_projects_after_the_first_solve():
-    case = make_case("dome", "grid:15x15", size="3x3")
+    case = case_from_specs("dome", "grid:15x15", size="3x3")
     assert case.pattern.n_vertices >= DEFAULTS.solver.projection_vertices
     messages = []
     run = generate(case, criterion="s", target_dof=GenerateOptions().target_dof)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from rigidfold.cli.commands import main
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.pipeline.workflows import report_run
 from rigidfold.reporting import page, render_figures, view_figure
 from rigidfold.reporting.view3d import best_fit
@@ -204,7 +204,7 @@ def test_best_fit_undoes_a_rigid_motion():
     [("bezier", {"seed": 4}), ("dome", {}), ("hp", {}), ("expr", {"expr": "0.2*sin(x)*y"})],
 )
 def test_target_surface_is_rebuilt_from_the_summary(name, options):
-    case = make_case(name, "grid:3x3", size="2x1.5", **options)
+    case = case_from_specs(name, "grid:3x3", size="2x1.5", **options)
     surface, note = target_surface(case.metadata()["surface"])
     assert note == "" and surface is not None
     x, y = np.meshgrid(np.linspace(0, 2, 5), np.linspace(0, 1.5, 4))
@@ -299,7 +299,7 @@ def test_a_mesh_target_is_shown_with_its_fit(tmp_path):
     text = html.unescape(report.html.read_text())
     assert "cannot be rebuilt" not in text and "the target surface is the grey overlay" in text
     run = load_run(out)
-    case = make_case(f"mesh:{MESH}", "grid:4x4", up="y")
+    case = case_from_specs(f"mesh:{MESH}", "grid:4x4", up="y")
     x, y = np.meshgrid(np.linspace(0, 3, 7), np.linspace(0, 3, 5))
     assert run.surface is not None
     assert np.allclose(run.surface.height(x, y), case.surface.height(x, y), rtol=0, atol=1e-12)

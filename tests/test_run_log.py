@@ -22,7 +22,7 @@ from conftest import main_code
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, GenerateOptions
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import append_json_line
 from rigidfold.pipeline import (
     AttemptEnded,
@@ -47,7 +47,7 @@ def logged(tmp_path_factory):
     seen)."""
     out = tmp_path_factory.mktemp("log")
     settings = DEFAULTS.with_(deploy_max_candidates=1, summary_interval=1e9)
-    case = make_case("bezier", "1", seed=SEED, settings=settings)
+    case = case_from_specs("bezier", "1", seed=SEED, settings=settings)
     writer = RunWriter(out, case, OPTIONS, report=False)
     snapshots: list[tuple[bytes, int]] = []
     writes = {"summary": 0, "solution": 0, "retract": 0}
@@ -134,7 +134,7 @@ def test_summary_json_is_written_when_it_changes_and_exact_at_the_end(logged):
 
 def test_summary_interval_0_writes_summary_json_after_every_attempt(tmp_path):
     settings = DEFAULTS.with_(deploy_max_candidates=1, summary_interval=0)
-    case = make_case("bezier", "1", seed=SEED, settings=settings)
+    case = case_from_specs("bezier", "1", seed=SEED, settings=settings)
     seen = []
 
     class Exact:  # after the writer: summary.json as each rejected attempt left it

@@ -166,19 +166,19 @@ def test_a_design_beyond_dz_fails_the_fit_check(tmp_path):
     farther from the target than dz fails it (Stage.FIT), with its words, in the verdict."""
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import generate
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.pipeline import run_verdict
     from rigidfold.pipeline.checks import check_solution
 
     options = GenerateOptions(target_dof=18, deform=False)
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     run = generate(case, options)
     final = run.final
     assert final is not None
     kept = check_solution(final, case, options, motion=False, deform=False).record
     assert kept.fit is not None and kept.fit["status"] == "within"
     assert kept.failed_stages() == []
-    tight = make_case(
+    tight = case_from_specs(
         "bezier", "1", seed=1, settings=DEFAULTS.with_(dz=kept.fit["max_abs_dz_m"] / 2)
     )
     record = check_solution(final, tight, options, motion=False, deform=False).record

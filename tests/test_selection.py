@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import folded_grid
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.mechanism.stiffness import PseudoStiffness, hinge_stiffness
 from rigidfold.selection import crease_groups, rank_candidates, score_creases
@@ -98,7 +98,7 @@ def test_random_ranking_is_a_seeded_permutation(mechanism):
 
 @pytest.mark.parametrize("surface", ["dome", "hp"])
 def test_mirror_groups_have_two_or_four_creases(surface):
-    case = make_case(surface, "11", symmetric=True)
+    case = case_from_specs(surface, "11", symmetric=True)
     groups = crease_groups(case.pattern, case.planes)
     assert {len(g) for g in groups} <= {1, 2, 4}
     assert sorted(e for g in groups for e in g) == case.pattern.interior_edges.tolist()

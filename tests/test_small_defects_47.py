@@ -19,7 +19,7 @@ from conftest import main_code
 from rigidfold.cli.structure_specs import parse_index_list
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions, Stop, best_so_far, generate
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.pipeline.verdict import run_verdict
 from rigidfold.reporting import render_figures
 from rigidfold.rundir import SolutionRecord, load_run, read_log
@@ -127,7 +127,7 @@ def test_supports_with_an_empty_item_exit_2(tmp_path, capsys):
 def chain():
     """A run of DOF 5 to 1 with the deployability check: only the DOF-1 solution's path is
     traced (``deploy_check_max_dof``), and it deploys."""
-    run = generate(make_case("bezier", "grid:3x3", seed=1, size="1x1"), seed=1)
+    run = generate(case_from_specs("bezier", "grid:3x3", seed=1, size="1x1"), seed=1)
     dofs = [s.mechanism.dof for s in run.solutions]
     assert dofs == [5, 4, 3, 2, 1]
     assert [s.path is not None and s.path.deploys for s in run.solutions] == [False] * 4 + [True]

@@ -18,7 +18,7 @@ import pytest
 from conftest import degree_n_vertex, folded_grid
 from conftest import paper_generate as generate
 from rigidfold.config import DEFAULTS
-from rigidfold.generate.case import make_case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism import (
     analysis_bytes,
@@ -65,25 +65,25 @@ SHAPES = {
         for s in range(8)
     },
     "flat-sheet": lambda: _flat_grid(6),
-    "bezier-1-seed-0": lambda: make_case("bezier", "1", seed=0).pattern,
+    "bezier-1-seed-0": lambda: case_from_specs("bezier", "1", seed=0).pattern,
     "bezier-1-seed-1-fixed": lambda: _with_random_fixed(
-        make_case("bezier", "1", seed=1).pattern, 12, 1
+        case_from_specs("bezier", "1", seed=1).pattern, 12, 1
     ),
-    "bezier-1p": lambda: make_case("bezier", "1p", seed=2).pattern,
-    "bezier-2": lambda: make_case("bezier", "2", seed=0).pattern,
-    "dome-11": lambda: make_case("dome", "11").pattern,
-    "hp-11-fixed": lambda: _with_random_fixed(make_case("hp", "11").pattern, 30, 3),
-    "dome-grid-9x7": lambda: make_case("dome", "grid:9x7", size="6x4").pattern,
-    "hp-mesh-hexagon": lambda: make_case("hp", f"mesh:{HEXAGON}", edge_length=1.0).pattern,
+    "bezier-1p": lambda: case_from_specs("bezier", "1p", seed=2).pattern,
+    "bezier-2": lambda: case_from_specs("bezier", "2", seed=0).pattern,
+    "dome-11": lambda: case_from_specs("dome", "11").pattern,
+    "hp-11-fixed": lambda: _with_random_fixed(case_from_specs("hp", "11").pattern, 30, 3),
+    "dome-grid-9x7": lambda: case_from_specs("dome", "grid:9x7", size="6x4").pattern,
+    "hp-mesh-hexagon": lambda: case_from_specs("hp", f"mesh:{HEXAGON}", edge_length=1.0).pattern,
     "dome-sym-dof1.fold": lambda: pattern_from_fold(DATA / "dome_sym_dof1.fold"),
     "dome-sym-dof13.fold": lambda: pattern_from_fold(DATA / "dome_sym_dof13.fold"),
     "dome-miura-ori.svg": lambda: (
-        make_case(
+        case_from_specs(
             "dome", str(DATA / "origami_simulator" / "miura-ori.svg"), rigid_panels=True
         ).pattern
     ),
     "dome-squaretwist.svg": lambda: (
-        make_case("dome", str(DATA / "origami_simulator" / "singlesquaretwist.svg")).pattern
+        case_from_specs("dome", str(DATA / "origami_simulator" / "singlesquaretwist.svg")).pattern
     ),
 }
 
@@ -126,7 +126,7 @@ def test_sparse_analysis_matches_dense_for_another_support():
 def test_sparse_analysis_matches_dense_along_a_generation():
     shapes: list[CreasePattern] = []
     generate(
-        make_case("bezier", "1", seed=1),
+        case_from_specs("bezier", "1", seed=1),
         criterion="s",
         on_solution=lambda run, sol: shapes.append(sol.result.pattern),
     )
@@ -148,7 +148,10 @@ def test_flat_sheet_grows_the_subspace():
 
 
 def test_auto_method_by_size():
-    small, large = make_case("dome", "11").pattern, make_case("dome", "grid:21x21").pattern
+    small, large = (
+        case_from_specs("dome", "11").pattern,
+        case_from_specs("dome", "grid:21x21").pattern,
+    )
     assert chosen_method(small, "auto") == "kinematic"
     assert chosen_method(large, "auto") == "sparse"
     assert chosen_method(large, "frame") == "frame"
@@ -162,7 +165,7 @@ def test_auto_method_by_size():
 
 def test_memory_estimate_follows_the_method():
     """A large grid that the dense analysis would refuse passes with the sparse one."""
-    big = make_case("dome", "grid:101x101").pattern
+    big = case_from_specs("dome", "grid:101x101").pattern
     rows = big.n_edges + 9
     assert analysis_memory(big, "kinematic") == analysis_bytes(rows, 3 * big.n_vertices)
     assert analysis_memory(big, "auto") == analysis_memory(big, "sparse") < 2 * 2**30

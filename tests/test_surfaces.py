@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import dome_mesh
+from rigidfold.generate.specs import parse_expression, parse_surface_spec
 from rigidfold.surfaces import (
     SURFACES,
     Bezier,
@@ -17,15 +18,26 @@ from rigidfold.surfaces import (
     HyperbolicParaboloid,
     MeshSurface,
     MirrorPlane,
-    get_surface,
+    surface_of,
 )
+
+
+def get_surface(name, *, seed=None, expr=None):
+    """The surface that ``--surface NAME --seed SEED --expr EXPR`` names."""
+    return surface_of(parse_surface_spec(name, seed=seed, expr=expr))
+
+
+def expression_surface(text, mirror_planes=()):
+    """The surface of ``--surface expr --expr TEXT``."""
+    return ExpressionSurface(parse_expression(text), mirror_planes)
+
 
 FACTORIES = {
     "bezier0": lambda: Bezier(0),
     "bezier7": lambda: Bezier(7),
     "dome": Dome,
     "hp": HyperbolicParaboloid,
-    "expr": lambda: ExpressionSurface("0.3*sin(x)*cos(y) + 0.1*x**2 - sqrt(1 + y)/3"),
+    "expr": lambda: expression_surface("0.3*sin(x)*cos(y) + 0.1*x**2 - sqrt(1 + y)/3"),
     # scaled to a pattern's plan box (which holds the sample points in [0, 3]^2)
     "bezier-box": lambda: Bezier(2, box=(12.0, 8.0)),
     "dome-box": lambda: Dome(box=(3.5, 6.0)),
@@ -212,7 +224,7 @@ def test_accepted_expressions(text):
 )
 def test_refused_expressions(text, reason):
     with pytest.raises(ValueError, match=reason) as info:
-        ExpressionSurface(text)
+        expression_surface(text)
     message = str(info.value)
     assert "\n" not in message
     assert message.startswith(("refused expression", "invalid expression", "empty expression"))
@@ -224,7 +236,7 @@ def test_refused_expression_is_never_evaluated(monkeypatch):
     calls = []
     monkeypatch.setattr(expression, "evaluate", lambda *a, **k: calls.append(a))
     with pytest.raises(ValueError):
-        ExpressionSurface("__import__('os').system('true')")
+        expression_surface("__import__('os').system('true')")
     assert calls == []
 
 
@@ -236,12 +248,12 @@ def test_refused_expression_has_no_side_effect(tmp_path):
         f"sin(x) + (__import__('pathlib').Path({str(marker)!r}).touch() or 0)",
     ]:
         with pytest.raises(ValueError, match="refused expression"):
-            ExpressionSurface(text)
+            expression_surface(text)
     assert not marker.exists()
 
 
 def test_expression_shapes_and_metadata():
-    surface = ExpressionSurface("  0.5 *  x*y ", mirror_planes=(MirrorPlane(1, -1, 0),))
+    surface = expression_surface("  0.5 *  x*y ", mirror_planes=(MirrorPlane(1, -1, 0),))
     assert surface.metadata() == {"name": "expr", "expression": "0.5 * x*y"}
     assert repr(surface) == "ExpressionSurface('0.5 * x*y')"
     assert [str(p) for p in surface.mirror_planes] == ["x - y = 0"]
@@ -254,22 +266,24 @@ def test_expression_shapes_and_metadata():
     assert np.shape(gx) == () and float(gy) == pytest.approx(1.0)
     gx, gy = surface.gradient(np.zeros(0), np.zeros(0))
     assert gx.shape == gy.shape == (0,)
-    constant = ExpressionSurface("2")
+    constant = expression_surface("2")
     assert np.array_equal(constant.height(np.zeros(4), np.zeros(4)), np.full(4, 2.0))
     assert np.array_equal(constant.gradient(np.zeros(4), np.zeros(4))[0], np.zeros(4))
     with pytest.raises(TypeError, match="must be text"):
-        ExpressionSurface(1.0)
+        parse_expression(1.0)
+    with pytest.raises(TypeError, match="takes an Expression"):
+        ExpressionSurface("2")
 
 
 @pytest.mark.parametrize("text", ["1/0", "log(x - 5)", "10.0**1000", "sqrt(-1 - x)"])
 def test_non_finite_expression_reported(text):
-    surface = ExpressionSurface(text)
+    surface = expression_surface(text)
     with pytest.raises(ValueError, match="not finite at"):
         surface.check_finite(np.array([0.0, 1.0]), np.array([0.0, 1.0]))
 
 
 def test_finite_expression_passes_check():
-    ExpressionSurface("log(x + 1) / (y + 1)").check_finite(*_plan_points())
+    expression_surface("log(x + 1) / (y + 1)").check_finite(*_plan_points())
 
 
 def test_get_surface_and_metadata():

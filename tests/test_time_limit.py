@@ -10,8 +10,8 @@ from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Stop, generate
-from rigidfold.generate.case import make_case
 from rigidfold.generate.options import GenerateOptions
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import SolverName
 
 
@@ -51,7 +51,7 @@ def test_a_time_limit_ends_the_run_with_a_named_design_and_exit_1(tmp_path, caps
 
 
 def test_generate_stops_at_the_limit_between_solves():
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     run = generate(case, GenerateOptions(deform=False), time_limit=1e-6)
     assert run.stop is Stop.TIME_LIMIT and run.stop_reason == "time limit of 1e-06 s reached"
     assert len(run.solutions) == 1 and run.final is run.solutions[0]
@@ -82,7 +82,7 @@ def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatc
     monkeypatch.setattr(generation, "trace_path", deploys_down_to_15)
     monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 12)
     options = GenerateOptions(deform=False, time_limit=3600.0)
-    run = generate(make_case("bezier", "1", seed=1), options)
+    run = generate(case_from_specs("bezier", "1", seed=1), options)
     assert run.stop is Stop.TIME_LIMIT
     dofs = [s.mechanism.dof for s in run.solutions]
     assert min(dofs) < 15 <= max(dofs)
@@ -125,7 +125,7 @@ def test_the_candidates_paths_are_traced_to_the_runs_deadline(monkeypatch):
         return real(pattern, **kw)
 
     monkeypatch.setattr(generation, "trace_path", spy)
-    case = make_case("bezier", "1", seed=1)
+    case = case_from_specs("bezier", "1", seed=1)
     t0 = time.monotonic()
     generate(case, GenerateOptions(deform=False, deploy_check=True, time_limit=3600.0))
     assert seen and all(d is not None and t0 + 3599.0 < d < t0 + 3601.0 for d in seen)
@@ -152,7 +152,7 @@ def test_a_solve_past_its_deadline_ends_at_its_iterate(solver, settings):
     from rigidfold.config import DEFAULTS
     from rigidfold.optimize import Status
 
-    case = make_case("dome", "grid:5x5", size="3x3", settings=DEFAULTS.with_(**settings))
+    case = case_from_specs("dome", "grid:5x5", size="3x3", settings=DEFAULTS.with_(**settings))
     problem = case.problem(build_ipopt=solver is SolverName.IPOPT)
     plain = problem.solve(solver=solver)
     assert plain.status is Status.CONVERGED
@@ -179,7 +179,7 @@ def test_a_solve_cut_by_the_time_limit_is_no_rejected_candidate(monkeypatch):
     monkeypatch.setattr(generation._Steps, "deadline", property(passed_after_three))
     monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 3)
     options = GenerateOptions(deform=False, time_limit=3600.0)
-    run = generate(make_case("bezier", "1", seed=1), options)
+    run = generate(case_from_specs("bezier", "1", seed=1), options)
     assert run.stop is Stop.TIME_LIMIT
     last = run.attempts[-1]
     assert last.outcome is AttemptOutcome.TIME_LIMIT and last.iterations <= 1
@@ -203,7 +203,7 @@ def test_a_trace_cut_by_the_time_limit_is_no_rejected_path(monkeypatch):
 
     monkeypatch.setattr(generation, "trace_path", cut)
     options = GenerateOptions(deform=False, time_limit=3600.0)
-    run = generate(make_case("bezier", "1", seed=1), options)
+    run = generate(case_from_specs("bezier", "1", seed=1), options)
     assert run.stop is Stop.TIME_LIMIT
     assert run.attempts[-1].outcome is AttemptOutcome.TIME_LIMIT
     assert run.attempts[-1].path is not None and run.attempts[-1].path["cut"]
@@ -230,13 +230,15 @@ def test_the_traces_naming_the_final_design_have_a_deadline_and_are_counted(monk
     monkeypatch.setattr(generation, "trace_path", slow)
     monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 6)
     t0 = time.monotonic()
-    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False, time_limit=100))
+    run = generate(
+        case_from_specs("bezier", "1", seed=1), GenerateOptions(deform=False, time_limit=100)
+    )
     assert run.stop is Stop.TIME_LIMIT and seen
     from rigidfold.generate.budget import time_budget
 
     # at the latest a grace after T less the idle reserve; the machine's load may stretch
     # the reserve, never beyond half of T
-    idle = time_budget(t0, 100, make_case("bezier", "1").pattern.n_vertices, DEFAULTS)
+    idle = time_budget(t0, 100, case_from_specs("bezier", "1").pattern.n_vertices, DEFAULTS)
     assert all(d is not None and t0 + 50 < d < idle.naming + 1 for d in seen)
     assert run.final_path_time >= 0.01 * len(seen)
     assert run.to_dict()["time_s"]["path"] >= run.final_path_time
@@ -251,7 +253,7 @@ def test_a_time_limited_run_ends_within_its_grace():
 
     t0 = time.monotonic()
     run = generate(
-        make_case("dome", "grid:15x15", size="3x3"),
+        case_from_specs("dome", "grid:15x15", size="3x3"),
         GenerateOptions(deform=False, criterion="s", lookahead=True),
         time_limit=2.0,
     )
@@ -271,7 +273,9 @@ def test_a_first_solve_cut_by_the_time_limit_ends_the_run_at_the_limit(monkeypat
     from rigidfold.generate.budget import TimeBudget
 
     monkeypatch.setattr(TimeBudget, "first_solve", property(lambda self: time.monotonic() - 1.0))
-    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False), time_limit=5)
+    run = generate(
+        case_from_specs("bezier", "1", seed=1), GenerateOptions(deform=False), time_limit=5
+    )
     assert run.stop is Stop.TIME_LIMIT and run.stop_reason == "time limit of 5 s reached"
     assert [a.outcome for a in run.attempts] == [AttemptOutcome.TIME_LIMIT]
     assert run.solutions == [] and run.final is None
@@ -286,7 +290,7 @@ def test_a_motion_cut_by_its_deadline_says_so_and_not_that_the_shape_is_stuck():
     from rigidfold.deform import MotionStatus, folding_motion
     from rigidfold.develop import develop
 
-    run = generate(make_case("bezier", "1", seed=1), GenerateOptions(deform=False))
+    run = generate(case_from_specs("bezier", "1", seed=1), GenerateOptions(deform=False))
     pattern = run.final.result.pattern
     flat = develop(pattern).coords2d
     cut = folding_motion(pattern, flat, dof=run.final_dof, deadline=time.monotonic() - 1.0)

@@ -4,13 +4,17 @@ The method of Hayakawa and Ohsaki in a few lines of Python: a case (target surfa
 crease pattern, Step 1), then :func:`rigidfold.generate.generate` (Steps 2-7: solve problem
 (6), fix the crease the criterion ranks first, solve again, down to the target DOF)::
 
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.generate import generate
 
-    case = make_case("bezier", "1", seed=1)  # surface, pattern; mirror planes, sizes, Settings
+    case = case_from_specs("bezier", "1", seed=1)  # surface, pattern; symmetry, size, Settings
     run = generate(case, criterion="shat", seed=1)
     print(run.stop_reason, run.n_lock)  # "target DOF 1 reached", the paper's counters
     design = run.final.result.pattern  # the final design: a CreasePattern (coords, faces)
+
+:func:`~rigidfold.generate.specs.case_from_specs` reads the texts the command line takes;
+:func:`rigidfold.generate.case.make_case` takes the typed specs
+(``make_case(SurfaceSpec(SurfaceKind.BEZIER, seed=1), PaperPattern("1"))``).
 
 :func:`rigidfold.deform.verify` checks a design (Steps 8-9 and its folding motion);
 ``rigidfold generate`` is :func:`rigidfold.pipeline.run` with the run directory's sink

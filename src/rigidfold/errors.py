@@ -7,8 +7,10 @@ instead. It is a ``ValueError``, so code that catches ``ValueError`` catches it 
 command line prints it as one line and exits 2::
 
     import rigidfold
+    from rigidfold.generate.specs import case_from_specs
+
     try:
-        case = make_case("dome", "grid:1500x900")
+        case = case_from_specs("dome", "grid:1500x900")
     except rigidfold.RigidfoldError as exc:
         print(exc)  # the pattern's triangle count, and the limit
 

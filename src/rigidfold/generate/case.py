@@ -1,6 +1,7 @@
 """A form-finding case: target surface + crease pattern + symmetry + settings (Step 1).
 
-This is the entry point that validates user choices once; the CLI and the benchmarks call it.
+This is the entry point that validates user choices once, as typed values; the texts the CLI
+and the study take are read by :mod:`rigidfold.generate.specs`, which calls it.
 """
 
 from __future__ import annotations
@@ -16,11 +17,10 @@ import numpy as np
 from rigidfold import patterns
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
-from rigidfold.io.fold import read_fold
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
 from rigidfold.protocols import SymmetryPlane, TargetSurface
-from rigidfold.surfaces import Surface, get_surface, placed_mesh
+from rigidfold.surfaces import Surface, SurfaceSpec, surface_of
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,41 +94,47 @@ class Case:
 
 
 def make_case(
-    surface: str | Surface,
-    pattern: str,
+    surface: SurfaceSpec | Surface,
+    pattern: patterns.PatternSpec | patterns.Plan,
     *,
-    seed: int | None = None,
-    expr: str | None = None,
     symmetric: bool = False,
     settings: Settings = DEFAULTS,
     **pattern_options: Unpack[patterns.PatternKeywords],
 ) -> Case:
     """Validate the user's choices and build the initial triangulated shape.
 
-    surface : a spec of :func:`rigidfold.surfaces.get_surface` ("bezier", "dome", "hp",
-        "expr", "mesh:FILE"), "fold:FILE" (the 3D shape of a FOLD file's top frame, in
-        metres, fitted like a mesh) or a Surface. A named built-in surface is scaled to the
-        bounding box of the pattern's plan (the paper's surfaces on the 3 m square); a mesh
-        is placed with its plan's lower-left corner at (0, 0); an "expr" surface and a
-        Surface object are used as they are.
-    pattern : a spec of :func:`rigidfold.patterns.parse_pattern` ("1", "1p", "2", "11",
-        "grid:NXxNY", "mesh:POLYGON", "FILE.fold", "FILE.svg"), with its keywords
-        (:class:`rigidfold.patterns.PatternKeywords`: ``size``, ``diagonals``,
-        ``edge_length``, ``scale``, ``up``, ``rigid_panels``); ``up``, the up axis (``"z"``
-        or ``"y"``) of a FOLD pattern, is also that of a mesh or FOLD surface.
-    ``seed`` draws a Bezier surface (which checks it). ``symmetric`` imposes the surface's
-    own mirror planes (9); a surface without any is refused.
+    surface : a :class:`rigidfold.surfaces.SurfaceSpec` (:func:`rigidfold.surfaces.surface_of`:
+        bezier with its seed, dome, hp, expr with its expression, a mesh file, a FOLD file's
+        3D shape) or a Surface. A named built-in surface is scaled to the bounding box of
+        the pattern's plan (the paper's surfaces on the 3 m square); a mesh is placed with its
+        plan's lower-left corner at (0, 0); an "expr" surface and a Surface object are used
+        as they are.
+    pattern : a :data:`rigidfold.patterns.PatternSpec` with its keywords
+        (:func:`rigidfold.patterns.make_plan`, :class:`rigidfold.patterns.PatternKeywords`:
+        ``size`` as (W, H) metres, ``diagonals``, ``edge_length``, ``scale``, ``up``,
+        ``rigid_panels``), or a Plan made already (then only ``up``); ``up``, the up axis
+        (``"z"`` or ``"y"``) of a FOLD pattern, is also that of a mesh or FOLD surface.
+    ``symmetric`` imposes the surface's own mirror planes (9); a surface without any is
+    refused. The texts the command line takes are read by :mod:`rigidfold.generate.specs`
+    (:func:`~rigidfold.generate.specs.case_from_specs` reads and makes a case in one call).
     """
     up = pattern_options.get("up", "z")
-    plan = patterns.parse_pattern(pattern, settings=settings, **pattern_options)
+    if isinstance(pattern, patterns.Plan):
+        extra = sorted(set(pattern_options) - {"up"})
+        if extra:
+            raise TypeError(f"a Plan is made already: {', '.join(extra)} cannot change it")
+        plan = pattern
+    else:
+        plan = patterns.make_plan(pattern, settings=settings, **pattern_options)
     if isinstance(surface, Surface):
         surf = surface
-    elif str(surface).partition(":")[0].strip().lower() == "fold":
-        path = str(surface).partition(":")[2].strip()
-        shape = read_fold(path, up=up, settings=settings).pattern
-        surf = placed_mesh(shape.coords, shape.faces, source=Path(path).name, settings=settings)
+    elif isinstance(surface, SurfaceSpec):
+        surf = surface_of(surface, box=plan.box, up=up, settings=settings)
     else:
-        surf = get_surface(surface, seed=seed, expr=expr, box=plan.box, up=up, settings=settings)
+        raise TypeError(
+            f"a case's surface is a SurfaceSpec or a Surface, got {type(surface).__name__} "
+            "(rigidfold.generate.specs.parse_surface_spec reads text)"
+        )
     shape = patterns.build(plan, surf, settings=settings)
     check_sector_angles(shape, settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
@@ -137,7 +143,7 @@ def make_case(
             f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
             "(dome or hp)"
         )
-    return Case(surf, plan, shape, planes, settings, _input_files(pattern, surface))
+    return Case(surf, plan, shape, planes, settings, _input_files(plan.spec, surface))
 
 
 def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> None:
@@ -169,19 +175,16 @@ def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> 
     )
 
 
-def _input_files(pattern: str, surface: str | Surface) -> tuple[Path, ...]:
+def _input_files(pattern: patterns.PatternSpec, surface: SurfaceSpec | Surface) -> tuple[Path, ...]:
     """The files named by a pattern spec (``FILE.fold``, ``FILE.svg``, ``mesh:FILE``) and a
     surface spec (``mesh:FILE``, ``fold:FILE``); specs were validated by reading them."""
     files = []
-    kind, colon, rest = str(pattern).strip().partition(":")
-    if patterns.is_pattern_file(str(pattern)):
-        files.append(Path(str(pattern).strip()))
-    elif colon and kind.strip().lower() == "mesh" and ";" not in rest:
-        files.append(Path(rest.strip()))
-    if not isinstance(surface, Surface):
-        kind, colon, rest = str(surface).partition(":")
-        if colon and kind.strip().lower() in ("mesh", "fold"):
-            files.append(Path(rest.strip()))
+    if isinstance(pattern, patterns.FilePattern):
+        files.append(pattern.path)
+    elif isinstance(pattern, patterns.MeshPattern) and pattern.file is not None:
+        files.append(pattern.file)
+    if isinstance(surface, SurfaceSpec) and surface.path is not None:
+        files.append(surface.path)
     return tuple(files)
 
 

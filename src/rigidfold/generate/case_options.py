@@ -13,7 +13,8 @@ from dataclasses import MISSING, dataclass
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
-from rigidfold.generate.case import Case, make_case
+from rigidfold.generate.case import Case
+from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import UP_AXES
 from rigidfold.patterns import DEFAULT_SIZE, DIAGONALS, FORMS
 from rigidfold.surfaces import SURFACE_FORMS
@@ -22,7 +23,8 @@ from rigidfold.surfaces import SURFACE_FORMS
 @dataclass(frozen=True)
 class CaseOptions:
     """The target surface and the crease pattern of a case
-    (:func:`rigidfold.generate.case.make_case`, which checks them: :meth:`make`)."""
+    as the command line gives them, texts (:meth:`make` reads them with
+    :func:`rigidfold.generate.specs.case_from_specs`, and the case checks them)."""
 
     surface: str = option(
         MISSING,
@@ -106,7 +108,7 @@ class CaseOptions:
             )
         if self.expr and self.surface != "expr":
             raise RigidfoldError(f"--expr is only used with --surface expr, not {self.surface}")
-        return make_case(
+        return case_from_specs(
             self.surface,
             self.pattern,
             seed=self.seed,

@@ -54,11 +54,6 @@ class PatternFile:
     source: dict
 
 
-def is_pattern_file(spec: str) -> bool:
-    """True when a pattern spec names a file by one of the suffixes of :data:`FILE_FORMATS`."""
-    return Path(spec.strip()).suffix.lower() in FILE_FORMATS
-
-
 def read_pattern_file(
     path: str | os.PathLike,
     *,

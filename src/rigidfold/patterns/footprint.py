@@ -1,7 +1,8 @@
 """Crease patterns over any simple polygon: a quality constrained Delaunay triangulation.
 
-The footprint is a simple polygon in metres, given as text ``"x1,y1; x2,y2; ..."`` or as a
-file of one ``x,y`` (or ``x y``) pair per line. :func:`footprint_mesh` triangulates it with
+The footprint is a simple polygon in metres, given as text ``"x1,y1; x2,y2; ..."`` (read by
+:mod:`rigidfold.generate.specs`) or as a file of one ``x,y`` (or ``x y``) pair per line
+(:func:`read_footprint`). :func:`footprint_mesh` triangulates it with
 Jonathan Shewchuk's Triangle (the ``triangle`` package): constrained to the polygon's sides,
 no angle below the design's theta_min where the geometry allows, and no triangle larger than
 the equilateral triangle of the target edge length. The points that Triangle adds on the
@@ -25,27 +26,28 @@ from rigidfold.patterns.grids import check_extent, counter_clockwise
 _PAIR = re.compile(r"^\s*(\S+?)\s*(?:,|\s)\s*(\S+)\s*$")
 
 
-def read_footprint(text: str, settings: Settings = DEFAULTS) -> np.ndarray:
-    """Polygon vertices (N, 2) from ``"x1,y1; x2,y2; ..."`` or from a file of such pairs.
+def read_footprint(path: str | os.PathLike, settings: Settings = DEFAULTS) -> np.ndarray:
+    """Polygon vertices (N, 2) from a file of one ``x,y`` or ``x y`` pair per line (blank
+    lines and lines starting with ``#`` skipped; :func:`footprint_points`), checked by
+    :func:`check_footprint`."""
+    given, path = os.fspath(path), Path(path).expanduser()
+    if not path.is_file():
+        raise RigidfoldError(
+            f"mesh footprint {given!r} is neither 'x1,y1;x2,y2;...' nor an existing file"
+        )
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RigidfoldError(f"cannot read footprint file {os.fspath(path)!r}: {exc}") from None
+    points = footprint_points(lines, f"footprint file {os.fspath(path)!r}: line")
+    return check_footprint(points, settings)
 
-    Text with a ``;`` is the polygon itself; anything else names a file of one ``x,y`` or
-    ``x y`` pair per line (blank lines and lines starting with ``#`` are skipped). A last
-    point equal to the first (a closed outline, as CAD and GIS tools write them) is dropped.
-    The polygon is checked by :func:`check_footprint`.
-    """
-    if ";" in text:
-        lines, where = text.split(";"), "footprint: point"
-    else:
-        path = Path(text).expanduser()
-        if not path.is_file():
-            raise RigidfoldError(
-                f"mesh footprint {text!r} is neither 'x1,y1;x2,y2;...' nor an existing file"
-            )
-        try:
-            lines = path.read_text(encoding="utf-8").splitlines()
-        except (OSError, UnicodeDecodeError) as exc:
-            raise RigidfoldError(f"cannot read footprint file {os.fspath(path)!r}: {exc}") from None
-        where = f"footprint file {os.fspath(path)!r}: line"
+
+def footprint_points(lines: list[str], where: str) -> np.ndarray:
+    """The (N, 2) float64 points of ``lines``, one ``x,y`` or ``x y`` pair each (blank lines
+    and lines starting with ``#`` skipped), unchecked but for being numbers; a last point
+    equal to the first (a closed outline, as CAD and GIS tools write them) is dropped. A bad
+    line is a one-line RigidfoldError ``"<where> <k> is not an 'x,y' pair of numbers"``."""
     points = []
     for k, line in enumerate(lines, 1):
         if not line.strip() or line.lstrip().startswith("#"):
@@ -62,7 +64,7 @@ def read_footprint(text: str, settings: Settings = DEFAULTS) -> np.ndarray:
     xy = np.asarray(points, dtype=float).reshape(-1, 2)
     if len(xy) > 3 and np.array_equal(xy[0], xy[-1]):
         xy = xy[:-1]
-    return check_footprint(xy, settings)
+    return xy
 
 
 def check_footprint(xy: np.ndarray, settings: Settings = DEFAULTS) -> np.ndarray:

@@ -309,7 +309,7 @@ def optimize_case(
     fold = write_fold(
         out_dir / "solution.fold",
         result.pattern,
-        title=f"rigidfold optimize: {case.surface.name} on pattern {case.plan.spec}",
+        title=f"rigidfold optimize: {case.surface.name} on pattern {case.plan.spec.text}",
         metadata={**case.metadata(), **result.to_dict()},
     )
     summary = write_json(out_dir / "summary.json", report)

@@ -24,6 +24,7 @@ import numpy as np
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Attempt
+from rigidfold.generate.specs import parse_surface_spec
 from rigidfold.io import inside_dir, parse_json, read_fold, read_frames, read_png
 from rigidfold.protocols import TargetSurface
 from rigidfold.rundir.json_shapes import check_shape, received
@@ -39,7 +40,7 @@ from rigidfold.rundir.schema import (
     aggregate,
     check_version,
 )
-from rigidfold.surfaces import Bezier, SplineSurface, get_surface
+from rigidfold.surfaces import Bezier, SplineSurface, SurfaceKind, SurfaceSpec, surface_of
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,9 +122,9 @@ def target_surface(metadata: dict) -> tuple[TargetSurface | None, str]:
             heights = np.asarray(metadata["control_heights"], dtype=float)
             return Bezier.from_heights(heights, box=(box[0], box[1])), ""
         if name in ("dome", "hp"):
-            return get_surface(name, box=(box[0], box[1])), ""
-        if name == "expr":
-            return get_surface("expr", expr=metadata.get("expression")), ""
+            return surface_of(SurfaceSpec(SurfaceKind(name)), box=(box[0], box[1])), ""
+        if name == "expr":  # the text summary.json holds, read as the command line's
+            return surface_of(parse_surface_spec("expr", expr=metadata.get("expression"))), ""
     except (TypeError, ValueError) as exc:
         return None, f"the target surface could not be rebuilt ({' '.join(str(exc).split())})"
     return None, f"the target surface {name!r} cannot be rebuilt from summary.json"

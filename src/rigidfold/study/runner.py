@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 from rigidfold.config import DEFAULT_SEED, DEFAULTS, Check, Settings, check_seed
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
-from rigidfold.patterns import parse_pattern
+from rigidfold.generate.specs import parse_pattern
 from rigidfold.selection import CRITERIA
 from rigidfold.study.rows import ERROR_PREFIX, Key, RunRow
 from rigidfold.study.store import Store
@@ -82,7 +82,7 @@ def plan(
     settings: Settings = DEFAULTS,
 ) -> list[Key]:
     """The runs of a Bezier study, validated: seeds first_seed .. first_seed + surfaces - 1,
-    on crease patterns given by spec (:func:`rigidfold.patterns.parse_pattern` with its
+    on crease patterns given by spec (:func:`rigidfold.generate.specs.parse_pattern` with its
     defaults: the paper's names, ``grid:NXxNY`` on 3 m x 3 m, ``mesh:FILE``, ``FILE.fold``,
     ``FILE.svg`` fitted into 3 m x 3 m) and criteria.
 
@@ -140,7 +140,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
     could not run; its status is then "error: <message>".
     """
     from rigidfold import __version__
-    from rigidfold.generate.case import make_case
+    from rigidfold.generate.specs import case_from_specs
     from rigidfold.pipeline import run
     from rigidfold.runtime.numerics import numeric_environment
 
@@ -152,7 +152,7 @@ def run_one(key: Key, config: StudyConfig) -> tuple[Key, dict, list[dict]]:
         "numerics": numeric_environment().key,
     }
     try:
-        case = make_case(
+        case = case_from_specs(  # the stored key's texts, read as the command line's
             key.study,
             key.pattern,
             seed=key.seed if key.study == "bezier" else None,

@@ -1,10 +1,11 @@
-"""A user's target surface ``z = f(x, y)`` given as text, parsed safely.
+"""A user's target surface ``z = f(x, y)`` given as text, evaluated safely.
 
 The text is parsed with :mod:`ast` and checked against a whitelist *before* anything is
-evaluated: numbers, ``x``, ``y``, ``pi``, ``e``, ``+ - * / **``, unary signs, parentheses and
-calls of whitelisted maths functions by plain name with positional arguments. The checked tree
-is then evaluated by a small interpreter of our own on NumPy arrays or CasADi symbols; user
-text never reaches ``eval`` or ``compile``.
+evaluated (:func:`rigidfold.generate.specs.parse_expression`, which makes an
+:class:`Expression`): numbers, ``x``, ``y``, ``pi``, ``e``, ``+ - * / **``, unary signs,
+parentheses and calls of whitelisted maths functions (:data:`FUNCTIONS`) by plain name with
+positional arguments. The checked tree is then evaluated by a small interpreter of our own on
+NumPy arrays or CasADi symbols; user text never reaches ``eval`` or ``compile``.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import ast
 import math
 import operator
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Literal
 
@@ -51,116 +53,38 @@ VARIABLES = ("x", "y")
 MAX_LENGTH = 1000  # characters of text
 MAX_DEPTH = 100  # nesting depth of the syntax tree
 
-_BINARY: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
+BINARY: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
     ast.Add: operator.add,
     ast.Sub: operator.sub,
     ast.Mult: operator.mul,
     ast.Div: operator.truediv,
     ast.Pow: operator.pow,
 }
-_UNARY: dict[type[ast.unaryop], Callable[[Any], Any]] = {
+UNARY: dict[type[ast.unaryop], Callable[[Any], Any]] = {
     ast.UAdd: operator.pos,
     ast.USub: operator.neg,
 }
-_REFUSED = {  # node type -> what the error message calls it
-    ast.Attribute: "attribute access",
-    ast.Subscript: "subscripting",
-    ast.Lambda: "a lambda",
-    ast.Compare: "a comparison",
-    ast.BoolOp: "a boolean operator",
-    ast.IfExp: "a conditional expression",
-    ast.NamedExpr: "an assignment expression",
-    ast.JoinedStr: "an f-string",
-    ast.Starred: "a starred argument",
-    ast.List: "a list",
-    ast.Tuple: "a tuple",
-    ast.Dict: "a dict",
-    ast.Set: "a set",
-    ast.ListComp: "a comprehension",
-    ast.SetComp: "a comprehension",
-    ast.DictComp: "a comprehension",
-    ast.GeneratorExp: "a comprehension",
-}
 
 
-def parse_expression(text: str) -> ast.Expression:
-    """Parse and check ``text``; raise a one-line ValueError for anything not allowed."""
-    if not isinstance(text, str):
-        raise TypeError(f"an expression must be text, got {type(text).__name__}")
-    if not text.strip():
-        raise RigidfoldError("empty expression: give z = f(x, y), e.g. '0.3*sin(x)*cos(y)'")
-    shown = " ".join(text.split())
-    if len(shown) > 60:
-        shown = shown[:57] + "..."
-    if len(text) > MAX_LENGTH:
-        raise RigidfoldError(f"refused expression {shown!r}: longer than {MAX_LENGTH} characters")
-    try:
-        tree = ast.parse(text.strip(), mode="eval")
-    except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
-        reason = " ".join(str(getattr(exc, "msg", exc) or "nested too deeply").split())
-        raise RigidfoldError(f"invalid expression {shown!r}: {reason}") from None
-    if _depth(tree) > MAX_DEPTH:
-        raise RigidfoldError(f"refused expression {shown!r}: nested deeper than {MAX_DEPTH} levels")
-    called = {id(n.func) for n in ast.walk(tree) if isinstance(n, ast.Call)}
-    for node in ast.walk(tree):
-        if id(node) in called and isinstance(node, ast.Name):
-            continue  # a function name, checked with its call
-        problem = _check(node)
-        if problem:
-            raise RigidfoldError(f"refused expression {shown!r}: {problem}")
-    return tree
+@dataclass(frozen=True)
+class Expression:
+    """A user's z = f(x, y), checked: ``text`` as recorded (runs of white space made one
+    space) and ``tree``, its syntax tree, whose every node the whitelist admits.
 
+    Made by :func:`rigidfold.generate.specs.parse_expression`, which parses the text and
+    checks the tree; :func:`evaluate` interprets only the nodes that check admits.
+    """
 
-def _depth(tree: ast.AST) -> int:
-    """Nesting depth of a syntax tree, found without recursion."""
-    deepest, stack = 0, [(tree, 1)]
-    while stack:
-        node, depth = stack.pop()
-        deepest = max(deepest, depth)
-        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
-    return deepest
+    text: str
+    tree: ast.Expression = field(compare=False, repr=False)
 
-
-def _check(node: ast.AST) -> str | None:
-    """Why ``node`` is not allowed, or None."""
-    if isinstance(node, (ast.Expression, ast.Load)):
-        return None
-    if isinstance(node, ast.Constant):
-        value = node.value
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            return f"constant {value!r} is not allowed (only real numbers)"
-        try:
-            float(value)
-        except OverflowError:
-            return "a number is too large"
-        return None
-    if isinstance(node, ast.Name):
-        if node.id in VARIABLES or node.id in CONSTANTS:
-            return None
-        if node.id in FUNCTIONS:
-            return f"function '{node.id}' must be called"
-        return f"name '{node.id}' is not allowed (use x, y, pi, e)"
-    if isinstance(node, ast.BinOp):
-        return None if type(node.op) in _BINARY else "only + - * / ** are allowed"
-    if isinstance(node, ast.UnaryOp):
-        return None if type(node.op) in _UNARY else "only unary + and - are allowed"
-    if isinstance(node, tuple(_BINARY) + tuple(_UNARY)):
-        return None
-    if isinstance(node, ast.Call):
-        if not isinstance(node.func, ast.Name):
-            return _check(node.func) or "only maths functions may be called, by plain name"
-        name = node.func.id
-        if name not in FUNCTIONS:
-            return f"function '{name}' is not allowed (allowed: {', '.join(FUNCTIONS)})"
-        if node.keywords:
-            return f"keyword arguments are not allowed in {name}()"
-        if any(isinstance(a, ast.Starred) for a in node.args):
-            return f"starred arguments are not allowed in {name}()"
-        nargs = FUNCTIONS[name][0]
-        if len(node.args) != nargs:
-            return f"{name}() takes {nargs} argument{'s' if nargs > 1 else ''}"
-        return None
-    return f"{_REFUSED.get(type(node), type(node).__name__ + ' syntax')} is not allowed"
+    def __post_init__(self) -> None:
+        if not isinstance(self.text, str) or not isinstance(self.tree, ast.Expression):
+            raise TypeError(
+                "an Expression is its text and its checked syntax tree "
+                "(rigidfold.generate.specs.parse_expression makes one), got "
+                f"{type(self.text).__name__} and {type(self.tree).__name__}"
+            )
 
 
 def evaluate(tree: ast.Expression, x: Any, y: Any, xp: ModuleType = np) -> Any:
@@ -179,20 +103,18 @@ def evaluate(tree: ast.Expression, x: Any, y: Any, xp: ModuleType = np) -> Any:
         if isinstance(node, ast.Expression):
             return ev(node.body)
         if isinstance(node, ast.Constant):
-            assert isinstance(node.value, (int, float))  # parse_expression admits only these
+            assert isinstance(node.value, (int, float))  # the check admits only these
             return number(node.value)
         if isinstance(node, ast.Name):
             return names[node.id]
         if isinstance(node, ast.BinOp):
-            return _BINARY[type(node.op)](ev(node.left), ev(node.right))
+            return BINARY[type(node.op)](ev(node.left), ev(node.right))
         if isinstance(node, ast.UnaryOp):
-            return _UNARY[type(node.op)](ev(node.operand))
+            return UNARY[type(node.op)](ev(node.operand))
         if isinstance(node, ast.Call):
-            assert isinstance(node.func, ast.Name)  # parse_expression admits no other call
+            assert isinstance(node.func, ast.Name)  # the check admits no other call
             return FUNCTIONS[node.func.id][column](*(ev(a) for a in node.args))
-        raise RigidfoldError(
-            f"unchecked node {type(node).__name__}"
-        )  # parse_expression excludes it
+        raise RigidfoldError(f"unchecked node {type(node).__name__}")  # the check excludes it
 
     return ev(tree)
 
@@ -200,15 +122,22 @@ def evaluate(tree: ast.Expression, x: Any, y: Any, xp: ModuleType = np) -> Any:
 class ExpressionSurface(Surface):
     """z = f(x, y) from user text; exact gradient by CasADi's automatic differentiation.
 
-    text : e.g. ``"0.3*sin(x)*cos(y) + 0.1*x**2"`` (see :data:`FUNCTIONS`, :data:`CONSTANTS`).
+    expression : the checked text (:class:`Expression`, from
+        :func:`rigidfold.generate.specs.parse_expression`), e.g. ``"0.3*sin(x)*cos(y) +
+        0.1*x**2"`` (see :data:`FUNCTIONS`, :data:`CONSTANTS`).
     mirror_planes : the surface's mirror planes, if the user knows any (none are derived).
     """
 
     name = "expr"
 
-    def __init__(self, text: str, mirror_planes: tuple[MirrorPlane, ...] = ()) -> None:
-        self._tree = parse_expression(text)
-        self.text = " ".join(text.split())
+    def __init__(self, expression: Expression, mirror_planes: tuple[MirrorPlane, ...] = ()) -> None:
+        if not isinstance(expression, Expression):
+            raise TypeError(
+                "an expression surface takes an Expression (rigidfold.generate.specs."
+                f"parse_expression reads one from text), got {type(expression).__name__}"
+            )
+        self._tree = expression.tree
+        self.text = expression.text
         self.mirror_planes = tuple(mirror_planes)
         sx, sy = ca.SX.sym("x"), ca.SX.sym("y")
         z = evaluate(self._tree, sx, sy, xp=ca) + 0 * sx
