@@ -19,6 +19,7 @@ from __future__ import annotations
 import ast
 import re
 from pathlib import Path
+from typing import Unpack
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.errors import RigidfoldError
@@ -34,8 +35,10 @@ from rigidfold.patterns import (
     PaperPattern,
     PatternSpec,
     Plan,
+    PlanKeywords,
     check_size,
     footprint_points,
+    given_options,
     make_plan,
     refuse_options,
 )
@@ -111,12 +114,8 @@ def parse_pattern(
     spec: str,
     *,
     size: str | tuple[float, float] | None = None,
-    diagonals: str | None = None,
-    edge_length: float | None = None,
-    scale: float | None = None,
-    up: str = "z",
-    rigid_panels: bool = False,
     settings: Settings = DEFAULTS,
+    **options: Unpack[PlanKeywords],
 ) -> Plan:
     """The plan of a pattern's text (:func:`parse_pattern_spec`, then
     :func:`rigidfold.patterns.make_plan` with these options); a one-line RigidfoldError
@@ -128,23 +127,12 @@ def parse_pattern(
     the other options : as :func:`rigidfold.patterns.make_plan` takes them.
     """
     text = str(spec).strip()
-    given = {
-        "size": size,
-        "diagonals": diagonals,
-        "edge length": edge_length,
-        "scale": scale,
-        "rigid panels": rigid_panels or None,
-    }
-    refuse_options(text, _pattern_type(text, spec), given)
+    refuse_options(text, _pattern_type(text, spec), given_options(size, options))
     return make_plan(
         parse_pattern_spec(spec),
         size=None if size is None else parse_size(size),
-        diagonals=diagonals,
-        edge_length=edge_length,
-        scale=scale,
-        up=up,
-        rigid_panels=rigid_panels,
         settings=settings,
+        **options,
     )
 
 
@@ -300,12 +288,8 @@ def case_from_specs(
     expr: str | None = None,
     symmetric: bool = False,
     size: str | tuple[float, float] | None = None,
-    diagonals: str | None = None,
-    edge_length: float | None = None,
-    scale: float | None = None,
-    up: str = "z",
-    rigid_panels: bool = False,
     settings: Settings = DEFAULTS,
+    **options: Unpack[PlanKeywords],
 ) -> Case:
     """The case of the texts the command line takes (:func:`rigidfold.generate.case.make_case`
     of the pattern's plan, :func:`parse_pattern`, and the surface's spec,
@@ -318,19 +302,11 @@ def case_from_specs(
     ``"y"``) of a FOLD pattern and of a mesh or FOLD surface; symmetric : the surface's own
     mirror planes (9) imposed; the other options : :func:`parse_pattern`'s.
     """
-    plan = parse_pattern(
-        pattern,
-        size=size,
-        diagonals=diagonals,
-        edge_length=edge_length,
-        scale=scale,
-        up=up,
-        rigid_panels=rigid_panels,
-        settings=settings,
-    )
+    plan = parse_pattern(pattern, size=size, settings=settings, **options)
     spec = (
         surface
         if isinstance(surface, Surface)
         else parse_surface_spec(surface, seed=seed, expr=expr)
     )
+    up = options.get("up", "z")
     return make_case(spec, plan, symmetric=symmetric, up=up, settings=settings)

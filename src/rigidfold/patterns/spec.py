@@ -15,7 +15,7 @@ import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypedDict
+from typing import TypedDict, Unpack
 
 import numpy as np
 
@@ -232,11 +232,10 @@ class Plan:
         }
 
 
-class PatternKeywords(TypedDict, total=False):
-    """The keywords of :func:`make_plan` besides the spec and the settings, as
-    :func:`rigidfold.generate.case.make_case` passes them on (one list, not two)."""
+class PlanKeywords(TypedDict, total=False):
+    """The keywords of :func:`make_plan` besides the spec, its size and the settings (the
+    readers of texts take the size as text too)."""
 
-    size: tuple[float, float] | None
     diagonals: str | None
     edge_length: float | None
     scale: float | None
@@ -244,16 +243,30 @@ class PatternKeywords(TypedDict, total=False):
     rigid_panels: bool
 
 
+class PatternKeywords(PlanKeywords, total=False):
+    """The keywords of :func:`make_plan` besides the spec and the settings, as
+    :func:`rigidfold.generate.case.make_case` passes them on (one list, not two)."""
+
+    size: tuple[float, float] | None
+
+
+def given_options(size: object, options: PlanKeywords) -> dict[str, object]:
+    """The options a pattern was given, by the names its messages use (None: not given),
+    for :func:`refuse_options`."""
+    return {
+        "size": size,
+        "diagonals": options.get("diagonals"),
+        "edge length": options.get("edge_length"),
+        "scale": options.get("scale"),
+        "rigid panels": options.get("rigid_panels") or None,
+    }
+
+
 def make_plan(
     spec: PatternSpec,
     *,
-    size: tuple[float, float] | None = None,
-    diagonals: str | None = None,
-    edge_length: float | None = None,
-    scale: float | None = None,
-    up: str = "z",
-    rigid_panels: bool = False,
     settings: Settings = DEFAULTS,
+    **options: Unpack[PatternKeywords],
 ) -> Plan:
     """The plan of a pattern spec; a one-line RigidfoldError naming what was received if bad.
 
@@ -279,14 +292,8 @@ def make_plan(
             "text)"
         )
     text = spec.text
-    given = {
-        "size": size,
-        "diagonals": diagonals,
-        "edge length": edge_length,
-        "scale": scale,
-        "rigid panels": rigid_panels or None,
-    }
-    refuse_options(text, type(spec), given)
+    size, diagonals = options.get("size"), options.get("diagonals")
+    refuse_options(text, type(spec), given_options(size, options))
     if isinstance(spec, PaperPattern):
         xy, faces = PATTERNS[spec.name]()
         return Plan(spec, xy, faces)
@@ -304,16 +311,17 @@ def make_plan(
         else:
             outline = check_footprint(spec.outline, settings)
         outline = outline - outline.min(axis=0)
-        length = default_edge_length(outline, settings) if edge_length is None else edge_length
+        length = options.get("edge_length")
+        length = default_edge_length(outline, settings) if length is None else length
         xy, faces = footprint_mesh(outline, length, settings)
         check_faces(len(faces), f"pattern {text!r}", settings)
         return Plan(spec, xy, faces, edge_length=float(length), footprint=outline)
     read = read_pattern_file(
         spec.path,
         size=None if size is None else check_size(size),
-        scale=scale,
-        up=up,
-        rigid_panels=rigid_panels,
+        scale=options.get("scale"),
+        up=options.get("up", "z"),
+        rigid_panels=options.get("rigid_panels", False),
         settings=settings,
     )
     check_faces(len(read.faces), f"pattern {text!r}", settings)

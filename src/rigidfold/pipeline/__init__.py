@@ -7,17 +7,8 @@ command of the command line is in :mod:`.workflows`. The files it writes are def
 :mod:`rigidfold.rundir`.
 """
 
-from rigidfold.pipeline.events import (
-    AttemptEnded,
-    Event,
-    FinalChecked,
-    RunEnded,
-    RunFailed,
-    RunInterrupted,
-    Sink,
-    SolutionAccepted,
-    SolutionsRetracted,
-)
+from rigidfold.pipeline import events
+from rigidfold.pipeline.events import *  # noqa: F403 (the event types and Sink: events.__all__)
 from rigidfold.pipeline.report import write_report
 from rigidfold.pipeline.result import RunResult
 from rigidfold.pipeline.run import Interrupted, run
@@ -25,20 +16,12 @@ from rigidfold.pipeline.verdict import RunOutcome, RunVerdict, run_verdict
 from rigidfold.pipeline.writer import RunWriter, verification_frames, write_checked_shape
 
 __all__ = [
-    "AttemptEnded",
-    "Event",
-    "FinalChecked",
+    *events.__all__,
     "Interrupted",
-    "RunEnded",
-    "RunFailed",
-    "RunInterrupted",
     "RunOutcome",
     "RunResult",
     "RunVerdict",
     "RunWriter",
-    "Sink",
-    "SolutionAccepted",
-    "SolutionsRetracted",
     "run",
     "run_verdict",
     "verification_frames",

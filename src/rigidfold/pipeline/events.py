@@ -40,6 +40,19 @@ class Sink(Protocol):
     def on_event(self, event: Event) -> None: ...
 
 
+__all__ = [
+    "AttemptEnded",
+    "Event",
+    "FinalChecked",
+    "RunEnded",
+    "RunFailed",
+    "RunInterrupted",
+    "Sink",
+    "SolutionAccepted",
+    "SolutionsRetracted",
+]
+
+
 @dataclass(frozen=True, eq=False)
 class AttemptEnded:
     """A solve of the search ended: ``attempt`` (its outcome, times), the last of

@@ -44,18 +44,9 @@ from rigidfold.io import (
     write_svg,
 )
 from rigidfold.mesh import CreasePattern
+from rigidfold.pipeline import events as ev
 from rigidfold.pipeline.built import check_built_options
 from rigidfold.pipeline.checks import Checked, traced_motion
-from rigidfold.pipeline.events import (
-    AttemptEnded,
-    Event,
-    FinalChecked,
-    RunEnded,
-    RunFailed,
-    RunInterrupted,
-    SolutionAccepted,
-    SolutionsRetracted,
-)
 from rigidfold.pipeline.report import report_run
 from rigidfold.pipeline.result import RunResult
 from rigidfold.pipeline.run import stopped
@@ -250,20 +241,20 @@ class RunWriter:
         """Remove the run's lock on DIR (:func:`lock_run_dir`); again changes nothing."""
         self.lock.unlink(missing_ok=True)
 
-    def on_event(self, event: Event) -> None:
+    def on_event(self, event: ev.Event) -> None:
         match event:
-            case AttemptEnded(result, attempt):
+            case ev.AttemptEnded(result, attempt):
                 self.log.sync(result.generation.attempts)
                 interval = self.case.settings.generation.summary_interval
                 if attempt.outcome is not AttemptOutcome.ACCEPTED and (
                     time.monotonic() - self.summary_written >= interval
                 ):
                     self.write_summary(result)  # an accepted one: its solution's writes it
-            case SolutionAccepted(result, solution, checked):
+            case ev.SolutionAccepted(result, solution, checked):
                 self._write_solution(solution, checked)
                 self.log.sync(result.generation.attempts)  # backtracking: accepted again
                 self.write_summary(result)
-            case SolutionsRetracted(result, taken):
+            case ev.SolutionsRetracted(result, taken):
                 with held_interrupts():  # the files go together
                     for solution in taken:
                         fold = self.out / solution_file(solution.step, solution.mechanism.dof)
@@ -271,22 +262,22 @@ class RunWriter:
                             path.unlink(missing_ok=True)
                 self.log.sync(result.generation.attempts)
                 self.write_summary(result)
-            case FinalChecked(result, solution, checked):
+            case ev.FinalChecked(result, solution, checked):
                 self._write_solution(solution, checked)
                 self.seen = result
-            case RunEnded(result):
+            case ev.RunEnded(result):
                 self.log.sync(result.generation.attempts)
                 self.write_summary(result)
                 if self.report:
                     report_run(self.out)
                 self._end(result)
-            case RunInterrupted(result):
+            case ev.RunInterrupted(result):
                 with held_interrupts(reraise=False):
                     self.log.start()
                     self.log.sync(result.generation.attempts)
                     self.write_summary(result)
                     self._end(result)
-            case RunFailed(result):
+            case ev.RunFailed(result):
                 with contextlib.suppress(RigidfoldError):
                     self.log.sync(result.generation.attempts)
                     self.write_summary(result)
