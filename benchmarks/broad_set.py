@@ -58,10 +58,12 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "today": (),
     "criterion-s": ("--criterion", "s"),
     "batch-auto": ("--batch", "auto"),
+    "theta-pattern": ("--theta-from-pattern",),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
-``batch-auto`` several creases fixed per solve where the first-order analysis allows."""
+``batch-auto`` several creases fixed per solve where the first-order analysis allows;
+``theta-pattern`` the sector-angle bounds widened to a pattern's own angles."""
 
 COMMON = ("--lookahead", "--no-deform", "--quiet")
 """The flags every run gets (besides ``--time-limit`` and ``--out``): the README's command;

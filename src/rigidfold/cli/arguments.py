@@ -87,7 +87,15 @@ def _case(p: Parser, *, out: str) -> None:
     add_options(
         p,
         SettingsOptions,
-        only=("dz", "theta_min", "theta_max", "rho_max", "hessian", "svg_tolerance"),
+        only=(
+            "dz",
+            "theta_min",
+            "theta_max",
+            "theta_from_pattern",
+            "rho_max",
+            "hessian",
+            "svg_tolerance",
+        ),
     )
     p.add_argument("--out", required=True, type=directory, metavar="DIR", help=out)
 

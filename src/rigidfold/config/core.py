@@ -29,6 +29,14 @@ class DesignSettings(Group):
     rho_max: float | None = setting(
         None, "Optional bound on |rho_j| of free creases, constraint (12), radians."
     )
+    theta_from_pattern: bool = setting(
+        False,
+        "The sector-angle bounds widened to the initial shape's own angles where it has "
+        "angles outside them (to 0.9 of its smallest, and its largest plus a tenth of what "
+        "is left to 180 degrees): the slivers of a pattern drawn in another tool are its "
+        "designer's, not a mesh's, and problem (6) no longer starts by forcing them to "
+        "[theta_min, theta_max] (:func:`rigidfold.generate.case.make_case`).",
+    )
     f_tol: float = setting(1e-7, "A solution of (6) is accepted when F <= f_tol (paper: 1e-7).")
     dz_bound_tol: float = setting(
         1e-3,

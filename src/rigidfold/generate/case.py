@@ -136,6 +136,7 @@ def make_case(
             "(rigidfold.generate.specs.parse_surface_spec reads text)"
         )
     shape = patterns.build(plan, surf, settings=settings)
+    settings = pattern_angle_bounds(shape, settings)  # the shape's tolerances are the same
     check_sector_angles(shape, settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
@@ -144,6 +145,23 @@ def make_case(
             "(dome or hp)"
         )
     return Case(surf, plan, shape, planes, settings, _input_files(plan.spec, surface))
+
+
+def pattern_angle_bounds(shape: CreasePattern, settings: Settings) -> Settings:
+    """``settings`` with the sector-angle bounds widened to the initial shape's own angles
+    where ``Settings.design.theta_from_pattern`` asks: where it has angles below theta_min,
+    that bound goes to 0.9 of its smallest; where above theta_max, that one to its largest
+    plus a tenth of what is left to 180 degrees (so the start lies strictly inside); else
+    ``settings`` as they are."""
+    d = settings.design
+    if not d.theta_from_pattern:
+        return settings
+    low, top = float(shape.corner_angles.min()), float(shape.corner_angles.max())
+    lo = 0.9 * low if low < d.theta_min else d.theta_min
+    hi = top + 0.1 * (math.pi - top) if top > d.theta_max else d.theta_max
+    if lo == d.theta_min and hi == d.theta_max:
+        return settings
+    return settings.with_(theta_min=lo, theta_max=hi)
 
 
 def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> None:

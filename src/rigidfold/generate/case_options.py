@@ -153,6 +153,12 @@ class SettingsOptions:
         parse=float,
         metavar="DEG",
     )
+    theta_from_pattern: bool = option(
+        False,
+        "widening of the sector-angle bounds to the crease pattern's own angles where it has "
+        "angles outside them (a pattern drawn in another tool keeps its slivers; "
+        "Settings.design.theta_from_pattern)",
+    )
     rho_max: float | None = option(
         None,
         "bound (12) on the fold angle of every free crease, |rho| <= this, degrees (default: "
@@ -210,6 +216,7 @@ class SettingsOptions:
             theta_min_deg=self.theta_min,
             theta_max_deg=self.theta_max,
             rho_max_deg=self.rho_max,
+            theta_from_pattern=self.theta_from_pattern,
             retry_zero_dof=self.retry_zero_dof,
             ipopt_hessian=self.hessian,
             svg_snap_tol=self.svg_tolerance,
