@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test browser bench lint format clean same-path
+.PHONY: demo test browser bench broad-set lint format clean same-path
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -58,6 +58,11 @@ bench: $(STAMP)
 	$(PY) benchmarks/panel_pin_trend.py
 	$(PY) benchmarks/bench_fabricate.py
 	$(PY) benchmarks/bench_drive.py
+
+# the broad set of issue 49 (a sample of about 60 cases, 3 min each: about two hours on 2
+# cores; docs/broad_set.md), not part of bench
+broad-set: $(STAMP)
+	$(PY) benchmarks/broad_set.py --sample 50 --variants today,batch-auto --jobs 2 --out out/broad_set.jsonl --resume
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
