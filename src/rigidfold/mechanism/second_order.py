@@ -332,21 +332,22 @@ def _best_stress(basis: np.ndarray, k: int, settings: Settings) -> tuple[float, 
     return best, bound, best_coef
 
 
-def _flex_test(settings: Settings) -> tuple[float, float, int]:
-    """(step, tol, iterations) of the finite-motion test of supports (``Settings.structure``)."""
+def _flex_test(settings: Settings) -> tuple[float, float, int, float]:
+    """(step, tol, iterations, delta) of the finite-motion test of supports
+    (``Settings.structure``; ``delta``, ``Settings.path.regularization``)."""
     st = settings.structure
-    return st.flex_step, st.flex_tol, st.max_iter
+    return st.flex_step, st.flex_tol, st.max_iter, settings.path.regularization
 
 
 def _finite_motion(
-    cons: Constraints, z: np.ndarray, step: float, tol: float, iterations: int
+    cons: Constraints, z: np.ndarray, step: float, tol: float, iterations: int, delta: float
 ) -> np.ndarray | None:
     """The design moved ``step`` mean edge lengths along the flex z (3V,), corrected at
     right angles to z by Gauss-Newton until every constraint holds to ``tol`` (of the mean
     edge length): that displacement (3V,) when it does within a correction smaller than
     the step, else None. Each correction is the least-norm solution of the linearised
     constraints and z . dx = 0, from the sparse system ``[[I, A^T], [A, -delta I]]``
-    (``delta`` = ``Settings.path.regularization``'s default: redundant rows, self-stresses,
+    (``delta``: ``Settings.path.regularization``, so that redundant rows, self-stresses,
     are allowed): a dense least-squares solve took 1.5 s at 500 vertices."""
     scale = float(np.mean(cons.lengths))
     t = step * scale
@@ -354,7 +355,6 @@ def _finite_motion(
     x0 = cons.x0.ravel()
     x = x0 + t * z
     n = len(x0)
-    delta = DEFAULTS.path.regularization
     for _ in range(iterations):
         g = cons.values(x.reshape(-1, 3))
         if np.linalg.norm(g) <= tol * scale:
@@ -528,6 +528,7 @@ def _obstruction(
         settings.path.step,
         settings.path.tol,
         settings.structure.max_iter,
+        settings.path.regularization,
     )
     rigid = moved is None and strain > settings.path.tol
     return Obstruction(rigid, k, s, float(margin), sigma, energy, strain, moved is not None)
