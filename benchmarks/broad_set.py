@@ -58,12 +58,13 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "today": (),
     "criterion-s": ("--criterion", "s"),
     "batch-auto": ("--batch", "auto"),
-    "theta-pattern": ("--theta-from-pattern",),
+    "theta-none": ("--theta-widen", "none"),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
 ``batch-auto`` several creases fixed per solve where the first-order analysis allows;
-``theta-pattern`` the sector-angle bounds widened to a pattern's own angles."""
+``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
+(the default before session 24)."""
 
 COMMON = ("--lookahead", "--no-deform", "--quiet")
 """The flags every run gets (besides ``--time-limit`` and ``--out``): the README's command;
@@ -369,7 +370,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--resume", action="store_true", help="skip the runs already in --out")
     parser.add_argument("--work", type=Path, default=None, help="folder for the runs' outputs")
     parser.add_argument("--keep", action="store_true", help="keep each run's output folder")
-    parser.add_argument("--list", action="store_true", help="list the cases and exit")
+    parser.add_argument(
+        "--list", action="store_true", help="list the cases (of --only, --sample) and exit"
+    )
     parser.add_argument(
         "--summarize", type=Path, default=None, metavar="FILE", help="summarize a results file"
     )
@@ -389,22 +392,22 @@ def main(argv: list[str] | None = None) -> int:
         work = (args.work or Path(tmp)).resolve()
         work.mkdir(parents=True, exist_ok=True)
         every, left = cases(work)
+        wanted = None if args.only is None else [w for w in args.only.split(",") if w]
+        chosen = [c for c in every if wanted is None or any(w in c.name for w in wanted)]
+        if args.sample is not None:
+            chosen = stratified(chosen, args.sample)
         if args.list:
             counts: dict[str, int] = defaultdict(int)
-            for c in every:
+            for c in chosen:
                 counts[c.family] += 1
                 shown = [
                     Path(a).name if a.endswith((".svg", ".fold")) else a for a in c.cli_args(work)
                 ]
                 print(f"{c.name}\t{' '.join(shown)}")
-            print(f"{len(every)} cases: " + ", ".join(f"{f} {n}" for f, n in counts.items()))
+            print(f"{len(chosen)} cases: " + ", ".join(f"{f} {n}" for f, n in counts.items()))
             for name, reason in left:
                 print(f"left out {name}: {reason}")
             return 0
-        wanted = None if args.only is None else [w for w in args.only.split(",") if w]
-        chosen = [c for c in every if wanted is None or any(w in c.name for w in wanted)]
-        if args.sample is not None:
-            chosen = stratified(chosen, args.sample)
         done: set[tuple[str, str]] = set()
         if args.resume and args.out.is_file():
             done = {(r["case"], r["variant"]) for r in read_rows(args.out)}

@@ -310,11 +310,12 @@ def run_command(argv: list[str], label: str, root: Path, inputs: list[Path], cap
     assert seconds < SECONDS, f"{label}: {seconds:.1f} s"
     assert code in (0, 1, 2), f"{label}: exit code {code}"
     assert "Traceback" not in stdout + stderr, label
-    warnings = [line for line in stderr.splitlines() if line.startswith("rigidfold: warning: ")]
+    notes = ("rigidfold: warning: ", "rigidfold: note: ")
+    warnings = [line for line in stderr.splitlines() if line.startswith(notes)]
     stderr = "".join(f"{line}\n" for line in stderr.splitlines() if line not in warnings)
     if code == 2:
         one_line_error(stderr, label)
-    else:  # nothing on stderr but rigidfold's one-line warnings (sizes in millimetres)
+    else:  # nothing on stderr but rigidfold's one-line warnings and notes (sizes in mm)
         assert not stderr.strip(), f"{label}: {stderr!r}"
     after = snapshot(root)
     changed = {p for p in before.keys() | after.keys() if before.get(p) != after.get(p)}

@@ -32,15 +32,17 @@ def test_a_plan_far_outside_the_angle_bounds_is_refused_before_solving():
     """Origami Simulator's hypar.svg lifted onto the hp surface: about a third of its sector
     angles are slivers far below theta_min. It failed after the solve with "face 0 ... is
     degenerate"; it is refused when the case is made, saying what is out of range and which
-    options change the bounds."""
+    options change the bounds. (By default a drawn plan's own angles widen the bounds, and
+    hypar.svg loads: the refusal is that of bounds kept as given, ``--theta-widen none``.)"""
+    given = DEFAULTS.with_(theta_widen="none")
     angles = np.degrees(
         case_from_specs(
-            "hp", str(HYPAR), settings=DEFAULTS.with_(theta_far_share=1.0)
+            "hp", str(HYPAR), settings=given.with_(theta_far_share=1.0)
         ).pattern.corner_angles
     )
     below, above = int((angles < 30).sum()), int((angles > 120).sum())
     with pytest.raises(ValueError) as info:
-        case_from_specs("hp", str(HYPAR))
+        case_from_specs("hp", str(HYPAR), settings=given)
     message = str(info.value)
     assert "\n" not in message
     assert f"{below + above} of {angles.size} sector angles outside" in message
@@ -49,8 +51,11 @@ def test_a_plan_far_outside_the_angle_bounds_is_refused_before_solving():
     assert "[30, 120] degrees" in message
     assert "--theta-min" in message and "--theta-max" in message
     # the bounds that the options set decide: wide ones let the same plan through
-    wide = DEFAULTS.with_(theta_min=math.radians(0.1), theta_max=math.radians(179))
+    wide = given.with_(theta_min=math.radians(0.1), theta_max=math.radians(179))
     assert case_from_specs("hp", str(HYPAR), settings=wide).pattern.n_faces == angles.size // 3
+    # and so does its own plan, by default
+    case = case_from_specs("hp", str(HYPAR))
+    assert case.settings.design.theta_min < math.radians(angles.min()) and case.notes
 
 
 @pytest.mark.parametrize("spec", ["1", "2", "11", "grid:9x6"])
@@ -62,7 +67,17 @@ def test_the_paper_patterns_and_grids_pass_the_angle_check(spec):
 
 def test_the_cli_refuses_the_plan_in_one_line(tmp_path, capsys):
     code, _, err = run(
-        ["generate", "--surface", "hp", "--pattern", str(HYPAR), "--out", str(tmp_path / "o")],
+        [
+            "generate",
+            "--surface",
+            "hp",
+            "--pattern",
+            str(HYPAR),
+            "--theta-widen",
+            "none",
+            "--out",
+            str(tmp_path / "o"),
+        ],
         capsys,
     )
     assert code == 2 and err.count("\n") == 1, err

@@ -91,7 +91,7 @@ def _case(p: Parser, *, out: str) -> None:
             "dz",
             "theta_min",
             "theta_max",
-            "theta_from_pattern",
+            "theta_widen",
             "rho_max",
             "hessian",
             "svg_tolerance",

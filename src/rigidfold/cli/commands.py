@@ -65,6 +65,8 @@ def _case(args: argparse.Namespace):
     case = options_of(CaseOptions, args).make(options_of(SettingsOptions, args).settings())
     for warning in case.warnings:
         print(one_line(f"rigidfold: warning: {warning}"), file=sys.stderr)
+    for note in case.notes:
+        print(one_line(f"rigidfold: note: {note}"), file=sys.stderr)
     return case
 
 

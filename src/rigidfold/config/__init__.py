@@ -25,6 +25,7 @@ from rigidfold.config.checks import (
 )
 from rigidfold.config.core import (
     HESSIANS,
+    THETA_WIDEN,
     DesignSettings,
     GenerationSettings,
     GeometrySettings,
@@ -57,6 +58,7 @@ __all__ = [
     "HESSIANS",
     "SEED_LIMIT",
     "SIDES",
+    "THETA_WIDEN",
     "Check",
     "DeformationSettings",
     "DesignSettings",

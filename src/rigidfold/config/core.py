@@ -10,9 +10,12 @@ from rigidfold.config.base import Group, setting
 from rigidfold.errors import RigidfoldError
 
 HESSIANS = ("closed-form", "casadi")
+"""The Hessians of the Lagrangian IPOPT can use (``SolverSettings.ipopt_hessian``)."""
 DOF_COUNTS = ("auto", "gap", "threshold")
 """How generation counts a shape's DOF (``MechanismSettings.dof_count``)."""
-"""The Hessians of the Lagrangian IPOPT can use (``SolverSettings.ipopt_hessian``)."""
+THETA_WIDEN = ("files", "all", "none")
+"""Which crease patterns widen the sector-angle bounds to their own plan angles
+(``DesignSettings.theta_widen``), the default first."""
 
 
 @dataclass(frozen=True)
@@ -29,13 +32,27 @@ class DesignSettings(Group):
     rho_max: float | None = setting(
         None, "Optional bound on |rho_j| of free creases, constraint (12), radians."
     )
-    theta_from_pattern: bool = setting(
-        False,
-        "The sector-angle bounds widened to the initial shape's own angles where it has "
-        "angles outside them (to 0.9 of its smallest, and its largest plus a tenth of what "
-        "is left to 180 degrees): the slivers of a pattern drawn in another tool are its "
-        "designer's, not a mesh's, and problem (6) no longer starts by forcing them to "
-        "[theta_min, theta_max] (:func:`rigidfold.generate.case.make_case`).",
+    theta_widen: str = setting(
+        "files",
+        "Which crease patterns widen the sector-angle bounds to their own plan angles where "
+        "the plan breaks them: 'files' (patterns read from FOLD or SVG files: their angles are "
+        "their designer's, and a design's sector angles are those of its flat pattern), 'all' "
+        "(the paper's patterns and rigidfold's grid: and mesh: triangulations too), 'none' "
+        "(the bounds as given). The paper's patterns keep the paper's bounds under 'files' "
+        "(:func:`rigidfold.generate.case.widened_angle_bounds`).",
+    )
+    theta_widen_room: float = setting(
+        0.1,
+        "Where a bound is widened, how far beyond the plan's own extreme angle it lies, as a "
+        "fraction of the room: theta_min goes to (1 - this) x the smallest plan angle, "
+        "theta_max to the largest plus this x (180 degrees - the largest), so that the flat "
+        "pattern lies strictly inside.",
+    )
+    theta_widen_tol: float = setting(
+        1e-3,
+        "A plan angle breaks a sector-angle bound when it lies beyond it by more than this, "
+        "radians (about 0.06 degrees): an angle drawn at the bound and rounded in the file "
+        "(reschTriTessellation.svg: 29.996 degrees for 30) widens nothing.",
     )
     f_tol: float = setting(1e-7, "A solution of (6) is accepted when F <= f_tol (paper: 1e-7).")
     dz_bound_tol: float = setting(
@@ -61,6 +78,10 @@ class DesignSettings(Group):
             )
         if not self.f_tol > 0:
             raise RigidfoldError(f"f_tol must be positive, got {self.f_tol!r}")
+        self._choice("theta_widen", THETA_WIDEN)
+        self._positive("theta_widen_room")
+        self._fraction("theta_widen_room", below_one=True)
+        self._non_negative("theta_widen_tol")
 
 
 @dataclass(frozen=True)

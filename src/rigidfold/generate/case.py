@@ -15,9 +15,9 @@ from typing import Unpack
 import numpy as np
 
 from rigidfold import patterns
-from rigidfold.config import DEFAULTS, Settings
+from rigidfold.config import DEFAULTS, DesignSettings, Settings
 from rigidfold.errors import RigidfoldError
-from rigidfold.mesh import CreasePattern
+from rigidfold.mesh import CreasePattern, geometry
 from rigidfold.optimize import FormFindingProblem, OptimizeResult
 from rigidfold.protocols import SymmetryPlane, TargetSurface
 from rigidfold.surfaces import Surface, SurfaceSpec, surface_of
@@ -32,7 +32,8 @@ class Case:
     target surface); planes : mirror planes (SymmetryPlane) used for constraint (9);
     settings : Settings; inputs : the files the pattern and the surface were read from (a
     FOLD or SVG pattern, a footprint file, a mesh or FOLD surface), which a run must never
-    remove or replace.
+    remove or replace; notes : what the case changed of the settings given, one sentence
+    each (the sector-angle bounds widened to a drawn plan's angles).
     """
 
     surface: TargetSurface
@@ -41,6 +42,7 @@ class Case:
     planes: tuple[SymmetryPlane, ...]
     settings: Settings
     inputs: tuple[Path, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def warnings(self) -> list[str]:
@@ -135,8 +137,10 @@ def make_case(
             f"a case's surface is a SurfaceSpec or a Surface, got {type(surface).__name__} "
             "(rigidfold.generate.specs.parse_surface_spec reads text)"
         )
+    given = settings.design
+    settings = widened_angle_bounds(plan, settings)
+    notes = () if settings.design is given else (_widened_note(given, settings.design),)
     shape = patterns.build(plan, surf, settings=settings)
-    settings = pattern_angle_bounds(shape, settings)  # the shape's tolerances are the same
     check_sector_angles(shape, settings)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
@@ -144,24 +148,57 @@ def make_case(
             f"surface '{surf.name}' has no mirror planes; --symmetric needs a symmetric surface "
             "(dome or hp)"
         )
-    return Case(surf, plan, shape, planes, settings, _input_files(plan.spec, surface))
+    return Case(surf, plan, shape, planes, settings, _input_files(plan.spec, surface), notes)
 
 
-def pattern_angle_bounds(shape: CreasePattern, settings: Settings) -> Settings:
-    """``settings`` with the sector-angle bounds widened to the initial shape's own angles
-    where ``Settings.design.theta_from_pattern`` asks: where it has angles below theta_min,
-    that bound goes to 0.9 of its smallest; where above theta_max, that one to its largest
-    plus a tenth of what is left to 180 degrees (so the start lies strictly inside); else
-    ``settings`` as they are."""
+def widened_angle_bounds(plan: patterns.Plan, settings: Settings) -> Settings:
+    """``settings`` with the sector-angle bounds widened to the plan's own angles where
+    ``Settings.design.theta_widen`` asks it of this plan (``"files"``: a pattern read from a
+    FOLD or SVG file; ``"all"``; ``"none"``) and the plan breaks them by more than
+    ``theta_widen_tol``: theta_min to (1 - room) x its smallest angle, theta_max to its largest
+    plus room x (pi - its largest), ``room`` = ``theta_widen_room``, the side it breaks only;
+    else ``settings`` as they are.
+
+    A design's sector angles are those of its flat pattern, so bounds that the drawn plan
+    itself breaks could only be met by redrawing it: problem (6) would start by forcing every
+    sliver of the drawing into the bounds (slow first solves, or no design within dz).
+    """
     d = settings.design
-    if not d.theta_from_pattern:
+    if d.theta_widen == "none" or (
+        d.theta_widen == "files" and not isinstance(plan.spec, patterns.FilePattern)
+    ):
         return settings
-    low, top = float(shape.corner_angles.min()), float(shape.corner_angles.max())
-    lo = 0.9 * low if low < d.theta_min else d.theta_min
-    hi = top + 0.1 * (math.pi - top) if top > d.theta_max else d.theta_max
+    angles = plan_corner_angles(plan)
+    low, top = float(angles.min()), float(angles.max())
+    room = d.theta_widen_room
+    lo = (1 - room) * low if low < d.theta_min - d.theta_widen_tol else d.theta_min
+    hi = top + room * (math.pi - top) if top > d.theta_max + d.theta_widen_tol else d.theta_max
     if lo == d.theta_min and hi == d.theta_max:
         return settings
     return settings.with_(theta_min=lo, theta_max=hi)
+
+
+def _widened_note(given: DesignSettings, widened: DesignSettings) -> str:
+    """One sentence: the sector-angle bounds, as given and as widened."""
+
+    def bounds(d: DesignSettings) -> str:
+        return f"[{math.degrees(d.theta_min):.4g}, {math.degrees(d.theta_max):.4g}]"
+
+    return (
+        f"the sector-angle bounds are {bounds(widened)} degrees (given: {bounds(given)}): "
+        "the crease pattern's plan has angles outside those given, which a design could "
+        "meet only by redrawing it (--theta-widen none keeps the bounds given)"
+    )
+
+
+def plan_corner_angles(plan: patterns.Plan) -> np.ndarray:
+    """The plan's sector angles as drawn, (F, 3) float64 radians (entry ``[f, k]`` at vertex
+    ``plan.faces[f, k]``): a file's own (:attr:`rigidfold.patterns.Plan.drawn_angles`, in 3D
+    for a folded FOLD file, whose projection is no flat pattern), else the flat plan's."""
+    if plan.drawn_angles is not None:
+        return plan.drawn_angles
+    flat = np.column_stack([plan.xy, np.zeros(len(plan.xy))])
+    return geometry.corner_angles(flat, plan.faces)
 
 
 def check_sector_angles(shape: CreasePattern, settings: Settings = DEFAULTS) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import MISSING, dataclass
 
-from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, Settings
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, THETA_WIDEN, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
 from rigidfold.generate.case import Case
@@ -153,11 +153,12 @@ class SettingsOptions:
         parse=float,
         metavar="DEG",
     )
-    theta_from_pattern: bool = option(
-        False,
-        "widening of the sector-angle bounds to the crease pattern's own angles where it has "
-        "angles outside them (a pattern drawn in another tool keeps its slivers; "
-        "Settings.design.theta_from_pattern)",
+    theta_widen: str = option(
+        DEFAULTS.design.theta_widen,
+        "which crease patterns widen the sector-angle bounds to their own plan angles where "
+        "the plan breaks them: files (patterns read from FOLD or SVG files: a drawing keeps "
+        "its slivers), all, or none (the bounds as given) (Settings.design.theta_widen)",
+        choices=THETA_WIDEN,
     )
     rho_max: float | None = option(
         None,
@@ -216,7 +217,7 @@ class SettingsOptions:
             theta_min_deg=self.theta_min,
             theta_max_deg=self.theta_max,
             rho_max_deg=self.rho_max,
-            theta_from_pattern=self.theta_from_pattern,
+            theta_widen=self.theta_widen,
             retry_zero_dof=self.retry_zero_dof,
             ipopt_hessian=self.hessian,
             svg_snap_tol=self.svg_tolerance,

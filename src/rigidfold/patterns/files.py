@@ -45,13 +45,17 @@ class PatternFile:
     faces : (F, 3) int64 triangles, counter-clockwise seen from +z;
     fixed : (k, 2) int64 vertex pairs of the crease lines that start fixed;
     source : dict, what was read and how: file name, format, unit, metres per unit, up axis,
-        rigid panels, and the size the drawing was fitted into (None when not fitted).
+        rigid panels, and the size the drawing was fitted into (None when not fitted);
+    sector_angles : (F, 3) float64 radians, the corner angles of ``faces`` in the file's own
+        coordinates (a folded FOLD file's in 3D, not those of its projection): the panels'
+        angles as their designer drew them.
     """
 
     xy: np.ndarray
     faces: np.ndarray
     fixed: np.ndarray
     source: dict
+    sector_angles: np.ndarray
 
 
 def read_pattern_file(
@@ -87,6 +91,7 @@ def read_pattern_file(
         xy = data.pattern.coords[:, :2]
         faces = data.pattern.faces
         fixed = data.pattern.edges[data.pattern.fixed]
+        angles = data.pattern.corner_angles  # in 3D for a folded form
         unit, per_unit = data.unit, data.scale
         plan, fitted, per_unit = _scaled(xy, path, unit, per_unit, size, scale, settings)
     else:
@@ -106,6 +111,7 @@ def read_pattern_file(
         coords = np.column_stack([xy, np.zeros(len(xy))])
         triangles, diagonals = _triangulate_drawing(path, drawing, coords, settings)
         faces = orient_up(coords, triangles)
+        angles = geometry.corner_angles(coords, faces)
         fixed = np.asarray(diagonals if rigid_panels else [], dtype=np.int64).reshape(-1, 2)
     xy = plan
     _check_unfolded(xy, faces, path, settings)
@@ -118,7 +124,8 @@ def read_pattern_file(
         "rigid_panels": rigid_panels,
         "fitted_into_m": fitted,
     }
-    return PatternFile(xy - xy.min(axis=0), np.asarray(faces, dtype=np.int64), fixed, source)
+    faces = np.asarray(faces, dtype=np.int64)
+    return PatternFile(xy - xy.min(axis=0), faces, fixed, source, np.asarray(angles, dtype=float))
 
 
 def _triangulate_drawing(

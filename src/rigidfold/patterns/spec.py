@@ -202,7 +202,10 @@ class Plan:
     edge_length : float, the target edge length (metres) of a ``mesh:`` pattern, else None;
     footprint : (N, 2) float64 counter-clockwise polygon of a ``mesh:`` pattern, placed as
         ``xy``, else None;
-    source : dict of a pattern read from a file (:attr:`files.PatternFile.source`), else None.
+    source : dict of a pattern read from a file (:attr:`files.PatternFile.source`), else None;
+    drawn_angles : (F, 3) float64 radians of a pattern read from a file, the corner angles of
+        ``faces`` as the file draws them (:attr:`files.PatternFile.sector_angles`: a folded
+        FOLD file's in 3D), else None.
     """
 
     spec: PatternSpec
@@ -213,6 +216,7 @@ class Plan:
     edge_length: float | None = None
     footprint: np.ndarray | None = None
     source: dict | None = None
+    drawn_angles: np.ndarray | None = None
 
     @property
     def box(self) -> tuple[float, float]:
@@ -325,7 +329,14 @@ def make_plan(
         settings=settings,
     )
     check_faces(len(read.faces), f"pattern {text!r}", settings)
-    return Plan(spec, read.xy, read.faces, fixed=read.fixed, source=read.source)
+    return Plan(
+        spec,
+        read.xy,
+        read.faces,
+        fixed=read.fixed,
+        source=read.source,
+        drawn_angles=read.sector_angles,
+    )
 
 
 def check_faces(count: int, what: str, settings: Settings = DEFAULTS) -> None:
