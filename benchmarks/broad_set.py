@@ -59,12 +59,14 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "criterion-s": ("--criterion", "s"),
     "batch-auto": ("--batch", "auto"),
     "theta-none": ("--theta-widen", "none"),
+    "accept-no-gap": ("--accept-no-gap",),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
 ``batch-auto`` several creases fixed per solve where the first-order analysis allows;
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
-(the default before session 24)."""
+(the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
+ends the run (the default before session 24)."""
 
 COMMON = ("--lookahead", "--no-deform", "--quiet")
 """The flags every run gets (besides ``--time-limit`` and ``--out``): the README's command;

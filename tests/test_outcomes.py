@@ -33,6 +33,7 @@ VALUES = {
         "path",
         "second_order_rigid",
         "time_limit",
+        "no_gap",
         "initial_failed",
         "dead_end",
     ],

@@ -111,7 +111,7 @@ def test_the_command_lines_option_and_bad_values():
 def test_a_folded_fold_files_angles_are_its_panels_not_its_projections(tmp_path):
     """A 3D FOLD file (a design of rigidfold, a folded form) is read in plan by its
     projection, whose angles are no panel's: its widening looks at the angles in 3D."""
-    from rigidfold.io.fold import write_fold
+    from rigidfold.io.fold_write import write_fold
 
     lifted = case_from_specs("hp", "grid:5x5").pattern  # 3D, angles 38-97 degrees
     path = write_fold(tmp_path / "folded.fold", lifted)

@@ -50,7 +50,9 @@ def _generate(p: Parser) -> None:
         "exported in every format of rigidfold export) and report.html",
     )
     add_options(p, GenerateOptions)
-    add_options(p, SettingsOptions, only=("backtrack", "fold_limit", "retry_zero_dof"))
+    add_options(
+        p, SettingsOptions, only=("backtrack", "fold_limit", "retry_zero_dof", "accept_no_gap")
+    )
     fabricate_arguments(p, generate=True)
     structure_arguments(p, generate=True)
     p.add_argument(

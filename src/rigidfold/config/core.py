@@ -97,6 +97,15 @@ class GenerationSettings(Group):
         "try the next candidate (Step 7) instead, which reaches the target more often at the "
         "price of more solves.",
     )
+    clear_gap: bool = setting(
+        True,
+        "With the deployability check: a solution at the target DOF whose DOF has no clear "
+        "gap (:class:`rigidfold.mechanism.margin.DofMargin`: near-mechanisms, or the "
+        "search's count and the singular values' differ) is a rejected candidate "
+        "(``no_gap``): the search goes on for one with a clear gap and delivers that one "
+        "only where it finds none (the verdict says so). ``False`` (``--accept-no-gap``): "
+        "such a solution ends the run, as before session 24.",
+    )
     hinge_stiffness: float = setting(
         1e-3, "Mean of the fictitious hinge stiffnesses K_j, N m (Section 6.1)."
     )

@@ -33,7 +33,8 @@ import numpy as np
 from rigidfold.drive.energy import derivative
 from rigidfold.drive.result import DriveResult
 from rigidfold.io.files import jsonable, prepare_output_dir, write_together
-from rigidfold.io.fold import fold_dict, motion_frames
+from rigidfold.io.fold_frames import motion_frames
+from rigidfold.io.fold_write import fold_dict
 
 DEPLOY_FILES = ("deploy.json", "deploy.fold", "deploy.csv", "deploy.png")
 """The files :func:`write_drive` writes."""

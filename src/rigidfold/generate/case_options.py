@@ -200,6 +200,13 @@ class SettingsOptions:
         parse=int,
         metavar="N",
     )
+    accept_no_gap: bool = option(
+        False,
+        "with the deployability check: a design at the target DOF without a clear DOF gap "
+        "(near-mechanisms) ends the run; by default the search goes on for one with a clear "
+        "gap and delivers such a design only where it finds none "
+        "(Settings.generation.clear_gap)",
+    )
     retry_zero_dof: bool = option(
         False,
         "retries of a 0-DOF solution: treated as a lock, the next crease is tried (the "
@@ -219,6 +226,7 @@ class SettingsOptions:
             rho_max_deg=self.rho_max,
             theta_widen=self.theta_widen,
             retry_zero_dof=self.retry_zero_dof,
+            clear_gap=not self.accept_no_gap,
             ipopt_hessian=self.hessian,
             svg_snap_tol=self.svg_tolerance,
             **given,

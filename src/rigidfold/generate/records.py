@@ -44,6 +44,12 @@ class AttemptOutcome(Outcome):
         "the run's time limit cut the solve or its path trace short: no verdict on the "
         "candidate (not counted in N_exceed or N_path; the run ends)",
     )
+    NO_GAP = (
+        "no_gap",
+        "a solution at the target DOF without a clear gap (near-mechanisms, or the search's "
+        "count and the singular values' differ): kept as the run's fallback design while the "
+        "search looks for one with a clear gap (``Settings.generation.clear_gap``)",
+    )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
         "dead_end",

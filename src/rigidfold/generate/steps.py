@@ -236,6 +236,17 @@ class _Steps:
                 if second is not None and second.rigid:
                     outcome = AttemptOutcome.RIGID
             t_path = time.perf_counter() - t2
+        if outcome is AttemptOutcome.ACCEPTED and start is not None and self.wants_gap(mech):
+            assert mech is not None
+            margin = dof_margin(
+                result.pattern,
+                self.support_face(result.pattern),
+                self.settings,
+                count=self.count,
+                counted=mech.dof,
+            )
+            if not margin.clear:
+                outcome = AttemptOutcome.NO_GAP
         locked = [] if mech is None else mech.locked_creases.tolist()
         rec = Attempt(
             index=len(self.run.attempts),
@@ -308,6 +319,33 @@ class _Steps:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
         deadline = self.deadline
         return deadline is not None and time.monotonic() > deadline
+
+    def wants_gap(self, mech: Mechanism | None) -> bool:
+        """Whether a solution of ``mech`` must show a clear DOF gap to be accepted
+        (``Settings.generation.clear_gap``, with the deployability check, at the target)."""
+        return (
+            mech is not None
+            and self.options.deploy_check
+            and self.settings.generation.clear_gap
+            and 1 <= mech.dof <= self.options.target_dof
+        )
+
+    def keep_no_gap(self, rec: Attempt, trial: _Trial) -> None:
+        """Keep a solution at the target DOF without a clear gap (its attempt's outcome
+        NO_GAP) as the run's fallback: the chain that ends with it becomes :attr:`deepest`
+        where it is lower than the one kept, so that :meth:`settle` delivers it when the
+        search finds nothing better."""
+        assert trial.mechanism is not None  # a solution was analysed
+        run = self.run
+        sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
+        chain = _Chain(
+            [*run.solutions, sol],
+            [*self.accepted, rec],
+            Stop.TARGET_REACHED,
+            str(self.options.target_dof),
+        )
+        if self.deepest is None or _dof(chain.solutions) < _dof(self.deepest.solutions):
+            self.deepest = chain
 
     def is_solution(self, rec: Attempt) -> bool:
         """Whether an attempt gives a solution: accepted, or the DOF-0 shape of a target 0."""
@@ -426,13 +464,15 @@ class _Steps:
             self.record(rec, trial)
             if self.is_solution(rec):
                 return None
+            if rec.outcome is AttemptOutcome.NO_GAP:
+                self.keep_no_gap(rec, trial)
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
             if rec.outcome is AttemptOutcome.TIME_LIMIT:
                 self.run.stop_detail = f"{self.options.time_limit:g}"
                 return Stop.TIME_LIMIT
             rigid = rec.outcome is AttemptOutcome.RIGID
-            rejected = rigid or rec.outcome is AttemptOutcome.PATH
+            rejected = rigid or rec.outcome in (AttemptOutcome.PATH, AttemptOutcome.NO_GAP)
             shape.undeployable += rejected
             shape.failed += 1
             self.rejected += rejected
@@ -616,8 +656,8 @@ class _Steps:
         for solution, rec in zip(
             deepest.solutions[common:], deepest.accepted[common:], strict=True
         ):
-            rec.outcome = AttemptOutcome.ACCEPTED
-            run.n_backtrack -= 1  # no longer retracted
+            run.n_backtrack -= rec.outcome is AttemptOutcome.DEAD_END  # no longer retracted
+            rec.outcome = AttemptOutcome.ACCEPTED  # or a fallback without a clear gap, taken
             assert solution.step == len(run.solutions)  # the chains share what is before
             run.solutions.append(solution)
             self.accepted.append(rec)

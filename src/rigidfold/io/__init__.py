@@ -13,24 +13,17 @@ from rigidfold.io.files import (
     refuse_replacing_inputs,
     write_json,
 )
-from rigidfold.io.fold import (
+from rigidfold.io.fold import UNITS, UP_AXES, FoldData, pattern_from_fold, read_fold
+from rigidfold.io.fold_frames import (
     FRACTION_KEY,
-    UNITS,
-    UP_AXES,
     DesignFrames,
-    FoldData,
     crease_pattern_frame,
     crease_pattern_frames,
-    fold_dict,
     motion_fraction,
     motion_frames,
-    pattern_from_fold,
-    read_fold,
     read_frames,
-    round_trip_dict,
-    write_document,
-    write_fold,
 )
+from rigidfold.io.fold_write import fold_dict, round_trip_dict, write_document, write_fold
 from rigidfold.io.svg import svg_text, write_svg
 from rigidfold.io.svg_read import SvgDrawing, read_svg
 

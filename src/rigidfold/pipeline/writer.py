@@ -126,8 +126,9 @@ class AttemptLog:
     first line written.
     """
 
-    _CHANGING = frozenset({AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END})
-    """The outcomes that may change after an attempt was logged (backtracking)."""
+    _CHANGING = frozenset({AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END, AttemptOutcome.NO_GAP})
+    """The outcomes that may change after an attempt was logged (backtracking; a fallback
+    design without a clear gap taken at the end)."""
 
     def __init__(self, path: Path) -> None:
         self.path = path
