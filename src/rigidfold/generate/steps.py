@@ -66,7 +66,7 @@ from rigidfold.generate.records import (
     Stop,
 )
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
-from rigidfold.mechanism.margin import dof_margin
+from rigidfold.mechanism.margin import DofMargin, dof_margin
 from rigidfold.mechanism.path import FoldingPath, trace_path
 from rigidfold.mechanism.second_order import ChildForecast, Obstruction, obstruction
 from rigidfold.mechanism.stiffness import hinge_stiffness
@@ -175,6 +175,7 @@ class _Steps:
         self.shapes: list[_Frame] = []  # Step 6 at each solution being reduced, the last on top
         self.accepted: list[Attempt] = []  # the attempt of each solution
         self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
+        self.margins: dict[int, DofMargin] = {}  # by attempt index: those of target solutions
         self.backtracks = 0  # retractions by backtracking in the chain being built
         self.rejected = 0  # the chain's candidates whose paths do not reach the flat state
         # the restarts with bound (12) at each fold limit in turn: (limit, case) not yet used
@@ -238,13 +239,8 @@ class _Steps:
             t_path = time.perf_counter() - t2
         if outcome is AttemptOutcome.ACCEPTED and start is not None and self.wants_gap(mech):
             assert mech is not None
-            margin = dof_margin(
-                result.pattern,
-                self.support_face(result.pattern),
-                self.settings,
-                count=self.count,
-                counted=mech.dof,
-            )
+            margin = self.margin(result.pattern, mech.dof)
+            self.margins[len(self.run.attempts)] = margin  # this attempt's index
             if not margin.clear:
                 outcome = AttemptOutcome.NO_GAP
         locked = [] if mech is None else mech.locked_creases.tolist()
@@ -328,6 +324,12 @@ class _Steps:
             and self.options.deploy_check
             and self.settings.generation.clear_gap
             and 1 <= mech.dof <= self.options.target_dof
+        )
+
+    def margin(self, pattern: CreasePattern, counted: int) -> DofMargin:
+        """The DOF margin of a solution's shape whose search counted ``counted``."""
+        return dof_margin(
+            pattern, self.support_face(pattern), self.settings, count=self.count, counted=counted
         )
 
     def keep_no_gap(self, rec: Attempt, trial: _Trial) -> None:
@@ -729,15 +731,12 @@ def generate(
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
     final = run.final
-    if final is not None:
-        pattern = final.result.pattern
-        run.dof_margin = dof_margin(
-            pattern,
-            steps.support_face(pattern),
-            case.settings,
-            count=steps.count,
-            counted=final.mechanism.dof,
-        ).to_dict()
+    if final is not None:  # its margin, once: the search's where it took one
+        attempt = steps.accepted[final.step].index
+        margin = steps.margins.get(attempt) or steps.margin(
+            final.result.pattern, final.mechanism.dof
+        )
+        run.dof_margin = margin.to_dict()
     return run
 
 
