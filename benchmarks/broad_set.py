@@ -58,12 +58,15 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "today": (),
     "criterion-s": ("--criterion", "s"),
     "batch-auto": ("--batch", "auto"),
+    "batch-on": ("--batch", "on"),
     "theta-none": ("--theta-widen", "none"),
     "accept-no-gap": ("--accept-no-gap",),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
-``batch-auto`` several creases fixed per solve where the first-order analysis allows;
+``batch-auto`` several creases fixed per solve where the first-order analysis allows, in
+the first chain (a restart fixes one per solve); ``batch-on`` the same in every chain (what
+``batch-auto`` was before session 25);
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
 ends the run (the default before session 24)."""

@@ -83,3 +83,42 @@ def test_the_papers_step_5_fixes_one_crease_per_solve():
         case_from_specs("bezier", "1", seed=1), deploy_check=False, target_dof=10, batch="auto"
     )
     assert all(a.batch == 0 and len(a.fixed_added) <= 1 for a in run.attempts)
+
+
+@pytest.mark.parametrize("batch", ["auto", "on"])
+def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(monkeypatch, batch):
+    """``batch`` auto: when the batched first chain dead-ends and the run restarts under a
+    fold limit, the new chain is the paper's one crease per solve (a different chain, not
+    the same one under the bound); ``on`` batches every chain. The restart is made to keep
+    the initial shape only, so that the bounded chain starts far from the target."""
+    import dataclasses
+    import math
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.mechanism.path import PathStatus
+
+    real, traces = generation.trace_path, []
+
+    def first_turns_back(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        traces.append(path)
+        if len(traces) == 1:
+            return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
+        return path
+
+    monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    monkeypatch.setattr(generation, "_within", lambda solutions, limit: 1)
+    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+    settings = DEFAULTS.with_(restart_after=1, fold_limits=(math.radians(120.0),))
+    case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
+    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch=batch)
+    run = generate(case, opts)
+    first = [a for a in run.attempts if a.fold_limit_deg is None]
+    bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
+    assert any(a.batch >= 2 for a in first)
+    assert bounded
+    if batch == "auto":  # from the initial shape, one crease per solve
+        assert all(a.batch == 0 and len(a.fixed_added) == 1 for a in bounded)
+        assert bounded[0].dof == run.initial_dof - 1
+    else:
+        assert any(a.batch >= 2 for a in bounded)

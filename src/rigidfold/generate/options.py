@@ -31,7 +31,8 @@ from rigidfold.selection import CRITERIA
 from rigidfold.structure.design import StructureOptions
 
 BATCH_CHOICES = ("auto", "on", "off")
-"""``GenerateOptions.batch``: several creases per solve (auto: with the deployability check)."""
+"""``GenerateOptions.batch``: several creases per solve (auto: with the deployability check,
+in the first chain)."""
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,9 @@ class GenerateOptions:
         "are independent and lock no crease at first order (rigidfold.selection.batch), "
         "halved on failure; one crease per solve near the target DOF. off = the paper's one "
         "crease per solve (the default and the study's, until the broad benchmark of issue 49 "
-        "has judged it); auto = on with the deployability check, off without it",
+        "has judged it); on = in every chain of the run; auto = with the deployability check, "
+        "in the run's first chain only (a restart after it dead-ends fixes one crease per "
+        "solve), off without the check",
         choices=BATCH_CHOICES,
     )
     time_limit: float | None = option(

@@ -604,7 +604,8 @@ class _Steps:
         (``after_backtracking``) or, where a further limit is left, once
         ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
         shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
-        (:meth:`settle`). Returns whether it did."""
+        (:meth:`settle`). With ``GenerateOptions.batch`` "auto" the restarted chain fixes one
+        crease per solve. Returns whether it did."""
         run = self.run
         if (
             not self.restarts
@@ -624,6 +625,9 @@ class _Steps:
         run.build_time += time.perf_counter() - t0
         self.backtracks = self.rejected = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
+        # batch auto: the batched chain dead-ended, the restart's is the paper's one crease
+        # per solve (a different chain, not the same one again under the bound)
+        self.batch = self.batch and self.options.batch == "on"
         run.stop_detail = ""
         return True
 
