@@ -128,8 +128,8 @@ class GenerateOptions:
         "halved on failure; one crease per solve near the target DOF. off = the paper's one "
         "crease per solve (the default and the study's, until the broad benchmark of issue 49 "
         "has judged it); on = in every chain of the run; auto = with the deployability check, "
-        "in the run's first chain only (a restart after it dead-ends fixes one crease per "
-        "solve), off without the check",
+        "in the run's first chain only (a restart after it dead-ends goes back to the shape "
+        "before its first set and fixes one crease per solve), off without the check",
         choices=BATCH_CHOICES,
     )
     time_limit: float | None = option(

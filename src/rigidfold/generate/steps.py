@@ -605,7 +605,7 @@ class _Steps:
         ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
         shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
         (:meth:`settle`). With ``GenerateOptions.batch`` "auto" the restarted chain fixes one
-        crease per solve. Returns whether it did."""
+        crease per solve and keeps no solution of a set of creases. Returns whether it did."""
         run = self.run
         if (
             not self.restarts
@@ -616,6 +616,10 @@ class _Steps:
         self.keep_deepest(stop)
         limit, case = self.restarts.pop(0)
         keep = _within(run.solutions, limit)
+        if self.batch and self.options.batch == "auto":
+            # the batched chain dead-ended: the restart's is the paper's one crease per
+            # solve from before its first set (a different chain, not the same one again)
+            keep = min([keep, *(k for k, rec in enumerate(self.accepted) if rec.batch >= 2)])
         self.retract(keep=keep)
         self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
         self.shapes.clear()
@@ -625,9 +629,7 @@ class _Steps:
         run.build_time += time.perf_counter() - t0
         self.backtracks = self.rejected = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
-        # batch auto: the batched chain dead-ended, the restart's is the paper's one crease
-        # per solve (a different chain, not the same one again under the bound)
-        self.batch = self.batch and self.options.batch == "on"
+        self.batch = self.batch and self.options.batch == "on"  # auto: the first chain only
         run.stop_detail = ""
         return True
 
