@@ -29,9 +29,11 @@ by case, so the variants run side by side on the same machine load). Every finis
 appended to ``--out`` as one JSON line at once, so an interrupted benchmark keeps its results;
 ``--resume`` runs only the (case, variant) pairs not in the file yet. At the end (and with
 ``--summarize``), per variant and per family: the share that passes, the median and 90th
-percentile wall time, the median solves per DOF removed, and the share of wall time in the
-development diagrams (``time_s.develop``) and outside the search (everything but build, solve,
-analysis, selection and path: start-up, diagrams, motion, writing, exports, report).
+percentile wall time, the median solves per DOF removed, the largest number of solves per DOF
+removed above DOF 10 on runs of initial DOF 40 or more (issue 49's target: at most 0.25; read
+from each run's log.jsonl), and the share of wall time in the development diagrams
+(``time_s.develop``) and outside the search (everything but build, solve, analysis,
+selection and path: start-up, diagrams, motion, writing, exports, report).
 """
 
 from __future__ import annotations
@@ -163,6 +165,7 @@ def run_one(
         "args": argv[4:],
     }
     row.update(_read_summary(out / "summary.json"))
+    row.update(_read_descent(out / "log.jsonl"))
     if row.get("summary") is False:
         tail = log.read_text(encoding="utf-8", errors="replace").strip().splitlines()
         row["error"] = tail[-1] if tail else f"exit {code}, nothing printed"
@@ -206,6 +209,41 @@ def _read_summary(path: Path) -> dict:
     }
 
 
+ABOVE_DOF = 10
+"""Issue 49's target: solves per DOF removed above this DOF, on runs of initial DOF at least
+``LARGE_DOF``."""
+LARGE_DOF = 40
+
+
+def _read_descent(path: Path) -> dict:
+    """From a run's log.jsonl: ``solves_above`` (the attempts after the first solve up to the
+    first accepted solution at DOF <= ``ABOVE_DOF``, those retracted later included) per
+    DOF removed above it, ``solves_above_per_dof`` (None where the run started at or below
+    it, or never got there)."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError:
+        return {}
+    attempts = []
+    for line in lines:
+        try:
+            record = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(record, dict) and "outcome" in record:
+            attempts.append(record)
+    if not attempts or not isinstance(attempts[0].get("dof"), int):
+        return {}
+    initial = attempts[0]["dof"]
+    if initial <= ABOVE_DOF:
+        return {}
+    for n, record in enumerate(attempts[1:], start=1):
+        dof = record.get("dof")
+        if record.get("outcome") == "accepted" and isinstance(dof, int) and dof <= ABOVE_DOF:
+            return {"solves_above": n, "solves_above_per_dof": n / (initial - ABOVE_DOF)}
+    return {}
+
+
 def _remove(path: Path) -> None:
     import shutil
 
@@ -235,6 +273,11 @@ def stats(rows: list[dict]) -> dict:
     walls = [r["wall_s"] for r in rows]
     cpus = [r["cpu_s"] for r in rows]
     per_dof = [r["solves_per_dof"] for r in rows if r.get("solves_per_dof") is not None]
+    above = [
+        r["solves_above_per_dof"]
+        for r in rows
+        if r.get("solves_above_per_dof") is not None and (r.get("initial_dof") or 0) >= LARGE_DOF
+    ]
     wall_total = sum(walls)
     develop = sum((r.get("time_s") or {}).get("develop", 0.0) for r in rows)
     search = sum(sum((r.get("time_s") or {}).get(k, 0.0) for k in SEARCH_KEYS) for r in rows)
@@ -251,6 +294,8 @@ def stats(rows: list[dict]) -> dict:
         "max_s": max(walls) if walls else math.nan,
         "median_cpu_s": statistics.median(cpus) if cpus else math.nan,
         "median_solves_per_dof": statistics.median(per_dof) if per_dof else math.nan,
+        "large": len(above),
+        "max_solves_above": max(above) if above else math.nan,
         "develop_share": develop / wall_total if wall_total else math.nan,
         "outside_search_share": (wall_total - search) / wall_total if wall_total else math.nan,
     }
@@ -264,6 +309,8 @@ def _line(label: str, s: dict) -> str:
         f"overrun {s['overrun']:>2}  median {s['median_s']:>6.1f} s  p90 {s['p90_s']:>6.1f} s  "
         f"max {s['max_s']:>6.1f} s  (CPU median {s['median_cpu_s']:>6.1f} s)  "
         f"solves/DOF {s['median_solves_per_dof']:>5.2f}  "
+        f"above {ABOVE_DOF} (initial >= {LARGE_DOF}: {s['large']} runs) "
+        f"max {s['max_solves_above']:>4.2f}  "
         f"develop {s['develop_share']:>4.0%}  outside search {s['outside_search_share']:>4.0%}"
     )
 

@@ -152,3 +152,32 @@ def test_the_run_environment_is_pinned():
     for key, value in pinned_environ({}).items():
         if key != "GLIBC_TUNABLES":
             assert env[key] == value
+
+
+def test_the_solves_above_dof_10_are_read_from_the_runs_log(tmp_path):
+    """Issue 49's target figure: the attempts after the first solve up to the first accepted
+    solution at DOF <= 10 (a failed one included), per DOF removed above 10; none where the
+    run never got there or started at or below it."""
+    import json
+
+    def log(dofs_outcomes, name):
+        path = tmp_path / name
+        lines = [json.dumps({"schema_version": 1})]
+        lines += [json.dumps({"dof": d, "outcome": o}) for d, o in dofs_outcomes]
+        path.write_text("\n".join(lines) + "\n{torn", encoding="utf-8")
+        return path
+
+    run = [(50, "accepted"), (34, "accepted"), (None, "exceed"), (18, "accepted"), (9, "accepted")]
+    got = bs._read_descent(log(run, "a.jsonl"))
+    assert got == {"solves_above": 4, "solves_above_per_dof": 4 / 40}
+    assert bs._read_descent(log(run[:3], "b.jsonl")) == {}
+    assert bs._read_descent(log([(8, "accepted"), (7, "accepted")], "c.jsonl")) == {}
+    assert bs._read_descent(tmp_path / "missing.jsonl") == {}
+    rows = [
+        {"initial_dof": 50, "solves_above_per_dof": 0.1, "wall_s": 1.0, "cpu_s": 1.0},
+        {"initial_dof": 30, "solves_above_per_dof": 0.9, "wall_s": 1.0, "cpu_s": 1.0},
+    ]
+    for r in rows:
+        r.update(passed=True, overrun=False, summary=True)
+    s = bs.stats(rows)
+    assert (s["large"], s["max_solves_above"]) == (1, 0.1)
