@@ -61,14 +61,16 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "criterion-s": ("--criterion", "s"),
     "batch-auto": ("--batch", "auto"),
     "batch-on": ("--batch", "on"),
+    "batch-off": ("--batch", "off"),
     "theta-none": ("--theta-widen", "none"),
     "accept-no-gap": ("--accept-no-gap",),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
 ``batch-auto`` several creases fixed per solve where the first-order analysis allows, in
-the first chain (a restart fixes one per solve); ``batch-on`` the same in every chain (what
-``batch-auto`` was before session 25);
+the first chain (a restart fixes one per solve; the default since session 25);
+``batch-on`` the same in every chain (what ``batch-auto`` was before session 25);
+``batch-off`` one crease per solve (the default before session 25);
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
 ends the run (the default before session 24)."""

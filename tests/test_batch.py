@@ -51,7 +51,8 @@ def test_a_set_takes_candidates_in_the_rankings_order_and_skips_what_it_is_told(
 
 
 def test_batch_is_checked():
-    assert GenerateOptions().batch == "off"  # the paper's order unless asked
+    assert GenerateOptions().batch == "auto"  # with the deployability check only
+    assert GenerateOptions(batch="off").batch == "off"  # the paper's order when asked
     with pytest.raises(RigidfoldError, match="batch"):
         GenerateOptions(batch="yes")
     with pytest.raises(RigidfoldError, match="batch_max"):
@@ -122,3 +123,39 @@ def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(m
         assert bounded[0].dof == run.initial_dof - 1
     else:
         assert any(a.batch >= 2 for a in bounded)
+
+
+@pytest.mark.parametrize("batch", ["auto", "on"])
+def test_an_auto_restart_keeps_no_shape_made_by_a_set(monkeypatch, batch):
+    """Where the restart may keep every shape of the dead-ended chain but its last (all
+    within the fold limit), ``auto`` goes back to the shape before the first set (here the
+    initial one) and ``on`` goes on from the kept shapes."""
+    import dataclasses
+    import math
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.mechanism.path import PathStatus
+
+    real, traces = generation.trace_path, []
+
+    def first_turns_back(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        traces.append(path)
+        if len(traces) == 1:
+            return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
+        return path
+
+    monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    monkeypatch.setattr(generation, "_within", lambda solutions, limit: len(solutions) - 1)
+    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+    settings = DEFAULTS.with_(restart_after=1, fold_limits=(math.radians(120.0),))
+    case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
+    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch=batch)
+    run = generate(case, opts)
+    first = [a for a in run.attempts if a.fold_limit_deg is None]
+    bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
+    assert first[1].batch >= 2 and bounded  # the first set was made at the initial shape
+    if batch == "auto":
+        assert bounded[0].dof == run.initial_dof - 1
+    else:
+        assert bounded[0].dof <= opts.target_dof + 1

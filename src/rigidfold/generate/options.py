@@ -122,14 +122,14 @@ class GenerateOptions:
         flag=False,
     )
     batch: str = option(
-        "off",
+        "auto",
         "several creases per solve: from the ranked candidates, the largest set whose fixes "
         "are independent and lock no crease at first order (rigidfold.selection.batch), "
-        "halved on failure; one crease per solve near the target DOF. off = the paper's one "
-        "crease per solve (the default and the study's, until the broad benchmark of issue 49 "
-        "has judged it); on = in every chain of the run; auto = with the deployability check, "
-        "in the run's first chain only (a restart after it dead-ends goes back to the shape "
-        "before its first set and fixes one crease per solve), off without the check",
+        "halved on failure; one crease per solve near the target DOF. auto (the default) = "
+        "with the deployability check, in the run's first chain (a restart after it "
+        "dead-ends goes back to the shape before its first set and fixes one crease per "
+        "solve), off without the check (the paper's Step 5 and the study); on = in every "
+        "chain; off = the paper's one crease per solve",
         choices=BATCH_CHOICES,
     )
     time_limit: float | None = option(
