@@ -146,7 +146,8 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
     settings = DEFAULTS.with_(
         restart_after=1, deploy_max_candidates=2, fold_limits=(math.radians(60.0),)
     )
-    run = generate(case_from_specs("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
+    case = case_from_specs("bezier", "1", seed=1, settings=settings)
+    run = generate(case, criterion="s", seed=1, batch="off")
     bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
     assert [a.outcome for a in bounded] == [AttemptOutcome.EXCEED] * 2
     assert run.stop is Stop.NO_DEPLOYABLE  # the first chain's stop, with its chain
@@ -217,6 +218,7 @@ def test_a_restart_keeps_the_solutions_within_its_bound(monkeypatch):
             seed=1,
             lookahead=True,
             deform=False,
+            batch="off",  # the one-crease chain: the restart keeps what lies within the limit
             on_retract=lambda _run, t: taken.append(len(t)),  # noqa: B023
         )
         first = [a for a in run.attempts if a.fold_limit_deg is None]

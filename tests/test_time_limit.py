@@ -81,7 +81,7 @@ def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatc
 
     monkeypatch.setattr(generation, "trace_path", deploys_down_to_15)
     monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 12)
-    options = GenerateOptions(deform=False, time_limit=3600.0)
+    options = GenerateOptions(deform=False, time_limit=3600.0, batch="off")  # a long chain
     run = generate(case_from_specs("bezier", "1", seed=1), options)
     assert run.stop is Stop.TIME_LIMIT
     dofs = [s.mechanism.dof for s in run.solutions]
