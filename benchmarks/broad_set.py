@@ -68,9 +68,9 @@ VARIANTS: dict[str, tuple[str, ...]] = {
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
 ``batch-auto`` several creases fixed per solve where the first-order analysis allows, in
-the first chain (a restart fixes one per solve; the default since session 25);
+the first chain (a restart fixes one per solve);
 ``batch-on`` the same in every chain (what ``batch-auto`` was before session 25);
-``batch-off`` one crease per solve (the default before session 25);
+``batch-off`` one crease per solve (the default, as ``today``);
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
 ends the run (the default before session 24)."""

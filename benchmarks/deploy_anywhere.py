@@ -6,7 +6,7 @@ second-order test, ``no-second-order``; every solve bounded, ``bounded``), in th
 process.
 
 Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only
-TEXT[,TEXT...]] [--modes after,one-crease,before,no-second-order]``. Every run uses S-hat with the
+TEXT[,TEXT...]] [--modes after,batch-auto,before,no-second-order]``. Every run uses S-hat with the
 look-ahead and the deployability check, as the README recommends, and ``--time-limit`` (180
 s for a drawn pattern, 420 s for the roof; ``--limit S`` for all): a run that hits it ends
 with its best design, counted as not reaching DOF 1. Each run's wall and CPU seconds are
@@ -59,16 +59,16 @@ MODES: dict[str, dict] = {
     "before": {"fold_limits": ()},
     "no-second-order": {"second_order": False},
     "bounded": {"rho_max": math.radians(120.0)},
-    "one-crease": {},
+    "batch-auto": {},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
 second-order test and forecast (the search before session 17); ``bounded`` bound (12) at 120
-degrees on every solve from the start (``generate --rho-max 120``); ``one-crease`` the
-defaults with one crease fixed per solve (:data:`MODE_OPTIONS`)."""
-MODE_OPTIONS: dict[str, dict] = {"one-crease": {"batch": "off"}}
-"""Each mode's options changed from ``generate``'s defaults: ``one-crease`` the paper's one
-crease per solve (``generate --batch off``; the default before session 25)."""
+degrees on every solve from the start (``generate --rho-max 120``); ``batch-auto`` the
+defaults with several creases per solve far from the target (:data:`MODE_OPTIONS`)."""
+MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}}
+"""Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
+per solve (``generate --batch auto``; session 25)."""
 
 
 def paper_cases(surfaces: int) -> list[dict]:

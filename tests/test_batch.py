@@ -51,8 +51,8 @@ def test_a_set_takes_candidates_in_the_rankings_order_and_skips_what_it_is_told(
 
 
 def test_batch_is_checked():
-    assert GenerateOptions().batch == "auto"  # with the deployability check only
-    assert GenerateOptions(batch="off").batch == "off"  # the paper's order when asked
+    assert GenerateOptions().batch == "off"  # the paper's order unless asked
+    assert GenerateOptions(batch="auto").batch == "auto"
     with pytest.raises(RigidfoldError, match="batch"):
         GenerateOptions(batch="yes")
     with pytest.raises(RigidfoldError, match="batch_max"):

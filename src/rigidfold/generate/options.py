@@ -122,14 +122,15 @@ class GenerateOptions:
         flag=False,
     )
     batch: str = option(
-        "auto",
+        "off",
         "several creases per solve: from the ranked candidates, the largest set whose fixes "
         "are independent and lock no crease at first order (rigidfold.selection.batch), "
-        "halved on failure; one crease per solve near the target DOF. auto (the default) = "
-        "with the deployability check, in the run's first chain (a restart after it "
-        "dead-ends goes back to the shape before its first set and fixes one crease per "
-        "solve), off without the check (the paper's Step 5 and the study); on = in every "
-        "chain; off = the paper's one crease per solve",
+        "halved on failure; one crease per solve near the target DOF. off = the paper's one "
+        "crease per solve (the default: sets of creases lose the waterbomb family of the "
+        "drawn and roof cases, docs/broad_set.md, session 25); auto = with the deployability "
+        "check, in the run's first chain (a restart after it dead-ends goes back to the shape "
+        "before its first set and fixes one crease per solve), off without the check (the "
+        "paper's Step 5 and the study); on = in every chain",
         choices=BATCH_CHOICES,
     )
     time_limit: float | None = option(
