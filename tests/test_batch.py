@@ -86,12 +86,11 @@ def test_the_papers_step_5_fixes_one_crease_per_solve():
     assert all(a.batch == 0 and len(a.fixed_added) <= 1 for a in run.attempts)
 
 
-@pytest.mark.parametrize("batch", ["auto", "on"])
-def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(monkeypatch, batch):
-    """``batch`` auto: when the batched first chain dead-ends and the run restarts under a
-    fold limit, the new chain is the paper's one crease per solve (a different chain, not
-    the same one under the bound); ``on`` batches every chain. The restart is made to keep
-    the initial shape only, so that the bounded chain starts far from the target."""
+def _restarted(monkeypatch, batch: str, keep):
+    """An 11 x 11 grid on the dome to DOF 8 whose first traced path is made to turn back, so
+    that the first chain restarts at once under a 120-degree fold limit, keeping
+    ``keep(solutions)`` of its solutions (in place of ``_within``): (options, run, the first
+    chain's attempts, the bounded chain's)."""
     import dataclasses
     import math
 
@@ -108,7 +107,7 @@ def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(m
         return path
 
     monkeypatch.setattr(generation, "trace_path", first_turns_back)
-    monkeypatch.setattr(generation, "_within", lambda solutions, limit: 1)
+    monkeypatch.setattr(generation, "_within", lambda solutions, limit: keep(solutions))
     monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
     settings = DEFAULTS.with_(restart_after=1, fold_limits=(math.radians(120.0),))
     case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
@@ -116,6 +115,16 @@ def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(m
     run = generate(case, opts)
     first = [a for a in run.attempts if a.fold_limit_deg is None]
     bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
+    return opts, run, first, bounded
+
+
+@pytest.mark.parametrize("batch", ["auto", "on"])
+def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(monkeypatch, batch):
+    """``batch`` auto: when the batched first chain dead-ends and the run restarts under a
+    fold limit, the new chain is the paper's one crease per solve (a different chain, not
+    the same one under the bound); ``on`` batches every chain. The restart is made to keep
+    the initial shape only, so that the bounded chain starts far from the target."""
+    _, run, first, bounded = _restarted(monkeypatch, batch, keep=lambda solutions: 1)
     assert any(a.batch >= 2 for a in first)
     assert bounded
     if batch == "auto":  # from the initial shape, one crease per solve
@@ -130,30 +139,9 @@ def test_an_auto_restart_keeps_no_shape_made_by_a_set(monkeypatch, batch):
     """Where the restart may keep every shape of the dead-ended chain but its last (all
     within the fold limit), ``auto`` goes back to the shape before the first set (here the
     initial one) and ``on`` goes on from the kept shapes."""
-    import dataclasses
-    import math
-
-    import rigidfold.generate.steps as generation
-    from rigidfold.mechanism.path import PathStatus
-
-    real, traces = generation.trace_path, []
-
-    def first_turns_back(pattern, **kwargs):
-        path = real(pattern, **kwargs)
-        traces.append(path)
-        if len(traces) == 1:
-            return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
-        return path
-
-    monkeypatch.setattr(generation, "trace_path", first_turns_back)
-    monkeypatch.setattr(generation, "_within", lambda solutions, limit: len(solutions) - 1)
-    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
-    settings = DEFAULTS.with_(restart_after=1, fold_limits=(math.radians(120.0),))
-    case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
-    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch=batch)
-    run = generate(case, opts)
-    first = [a for a in run.attempts if a.fold_limit_deg is None]
-    bounded = [a for a in run.attempts if a.fold_limit_deg is not None]
+    opts, run, first, bounded = _restarted(
+        monkeypatch, batch, keep=lambda solutions: len(solutions) - 1
+    )
     assert first[1].batch >= 2 and bounded  # the first set was made at the initial shape
     if batch == "auto":
         assert bounded[0].dof == run.initial_dof - 1
