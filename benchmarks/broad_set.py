@@ -19,13 +19,16 @@ max(10 s, 5 %) after the limit is flagged ``overrun`` and fails; one still going
 Usage::
 
     python benchmarks/broad_set.py [--jobs N] [--only TEXT[,TEXT...]] [--limit S]
-        [--variants today[,NAME...]] [--out results.jsonl [--resume]] [--work DIR [--keep]]
+        [--variants today[,NAME...]] [--reference DIR] [--out results.jsonl [--resume]]
+        [--work DIR [--keep]]
     python benchmarks/broad_set.py --list                      # the cases, and those left out
     python benchmarks/broad_set.py --summarize results.jsonl   # the summary of a past run
 
 A *variant* (:data:`VARIANTS`) is a named set of extra command-line flags; ``today`` adds
-none. With several variants, each case is run with each of them in turn (jobs submitted case
-by case, so the variants run side by side on the same machine load). Every finished run is
+none; ``reference`` is ``today`` run by another checkout of rigidfold (``--reference DIR``),
+to compare a change of the search with the search before it. With several variants, each
+case is run with each of them in turn (jobs submitted case by case, so the variants run side
+by side on the same machine load). Every finished run is
 appended to ``--out`` as one JSON line at once, so an interrupted benchmark keeps its results;
 ``--resume`` runs only the (case, variant) pairs not in the file yet. At the end (and with
 ``--summarize``), per variant and per family: the share that passes, the median and 90th
@@ -64,6 +67,7 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "batch-off": ("--batch", "off"),
     "theta-none": ("--theta-widen", "none"),
     "accept-no-gap": ("--accept-no-gap",),
+    "reference": (),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
@@ -73,7 +77,9 @@ the first chain (a restart fixes one per solve);
 ``batch-off`` one crease per solve (the default, as ``today``);
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
-ends the run (the default before session 24)."""
+ends the run (the default before session 24); ``reference`` the defaults of another checkout
+of rigidfold (``--reference DIR``: its ``src`` first on PYTHONPATH), to compare a change of
+the search with the search before it in the same run."""
 
 COMMON = ("--lookahead", "--no-deform", "--quiet")
 """The flags every run gets (besides ``--time-limit`` and ``--out``): the README's command;
@@ -89,14 +95,15 @@ def grace(limit: float) -> float:
     return max(10.0, 0.05 * limit)
 
 
-def run_environment() -> dict[str, str]:
+def run_environment(source: Path | None = None) -> dict[str, str]:
     """This process's environment with the pinned numerics, as ``python -m rigidfold.pinned``
-    starts a command, and this benchmark's ``src`` first on PYTHONPATH."""
+    starts a command, and this benchmark's ``src`` (or ``source``'s, a checkout of rigidfold)
+    first on PYTHONPATH."""
     from rigidfold.runtime.numerics import RESTARTED_ENV, pinned_environ
 
     env = pinned_environ(os.environ)
     env[RESTARTED_ENV] = "1"
-    src = str(Path(__file__).resolve().parents[1] / "src")
+    src = str((source or Path(__file__).resolve().parents[1]) / "src")
     rest = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p and p != src]
     env["PYTHONPATH"] = os.pathsep.join([src, *rest])
     return env
@@ -137,9 +144,16 @@ def _wait(proc: subprocess.Popen, deadline: float) -> tuple[int, float, bool]:
 
 
 def run_one(
-    case: BroadCase, variant: str, limit: float, kill_after: float, work: Path, keep: bool
+    case: BroadCase,
+    variant: str,
+    limit: float,
+    kill_after: float,
+    work: Path,
+    keep: bool,
+    reference: Path | None = None,
 ) -> dict:
-    """Run one case with one variant; the result row (JSON data)."""
+    """Run one case with one variant (``reference``: the checkout of the variant of that
+    name); the result row (JSON data)."""
     out = work / "runs" / variant / case.name.replace("/", "__").replace(":", "_")
     if out.exists():
         _remove(out)
@@ -149,7 +163,11 @@ def run_one(
     with log.open("wb") as sink:
         t0 = time.perf_counter()
         proc = subprocess.Popen(
-            argv, stdout=sink, stderr=subprocess.STDOUT, env=run_environment(), cwd=work
+            argv,
+            stdout=sink,
+            stderr=subprocess.STDOUT,
+            env=run_environment(reference if variant == "reference" else None),
+            cwd=work,
         )
         code, cpu, killed = _wait(proc, t0 + kill_after)
         wall = time.perf_counter() - t0
@@ -420,6 +438,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--variants", default="today", help=f"comma-separated, of {', '.join(VARIANTS)}"
     )
+    parser.add_argument(
+        "--reference",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="a checkout of rigidfold whose search the variant 'reference' runs",
+    )
     parser.add_argument("--out", type=Path, default=None, help="results file (JSON lines)")
     parser.add_argument("--resume", action="store_true", help="skip the runs already in --out")
     parser.add_argument("--work", type=Path, default=None, help="folder for the runs' outputs")
@@ -438,6 +463,12 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [v for v in variants if v not in VARIANTS]
     if unknown or not variants:
         parser.error(f"unknown variants {unknown} (choose from {', '.join(VARIANTS)})")
+    if ("reference" in variants) != (args.reference is not None):
+        parser.error("the variant 'reference' and --reference DIR go together")
+    if args.reference is not None and not (args.reference / "src" / "rigidfold").is_dir():
+        parser.error(
+            f"--reference {args.reference}: not a checkout of rigidfold (no src/rigidfold)"
+        )
     if args.resume and args.out is None:
         parser.error("--resume needs --out")
     if args.jobs < 1:
@@ -479,7 +510,8 @@ def main(argv: list[str] | None = None) -> int:
         lock = threading.Lock()
         with ThreadPoolExecutor(args.jobs) as pool:
             futures = [
-                pool.submit(run_one, c, v, args.limit, kill_after, work, args.keep) for c, v in todo
+                pool.submit(run_one, c, v, args.limit, kill_after, work, args.keep, args.reference)
+                for c, v in todo
             ]
             for future in as_completed(futures):
                 row = future.result()

@@ -154,6 +154,22 @@ def test_the_run_environment_is_pinned():
             assert env[key] == value
 
 
+def test_the_reference_variant_runs_another_checkouts_search(tmp_path):
+    """``--variants reference,today --reference DIR``: the same command, with DIR's src
+    first on PYTHONPATH (a change of the search against the one before it, in one run)."""
+    import os
+
+    here = str(BENCH.parent / "src")
+    assert bs.run_environment()["PYTHONPATH"].split(os.pathsep)[0] == here
+    other = bs.run_environment(tmp_path)["PYTHONPATH"].split(os.pathsep)
+    assert other[0] == str(tmp_path / "src") and here not in other[:1]
+    assert bs.VARIANTS["reference"] == bs.VARIANTS["today"]
+    with pytest.raises(SystemExit):  # a variant and its checkout go together
+        bs.main(["--variants", "reference", "--list"])
+    with pytest.raises(SystemExit):  # not a checkout of rigidfold
+        bs.main(["--variants", "reference,today", "--reference", str(tmp_path), "--list"])
+
+
 def test_the_solves_above_dof_10_are_read_from_the_runs_log(tmp_path):
     """Issue 49's target figure: the attempts after the first solve up to the first accepted
     solution at DOF <= 10 (a failed one included), per DOF removed above 10; none where the

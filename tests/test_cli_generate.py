@@ -181,15 +181,15 @@ def test_analyze_missing_file():
 
 def test_generate_interrupt_leaves_valid_files(tmp_path, monkeypatch, capsys):
     calls = {"n": 0}
-    real = generate_module.analyze
+    real = generate_module._classify
 
-    def interrupting(*args, **kwargs):
+    def interrupting(*args, **kwargs):  # the third solve's verdict: after two solutions
         calls["n"] += 1
         if calls["n"] == 3:
             raise KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(generate_module, "analyze", interrupting)
+    monkeypatch.setattr(generate_module, "_classify", interrupting)
     code = main(
         [
             "generate",

@@ -221,6 +221,18 @@ class GenerationSettings(Group):
         "the set keeps at least this share of its own rotations (no first-order lock; "
         ":mod:`rigidfold.selection.batch`).",
     )
+    near_tries: int = setting(
+        3,
+        "With the deployability check and the gap count: at a shape with near-mechanisms "
+        "(fewer exact mechanisms than its DOF), this many candidates that turn in them but "
+        "hardly in the exact ones are tried first, one per solve "
+        "(:mod:`rigidfold.selection.near`; 0: none).",
+    )
+    near_ratio: float = setting(
+        1e-2,
+        "With ``near_tries``: a candidate is tried first when its rotation in the shape's "
+        "exact mechanisms is below this share of its rotation in all those counted.",
+    )
     time_limit_grace: float = setting(
         0.025,
         "With a time limit T (``--time-limit``): naming the final design of a run stopped by "
@@ -285,6 +297,7 @@ class GenerationSettings(Group):
             "time_limit_reserve",
             "time_limit_reserve_per_vertex",
             "batch_tol",
+            "near_ratio",
         )
         if not self.time_limit_load_max >= 1:
             raise RigidfoldError(
@@ -295,6 +308,8 @@ class GenerationSettings(Group):
                 "time_limit_reserve_share must lie in [0, 1), got "
                 f"{self.time_limit_reserve_share!r}"
             )
+        if not (isinstance(self.near_tries, int) and self.near_tries >= 0):
+            raise RigidfoldError(f"near_tries must be a whole number >= 0, got {self.near_tries!r}")
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):

@@ -147,6 +147,10 @@ class Attempt:
         With several creases per solve (``GenerateOptions.batch``): the number of ranked
         candidates fixed together in this solve (``fixed_added`` holds their creases);
         0 for a solve of one candidate.
+    near : float or None
+        For a candidate tried before the ranked ones because it turns in the shape's
+        near-mechanisms but hardly in its exact ones (:mod:`rigidfold.selection.near`): its
+        share r (exact rotation over counted); None for any other.
     """
 
     index: int
@@ -174,6 +178,7 @@ class Attempt:
     rigid_forecast: bool | None = None
     fold_limit_deg: float | None = None
     batch: int = 0
+    near: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""

@@ -46,7 +46,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -82,6 +82,7 @@ from rigidfold.selection import (
     score_creases,
 )
 from rigidfold.selection.batch import compatible_set
+from rigidfold.selection.near import near_candidates
 
 
 @dataclass
@@ -112,6 +113,8 @@ class _Frame:
     t_sel: float = 0.0
     spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
     batched: bool = False  # a set of several creases was tried here (GenerateOptions.batch)
+    swept: bool = False  # its near-mechanisms' candidates were tried here (fix_near)
+    tried: set = field(default_factory=set)  # the fixes tried by fix_near
     fallback: bool = False  # the last candidate was forecast to lock or to be rigid
 
 
@@ -168,6 +171,10 @@ class _Steps:
         )
         self.batch = options.batch == "on" or (options.batch == "auto" and options.deploy_check)
         self.batch_size = self.settings.generation.batch_first  # the next set's size
+        # near-mechanisms first (rigidfold.selection.near): with the gap count and the check
+        self.sweep = (
+            options.deploy_check and self.count == "gap" and self.settings.generation.near_tries > 0
+        )
         self.zero_ends = (
             not self.settings.generation.retry_zero_dof and not options.deploy_check
         ) or options.target_dof == 0
@@ -438,6 +445,11 @@ class _Steps:
             self.shapes.append(_Frame(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
+        if self.sweep and not shape.swept:
+            shape.swept = True
+            done = self.fix_near(current, shape)
+            if done is not False:
+                return None if done is True else done
         if self.batch and not shape.batched:
             shape.batched = True
             done = self.fix_set(current, shape)
@@ -454,8 +466,8 @@ class _Steps:
                 return Stop.NO_CANDIDATE
             group, score = ranked[choice.index]
             fix = (*group, *choice.carried.tolist())
-            if fix in self.dead.get(current.step, ()):  # retracted before: a dead end
-                continue
+            if fix in self.dead.get(current.step, ()) or fix in shape.tried:
+                continue  # retracted before (a dead end), or tried first (fix_near)
             trial_fixed = current.result.pattern.fixed.copy()
             trial_fixed[list(fix)] = True
             rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
@@ -498,6 +510,44 @@ class _Steps:
             ):
                 self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
+
+    def fix_near(self, current: Solution, shape: _Frame) -> Stop | bool:
+        """Near-mechanisms first (:mod:`rigidfold.selection.near`): at a shape whose DOF,
+        counted with the gap, has fewer exact mechanisms, up to ``near_tries`` candidates
+        that turn in its near-mechanisms but hardly in the exact ones (share below
+        ``near_ratio``) are fixed one per solve before the ranked ones. Returns True when
+        one gave a solution, the run's Stop (the time limit), or False (the shape goes on
+        with its ranked candidates, those tried here left out)."""
+        g = self.settings.generation
+        t1 = time.perf_counter()
+        exact = analyze(
+            current.result.pattern, support_face=self.options.support_face, settings=self.settings
+        )
+        found = near_candidates(
+            current.mechanism, exact, self.groups, g.near_ratio, self.settings.mechanism.lock_tol
+        )
+        shape.t_sel += time.perf_counter() - t1
+        dead = self.dead.get(current.step, ())
+        for group, share in [c for c in found if c[0] not in dead][: g.near_tries]:
+            if self.out_of_time():
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
+            shape.tried.add(group)
+            trial_fixed = current.result.pattern.fixed.copy()
+            trial_fixed[list(group)] = True
+            rec, trial = self.solve(trial_fixed, current.result.coords, group, None)
+            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            rec.near = share
+            shape.spent += _attempt_time(rec)
+            self.record(rec, trial)
+            if self.is_solution(rec):
+                return True
+            if rec.outcome is AttemptOutcome.TIME_LIMIT:
+                self.run.stop_detail = f"{self.options.time_limit:g}"
+                return Stop.TIME_LIMIT
+            if rec.outcome is AttemptOutcome.ZERO_DOF:
+                return Stop.ZERO_DOF
+        return False
 
     def fix_set(self, current: Solution, shape: _Frame) -> Stop | bool:
         """Several creases in one solve (``GenerateOptions.batch``; :mod:`rigidfold.selection.

@@ -1,0 +1,114 @@
+"""Near-mechanisms first (issue 49, item 5): at a shape whose DOF counted with the gap has
+fewer exact mechanisms, the candidates that turn in the near-mechanisms but hardly in the
+exact ones are fixed first; their fix keeps the exact motion (checked in the frame's
+displacements, a second method), and the run tries them before its ranked candidates."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rigidfold.config import DEFAULTS
+from rigidfold.errors import RigidfoldError
+from rigidfold.generate import AttemptOutcome, GenerateOptions, generate
+from rigidfold.generate.specs import case_from_specs
+from rigidfold.mechanism import analyze
+from rigidfold.mesh import CreasePattern
+from rigidfold.selection.near import near_candidates
+
+DATA = Path(__file__).parent / "data" / "near_mechanism"
+# A DOF-2 shape of the search (pattern 1 on Bezier surface 2027, S-hat, look-ahead; the
+# broad set, session 25) whose every DOF-1 child it tried was second-order rigid: one exact
+# mechanism (singular value ~1e-17 of the largest) and one near-mechanism (~4e-7, counted
+# under the gap, 1e-6), the latter at two vertices whose creases turn by less than 2e-4 rad.
+SHAPE = DATA / "paper1_bezier2027_dof2.npz"
+LOCK_TOL = DEFAULTS.mechanism.lock_tol
+RATIO = DEFAULTS.generation.near_ratio
+
+
+@pytest.fixture(scope="module")
+def shape() -> CreasePattern:
+    data = np.load(SHAPE)
+    return CreasePattern(
+        coords=data["coords"],
+        faces=data["faces"].astype(np.int64),
+        edges=data["edges"].astype(np.int64),
+        fixed=data["fixed"],
+    )
+
+
+@pytest.fixture(scope="module")
+def analyses(shape):
+    m = DEFAULTS.mechanism
+    gap = DEFAULTS.with_(mechanism_rank_tol=m.rank_tol * m.dof_gap)
+    return analyze(shape, settings=gap), analyze(shape)
+
+
+def test_the_shape_has_a_near_mechanism_beside_its_exact_one(analyses):
+    counted, exact = analyses
+    assert counted.dof == 2 and exact.dof == 1
+
+
+def test_the_first_candidates_keep_the_exact_motion(analyses):
+    counted, exact = analyses
+    found = near_candidates(counted, exact, None, RATIO, LOCK_TOL)
+    assert found
+    shares = [share for _, share in found]
+    assert shares == sorted(shares) and max(shares) < RATIO
+    e = exact.H[:, 0] / np.linalg.norm(exact.H[:, 0])
+    row_of = {int(c): j for j, c in enumerate(counted.hinges)}
+    for group, share in found:
+        # fixing c keeps the counted motions H a with H_phi[c] a = 0 (d = 2: one line)
+        r = counted.H_phi[row_of[group[0]]]
+        kept = counted.H @ np.array([-r[1], r[0]])
+        overlap = abs(kept @ e) / np.linalg.norm(kept)
+        assert overlap > 1 - 10 * share**2 - 1e-6  # the exact motion, to second order in r
+    # a crease that turns in the exact motion keeps a motion far from it
+    hinge = int(np.argmax(np.abs(exact.H_phi[:, 0])))
+    r = counted.H_phi[hinge]
+    kept = counted.H @ np.array([-r[1], r[0]])
+    assert abs(kept @ e) / np.linalg.norm(kept) < 0.9
+
+
+def test_groups_are_judged_whole_and_only_where_every_crease_is_free(analyses, shape):
+    counted, exact = analyses
+    alone = near_candidates(counted, exact, None, RATIO, LOCK_TOL)
+    singles = [(int(c),) for c in counted.hinges]
+    assert near_candidates(counted, exact, singles, RATIO, LOCK_TOL) == alone
+    best = alone[0][0][0]
+    fixed_edge = int(np.flatnonzero(shape.fixed)[0]) if shape.fixed.any() else None
+    boundary_edge = int(shape.boundary_edges[0])
+    with_held = [(best, fixed_edge if fixed_edge is not None else boundary_edge)]
+    assert near_candidates(counted, exact, with_held, RATIO, LOCK_TOL) == []
+
+
+def test_no_candidates_without_near_mechanisms_or_without_exact_ones(analyses):
+    counted, exact = analyses
+    assert near_candidates(exact, exact, None, RATIO, LOCK_TOL) == []
+    assert near_candidates(counted, counted, None, RATIO, LOCK_TOL) == []
+
+
+def test_the_settings_are_checked():
+    with pytest.raises(RigidfoldError, match="near_tries"):
+        DEFAULTS.with_(near_tries=-1)
+    with pytest.raises(RigidfoldError, match="near_ratio"):
+        DEFAULTS.with_(near_ratio=-0.1)
+
+
+def test_a_run_tries_the_near_mechanisms_candidates_first():
+    """Pattern 1 on Bezier surface 2027 with the look-ahead and the check (the case above):
+    every candidate tried first has its share below near_ratio and is one crease; where the
+    shape had any, they come before its ranked candidates."""
+    case = case_from_specs("bezier", "1", seed=2027)
+    run = generate(case, GenerateOptions(deform=False, lookahead=True, seed=2027, time_limit=120))
+    near = [a for a in run.attempts if a.near is not None]
+    assert near
+    assert all(a.near < RATIO and len(a.fixed_added) == 1 for a in near)
+    for a in near:  # after the solve that made the shape, or another candidate tried first
+        before = run.attempts[a.index - 1]
+        assert before.near is not None or before.outcome in (
+            AttemptOutcome.ACCEPTED,
+            AttemptOutcome.DEAD_END,
+        )
