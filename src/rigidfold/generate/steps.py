@@ -468,11 +468,7 @@ class _Steps:
             fix = (*group, *choice.carried.tolist())
             if fix in self.dead.get(current.step, ()) or fix in shape.tried:
                 continue  # retracted before (a dead end), or tried first (fix_near)
-            trial_fixed = current.result.pattern.fixed.copy()
-            trial_fixed[list(fix)] = True
-            rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
-            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
-            shape.spent += _attempt_time(rec)
+            rec, trial = self.try_fix(current, shape, fix, score)
             shape.fallback = choice.put_off  # every candidate forecast to deploy was tried
             self.annotate(rec, choice, shape, current)
             self.record(rec, trial)
@@ -511,6 +507,19 @@ class _Steps:
                 self.run.stop_detail = str(shape.failed if bounded else shape.undeployable)
                 return Stop.NO_DEPLOYABLE
 
+    def try_fix(
+        self, current: Solution, shape: _Frame, fix: tuple[int, ...], score: float | None
+    ) -> tuple[Attempt, _Trial]:
+        """Steps 3-5 at the shape ``current`` with the creases ``fix`` fixed as well
+        (:meth:`solve` from its coordinates); the attempt is charged the selection time not
+        yet charged, and ``shape`` the attempt's seconds. Not yet recorded."""
+        trial_fixed = current.result.pattern.fixed.copy()
+        trial_fixed[list(fix)] = True
+        rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
+        rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+        shape.spent += _attempt_time(rec)
+        return rec, trial
+
     def fix_near(self, current: Solution, shape: _Frame) -> Stop | bool:
         """Near-mechanisms first (:mod:`rigidfold.selection.near`): at a shape whose DOF,
         counted with the gap, has fewer exact mechanisms, up to ``near_tries`` candidates
@@ -533,12 +542,8 @@ class _Steps:
                 self.run.stop_detail = f"{self.options.time_limit:g}"
                 return Stop.TIME_LIMIT
             shape.tried.add(group)
-            trial_fixed = current.result.pattern.fixed.copy()
-            trial_fixed[list(group)] = True
-            rec, trial = self.solve(trial_fixed, current.result.coords, group, None)
-            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            rec, trial = self.try_fix(current, shape, group, None)
             rec.near = share
-            shape.spent += _attempt_time(rec)
             self.record(rec, trial)
             if self.is_solution(rec):
                 return True
@@ -578,14 +583,8 @@ class _Steps:
                 self.run.stop_detail = f"{self.options.time_limit:g}"
                 return Stop.TIME_LIMIT
             fix = tuple(e for k in chosen for e in groups[k])
-            trial_fixed = current.result.pattern.fixed.copy()
-            trial_fixed[list(fix)] = True
-            rec, trial = self.solve(
-                trial_fixed, current.result.coords, fix, shape.ranked[chosen[0]][1]
-            )
-            rec.selection_time, shape.t_sel = shape.t_sel, 0.0
+            rec, trial = self.try_fix(current, shape, fix, shape.ranked[chosen[0]][1])
             rec.batch = len(chosen)
-            shape.spent += _attempt_time(rec)
             self.record(rec, trial)
             if self.is_solution(rec):
                 self.batch_size = min(2 * len(chosen), g.batch_max)
