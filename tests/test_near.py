@@ -90,9 +90,19 @@ def test_no_candidates_without_near_mechanisms_or_without_exact_ones(analyses):
     assert near_candidates(counted, counted, None, RATIO, LOCK_TOL) == []
 
 
+def test_none_where_the_shape_has_more_near_mechanisms_than_near_max(analyses):
+    counted, exact = analyses  # one near-mechanism
+    found = near_candidates(counted, exact, None, RATIO, LOCK_TOL)
+    assert near_candidates(counted, exact, None, RATIO, LOCK_TOL, most=1) == found
+    assert near_candidates(counted, exact, None, RATIO, LOCK_TOL, most=0) == []
+
+
 def test_the_settings_are_checked():
     with pytest.raises(RigidfoldError, match="near_tries"):
         DEFAULTS.with_(near_tries=-1)
+    for bad in (-1, 2.5, True):
+        with pytest.raises(RigidfoldError, match="near_max"):
+            DEFAULTS.with_(near_max=bad)
     with pytest.raises(RigidfoldError, match="near_ratio"):
         DEFAULTS.with_(near_ratio=-0.1)
 
@@ -106,9 +116,67 @@ def test_a_run_tries_the_near_mechanisms_candidates_first():
     near = [a for a in run.attempts if a.near is not None]
     assert near
     assert all(a.near < RATIO and len(a.fixed_added) == 1 for a in near)
+    assert all(a.near is not None for a in run.attempts if a.outcome is AttemptOutcome.NO_GAIN)
     for a in near:  # after the solve that made the shape, or another candidate tried first
         before = run.attempts[a.index - 1]
         assert before.near is not None or before.outcome in (
             AttemptOutcome.ACCEPTED,
             AttemptOutcome.DEAD_END,
         )
+
+
+def test_a_near_fix_that_raises_the_count_is_not_kept(monkeypatch):
+    """A solution of a near candidate with more DOF than its shape is ``no_gain``: counted in
+    no N, never a solution, and the shape goes on with its ranked candidates."""
+    import rigidfold.generate.steps as steps
+
+    calls: list[int] = []
+
+    def one_candidate(counted, exact, groups, ratio, floor, most=None):
+        calls.append(counted.dof)
+        return [((int(counted.hinges[0]),), 0.0)] if len(calls) == 1 else []
+
+    solve = steps._Steps.try_fix
+
+    def raised(self, current, shape, fix, score):
+        rec, trial = solve(self, current, shape, fix, score)
+        if len(calls) == 1 and rec.outcome is AttemptOutcome.ACCEPTED:
+            rec.dof = current.mechanism.dof + 1  # as if the solve found a softer shape
+        return rec, trial
+
+    monkeypatch.setattr(steps, "near_candidates", one_candidate)
+    monkeypatch.setattr(steps._Steps, "try_fix", raised)
+    case = case_from_specs("dome", "grid:4x4", size="2x2")
+    run = generate(case, GenerateOptions(deform=False, lookahead=True, time_limit=60))
+    first = run.attempts[1]
+    assert first.near == 0.0 and first.outcome is AttemptOutcome.NO_GAIN
+    assert run.n_reduce >= 1 and all(
+        s.mechanism.dof < run.solutions[0].mechanism.dof for s in run.solutions[1:]
+    )
+    assert run.solutions[1].step == 1 and run.attempts[2].near is None
+
+
+def test_a_shape_rigid_but_for_near_mechanisms_is_a_dead_end(monkeypatch):
+    """With ``near_rigid_backtrack``, a shape after the first without exact mechanisms is
+    backtracked at once: its solution becomes a dead end and its parent goes on."""
+    import types
+
+    import rigidfold.generate.steps as steps
+
+    strict: list[int] = []
+    analyse = steps.analyze
+
+    def exact_rigid_once(pattern, *, support_face=None, settings=DEFAULTS):
+        if settings.mechanism.rank_tol == DEFAULTS.mechanism.rank_tol:  # fix_near's analysis
+            strict.append(1)
+            if len(strict) == 2:  # the second shape, the first after the initial one
+                return types.SimpleNamespace(dof=0)
+        return analyse(pattern, support_face=support_face, settings=settings)
+
+    monkeypatch.setattr(steps, "analyze", exact_rigid_once)
+    settings = DEFAULTS.with_(near_rigid_backtrack=True)
+    case = case_from_specs("dome", "grid:4x4", size="2x2", settings=settings)
+    run = generate(case, GenerateOptions(deform=False, lookahead=True, time_limit=60))
+    assert len(strict) >= 3
+    assert run.attempts[1].outcome is AttemptOutcome.DEAD_END
+    assert run.attempts[2].outcome is not AttemptOutcome.DEAD_END  # the parent went on

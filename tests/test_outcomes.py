@@ -34,6 +34,7 @@ VALUES = {
         "second_order_rigid",
         "time_limit",
         "no_gap",
+        "no_gain",
         "initial_failed",
         "dead_end",
     ],
@@ -110,3 +111,10 @@ def test_development_figures_are_the_same_in_the_cli_and_the_check():
     out = check.to_dict()
     assert out["development"] == dev and out["deformation"] is None and out["motion"] is None
     json.dumps(out)
+
+
+def test_the_report_draws_every_attempt_outcome():
+    from rigidfold.reporting.figures import OUTCOME_STYLE
+
+    assert set(OUTCOME_STYLE) == {o.value for o in AttemptOutcome}
+    assert len({style[:2] for style in OUTCOME_STYLE.values()}) == len(OUTCOME_STYLE)

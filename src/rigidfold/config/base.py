@@ -87,6 +87,13 @@ class Group:
                     f"{self._flat(name)} must be an integer >= {low}, got {value!r}"
                 )
 
+    def _boolean(self, *names: str) -> None:
+        """Each field True or False."""
+        for name in names:
+            value = getattr(self, name)
+            if not isinstance(value, bool):
+                raise RigidfoldError(f"{self._flat(name)} must be true or false, got {value!r}")
+
     def _choice(self, name: str, choices: tuple[str, ...]) -> None:
         """The field one of ``choices``."""
         value = getattr(self, name)

@@ -228,6 +228,23 @@ class GenerationSettings(Group):
         "hardly in the exact ones are tried first, one per solve "
         "(:mod:`rigidfold.selection.near`; 0: none).",
     )
+    near_max: int = setting(
+        8,
+        "With ``near_tries``: near-mechanisms first only at shapes with at most this many "
+        "(the DOF counted with the gap less the exact one). More is a continuum of soft "
+        "modes, not a few isolated ones: on a 41 x 41 grid on the dome the singular values "
+        "run evenly from 1e-8 to 1e-5 of the largest (68 near-mechanisms at the first "
+        "shape), single fixes move the count up as often as down, and near-mechanisms first "
+        "did not finish in 10 min (docs/broad_set.md, session 27).",
+    )
+    near_rigid_backtrack: bool = setting(
+        True,
+        "With ``near_tries``: a shape after the first whose DOF are all near-mechanisms "
+        "(none at the rank threshold itself: it cannot fold, and its children, solved from "
+        "it, rarely can) is a dead end: backtracked at once, its candidates untried "
+        "(docs/broad_set.md, session 27: 26/40 either way on the broad set; a case that "
+        "always failed passes, one that passes or fails by seconds at the limit failed).",
+    )
     near_ratio: float = setting(
         1e-2,
         "With ``near_tries``: a candidate is tried first when its rotation in the shape's "
@@ -308,8 +325,8 @@ class GenerationSettings(Group):
                 "time_limit_reserve_share must lie in [0, 1), got "
                 f"{self.time_limit_reserve_share!r}"
             )
-        if not (isinstance(self.near_tries, int) and self.near_tries >= 0):
-            raise RigidfoldError(f"near_tries must be a whole number >= 0, got {self.near_tries!r}")
+        self._integer(near_tries=0, near_max=0)
+        self._boolean("retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack")
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):

@@ -50,6 +50,12 @@ class AttemptOutcome(Outcome):
         "count and the singular values' differ): kept as the run's fallback design while the "
         "search looks for one with a clear gap (``Settings.generation.clear_gap``)",
     )
+    NO_GAIN = (
+        "no_gain",
+        "a fix of a near-mechanism (``Settings.generation.near_tries``) whose solution has "
+        "more DOF than its shape: not kept (the solve moved the shape into softer modes), "
+        "the shape goes on with its ranked candidates",
+    )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
         "dead_end",

@@ -524,7 +524,9 @@ class _Steps:
         """Near-mechanisms first (:mod:`rigidfold.selection.near`): at a shape whose DOF,
         counted with the gap, has fewer exact mechanisms, up to ``near_tries`` candidates
         that turn in its near-mechanisms but hardly in the exact ones (share below
-        ``near_ratio``) are fixed one per solve before the ranked ones. Returns True when
+        ``near_ratio``) are fixed one per solve before the ranked ones, where the shape has
+        at most ``near_max`` near-mechanisms; a fix whose solution has more DOF than its
+        shape is not kept (``no_gain``). Returns True when
         one gave a solution, the run's Stop (the time limit), or False (the shape goes on
         with its ranked candidates, those tried here left out)."""
         g = self.settings.generation
@@ -533,9 +535,16 @@ class _Steps:
             current.result.pattern, support_face=self.options.support_face, settings=self.settings
         )
         found = near_candidates(
-            current.mechanism, exact, self.groups, g.near_ratio, self.settings.mechanism.lock_tol
+            current.mechanism,
+            exact,
+            self.groups,
+            g.near_ratio,
+            self.settings.mechanism.lock_tol,
+            most=g.near_max,
         )
         shape.t_sel += time.perf_counter() - t1
+        if exact.dof == 0 and current.step > 0 and g.near_rigid_backtrack:
+            return Stop.NO_CANDIDATE  # rigid but for near-mechanisms: a dead end
         dead = self.dead.get(current.step, ())
         for group, share in [c for c in found if c[0] not in dead][: g.near_tries]:
             if self.out_of_time():
@@ -544,6 +553,8 @@ class _Steps:
             shape.tried.add(group)
             rec, trial = self.try_fix(current, shape, group, None)
             rec.near = share
+            if self.is_solution(rec) and (rec.dof or 0) > current.mechanism.dof:
+                rec.outcome = AttemptOutcome.NO_GAIN  # the count rose: not kept
             self.record(rec, trial)
             if self.is_solution(rec):
                 return True

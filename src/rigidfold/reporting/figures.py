@@ -46,6 +46,10 @@ OUTCOME_STYLE = {
     "exceed": ("v", "#ff7f0e", "F > F_tol or not converged (N_exceed)"),
     "zero_dof": ("s", "#9467bd", "DOF 0"),
     "path": ("P", "#8c564b", "folding path does not reach flat (N_path)"),
+    "second_order_rigid": ("p", "#bcbd22", "rigid at second order (N_rigid)"),
+    "time_limit": ("|", "#000000", "cut by the time limit"),
+    "no_gap": ("h", "#17becf", "target DOF without a clear gap"),
+    "no_gain": ("1", "#aec7e8", "near-mechanism fix raised the DOF"),
     "initial_failed": ("D", "#7f7f7f", "initial solve failed"),
     "dead_end": ("*", "#e377c2", "retracted: no deployable candidate at its shape"),
 }

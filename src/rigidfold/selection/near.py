@@ -25,8 +25,14 @@ target a DOF-1 child that keeps only a near-mechanism cannot fold, and one that 
 exact mechanism can; further up, a near-mechanism left in place is a DOF that no later fix of
 a real fold removes. (Tried only at the shapes whose children are checked, DOF 2, it won 1 of
 the broad set's 26 non-drawn cases instead of 4: ``docs/broad_set.md``, session 26.) A shape
-without exact mechanisms (d_0 = 0: rigid but for its near-mechanisms) or without near ones
-(d_0 = d) has none.
+without exact mechanisms (d_0 = 0: rigid but for its near-mechanisms; the search leaves it at
+once, ``Settings.generation.near_rigid_backtrack``) or without near ones (d_0 = d) has
+none, nor has one with many (d - d_0 above ``Settings.generation.near_max``): on large,
+nearly flat grids the singular values run evenly across the gap's bound (a 41 x 41 grid on
+the dome: from 1e-8 to 1e-5 of the largest, 68 near-mechanisms at the first shape), there
+is no separate near-mechanism to remove, and a single fix moves the count up as often as
+down. A fix whose solution counts more DOF than its shape is not kept
+(``AttemptOutcome.NO_GAIN``).
 """
 
 from __future__ import annotations
@@ -44,13 +50,15 @@ def near_candidates(
     groups: Sequence[Sequence[int]] | None,
     ratio: float,
     floor: float,
+    most: int | None = None,
 ) -> list[tuple[tuple[int, ...], float]]:
     """The crease groups whose fix removes a near-mechanism of ``counted`` (the gap count)
     and keeps the exact mechanisms ``exact`` (the same shape at the rank threshold), with
     their shares r (see the module's text), smallest first: those with r below ``ratio``
     whose rows in ``counted`` are at least ``floor`` of the largest. ``groups``: mirror
     groups of edges fixed together (None: every free crease alone); a group's share is its
-    largest exact row over its largest counted one.
+    largest exact row over its largest counted one. ``most``: none where the shape has more
+    near-mechanisms than this (``Settings.generation.near_max``; None: no bound).
 
     Returns
     -------
@@ -58,6 +66,8 @@ def near_candidates(
     """
     if exact.dof == 0 or exact.dof >= counted.dof:
         return []
+    if most is not None and counted.dof - exact.dof > most:
+        return []  # a continuum of soft modes, not a few near-mechanisms
     hinges = counted.hinges
     if not np.array_equal(hinges, exact.hinges):
         raise ValueError("the two analyses are of different shapes")
