@@ -526,9 +526,10 @@ class _Steps:
         that turn in its near-mechanisms but hardly in the exact ones (share below
         ``near_ratio``) are fixed one per solve before the ranked ones, where the shape has
         at most ``near_max`` near-mechanisms; a fix whose solution has more DOF than its
-        shape is not kept (``no_gain``). Returns True when
-        one gave a solution, the run's Stop (the time limit), or False (the shape goes on
-        with its ranked candidates, those tried here left out)."""
+        shape is not kept (``no_gain``). Returns True when one gave a solution, the run's
+        Stop (the time limit; NO_CANDIDATE for a shape after the first without an exact
+        mechanism, with ``near_rigid_backtrack``), or False (the shape goes on with its ranked
+        candidates, those tried here left out)."""
         g = self.settings.generation
         t1 = time.perf_counter()
         exact = analyze(
