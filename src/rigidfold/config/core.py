@@ -233,7 +233,7 @@ class GenerationSettings(Group):
         "With ``near_tries``: near-mechanisms first only at shapes with at most this many "
         "(the DOF counted with the gap less the exact one). More is a continuum of soft "
         "modes, not a few isolated ones: on a 41 x 41 grid on the dome the singular values "
-        "run evenly from 1e-8 to 1e-5 of the largest (68 near-mechanisms at the first "
+        "run evenly from 5e-8 to 1e-5 of the largest (68 near-mechanisms at the first "
         "shape), single fixes move the count up as often as down, and near-mechanisms first "
         "did not finish in 10 min (docs/broad_set.md, session 27).",
     )

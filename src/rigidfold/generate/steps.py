@@ -114,7 +114,7 @@ class _Frame:
     spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
     batched: bool = False  # a set of several creases was tried here (GenerateOptions.batch)
     swept: bool = False  # its near-mechanisms' candidates were tried here (fix_near)
-    tried: set = field(default_factory=set)  # the fixes tried by fix_near
+    tried: set[tuple[int, ...]] = field(default_factory=set)  # fixes tried by fix_near
     fallback: bool = False  # the last candidate was forecast to lock or to be rigid
 
 
@@ -318,6 +318,11 @@ class _Steps:
         search's end; None without a limit)."""
         return None if self.budget is None else self.budget.naming
 
+    def time_up(self) -> Stop:
+        """The run's Stop at its time limit, with the limit as its detail."""
+        self.run.stop_detail = f"{self.options.time_limit:g}"
+        return Stop.TIME_LIMIT
+
     def out_of_time(self) -> bool:
         """The run's time limit (``GenerateOptions.time_limit``) has passed."""
         deadline = self.deadline
@@ -439,8 +444,7 @@ class _Steps:
         reduced before (backtracking returned to it), the candidates not yet tried."""
         if not self.shapes or self.shapes[-1].solution is not current:
             if self.out_of_time():  # no ranking of a shape that no solve will reduce
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             ranked, order, forecast, t_sel = self.rank(current)
             self.shapes.append(_Frame(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
@@ -457,8 +461,7 @@ class _Steps:
                 return None if done is True else done
         while True:
             if self.out_of_time():
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             t1 = time.perf_counter()
             choice = next(order, None)  # look-ahead: lazy forecast
             shape.t_sel += time.perf_counter() - t1
@@ -479,8 +482,7 @@ class _Steps:
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
             if rec.outcome is AttemptOutcome.TIME_LIMIT:
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             rigid = rec.outcome is AttemptOutcome.RIGID
             rejected = rigid or rec.outcome in (AttemptOutcome.PATH, AttemptOutcome.NO_GAP)
             shape.undeployable += rejected
@@ -535,6 +537,9 @@ class _Steps:
         exact = analyze(
             current.result.pattern, support_face=self.options.support_face, settings=self.settings
         )
+        if exact.dof == 0 and current.step > 0 and g.near_rigid_backtrack:
+            shape.t_sel += time.perf_counter() - t1
+            return Stop.NO_CANDIDATE  # rigid but for near-mechanisms: a dead end
         found = near_candidates(
             current.mechanism,
             exact,
@@ -544,13 +549,10 @@ class _Steps:
             most=g.near_max,
         )
         shape.t_sel += time.perf_counter() - t1
-        if exact.dof == 0 and current.step > 0 and g.near_rigid_backtrack:
-            return Stop.NO_CANDIDATE  # rigid but for near-mechanisms: a dead end
         dead = self.dead.get(current.step, ())
         for group, share in [c for c in found if c[0] not in dead][: g.near_tries]:
             if self.out_of_time():
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             shape.tried.add(group)
             rec, trial = self.try_fix(current, shape, group, None)
             rec.near = share
@@ -560,8 +562,7 @@ class _Steps:
             if self.is_solution(rec):
                 return True
             if rec.outcome is AttemptOutcome.TIME_LIMIT:
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
         return False
@@ -592,8 +593,7 @@ class _Steps:
         shape.t_sel += time.perf_counter() - t1
         while len(chosen) >= 2:
             if self.out_of_time():
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             fix = tuple(e for k in chosen for e in groups[k])
             rec, trial = self.try_fix(current, shape, fix, shape.ranked[chosen[0]][1])
             rec.batch = len(chosen)
@@ -602,8 +602,7 @@ class _Steps:
                 self.batch_size = min(2 * len(chosen), g.batch_max)
                 return True
             if rec.outcome is AttemptOutcome.TIME_LIMIT:
-                self.run.stop_detail = f"{self.options.time_limit:g}"
-                return Stop.TIME_LIMIT
+                return self.time_up()
             chosen = chosen[: len(chosen) // 2]
             self.batch_size = max(2, len(chosen))
         return False

@@ -29,7 +29,7 @@ without exact mechanisms (d_0 = 0: rigid but for its near-mechanisms; the search
 once, ``Settings.generation.near_rigid_backtrack``) or without near ones (d_0 = d) has
 none, nor has one with many (d - d_0 above ``Settings.generation.near_max``): on large,
 nearly flat grids the singular values run evenly across the gap's bound (a 41 x 41 grid on
-the dome: from 1e-8 to 1e-5 of the largest, 68 near-mechanisms at the first shape), there
+the dome: from 5e-8 to 1e-5 of the largest, 68 near-mechanisms at the first shape), there
 is no separate near-mechanism to remove, and a single fix moves the count up as often as
 down. A fix whose solution counts more DOF than its shape is not kept
 (``AttemptOutcome.NO_GAIN``).
