@@ -67,6 +67,8 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "batch-off": ("--batch", "off"),
     "theta-none": ("--theta-widen", "none"),
     "accept-no-gap": ("--accept-no-gap",),
+    "count-threshold": ("--dof-count", "threshold"),
+    "count-gap": ("--dof-count", "gap"),
     "reference": (),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
@@ -77,7 +79,9 @@ the first chain (a restart fixes one per solve);
 ``batch-off`` one crease per solve (the default, as ``today``);
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
-ends the run (the default before session 24); ``reference`` the defaults of another checkout
+ends the run (the default before session 24); ``count-threshold`` and ``count-gap`` the
+search's DOF count (``--dof-count``): the paper's threshold, or with the near-mechanisms;
+``reference`` the defaults of another checkout
 of rigidfold (``--reference DIR``: its ``src`` first on PYTHONPATH), to compare a change of
 the search with the search before it in the same run."""
 

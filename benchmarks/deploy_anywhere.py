@@ -60,12 +60,15 @@ MODES: dict[str, dict] = {
     "no-second-order": {"second_order": False},
     "bounded": {"rho_max": math.radians(120.0)},
     "batch-auto": {},
+    "count-threshold": {"dof_count": "threshold"},
+    "count-gap": {"dof_count": "gap"},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
 second-order test and forecast (the search before session 17); ``bounded`` bound (12) at 120
 degrees on every solve from the start (``generate --rho-max 120``); ``batch-auto`` the
-defaults with several creases per solve far from the target (:data:`MODE_OPTIONS`)."""
+defaults with several creases per solve far from the target (:data:`MODE_OPTIONS`);
+``count-threshold`` and ``count-gap`` the search's DOF count (``generate --dof-count``)."""
 MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
 per solve (``generate --batch auto``; session 25)."""
@@ -139,6 +142,7 @@ def run(case: dict, mode: str) -> dict:
     )
     final = gen.final
     deploys = final is not None and final.path is not None and final.path.deploys
+    margin = gen.dof_margin or {}
     removed = (gen.initial_dof or 0) - (gen.lowest_dof or gen.initial_dof or 0)
     forecast = Counter(
         f"{'rigid' if a.rigid_forecast else 'free'}->{cause(a) or 'accepted'}"
@@ -153,6 +157,9 @@ def run(case: dict, mode: str) -> dict:
         "final_dof": gen.final_dof,
         "lowest_dof": gen.lowest_dof,
         "dof1_deploys": bool(gen.stop is Stop.TARGET_REACHED and deploys),
+        "clear_gap": bool(margin.get("clear")),
+        "near": margin.get("near"),
+        "nonzero_min": margin.get("nonzero_min"),
         "solves": len(gen.attempts),
         "solves_per_dof": len(gen.attempts) / removed if removed else None,
         "time_s": time.perf_counter() - t0,
@@ -220,6 +227,7 @@ def main() -> None:
         if not sel:
             continue
         share = sum(r["dof1_deploys"] for r in sel)
+        clear = sum(r["dof1_deploys"] and r.get("clear_gap", False) for r in sel)
         per_dof = [r["solves_per_dof"] for r in sel if r["solves_per_dof"] is not None]
         causes: Counter = Counter()
         forecast: Counter = Counter()
@@ -227,7 +235,8 @@ def main() -> None:
             causes.update(r["causes"])
             forecast.update(r["forecast"])
         print(
-            f"{mode}: {share}/{len(sel)} reach DOF 1 and deploy; median run "
+            f"{mode}: {share}/{len(sel)} reach DOF 1 and deploy, {clear} with a clear DOF gap; "
+            f"median run "
             f"{statistics.median(r['time_s'] for r in sel):.1f} s, longest "
             f"{max(r['time_s'] for r in sel):.1f} s (CPU: median "
             f"{statistics.median(r['cpu_s'] for r in sel):.1f} s, longest "

@@ -51,7 +51,9 @@ def _generate(p: Parser) -> None:
     )
     add_options(p, GenerateOptions)
     add_options(
-        p, SettingsOptions, only=("backtrack", "fold_limit", "retry_zero_dof", "accept_no_gap")
+        p,
+        SettingsOptions,
+        only=("backtrack", "fold_limit", "retry_zero_dof", "accept_no_gap", "dof_count"),
     )
     fabricate_arguments(p, generate=True)
     structure_arguments(p, generate=True)

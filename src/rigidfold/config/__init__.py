@@ -24,6 +24,7 @@ from rigidfold.config.checks import (
     StructureSettings,
 )
 from rigidfold.config.core import (
+    DOF_COUNTS,
     HESSIANS,
     THETA_WIDEN,
     DesignSettings,
@@ -53,6 +54,7 @@ __all__ = [
     "CHECKS",
     "DEFAULTS",
     "DEFAULT_SEED",
+    "DOF_COUNTS",
     "FLAT_NAMES",
     "GROUPS",
     "HESSIANS",

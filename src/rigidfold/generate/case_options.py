@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import MISSING, dataclass
 
-from rigidfold.config import DEFAULT_SEED, DEFAULTS, HESSIANS, THETA_WIDEN, Settings
+from rigidfold.config import DEFAULT_SEED, DEFAULTS, DOF_COUNTS, HESSIANS, THETA_WIDEN, Settings
 from rigidfold.errors import RigidfoldError
 from rigidfold.flags import option
 from rigidfold.generate.case import Case
@@ -207,6 +207,14 @@ class SettingsOptions:
         "gap and delivers such a design only where it finds none "
         "(Settings.generation.clear_gap)",
     )
+    dof_count: str = option(
+        DEFAULTS.mechanism.dof_count,
+        "how the search counts a shape's DOF: threshold (the paper's: the singular values of "
+        "the constraints below the rank threshold; the design at the target DOF must still "
+        "show a clear gap) or gap (also the near-mechanisms, below the threshold times the "
+        "DOF gap, at every shape) (Settings.mechanism.dof_count)",
+        choices=DOF_COUNTS,
+    )
     retry_zero_dof: bool = option(
         False,
         "retries of a 0-DOF solution: treated as a lock, the next crease is tried (the "
@@ -227,6 +235,7 @@ class SettingsOptions:
             theta_widen=self.theta_widen,
             retry_zero_dof=self.retry_zero_dof,
             clear_gap=not self.accept_no_gap,
+            dof_count=self.dof_count,
             ipopt_hessian=self.hessian,
             svg_snap_tol=self.svg_tolerance,
             **given,
