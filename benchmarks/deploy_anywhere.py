@@ -17,13 +17,15 @@ waterbomb, Resch's triangles, Miura-ori, Lang's wedge, the polygami cross, the s
 Miura-ori, the strip of squares) on the dome, the HP and the Bezier surface of seed 7; and a
 15 x 9 grid on a 12 m x 8 m roof (a barrel vault with a cross fall) with the criterion S.
 
-Each line: the case, whether it reached DOF 1 and deploys, the final design's DOF, the
+Each line: the case, whether it reached DOF 1 and deploys, whether the final design's DOF
+has a clear gap (``clear_gap``; ``near`` and ``nonzero_min`` of its margin), its DOF, the
 solves, the solves per DOF removed, the seconds, and the rejected candidates by cause
 (``lock``, ``exceed``, ``second_order_rigid``, and for paths that do not reach the flat state
 their status: ``turned_back``, ``stops_short``, ``collision``, ``max_steps``, ``stalled`` (the
 tracer's failure), ``zero_dof``; ``dead_end``: retracted by backtracking). At the end, per
-mode: the share, the median time and the median solves per DOF removed, and the causes
-summed; where the forecast ran, how its calls matched what the solve and trace found.
+mode: the share (and of it, those with a clear gap), the median time and the median solves
+per DOF removed, and the causes summed; where the forecast ran, how its calls matched what
+the solve and trace found.
 """
 
 from __future__ import annotations
