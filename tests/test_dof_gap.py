@@ -1,12 +1,9 @@
-"""One honest DOF with a clear gap (issue 49, item 5): by default the search counts the
-paper's way (the singular values of the constraints below the rank threshold) and a design at
-the target DOF must show a clear gap; with ``dof_count`` "gap" it counts those below
-``dof_gap`` times the threshold at every shape (near-mechanisms are mechanisms of the built
-design), one count everywhere; the paper's Step 5 keeps the paper's count."""
+"""One honest DOF with a clear gap (issue 49, item 5): with the deployability check the
+search counts the singular values of the constraints below ``dof_gap`` times the rank
+threshold (near-mechanisms are mechanisms of the built design), one count everywhere; the
+paper's Step 5 keeps the paper's count."""
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -44,35 +41,20 @@ def test_the_gap_count_is_clear_where_the_search_counted_the_same():
 
 
 def test_the_dof_count_setting_is_checked():
-    assert DEFAULTS.mechanism.dof_count == "threshold"
+    assert DEFAULTS.mechanism.dof_count == "auto"
     with pytest.raises(RigidfoldError, match="dof_count"):
         DEFAULTS.with_(dof_count="loose")
 
 
 @pytest.fixture(scope="module")
 def checked_run():
-    case = case_from_specs("bezier", "1", seed=1, settings=DEFAULTS.with_(dof_count="gap"))
-    return generate(case, GenerateOptions(deform=False))
+    return generate(case_from_specs("bezier", "1", seed=1), GenerateOptions(deform=False))
 
 
-def test_the_default_count_is_the_papers_and_the_design_has_a_clear_gap():
-    """With the defaults (the deployability check, the paper's count), every solution's DOF
-    (its file name) is the paper's count, and the design delivered at the target DOF has a
-    clear gap: no singular value within dof_gap of the threshold, either side."""
-    run = generate(case_from_specs("bezier", "1", seed=1), GenerateOptions(deform=False))
-    for solution in run.solutions:
-        assert solution.mechanism.dof == analyze(solution.result.pattern).dof
-    assert run.dof_margin is not None and run.dof_margin["count"] == "threshold"
-    assert run.final_dof == 1 == run.dof_margin["dof"] == run.dof_margin["counted"]
-    assert run.dof_margin["clear"] and run.dof_margin["near"] == 0
-    m = DEFAULTS.mechanism
-    assert run.dof_margin["nonzero_min"] >= m.rank_tol * m.dof_gap
-
-
-def test_one_count_everywhere_with_the_gap_count(checked_run):
-    """With the gap count every solution's DOF (its file name, final_dof) is the number of
-    singular values of its constraints below dof_gap times the rank threshold, and the final
-    design's margin says the same count with its gap."""
+def test_one_count_everywhere_with_the_deployability_check(checked_run):
+    """Every solution's DOF (its file name, final_dof) is the number of singular values of
+    its constraints below dof_gap times the rank threshold, and the final design's margin
+    says the same count with its gap."""
     run = checked_run
     assert run.dof_margin is not None and run.dof_margin["count"] == "gap"
     assert run.dof_margin["dof"] == run.final_dof == run.dof_margin["counted"]
@@ -118,17 +100,19 @@ def test_a_flat_vertex_is_a_mechanism_whose_creases_rank_first():
 
 
 def test_the_command_line_chooses_the_count(tmp_path, capsys):
-    """``--dof-count gap`` reaches the run (the final design's margin says which count) and
-    an unknown count is refused in one line, before anything is written."""
+    """``--dof-count threshold`` reaches the run (the final design's margin says which count)
+    and an unknown count is refused in one line, before anything is written."""
     import json
+    from pathlib import Path
 
     from rigidfold.cli.commands import main
 
     pattern = Path(__file__).parent / "data" / "origami_simulator" / "test.svg"
     argv = ["generate", "--surface", "dome", "--pattern", str(pattern), "--quiet"]
-    assert main([*argv, "--no-report", "--dof-count", "gap", "--out", str(tmp_path / "g")]) == 0
-    summary = json.loads((tmp_path / "g" / "summary.json").read_text())
-    assert summary["dof_margin"]["count"] == "gap" and summary["final_dof"] == 1
+    out = tmp_path / "t"
+    assert main([*argv, "--no-report", "--dof-count", "threshold", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["dof_margin"]["count"] == "threshold" and summary["final_dof"] == 1
     capsys.readouterr()
     with pytest.raises(SystemExit) as stop:
         main([*argv, "--dof-count", "loose", "--out", str(tmp_path / "b")])

@@ -24,7 +24,6 @@ DATA = Path(__file__).parent / "data" / "near_mechanism"
 # mechanism (singular value ~1e-17 of the largest) and one near-mechanism (~4e-7, counted
 # under the gap, 1e-6), the latter at two vertices whose creases turn by less than 2e-4 rad.
 SHAPE = DATA / "paper1_bezier2027_dof2.npz"
-GAP = DEFAULTS.with_(dof_count="gap")  # near-mechanisms first works with the gap count
 LOCK_TOL = DEFAULTS.mechanism.lock_tol
 RATIO = DEFAULTS.generation.near_ratio
 
@@ -112,7 +111,7 @@ def test_a_run_tries_the_near_mechanisms_candidates_first():
     """Pattern 1 on Bezier surface 2027 with the look-ahead and the check (the case above):
     every candidate tried first has its share below near_ratio and is one crease; where the
     shape had any, they come before its ranked candidates."""
-    case = case_from_specs("bezier", "1", seed=2027, settings=GAP)
+    case = case_from_specs("bezier", "1", seed=2027)
     run = generate(case, GenerateOptions(deform=False, lookahead=True, seed=2027, time_limit=120))
     near = [a for a in run.attempts if a.near is not None]
     assert near
@@ -147,7 +146,7 @@ def test_a_near_fix_that_raises_the_count_is_not_kept(monkeypatch):
 
     monkeypatch.setattr(steps, "near_candidates", one_candidate)
     monkeypatch.setattr(steps._Steps, "try_fix", raised)
-    case = case_from_specs("dome", "grid:4x4", size="2x2", settings=GAP)
+    case = case_from_specs("dome", "grid:4x4", size="2x2")
     run = generate(case, GenerateOptions(deform=False, lookahead=True, time_limit=60))
     first = run.attempts[1]
     assert first.near == 0.0 and first.outcome is AttemptOutcome.NO_GAIN
@@ -175,7 +174,7 @@ def test_a_shape_rigid_but_for_near_mechanisms_is_a_dead_end(monkeypatch):
         return analyse(pattern, support_face=support_face, settings=settings)
 
     monkeypatch.setattr(steps, "analyze", exact_rigid_once)
-    settings = GAP.with_(near_rigid_backtrack=True)
+    settings = DEFAULTS.with_(near_rigid_backtrack=True)
     case = case_from_specs("dome", "grid:4x4", size="2x2", settings=settings)
     run = generate(case, GenerateOptions(deform=False, lookahead=True, time_limit=60))
     assert len(strict) >= 3

@@ -11,7 +11,7 @@ from rigidfold.errors import RigidfoldError
 
 HESSIANS = ("closed-form", "casadi")
 """The Hessians of the Lagrangian IPOPT can use (``SolverSettings.ipopt_hessian``)."""
-DOF_COUNTS = ("threshold", "gap")
+DOF_COUNTS = ("auto", "gap", "threshold")
 """How generation counts a shape's DOF (``MechanismSettings.dof_count``)."""
 THETA_WIDEN = ("files", "all", "none")
 """Which crease patterns widen the sector-angle bounds to their own plan angles
@@ -493,17 +493,15 @@ class MechanismSettings(Group):
         "above this many vertices it is not made (the failed path stays in N_path).",
     )
     dof_count: str = setting(
-        "threshold",
+        "auto",
         "How generation counts a shape's DOF. \"threshold\": the paper's, the singular values "
-        "of the constraints below ``mechanism_rank_tol`` times the largest; with the "
-        "deployability check a design at the target DOF must still show a clear gap "
-        "(``Settings.generation.clear_gap``), so near-mechanisms are kept out of the delivered "
-        'design without counting them at every shape. "gap": those below ``dof_gap`` times '
-        "the threshold (1e-6 of the largest by default) at every shape: near-mechanisms are "
-        "DOF the search must remove (with near-mechanisms first, "
-        "``Settings.generation.near_tries``). On the 25 drawn and roof cases of "
-        "``benchmarks/deploy_anywhere.py`` the threshold count reached DOF 1 with a clear gap "
-        "in 15, the gap count in 12 (docs/broad_set.md, session 28).",
+        'of the constraints below ``mechanism_rank_tol`` times the largest. "gap": those '
+        "below ``dof_gap`` times that (1e-6 of the largest by default): a near-mechanism "
+        "within the gap of the threshold is a mechanism of the built design (its stiffness "
+        "goes with sigma^2 times the panels' bar stiffness: below 1e-12 of it, far below what "
+        "a panel's weight asks; docs/deployability.md), so it is counted as a DOF and the "
+        'search goes on until the DOF has a clear gap. "auto": "gap" with the '
+        "deployability check, the paper's \"threshold\" with the paper's Step 5 (the study).",
     )
     dof_gap: float = setting(
         1e3,

@@ -210,9 +210,10 @@ class SettingsOptions:
     dof_count: str = option(
         DEFAULTS.mechanism.dof_count,
         "how the search counts a shape's DOF: threshold (the paper's: the singular values of "
-        "the constraints below the rank threshold; the design at the target DOF must still "
-        "show a clear gap) or gap (also the near-mechanisms, below the threshold times the "
-        "DOF gap, at every shape) (Settings.mechanism.dof_count)",
+        "the constraints below the rank threshold; a design at the target DOF must still show "
+        "a clear gap), gap (also the near-mechanisms, below the threshold times the DOF gap, "
+        "at every shape), auto (gap with the deployability check, threshold without) "
+        "(Settings.mechanism.dof_count)",
         choices=DOF_COUNTS,
     )
     retry_zero_dof: bool = option(

@@ -162,7 +162,7 @@ class _Steps:
         # over-reduction, retried like a lock (as with retry_zero_dof=True)
         # the DOF the search counts (Settings.mechanism.dof_count): with "gap", the analysis
         # counts the singular values below dof_gap times rank_tol (near-mechanisms are DOF)
-        self.count = self.settings.mechanism.dof_count
+        self.count = _dof_count(self.settings, options)
         m = self.settings.mechanism
         self.asettings = (
             self.settings.with_(mechanism_rank_tol=m.rank_tol * m.dof_gap)
@@ -855,6 +855,15 @@ def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterato
         else:
             yield Choice(k)
     yield from rigid
+
+
+def _dof_count(settings: Settings, options: GenerateOptions) -> str:
+    """The DOF count of a run (``Settings.mechanism.dof_count``): "auto" is "gap" with the
+    deployability check, the paper's "threshold" without it (the paper's Step 5)."""
+    count = settings.mechanism.dof_count
+    if count == "auto":
+        return "gap" if options.deploy_check else "threshold"
+    return count
 
 
 def _attempt_time(rec: Attempt) -> float:
