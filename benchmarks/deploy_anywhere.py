@@ -229,7 +229,7 @@ def main() -> None:
         if not sel:
             continue
         share = sum(r["dof1_deploys"] for r in sel)
-        clear = sum(r["dof1_deploys"] and r.get("clear_gap", False) for r in sel)
+        clear = sum(r["dof1_deploys"] and r["clear_gap"] for r in sel)
         per_dof = [r["solves_per_dof"] for r in sel if r["solves_per_dof"] is not None]
         causes: Counter = Counter()
         forecast: Counter = Counter()

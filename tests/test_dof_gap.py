@@ -5,9 +5,13 @@ paper's Step 5 keeps the paper's count."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+from rigidfold.cli.commands import main
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.frame.model import default_support_face
@@ -102,11 +106,6 @@ def test_a_flat_vertex_is_a_mechanism_whose_creases_rank_first():
 def test_the_command_line_chooses_the_count(tmp_path, capsys):
     """``--dof-count threshold`` reaches the run (the final design's margin says which count)
     and an unknown count is refused in one line, before anything is written."""
-    import json
-    from pathlib import Path
-
-    from rigidfold.cli.commands import main
-
     pattern = Path(__file__).parent / "data" / "origami_simulator" / "test.svg"
     argv = ["generate", "--surface", "dome", "--pattern", str(pattern), "--quiet"]
     out = tmp_path / "t"
