@@ -84,6 +84,26 @@ def test_groups_are_judged_whole_and_only_where_every_crease_is_free(analyses, s
     assert near_candidates(counted, exact, with_held, RATIO, LOCK_TOL) == []
 
 
+def test_the_best_candidate_keeps_the_exact_motion_and_removes_the_near_one(analyses, shape):
+    """A second method: the shape analysed again with its best near candidate fixed, at the
+    same geometry (first order; the search then re-solves), keeps its exact DOF 1 and its
+    gap count falls from 2 to 1; a crease that turns in the exact motion leaves DOF 0."""
+    counted, exact = analyses
+    m = DEFAULTS.mechanism
+    gap = DEFAULTS.with_(mechanism_rank_tol=m.rank_tol * m.dof_gap)
+    (best,), _ = near_candidates(counted, exact, None, RATIO, LOCK_TOL)[0]
+    fixed = shape.fixed.copy()
+    fixed[best] = True
+    repaired = shape.with_fixed(fixed)
+    assert analyze(repaired).dof == exact.dof == 1
+    assert analyze(repaired, settings=gap).dof == 1
+    # a crease that turns in the exact motion takes it away instead
+    hinge = int(exact.hinges[np.argmax(np.abs(exact.H_phi[:, 0]))])
+    fixed = shape.fixed.copy()
+    fixed[hinge] = True
+    assert analyze(shape.with_fixed(fixed)).dof == 0
+
+
 def test_no_candidates_without_near_mechanisms_or_without_exact_ones(analyses):
     counted, exact = analyses
     assert near_candidates(exact, exact, None, RATIO, LOCK_TOL) == []
@@ -144,8 +164,12 @@ def test_a_near_fix_that_raises_the_count_is_not_kept(monkeypatch):
             rec.dof = current.mechanism.dof + 1  # as if the solve found a softer shape
         return rec, trial
 
+    def one_near(self, rank_tol):  # every shape has one near-mechanism: fix_near looks
+        return self.dof - 1
+
     monkeypatch.setattr(steps, "near_candidates", one_candidate)
     monkeypatch.setattr(steps._Steps, "try_fix", raised)
+    monkeypatch.setattr(steps.Mechanism, "dof_at", one_near)
     case = case_from_specs("dome", "grid:4x4", size="2x2")
     run = generate(case, GenerateOptions(deform=False, lookahead=True, time_limit=60))
     first = run.attempts[1]
@@ -159,24 +183,37 @@ def test_a_near_fix_that_raises_the_count_is_not_kept(monkeypatch):
 def test_a_shape_rigid_but_for_near_mechanisms_is_a_dead_end(monkeypatch):
     """With ``near_rigid_backtrack``, a shape after the first without exact mechanisms is
     backtracked at once: its solution becomes a dead end and its parent goes on."""
-    import types
+    from rigidfold.mechanism import Mechanism
 
-    import rigidfold.generate.steps as steps
+    asked: list[int] = []
+    exact_dof = Mechanism.dof_at
 
-    strict: list[int] = []
-    analyse = steps.analyze
+    def exact_rigid_once(self, rank_tol):  # fix_near's exact count
+        asked.append(1)
+        if len(asked) == 2:  # the second shape, the first after the initial one
+            return 0
+        return exact_dof(self, rank_tol)
 
-    def exact_rigid_once(pattern, *, support_face=None, settings=DEFAULTS):
-        if settings.mechanism.rank_tol == DEFAULTS.mechanism.rank_tol:  # fix_near's analysis
-            strict.append(1)
-            if len(strict) == 2:  # the second shape, the first after the initial one
-                return types.SimpleNamespace(dof=0)
-        return analyse(pattern, support_face=support_face, settings=settings)
-
-    monkeypatch.setattr(steps, "analyze", exact_rigid_once)
+    monkeypatch.setattr(Mechanism, "dof_at", exact_rigid_once)
     settings = DEFAULTS.with_(near_rigid_backtrack=True)
     case = case_from_specs("dome", "grid:4x4", size="2x2", settings=settings)
     run = generate(case, GenerateOptions(deform=False, lookahead=True, time_limit=60))
-    assert len(strict) >= 3
+    assert len(asked) >= 3
     assert run.attempts[1].outcome is AttemptOutcome.DEAD_END
     assert run.attempts[2].outcome is not AttemptOutcome.DEAD_END  # the parent went on
+
+
+@pytest.mark.parametrize("method", ["kinematic", "sparse", "frame"])
+def test_the_exact_count_from_the_gap_counts_factorisation_is_a_second_analysis(shape, method):
+    """``Mechanism.dof_at``: the DOF of the gap count's own factorisation at the rank
+    threshold is the DOF a second analysis at that threshold finds, by every method."""
+    m = DEFAULTS.mechanism
+    gap = DEFAULTS.with_(mechanism_rank_tol=m.rank_tol * m.dof_gap)
+    counted = analyze(shape, method=method, settings=gap)
+    exact = analyze(shape, method=method)
+    assert counted.dof == 2 and exact.dof == 1
+    assert counted.dof_at(m.rank_tol) == exact.dof
+    assert counted.dof_at(m.rank_tol * m.dof_gap) == counted.dof
+    assert counted.dof_at(0.0) <= exact.dof
+    with pytest.raises(ValueError, match="above"):
+        exact.dof_at(m.rank_tol * m.dof_gap)

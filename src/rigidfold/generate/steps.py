@@ -533,15 +533,20 @@ class _Steps:
         mechanism, with ``near_rigid_backtrack``), or False (the shape goes on with its ranked
         candidates, those tried here left out)."""
         g = self.settings.generation
+        counted = current.mechanism
+        # the exact DOF from the search's own factorisation; its modes, where there are a few
+        # near-mechanisms, from a second analysis at the rank threshold
+        exact_dof = counted.dof_at(self.settings.mechanism.rank_tol)
+        if exact_dof == 0 and current.step > 0 and g.near_rigid_backtrack:
+            return Stop.NO_CANDIDATE  # rigid but for near-mechanisms: a dead end
+        if exact_dof in (0, counted.dof) or counted.dof - exact_dof > g.near_max:
+            return False  # no near-mechanism to take away, or a continuum (near_candidates)
         t1 = time.perf_counter()
         exact = analyze(
             current.result.pattern, support_face=self.options.support_face, settings=self.settings
         )
-        if exact.dof == 0 and current.step > 0 and g.near_rigid_backtrack:
-            shape.t_sel += time.perf_counter() - t1
-            return Stop.NO_CANDIDATE  # rigid but for near-mechanisms: a dead end
         found = near_candidates(
-            current.mechanism,
+            counted,
             exact,
             self.groups,
             g.near_ratio,

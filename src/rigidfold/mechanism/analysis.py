@@ -30,7 +30,7 @@ from rigidfold.config import DEFAULTS, Settings, one_blas_thread
 from rigidfold.errors import RigidfoldError
 from rigidfold.frame import FrameModel
 from rigidfold.mechanism import kinematics
-from rigidfold.mechanism.sparse import sparse_analysis_bytes, sparse_kernel
+from rigidfold.mechanism.sparse import row_scale, sparse_analysis_bytes, sparse_kernel
 from rigidfold.mesh import CreasePattern
 
 METHODS = ("auto", "kinematic", "sparse", "frame")
@@ -46,6 +46,8 @@ class Mechanism:
     H_phi : (h, d) float64, its hinge-rotation rows (Eq. 18); row j is free crease hinges[j]
     rank_values : (k,) singular values (or |R_ii| of a pivoted QR, or the Ritz values of the
         sparse method) of the matrix whose kernel was taken, decreasing
+    rank_scale : float, the value the rank threshold multiplies (the largest of
+        ``rank_values``; for the sparse method the matrix's largest row norm)
     rank : int
     locked : (h,) bool, per hinge (free crease): no rotation in any mode although folded
     settings : Settings
@@ -55,6 +57,7 @@ class Mechanism:
     basis: np.ndarray | Callable[[], np.ndarray]
     H_phi: np.ndarray
     rank_values: np.ndarray
+    rank_scale: float
     rank: int
     locked: np.ndarray
     settings: Settings
@@ -88,6 +91,18 @@ class Mechanism:
         """(h,) norm of each hinge's rotations over all modes (0 for a locked hinge)."""
         return np.linalg.norm(self.H_phi, axis=1)
 
+    def dof_at(self, rank_tol: float) -> int:
+        """The DOF the same factorisation gives with the threshold ``rank_tol`` (at most the
+        ``mechanism_rank_tol`` of :attr:`settings`): fewer by the values that lie between
+        the two thresholds. With a gap count (``rank_tol`` times ``dof_gap``) this is the
+        exact count, the paper's, without a second analysis."""
+        tol = self.settings.mechanism.rank_tol
+        if rank_tol > tol:
+            raise ValueError(f"rank_tol {rank_tol!r} above the analysis's own {tol!r}")
+        v = self.rank_values
+        between = (v > rank_tol * self.rank_scale) & (v <= tol * self.rank_scale)
+        return self.dof - int(np.count_nonzero(between))
+
     @property
     def locked_creases(self) -> np.ndarray:
         """Edge indices of locked free creases."""
@@ -120,6 +135,7 @@ def analyze(
     if method == "frame":
         H, values, rank = _svd_kernel(frame.compatibility_matrix().toarray(), settings)
         H_phi, basis = H[H.shape[0] - h :], H
+        scale = float(values[0]) if len(values) else 0.0
     else:
         C = kinematics.constraint_matrix(pattern, frame.support_face)
         L = kinematics.frame_map(frame)
@@ -127,9 +143,11 @@ def analyze(
         if method == "kinematic":
             N, values, rank = _qr_kernel(C.toarray(), settings)
             gram = N.T @ (L.T @ (L @ N))
+            scale = float(values[0]) if len(values) else 0.0
         else:  # L^T L is sparse (3V x 3V): no product of L with the modes
             N, values, rank = sparse_kernel(C, settings)
             gram = N.T @ ((L.T @ L) @ N)
+            scale = row_scale(C)
         R = np.linalg.cholesky(gram).T if N.shape[1] else np.zeros((0, 0))
         Rinv = scipy.linalg.solve_triangular(R, np.eye(len(R))) if len(R) else R
         H_phi = L[L.shape[0] - h :] @ N @ Rinv
@@ -139,7 +157,8 @@ def analyze(
 
         basis = modes
 
-    return Mechanism(frame, basis, H_phi, values, rank, _locked(frame, H_phi, settings), settings)
+    locked = _locked(frame, H_phi, settings)
+    return Mechanism(frame, basis, H_phi, values, scale, rank, locked, settings)
 
 
 def chosen_method(pattern: CreasePattern, method: str, settings: Settings = DEFAULTS) -> str:

@@ -37,7 +37,7 @@ import scipy.linalg
 
 from rigidfold.config import DEFAULTS, Settings
 from rigidfold.mechanism import kinematics
-from rigidfold.mechanism.sparse import sparse_kernel
+from rigidfold.mechanism.sparse import row_scale, sparse_kernel
 from rigidfold.mesh import CreasePattern
 
 
@@ -157,7 +157,7 @@ def dof_margin(
         method = "dense"
     else:
         _, ritz, _ = sparse_kernel(C, settings)
-        top = float(np.sqrt(C.multiply(C).sum(axis=1).max()))
+        top = row_scale(C)
         values = np.concatenate([[top], np.sort(ritz)[::-1]])
         method = "sparse"
     values = values / values[0] if len(values) and values[0] > 0 else values

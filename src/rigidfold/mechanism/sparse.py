@@ -62,7 +62,7 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
     A = C[:-9][:, free]
     A = A[np.diff(A.indptr) > 0]
     k, n = A.shape
-    limit = settings.mechanism.rank_tol * np.sqrt(C.multiply(C).sum(axis=1).max())
+    limit = settings.mechanism.rank_tol * row_scale(C)
     if n == 0:
         return np.zeros((C.shape[1], 0)), np.zeros(0), C.shape[1]
     order = _vertex_order(A, free // 3)
@@ -100,6 +100,11 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
     N = np.zeros((C.shape[1], int(small.sum())))
     N[free] = Y @ vt[small].T
     return N, values, C.shape[1] - N.shape[1]
+
+
+def row_scale(C: sp.spmatrix) -> float:
+    """The largest row norm of C, the scale of the sparse method's rank threshold."""
+    return float(np.sqrt(C.multiply(C).sum(axis=1).max()))
 
 
 def _vertex_order(A: sp.csr_matrix, vertex: np.ndarray) -> np.ndarray:
