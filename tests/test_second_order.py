@@ -3,6 +3,8 @@ self-stresses, forecasts that agree with the test of the child, the run's record
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -146,6 +148,45 @@ def test_a_dense_step_passes_the_bifurcation_point_of_a_flat_vertex_on_its_branc
     moved = (y - x0).reshape(-1, 3) * cons.scale
     assert abs(moved[3, 2]) > 1e-3  # along the branch it came on
     assert np.abs(moved[[0, 1, 2, 4]]).max() < 1e-9  # the other branch is not taken
+
+
+def test_a_dense_step_is_not_tried_past_its_deadline():
+    """The dense step of the flat vertex above, its deadline passed: none is tried (each
+    corrector iteration is a dense least-squares solve; on a 463-vertex pattern they ran a
+    trace 15 s past a run's time limit, docs/broad_set.md, session 29)."""
+    from rigidfold.mechanism.recovery import escape
+    from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints
+
+    cons = RigidFoldingConstraints(CreasePattern.from_faces(STRAIGHT4, FACES4), 0)
+    t = np.zeros(cons.n)
+    t[3 * 3 + 2] = 1.0
+    x0, rho = cons.x0, cons.free_angles(cons.x0)
+    for mode in ("projection", "descent"):
+        assert escape(cons, x0, t, rho, 0.05, mode, DEFAULTS) is not None
+        gone = time.monotonic() - 1.0
+        assert escape(cons, x0, t, rho, 0.05, mode, DEFAULTS, deadline=gone) is None
+
+
+def test_a_trace_whose_dense_step_outlasts_its_deadline_is_cut(monkeypatch):
+    """A stall reached before the deadline whose dense step ends after it: the trace is cut
+    (no verdict on the shape), not stalled."""
+    from rigidfold.mechanism import path as path_module
+
+    real, deadline = path_module.correct, time.monotonic() + 1.0
+
+    def failing(*args, **kwargs):
+        y, _, nf, system = real(*args, **kwargs)
+        return y, False, nf, system
+
+    def slow_escape(*args, **kwargs):
+        while time.monotonic() <= deadline:
+            time.sleep(0.01)
+        return None
+
+    monkeypatch.setattr(path_module, "correct", failing)
+    monkeypatch.setattr(path_module, "escape", slow_escape)
+    path = trace_path(_folded_vertex(0.8), dof=1, support_face=0, deadline=deadline)
+    assert path.cut and path.status.name == "MAX_STEPS"
 
 
 def test_a_trace_whose_sparse_corrector_fails_goes_on_by_dense_steps(monkeypatch):

@@ -421,6 +421,9 @@ class _Tracer:
         where the constraints have no solution within ``path_tol`` (stops short) or nothing
         goes on (stalled)."""
         cons, settings, tr = self.cons, self.settings, self.trace
+        late = self.out_of_budget()  # each way on below is a dense factorisation or more
+        if late is not None:
+            return late
         if self.mode is Mode.PROJECTION and self.rows is None and may_reduce(cons, settings):
             assert self.t is not None
             reduced = reduce_rows(cons, self.x, self.t, settings)
@@ -453,10 +456,14 @@ class _Tracer:
                 settings,
                 self.rows,
                 self.frozen,
+                self.deadline,
             )
             if tr.escapes < settings.path.max_escapes
             else None
         )
+        late = self.out_of_budget()
+        if late is not None:
+            return late  # the escape was cut by the deadline: no verdict
         if escaped is None:
             if self.mode is Mode.AUGMENTED and self.rows is None and self.frozen is None:
                 # a trace of n - 1 rows (none redundant) past its dense steps: J's near

@@ -15,6 +15,7 @@ Each is limited to ``mechanism_second_order_vertices`` vertices (the dense SVD).
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -97,6 +98,7 @@ def escape(
     settings: Settings,
     rows: np.ndarray | None = None,
     frozen: np.ndarray | None = None,
+    deadline: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, System, str] | None:
     """One step past the point x where the sparse continuation stalled (see
     ``Settings.path.escape_tol``): the null space N of J at x from a dense SVD; the
@@ -111,7 +113,12 @@ def escape(
     with the pseudo-inverse truncated at ``mechanism_rank_tol``; until every constraint
     holds to ``path_tol``. Returns (the point, its direction, the factored system there, the
     mode: "projection" where the augmented matrix is singular), or None (no step converged,
-    or more than ``mechanism_second_order_vertices`` vertices)."""
+    or more than ``mechanism_second_order_vertices`` vertices, or ``deadline``, a time of
+    ``time.monotonic()``, passed: each corrector iteration is a dense least-squares solve)."""
+
+    def late() -> bool:
+        return deadline is not None and time.monotonic() > deadline
+
     if cons.pattern.n_vertices > settings.mechanism.second_order_vertices:
         return None
     J, J_rho = cons.jacobian(x)
@@ -143,6 +150,8 @@ def escape(
             continue  # tried already
         done.append(d)
         for h in (first, first / 4, first / 16):
+            if late():
+                return None
             if square:
                 # the module's corrector (the continuation's, ``correct``, may be swapped)
                 y, ok, _, system = rigid_folding.correct(
@@ -153,6 +162,8 @@ def escape(
                 continue
             y = x + h * d
             for _ in range(3 * settings.path.corrector_iter):
+                if late():
+                    return None
                 c = cons.residual(y)
                 if not np.isfinite(c).all():
                     break
