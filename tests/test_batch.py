@@ -4,6 +4,8 @@ creases near the target; the paper's one crease per solve without the deployabil
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from rigidfold.config import DEFAULTS
@@ -59,11 +61,22 @@ def test_batch_is_checked():
         DEFAULTS.with_(batch_max=0)
 
 
-def test_several_creases_per_solve_far_from_the_target_one_near_it():
+def test_several_creases_per_solve_far_from_the_target_one_near_it(monkeypatch):
     """With the deployability check (batch auto), far from the target DOF sets of creases
     are fixed in one solve, each removing as many DOF at least as its size forecast allows;
     within batch_single_dof of the target every solve fixes one candidate; fewer solves than
-    the one-crease order to the same target."""
+    the one-crease order to the same target. A set's solution is not polished (it is never
+    traced), every other one is; no near-mechanism is fixed alone at a shape that gets a set."""
+    import rigidfold.generate.steps as steps
+
+    polished: list[bool] = []
+    solve = steps._Steps.solve
+
+    def watched(self, fixed, start, added, score, *, polish=True):
+        polished.append(polish)
+        return solve(self, fixed, start, added, score, polish=polish)
+
+    monkeypatch.setattr(steps._Steps, "solve", watched)
     case = case_from_specs("dome", "grid:11x11", size="3x3")
     single = DEFAULTS.generation.batch_single_dof
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch="auto")
@@ -71,6 +84,13 @@ def test_several_creases_per_solve_far_from_the_target_one_near_it():
     assert run.final_dof == 8
     sets = [a for a in run.attempts if a.batch >= 2]
     assert sets and all(len(a.fixed_added) >= a.batch for a in sets)
+    assert polished == [a.batch < 2 for a in run.attempts]
+    shape_dof = run.initial_dof
+    for a in run.attempts[1:]:
+        if a.near is not None:  # one crease per solve from here: no set at this shape
+            assert shape_dof - opts.target_dof - single < 2
+        if a.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END):
+            shape_dof = a.dof
     for a in sets:
         if a.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END):
             assert a.dof >= opts.target_dof + single
@@ -118,32 +138,65 @@ def _restarted(monkeypatch, batch: str, keep):
     return opts, run, first, bounded
 
 
-@pytest.mark.parametrize("batch", ["auto", "on"])
-def test_auto_batches_the_first_chain_and_a_restart_fixes_one_crease_per_solve(monkeypatch, batch):
-    """``batch`` auto: when the batched first chain dead-ends and the run restarts under a
-    fold limit, the new chain is the paper's one crease per solve (a different chain, not
-    the same one under the bound); ``on`` batches every chain. The restart is made to keep
-    the initial shape only, so that the bounded chain starts far from the target."""
-    _, run, first, bounded = _restarted(monkeypatch, batch, keep=lambda solutions: 1)
-    assert any(a.batch >= 2 for a in first)
-    assert bounded
-    if batch == "auto":  # from the initial shape, one crease per solve
-        assert all(a.batch == 0 and len(a.fixed_added) == 1 for a in bounded)
-        assert bounded[0].dof == run.initial_dof - 1
-    else:
-        assert any(a.batch >= 2 for a in bounded)
+def test_auto_leaves_sets_at_the_first_dead_end_for_one_crease_per_solve(monkeypatch):
+    """``batch`` auto: at the batched first chain's first dead end (its first traced path
+    made to turn back), the solutions from the first set on are retracted and the chain
+    goes on from the shape before it (the initial one) one crease per solve, without a fold
+    limit: from there the run is the paper's order (``batch`` off)."""
+    _, run, first, _ = _restarted(monkeypatch, "auto", keep=lambda solutions: 1)
+    assert first[1].batch >= 2  # the first set was made at the initial shape
+    turned = next(k for k, a in enumerate(first) if a.outcome is AttemptOutcome.PATH)
+    assert any(a.batch >= 2 for a in first[:turned])
+    after = first[turned + 1 :]
+    assert after and all(a.batch == 0 and len(a.fixed_added) == 1 for a in after)
+    assert after[0].dof == run.initial_dof - 1
+    assert all(a.outcome is not AttemptOutcome.ACCEPTED for a in first[:turned] if a.batch >= 2)
 
 
-@pytest.mark.parametrize("batch", ["auto", "on"])
-def test_an_auto_restart_keeps_no_shape_made_by_a_set(monkeypatch, batch):
-    """Where the restart may keep every shape of the dead-ended chain but its last (all
-    within the fold limit), ``auto`` goes back to the shape before the first set (here the
-    initial one) and ``on`` goes on from the kept shapes."""
-    opts, run, first, bounded = _restarted(
-        monkeypatch, batch, keep=lambda solutions: len(solutions) - 1
-    )
-    assert first[1].batch >= 2 and bounded  # the first set was made at the initial shape
-    if batch == "auto":
-        assert bounded[0].dof == run.initial_dof - 1
-    else:
-        assert bounded[0].dof <= opts.target_dof + 1
+def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
+    """From the initial shape, the chain that follows the sets' dead end is the run of
+    ``batch`` off, attempt for attempt (the same fixes, outcomes and DOF: the ranking draws
+    from its generator as at the start)."""
+    import rigidfold.generate.steps as steps
+    from rigidfold.mechanism.path import PathStatus
+
+    real, traces = steps.trace_path, []
+
+    def first_turns_back(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        traces.append(path)
+        return replace(path, status=PathStatus.TURNED_BACK) if len(traces) == 1 else path
+
+    settings = DEFAULTS.with_(restart_after=1)
+    case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
+    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8)
+    paper = generate(case, opts.replace(batch="off"))
+    monkeypatch.setattr(steps, "trace_path", first_turns_back)
+    monkeypatch.setattr(steps, "_attempt_time", lambda rec: 0.0)  # given up at once
+    rank, draws = steps._Steps.rank, []
+
+    def watched(self, current):  # the generator's state as each shape is ranked
+        draws.append((current.step, len(self.run.attempts), self.rng.bit_generator.state))
+        return rank(self, current)
+
+    monkeypatch.setattr(steps._Steps, "rank", watched)
+    run = generate(case, opts.replace(batch="auto"))
+    turned = next(a.index for a in run.attempts if a.outcome is AttemptOutcome.PATH)
+    assert any(a.batch >= 2 for a in run.attempts[:turned])
+    again = next(d for d in draws if d[1] > turned)
+    assert again[0] == 0 and again[2] == draws[0][2]  # the initial shape, as at the start
+
+    def seen(attempts):
+        return [(a.fixed_added, a.outcome, a.dof) for a in attempts]
+
+    assert seen(run.attempts[turned + 1 :]) == seen(paper.attempts[1:])
+    assert run.final_dof == paper.final_dof == opts.target_dof
+
+
+def test_on_batches_a_restarted_chain_too(monkeypatch):
+    """``batch`` on: the dead-ended first chain restarts under the fold limit (here from
+    the initial shape) and goes on with sets of creases."""
+    _, _, first, bounded = _restarted(monkeypatch, "on", keep=lambda solutions: 1)
+    assert any(a.batch >= 2 for a in first) and bounded
+    assert all(a.fold_limit_deg is not None for a in bounded)
+    assert any(a.batch >= 2 for a in bounded)

@@ -135,8 +135,8 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
             dataclasses.replace(path, status=PathStatus.TURNED_BACK) if len(traces) == 1 else path
         )
 
-    def bounded_solves_fail(self, *args):
-        rec, trial = real_solve(self, *args)
+    def bounded_solves_fail(self, *args, **kwargs):
+        rec, trial = real_solve(self, *args, **kwargs)
         if self.fold_limit is not None:
             rec.outcome = AttemptOutcome.EXCEED
         return rec, trial
@@ -179,8 +179,8 @@ def test_the_ladder_goes_on_whatever_the_bounded_chain_accepted(monkeypatch):
     _first_turn_back(monkeypatch, 1)
     real_solve = generation._Steps.solve
 
-    def bounded_solves_fail(self, *args):
-        rec, trial = real_solve(self, *args)
+    def bounded_solves_fail(self, *args, **kwargs):
+        rec, trial = real_solve(self, *args, **kwargs)
         if self.fold_limit is not None:
             rec.outcome = AttemptOutcome.EXCEED
         return rec, trial

@@ -158,8 +158,8 @@ def test_a_near_fix_that_raises_the_count_is_not_kept(monkeypatch):
 
     solve = steps._Steps.try_fix
 
-    def raised(self, current, shape, fix, score):
-        rec, trial = solve(self, current, shape, fix, score)
+    def raised(self, current, shape, fix, score, **kwargs):
+        rec, trial = solve(self, current, shape, fix, score, **kwargs)
         if len(calls) == 1 and rec.outcome is AttemptOutcome.ACCEPTED:
             rec.dof = current.mechanism.dof + 1  # as if the solve found a softer shape
         return rec, trial

@@ -32,7 +32,7 @@ from rigidfold.structure.design import StructureOptions
 
 BATCH_CHOICES = ("auto", "on", "off")
 """``GenerateOptions.batch``: several creases per solve (auto: with the deployability check,
-in the first chain)."""
+until the first chain's first dead end)."""
 
 
 @dataclass(frozen=True)
@@ -128,9 +128,9 @@ class GenerateOptions:
         "halved on failure; one crease per solve near the target DOF. off = the paper's one "
         "crease per solve (the default: sets of creases lose the waterbomb family of the "
         "drawn and roof cases, docs/broad_set.md, session 25); auto = with the deployability "
-        "check, in the run's first chain (a restart after it dead-ends goes back to the shape "
-        "before its first set and fixes one crease per solve), off without the check (the "
-        "paper's Step 5 and the study); on = in every chain",
+        "check, until the first dead end of the run's first chain (then back to the shape "
+        "before its first set, one crease per solve from there, as off), off without the "
+        "check (the paper's Step 5 and the study); on = in every chain",
         choices=BATCH_CHOICES,
     )
     time_limit: float | None = option(

@@ -196,9 +196,12 @@ class _Steps:
         # not tried again where a restart's kept shape is ranked anew
         self.dead: dict[int, set[tuple[int, ...]]] = {}
 
-    def solve(self, fixed: np.ndarray, start, added, score) -> tuple[Attempt, _Trial]:
+    def solve(
+        self, fixed: np.ndarray, start, added, score, *, polish: bool = True
+    ) -> tuple[Attempt, _Trial]:
         """Steps 3-5 for one set of fixed creases: solve problem (6) from ``start``, polish
-        (with the deployability check), analyse the mechanism, classify, trace the path.
+        (with the deployability check and ``polish``), analyse the mechanism, classify, trace
+        the path.
         With a time limit the solve ends at the run's deadline, the initial solve (``start``
         None: without it the run has no design) half a grace after T
         (:attr:`TimeBudget.first_solve`)."""
@@ -209,7 +212,7 @@ class _Steps:
             deadline = self.budget.first_solve
         result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
         cut = deadline is not None and time.monotonic() > deadline
-        if opts.deploy_check:
+        if opts.deploy_check and polish:
             result = self.problem.polish(result, deadline)
         t1 = time.perf_counter()
         mech = (
@@ -449,7 +452,9 @@ class _Steps:
             self.shapes.append(_Frame(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
-        if self.sweep and not shape.swept:
+        if self.sweep and not shape.swept and self.set_size(current) < 2:
+            # a shape that gets a set of creases leaves its near-mechanisms to the set:
+            # taken one per solve far from the target, they mostly gain no DOF (issue 49)
             shape.swept = True
             done = self.fix_near(current, shape)
             if done is not False:
@@ -510,14 +515,21 @@ class _Steps:
                 return Stop.NO_DEPLOYABLE
 
     def try_fix(
-        self, current: Solution, shape: _Frame, fix: tuple[int, ...], score: float | None
+        self,
+        current: Solution,
+        shape: _Frame,
+        fix: tuple[int, ...],
+        score: float | None,
+        *,
+        polish: bool = True,
     ) -> tuple[Attempt, _Trial]:
         """Steps 3-5 at the shape ``current`` with the creases ``fix`` fixed as well
-        (:meth:`solve` from its coordinates); the attempt is charged the selection time not
-        yet charged, and ``shape`` the attempt's seconds. Not yet recorded."""
+        (:meth:`solve` from its coordinates, ``polish`` passed on); the attempt is charged
+        the selection time not yet charged, and ``shape`` the attempt's seconds. Not yet
+        recorded."""
         trial_fixed = current.result.pattern.fixed.copy()
         trial_fixed[list(fix)] = True
-        rec, trial = self.solve(trial_fixed, current.result.coords, fix, score)
+        rec, trial = self.solve(trial_fixed, current.result.coords, fix, score, polish=polish)
         rec.selection_time, shape.t_sel = shape.t_sel, 0.0
         shape.spent += _attempt_time(rec)
         return rec, trial
@@ -572,6 +584,16 @@ class _Steps:
                 return Stop.ZERO_DOF
         return False
 
+    def set_size(self, current: Solution) -> int:
+        """The size of the next set of creases at the shape ``current``: 0 without sets
+        (``GenerateOptions.batch``), otherwise at most the next set's size, never taking the
+        DOF within ``batch_single_dof`` of the target (below 2: one crease per solve)."""
+        if not self.batch:
+            return 0
+        g = self.settings.generation
+        room = current.mechanism.dof - max(self.options.target_dof, 1) - g.batch_single_dof
+        return max(0, min(self.batch_size, g.batch_max, room))
+
     def fix_set(self, current: Solution, shape: _Frame) -> Stop | bool:
         """Several creases in one solve (``GenerateOptions.batch``; :mod:`rigidfold.selection.
         batch`): at a shape more than ``batch_single_dof`` DOF above the target, the largest
@@ -580,12 +602,10 @@ class _Steps:
         of it, down to two candidates. Returns True when a set gave a solution (the next set
         may be twice as large), the run's Stop (the time limit), or False (the shape goes on
         one crease at a time)."""
-        g = self.settings.generation
-        dof = current.mechanism.dof
-        room = dof - max(self.options.target_dof, 1) - g.batch_single_dof
-        size = min(self.batch_size, g.batch_max, room)
+        size = self.set_size(current)
         if size < 2:
             return False
+        g = self.settings.generation
         t1 = time.perf_counter()
         groups = [tuple(map(int, grp)) for grp, _ in shape.ranked]
         chosen = compatible_set(
@@ -600,7 +620,10 @@ class _Steps:
             if self.out_of_time():
                 return self.time_up()
             fix = tuple(e for k in chosen for e in groups[k])
-            rec, trial = self.try_fix(current, shape, fix, shape.ranked[chosen[0]][1])
+            # not polished: a set never takes the DOF to where the deployability check
+            # runs, and the polish of a shape with many fixed creases (redundant rows) creeps
+            # for its 60 factorisations (41 x 41: 2-3.5 s a solve; issue 49)
+            rec, trial = self.try_fix(current, shape, fix, shape.ranked[chosen[0]][1], polish=False)
             rec.batch = len(chosen)
             self.record(rec, trial)
             if self.is_solution(rec):
@@ -669,8 +692,7 @@ class _Steps:
         (``after_backtracking``) or, where a further limit is left, once
         ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
         shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
-        (:meth:`settle`). With ``GenerateOptions.batch`` "auto" the restarted chain fixes one
-        crease per solve and keeps no solution of a set of creases. Returns whether it did."""
+        (:meth:`settle`). Returns whether it did."""
         run = self.run
         if (
             not self.restarts
@@ -681,10 +703,6 @@ class _Steps:
         self.keep_deepest(stop)
         limit, case = self.restarts.pop(0)
         keep = _within(run.solutions, limit)
-        if self.batch and self.options.batch == "auto":
-            # the batched chain dead-ended: the restart's is the paper's one crease per
-            # solve from before its first set (a different chain, not the same one again)
-            keep = min([keep, *(k for k, rec in enumerate(self.accepted) if rec.batch >= 2)])
         self.retract(keep=keep)
         self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
         self.shapes.clear()
@@ -694,8 +712,39 @@ class _Steps:
         run.build_time += time.perf_counter() - t0
         self.backtracks = self.rejected = 0
         self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
-        self.batch = self.batch and self.options.batch == "on"  # auto: the first chain only
         run.stop_detail = ""
+        return True
+
+    def unbatch(self, stop: Stop) -> bool:
+        """With ``GenerateOptions.batch`` "auto", the first dead end of the batched chain
+        (``stop``: its shape's candidates' paths do not reach the flat state, or none is
+        left) ends the sets of creases: the solutions from the first set on are retracted
+        and the chain goes on from the shape before it one crease per solve, unbounded, with
+        the run's backtracking and restarts still to come: from there on the run is the one
+        of ``batch`` "off" (the sets cost what their solves took). Where the sets dead-end
+        (the waterbomb family: DOF 2 in a few solves, no DOF-1 child deploys) the paper's
+        order is not lost; where they reach the target, the run took a few solves per
+        dozen DOF. Returns whether it retracted (no set accepted: the chain is already the
+        paper's, and the run goes on as without sets)."""
+        if not (self.batch and self.options.batch == "auto") or stop not in (
+            Stop.NO_DEPLOYABLE,
+            Stop.NO_CANDIDATE,
+        ):
+            return False
+        self.batch = False
+        first = next((k for k, rec in enumerate(self.accepted) if rec.batch >= 2), None)
+        if first is None:
+            return False
+        self.keep_deepest(stop)
+        self.retract(keep=first)
+        self.dead = {step: fixes for step, fixes in self.dead.items() if step < first}
+        self.shapes.clear()
+        self.backtracks = self.rejected = 0
+        self.locked_before.clear()
+        # the ranking's draws as at the start, so that from the initial shape the chain is
+        # the one of batch "off" (the sets' rankings drew from the same generator)
+        self.rng = np.random.default_rng(self.options.seed)
+        self.run.stop_detail = ""
         return True
 
     def retract(self, keep: int | None = None) -> None:
@@ -786,7 +835,8 @@ def generate(
     while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
         stop = steps.reduce(run.solutions[-1])
         if stop is not None and not (
-            steps.restart(stop)
+            steps.unbatch(stop)
+            or steps.restart(stop)
             or steps.backtrack(stop)
             or steps.restart(stop, after_backtracking=True)
         ):
