@@ -702,18 +702,23 @@ class _Steps:
             return False
         self.keep_deepest(stop)
         limit, case = self.restarts.pop(0)
-        keep = _within(run.solutions, limit)
-        self.retract(keep=keep)
-        self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
-        self.shapes.clear()
+        self.new_chain(keep=_within(run.solutions, limit))
         self.fold_limit = limit
         t0 = time.perf_counter()
         self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
         run.build_time += time.perf_counter() - t0
-        self.backtracks = self.rejected = 0
-        self.locked_before.clear()  # a new chain: the look-ahead's memory of locks is its own
-        run.stop_detail = ""
         return True
+
+    def new_chain(self, keep: int) -> None:
+        """A new chain from the first ``keep`` solutions (:meth:`restart`, :meth:`unbatch`):
+        the rest retracted, with their dead ends, the shapes being reduced, the chain's
+        backtracking and rejected paths, and the look-ahead's memory of locks."""
+        self.retract(keep=keep)
+        self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
+        self.shapes.clear()
+        self.backtracks = self.rejected = 0
+        self.locked_before.clear()
+        self.run.stop_detail = ""
 
     def unbatch(self, stop: Stop) -> bool:
         """With ``GenerateOptions.batch`` "auto", the first dead end of the batched chain
@@ -736,15 +741,10 @@ class _Steps:
         if first is None:
             return False
         self.keep_deepest(stop)
-        self.retract(keep=first)
-        self.dead = {step: fixes for step, fixes in self.dead.items() if step < first}
-        self.shapes.clear()
-        self.backtracks = self.rejected = 0
-        self.locked_before.clear()
+        self.new_chain(keep=first)
         # the ranking's draws as at the start, so that from the initial shape the chain is
         # the one of batch "off" (the sets' rankings drew from the same generator)
         self.rng = np.random.default_rng(self.options.seed)
-        self.run.stop_detail = ""
         return True
 
     def retract(self, keep: int | None = None) -> None:
