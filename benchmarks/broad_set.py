@@ -73,10 +73,10 @@ VARIANTS: dict[str, tuple[str, ...]] = {
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
 ``today`` the command line's defaults; ``criterion-s`` the criterion S instead of S-hat;
-``batch-auto`` several creases fixed per solve where the first-order analysis allows, in
-the first chain (a restart fixes one per solve);
+``batch-auto`` several creases fixed per solve where the first-order analysis allows, until
+the first chain's first dead end (the default since session 31, as ``today``);
 ``batch-on`` the same in every chain (what ``batch-auto`` was before session 25);
-``batch-off`` one crease per solve (the default, as ``today``);
+``batch-off`` one crease per solve (the paper's order; the default before session 31);
 ``theta-none`` the sector-angle bounds as given, never widened to a drawn plan's angles
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
 ends the run (the default before session 24); ``count-threshold`` and ``count-gap`` the

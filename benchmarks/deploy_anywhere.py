@@ -6,7 +6,7 @@ second-order test, ``no-second-order``; every solve bounded, ``bounded``), in th
 process.
 
 Run with ``python benchmarks/deploy_anywhere.py [--jobs 2] [--out FILE.jsonl] [--only
-TEXT[,TEXT...]] [--modes after,batch-auto,before,no-second-order]``. Every run uses S-hat with the
+TEXT[,TEXT...]] [--modes after,batch-off,before,no-second-order]``. Every run uses S-hat with the
 look-ahead and the deployability check, as the README recommends, and ``--time-limit`` (180
 s for a drawn pattern, 420 s for the roof; ``--limit S`` for all): a run that hits it ends
 with its best design, counted as not reaching DOF 1. Each run's wall and CPU seconds are
@@ -62,18 +62,20 @@ MODES: dict[str, dict] = {
     "no-second-order": {"second_order": False},
     "bounded": {"rho_max": math.radians(120.0)},
     "batch-auto": {},
+    "batch-off": {},
     "count-threshold": {"dof_count": "threshold"},
     "count-gap": {"dof_count": "gap"},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
 second-order test and forecast (the search before session 17); ``bounded`` bound (12) at 120
-degrees on every solve from the start (``generate --rho-max 120``); ``batch-auto`` the
-defaults with several creases per solve far from the target (:data:`MODE_OPTIONS`);
+degrees on every solve from the start (``generate --rho-max 120``); ``batch-auto`` several
+creases per solve far from the target (the default since session 31, as ``after``) and
+``batch-off`` one crease per solve, the paper's order (:data:`MODE_OPTIONS`);
 ``count-threshold`` and ``count-gap`` the search's DOF count (``generate --dof-count``)."""
-MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}}
+MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}, "batch-off": {"batch": "off"}}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
-per solve (``generate --batch auto``; session 25)."""
+per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``)."""
 
 
 def paper_cases(surfaces: int) -> list[dict]:

@@ -21,7 +21,8 @@ from rigidfold.pipeline import RunWriter, run
 from rigidfold.rundir import load_run, read_log
 
 SEED = 102
-OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False)
+# one crease per solve: backtracking alone, not the end of the sets (tests/test_batch.py)
+OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False, batch="off")
 
 
 def _case(backtrack_max: int):

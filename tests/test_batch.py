@@ -15,6 +15,7 @@ from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism import analyze
 from rigidfold.selection import lock_forecast, rank_candidates, score_creases
 from rigidfold.selection.batch import compatible_set
+from rigidfold.study import STUDY_OPTIONS
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +54,10 @@ def test_a_set_takes_candidates_in_the_rankings_order_and_skips_what_it_is_told(
 
 
 def test_batch_is_checked():
-    assert GenerateOptions().batch == "off"  # the paper's order unless asked
+    assert GenerateOptions().batch == "auto"  # sets until the first dead end (issue 49)
+    assert GenerateOptions(batch="off").batch == "off"
+    # a study keeps the paper's order, with the deployability check too
+    assert STUDY_OPTIONS.replace(deploy_check=True).batch == "off"
     assert GenerateOptions(batch="auto").batch == "auto"
     with pytest.raises(RigidfoldError, match="batch"):
         GenerateOptions(batch="yes")

@@ -75,6 +75,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         seed=1,
         lookahead=True,
         deform=False,
+        batch="off",  # a dead end of the sets would end the sets, not the chain
         on_retract=lambda _run, taken: taken_at_once.append(len(taken)),
     )
 

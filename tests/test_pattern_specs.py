@@ -265,8 +265,10 @@ def test_generate_on_a_6_by_4_grid(tmp_path):
     assert code == 0 and summary["verdict"]["outcome"] == "passed", summary["verdict"]
     assert summary["case"]["plan_size_m"] == [6.0, 4.0]
     files = sorted((tmp_path / "solutions").glob("*.fold"))
-    # a fix may leave the DOF as it was (a crease whose every mode is already still)
-    assert len(files) == summary["n_solutions"] >= summary["initial_dof"]
+    # several creases per solve far from the target (--batch auto), one near it
+    assert len(files) == summary["n_solutions"] >= 2
+    dofs = [int(path.stem.split("_dof_")[1]) for path in files]
+    assert dofs[0] == summary["initial_dof"] and dofs[-1] == 1
     # the run counts the DOF with a clear gap (its deployability check is on: issue 49):
     # near-mechanisms within dof_gap of the threshold are modes, so analyse with that count
     m = DEFAULTS.mechanism

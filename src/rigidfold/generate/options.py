@@ -122,15 +122,14 @@ class GenerateOptions:
         flag=False,
     )
     batch: str = option(
-        "off",
+        "auto",
         "several creases per solve: from the ranked candidates, the largest set whose fixes "
         "are independent and lock no crease at first order (rigidfold.selection.batch), "
-        "halved on failure; one crease per solve near the target DOF. off = the paper's one "
-        "crease per solve (the default: sets of creases lose the waterbomb family of the "
-        "drawn and roof cases, docs/broad_set.md, session 25); auto = with the deployability "
-        "check, until the first dead end of the run's first chain (then back to the shape "
-        "before its first set, one crease per solve from there, as off), off without the "
-        "check (the paper's Step 5 and the study); on = in every chain",
+        "halved on failure; one crease per solve near the target DOF. auto (the default) = "
+        "with the deployability check, until the first dead end of the run's first chain "
+        "(then back to the shape before its first set, one crease per solve from there, as "
+        "off), off without the check (the paper's Step 5 and the study); off = the paper's "
+        "one crease per solve; on = in every chain",
         choices=BATCH_CHOICES,
     )
     time_limit: float | None = option(

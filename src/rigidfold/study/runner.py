@@ -37,9 +37,10 @@ PRESETS = {
 }
 
 
-STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check=Check.ALL)
+STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check=Check.ALL, batch="off")
 """The generate options of a study by default: the paper's Step 5 (no deployability check;
-the final design's path is traced after the run), no Step 9."""
+the final design's path is traced after the run), no Step 9, and the paper's one crease per
+solve, with the deployability check too (``rigidfold study --deploy-check``)."""
 
 
 @dataclass(frozen=True)
