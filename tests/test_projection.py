@@ -15,7 +15,7 @@ from rigidfold.config import DEFAULTS
 from rigidfold.generate import GenerateOptions
 from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
-from rigidfold.optimize import Status
+from rigidfold.optimize import Status, projection
 from rigidfold.optimize.hessian import angle_derivatives
 from rigidfold.optimize.projection import Projection
 from rigidfold.optimize.residuals import Residuals, angle_gradients, fold_angle_gradients
@@ -180,6 +180,36 @@ def test_a_projection_stopped_near_a_zero_is_taken_without_ipopt(solved_grid):
     assert again.F <= 1e-6 and again.max_violation == 0.0
 
 
+def test_a_creeping_polish_stops_when_its_steps_stall(solved_grid, monkeypatch):
+    """Steps cut to 2 % of the Gauss-Newton step lower F by about 4 % each: with ``stall``
+    5 the projection stops once five accepted steps have not halved F ("stalled"), where
+    without it it runs all ``projection_max_iter`` factorisations; full steps from the same
+    start converge and never stall."""
+    _, problem, result = solved_grid
+    rho = np.abs(result.pattern.fold_angles)
+    folded = np.flatnonzero(~result.pattern.is_boundary_edge & (rho > 1e-3))
+    w = result.pattern.fixed.astype(float)
+    w[folded[np.argmin(rho[folded])]] = 1.0
+    start = problem.start_point(result.coords)
+    tol = DEFAULTS.solver.polish_tol
+    stall = DEFAULTS.solver.polish_stall_steps
+    assert stall >= 1
+    full = Projection(problem)(start, w, tol=tol, stall=stall)
+    assert full.converged and "stalled" not in full.reason
+
+    real = projection._solve
+    monkeypatch.setattr(projection, "_solve", lambda JJ, mu, r: 0.02 * real(JJ, mu, r))
+    creeping = Projection(problem)(start, w, tol=tol, stall=stall)
+    assert creeping.reason.startswith("stalled at F = ")
+    assert stall <= creeping.iterations < DEFAULTS.solver.projection_max_iter
+    assert not creeping.converged and creeping.feasible
+    F0, _, _ = (float(v) for v in problem.objective(start, w))
+    assert 0.5 * F0 < creeping.F < F0
+    endless = Projection(problem)(start, w, tol=tol)  # stall 0: never
+    assert endless.iterations == DEFAULTS.solver.projection_max_iter
+    assert endless.reason.startswith("stopped at F = ") and endless.F < creeping.F
+
+
 def test_an_infeasible_start_is_not_projected():
     problem = case_from_specs("dome", "grid:21x21", size="3x3").problem(build_ipopt=False)
     out = Projection(problem)(problem.start_point(), np.zeros(problem.pattern.n_edges))
@@ -209,6 +239,7 @@ def test_generate_on_a_large_grid_projects_after_the_first_solve():
         ("projection_tol", 0.0),
         ("projection_damping", -1.0),
         ("projection_margin", 0.0),
+        ("polish_stall_steps", -1),
         ("ipopt_stop_f", float("nan")),
     ],
 )

@@ -384,6 +384,14 @@ class SolverSettings(Group):
         "Before the deployability check, an accepted solution is projected onto F = 0 to this "
         "F (:meth:`rigidfold.optimize.FormFindingProblem.polish`): developable to round-off.",
     )
+    polish_stall_steps: int = setting(
+        5,
+        "The polish stops (stalled) once its last this many accepted steps together lowered F "
+        "by less than half: the Gauss-Newton model then predicts a decrease of a few per cent "
+        "a step (the residual lies in directions the damping all but cuts off, or against a "
+        "held bound), and the factorisations up to ``projection_max_iter`` would end near "
+        "the same F. 0: never.",
+    )
     develop_tol: float = setting(
         1e-12,
         "IPOPT tolerance of problem (13) (the development diagram, Step 8); tighter than "
@@ -399,7 +407,7 @@ class SolverSettings(Group):
 
     def __post_init__(self) -> None:
         self._positive("projection_tol", "projection_damping", "projection_margin", "ipopt_stop_f")
-        self._integer(projection_vertices=3, projection_max_iter=1)
+        self._integer(projection_vertices=3, projection_max_iter=1, polish_stall_steps=0)
         self._choice("ipopt_hessian", HESSIANS)
 
 

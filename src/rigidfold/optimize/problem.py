@@ -288,6 +288,7 @@ class FormFindingProblem:
                     w,
                     tol=self.settings.solver.polish_tol,
                     deadline=deadline,
+                    stall=self.settings.solver.polish_stall_steps,
                 )
         except RuntimeError:  # a singular factor (redundant rows at F ~ 0): keep the result
             return result

@@ -12,7 +12,10 @@ one, the nearest is found by Gauss-Newton steps of least norm on the residuals o
 so one step costs a sparse factorisation of that size (SuperLU); near a zero of F the steps
 converge quadratically. The damping is proportional to |r| (Fan and Yuan's choice, which keeps
 the fast local convergence where the zeros of F form a family, as they do here), and lambda
-follows the ratio of the actual to the predicted decrease of F.
+follows the ratio of the actual to the predicted decrease of F. Where the residual lies in
+directions that the damping all but cuts off (or against a held bound), the steps creep, F
+falling a per cent or less a step; given ``stall`` steps, the projection stops there
+("stalled") once its last ``stall`` accepted steps together lowered F by less than half.
 
 Every iterate meets the constraints of (6) (the dz, sector angle and fold angle bounds): the
 projection starts only from a feasible shape and refuses a step that leaves the feasible set,
@@ -109,10 +112,12 @@ class Projection:
         *,
         tol: float | None = None,
         deadline: float | None = None,
+        stall: int = 0,
     ) -> Projected:
         """Project from ``xi0`` (n,) with fixed-crease weights ``w`` (E,) to F <= ``tol``
         (default ``Settings.solver.projection_tol``); ``deadline`` (of ``time.monotonic()``):
-        it stops there ("stopped")."""
+        it stops there ("stopped"); ``stall`` (0: never): it stops once the last ``stall``
+        accepted steps together lowered F by less than half ("stalled")."""
         s = self.settings
         tol = s.solver.projection_tol if tol is None else tol
         xi = np.asarray(xi0, dtype=float).copy()
@@ -129,6 +134,7 @@ class Projection:
         scale = -1.0  # the largest diagonal entry of A A^T at the start
         lam, nu = s.solver.projection_damping, 2.0
         slack = 0.1 * s.solver.constraint_tol
+        taken = [F]  # F after each accepted step, the start first
         k = 0
         for k in range(s.solver.projection_max_iter):
             if F <= tol:
@@ -164,6 +170,9 @@ class Projection:
                 A, ra = self._augment(point, held)
                 lam *= 0.25 if gain > 0.75 else 1.0 if gain > 0.25 else 4.0
                 nu = 2.0
+                taken.append(F)
+                if stall and len(taken) > stall and F > tol and F > 0.5 * taken[-1 - stall]:
+                    return self._end(xi, F, k + 1, held, "stalled", tol)
             else:
                 lam *= nu
                 nu *= 2
