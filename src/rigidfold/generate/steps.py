@@ -118,6 +118,11 @@ class _Frame:
     fallback: bool = False  # the last candidate was forecast to lock or to be rigid
 
 
+_DEAD_ENDS = (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
+"""The stops at a shape that end a chain (no candidate deploys, or none is left): where
+sets end (:meth:`_Steps.unbatch`), a chain restarts or backtracks."""
+
+
 @dataclass
 class _Chain:
     """The solutions of a run (and their attempts) when it stopped at their last shape, kept
@@ -621,8 +626,7 @@ class _Steps:
                 return self.time_up()
             fix = tuple(e for k in chosen for e in groups[k])
             # not polished: a set never takes the DOF to where the deployability check
-            # runs, and the polish of a shape with many fixed creases (redundant rows) creeps
-            # for its 60 factorisations (41 x 41: 2-3.5 s a solve; issue 49)
+            # runs, so no path is traced from its shape (issue 49)
             rec, trial = self.try_fix(current, shape, fix, shape.ranked[chosen[0]][1], polish=False)
             rec.batch = len(chosen)
             self.record(rec, trial)
@@ -660,7 +664,7 @@ class _Steps:
         run = self.run
         if (
             not self.options.deploy_check
-            or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
+            or stop not in _DEAD_ENDS
             or len(run.solutions) < 2
             or self.backtracks >= self.settings.generation.backtrack_max
         ):
@@ -697,7 +701,7 @@ class _Steps:
         if (
             not self.restarts
             or not (after_backtracking or self.fold_limit is None or self.spent())
-            or stop not in (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
+            or stop not in _DEAD_ENDS
         ):
             return False
         self.keep_deepest(stop)
@@ -731,10 +735,7 @@ class _Steps:
         order is not lost; where they reach the target, the run took a few solves per
         dozen DOF. Returns whether it retracted (no set accepted: the chain is already the
         paper's, and the run goes on as without sets)."""
-        if not (self.batch and self.options.batch == "auto") or stop not in (
-            Stop.NO_DEPLOYABLE,
-            Stop.NO_CANDIDATE,
-        ):
+        if not (self.batch and self.options.batch == "auto") or stop not in _DEAD_ENDS:
             return False
         self.batch = False
         first = next((k for k, rec in enumerate(self.accepted) if rec.batch >= 2), None)
