@@ -113,7 +113,7 @@ def test_the_papers_step_5_fixes_one_crease_per_solve():
 def _restarted(monkeypatch, batch: str, keep):
     """An 11 x 11 grid on the dome to DOF 8 whose first traced path is made to turn back, so
     that the first chain restarts at once under a 120-degree fold limit, keeping
-    ``keep(solutions)`` of its solutions (in place of ``_within``): (options, run, the first
+    ``keep(solutions)`` of its solutions (in place of ``within``): (options, run, the first
     chain's attempts, the bounded chain's)."""
     import dataclasses
     import math
@@ -131,8 +131,12 @@ def _restarted(monkeypatch, batch: str, keep):
         return path
 
     monkeypatch.setattr(generation, "trace_path", first_turns_back)
-    monkeypatch.setattr(generation, "_within", lambda solutions, limit: keep(solutions))
-    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+    monkeypatch.setattr("rigidfold.generate.final.trace_path", first_turns_back)
+    monkeypatch.setattr(
+        "rigidfold.generate.chains.within", lambda solutions, limit: keep(solutions)
+    )
+    for module in ("chains", "steps"):  # restart at once
+        monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
     settings = DEFAULTS.with_(restart_after=1, fold_limits=(math.radians(120.0),))
     case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch=batch)
@@ -176,7 +180,8 @@ def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8)
     paper = generate(case, opts.replace(batch="off"))
     monkeypatch.setattr(steps, "trace_path", first_turns_back)
-    monkeypatch.setattr(steps, "_attempt_time", lambda rec: 0.0)  # given up at once
+    for module in ("chains", "steps"):  # given up at once
+        monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
     rank, draws = steps._Steps.rank, []
 
     def watched(self, current):  # the generator's state as each shape is ranked

@@ -61,6 +61,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         return path
 
     monkeypatch.setattr(generation, "trace_path", first_two_turn_back)
+    monkeypatch.setattr("rigidfold.generate.final.trace_path", first_two_turn_back)
     limits = (60.0, 40.0)
     settings = DEFAULTS.with_(
         restart_after=1,
@@ -143,6 +144,7 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
         return rec, trial
 
     monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    monkeypatch.setattr("rigidfold.generate.final.trace_path", first_turns_back)
     monkeypatch.setattr(generation._Steps, "solve", bounded_solves_fail)
     settings = DEFAULTS.with_(
         restart_after=1, deploy_max_candidates=2, fold_limits=(math.radians(60.0),)
@@ -171,6 +173,7 @@ def _first_turn_back(monkeypatch, count: int, then: PathStatus | None = None) ->
         return path if then is None else dataclasses.replace(path, status=then)
 
     monkeypatch.setattr(generation, "trace_path", turn_back)
+    monkeypatch.setattr("rigidfold.generate.final.trace_path", turn_back)
     return calls
 
 
@@ -193,7 +196,8 @@ def test_the_ladder_goes_on_whatever_the_bounded_chain_accepted(monkeypatch):
         deploy_max_candidates=2,
         fold_limits=tuple(math.radians(a) for a in limits),
     )
-    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+    for module in ("chains", "steps"):  # restart at once
+        monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
     run = generate(case_from_specs("bezier", "1", seed=1, settings=settings), criterion="s", seed=1)
     tried = {a.fold_limit_deg for a in run.attempts if a.fold_limit_deg is not None}
     assert sorted(round(t) for t in tried) == sorted(limits)
@@ -207,7 +211,8 @@ def test_a_restart_keeps_the_solutions_within_its_bound(monkeypatch):
     only."""
     for limit_deg in (179.0, 20.0):
         _first_turn_back(monkeypatch, 1)
-        monkeypatch.setattr(generation, "_attempt_time", lambda rec: 0.0)  # restart at once
+        for module in ("chains", "steps"):  # restart at once
+            monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
         settings = DEFAULTS.with_(
             restart_after=1, deploy_max_candidates=3, fold_limits=(math.radians(limit_deg),)
         )
@@ -244,16 +249,17 @@ def test_the_first_chain_is_not_given_up_while_trying_is_cheaper(monkeypatch):
     )
     case = case_from_specs("bezier", "1", seed=1, settings=settings)
     _first_turn_back(monkeypatch, 3, then=PathStatus.FLAT)
-    monkeypatch.setattr(generation, "_attempt_time", lambda rec: 1.0)
+    for module in ("chains", "steps"):  # the chain's cost, a shape's
+        monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 1.0)
     run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
     assert all(a.fold_limit_deg is None for a in run.attempts)
     assert sum(a.outcome is AttemptOutcome.PATH for a in run.attempts) >= 3
     assert run.stop is Stop.TARGET_REACHED and run.final.path.deploys
     _first_turn_back(monkeypatch, 3, then=PathStatus.FLAT)
-    monkeypatch.setattr(
-        generation,
-        "_attempt_time",
-        lambda rec: 0.0 if rec.outcome is AttemptOutcome.ACCEPTED else 1.0,
-    )
+    for module in ("chains", "steps"):  # the chain's cost, a shape's
+        monkeypatch.setattr(
+            f"rigidfold.generate.{module}.attempt_time",
+            lambda rec: 0.0 if rec.outcome is AttemptOutcome.ACCEPTED else 1.0,
+        )
     run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
     assert any(a.fold_limit_deg is not None for a in run.attempts)

@@ -46,7 +46,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -57,6 +57,15 @@ from rigidfold.config import (
 from rigidfold.frame.model import default_support_face
 from rigidfold.generate.budget import time_budget
 from rigidfold.generate.case import Case
+from rigidfold.generate.chains import (
+    Chain,
+    ChainControl,
+    Frame,
+    attempt_time,
+    chain_dof,
+    with_fold_limit,
+)
+from rigidfold.generate.final import deployable_final
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import (
     Attempt,
@@ -95,48 +104,10 @@ class _Trial:
     path: FoldingPath | None
 
 
-@dataclass
-class _Frame:
-    """Step 6 at one accepted shape, kept while the shape may be reduced again: the ranked
-    crease groups with their scores, the candidates not yet tried (an iterator, lazy with
-    look-ahead), the candidates whose paths did not reach the flat state, the candidates
-    that failed for any reason, and the seconds of selection not yet charged to an
-    attempt."""
-
-    solution: Solution
-    ranked: list
-    order: Iterator[Choice]
-    forecast: ChildForecast | None = None
-    undeployable: int = 0
-    failed: int = 0
-    rigid_in_row: int = 0
-    t_sel: float = 0.0
-    spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
-    batched: bool = False  # a set of several creases was tried here (GenerateOptions.batch)
-    swept: bool = False  # its near-mechanisms' candidates were tried here (fix_near)
-    tried: set[tuple[int, ...]] = field(default_factory=set)  # fixes tried by fix_near
-    fallback: bool = False  # the last candidate was forecast to lock or to be rigid
-
-
-_DEAD_ENDS = (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
-"""The stops at a shape that end a chain (no candidate deploys, or none is left): where
-sets end (:meth:`_Steps.unbatch`), a chain restarts or backtracks."""
-
-
-@dataclass
-class _Chain:
-    """The solutions of a run (and their attempts) when it stopped at their last shape, kept
-    in case backtracking ends at a higher DOF: the stop and its detail."""
-
-    solutions: list[Solution]
-    accepted: list[Attempt]
-    stop: Stop
-    detail: str
-
-
-class _Steps:
+class _Steps(ChainControl):
     """The steps of one generation run on its state: the problem (built once), the options,
-    the run being recorded and the callbacks that see it."""
+    the run being recorded and the callbacks that see it; the moves between chains
+    (backtracking, restarts, the sets' end) are :class:`ChainControl`'s."""
 
     def __init__(
         self,
@@ -184,9 +155,9 @@ class _Steps:
             not self.settings.generation.retry_zero_dof and not options.deploy_check
         ) or options.target_dof == 0
         self.locked_before: dict[tuple[int, ...], list[int]] = {}  # look-ahead: fixes that locked
-        self.shapes: list[_Frame] = []  # Step 6 at each solution being reduced, the last on top
+        self.shapes: list[Frame] = []  # Step 6 at each solution being reduced, the last on top
         self.accepted: list[Attempt] = []  # the attempt of each solution
-        self.deepest: _Chain | None = None  # the chain of lowest DOF that backtracking left
+        self.deepest: Chain | None = None  # the chain of lowest DOF that backtracking left
         self.margins: dict[int, DofMargin] = {}  # by attempt index: those of target solutions
         self.backtracks = 0  # retractions by backtracking in the chain being built
         self.rejected = 0  # the chain's candidates whose paths do not reach the flat state
@@ -360,13 +331,13 @@ class _Steps:
         assert trial.mechanism is not None  # a solution was analysed
         run = self.run
         sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
-        chain = _Chain(
+        chain = Chain(
             [*run.solutions, sol],
             [*self.accepted, rec],
             Stop.TARGET_REACHED,
             str(self.options.target_dof),
         )
-        if self.deepest is None or _dof(chain.solutions) < _dof(self.deepest.solutions):
+        if self.deepest is None or chain_dof(chain.solutions) < chain_dof(self.deepest.solutions):
             self.deepest = chain
 
     def is_solution(self, rec: Attempt) -> bool:
@@ -418,7 +389,7 @@ class _Steps:
         )
         return ranked, order, forecast, time.perf_counter() - t1
 
-    def annotate(self, rec: Attempt, choice: Choice, shape: _Frame, current: Solution) -> None:
+    def annotate(self, rec: Attempt, choice: Choice, shape: Frame, current: Solution) -> None:
         """The look-ahead's record of a candidate's attempt (what it skipped, what it was
         predicted to lock, what it carried, whether it was forecast second-order rigid) and
         the forecast's view of the creases it locked."""
@@ -454,7 +425,7 @@ class _Steps:
             if self.out_of_time():  # no ranking of a shape that no solve will reduce
                 return self.time_up()
             ranked, order, forecast, t_sel = self.rank(current)
-            self.shapes.append(_Frame(current, ranked, order, forecast, t_sel=t_sel))
+            self.shapes.append(Frame(current, ranked, order, forecast, t_sel=t_sel))
         shape = self.shapes[-1]
         ranked, order = shape.ranked, shape.order
         if self.sweep and not shape.swept and self.set_size(current) < 2:
@@ -522,7 +493,7 @@ class _Steps:
     def try_fix(
         self,
         current: Solution,
-        shape: _Frame,
+        shape: Frame,
         fix: tuple[int, ...],
         score: float | None,
         *,
@@ -536,10 +507,10 @@ class _Steps:
         trial_fixed[list(fix)] = True
         rec, trial = self.solve(trial_fixed, current.result.coords, fix, score, polish=polish)
         rec.selection_time, shape.t_sel = shape.t_sel, 0.0
-        shape.spent += _attempt_time(rec)
+        shape.spent += attempt_time(rec)
         return rec, trial
 
-    def fix_near(self, current: Solution, shape: _Frame) -> Stop | bool:
+    def fix_near(self, current: Solution, shape: Frame) -> Stop | bool:
         """Near-mechanisms first (:mod:`rigidfold.selection.near`): at a shape whose DOF,
         counted with the gap, has fewer exact mechanisms, up to ``near_tries`` candidates
         that turn in its near-mechanisms but hardly in the exact ones (share below
@@ -599,7 +570,7 @@ class _Steps:
         room = current.mechanism.dof - max(self.options.target_dof, 1) - g.batch_single_dof
         return max(0, min(self.batch_size, g.batch_max, room))
 
-    def fix_set(self, current: Solution, shape: _Frame) -> Stop | bool:
+    def fix_set(self, current: Solution, shape: Frame) -> Stop | bool:
         """Several creases in one solve (``GenerateOptions.batch``; :mod:`rigidfold.selection.
         batch`): at a shape more than ``batch_single_dof`` DOF above the target, the largest
         compatible set of its ranked candidates, of at most the next set's size and never
@@ -638,155 +609,6 @@ class _Steps:
             chosen = chosen[: len(chosen) // 2]
             self.batch_size = max(2, len(chosen))
         return False
-
-    def worth_more(self, shape: _Frame) -> bool:
-        """Whether the first chain keeps trying candidates at ``shape`` past
-        ``restart_after`` rejected paths instead of restarting: while its next candidates
-        are still forecast to deploy (the last one tried was not put off by the look-ahead
-        or the second-order forecast) and what its candidates have cost so far is less than
-        re-solving the chain to this shape (the seconds of its accepted attempts)."""
-        chain = sum(_attempt_time(rec) for rec in self.accepted[1:])
-        return not shape.fallback and shape.spent < chain
-
-    def spent(self) -> bool:
-        """Whether the chain, bounded and with a further fold limit, has had as many
-        candidates rejected by their paths (N_path, N_rigid) as ``deploy_max_candidates``,
-        at whatever shapes: it is then given up for the next limit, not backtracked."""
-        budget = self.settings.generation.deploy_max_candidates
-        return self.fold_limit is not None and bool(self.restarts) and self.rejected >= budget > 0
-
-    def backtrack(self, stop: Stop) -> bool:
-        """Step 7 beyond the last fix: after ``stop`` at the last solution's shape, retract
-        that solution (not the initial shape's) while the run's budget
-        (``Settings.generation.backtrack_max``) lasts and the deployability check runs; its
-        attempt's outcome becomes DEAD_END. Returns whether it did (then the shape before it
-        is reduced again)."""
-        run = self.run
-        if (
-            not self.options.deploy_check
-            or stop not in _DEAD_ENDS
-            or len(run.solutions) < 2
-            or self.backtracks >= self.settings.generation.backtrack_max
-        ):
-            return False
-        self.keep_deepest(stop)
-        self.shapes.pop()
-        parent = len(run.solutions) - 2
-        self.dead.setdefault(parent, set()).add(tuple(self.accepted[-1].fixed_added))
-        self.retract()
-        self.backtracks += 1
-        run.stop_detail = ""
-        return True
-
-    def keep_deepest(self, stop: Stop) -> None:
-        """Keep the chain as it stands (with ``stop``) as :attr:`deepest` where it reached a
-        lower DOF than the one kept."""
-        run = self.run
-        if self.deepest is None or _dof(run.solutions) < _dof(self.deepest.solutions):
-            self.deepest = _Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
-
-    def restart(self, stop: Stop, *, after_backtracking: bool = False) -> bool:
-        """Step 7 beyond backtracking: after ``stop`` at the last solution's shape (its
-        candidates' paths do not reach the flat state, or none is left), every solution after
-        the initial one is retracted and the chain starts again from the initial shape with
-        bound (12) at the next of ``Settings.generation.fold_limits`` on every solve
-        (:func:`with_fold_limit`; the attempts' ``fold_limit_deg``), with a backtracking
-        budget of its own. The first chain is given up after ``restart_after`` rejected paths
-        at one shape, before any backtracking; a bounded chain once its backtracking is spent
-        (``after_backtracking``) or, where a further limit is left, once
-        ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
-        shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
-        (:meth:`settle`). Returns whether it did."""
-        run = self.run
-        if (
-            not self.restarts
-            or not (after_backtracking or self.fold_limit is None or self.spent())
-            or stop not in _DEAD_ENDS
-        ):
-            return False
-        self.keep_deepest(stop)
-        limit, case = self.restarts.pop(0)
-        self.new_chain(keep=_within(run.solutions, limit))
-        self.fold_limit = limit
-        t0 = time.perf_counter()
-        self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
-        run.build_time += time.perf_counter() - t0
-        return True
-
-    def new_chain(self, keep: int) -> None:
-        """A new chain from the first ``keep`` solutions (:meth:`restart`, :meth:`unbatch`):
-        the rest retracted, with their dead ends, the shapes being reduced, the chain's
-        backtracking and rejected paths, and the look-ahead's memory of locks."""
-        self.retract(keep=keep)
-        self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
-        self.shapes.clear()
-        self.backtracks = self.rejected = 0
-        self.locked_before.clear()
-        self.run.stop_detail = ""
-
-    def unbatch(self, stop: Stop) -> bool:
-        """With ``GenerateOptions.batch`` "auto", the first dead end of the batched chain
-        (``stop``: its shape's candidates' paths do not reach the flat state, or none is
-        left) ends the sets of creases: the solutions from the first set on are retracted
-        and the chain goes on from the shape before it one crease per solve, unbounded, with
-        the run's backtracking and restarts still to come: from there on the run is the one
-        of ``batch`` "off" (the sets cost what their solves took). Where the sets dead-end
-        (the waterbomb family: DOF 2 in a few solves, no DOF-1 child deploys) the paper's
-        order is not lost; where they reach the target, the run took a few solves per
-        dozen DOF. Returns whether it retracted (no set accepted: the chain is already the
-        paper's, and the run goes on as without sets)."""
-        if not (self.batch and self.options.batch == "auto") or stop not in _DEAD_ENDS:
-            return False
-        self.batch = False
-        first = next((k for k, rec in enumerate(self.accepted) if rec.batch >= 2), None)
-        if first is None:
-            return False
-        self.keep_deepest(stop)
-        self.new_chain(keep=first)
-        # the ranking's draws as at the start, so that from the initial shape the chain is
-        # the one of batch "off" (the sets' rankings drew from the same generator)
-        self.rng = np.random.default_rng(self.options.seed)
-        return True
-
-    def retract(self, keep: int | None = None) -> None:
-        """Take back the last solution (``keep`` given: every solution after the first
-        ``keep``): their attempts' outcome becomes DEAD_END; the callback sees them at once,
-        the last first."""
-        run = self.run
-        keep = len(run.solutions) - 1 if keep is None else keep
-        taken: list[Solution] = []
-        while len(run.solutions) > keep:
-            taken.append(run.solutions.pop())
-            self.accepted.pop().outcome = AttemptOutcome.DEAD_END
-            run.n_backtrack += 1
-        if self.on_retract and taken:
-            self.on_retract(run, tuple(taken))
-
-    def settle(self, stop: Stop) -> None:
-        """The run ends with ``stop`` at its last shape; where backtracking had left a chain
-        that reached a lower DOF (:attr:`deepest`), that chain is taken back instead (the
-        solutions found since are retracted, its own accepted again) with its stop."""
-        run, deepest = self.run, self.deepest
-        if deepest is None or _dof(deepest.solutions) >= _dof(run.solutions):
-            run.stop = stop
-            return
-        common = 0
-        for a, b in zip(deepest.solutions, run.solutions, strict=False):
-            if a is not b:
-                break
-            common += 1
-        self.retract(keep=common)
-        for solution, rec in zip(
-            deepest.solutions[common:], deepest.accepted[common:], strict=True
-        ):
-            run.n_backtrack -= rec.outcome is AttemptOutcome.DEAD_END  # no longer retracted
-            rec.outcome = AttemptOutcome.ACCEPTED  # or a fallback without a clear gap, taken
-            assert solution.step == len(run.solutions)  # the chains share what is before
-            run.solutions.append(solution)
-            self.accepted.append(rec)
-            if self.on_solution:
-                self.on_solution(run, solution)
-        run.stop, run.stop_detail = deepest.stop, deepest.detail
 
 
 @one_blas_thread()  # the same path on every machine (see one_blas_thread)
@@ -842,7 +664,7 @@ def generate(
             or steps.restart(stop, after_backtracking=True)
         ):
             steps.settle(stop)
-            _deployable_final(
+            deployable_final(
                 run,
                 opts,
                 case.settings,
@@ -860,41 +682,6 @@ def generate(
         )
         run.dof_margin = margin.to_dict()
     return run
-
-
-def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
-    """The case of a run's restart at the fold limit ``limit`` (radians;
-    :meth:`_Steps.restart`): with the deployability check and no bound (12) of the user's
-    (``Settings.design.rho_max``), (12) at ``limit``; otherwise ``case`` itself (no
-    restart).
-
-    Each fix flattens a crease, and the solve makes up for it by folding the creases left
-    free further: on drawn patterns the chain ends with panels folded nearly onto each other
-    (creases near 180 degrees), and the folding paths of such shapes turn back or collide
-    before the flat state (docs/deployability.md, issue 40). Bound (12) keeps every solve
-    away from that, and IPOPT's barrier on it favours the less folded of the shapes that
-    solve (6)."""
-    s = case.settings
-    if not options.deploy_check or s.design.rho_max is not None:
-        return case
-    return replace(case, settings=s.with_(rho_max=limit))
-
-
-def best_so_far(run: Generation) -> None:
-    """Name the final design of a run that stops before its end (interrupted): the
-    lowest-DOF solution whose folding path is known to reach the flat state (of two at one
-    DOF, the later); where none is known, ``final_step`` stays None (the last solution),
-    which the verdict does not name as a design (:func:`known_to_deploy`). No path is
-    traced."""
-    known = [s for s in run.solutions if known_to_deploy(s)]
-    if known:
-        run.final_step = min(known, key=lambda s: (s.mechanism.dof, -s.step)).step
-
-
-def known_to_deploy(solution: Solution) -> bool:
-    """Whether the solution's folding path was traced and reached the flat state (the
-    deployability check of Step 5)."""
-    return solution.path is not None and bool(solution.path.deploys)
 
 
 def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterator[Choice]:
@@ -922,31 +709,6 @@ def _dof_count(settings: Settings, options: GenerateOptions) -> str:
     return count
 
 
-def _attempt_time(rec: Attempt) -> float:
-    """Seconds of one attempt: its selection, solve, analysis and trace."""
-    return rec.selection_time + rec.solve_time + rec.analysis_time + rec.path_time
-
-
-def _within(solutions: list[Solution], limit: float) -> int:
-    """How many solutions of a chain a restart at the fold limit ``limit`` (radians) keeps:
-    those before the first whose free creases are not all within it (they solve problem (6)
-    with bound (12) too), but not the chain's last (its candidates failed), and at least
-    the initial shape."""
-    keep = 1
-    for k, solution in enumerate(solutions[1:-1], start=1):
-        shape = solution.result.pattern
-        free = ~shape.fixed & ~shape.is_boundary_edge
-        if np.abs(shape.fold_angles[free]).max(initial=0.0) > limit:
-            break
-        keep = k + 1
-    return keep
-
-
-def _dof(solutions: list[Solution]) -> int:
-    """The DOF of a chain's last solution."""
-    return solutions[-1].mechanism.dof
-
-
 def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
     """Steps 4-5 on a solve's mechanism (None: not accepted, not analysed)."""
     if mech is None:
@@ -956,66 +718,6 @@ def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
         # over-reduction counted as a lock: every folded free crease has stopped moving
         return AttemptOutcome.ZERO_DOF if zero_ends else AttemptOutcome.LOCK
     return AttemptOutcome.LOCK if mech.has_lock else AttemptOutcome.ACCEPTED
-
-
-def _deployable_final(
-    run: Generation,
-    options: GenerateOptions,
-    settings: Settings,
-    *,
-    bisect: bool,
-    deadline: float | None = None,
-) -> None:
-    """With the deployability check, a run that ends short of its target names as its final
-    design the lowest-DOF solution whose folding path reaches the flat state (tracing the
-    paths not yet traced, from the last solution back); none: the last solution.
-
-    A run stopped by its time limit (``bisect``) bisects the chain instead, so that the
-    limit is not overrun by up to K traces of its K solutions (the many-DOF paths above the
-    lowest are the slow ones) but about log2(K): it names a solution whose own path deploys
-    and none of whose probed successors' does. Where the chain's paths deploy down to some
-    DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
-    the lowest-DOF solution that deploys, as the scan finds it.
-
-    ``deadline`` (of ``time.monotonic()``: the run's time limit and its grace): every trace
-    ends there (a trace it cuts counts as not deploying and is not kept), and none starts
-    after it; their seconds are ``Generation.final_path_time`` (``time_s.path``).
-    """
-    if not options.deploy_check:
-        return
-
-    def deploys(solution: Solution) -> bool:
-        if solution.path is None:
-            if deadline is not None and time.monotonic() > deadline:
-                return False
-            t0 = time.perf_counter()
-            path = trace_path(
-                solution.result.pattern,
-                dof=solution.mechanism.dof,
-                support_face=options.support_face,
-                settings=settings,
-                deadline=deadline,
-            )
-            run.final_path_time += time.perf_counter() - t0
-            if path.cut:
-                return False
-            solution.path = path
-        return solution.path.deploys
-
-    chain = run.solutions
-    if bisect:
-        known = [i for i, s in enumerate(chain) if s.path is not None and s.path.deploys]
-        lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not known above
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
-        if lo >= 0:
-            run.final_step = chain[lo].step
-        return
-    for solution in reversed(chain):
-        if deploys(solution):
-            run.final_step = solution.step
-            return
 
 
 def _checked(mech: Mechanism | None, options: GenerateOptions, settings: Settings) -> bool:

@@ -1,0 +1,281 @@
+"""The chains of a run (Step 7 beyond the last fix, with the deployability check): a chain
+is the stack of accepted shapes being reduced, one :class:`Frame` each; when a shape's
+candidates are spent, the chain backtracks to the shape before it, restarts from the
+initial shape with bound (12) at the next fold limit, or ends its sets of creases
+(``GenerateOptions.batch`` "auto") and goes on one crease per solve; a run ends with the
+chain that reached the lowest DOF (:meth:`ChainControl.settle`).
+
+:class:`ChainControl` holds these moves; the steps of one run (:mod:`rigidfold.generate.
+steps`) inherit them and own the state they act on, declared here.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from rigidfold.config import Settings
+from rigidfold.generate.case import Case
+from rigidfold.generate.options import GenerateOptions
+from rigidfold.generate.records import Attempt, AttemptOutcome, Generation, Solution, Stop
+from rigidfold.mechanism.second_order import ChildForecast
+from rigidfold.optimize import FormFindingProblem, SolverName
+from rigidfold.selection import Choice
+
+
+@dataclass
+class Frame:
+    """Step 6 at one accepted shape, kept while the shape may be reduced again: the ranked
+    crease groups with their scores, the candidates not yet tried (an iterator, lazy with
+    look-ahead), the candidates whose paths did not reach the flat state, the candidates
+    that failed for any reason, and the seconds of selection not yet charged to an
+    attempt."""
+
+    solution: Solution
+    ranked: list
+    order: Iterator[Choice]
+    forecast: ChildForecast | None = None
+    undeployable: int = 0
+    failed: int = 0
+    rigid_in_row: int = 0
+    t_sel: float = 0.0
+    spent: float = 0.0  # seconds of its candidates' attempts (selection, solve, trace)
+    batched: bool = False  # a set of several creases was tried here (GenerateOptions.batch)
+    swept: bool = False  # its near-mechanisms' candidates were tried here (fix_near)
+    tried: set[tuple[int, ...]] = field(default_factory=set)  # fixes tried by fix_near
+    fallback: bool = False  # the last candidate was forecast to lock or to be rigid
+
+
+DEAD_ENDS = (Stop.NO_DEPLOYABLE, Stop.NO_CANDIDATE)
+"""The stops at a shape that end a chain (no candidate deploys, or none is left): where
+sets end (:meth:`ChainControl.unbatch`), a chain restarts or backtracks."""
+
+
+@dataclass
+class Chain:
+    """The solutions of a run (and their attempts) when it stopped at their last shape, kept
+    in case backtracking ends at a higher DOF: the stop and its detail."""
+
+    solutions: list[Solution]
+    accepted: list[Attempt]
+    stop: Stop
+    detail: str
+
+
+class ChainControl:
+    """Backtracking, restarts at the fold limits, the end of the sets and the chain a run
+    ends with, on the state of one run's steps (:mod:`rigidfold.generate.steps`)."""
+
+    run: Generation
+    case: Case
+    options: GenerateOptions
+    settings: Settings
+    problem: FormFindingProblem
+    on_solution: Callable[[Generation, Solution], None] | None
+    on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None
+    rng: np.random.Generator
+    batch: bool  # sets of creases are made (GenerateOptions.batch)
+    shapes: list[Frame]  # Step 6 at each solution being reduced, the last on top
+    accepted: list[Attempt]  # the attempt of each solution
+    deepest: Chain | None  # the chain of lowest DOF that backtracking left
+    backtracks: int  # retractions by backtracking in the chain being built
+    rejected: int  # the chain's candidates whose paths do not reach the flat state
+    restarts: list[tuple[float, Case]]  # (fold limit, case) not yet used
+    fold_limit: float | None  # the bound of the chain's solves (radians)
+    dead: dict[int, set[tuple[int, ...]]]  # retracted fixes, by the step of their shape
+    locked_before: dict[tuple[int, ...], list[int]]  # look-ahead: fixes that locked
+
+    def worth_more(self, shape: Frame) -> bool:
+        """Whether the first chain keeps trying candidates at ``shape`` past
+        ``restart_after`` rejected paths instead of restarting: while its next candidates
+        are still forecast to deploy (the last one tried was not put off by the look-ahead
+        or the second-order forecast) and what its candidates have cost so far is less than
+        re-solving the chain to this shape (the seconds of its accepted attempts)."""
+        chain = sum(attempt_time(rec) for rec in self.accepted[1:])
+        return not shape.fallback and shape.spent < chain
+
+    def spent(self) -> bool:
+        """Whether the chain, bounded and with a further fold limit, has had as many
+        candidates rejected by their paths (N_path, N_rigid) as ``deploy_max_candidates``,
+        at whatever shapes: it is then given up for the next limit, not backtracked."""
+        budget = self.settings.generation.deploy_max_candidates
+        return self.fold_limit is not None and bool(self.restarts) and self.rejected >= budget > 0
+
+    def backtrack(self, stop: Stop) -> bool:
+        """Step 7 beyond the last fix: after ``stop`` at the last solution's shape, retract
+        that solution (not the initial shape's) while the run's budget
+        (``Settings.generation.backtrack_max``) lasts and the deployability check runs; its
+        attempt's outcome becomes DEAD_END. Returns whether it did (then the shape before it
+        is reduced again)."""
+        run = self.run
+        if (
+            not self.options.deploy_check
+            or stop not in DEAD_ENDS
+            or len(run.solutions) < 2
+            or self.backtracks >= self.settings.generation.backtrack_max
+        ):
+            return False
+        self.keep_deepest(stop)
+        self.shapes.pop()
+        parent = len(run.solutions) - 2
+        self.dead.setdefault(parent, set()).add(tuple(self.accepted[-1].fixed_added))
+        self.retract()
+        self.backtracks += 1
+        run.stop_detail = ""
+        return True
+
+    def keep_deepest(self, stop: Stop) -> None:
+        """Keep the chain as it stands (with ``stop``) as :attr:`deepest` where it reached a
+        lower DOF than the one kept."""
+        run = self.run
+        if self.deepest is None or chain_dof(run.solutions) < chain_dof(self.deepest.solutions):
+            self.deepest = Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
+
+    def restart(self, stop: Stop, *, after_backtracking: bool = False) -> bool:
+        """Step 7 beyond backtracking: after ``stop`` at the last solution's shape (its
+        candidates' paths do not reach the flat state, or none is left), every solution after
+        the initial one is retracted and the chain starts again from the initial shape with
+        bound (12) at the next of ``Settings.generation.fold_limits`` on every solve
+        (:func:`with_fold_limit`; the attempts' ``fold_limit_deg``), with a backtracking
+        budget of its own. The first chain is given up after ``restart_after`` rejected paths
+        at one shape, before any backtracking; a bounded chain once its backtracking is spent
+        (``after_backtracking``) or, where a further limit is left, once
+        ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
+        shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
+        (:meth:`settle`). Returns whether it did."""
+        run = self.run
+        if (
+            not self.restarts
+            or not (after_backtracking or self.fold_limit is None or self.spent())
+            or stop not in DEAD_ENDS
+        ):
+            return False
+        self.keep_deepest(stop)
+        limit, case = self.restarts.pop(0)
+        self.new_chain(keep=within(run.solutions, limit))
+        self.fold_limit = limit
+        t0 = time.perf_counter()
+        self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
+        run.build_time += time.perf_counter() - t0
+        return True
+
+    def new_chain(self, keep: int) -> None:
+        """A new chain from the first ``keep`` solutions (:meth:`restart`, :meth:`unbatch`):
+        the rest retracted, with their dead ends, the shapes being reduced, the chain's
+        backtracking and rejected paths, and the look-ahead's memory of locks."""
+        self.retract(keep=keep)
+        self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
+        self.shapes.clear()
+        self.backtracks = self.rejected = 0
+        self.locked_before.clear()
+        self.run.stop_detail = ""
+
+    def unbatch(self, stop: Stop) -> bool:
+        """With ``GenerateOptions.batch`` "auto", the first dead end of the batched chain
+        (``stop``: its shape's candidates' paths do not reach the flat state, or none is
+        left) ends the sets of creases: the solutions from the first set on are retracted
+        and the chain goes on from the shape before it one crease per solve, unbounded, with
+        the run's backtracking and restarts still to come: from there on the run is the one
+        of ``batch`` "off" (the sets cost what their solves took). Where the sets dead-end
+        (the waterbomb family: DOF 2 in a few solves, no DOF-1 child deploys) the paper's
+        order is not lost; where they reach the target, the run took a few solves per
+        dozen DOF. Returns whether it retracted (no set accepted: the chain is already the
+        paper's, and the run goes on as without sets)."""
+        if not (self.batch and self.options.batch == "auto") or stop not in DEAD_ENDS:
+            return False
+        self.batch = False
+        first = next((k for k, rec in enumerate(self.accepted) if rec.batch >= 2), None)
+        if first is None:
+            return False
+        self.keep_deepest(stop)
+        self.new_chain(keep=first)
+        # the ranking's draws as at the start, so that from the initial shape the chain is
+        # the one of batch "off" (the sets' rankings drew from the same generator)
+        self.rng = np.random.default_rng(self.options.seed)
+        return True
+
+    def retract(self, keep: int | None = None) -> None:
+        """Take back the last solution (``keep`` given: every solution after the first
+        ``keep``): their attempts' outcome becomes DEAD_END; the callback sees them at once,
+        the last first."""
+        run = self.run
+        keep = len(run.solutions) - 1 if keep is None else keep
+        taken: list[Solution] = []
+        while len(run.solutions) > keep:
+            taken.append(run.solutions.pop())
+            self.accepted.pop().outcome = AttemptOutcome.DEAD_END
+            run.n_backtrack += 1
+        if self.on_retract and taken:
+            self.on_retract(run, tuple(taken))
+
+    def settle(self, stop: Stop) -> None:
+        """The run ends with ``stop`` at its last shape; where backtracking had left a chain
+        that reached a lower DOF (:attr:`deepest`), that chain is taken back instead (the
+        solutions found since are retracted, its own accepted again) with its stop."""
+        run, deepest = self.run, self.deepest
+        if deepest is None or chain_dof(deepest.solutions) >= chain_dof(run.solutions):
+            run.stop = stop
+            return
+        common = 0
+        for a, b in zip(deepest.solutions, run.solutions, strict=False):
+            if a is not b:
+                break
+            common += 1
+        self.retract(keep=common)
+        for solution, rec in zip(
+            deepest.solutions[common:], deepest.accepted[common:], strict=True
+        ):
+            run.n_backtrack -= rec.outcome is AttemptOutcome.DEAD_END  # no longer retracted
+            rec.outcome = AttemptOutcome.ACCEPTED  # or a fallback without a clear gap, taken
+            assert solution.step == len(run.solutions)  # the chains share what is before
+            run.solutions.append(solution)
+            self.accepted.append(rec)
+            if self.on_solution:
+                self.on_solution(run, solution)
+        run.stop, run.stop_detail = deepest.stop, deepest.detail
+
+
+def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
+    """The case of a run's restart at the fold limit ``limit`` (radians;
+    :meth:`ChainControl.restart`): with the deployability check and no bound (12) of the user's
+    (``Settings.design.rho_max``), (12) at ``limit``; otherwise ``case`` itself (no
+    restart).
+
+    Each fix flattens a crease, and the solve makes up for it by folding the creases left
+    free further: on drawn patterns the chain ends with panels folded nearly onto each other
+    (creases near 180 degrees), and the folding paths of such shapes turn back or collide
+    before the flat state (docs/deployability.md, issue 40). Bound (12) keeps every solve
+    away from that, and IPOPT's barrier on it favours the less folded of the shapes that
+    solve (6)."""
+    s = case.settings
+    if not options.deploy_check or s.design.rho_max is not None:
+        return case
+    return replace(case, settings=s.with_(rho_max=limit))
+
+
+def attempt_time(rec: Attempt) -> float:
+    """Seconds of one attempt: its selection, solve, analysis and trace."""
+    return rec.selection_time + rec.solve_time + rec.analysis_time + rec.path_time
+
+
+def within(solutions: list[Solution], limit: float) -> int:
+    """How many solutions of a chain a restart at the fold limit ``limit`` (radians) keeps:
+    those before the first whose free creases are not all within it (they solve problem (6)
+    with bound (12) too), but not the chain's last (its candidates failed), and at least
+    the initial shape."""
+    keep = 1
+    for k, solution in enumerate(solutions[1:-1], start=1):
+        shape = solution.result.pattern
+        free = ~shape.fixed & ~shape.is_boundary_edge
+        if np.abs(shape.fold_angles[free]).max(initial=0.0) > limit:
+            break
+        keep = k + 1
+    return keep
+
+
+def chain_dof(solutions: list[Solution]) -> int:
+    """The DOF of a chain's last solution."""
+    return solutions[-1].mechanism.dof

@@ -1,0 +1,94 @@
+"""The final design of a run that ends short of its target or is stopped: the lowest-DOF
+solution whose folding path reaches the flat state (Step 9's check, made while the run
+generates; docs/deployability.md).
+
+A run ended by its time limit bisects its chain instead of tracing every path, so that the
+limit is not overrun; an interrupted run traces nothing and names the best design known to
+deploy.
+"""
+
+from __future__ import annotations
+
+import time
+
+from rigidfold.config import Settings
+from rigidfold.generate.options import GenerateOptions
+from rigidfold.generate.records import Generation, Solution
+from rigidfold.mechanism.path import trace_path
+
+
+def deployable_final(
+    run: Generation,
+    options: GenerateOptions,
+    settings: Settings,
+    *,
+    bisect: bool,
+    deadline: float | None = None,
+) -> None:
+    """With the deployability check, a run that ends short of its target names as its final
+    design the lowest-DOF solution whose folding path reaches the flat state (tracing the
+    paths not yet traced, from the last solution back); none: the last solution.
+
+    A run stopped by its time limit (``bisect``) bisects the chain instead, so that the
+    limit is not overrun by up to K traces of its K solutions (the many-DOF paths above the
+    lowest are the slow ones) but about log2(K): it names a solution whose own path deploys
+    and none of whose probed successors' does. Where the chain's paths deploy down to some
+    DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
+    the lowest-DOF solution that deploys, as the scan finds it.
+
+    ``deadline`` (of ``time.monotonic()``: the run's time limit and its grace): every trace
+    ends there (a trace it cuts counts as not deploying and is not kept), and none starts
+    after it; their seconds are ``Generation.final_path_time`` (``time_s.path``).
+    """
+    if not options.deploy_check:
+        return
+
+    def deploys(solution: Solution) -> bool:
+        if solution.path is None:
+            if deadline is not None and time.monotonic() > deadline:
+                return False
+            t0 = time.perf_counter()
+            path = trace_path(
+                solution.result.pattern,
+                dof=solution.mechanism.dof,
+                support_face=options.support_face,
+                settings=settings,
+                deadline=deadline,
+            )
+            run.final_path_time += time.perf_counter() - t0
+            if path.cut:
+                return False
+            solution.path = path
+        return solution.path.deploys
+
+    chain = run.solutions
+    if bisect:
+        known = [i for i, s in enumerate(chain) if s.path is not None and s.path.deploys]
+        lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not known above
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
+        if lo >= 0:
+            run.final_step = chain[lo].step
+        return
+    for solution in reversed(chain):
+        if deploys(solution):
+            run.final_step = solution.step
+            return
+
+
+def best_so_far(run: Generation) -> None:
+    """Name the final design of a run that stops before its end (interrupted): the
+    lowest-DOF solution whose folding path is known to reach the flat state (of two at one
+    DOF, the later); where none is known, ``final_step`` stays None (the last solution),
+    which the verdict does not name as a design (:func:`known_to_deploy`). No path is
+    traced."""
+    known = [s for s in run.solutions if known_to_deploy(s)]
+    if known:
+        run.final_step = min(known, key=lambda s: (s.mechanism.dof, -s.step)).step
+
+
+def known_to_deploy(solution: Solution) -> bool:
+    """Whether the solution's folding path was traced and reached the flat state (the
+    deployability check of Step 5)."""
+    return solution.path is not None and bool(solution.path.deploys)
