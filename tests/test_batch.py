@@ -4,6 +4,7 @@ creases near the target; the paper's one crease per solve without the deployabil
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import pytest
@@ -116,7 +117,6 @@ def _restarted(monkeypatch, batch: str, keep):
     ``keep(solutions)`` of its solutions (in place of ``within``): (options, run, the first
     chain's attempts, the bounded chain's)."""
     import dataclasses
-    import math
 
     import rigidfold.generate.steps as generation
     from rigidfold.mechanism.path import PathStatus
@@ -209,3 +209,58 @@ def test_on_batches_a_restarted_chain_too(monkeypatch):
     assert any(a.batch >= 2 for a in first) and bounded
     assert all(a.fold_limit_deg is not None for a in bounded)
     assert any(a.batch >= 2 for a in bounded)
+
+
+def _every_path_turns_back(monkeypatch, settings, batch: str):
+    """An 11 x 11 grid on the dome to DOF 8 whose every traced path is made to turn back,
+    a chain's seconds made free (so that the first chain gives up after ``restart_after``,
+    not ``worth_more``) and no final design named: the run and the attempts of its first
+    chain (no fold limit)."""
+    import rigidfold.generate.steps as steps
+    from rigidfold.mechanism.path import PathStatus
+
+    def turns_back(pattern, **kwargs):  # a few steps of the trace: only its end is asked
+        short = kwargs["settings"].with_(path_max_steps=2)
+        path = steps_trace(pattern, **(kwargs | {"settings": short}))
+        return replace(path, status=PathStatus.TURNED_BACK)
+
+    steps_trace = steps.trace_path
+    monkeypatch.setattr(steps, "trace_path", turns_back)
+    monkeypatch.setattr(steps, "deployable_final", lambda *args, **kwargs: None)  # not asked
+    for module in ("chains", "steps"):
+        monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
+    case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
+    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch=batch)
+    run = generate(case, opts)
+    return run, [a for a in run.attempts if a.fold_limit_deg is None]
+
+
+REJECTED = (AttemptOutcome.PATH, AttemptOutcome.RIGID, AttemptOutcome.NO_GAP)
+
+
+def test_the_sets_end_at_their_first_rejected_path(monkeypatch):
+    """Once a set gave a solution, one rejected path at a shape (``batch_end_after``) ends
+    the sets, however many ``restart_after`` allows: the next attempt fixes one crease at
+    the initial shape. Without a set (none is made far enough from the target), the first
+    chain's shape is given up after ``restart_after`` rejected paths, as with ``batch``
+    off."""
+    settings = DEFAULTS.with_(  # one bounded chain, given up soon, no backtracking
+        restart_after=3,
+        second_order=False,
+        deploy_max_candidates=3,
+        backtrack_max=0,
+        fold_limits=(math.radians(120.0),),
+    )
+    assert settings.generation.batch_end_after == 1
+    run, first = _every_path_turns_back(monkeypatch, settings, "auto")
+    turned = next(k for k, a in enumerate(first) if a.outcome in REJECTED)
+    assert any(a.batch >= 2 and a.outcome is AttemptOutcome.DEAD_END for a in first[:turned])
+    assert first[turned + 1].batch == 0 and len(first[turned + 1].fixed_added) == 1
+    assert first[turned + 1].dof == run.initial_dof - 1
+    # no set: the paper's order, given up after restart_after rejected paths
+    unbatched = settings.with_(batch_single_dof=1000)
+    _, first = _every_path_turns_back(monkeypatch, unbatched, "auto")
+    assert all(a.batch == 0 for a in first)
+    assert sum(a.outcome in REJECTED for a in first) == 3
+    _, off = _every_path_turns_back(monkeypatch, unbatched, "off")
+    assert [(a.fixed_added, a.outcome) for a in off] == [(a.fixed_added, a.outcome) for a in first]

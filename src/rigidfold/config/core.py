@@ -213,6 +213,15 @@ class GenerationSettings(Group):
         "deployability check or the second-order forecast applies) one crease is fixed per "
         "solve, as in the paper; a set never takes a shape closer to the target.",
     )
+    batch_end_after: int = setting(
+        1,
+        'With ``GenerateOptions.batch`` "auto", once a set of creases gave a solution in the '
+        "chain: the candidates of one shape whose paths do not reach the flat state after "
+        "which the sets end and the chain goes on one crease per solve from the shape before "
+        "the first set (``restart_after`` otherwise). Where the sets reach a shape none of "
+        "whose children deploys, its first rejected path says so as well as five do "
+        "(docs/broad_set.md, session 32).",
+    )
     batch_tol: float = setting(
         1e-3,
         "With ``GenerateOptions.batch``: a candidate joins the set when each of its creases' "
@@ -306,6 +315,10 @@ class GenerationSettings(Group):
         if not (isinstance(self.restart_after, int) and self.restart_after >= 1):
             raise RigidfoldError(
                 f"restart_after must be a whole number >= 1, got {self.restart_after!r}"
+            )
+        if not (isinstance(self.batch_end_after, int) and self.batch_end_after >= 1):
+            raise RigidfoldError(
+                f"batch_end_after must be a whole number >= 1, got {self.batch_end_after!r}"
             )
         self._non_negative(
             "summary_interval",

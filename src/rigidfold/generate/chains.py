@@ -173,6 +173,17 @@ class ChainControl:
         self.locked_before.clear()
         self.run.stop_detail = ""
 
+    def sets_made(self) -> bool:
+        """Whether the chain is batched (``GenerateOptions.batch`` "auto", before its first
+        dead end) and a set of creases in it gave a solution: its shapes are then given up at
+        ``batch_end_after`` rejected paths, and :meth:`unbatch` goes back to before the
+        first set."""
+        return (
+            self.batch
+            and self.options.batch == "auto"
+            and any(rec.batch >= 2 for rec in self.accepted)
+        )
+
     def unbatch(self, stop: Stop) -> bool:
         """With ``GenerateOptions.batch`` "auto", the first dead end of the batched chain
         (``stop``: its shape's candidates' paths do not reach the flat state, or none is

@@ -476,6 +476,8 @@ class _Steps(ChainControl):
                 # the first chain: give up sooner
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
+            if self.sets_made():  # the sets end sooner (unbatch)
+                limit = self.settings.generation.batch_end_after
             confirm = self.settings.generation.rigid_confirmations
             if (
                 shape.undeployable >= limit > 0
