@@ -69,6 +69,7 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "accept-no-gap": ("--accept-no-gap",),
     "count-threshold": ("--dof-count", "threshold"),
     "count-gap": ("--dof-count", "gap"),
+    "backtrack-10": ("--backtrack", "10"),
     "reference": (),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
@@ -81,9 +82,9 @@ the first chain's first dead end (the default since session 31, as ``today``);
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
 ends the run (the default before session 24); ``count-threshold`` and ``count-gap`` the
 search's DOF count (``--dof-count``): the paper's threshold, or with the near-mechanisms;
-``reference`` the defaults of another checkout
-of rigidfold (``--reference DIR``: its ``src`` first on PYTHONPATH), to compare a change of
-the search with the search before it in the same run."""
+``backtrack-10`` ten retractions a chain instead of three (``--backtrack 10``); ``reference``
+the defaults of another checkout of rigidfold (``--reference DIR``: its ``src`` first on
+PYTHONPATH), to compare a change of the search with the search before it in the same run."""
 
 COMMON = ("--lookahead", "--no-deform", "--quiet")
 """The flags every run gets (besides ``--time-limit`` and ``--out``): the README's command;

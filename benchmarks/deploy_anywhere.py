@@ -65,6 +65,7 @@ MODES: dict[str, dict] = {
     "batch-off": {},
     "count-threshold": {"dof_count": "threshold"},
     "count-gap": {"dof_count": "gap"},
+    "backtrack-10": {"backtrack_max": 10},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
@@ -72,7 +73,8 @@ second-order test and forecast (the search before session 17); ``bounded`` bound
 degrees on every solve from the start (``generate --rho-max 120``); ``batch-auto`` several
 creases per solve far from the target (the default since session 31, as ``after``) and
 ``batch-off`` one crease per solve, the paper's order (:data:`MODE_OPTIONS`);
-``count-threshold`` and ``count-gap`` the search's DOF count (``generate --dof-count``)."""
+``count-threshold`` and ``count-gap`` the search's DOF count (``generate --dof-count``);
+``backtrack-10`` ten retractions a chain instead of three (``generate --backtrack 10``)."""
 MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}, "batch-off": {"batch": "off"}}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
 per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``)."""

@@ -154,8 +154,9 @@ class GenerationSettings(Group):
     )
     backtrack_max: int = setting(
         3,
-        "With the deployability check: retractions a run may make (0: none, the paper's Step "
-        "7). When every candidate of a shape after the first fails (``Stop.NO_DEPLOYABLE`` or "
+        "With the deployability check: retractions a chain may make (the run's first chain, "
+        "and each restart's under ``fold_limits``; 0: none, the paper's Step 7). When every "
+        "candidate of a shape after the first fails (``Stop.NO_DEPLOYABLE`` or "
         "``Stop.NO_CANDIDATE``), the solution of that shape is retracted (its attempt's "
         "outcome becomes ``dead_end``) and generation resumes at the shape before it with that "
         "shape's remaining candidates, in their ranked order. Without the check it does "
@@ -214,12 +215,13 @@ class GenerationSettings(Group):
         "solve, as in the paper; a set never takes a shape closer to the target.",
     )
     batch_end_after: int = setting(
-        1,
+        2,
         'With ``GenerateOptions.batch`` "auto", once a set of creases gave a solution in the '
         "chain: the candidates of one shape whose paths do not reach the flat state after "
         "which the sets end and the chain goes on one crease per solve from the shape before "
-        "the first set (``restart_after`` otherwise). Where the sets reach a shape none of "
-        "whose children deploys, its first rejected path says so as well as five do "
+        "the first set (``restart_after`` otherwise): where the sets reach a shape none of "
+        "whose children deploys (the waterbomb family), five rejected paths there cost tens "
+        "of seconds of traces; one gave up a shape whose second child deploys "
         "(docs/broad_set.md, session 32).",
     )
     batch_tol: float = setting(

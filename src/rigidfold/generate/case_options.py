@@ -193,10 +193,10 @@ class SettingsOptions:
     )
     backtrack: int | None = option(
         None,
-        "with the deployability check: how many times a run may retract a solution whose "
-        "shape had no deployable candidate and resume at the shape before, with its next "
-        f"candidates (default: {DEFAULTS.generation.backtrack_max}; 0: never, as in the "
-        "paper's Step 7)",
+        "with the deployability check: how many times a chain (the run's first, and each "
+        "restart's under --fold-limit) may retract a solution whose shape had no deployable "
+        "candidate and resume at the shape before, with its next candidates (default: "
+        f"{DEFAULTS.generation.backtrack_max}; 0: never, as in the paper's Step 7)",
         parse=int,
         metavar="N",
     )
