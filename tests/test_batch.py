@@ -217,14 +217,13 @@ def _every_path_turns_back(monkeypatch, settings, batch: str):
     not ``worth_more``) and no final design named: the run and the attempts of its first
     chain (no fold limit)."""
     import rigidfold.generate.steps as steps
-    from rigidfold.mechanism.path import PathStatus
+    from rigidfold.mechanism.path import PathStatus, trace_path
 
     def turns_back(pattern, **kwargs):  # a few steps of the trace: only its end is asked
         short = kwargs["settings"].with_(path_max_steps=2)
-        path = steps_trace(pattern, **(kwargs | {"settings": short}))
+        path = trace_path(pattern, **(kwargs | {"settings": short}))
         return replace(path, status=PathStatus.TURNED_BACK)
 
-    steps_trace = steps.trace_path
     monkeypatch.setattr(steps, "trace_path", turns_back)
     monkeypatch.setattr(steps, "deployable_final", lambda *args, **kwargs: None)  # not asked
     for module in ("chains", "steps"):

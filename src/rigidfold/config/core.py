@@ -219,7 +219,8 @@ class GenerationSettings(Group):
         'With ``GenerateOptions.batch`` "auto", once a set of creases gave a solution in the '
         "chain: the candidates of one shape whose paths do not reach the flat state after "
         "which the sets end and the chain goes on one crease per solve from the shape before "
-        "the first set (``restart_after`` otherwise): where the sets reach a shape none of "
+        "the first set (or sooner, where ``restart_after`` is smaller; without a set, "
+        "``restart_after``): where the sets reach a shape none of "
         "whose children deploys (the waterbomb family), five rejected paths there cost tens "
         "of seconds of traces; one gave up a shape whose second child deploys "
         "(docs/broad_set.md, session 32).",

@@ -477,7 +477,8 @@ class _Steps(ChainControl):
                 sooner = self.settings.generation.restart_after
                 limit = min(limit, sooner) if limit > 0 else sooner
             if self.sets_made():  # the sets end sooner (unbatch)
-                limit = self.settings.generation.batch_end_after
+                ends = self.settings.generation.batch_end_after
+                limit = min(limit, ends) if limit > 0 else ends
             confirm = self.settings.generation.rigid_confirmations
             if (
                 shape.undeployable >= limit > 0
