@@ -70,7 +70,6 @@ class ChainControl:
     ends with, on the state of one run's steps (:mod:`rigidfold.generate.steps`)."""
 
     run: Generation
-    case: Case
     options: GenerateOptions
     settings: Settings
     problem: FormFindingProblem
