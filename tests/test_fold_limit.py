@@ -263,3 +263,38 @@ def test_the_first_chain_is_not_given_up_while_trying_is_cheaper(monkeypatch):
         )
     run = generate(case, criterion="s", seed=1, lookahead=True, deform=False)
     assert any(a.fold_limit_deg is not None for a in run.attempts)
+
+
+def test_a_shape_met_again_is_rejected_as_before_without_a_trace(monkeypatch):
+    """A candidate's solution whose shape was rejected before (the same fixed creases, DOF
+    and coordinates: a kept shape's candidate tried again after a restart at a fold limit)
+    is rejected as before, its verdict taken from the earlier attempt (``path_from``),
+    without a trace; with ``same_shape_tol`` 0 it is traced again."""
+    traced: list[int] = []
+    real = generation.trace_path
+
+    def never_deploys(pattern, **kwargs):
+        traced.append(kwargs["dof"])
+        return dataclasses.replace(real(pattern, **kwargs), status=PathStatus.TURNED_BACK)
+
+    monkeypatch.setattr(generation, "trace_path", never_deploys)
+    for tol in (DEFAULTS.generation.same_shape_tol, 0.0):
+        traced.clear()
+        settings = DEFAULTS.with_(deploy_check_max_dof=0, same_shape_tol=tol)  # check all
+        case = case_from_specs("bezier", "1", seed=1, settings=settings)
+        steps = generation._Steps(case, GenerateOptions(deform=False, batch="off"), None, None)
+        _, first = steps.solve(case.pattern.fixed.copy(), None, (), None)
+        crease = int(np.flatnonzero(~case.pattern.fixed & ~case.pattern.is_boundary_edge)[0])
+        fixed = first.result.pattern.fixed.copy()
+        fixed[crease] = True
+        start = first.result.coords
+        (a, trial_a), (b, trial_b) = (steps.solve(fixed, start, (crease,), 0.0) for _ in "ab")
+        assert a.outcome in (AttemptOutcome.PATH, AttemptOutcome.RIGID) and a.path_from is None
+        assert np.array_equal(trial_a.result.coords, trial_b.result.coords)
+        assert b.outcome is a.outcome and b.dof == a.dof
+        if tol > 0:
+            assert b.path_from == a.index and b.path == a.path
+            assert b.second_order == a.second_order
+            assert traced == [first.mechanism.dof, a.dof]  # the initial shape's, a's
+        else:
+            assert b.path_from is None and traced == [first.mechanism.dof, a.dof, a.dof]

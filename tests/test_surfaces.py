@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import casadi as ca
 import numpy as np
@@ -311,3 +312,35 @@ def test_get_surface_errors():
         get_surface("expr")
     with pytest.raises(ValueError, match="non-negative integer"):
         get_surface("bezier", seed=-1)
+
+
+@pytest.mark.parametrize("box", [(3.0, 3.0), (3.5, 6.0)], ids=["square", "box"])
+def test_dome_is_defined_past_its_rim(box):
+    """A solve may move a vertex past the sphere's rim: the dome continues there along the
+    root's tangent (C1), finite, its gradient and Hessian exact, numpy and CasADi alike; over
+    the plan box it is the sphere."""
+    from rigidfold.surfaces.builtin import Surface as BaseSurface
+
+    dome = Dome(box=box)
+    angle = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    r = np.sqrt(dome.radius**2 - dome.u0)  # where the tangent takes over
+    for radius in (0.9 * r, 0.999 * r, 1.001 * r, dome.radius, 1.5 * dome.radius):
+        x, y = dome.cx + radius * np.cos(angle), dome.cy + radius * np.sin(angle)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            z, (gx, gy), hess = dome.height(x, y), dome.gradient(x, y), dome.hessian(x, y)
+        assert np.isfinite(z).all() and all(np.isfinite(h).all() for h in hess)
+        h = 1e-6
+        fx = (dome.height(x + h, y) - dome.height(x - h, y)) / (2 * h)
+        fy = (dome.height(x, y + h) - dome.height(x, y - h)) / (2 * h)
+        assert np.allclose(gx, fx, rtol=1e-6, atol=1e-6) and np.allclose(gy, fy, atol=1e-6)
+        if abs(radius / r - 1) > 0.01:  # off the seam, where d2z jumps
+            ad = BaseSurface.hessian(dome, x, y)
+            for mine, other in zip(hess, ad, strict=True):
+                assert np.allclose(mine, other, rtol=1e-10, atol=1e-10)
+        sx, sy = ca.SX.sym("x", len(x)), ca.SX.sym("y", len(x))
+        fun = ca.Function("z", [sx, sy], [dome.height(sx, sy, xp=ca)])
+        assert np.allclose(np.asarray(fun(x, y)).ravel(), z, rtol=1e-14)
+    gx, gy = np.meshgrid(np.linspace(0, box[0], 13), np.linspace(0, box[1], 13))
+    sphere = dome.centre_z + np.sqrt(dome.radius**2 - (gx - dome.cx) ** 2 - (gy - dome.cy) ** 2)
+    assert np.array_equal(dome.height(gx, gy), sphere)

@@ -64,9 +64,11 @@ def test_a_time_limit_must_be_a_positive_number_of_seconds(bad):
         GenerateOptions(time_limit=bad)
 
 
-def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatch):
-    """Stopped by its time limit at DOF 9, a run whose solutions' paths deploy down to DOF
-    15 and none below names the DOF-15 solution after about log2 of its solutions' traces,
+@pytest.mark.parametrize("stop", [Stop.TIME_LIMIT, Stop.NO_CANDIDATE], ids=["limit", "candidates"])
+def test_a_run_that_falls_short_searches_its_chain_for_the_design_it_names(monkeypatch, stop):
+    """Stopped at DOF 9 (by its time limit, or with no candidate left), a run whose
+    solutions' paths deploy down to DOF 15 and none below names the DOF-15 solution after
+    about 2 log2(d) traces, d its distance from the last solution, the last ones first;
     not one trace per solution from the last back."""
     import math
     from types import SimpleNamespace
@@ -81,14 +83,28 @@ def test_a_time_limited_run_bisects_its_chain_for_the_design_it_names(monkeypatc
 
     monkeypatch.setattr(generation, "trace_path", deploys_down_to_15)
     monkeypatch.setattr("rigidfold.generate.final.trace_path", deploys_down_to_15)
-    monkeypatch.setattr(generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 12)
+    if stop is Stop.TIME_LIMIT:
+        monkeypatch.setattr(
+            generation._Steps, "out_of_time", lambda self: len(self.run.attempts) > 12
+        )
+    else:
+        real = generation._Steps.reduce
+
+        def reduce(self, solution):
+            return Stop.NO_CANDIDATE if len(self.run.attempts) > 12 else real(self, solution)
+
+        monkeypatch.setattr(generation._Steps, "reduce", reduce)
+        for move in ("unbatch", "restart", "backtrack"):  # no other chain: this one ends
+            monkeypatch.setattr(generation._Steps, move, lambda self, *_, **__: False)
     options = GenerateOptions(deform=False, time_limit=3600.0, batch="off")  # a long chain
     run = generate(case_from_specs("bezier", "1", seed=1), options)
-    assert run.stop is Stop.TIME_LIMIT
+    assert run.stop is stop
     dofs = [s.mechanism.dof for s in run.solutions]
-    assert min(dofs) < 15 <= max(dofs)
+    assert min(dofs) < 15 <= max(dofs) and dofs == sorted(dofs, reverse=True)
     assert run.final is not None and run.final.mechanism.dof == 15
-    assert 0 < len(traced) <= math.ceil(math.log2(len(dofs))) + 1 < len(dofs) - dofs.index(15)
+    d = len(dofs) - dofs.index(15)  # the traces of a scan from the last back
+    assert traced[0] == dofs[-1]  # the last solution first
+    assert 0 < len(traced) <= 2 * math.ceil(math.log2(d)) < d
 
 
 def test_a_path_trace_ends_at_its_deadline_out_of_budget():

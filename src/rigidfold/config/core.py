@@ -257,6 +257,16 @@ class GenerationSettings(Group):
         "(docs/broad_set.md, session 27: 26/40 either way on the broad set; a case that "
         "always failed passes, one that passes or fails by seconds at the limit failed).",
     )
+    same_shape_tol: float = setting(
+        1e-6,
+        "With the deployability check: a candidate's solution whose shape lies within this "
+        "(the largest vertex distance, in mean edge lengths) of an earlier one with the same "
+        "fixed creases and DOF whose path did not reach the flat state is rejected as that "
+        "one was, without tracing its path again (``Attempt.path_from``). A chain started "
+        "again under a fold limit that its shapes never reach, or a shape come back to after "
+        "backtracking, meets the same candidates again; their traces (seconds each, the "
+        "solve a fraction of that) are not repeated. 0: every path is traced.",
+    )
     near_ratio: float = setting(
         1e-2,
         "With ``near_tries``: a candidate is tried first when its rotation in the shape's "
@@ -265,7 +275,7 @@ class GenerationSettings(Group):
     time_limit_grace: float = setting(
         0.025,
         "With a time limit T (``--time-limit``): naming the final design of a run stopped by "
-        "it (the path traces of its chain's bisection, each with this deadline) ends by T + "
+        "it (the path traces that search its chain, each with this deadline) ends by T + "
         "max(``time_limit_grace_min``, this times T). Half of the overrun a run may have "
         "(max(10 s, 5 % of T)); the checks and exports of the final design have the rest.",
     )
@@ -331,6 +341,7 @@ class GenerationSettings(Group):
             "time_limit_reserve_per_vertex",
             "batch_tol",
             "near_ratio",
+            "same_shape_tol",
         )
         if not self.time_limit_load_max >= 1:
             raise RigidfoldError(

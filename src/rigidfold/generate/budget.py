@@ -3,7 +3,7 @@
 A run given ``--time-limit T`` ends by T + 2 graces (a grace is max(
 ``Settings.generation.time_limit_grace_min``, ``time_limit_grace`` x T): T + max(10 s, 5 %
 of T) with the defaults). After the search come parts that take their own time whatever
-the search did: naming the final design (the path traces of the chain's bisection), the
+the search did: naming the final design (the path traces that search the chain), the
 final design's folding path and motion, its DOF margin (a dense SVD of the constraints), its
 checks, its exports and the report. The first two have deadlines; the others cannot be cut
 without losing what a run is for, so the search leaves them a *reserve*, estimated from the
@@ -73,7 +73,7 @@ class TimeBudget:
 
     @property
     def naming(self) -> float:
-        """Naming the final design ends here (the traces of the chain's bisection)."""
+        """Naming the final design ends here (the traces that search the chain)."""
         return self.search + self.grace
 
     @property

@@ -2,9 +2,11 @@
 solution whose folding path reaches the flat state (Step 9's check, made while the run
 generates; docs/deployability.md).
 
-A run ended by its time limit bisects its chain instead of tracing every path, so that the
-limit is not overrun; an interrupted run traces nothing and names the best design known to
-deploy.
+The chain is searched from its end back in doubling steps, then bisected, instead of
+tracing every path from the last back: about 2 log2(d) traces for a design d solutions
+above the last, the fast few-DOF paths first, so that a run that fails does not spend its
+time on many-DOF paths and the time limit is not overrun; an interrupted run traces nothing
+and names the best design known to deploy.
 """
 
 from __future__ import annotations
@@ -22,19 +24,20 @@ def deployable_final(
     options: GenerateOptions,
     settings: Settings,
     *,
-    bisect: bool,
     deadline: float | None = None,
 ) -> None:
     """With the deployability check, a run that ends short of its target names as its final
-    design the lowest-DOF solution whose folding path reaches the flat state (tracing the
-    paths not yet traced, from the last solution back); none: the last solution.
+    design the lowest-DOF solution whose folding path reaches the flat state; none: the last
+    solution.
 
-    A run stopped by its time limit (``bisect``) bisects the chain instead, so that the
-    limit is not overrun by up to K traces of its K solutions (the many-DOF paths above the
-    lowest are the slow ones) but about log2(K): it names a solution whose own path deploys
-    and none of whose probed successors' does. Where the chain's paths deploy down to some
-    DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
-    the lowest-DOF solution that deploys, as the scan finds it.
+    The paths not yet traced are probed from the chain's end back at 1, 2, 4, ... solutions
+    above the last, down to the latest solution known to deploy, until one deploys; the gap
+    between it and the probe below it is then bisected. That is about 2 log2(d) traces for a
+    design d solutions above the last, not d (the many-DOF paths above the lowest are the
+    slow ones), the few-DOF ones first: it names a solution whose own path deploys and
+    none of whose probed successors' does. Where the chain's paths deploy down to some DOF
+    and none below (as on the drawn patterns measured, docs/deployability.md), that is the
+    lowest-DOF solution that deploys, as a scan of every path from the last back finds it.
 
     ``deadline`` (of ``time.monotonic()``: the run's time limit and its grace): every trace
     ends there (a trace it cuts counts as not deploying and is not kept), and none starts
@@ -62,19 +65,20 @@ def deployable_final(
         return solution.path.deploys
 
     chain = run.solutions
-    if bisect:
-        known = [i for i, s in enumerate(chain) if s.path is not None and s.path.deploys]
-        lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not known above
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
-        if lo >= 0:
-            run.final_step = chain[lo].step
-        return
-    for solution in reversed(chain):
-        if deploys(solution):
-            run.final_step = solution.step
-            return
+    known = [i for i, s in enumerate(chain) if known_to_deploy(s)]
+    lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not at the probes above
+    back = 1
+    while len(chain) - back > lo:  # gallop back from the end
+        probe = len(chain) - back
+        if deploys(chain[probe]):
+            lo = probe
+            break
+        hi, back = probe, 2 * back
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
+    if lo >= 0:
+        run.final_step = chain[lo].step
 
 
 def best_so_far(run: Generation) -> None:

@@ -157,6 +157,10 @@ class Attempt:
         For a candidate tried before the ranked ones because it turns in the shape's
         near-mechanisms but hardly in its exact ones (:mod:`rigidfold.selection.near`): its
         share r (exact rotation over counted); None for any other.
+    path_from : int or None
+        For a solution rejected without a trace because an earlier attempt's solution had
+        the same shape (``Settings.generation.same_shape_tol``): that attempt's index, whose
+        ``path`` and ``second_order`` this one repeats; None for any other.
     """
 
     index: int
@@ -185,6 +189,7 @@ class Attempt:
     fold_limit_deg: float | None = None
     batch: int = 0
     near: float | None = None
+    path_from: int | None = None
 
     def to_dict(self) -> dict:
         """JSON-serialisable fields (the enums as their values)."""

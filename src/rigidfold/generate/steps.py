@@ -104,6 +104,19 @@ class _Trial:
     path: FoldingPath | None
 
 
+@dataclass(frozen=True)
+class _Verdict:
+    """A candidate's solution rejected by the deployability check, kept so that the same
+    shape met again is not traced again: its coordinates (V, 3) float64, its attempt's
+    index, the outcome (PATH or RIGID), the path traced and the second-order test."""
+
+    coords: np.ndarray
+    index: int
+    outcome: AttemptOutcome
+    path: FoldingPath
+    second: Obstruction | None
+
+
 class _Steps(ChainControl):
     """The steps of one generation run on its state: the problem (built once), the options,
     the run being recorded and the callbacks that see it; the moves between chains
@@ -171,6 +184,9 @@ class _Steps(ChainControl):
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
         # not tried again where a restart's kept shape is ranked anew
         self.dead: dict[int, set[tuple[int, ...]]] = {}
+        # the rejected candidates' shapes and verdicts, by fixed creases and DOF: a shape met
+        # again is rejected as before, not traced again (Settings.generation.same_shape_tol)
+        self.verdicts: dict[tuple[bytes, int], list[_Verdict]] = {}
 
     def solve(
         self, fixed: np.ndarray, start, added, score, *, polish: bool = True
@@ -200,7 +216,7 @@ class _Steps(ChainControl):
         outcome = _classify(mech, self.zero_ends)
         if mech is None and cut:  # the time limit ended the solve: no verdict
             outcome = AttemptOutcome.TIME_LIMIT
-        path, t_path, second = None, 0.0, None
+        path, t_path, second, seen = None, 0.0, None, None
         if (
             outcome is AttemptOutcome.ACCEPTED
             and opts.deploy_check
@@ -208,20 +224,11 @@ class _Steps(ChainControl):
         ):
             assert mech is not None
             t2 = time.perf_counter()
-            path = trace_path(
-                result.pattern,
-                dof=mech.dof,
-                support_face=opts.support_face,
-                settings=settings,
-                deadline=self.deadline,
-            )
-            if path.cut:  # the time limit ended the trace: no verdict on the candidate
-                outcome = AttemptOutcome.TIME_LIMIT
-            elif not path.deploys:
-                outcome = AttemptOutcome.PATH
-                second = None if self.out_of_time() else self.obstruction(result.pattern, mech.dof)
-                if second is not None and second.rigid:
-                    outcome = AttemptOutcome.RIGID
+            seen = self.seen(result.pattern, mech.dof)
+            if seen is not None:  # rejected before: the same verdict, not traced again
+                outcome, path, second = seen.outcome, seen.path, seen.second
+            else:
+                outcome, path, second = self.check(result.pattern, mech.dof)
             t_path = time.perf_counter() - t2
         if outcome is AttemptOutcome.ACCEPTED and start is not None and self.wants_gap(mech):
             assert mech is not None
@@ -247,9 +254,47 @@ class _Steps(ChainControl):
             path_time=t_path,
             second_order=None if second is None else second.to_dict(),
             fold_limit_deg=None if self.fold_limit is None else math.degrees(self.fold_limit),
+            path_from=None if seen is None else seen.index,
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
+
+    def check(
+        self, pattern: CreasePattern, dof: int
+    ) -> tuple[AttemptOutcome, FoldingPath, Obstruction | None]:
+        """The deployability check of a candidate's solution (Step 5): its path traced to the
+        run's deadline, and where it does not reach the flat state, the second-order test;
+        the outcome ACCEPTED, PATH, RIGID or TIME_LIMIT (a trace the limit cut: no verdict).
+        A rejection is kept for :meth:`seen`."""
+        path = trace_path(
+            pattern,
+            dof=dof,
+            support_face=self.options.support_face,
+            settings=self.settings,
+            deadline=self.deadline,
+        )
+        if path.cut:
+            return AttemptOutcome.TIME_LIMIT, path, None
+        if path.deploys:
+            return AttemptOutcome.ACCEPTED, path, None
+        second = None if self.out_of_time() else self.obstruction(pattern, dof)
+        outcome = (
+            AttemptOutcome.RIGID if second is not None and second.rigid else AttemptOutcome.PATH
+        )
+        verdict = _Verdict(pattern.coords.copy(), len(self.run.attempts), outcome, path, second)
+        self.verdicts.setdefault((pattern.fixed.tobytes(), dof), []).append(verdict)
+        return outcome, path, second
+
+    def seen(self, pattern: CreasePattern, dof: int) -> _Verdict | None:
+        """The verdict on an earlier candidate's solution of the same fixed creases and DOF
+        whose shape lies within ``Settings.generation.same_shape_tol`` mean edge lengths of
+        ``pattern``'s (every vertex), None where there is none."""
+        tol = self.settings.generation.same_shape_tol
+        earlier = self.verdicts.get((pattern.fixed.tobytes(), dof), ())
+        if tol <= 0 or not earlier:
+            return None
+        reach = tol * float(pattern.edge_lengths.mean())
+        return next((v for v in earlier if np.abs(pattern.coords - v.coords).max() <= reach), None)
 
     def support_face(self, pattern: CreasePattern) -> int:
         """The gauge triangle of the path and the second-order test (the options', or the
@@ -667,13 +712,7 @@ def generate(
             or steps.restart(stop, after_backtracking=True)
         ):
             steps.settle(stop)
-            deployable_final(
-                run,
-                opts,
-                case.settings,
-                bisect=stop is Stop.TIME_LIMIT,
-                deadline=steps.final_deadline,
-            )
+            deployable_final(run, opts, case.settings, deadline=steps.final_deadline)
             break
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)

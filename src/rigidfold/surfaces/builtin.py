@@ -204,6 +204,13 @@ class Dome(Surface):
     scaled by s = (half diagonal of the box) / (half diagonal of the 3 m square) about the
     box's centre (W / 2, H / 2), so that it still passes through the four corners: R = 2.25 s,
     apex 1.5 s. Mirror planes x = W / 2 and y = H / 2.
+
+    A solve may move a vertex past the sphere's rim (r = R from the plan centre), where the
+    square root has no real value. Past the circle midway (in R^2 - r^2) between the box's
+    corners and the rim, ``u = R^2 - r^2 < u0 = (R^2 - r_corner^2) / 2``, the root
+    continues along its tangent in u, ``sqrt(u0) + (u - u0) / (2 sqrt(u0))``: a paraboloid
+    joined to the sphere with its height and slope (C1), defined everywhere, unchanged over
+    the box, so that neither the solver nor a check meets a NaN outside it.
     """
 
     name = "dome"
@@ -216,20 +223,28 @@ class Dome(Surface):
         self.centre_z = -0.75 * scale
         self.apex = 1.5 * scale
         self.mirror_planes = (MirrorPlane(1.0, 0.0, -self.cx), MirrorPlane(0.0, 1.0, -self.cy))
+        corner_sq = (1.5 * scale) ** 2 * 2  # r^2 of the box's corners
+        self.u0 = (self.radius**2 - corner_sq) / 2  # where the root's tangent takes over
+
+    def _u(self, x: Any, y: Any) -> Any:
+        return self.radius**2 - (x - self.cx) ** 2 - (y - self.cy) ** 2
 
     def height(self, x: Any, y: Any, xp: ModuleType = np) -> Any:
-        return self.centre_z + xp.sqrt(self.radius**2 - (x - self.cx) ** 2 - (y - self.cy) ** 2)
+        u, u0 = self._u(x, y), self.u0
+        root = xp.sqrt(xp.fmax(u, u0)) + xp.fmin(u - u0, 0.0) / (2 * np.sqrt(u0))
+        return self.centre_z + root
 
     def gradient(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        root = np.sqrt(self.radius**2 - (x - self.cx) ** 2 - (y - self.cy) ** 2)
+        root = np.sqrt(np.fmax(self._u(x, y), self.u0))  # 2 dz/du, either side of u0
         return -(x - self.cx) / root, -(y - self.cy) / root
 
     def hessian(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         dx, dy = x - self.cx, y - self.cy
-        root = np.sqrt(self.radius**2 - dx**2 - dy**2)
-        cube = root**3
+        u = self._u(x, y)
+        root = np.sqrt(np.fmax(u, self.u0))
+        cube = np.where(u >= self.u0, root**3, np.inf)  # the tangent's d2z/du2 is 0
         return -1 / root - dx**2 / cube, -dx * dy / cube, -1 / root - dy**2 / cube
 
     def metadata(self) -> dict[str, Any]:
