@@ -25,6 +25,7 @@ from pathlib import Path
 
 from broad_set import run_environment
 
+DRAWN = Path(__file__).resolve().parents[1] / "tests" / "data" / "origami_simulator"
 CASES: dict[str, tuple[str, ...]] = {
     "paper1-bezier2027": ("--surface", "bezier", "--pattern", "1", "--seed", "2027"),
     "paper2-bezier2027": ("--surface", "bezier", "--pattern", "2", "--seed", "2027"),
@@ -37,17 +38,28 @@ CASES: dict[str, tuple[str, ...]] = {
         *("--surface", "hp", "--pattern", "grid:5x5", "--size", "3x3", "--seed", "3"),
         *("--criterion", "s"),
     ),
+    "resch-dome": (
+        *("--surface", "dome", "--pattern", str(DRAWN / "reschTriTessellation.svg")),
+        *("--seed", "7"),
+    ),
 }
 """Cases of a few seconds each with near-mechanism candidates (the paper's patterns on Bezier
-surfaces outside the study's seeds) and without (small grids)."""
+surfaces outside the study's seeds) and without (small grids); and one of about a minute
+whose restarts at the fold limits meet rejected shapes again (Resch's triangles on the
+dome: ``Attempt.path_from``)."""
 FIELDS = ("fixed_added", "outcome", "dof", "near")
 """What the search decided in each attempt."""
 
 
 def attempts(out: Path) -> list[tuple]:
-    """The decided fields of every attempt in ``out/log.jsonl``, in order."""
+    """The decided fields of every attempt in ``out/log.jsonl``, in order, and last whether
+    its verdict was taken from an earlier attempt (``path_from``: not compared)."""
     rows = [json.loads(line) for line in (out / "log.jsonl").read_text().splitlines()]
-    return [tuple(json.dumps(r.get(f)) for f in FIELDS) for r in rows if "index" in r]
+    return [
+        (*(json.dumps(r.get(f)) for f in FIELDS), r.get("path_from") is not None)
+        for r in rows
+        if "index" in r
+    ]
 
 
 def run(args: tuple[str, ...], source: Path | None, out: Path) -> tuple[list[tuple], float]:
@@ -70,12 +82,13 @@ def main(argv: list[str] | None = None) -> int:
     for name, case in CASES.items():
         today, t_today = run(case, None, work / "today" / name)
         before, t_before = run(case, args.reference.resolve(), work / "reference" / name)
-        same = today == before
+        same = [a[:-1] for a in today] == [a[:-1] for a in before]
         differ += not same
         near = sum(a[3] != "null" for a in today)
+        reused = sum(a[-1] for a in today)
         print(
             f"{name:20s} {'same' if same else 'DIFFERENT'}  attempts {len(today)} "
-            f"(reference {len(before)}), near candidates {near}, "
+            f"(reference {len(before)}), near candidates {near}, not traced again {reused}, "
             f"{t_today:.1f} s (reference {t_before:.1f} s)",
             flush=True,
         )

@@ -67,6 +67,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         restart_after=1,
         deploy_max_candidates=1,
         fold_limits=tuple(math.radians(a) for a in limits),
+        second_order_first=False,  # every candidate traced: the first two are the made-up
     )
     case = case_from_specs("bezier", "1", seed=1, settings=settings)
     taken_at_once: list[int] = []

@@ -206,3 +206,49 @@ def test_a_trace_whose_sparse_corrector_fails_goes_on_by_dense_steps(monkeypatch
     path = trace_path(shape, dof=1, support_face=0)
     assert path.deploys and path.escapes >= 1
     assert path.max_length_error < 1e-8
+
+
+def test_a_rigid_candidate_is_rejected_before_its_trace_with_the_same_verdict(monkeypatch):
+    """With ``second_order_first`` a candidate's solution found second-order rigid is
+    rejected (RIGID) without tracing its path; the search is the same attempt for attempt as
+    when the test follows a trace that does not reach the flat state (none of those
+    rigid solutions' traces reached it)."""
+    import dataclasses
+
+    import rigidfold.generate.steps as generation
+    from rigidfold.generate import generate
+    from rigidfold.generate.specs import case_from_specs
+    from rigidfold.mechanism.path import PathStatus
+
+    real = generation.trace_path
+    doomed: set[bytes] = set()
+    traced: list[tuple[bytes, str]] = []
+
+    def first_two_never_deploy(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        key = pattern.fixed.tobytes()
+        if kwargs.get("dof") == 1 and (len(doomed) < 2 or key in doomed):
+            doomed.add(key)
+            path = dataclasses.replace(path, status=PathStatus.TURNED_BACK)
+        traced.append((key, path.status.value))
+        return path
+
+    monkeypatch.setattr(generation, "trace_path", first_two_never_deploy)
+    runs, traces = [], []
+    for first in (True, False):
+        doomed.clear()
+        traced.clear()
+        settings = DEFAULTS.with_(second_order_first=first, restart_after=2, fold_limits=())
+        case = case_from_specs("bezier", "1", seed=1, settings=settings)
+        runs.append(generate(case, criterion="s", seed=1, lookahead=True, deform=False))
+        traces.append(list(traced))
+    before, after = runs
+    rigid = [a for a in before.attempts if a.outcome is AttemptOutcome.RIGID]
+    assert rigid, "the run met second-order rigid candidates"
+    assert all(a.path is None and a.second_order["rigid"] for a in rigid)
+    assert [(a.fixed_added, a.outcome, a.dof) for a in before.attempts] == [
+        (a.fixed_added, a.outcome, a.dof) for a in after.attempts
+    ]
+    assert len(traces[0]) == len(traces[1]) - len(rigid)
+    traced_after = [a for a in after.attempts if a.outcome is AttemptOutcome.RIGID]
+    assert all(a.path is not None and not a.path["deploys"] for a in traced_after)

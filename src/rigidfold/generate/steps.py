@@ -113,8 +113,16 @@ class _Verdict:
     coords: np.ndarray
     index: int
     outcome: AttemptOutcome
-    path: FoldingPath
+    path: FoldingPath | None
     second: Obstruction | None
+
+
+def _flat(pattern: CreasePattern, settings: Settings) -> bool:
+    """Whether every free crease of ``pattern`` is within ``Settings.path.flat_tol`` of flat
+    (its path has reached the flat state at its start)."""
+    free = ~pattern.fixed & ~pattern.is_boundary_edge
+    rho = pattern.fold_angles[free]
+    return not rho.size or float(np.abs(rho).max()) <= settings.path.flat_tol
 
 
 class _Steps(ChainControl):
@@ -261,23 +269,33 @@ class _Steps(ChainControl):
 
     def check(
         self, pattern: CreasePattern, dof: int
-    ) -> tuple[AttemptOutcome, FoldingPath, Obstruction | None]:
-        """The deployability check of a candidate's solution (Step 5): its path traced to the
-        run's deadline, and where it does not reach the flat state, the second-order test;
-        the outcome ACCEPTED, PATH, RIGID or TIME_LIMIT (a trace the limit cut: no verdict).
-        A rejection is kept for :meth:`seen`."""
-        path = trace_path(
-            pattern,
-            dof=dof,
-            support_face=self.options.support_face,
-            settings=self.settings,
-            deadline=self.deadline,
-        )
-        if path.cut:
-            return AttemptOutcome.TIME_LIMIT, path, None
-        if path.deploys:
-            return AttemptOutcome.ACCEPTED, path, None
-        second = None if self.out_of_time() else self.obstruction(pattern, dof)
+    ) -> tuple[AttemptOutcome, FoldingPath | None, Obstruction | None]:
+        """The deployability check of a candidate's solution (Step 5): the second-order test
+        (with ``Settings.generation.second_order_first``, of a shape not flat already: a
+        second-order rigid one is rejected, RIGID, without a trace, its path None), then
+        its path traced to the run's deadline, and where that does not reach the flat
+        state, the second-order test if not made yet; the outcome ACCEPTED, PATH, RIGID or
+        TIME_LIMIT (a trace the limit cut: no verdict). A rejection is kept for
+        :meth:`seen`."""
+        settings = self.settings
+        second = None
+        if settings.generation.second_order_first and not _flat(pattern, settings):
+            second = self.obstruction(pattern, dof)
+        path = None
+        if second is None or not second.rigid:
+            path = trace_path(
+                pattern,
+                dof=dof,
+                support_face=self.options.support_face,
+                settings=settings,
+                deadline=self.deadline,
+            )
+            if path.cut:
+                return AttemptOutcome.TIME_LIMIT, path, None
+            if path.deploys:
+                return AttemptOutcome.ACCEPTED, path, None
+            if second is None and not self.out_of_time():
+                second = self.obstruction(pattern, dof)
         outcome = (
             AttemptOutcome.RIGID if second is not None and second.rigid else AttemptOutcome.PATH
         )
