@@ -9,6 +9,7 @@ from dataclasses import replace
 
 import pytest
 
+import rigidfold.generate.deploy_check as deploy_check
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import AttemptOutcome, GenerateOptions, generate
@@ -118,10 +119,9 @@ def _restarted(monkeypatch, batch: str, keep):
     chain's attempts, the bounded chain's)."""
     import dataclasses
 
-    import rigidfold.generate.steps as generation
     from rigidfold.mechanism.path import PathStatus
 
-    real, traces = generation.trace_path, []
+    real, traces = deploy_check.trace_path, []
 
     def first_turns_back(pattern, **kwargs):
         path = real(pattern, **kwargs)
@@ -130,7 +130,7 @@ def _restarted(monkeypatch, batch: str, keep):
             return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
         return path
 
-    monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    monkeypatch.setattr(deploy_check, "trace_path", first_turns_back)
     monkeypatch.setattr("rigidfold.generate.final.trace_path", first_turns_back)
     monkeypatch.setattr(
         "rigidfold.generate.chains.within", lambda solutions, limit: keep(solutions)
@@ -168,7 +168,7 @@ def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
     import rigidfold.generate.steps as steps
     from rigidfold.mechanism.path import PathStatus
 
-    real, traces = steps.trace_path, []
+    real, traces = deploy_check.trace_path, []
 
     def first_turns_back(pattern, **kwargs):
         path = real(pattern, **kwargs)
@@ -179,7 +179,7 @@ def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
     case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8)
     paper = generate(case, opts.replace(batch="off"))
-    monkeypatch.setattr(steps, "trace_path", first_turns_back)
+    monkeypatch.setattr(deploy_check, "trace_path", first_turns_back)
     for module in ("chains", "steps"):  # given up at once
         monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
     rank, draws = steps._Steps.rank, []
@@ -224,7 +224,7 @@ def _every_path_turns_back(monkeypatch, settings, batch: str):
         path = trace_path(pattern, **(kwargs | {"settings": short}))
         return replace(path, status=PathStatus.TURNED_BACK)
 
-    monkeypatch.setattr(steps, "trace_path", turns_back)
+    monkeypatch.setattr(deploy_check, "trace_path", turns_back)
     monkeypatch.setattr(steps, "deployable_final", lambda *args, **kwargs: None)  # not asked
     for module in ("chains", "steps"):
         monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)

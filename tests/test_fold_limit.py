@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+import rigidfold.generate.deploy_check as deploy_check
 import rigidfold.generate.steps as generation
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
@@ -50,7 +51,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
     budget of rejected paths (``deploy_max_candidates`` 1) is spent, at the second, without
     backtracking; the chain bounded at 40 degrees (pattern 1 folds to about 50 on the way)
     keeps every free crease within it down to a DOF-1 design that deploys."""
-    real = generation.trace_path
+    real = deploy_check.trace_path
     calls = []
 
     def first_two_turn_back(pattern, **kwargs):
@@ -60,7 +61,7 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
             return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
         return path
 
-    monkeypatch.setattr(generation, "trace_path", first_two_turn_back)
+    monkeypatch.setattr(deploy_check, "trace_path", first_two_turn_back)
     monkeypatch.setattr("rigidfold.generate.final.trace_path", first_two_turn_back)
     limits = (60.0, 40.0)
     settings = DEFAULTS.with_(
@@ -128,7 +129,7 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
     """Under bound (12) a shape whose candidates' solves do not converge (N_exceed) is given
     up after ``deploy_max_candidates`` of them, not after every candidate (the paper's Step
     7, which the unbounded chain keeps); the run ends with the chain that got lowest."""
-    real_solve, real_trace = generation._Steps.solve, generation.trace_path
+    real_solve, real_trace = generation._Steps.solve, deploy_check.trace_path
     traces = []
 
     def first_turns_back(pattern, **kwargs):
@@ -144,7 +145,7 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
             rec.outcome = AttemptOutcome.EXCEED
         return rec, trial
 
-    monkeypatch.setattr(generation, "trace_path", first_turns_back)
+    monkeypatch.setattr(deploy_check, "trace_path", first_turns_back)
     monkeypatch.setattr("rigidfold.generate.final.trace_path", first_turns_back)
     monkeypatch.setattr(generation._Steps, "solve", bounded_solves_fail)
     settings = DEFAULTS.with_(
@@ -163,7 +164,7 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
 def _first_turn_back(monkeypatch, count: int, then: PathStatus | None = None) -> list:
     """The first ``count`` traced paths are made to turn back, the later ones to end as
     ``then`` (None: as traced); returns the traces."""
-    real = generation.trace_path
+    real = deploy_check.trace_path
     calls: list = []
 
     def turn_back(pattern, **kwargs):
@@ -173,7 +174,7 @@ def _first_turn_back(monkeypatch, count: int, then: PathStatus | None = None) ->
             return dataclasses.replace(path, status=PathStatus.TURNED_BACK)
         return path if then is None else dataclasses.replace(path, status=then)
 
-    monkeypatch.setattr(generation, "trace_path", turn_back)
+    monkeypatch.setattr(deploy_check, "trace_path", turn_back)
     monkeypatch.setattr("rigidfold.generate.final.trace_path", turn_back)
     return calls
 
@@ -272,13 +273,13 @@ def test_a_shape_met_again_is_rejected_as_before_without_a_trace(monkeypatch):
     is rejected as before, its verdict taken from the earlier attempt (``path_from``),
     without a trace; with ``same_shape_tol`` 0 it is traced again."""
     traced: list[int] = []
-    real = generation.trace_path
+    real = deploy_check.trace_path
 
     def never_deploys(pattern, **kwargs):
         traced.append(kwargs["dof"])
         return dataclasses.replace(real(pattern, **kwargs), status=PathStatus.TURNED_BACK)
 
-    monkeypatch.setattr(generation, "trace_path", never_deploys)
+    monkeypatch.setattr(deploy_check, "trace_path", never_deploys)
     for tol in (DEFAULTS.generation.same_shape_tol, 0.0):
         traced.clear()
         settings = DEFAULTS.with_(deploy_check_max_dof=0, same_shape_tol=tol)  # check all

@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 
+import rigidfold.generate.deploy_check as deploy_check
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, Generation, Solution, Stop
 from rigidfold.mechanism import analyze
@@ -215,12 +216,11 @@ def test_a_rigid_candidate_is_rejected_before_its_trace_with_the_same_verdict(mo
     rigid solutions' traces reached it)."""
     import dataclasses
 
-    import rigidfold.generate.steps as generation
     from rigidfold.generate import generate
     from rigidfold.generate.specs import case_from_specs
     from rigidfold.mechanism.path import PathStatus
 
-    real = generation.trace_path
+    real = deploy_check.trace_path
     doomed: set[bytes] = set()
     traced: list[tuple[bytes, str]] = []
 
@@ -233,7 +233,7 @@ def test_a_rigid_candidate_is_rejected_before_its_trace_with_the_same_verdict(mo
         traced.append((key, path.status.value))
         return path
 
-    monkeypatch.setattr(generation, "trace_path", first_two_never_deploy)
+    monkeypatch.setattr(deploy_check, "trace_path", first_two_never_deploy)
     runs, traces = [], []
     for first in (True, False):
         doomed.clear()

@@ -176,10 +176,10 @@ class GenerationSettings(Group):
         True,
         "With ``second_order``: a candidate's solution is tested at second order before its "
         "path is traced, and one found second-order rigid is rejected (N_rigid) without the "
-        "trace: it cannot fold at all, and its trace is the costliest of all (the tracer "
-        "halves its first step down to ``path_min_step`` before it stops short; about 1.7 "
-        "s against 0.45 s for the test on Resch's triangles on the dome, session 33). "
-        "False: the test only after a path that does not reach the flat state.",
+        "trace: it cannot fold at all, and its trace costs several times the test (the "
+        "tracer halves its first step down to ``path_min_step`` before it stops short; "
+        "docs/deployability.md, session 33). False: the test only after a path that does "
+        "not reach the flat state.",
     )
     rigid_confirmations: int = setting(
         3,

@@ -2,11 +2,12 @@
 solution whose folding path reaches the flat state (Step 9's check, made while the run
 generates; docs/deployability.md).
 
-The chain is searched from its end back in doubling steps, then bisected, instead of
-tracing every path from the last back: about 2 log2(d) traces for a design d solutions
-above the last, the fast few-DOF paths first, so that a run that fails does not spend its
-time on many-DOF paths and the time limit is not overrun; an interrupted run traces nothing
-and names the best design known to deploy.
+A run that ends with no candidate left probes its chain from the end back in doubling
+steps, then bisects, instead of tracing every path from the last back (about 2 log2(d)
+traces for a design d solutions above the last); a run ended by its time limit bisects the
+whole chain from its middle, so that the limit is not overrun (about log2(K) traces of K
+solutions, within a grace of seconds, which the few-DOF paths at the chain's end can spend
+alone); an interrupted run traces nothing and names the best design known to deploy.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ def deployable_final(
     options: GenerateOptions,
     settings: Settings,
     *,
+    bisect: bool,
     deadline: float | None = None,
 ) -> None:
     """With the deployability check, a run that ends short of its target names as its final
@@ -32,12 +34,17 @@ def deployable_final(
 
     The paths not yet traced are probed from the chain's end back at 1, 2, 4, ... solutions
     above the last, down to the latest solution known to deploy, until one deploys; the gap
-    between it and the probe below it is then bisected. That is about 2 log2(d) traces for a
-    design d solutions above the last, not d (the many-DOF paths above the lowest are the
-    slow ones), the few-DOF ones first: it names a solution whose own path deploys and
-    none of whose probed successors' does. Where the chain's paths deploy down to some DOF
-    and none below (as on the drawn patterns measured, docs/deployability.md), that is the
-    lowest-DOF solution that deploys, as a scan of every path from the last back finds it.
+    between it and the probe below it is then bisected: about 2 log2(d) traces for a design
+    d solutions above the last, not d. A run stopped by its time limit (``bisect``) bisects
+    the chain between the latest solution known to deploy and its end instead, from the
+    middle: about log2(K) traces of its K solutions, so that the limit is not overrun (the
+    few-DOF paths at the chain's end can take longer than the grace: on a 21 x 21 grid on
+    the HP the probes from the end named no design that deploys, the bisection one of DOF
+    20; docs/deployability.md, session 33). Either names a solution whose own path deploys
+    and none of whose probed successors' does. Where the chain's paths deploy down to some
+    DOF and none below (as on the drawn patterns measured, docs/deployability.md), that is
+    the lowest-DOF solution that deploys, as a scan of every path from the last back finds
+    it.
 
     ``deadline`` (of ``time.monotonic()``: the run's time limit and its grace): every trace
     ends there (a trace it cuts counts as not deploying and is not kept), and none starts
@@ -68,7 +75,7 @@ def deployable_final(
     known = [i for i, s in enumerate(chain) if known_to_deploy(s)]
     lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not at the probes above
     back = 1
-    while len(chain) - back > lo:  # gallop back from the end
+    while not bisect and len(chain) - back > lo:  # gallop back from the end
         probe = len(chain) - back
         if deploys(chain[probe]):
             lo = probe

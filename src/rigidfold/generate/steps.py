@@ -54,7 +54,6 @@ from rigidfold.config import (
     Settings,
     one_blas_thread,
 )
-from rigidfold.frame.model import default_support_face
 from rigidfold.generate.budget import time_budget
 from rigidfold.generate.case import Case
 from rigidfold.generate.chains import (
@@ -65,6 +64,7 @@ from rigidfold.generate.chains import (
     chain_dof,
     with_fold_limit,
 )
+from rigidfold.generate.deploy_check import DeployCheck
 from rigidfold.generate.final import deployable_final
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import (
@@ -76,8 +76,8 @@ from rigidfold.generate.records import (
 )
 from rigidfold.mechanism import Mechanism, analyze, check_analysis_size
 from rigidfold.mechanism.margin import DofMargin, dof_margin
-from rigidfold.mechanism.path import FoldingPath, trace_path
-from rigidfold.mechanism.second_order import ChildForecast, Obstruction, obstruction
+from rigidfold.mechanism.path import FoldingPath
+from rigidfold.mechanism.second_order import ChildForecast
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.mesh import CreasePattern
 from rigidfold.optimize import OptimizeResult, SolverName
@@ -102,27 +102,6 @@ class _Trial:
     result: OptimizeResult
     mechanism: Mechanism | None
     path: FoldingPath | None
-
-
-@dataclass(frozen=True)
-class _Verdict:
-    """A candidate's solution rejected by the deployability check, kept so that the same
-    shape met again is not traced again: its coordinates (V, 3) float64, its attempt's
-    index, the outcome (PATH or RIGID), the path traced and the second-order test."""
-
-    coords: np.ndarray
-    index: int
-    outcome: AttemptOutcome
-    path: FoldingPath | None
-    second: Obstruction | None
-
-
-def _flat(pattern: CreasePattern, settings: Settings) -> bool:
-    """Whether every free crease of ``pattern`` is within ``Settings.path.flat_tol`` of flat
-    (its path has reached the flat state at its start)."""
-    free = ~pattern.fixed & ~pattern.is_boundary_edge
-    rho = pattern.fold_angles[free]
-    return not rho.size or float(np.abs(rho).max()) <= settings.path.flat_tol
 
 
 class _Steps(ChainControl):
@@ -192,9 +171,7 @@ class _Steps(ChainControl):
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
         # not tried again where a restart's kept shape is ranked anew
         self.dead: dict[int, set[tuple[int, ...]]] = {}
-        # the rejected candidates' shapes and verdicts, by fixed creases and DOF: a shape met
-        # again is rejected as before, not traced again (Settings.generation.same_shape_tol)
-        self.verdicts: dict[tuple[bytes, int], list[_Verdict]] = {}
+        self.checks = DeployCheck(options, self.settings)  # Step 5's check, its rejections
 
     def solve(
         self, fixed: np.ndarray, start, added, score, *, polish: bool = True
@@ -205,7 +182,7 @@ class _Steps(ChainControl):
         With a time limit the solve ends at the run's deadline, the initial solve (``start``
         None: without it the run has no design) half a grace after T
         (:attr:`TimeBudget.first_solve`)."""
-        opts, settings = self.options, self.settings
+        opts = self.options
         if start is not None or self.budget is None:
             deadline = self.deadline
         else:
@@ -225,18 +202,16 @@ class _Steps(ChainControl):
         if mech is None and cut:  # the time limit ended the solve: no verdict
             outcome = AttemptOutcome.TIME_LIMIT
         path, t_path, second, seen = None, 0.0, None, None
-        if (
-            outcome is AttemptOutcome.ACCEPTED
-            and opts.deploy_check
-            and _checked(mech, opts, settings)
-        ):
+        if outcome is AttemptOutcome.ACCEPTED and self.checks.applies(mech):
             assert mech is not None
             t2 = time.perf_counter()
-            seen = self.seen(result.pattern, mech.dof)
+            seen = self.checks.seen(result.pattern, mech.dof)
             if seen is not None:  # rejected before: the same verdict, not traced again
                 outcome, path, second = seen.outcome, seen.path, seen.second
             else:
-                outcome, path, second = self.check(result.pattern, mech.dof)
+                outcome, path, second = self.checks.check(
+                    result.pattern, mech.dof, len(self.run.attempts), self.deadline
+                )
             t_path = time.perf_counter() - t2
         if outcome is AttemptOutcome.ACCEPTED and start is not None and self.wants_gap(mech):
             assert mech is not None
@@ -266,86 +241,6 @@ class _Steps(ChainControl):
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
-
-    def check(
-        self, pattern: CreasePattern, dof: int
-    ) -> tuple[AttemptOutcome, FoldingPath | None, Obstruction | None]:
-        """The deployability check of a candidate's solution (Step 5): the second-order test
-        (with ``Settings.generation.second_order_first``, of a shape not flat already: a
-        second-order rigid one is rejected, RIGID, without a trace, its path None), then
-        its path traced to the run's deadline, and where that does not reach the flat
-        state, the second-order test if not made yet; the outcome ACCEPTED, PATH, RIGID or
-        TIME_LIMIT (a trace the limit cut: no verdict). A rejection is kept for
-        :meth:`seen`."""
-        settings = self.settings
-        second = None
-        if settings.generation.second_order_first and not _flat(pattern, settings):
-            second = self.obstruction(pattern, dof)
-        path = None
-        if second is None or not second.rigid:
-            path = trace_path(
-                pattern,
-                dof=dof,
-                support_face=self.options.support_face,
-                settings=settings,
-                deadline=self.deadline,
-            )
-            if path.cut:
-                return AttemptOutcome.TIME_LIMIT, path, None
-            if path.deploys:
-                return AttemptOutcome.ACCEPTED, path, None
-            if second is None and not self.out_of_time():
-                second = self.obstruction(pattern, dof)
-        outcome = (
-            AttemptOutcome.RIGID if second is not None and second.rigid else AttemptOutcome.PATH
-        )
-        verdict = _Verdict(pattern.coords.copy(), len(self.run.attempts), outcome, path, second)
-        self.verdicts.setdefault((pattern.fixed.tobytes(), dof), []).append(verdict)
-        return outcome, path, second
-
-    def seen(self, pattern: CreasePattern, dof: int) -> _Verdict | None:
-        """The verdict on an earlier candidate's solution of the same fixed creases and DOF
-        whose shape lies within ``Settings.generation.same_shape_tol`` mean edge lengths of
-        ``pattern``'s (every vertex), None where there is none."""
-        tol = self.settings.generation.same_shape_tol
-        earlier = self.verdicts.get((pattern.fixed.tobytes(), dof), ())
-        if tol <= 0 or not earlier:
-            return None
-        reach = tol * float(pattern.edge_lengths.mean())
-        return next((v for v in earlier if np.abs(pattern.coords - v.coords).max() <= reach), None)
-
-    def support_face(self, pattern: CreasePattern) -> int:
-        """The gauge triangle of the path and the second-order test (the options', or the
-        one nearest the centroid)."""
-        face = self.options.support_face
-        return default_support_face(pattern) if face is None else int(face)
-
-    def obstruction(self, pattern: CreasePattern, dof: int) -> Obstruction | None:
-        """The second-order test of a checked solution whose path does not reach the flat
-        state (``Settings.generation.second_order``); None where it is not made."""
-        settings = self.settings
-        if (
-            not settings.generation.second_order
-            or pattern.n_vertices > settings.mechanism.second_order_vertices
-        ):
-            return None
-        return obstruction(pattern, self.support_face(pattern), dof, settings)
-
-    def child_forecast(self, current: Solution) -> ChildForecast | None:
-        """At a shape whose children get the deployability check: the second-order forecast
-        of its candidates (None where it is not made)."""
-        opts, settings = self.options, self.settings
-        dof = current.mechanism.dof
-        limit = settings.generation.deploy_check_max_dof
-        pattern = current.result.pattern
-        if (
-            not (opts.deploy_check and settings.generation.second_order)
-            or dof < 2
-            or (limit > 0 and dof - 1 > max(limit, opts.target_dof))
-            or pattern.n_vertices > settings.mechanism.second_order_vertices
-        ):
-            return None
-        return ChildForecast.at(pattern, self.support_face(pattern), dof, settings)
 
     @property
     def deadline(self) -> float | None:
@@ -383,7 +278,11 @@ class _Steps(ChainControl):
     def margin(self, pattern: CreasePattern, counted: int) -> DofMargin:
         """The DOF margin of a solution's shape whose search counted ``counted``."""
         return dof_margin(
-            pattern, self.support_face(pattern), self.settings, count=self.count, counted=counted
+            pattern,
+            self.checks.support_face(pattern),
+            self.settings,
+            count=self.count,
+            counted=counted,
         )
 
     def keep_no_gap(self, rec: Attempt, trial: _Trial) -> None:
@@ -437,7 +336,7 @@ class _Steps(ChainControl):
         )
         scores = score_creases(current.mechanism, K=K, settings=self.asettings)
         ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
-        forecast = self.child_forecast(current)
+        forecast = self.checks.child_forecast(current.result.pattern, current.mechanism.dof)
         order: Iterator[Choice] = (
             lookahead_order(
                 current.mechanism,
@@ -730,7 +629,13 @@ def generate(
             or steps.restart(stop, after_backtracking=True)
         ):
             steps.settle(stop)
-            deployable_final(run, opts, case.settings, deadline=steps.final_deadline)
+            deployable_final(
+                run,
+                opts,
+                case.settings,
+                bisect=stop is Stop.TIME_LIMIT,
+                deadline=steps.final_deadline,
+            )
             break
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
@@ -778,13 +683,6 @@ def _classify(mech: Mechanism | None, zero_ends: bool) -> AttemptOutcome:
         # over-reduction counted as a lock: every folded free crease has stopped moving
         return AttemptOutcome.ZERO_DOF if zero_ends else AttemptOutcome.LOCK
     return AttemptOutcome.LOCK if mech.has_lock else AttemptOutcome.ACCEPTED
-
-
-def _checked(mech: Mechanism | None, options: GenerateOptions, settings: Settings) -> bool:
-    """Whether the deployability check runs on an accepted solution with this mechanism: at
-    most ``Settings.generation.deploy_check_max_dof`` or the target DOF (0: every solution)."""
-    limit = settings.generation.deploy_check_max_dof
-    return mech is not None and (limit <= 0 or mech.dof <= max(limit, options.target_dof))
 
 
 def _explain_lock(
