@@ -236,6 +236,9 @@ def test_a_signal_a_library_swallowed_while_imported_stops_the_run(tmp_path):
     module = tmp_path / "swallowed.py"
     module.write_text(
         "import os, signal, sys, time\n"
+        "# as in a terminal: a process started in the background (a test worker may be one)\n"
+        "# inherits SIGINT ignored, and Python keeps that: the SIGINT below would do nothing\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "from rigidfold.runtime.interrupts import (\n"
         "    interrupt_handled, kept_interrupts, terminate_interrupts)\n"
         "terminate_interrupts()\n"
