@@ -2,12 +2,13 @@
 solution whose folding path reaches the flat state (Step 9's check, made while the run
 generates; docs/deployability.md).
 
-A run that ends with no candidate left probes its chain from the end back in doubling
-steps, then bisects, instead of tracing every path from the last back (about 2 log2(d)
-traces for a design d solutions above the last); a run ended by its time limit bisects the
-whole chain from its middle, so that the limit is not overrun (about log2(K) traces of K
-solutions, within a grace of seconds, which the few-DOF paths at the chain's end can spend
-alone); an interrupted run traces nothing and names the best design known to deploy.
+A run that ends short of its target otherwise (no candidate left, none that deploys)
+probes its chain from the end back in doubling steps, then bisects, instead of tracing
+every path from the last back (about 2 log2(d) traces for a design d solutions above the
+last); a run ended by its time limit bisects the whole chain from its middle, so that the
+limit is not overrun (about log2(K) traces of K solutions, within a grace of seconds, which
+the few-DOF paths at the chain's end can spend alone); an interrupted run traces nothing and
+names the best design known to deploy.
 """
 
 from __future__ import annotations
