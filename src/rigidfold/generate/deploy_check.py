@@ -19,7 +19,7 @@ session 33).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,22 +34,33 @@ from rigidfold.mesh import CreasePattern
 
 
 @dataclass(frozen=True)
+class Checked:
+    """What the check of one candidate's solution found.
+
+    outcome : ACCEPTED, PATH, RIGID or TIME_LIMIT (a trace the deadline cut: no verdict)
+    path : the path traced for it (None: no trace, a rigid shape or a verdict repeated)
+    path_record, second_record : the attempt's ``path`` and ``second_order``
+        (:meth:`FoldingPath.to_dict`, :meth:`Obstruction.to_dict`; None where not made)
+    path_from : the earlier attempt whose verdict is repeated (None: checked now)
+    """
+
+    outcome: AttemptOutcome
+    path: FoldingPath | None
+    path_record: dict | None
+    second_record: dict | None
+    path_from: int | None = None
+
+
+@dataclass(frozen=True)
 class Verdict:
     """A candidate's solution rejected by the deployability check, kept so that the same
-    shape met again is not traced again.
-
-    coords : (V, 3) float64, the solution's shape
-    index : the attempt that made it
-    outcome : PATH or RIGID
-    path : the path traced (None: rejected as second-order rigid before a trace)
-    second : the second-order test (None where it was not made)
-    """
+    shape met again is not traced again: its shape ``coords`` (V, 3) float64 and what the
+    check of attempt ``index`` recorded (its records, not the traced points, which a long
+    run's hundreds of rejections would keep in memory)."""
 
     coords: np.ndarray
     index: int
-    outcome: AttemptOutcome
-    path: FoldingPath | None
-    second: Obstruction | None
+    checked: Checked
 
 
 class DeployCheck:
@@ -73,14 +84,18 @@ class DeployCheck:
 
     def check(
         self, pattern: CreasePattern, dof: int, index: int, deadline: float | None
-    ) -> tuple[AttemptOutcome, FoldingPath | None, Obstruction | None]:
+    ) -> Checked:
         """The check of the solution ``pattern`` (first-order DOF ``dof``) of attempt
-        ``index``: the second-order test (with ``second_order_first``, of a shape not flat
+        ``index``: a shape rejected before (:meth:`seen`) is rejected as then, with no
+        trace; otherwise the second-order test (with ``second_order_first``, of a shape not flat
         already: a rigid one is RIGID without a trace, its path None), then its path traced
         to ``deadline`` (of ``time.monotonic()``; None: none), and where that does not reach
         the flat state, the second-order test if not made yet (and the deadline has not
         passed). The outcome ACCEPTED, PATH, RIGID or TIME_LIMIT (a trace the deadline cut:
         no verdict). A rejection is kept for :meth:`seen`."""
+        seen = self.seen(pattern, dof)
+        if seen is not None:
+            return replace(seen.checked, path_from=seen.index)
         settings = self.settings
         second = None
         if settings.generation.second_order_first and not flat(pattern, settings):
@@ -94,18 +109,23 @@ class DeployCheck:
                 settings=settings,
                 deadline=deadline,
             )
-            if path.cut:
-                return AttemptOutcome.TIME_LIMIT, path, None
-            if path.deploys:
-                return AttemptOutcome.ACCEPTED, path, None
+            if path.cut or path.deploys:
+                outcome = AttemptOutcome.TIME_LIMIT if path.cut else AttemptOutcome.ACCEPTED
+                return Checked(outcome, path, path.to_dict(), None)
             if second is None and not (deadline is not None and time.monotonic() > deadline):
                 second = self.obstruction(pattern, dof)
         outcome = (
             AttemptOutcome.RIGID if second is not None and second.rigid else AttemptOutcome.PATH
         )
-        verdict = Verdict(pattern.coords.copy(), index, outcome, path, second)
+        checked = Checked(
+            outcome,
+            path,
+            None if path is None else path.to_dict(),
+            None if second is None else second.to_dict(),
+        )
+        verdict = Verdict(pattern.coords.copy(), index, replace(checked, path=None))
         self.verdicts.setdefault((pattern.fixed.tobytes(), dof), []).append(verdict)
-        return outcome, path, second
+        return checked
 
     def seen(self, pattern: CreasePattern, dof: int) -> Verdict | None:
         """The verdict on an earlier candidate's solution of the same fixed creases and DOF

@@ -201,17 +201,14 @@ class _Steps(ChainControl):
         outcome = _classify(mech, self.zero_ends)
         if mech is None and cut:  # the time limit ended the solve: no verdict
             outcome = AttemptOutcome.TIME_LIMIT
-        path, t_path, second, seen = None, 0.0, None, None
+        path, t_path, checked = None, 0.0, None
         if outcome is AttemptOutcome.ACCEPTED and self.checks.applies(mech):
             assert mech is not None
             t2 = time.perf_counter()
-            seen = self.checks.seen(result.pattern, mech.dof)
-            if seen is not None:  # rejected before: the same verdict, not traced again
-                outcome, path, second = seen.outcome, seen.path, seen.second
-            else:
-                outcome, path, second = self.checks.check(
-                    result.pattern, mech.dof, len(self.run.attempts), self.deadline
-                )
+            checked = self.checks.check(
+                result.pattern, mech.dof, len(self.run.attempts), self.deadline
+            )
+            outcome, path = checked.outcome, checked.path
             t_path = time.perf_counter() - t2
         if outcome is AttemptOutcome.ACCEPTED and start is not None and self.wants_gap(mech):
             assert mech is not None
@@ -233,11 +230,11 @@ class _Steps(ChainControl):
             solve_time=result.wall_time,
             analysis_time=t_an,
             locked_fold_deg=np.degrees(result.pattern.fold_angles[locked]).tolist(),
-            path=None if path is None else path.to_dict(),
+            path=None if checked is None else checked.path_record,
             path_time=t_path,
-            second_order=None if second is None else second.to_dict(),
+            second_order=None if checked is None else checked.second_record,
             fold_limit_deg=None if self.fold_limit is None else math.degrees(self.fold_limit),
-            path_from=None if seen is None else seen.index,
+            path_from=None if checked is None else checked.path_from,
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
