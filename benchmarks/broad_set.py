@@ -70,6 +70,7 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "count-threshold": ("--dof-count", "threshold"),
     "count-gap": ("--dof-count", "gap"),
     "backtrack-10": ("--backtrack", "10"),
+    "one-round": ("--reseeds", "0"),
     "reference": (),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
@@ -82,7 +83,9 @@ the first chain's first dead end (the default since session 31, as ``today``);
 (the default before session 24); ``accept-no-gap`` a target-DOF design without a clear gap
 ends the run (the default before session 24); ``count-threshold`` and ``count-gap`` the
 search's DOF count (``--dof-count``): the paper's threshold, or with the near-mechanisms;
-``backtrack-10`` ten retractions a chain instead of three (``--backtrack 10``); ``reference``
+``backtrack-10`` ten retractions a chain instead of three (``--backtrack 10``);
+``one-round`` the search without its later rounds of other seeds (``--reseeds 0``, the
+search before session 34); ``reference``
 the defaults of another checkout of rigidfold (``--reference DIR``: its ``src`` first on
 PYTHONPATH), to compare a change of the search with the search before it in the same run."""
 

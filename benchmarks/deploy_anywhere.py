@@ -68,6 +68,7 @@ MODES: dict[str, dict] = {
     "backtrack-10": {"backtrack_max": 10},
     "check-dof-2": {"deploy_check_max_dof": 2},
     "trace-first": {"second_order_first": False, "same_shape_tol": 0.0},
+    "one-round": {"reseeds": 0},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
@@ -79,7 +80,9 @@ creases per solve far from the target (the default since session 31, as ``after`
 ``backtrack-10`` ten retractions a chain instead of three (``generate --backtrack 10``);
 ``check-dof-2`` the deployability check on solutions of DOF 2 too (a probe of session 33);
 ``trace-first`` every candidate's path traced, a shape met again too, and the second-order
-test only after a path that fails (the search before session 33, the same attempts)."""
+test only after a path that fails (the search before session 33, the same attempts);
+``one-round`` the search without its later rounds of other seeds (``reseeds`` 0, the search
+before session 34)."""
 MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}, "batch-off": {"batch": "off"}}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
 per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``)."""

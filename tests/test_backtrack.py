@@ -26,8 +26,11 @@ OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=Fa
 
 
 def _case(backtrack_max: int):
-    # backtracking alone: no restart with the fold limit (tests/test_fold_limit.py)
-    settings = DEFAULTS.with_(deploy_max_candidates=1, backtrack_max=backtrack_max, fold_limits=())
+    # backtracking alone: no restart with the fold limit (tests/test_fold_limit.py), one
+    # round (tests/test_reseed.py)
+    settings = DEFAULTS.with_(
+        deploy_max_candidates=1, backtrack_max=backtrack_max, fold_limits=(), reseeds=0
+    )
     return case_from_specs("bezier", "1", seed=SEED, settings=settings)
 
 

@@ -243,7 +243,8 @@ def test_the_sets_end_sooner_at_rejected_paths(monkeypatch):
     the initial shape. Without a set (none is made far enough from the target), the first
     chain's shape is given up after ``restart_after`` rejected paths, as with ``batch``
     off."""
-    settings = DEFAULTS.with_(  # one bounded chain, given up soon, no backtracking
+    settings = DEFAULTS.with_(  # one bounded chain, given up soon, no backtracking, one round
+        reseeds=0,
         restart_after=3,
         second_order=False,
         deploy_max_candidates=3,

@@ -148,8 +148,8 @@ def test_a_bounded_shape_whose_solves_fail_is_given_up_after_the_budget(monkeypa
     monkeypatch.setattr(deploy_check, "trace_path", first_turns_back)
     monkeypatch.setattr("rigidfold.generate.final.trace_path", first_turns_back)
     monkeypatch.setattr(generation._Steps, "solve", bounded_solves_fail)
-    settings = DEFAULTS.with_(
-        restart_after=1, deploy_max_candidates=2, fold_limits=(math.radians(60.0),)
+    settings = DEFAULTS.with_(  # one round (tests/test_reseed.py)
+        restart_after=1, deploy_max_candidates=2, fold_limits=(math.radians(60.0),), reseeds=0
     )
     case = case_from_specs("bezier", "1", seed=1, settings=settings)
     run = generate(case, criterion="s", seed=1, batch="off")

@@ -53,7 +53,14 @@ def _generate(p: Parser) -> None:
     add_options(
         p,
         SettingsOptions,
-        only=("backtrack", "fold_limit", "retry_zero_dof", "accept_no_gap", "dof_count"),
+        only=(
+            "backtrack",
+            "fold_limit",
+            "reseeds",
+            "retry_zero_dof",
+            "accept_no_gap",
+            "dof_count",
+        ),
     )
     fabricate_arguments(p, generate=True)
     structure_arguments(p, generate=True)
@@ -248,7 +255,9 @@ def _study(p: Parser) -> None:
     # the study's options, but Step 9 runs unless --no-deform, as in generate
     runs = STUDY_OPTIONS.replace(deform=True)
     add_options(p, GenerateOptions, defaults=runs, only=("deform", "lookahead", "deploy_check"))
-    add_options(p, SettingsOptions, only=("backtrack", "fold_limit", "hessian", "svg_tolerance"))
+    add_options(
+        p, SettingsOptions, only=("backtrack", "fold_limit", "reseeds", "hessian", "svg_tolerance")
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 

@@ -207,6 +207,27 @@ class GenerationSettings(Group):
         "flat state (N_path, N_rigid) after which the first chain is given up and the run "
         "starts again with the first fold limit (``deploy_max_candidates`` after that).",
     )
+    reseeds: int = setting(
+        3,
+        "With the deployability check: where every chain of the run is spent (backtracking "
+        "and the fold limits' restarts) without a design at the target DOF, the search "
+        "starts again from the initial shape up to this many times, each round with seeds of "
+        "its own and the wider spread ``reseed_spread`` for the fictitious hinge stiffnesses "
+        "K_j of the criteria, whatever else as in the first round (the sets of creases, "
+        "backtracking, the fold limits); a time limit ends the last. The verdicts of the "
+        "shapes rejected before are kept (``same_shape_tol``); the run ends with the chain "
+        "of lowest DOF of all rounds. 0: one round (the search before session 34).",
+    )
+    reseed_spread: float = setting(
+        0.1,
+        "With ``reseeds``: the K_j of a later round are uniform in ``hinge_stiffness`` times "
+        "1 +/- this. The paper's spread (``hinge_stiffness_spread``, 5e-4 of the mean) only "
+        "breaks ties between creases of equal score, and another seed of it mostly finds the "
+        "same chain again (waterbomb and Resch's triangles on the dome: the same 147 and "
+        "136-139 solves with seeds 1 and 2, docs/broad_set.md, session 34); a spread of 10 % "
+        "weighs the creases' rotations in each mode otherwise, and the rankings differ where "
+        "the scores are close: another chain, still ranked by the criterion.",
+    )
     batch_first: int = setting(
         8,
         "With several creases per solve (``GenerateOptions.batch``): the size of the first "
@@ -352,6 +373,7 @@ class GenerationSettings(Group):
             "near_ratio",
             "same_shape_tol",
         )
+        self._fraction("reseed_spread", below_one=True)
         if not self.time_limit_load_max >= 1:
             raise RigidfoldError(
                 f"time_limit_load_max must be at least 1, got {self.time_limit_load_max!r}"
@@ -361,7 +383,7 @@ class GenerationSettings(Group):
                 "time_limit_reserve_share must lie in [0, 1), got "
                 f"{self.time_limit_reserve_share!r}"
             )
-        self._integer(near_tries=0, near_max=0)
+        self._integer(near_tries=0, near_max=0, reseeds=0)
         self._boolean("retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack")
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)

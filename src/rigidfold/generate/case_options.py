@@ -200,6 +200,15 @@ class SettingsOptions:
         parse=int,
         metavar="N",
     )
+    reseeds: int | None = option(
+        None,
+        "with the deployability check: how many times the search starts again from the "
+        "initial shape, with other seeds for the ranking, where every chain of a round "
+        "(backtracking, --fold-limit) ended without a design at the target DOF; a time "
+        f"limit ends the last (default: {DEFAULTS.generation.reseeds}; 0: one round)",
+        parse=int,
+        metavar="N",
+    )
     accept_no_gap: bool = option(
         False,
         "with the deployability check: a design at the target DOF without a clear DOF gap "
@@ -226,6 +235,8 @@ class SettingsOptions:
     def settings(self) -> Settings:
         """The settings of these options, checked (RigidfoldError naming the setting)."""
         given: dict = {} if self.backtrack is None else {"backtrack_max": self.backtrack}
+        if self.reseeds is not None:
+            given["reseeds"] = self.reseeds
         if self.fold_limit is not None:  # (): none
             given["fold_limits"] = tuple(math.radians(a) for a in self.fold_limit)
         return Settings.from_degrees(

@@ -63,6 +63,7 @@ class Chain:
     accepted: list[Attempt]
     stop: Stop
     detail: str
+    search_round: int = 0
 
 
 class ChainControl:
@@ -77,6 +78,7 @@ class ChainControl:
     on_retract: Callable[[Generation, tuple[Solution, ...]], None] | None
     rng: np.random.Generator
     batch: bool  # sets of creases are made (GenerateOptions.batch)
+    batch_size: int  # the next set's size
     shapes: list[Frame]  # Step 6 at each solution being reduced, the last on top
     accepted: list[Attempt]  # the attempt of each solution
     deepest: Chain | None  # the chain of lowest DOF that backtracking left
@@ -86,6 +88,9 @@ class ChainControl:
     fold_limit: float | None  # the bound of the chain's solves (radians)
     dead: dict[int, set[tuple[int, ...]]]  # retracted fixes, by the step of their shape
     locked_before: dict[tuple[int, ...], list[int]]  # look-ahead: fixes that locked
+    search_round: int  # the round of the search (reseed), 0 the first
+    ladder: list[tuple[float, Case]]  # every round's restarts, in order
+    unbounded: FormFindingProblem  # the problem of a round's first chain
 
     def worth_more(self, shape: Frame) -> bool:
         """Whether the first chain keeps trying candidates at ``shape`` past
@@ -131,7 +136,9 @@ class ChainControl:
         lower DOF than the one kept."""
         run = self.run
         if self.deepest is None or chain_dof(run.solutions) < chain_dof(self.deepest.solutions):
-            self.deepest = Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
+            self.deepest = Chain(
+                list(run.solutions), list(self.accepted), stop, run.stop_detail, self.search_round
+            )
 
     def restart(self, stop: Stop, *, after_backtracking: bool = False) -> bool:
         """Step 7 beyond backtracking: after ``stop`` at the last solution's shape (its
@@ -159,6 +166,36 @@ class ChainControl:
         t0 = time.perf_counter()
         self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
         run.build_time += time.perf_counter() - t0
+        return True
+
+    def reseed(self, stop: Stop) -> bool:
+        """Step 7 beyond the fold limits: after ``stop`` at the last solution's shape with
+        every chain of the round spent, the search starts a new round from the initial shape
+        (``Settings.generation.reseeds`` of them at most, with the deployability check): the
+        ranking's generator seeded with (seed, round), and the fictitious hinge stiffnesses
+        K_j of the criteria spread by ``reseed_spread`` of their mean (:meth:`rank`), so
+        that creases of close scores rank otherwise; the round's first chain unbounded and
+        with the sets of creases, its restarts at the fold limits and its backtracking as in
+        the first round. What the rounds share: the
+        verdicts of rejected shapes (:class:`rigidfold.generate.deploy_check.DeployCheck`)
+        and the chain of lowest DOF (:attr:`deepest`, which :meth:`settle` takes where no
+        later chain ends lower). Returns whether it did."""
+        if (
+            not self.options.deploy_check
+            or stop not in DEAD_ENDS
+            or self.search_round >= self.settings.generation.reseeds
+        ):
+            return False
+        self.keep_deepest(stop)
+        self.search_round += 1
+        self.new_chain(keep=1)
+        self.dead.clear()
+        self.restarts = list(self.ladder)
+        self.fold_limit = None
+        self.problem = self.unbounded
+        self.batch = self.options.batch == "on" or self.options.batch == "auto"
+        self.batch_size = self.settings.generation.batch_first
+        self.rng = np.random.default_rng([self.options.seed, self.search_round])
         return True
 
     def new_chain(self, keep: int) -> None:
@@ -223,10 +260,14 @@ class ChainControl:
 
     def settle(self, stop: Stop) -> None:
         """The run ends with ``stop`` at its last shape; where backtracking had left a chain
-        that reached a lower DOF (:attr:`deepest`), that chain is taken back instead (the
-        solutions found since are retracted, its own accepted again) with its stop."""
+        that reached a lower DOF (:attr:`deepest`), or an earlier round one as low, that
+        chain is taken back instead (the solutions found since are retracted, its own
+        accepted again) with its stop."""
         run, deepest = self.run, self.deepest
-        if deepest is None or chain_dof(deepest.solutions) >= chain_dof(run.solutions):
+        if deepest is None or (chain_dof(deepest.solutions), deepest.search_round) >= (
+            chain_dof(run.solutions),
+            self.search_round,
+        ):
             run.stop = stop
             return
         common = 0

@@ -167,6 +167,9 @@ class _Steps(ChainControl):
             for limit in self.settings.generation.fold_limits
             if (bounded := with_fold_limit(case, options, limit)) is not case
         ]
+        self.ladder = list(self.restarts)
+        self.unbounded = self.problem
+        self.search_round = 0  # Settings.generation.reseeds
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
         # not tried again where a restart's kept shape is ranked anew
@@ -235,6 +238,7 @@ class _Steps(ChainControl):
             second_order=None if checked is None else checked.second_record,
             fold_limit_deg=None if self.fold_limit is None else math.degrees(self.fold_limit),
             path_from=None if checked is None else checked.path_from,
+            search_round=self.search_round,
         )
         self.run.attempts.append(rec)
         return rec, _Trial(result, mech, path)
@@ -328,8 +332,13 @@ class _Steps(ChainControl):
         forecast of its children and the seconds."""
         t1 = time.perf_counter()
         settings = self.settings
+        g = settings.generation
         K = hinge_stiffness(
-            current.mechanism.frame.n_hinges, int(self.rng.integers(2**32)), settings
+            current.mechanism.frame.n_hinges,
+            int(self.rng.integers(2**32)),
+            settings
+            if self.search_round == 0
+            else settings.with_(hinge_stiffness_spread=g.reseed_spread * g.hinge_stiffness),
         )
         scores = score_creases(current.mechanism, K=K, settings=self.asettings)
         ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
@@ -624,6 +633,7 @@ def generate(
             or steps.restart(stop)
             or steps.backtrack(stop)
             or steps.restart(stop, after_backtracking=True)
+            or steps.reseed(stop)
         ):
             steps.settle(stop)
             deployable_final(

@@ -1,0 +1,132 @@
+"""Later rounds of the search (``Settings.generation.reseeds``): where every chain of a round
+is spent without a design at the target DOF, the search starts again from the initial shape
+with other seeds for the ranking. The first round is the search of one round, attempt for
+attempt; every later round begins at the initial shape; the run ends with the chain of lowest
+DOF of all rounds; without the deployability check there is one round (the paper's Step 7).
+
+The case: pattern 1 on Bezier seed 102 (S-hat, look-ahead, one crease per solve) with
+``deploy_max_candidates = 1``, no backtracking and no fold limit, so that a round ends at the
+first path that does not reach the flat state (seconds).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import paper_generate
+from rigidfold.config import DEFAULTS
+from rigidfold.errors import RigidfoldError
+from rigidfold.generate import Attempt, AttemptOutcome, GenerateOptions, Stop, generate
+from rigidfold.generate.specs import case_from_specs
+
+SEED = 102
+OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False, batch="off")
+ROUNDS = 2
+
+
+def _case(reseeds: int):
+    settings = DEFAULTS.with_(
+        deploy_max_candidates=1, backtrack_max=0, fold_limits=(), reseeds=reseeds
+    )
+    return case_from_specs("bezier", "1", seed=SEED, settings=settings)
+
+
+def _run(reseeds: int):
+    """The run, and for each round the number of solutions when its first attempt ended
+    (before that attempt's own solution is kept)."""
+    starts: dict[int, int] = {}
+
+    def on_attempt(run, attempt):
+        starts.setdefault(attempt.search_round, len(run.solutions))
+
+    return generate(_case(reseeds), OPTIONS, on_attempt=on_attempt), starts
+
+
+@pytest.fixture(scope="module")
+def one_round():
+    return _run(0)
+
+
+@pytest.fixture(scope="module")
+def rounds():
+    return _run(ROUNDS)
+
+
+def test_the_first_round_is_the_search_of_one_round(one_round, rounds):
+    plain, _ = one_round
+    run, _ = rounds
+    assert plain.stop is Stop.NO_DEPLOYABLE  # one round is not enough here
+    assert {a.search_round for a in plain.attempts} == {0}
+    first = [a for a in run.attempts if a.search_round == 0]
+    assert len(first) == len(plain.attempts)
+    for a, b in zip(first, plain.attempts, strict=True):
+        assert a.fixed_added == b.fixed_added and a.F == b.F
+        assert a.outcome == b.outcome or a.outcome is AttemptOutcome.DEAD_END
+
+
+def test_every_later_round_starts_again_from_the_initial_shape(rounds):
+    run, starts = rounds
+    tags = [a.search_round for a in run.attempts]
+    assert tags == sorted(tags)  # the rounds follow each other
+    assert set(tags) == set(range(max(tags) + 1))
+    assert max(tags) == ROUNDS or run.stop is Stop.TARGET_REACHED
+    # the initial solve (round 0's first attempt) has no solution before it; each later
+    # round's first attempt reduces the initial shape, the only solution kept
+    assert starts[0] == 0
+    assert all(starts[k] == 1 for k in range(1, max(tags) + 1))
+    # the run's chain is one round's: the rounds share the initial shape alone
+    accepted = [a for a in run.attempts if a.outcome is AttemptOutcome.ACCEPTED]
+    assert len(accepted) == len(run.solutions)
+    assert len({a.search_round for a in accepted[1:]}) <= 1
+
+
+def test_the_run_ends_with_the_lowest_chain_of_all_rounds(one_round, rounds):
+    plain, _ = one_round
+    run, _ = rounds
+    # the first round's chain is the one-round run's; a later round's is kept where it ends
+    # lower
+    assert run.solutions[-1].mechanism.dof <= plain.solutions[-1].mechanism.dof
+    assert run.lowest_dof is not None and plain.lowest_dof is not None
+    assert run.lowest_dof <= plain.lowest_dof
+    assert [s.step for s in run.solutions] == list(range(len(run.solutions)))
+    for before, after in zip(run.solutions, run.solutions[1:], strict=False):
+        assert np.all(after.result.pattern.fixed[before.result.pattern.fixed])
+    # the log's record keeps the round
+    for a in run.attempts:
+        assert Attempt.from_dict(a.to_dict()).search_round == a.search_round
+
+
+def test_without_the_check_there_is_one_round():
+    run = paper_generate(_case(ROUNDS), criterion="shat", seed=SEED)
+    assert {a.search_round for a in run.attempts} == {0}
+    assert run.n_backtrack == 0
+
+
+@pytest.mark.parametrize("bad", [-1, 1.5, True])
+def test_a_bad_number_of_rounds_is_refused(bad):
+    with pytest.raises(RigidfoldError, match="reseeds"):
+        DEFAULTS.with_(reseeds=bad)
+
+
+def test_a_later_round_ranks_with_the_wider_spread(monkeypatch):
+    """The K_j of the first round are the paper's (1e-3 +/- 0.5e-6 N m); a later round's
+    spread by ``reseed_spread`` of the mean, drawn from a generator of its own."""
+    import rigidfold.generate.steps as steps
+
+    real, spreads = steps.hinge_stiffness, []
+
+    def recorded(h, seed, settings):
+        K = real(h, seed, settings)
+        g = settings.generation
+        assert np.all(np.abs(K - g.hinge_stiffness) <= g.hinge_stiffness_spread)
+        spreads.append(g.hinge_stiffness_spread)
+        return K
+
+    monkeypatch.setattr(steps, "hinge_stiffness", recorded)
+    run = generate(_case(1), OPTIONS)
+    g = DEFAULTS.generation
+    assert max(a.search_round for a in run.attempts) == 1
+    paper, wide = g.hinge_stiffness_spread, g.reseed_spread * g.hinge_stiffness
+    assert spreads[0] == paper and spreads[-1] == wide
+    assert spreads == sorted(spreads)  # the paper's, then the later round's
