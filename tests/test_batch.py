@@ -216,7 +216,7 @@ def _every_path_turns_back(monkeypatch, settings, batch: str):
     a chain's seconds made free (so that the first chain gives up after ``restart_after``,
     not ``worth_more``) and no final design named: the run and the attempts of its first
     chain (no fold limit)."""
-    import rigidfold.generate.steps as steps
+    import rigidfold.generate.chains as chains
     from rigidfold.mechanism.path import PathStatus, trace_path
 
     def turns_back(pattern, **kwargs):  # a few steps of the trace: only its end is asked
@@ -225,7 +225,7 @@ def _every_path_turns_back(monkeypatch, settings, batch: str):
         return replace(path, status=PathStatus.TURNED_BACK)
 
     monkeypatch.setattr(deploy_check, "trace_path", turns_back)
-    monkeypatch.setattr(steps, "deployable_final", lambda *args, **kwargs: None)  # not asked
+    monkeypatch.setattr(chains, "deployable_final", lambda *args, **kwargs: None)  # not asked
     for module in ("chains", "steps"):
         monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
     case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)

@@ -2,8 +2,11 @@
 is the stack of accepted shapes being reduced, one :class:`Frame` each; when a shape's
 candidates are spent, the chain backtracks to the shape before it, restarts from the
 initial shape with bound (12) at the next fold limit, or ends its sets of creases
-(``GenerateOptions.batch`` "auto") and goes on one crease per solve; a run ends with the
-chain that reached the lowest DOF (:meth:`ChainControl.settle`).
+(``GenerateOptions.batch`` "auto") and goes on one crease per solve; a round of the search
+ends with the chain that reached the lowest DOF (:meth:`ChainControl.settle`), and its final
+design is named; where it falls short of the target, later rounds start again from the
+initial shape with other fictitious hinge stiffnesses (:meth:`ChainControl.reseed`), kept
+only where one reaches the target (:meth:`ChainControl.conclude`).
 
 :class:`ChainControl` holds these moves; the steps of one run (:mod:`rigidfold.generate.
 steps`) inherit them and own the state they act on, declared here.
@@ -19,6 +22,7 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.generate.case import Case
+from rigidfold.generate.final import deployable_final
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import Attempt, AttemptOutcome, Generation, Solution, Stop
 from rigidfold.mechanism.second_order import ChildForecast
@@ -63,7 +67,7 @@ class Chain:
     accepted: list[Attempt]
     stop: Stop
     detail: str
-    search_round: int = 0
+    final_step: int | None = None  # the design named at its end (the first round's)
 
 
 class ChainControl:
@@ -89,6 +93,7 @@ class ChainControl:
     dead: dict[int, set[tuple[int, ...]]]  # retracted fixes, by the step of their shape
     locked_before: dict[tuple[int, ...], list[int]]  # look-ahead: fixes that locked
     search_round: int  # the round of the search (reseed), 0 the first
+    first: Chain | None  # the first round's chain and design, once later rounds began
     ladder: list[tuple[float, Case]]  # every round's restarts, in order
     unbounded: FormFindingProblem  # the problem of a round's first chain
 
@@ -136,9 +141,7 @@ class ChainControl:
         lower DOF than the one kept."""
         run = self.run
         if self.deepest is None or chain_dof(run.solutions) < chain_dof(self.deepest.solutions):
-            self.deepest = Chain(
-                list(run.solutions), list(self.accepted), stop, run.stop_detail, self.search_round
-            )
+            self.deepest = Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)
 
     def restart(self, stop: Stop, *, after_backtracking: bool = False) -> bool:
         """Step 7 beyond backtracking: after ``stop`` at the last solution's shape (its
@@ -168,26 +171,45 @@ class ChainControl:
         run.build_time += time.perf_counter() - t0
         return True
 
-    def reseed(self, stop: Stop) -> bool:
+    def out_of_time(self) -> bool:
+        """Whether the search's time is spent (the steps' time limit)."""
+        raise NotImplementedError
+
+    def reseed(self, stop: Stop, deadline: float | None) -> bool:
         """Step 7 beyond the fold limits: after ``stop`` at the last solution's shape with
         every chain of the round spent, the search starts a new round from the initial shape
-        (``Settings.generation.reseeds`` of them at most, with the deployability check): the
-        ranking's generator seeded with (seed, round), and the fictitious hinge stiffnesses
-        K_j of the criteria spread by ``reseed_spread`` of their mean (:meth:`rank`), so
-        that creases of close scores rank otherwise; the round's first chain unbounded and
-        with the sets of creases, its restarts at the fold limits and its backtracking as in
-        the first round. What the rounds share: the
-        verdicts of rejected shapes (:class:`rigidfold.generate.deploy_check.DeployCheck`)
-        and the chain of lowest DOF (:attr:`deepest`, which :meth:`settle` takes where no
-        later chain ends lower). Returns whether it did."""
+        (``Settings.generation.reseeds`` of them at most, with the deployability check and
+        while the search has time): the ranking's generator seeded with (seed, round), and
+        the fictitious hinge stiffnesses K_j of the criteria spread by ``reseed_spread`` of
+        their mean (:meth:`rigidfold.generate.steps._Steps.rank`), so that creases of close
+        scores rank otherwise; the round's first chain unbounded and with the sets of
+        creases, its restarts at the fold limits and its backtracking as in the first round.
+        The rounds share the verdicts of rejected shapes
+        (:class:`rigidfold.generate.deploy_check.DeployCheck`).
+
+        At the first round's end, its chain is settled and its final design named
+        (``deadline``, :func:`rigidfold.generate.final.deployable_final`) as a run of one
+        round would, and kept (:attr:`first`): a later round is kept only where it reaches
+        the target; otherwise :meth:`conclude` takes the first round's chain and design back.
+        Returns whether a round began."""
         if (
             not self.options.deploy_check
             or stop not in DEAD_ENDS
             or self.search_round >= self.settings.generation.reseeds
         ):
             return False
-        self.keep_deepest(stop)
+        run = self.run
+        if self.first is None:  # the first round ends as a run of one round would
+            self.settle(stop)
+            self.name_final(stop, deadline)
+            self.first = Chain(
+                list(run.solutions), list(self.accepted), run.stop, run.stop_detail, run.final_step
+            )
+        if self.out_of_time():
+            return False
         self.search_round += 1
+        self.deepest = None
+        run.final_step = None
         self.new_chain(keep=1)
         self.dead.clear()
         self.restarts = list(self.ladder)
@@ -197,6 +219,30 @@ class ChainControl:
         self.batch_size = self.settings.generation.batch_first
         self.rng = np.random.default_rng([self.options.seed, self.search_round])
         return True
+
+    def conclude(self, stop: Stop, deadline: float | None) -> None:
+        """The run ends with ``stop`` short of its target: its chain settled
+        (:meth:`settle`) and its final design named (``deadline``); where later rounds
+        began (:meth:`reseed`) and none reached the target, the first round's chain and
+        design are taken back (its stop too)."""
+        first = self.first
+        if first is None:
+            self.settle(stop)
+            self.name_final(stop, deadline)
+            return
+        self.take_back(first)
+        self.run.final_step = first.final_step
+
+    def name_final(self, stop: Stop, deadline: float | None) -> None:
+        """Name the final design of the chain as it stands (the lowest-DOF solution that
+        deploys; a stop by the time limit bisects the chain)."""
+        deployable_final(
+            self.run,
+            self.options,
+            self.settings,
+            bisect=stop is Stop.TIME_LIMIT,
+            deadline=deadline,
+        )
 
     def new_chain(self, keep: int) -> None:
         """A new chain from the first ``keep`` solutions (:meth:`restart`, :meth:`unbatch`):
@@ -259,26 +305,27 @@ class ChainControl:
             self.on_retract(run, tuple(taken))
 
     def settle(self, stop: Stop) -> None:
-        """The run ends with ``stop`` at its last shape; where backtracking had left a chain
-        that reached a lower DOF (:attr:`deepest`), or an earlier round one as low, that
-        chain is taken back instead (the solutions found since are retracted, its own
-        accepted again) with its stop."""
+        """The round ends with ``stop`` at its last shape; where backtracking had left a
+        chain that reached a lower DOF (:attr:`deepest`), that chain is taken back instead
+        (:meth:`take_back`) with its stop."""
         run, deepest = self.run, self.deepest
-        if deepest is None or (chain_dof(deepest.solutions), deepest.search_round) >= (
-            chain_dof(run.solutions),
-            self.search_round,
-        ):
+        if deepest is None or chain_dof(deepest.solutions) >= chain_dof(run.solutions):
             run.stop = stop
             return
+        self.take_back(deepest)
+
+    def take_back(self, chain: Chain) -> None:
+        """Make ``chain`` the run's again: the solutions found since it was left are
+        retracted, its own accepted again (the callbacks see both), and the run's stop is
+        its stop."""
+        run = self.run
         common = 0
-        for a, b in zip(deepest.solutions, run.solutions, strict=False):
+        for a, b in zip(chain.solutions, run.solutions, strict=False):
             if a is not b:
                 break
             common += 1
         self.retract(keep=common)
-        for solution, rec in zip(
-            deepest.solutions[common:], deepest.accepted[common:], strict=True
-        ):
+        for solution, rec in zip(chain.solutions[common:], chain.accepted[common:], strict=True):
             run.n_backtrack -= rec.outcome is AttemptOutcome.DEAD_END  # no longer retracted
             rec.outcome = AttemptOutcome.ACCEPTED  # or a fallback without a clear gap, taken
             assert solution.step == len(run.solutions)  # the chains share what is before
@@ -286,7 +333,7 @@ class ChainControl:
             self.accepted.append(rec)
             if self.on_solution:
                 self.on_solution(run, solution)
-        run.stop, run.stop_detail = deepest.stop, deepest.detail
+        run.stop, run.stop_detail = chain.stop, chain.detail
 
 
 def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:

@@ -65,7 +65,6 @@ from rigidfold.generate.chains import (
     with_fold_limit,
 )
 from rigidfold.generate.deploy_check import DeployCheck
-from rigidfold.generate.final import deployable_final
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import (
     Attempt,
@@ -170,6 +169,7 @@ class _Steps(ChainControl):
         self.ladder = list(self.restarts)
         self.unbounded = self.problem
         self.search_round = 0  # Settings.generation.reseeds
+        self.first: Chain | None = None  # the first round's chain, once later rounds began
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
         # not tried again where a restart's kept shape is ranked anew
@@ -633,16 +633,9 @@ def generate(
             or steps.restart(stop)
             or steps.backtrack(stop)
             or steps.restart(stop, after_backtracking=True)
-            or steps.reseed(stop)
+            or steps.reseed(stop, steps.final_deadline)
         ):
-            steps.settle(stop)
-            deployable_final(
-                run,
-                opts,
-                case.settings,
-                bisect=stop is Stop.TIME_LIMIT,
-                deadline=steps.final_deadline,
-            )
+            steps.conclude(stop, steps.final_deadline)
             break
     else:
         run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
