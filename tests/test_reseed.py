@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import paper_generate
+from conftest import main_code, paper_generate
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Attempt, AttemptOutcome, GenerateOptions, Stop, generate
@@ -136,3 +136,31 @@ def test_a_later_round_ranks_with_the_wider_spread(monkeypatch):
     paper, wide = g.hinge_stiffness_spread, g.reseed_spread * g.hinge_stiffness
     assert spreads[0] == paper and spreads[-1] == wide
     assert spreads == sorted(spreads)  # the paper's, then the later round's
+
+
+def test_a_run_with_a_time_limit_makes_the_timed_rounds():
+    """``reseeds`` bounds the rounds of a run without a time limit, ``reseeds_timed`` those
+    of a run with one (the limit ends the last)."""
+    settings = _case(0).settings.with_(reseeds_timed=1)
+    case = case_from_specs("bezier", "1", seed=SEED, settings=settings)
+    untimed = generate(case, OPTIONS)
+    timed = generate(case, OPTIONS.replace(time_limit=600.0))
+    assert {a.search_round for a in untimed.attempts} == {0}
+    assert {a.search_round for a in timed.attempts} == {0, 1}
+
+
+def test_the_command_line_sets_both_bounds(capsys, tmp_path):
+    from rigidfold.generate.case_options import SettingsOptions
+
+    g = SettingsOptions().settings().generation
+    assert (g.reseeds, g.reseeds_timed) == (
+        DEFAULTS.generation.reseeds,
+        DEFAULTS.generation.reseeds_timed,
+    )
+    g = SettingsOptions(reseeds=0).settings().generation
+    assert (g.reseeds, g.reseeds_timed) == (0, 0)
+    argv = ["generate", "--surface", "dome", "--pattern", "grid:3x3", "--reseeds", "-1"]
+    code = main_code([*argv, "--out", str(tmp_path / "run")])
+    err = capsys.readouterr().err.strip()
+    assert code != 0 and "reseeds" in err and "-1" in err and "Traceback" not in err
+    assert not (tmp_path / "run").exists()

@@ -209,14 +209,21 @@ class GenerationSettings(Group):
     )
     reseeds: int = setting(
         3,
-        "With the deployability check: where every chain of the run is spent (backtracking "
-        "and the fold limits' restarts) without a design at the target DOF, the search "
-        "starts again from the initial shape up to this many times, each round with seeds of "
-        "its own and the wider spread ``reseed_spread`` for the fictitious hinge stiffnesses "
-        "K_j of the criteria, whatever else as in the first round (the sets of creases, "
-        "backtracking, the fold limits); a time limit ends the last. The verdicts of the "
-        "shapes rejected before are kept (``same_shape_tol``); the run ends with the chain "
-        "of lowest DOF of all rounds. 0: one round (the search before session 34).",
+        "With the deployability check: where every chain of a run without a time limit is "
+        "spent (backtracking and the fold limits' restarts) short of the target DOF, the "
+        "search starts again from the initial shape up to this many times, each round with a "
+        "seed of its own and the wider spread ``reseed_spread`` for the fictitious hinge "
+        "stiffnesses K_j of the criteria, whatever else as in the first round (the sets of "
+        "creases, backtracking, the fold limits). The first round's final design is named "
+        "when it ends; a later round is kept only where it reaches the target, otherwise the "
+        "run ends as its first round did. The verdicts of the shapes rejected before are "
+        "kept (``same_shape_tol``). 0: one round (the search before session 34).",
+    )
+    reseeds_timed: int = setting(
+        30,
+        "As ``reseeds``, for a run with a time limit, which ends the last round: a run that "
+        "falls short spends its time on other chains (rounds of 10-70 s on the drawn "
+        "patterns, docs/broad_set.md, session 34) instead of ending early.",
     )
     reseed_spread: float = setting(
         0.1,
@@ -383,7 +390,7 @@ class GenerationSettings(Group):
                 "time_limit_reserve_share must lie in [0, 1), got "
                 f"{self.time_limit_reserve_share!r}"
             )
-        self._integer(near_tries=0, near_max=0, reseeds=0)
+        self._integer(near_tries=0, near_max=0, reseeds=0, reseeds_timed=0)
         self._boolean("retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack")
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)

@@ -203,9 +203,11 @@ class SettingsOptions:
     reseeds: int | None = option(
         None,
         "with the deployability check: how many times the search starts again from the "
-        "initial shape, with other seeds for the ranking, where every chain of a round "
-        "(backtracking, --fold-limit) ended without a design at the target DOF; a time "
-        f"limit ends the last (default: {DEFAULTS.generation.reseeds}; 0: one round)",
+        "initial shape, with other fictitious hinge stiffnesses for the ranking, where every "
+        "chain of a round (backtracking, --fold-limit) ended short of the target DOF; a later "
+        "round is kept only where it reaches the target (default: "
+        f"{DEFAULTS.generation.reseeds}, {DEFAULTS.generation.reseeds_timed} with "
+        "--time-limit, which ends the last; 0: one round)",
         parse=int,
         metavar="N",
     )
@@ -236,7 +238,7 @@ class SettingsOptions:
         """The settings of these options, checked (RigidfoldError naming the setting)."""
         given: dict = {} if self.backtrack is None else {"backtrack_max": self.backtrack}
         if self.reseeds is not None:
-            given["reseeds"] = self.reseeds
+            given["reseeds"] = given["reseeds_timed"] = self.reseeds
         if self.fold_limit is not None:  # (): none
             given["fold_limits"] = tuple(math.radians(a) for a in self.fold_limit)
         return Settings.from_degrees(

@@ -178,12 +178,13 @@ class ChainControl:
     def reseed(self, stop: Stop, deadline: float | None) -> bool:
         """Step 7 beyond the fold limits: after ``stop`` at the last solution's shape with
         every chain of the round spent, the search starts a new round from the initial shape
-        (``Settings.generation.reseeds`` of them at most, with the deployability check and
-        while the search has time): the ranking's generator seeded with (seed, round), and
-        the fictitious hinge stiffnesses K_j of the criteria spread by ``reseed_spread`` of
-        their mean (:meth:`rigidfold.generate.steps._Steps.rank`), so that creases of close
-        scores rank otherwise; the round's first chain unbounded and with the sets of
-        creases, its restarts at the fold limits and its backtracking as in the first round.
+        (``Settings.generation.reseeds`` of them at most, ``reseeds_timed`` with a time
+        limit, with the deployability check and while the search has time): the ranking's
+        generator seeded with (seed, round), and the fictitious hinge stiffnesses K_j of the
+        criteria spread by ``reseed_spread`` of their mean
+        (:meth:`rigidfold.generate.steps._Steps.rank`), so that creases of close scores rank
+        otherwise; the round's first chain unbounded and with the sets of creases, its
+        restarts at the fold limits and its backtracking as in the first round.
         The rounds share the verdicts of rejected shapes
         (:class:`rigidfold.generate.deploy_check.DeployCheck`).
 
@@ -195,7 +196,7 @@ class ChainControl:
         if (
             not self.options.deploy_check
             or stop not in DEAD_ENDS
-            or self.search_round >= self.settings.generation.reseeds
+            or self.search_round >= self.rounds_allowed()
         ):
             return False
         run = self.run
@@ -219,6 +220,12 @@ class ChainControl:
         self.batch_size = self.settings.generation.batch_first
         self.rng = np.random.default_rng([self.options.seed, self.search_round])
         return True
+
+    def rounds_allowed(self) -> int:
+        """The later rounds a run may make: ``reseeds``, or ``reseeds_timed`` with a time
+        limit (which ends the last)."""
+        g = self.settings.generation
+        return g.reseeds if self.options.time_limit is None else g.reseeds_timed
 
     def conclude(self, stop: Stop, deadline: float | None) -> None:
         """The run ends with ``stop`` short of its target: its chain settled
