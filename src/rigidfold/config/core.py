@@ -208,7 +208,7 @@ class GenerationSettings(Group):
         "starts again with the first fold limit (``deploy_max_candidates`` after that).",
     )
     reseeds: int = setting(
-        3,
+        0,
         "With the deployability check: where every chain of a run without a time limit is "
         "spent (backtracking and the fold limits' restarts) short of the target DOF, the "
         "search starts again from the initial shape up to this many times, each round with a "
@@ -217,7 +217,9 @@ class GenerationSettings(Group):
         "creases, backtracking, the fold limits). The first round's final design is named "
         "when it ends; a later round is kept only where it reaches the target, otherwise the "
         "run ends as its first round did. The verdicts of the shapes rejected before are "
-        "kept (``same_shape_tol``). 0: one round (the search before session 34).",
+        "kept (``same_shape_tol``). 0 (the default): one round, as before session 34: a "
+        "later round replaces the first round's files as it goes, so a run stopped by Ctrl-C "
+        "in it would have neither that design nor one of its own.",
     )
     reseeds_timed: int = setting(
         30,

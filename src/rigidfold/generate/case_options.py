@@ -206,8 +206,8 @@ class SettingsOptions:
         "initial shape, with other fictitious hinge stiffnesses for the ranking, where every "
         "chain of a round (backtracking, --fold-limit) ended short of the target DOF; a later "
         "round is kept only where it reaches the target (default: "
-        f"{DEFAULTS.generation.reseeds}, {DEFAULTS.generation.reseeds_timed} with "
-        "--time-limit, which ends the last; 0: one round)",
+        f"{DEFAULTS.generation.reseeds_timed} with --time-limit, which ends the last, "
+        f"{DEFAULTS.generation.reseeds} without; 0: one round)",
         parse=int,
         metavar="N",
     )
