@@ -68,7 +68,8 @@ MODES: dict[str, dict] = {
     "backtrack-10": {"backtrack_max": 10},
     "check-dof-2": {"deploy_check_max_dof": 2},
     "trace-first": {"second_order_first": False, "same_shape_tol": 0.0},
-    "one-round": {"reseeds": 0},
+    "one-round": {"reseeds": 0, "reseeds_timed": 0},
+    "spread-first": {"hinge_stiffness_spread": 1e-4},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
@@ -82,7 +83,8 @@ creases per solve far from the target (the default since session 31, as ``after`
 ``trace-first`` every candidate's path traced, a shape met again too, and the second-order
 test only after a path that fails (the search before session 33, the same attempts);
 ``one-round`` the search without its later rounds of other seeds (``reseeds`` 0, the search
-before session 34)."""
+before session 34); ``spread-first`` the first round's K_j spread by 10 % too (a probe of
+session 34)."""
 MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}, "batch-off": {"batch": "off"}}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
 per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``)."""
