@@ -83,6 +83,7 @@ class ChainControl:
     rng: np.random.Generator
     batch: bool  # sets of creases are made (GenerateOptions.batch)
     batch_size: int  # the next set's size
+    stiffness: Settings  # the settings of the round's K_j (reseed_spread after the first)
     shapes: list[Frame]  # Step 6 at each solution being reduced, the last on top
     accepted: list[Attempt]  # the attempt of each solution
     deepest: Chain | None  # the chain of lowest DOF that backtracking left
@@ -216,9 +217,13 @@ class ChainControl:
         self.restarts = list(self.ladder)
         self.fold_limit = None
         self.problem = self.unbounded
-        self.batch = self.options.batch == "on" or self.options.batch == "auto"
+        self.batch = makes_sets(self.options)
         self.batch_size = self.settings.generation.batch_first
         self.rng = np.random.default_rng([self.options.seed, self.search_round])
+        g = self.settings.generation
+        self.stiffness = self.settings.with_(
+            hinge_stiffness_spread=g.reseed_spread * g.hinge_stiffness
+        )
         return True
 
     def rounds_allowed(self) -> int:
@@ -359,6 +364,12 @@ def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
     if not options.deploy_check or s.design.rho_max is not None:
         return case
     return replace(case, settings=s.with_(rho_max=limit))
+
+
+def makes_sets(options: GenerateOptions) -> bool:
+    """Whether a round's first chain fixes sets of several creases per solve
+    (``GenerateOptions.batch`` "on", or "auto" with the deployability check)."""
+    return options.batch == "on" or (options.batch == "auto" and options.deploy_check)
 
 
 def attempt_time(rec: Attempt) -> float:

@@ -62,6 +62,7 @@ from rigidfold.generate.chains import (
     Frame,
     attempt_time,
     chain_dof,
+    makes_sets,
     with_fold_limit,
 )
 from rigidfold.generate.deploy_check import DeployCheck
@@ -144,7 +145,7 @@ class _Steps(ChainControl):
             if self.count == "gap"
             else self.settings
         )
-        self.batch = options.batch == "on" or (options.batch == "auto" and options.deploy_check)
+        self.batch = makes_sets(options)
         self.batch_size = self.settings.generation.batch_first  # the next set's size
         # near-mechanisms first (rigidfold.selection.near): with the gap count and the check
         self.sweep = (
@@ -169,6 +170,7 @@ class _Steps(ChainControl):
         self.ladder = list(self.restarts)
         self.unbounded = self.problem
         self.search_round = 0  # Settings.generation.reseeds
+        self.stiffness = self.settings  # the K_j's spread: the paper's in the first round
         self.first: Chain | None = None  # the first round's chain, once later rounds began
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
@@ -331,14 +333,8 @@ class _Steps(ChainControl):
         order to try them in (look-ahead: lazy, forecast block by block), the second-order
         forecast of its children and the seconds."""
         t1 = time.perf_counter()
-        settings = self.settings
-        g = settings.generation
         K = hinge_stiffness(
-            current.mechanism.frame.n_hinges,
-            int(self.rng.integers(2**32)),
-            settings
-            if self.search_round == 0
-            else settings.with_(hinge_stiffness_spread=g.reseed_spread * g.hinge_stiffness),
+            current.mechanism.frame.n_hinges, int(self.rng.integers(2**32)), self.stiffness
         )
         scores = score_creases(current.mechanism, K=K, settings=self.asettings)
         ranked = rank_candidates(scores, self.options.criterion, groups=self.groups, rng=self.rng)
