@@ -135,6 +135,23 @@ def test_path_settings_take_effect():
     assert fine.deploys and fine.steps > coarse.steps
 
 
+def test_a_creeping_descent_ends_where_its_pace_puts_the_flat_state_beyond_its_budget():
+    """A descent (DOF 9) held to small steps falls by about 1/177 of the design's measure a
+    step: with a budget of 150 steps, the flat state is beyond it at that pace and the trace
+    ends after its first window of steps; with 220 it reaches the flat state, as it does
+    with the default pace settings."""
+    shape = free(miura(3, 3))
+    small = DEFAULTS.with_(path_max_fold_step=math.radians(0.2))
+    whole = trace_path(shape, settings=small)
+    assert whole.deploys and 150 < whole.steps < 220
+    pace = {"path_pace_steps": 10, "path_pace_margin": 1.0}
+    short = trace_path(shape, settings=small.with_(path_max_steps=150, **pace))
+    assert short.status is PathStatus.MAX_STEPS and short.steps == 10 and not short.cut
+    assert "at its pace" in short.message and "140 steps left" in short.message
+    room = trace_path(shape, settings=small.with_(path_max_steps=220, **pace))
+    assert room.deploys and room.steps == whole.steps
+
+
 def test_motion_frames_are_equal_steps_of_the_path_and_keep_lengths():
     from rigidfold.deform import folding_motion
     from rigidfold.develop import develop

@@ -56,6 +56,10 @@ def test_with_changes_a_copy_and_checks_it_again():
         RigidfoldError, match="fabricate_relief_rounds must be an integer >= 0, got -1"
     ):
         DEFAULTS.with_(fabricate_relief_rounds=-1)
+    with pytest.raises(RigidfoldError, match="path_pace_steps must be an integer >= 1, got 0"):
+        DEFAULTS.with_(path_pace_steps=0)
+    with pytest.raises(RigidfoldError, match="path_pace_margin must be a positive number"):
+        DEFAULTS.with_(path_pace_margin=0.0)
     with pytest.raises(RigidfoldError, match="fabricate_side must be one of bottom, top"):
         DEFAULTS.with_(fabricate_side="left")
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -89,6 +89,21 @@ class PathSettings(Group):
         "A step that lowers the folding measure by less than this fraction of its lowest so "
         "far makes no progress (``path_stall_steps``, ``path_wander_steps``).",
     )
+    pace_steps: int = setting(
+        50,
+        "With DOF > 1 the path's pace is the fall of the folding measure over this many "
+        "steps (``path_pace_margin``).",
+    )
+    pace_margin: float = setting(
+        2.0,
+        "With DOF > 1 the path ends out of budget (``max_steps``) where, at its pace "
+        "(``path_pace_steps``), the flat state lies more than this many times the steps left "
+        "of ``path_max_steps`` away: a descent that creeps (every step lowers the measure a "
+        "little, so it never stalls) would run out of steps anyway. On a Huffman waterbomb on "
+        "the dome, two such traces of DOF 2 and 3 fell by 3.5e-4 of the design's measure a "
+        "step and took 80 s each to end at 1000 steps, 31 % of the way (docs/deployability.md, "
+        "session 35).",
+    )
     wander_steps: int = setting(
         40,
         "With DOF 1 the path stops short when this many steps in a row bring the folding "
@@ -129,6 +144,10 @@ class PathSettings(Group):
         "costs a dense SVD and dense corrections (seconds at 200 vertices), and a path that "
         "stalls again after 5 rarely gets through (docs/deployability.md).",
     )
+
+    def __post_init__(self) -> None:
+        self._integer(pace_steps=1)
+        self._positive("pace_margin")
 
 
 @dataclass(frozen=True)

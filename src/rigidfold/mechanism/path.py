@@ -349,6 +349,27 @@ class _Tracer:
                 return self.trace, end.status, end.message
             self.h = min(2 * step.length, self.largest) if step.factorizations == 1 else step.length
 
+    def out_of_pace(self) -> _End | None:
+        """A descent (DOF > 1) that creeps ends out of budget: where, at the fall of the
+        folding measure over the last ``path_pace_steps`` steps, the flat state lies more
+        than ``path_pace_margin`` times the steps left of ``path_max_steps`` away (a descent's
+        measure falls at every step, else it stalls, so its pace is positive)."""
+        settings, tr = self.settings.path, self.trace
+        window = settings.pace_steps
+        if tr.steps < window:
+            return None
+        m = tr.measure[-1]
+        fallen = tr.measure[-1 - window] - m
+        left = settings.max_steps - tr.steps
+        if m * window <= settings.pace_margin * left * fallen:
+            return None
+        return _End(
+            PathStatus.MAX_STEPS,
+            f"at its pace (the folding measure down {fallen / window:.2g} of the design's a "
+            f"step over the last {window}), the flat state is beyond the {left} steps left "
+            f"after {tr.steps} (m = {m:.3g})",
+        )
+
     def out_of_budget(self) -> _End | None:
         """The end of a trace that has taken ``path_max_steps`` steps or passed its deadline."""
         tr = self.trace
@@ -564,6 +585,8 @@ class _Tracer:
                 f"no rigid folding lowers the folding measure below {self.best:.3g} of the "
                 f"design's (none in the last {self.slow} steps)",
             )
+        if self.mode is Mode.DESCENT:
+            return self.out_of_pace()
         if self.mode is not Mode.DESCENT:
             if slope < 0:  # m falls: from here on a rise of path_turn_back is a turn back
                 self.lowest = min(self.lowest, m)
