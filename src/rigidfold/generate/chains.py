@@ -95,6 +95,8 @@ class ChainControl:
     locked_before: dict[tuple[int, ...], list[int]]  # look-ahead: fixes that locked
     search_round: int  # the round of the search (reseed), 0 the first
     first: Chain | None  # the first round's chain and design, once later rounds began
+    silent: bool  # a later round under way: its solutions not shown to the callbacks (publish)
+    shown: int | None  # while a round is published: the solutions the callbacks have seen
     ladder: list[tuple[float, Case]]  # every round's restarts, in order
     unbounded: FormFindingProblem  # the problem of a round's first chain
 
@@ -193,7 +195,11 @@ class ChainControl:
         (``deadline``, :func:`rigidfold.generate.final.deployable_final`) as a run of one
         round would, and kept (:attr:`first`): a later round is kept only where it reaches
         the target; otherwise :meth:`conclude` takes the first round's chain and design back.
-        Returns whether a round began."""
+        The later rounds are :attr:`silent`: the callbacks keep the first round's chain (a
+        run directory its files, the design named) while they go, and see a round's chain
+        only once it reached the target (:meth:`publish`); an interrupt meanwhile ends the
+        run with the first round's chain (:meth:`interrupted`). Returns whether a round
+        began."""
         if (
             not self.options.deploy_check
             or stop not in DEAD_ENDS
@@ -209,6 +215,7 @@ class ChainControl:
             )
         if self.out_of_time():
             return False
+        self.silent = True
         self.search_round += 1
         self.deepest = None
         run.final_step = None
@@ -242,8 +249,46 @@ class ChainControl:
             self.settle(stop)
             self.name_final(stop, deadline)
             return
-        self.take_back(first)
+        self.take_back(first)  # silently: the callbacks have had its chain all along
         self.run.final_step = first.final_step
+        self.silent = False
+
+    def publish(self) -> None:
+        """A later round reached the target: the callbacks see the first round's chain
+        retracted (but its initial shape) and the round's accepted, in order. Where an
+        interrupt comes as they do, :meth:`interrupted` keeps the chain as far as they saw
+        it."""
+        if not self.silent:
+            return
+        first, run = self.first, self.run
+        assert first is not None
+        self.silent = False
+        self.shown = 1  # the initial shape, the chains' common start
+        if self.on_retract and len(first.solutions) > 1:
+            self.on_retract(run, tuple(reversed(first.solutions[1:])))
+        for k, solution in enumerate(run.solutions[1:], start=2):
+            if self.on_solution:
+                self.on_solution(run, solution)
+            self.shown = k
+        self.shown = None
+
+    def interrupted(self) -> None:
+        """An interrupt (Ctrl-C, SIGTERM) stops the run: where a later round was under way,
+        the run's chain is the first round's again and its design the one named at the
+        first round's end, as the callbacks have them; where it came as a round was
+        published, the chain as far as the callbacks saw it. Nothing is shown to the
+        callbacks."""
+        if self.silent and self.first is not None:
+            self.take_back(self.first)
+            self.run.final_step = self.first.final_step
+            for rec in self.run.attempts:  # one accepted as the interrupt came: its round's
+                if rec.search_round > 0 and rec.outcome is AttemptOutcome.ACCEPTED:
+                    rec.outcome = AttemptOutcome.DEAD_END
+        elif self.shown is not None:  # publish was cut short
+            self.silent = True
+            self.retract(keep=self.shown)
+            self.run.final_step = None
+        self.silent, self.shown = False, None
 
     def name_final(self, stop: Stop, deadline: float | None) -> None:
         """Name the final design of the chain as it stands (the lowest-DOF solution that
@@ -305,7 +350,7 @@ class ChainControl:
     def retract(self, keep: int | None = None) -> None:
         """Take back the last solution (``keep`` given: every solution after the first
         ``keep``): their attempts' outcome becomes DEAD_END; the callback sees them at once,
-        the last first."""
+        the last first (not in a :attr:`silent` round)."""
         run = self.run
         keep = len(run.solutions) - 1 if keep is None else keep
         taken: list[Solution] = []
@@ -313,7 +358,7 @@ class ChainControl:
             taken.append(run.solutions.pop())
             self.accepted.pop().outcome = AttemptOutcome.DEAD_END
             run.n_backtrack += 1
-        if self.on_retract and taken:
+        if self.on_retract and taken and not self.silent:
             self.on_retract(run, tuple(taken))
 
     def settle(self, stop: Stop) -> None:
@@ -343,7 +388,7 @@ class ChainControl:
             assert solution.step == len(run.solutions)  # the chains share what is before
             run.solutions.append(solution)
             self.accepted.append(rec)
-            if self.on_solution:
+            if self.on_solution and not self.silent:
                 self.on_solution(run, solution)
         run.stop, run.stop_detail = chain.stop, chain.detail
 

@@ -172,6 +172,8 @@ class _Steps(ChainControl):
         self.search_round = 0  # Settings.generation.reseeds
         self.stiffness = self.settings  # the K_j's spread: the paper's in the first round
         self.first: Chain | None = None  # the first round's chain, once later rounds began
+        self.silent = False  # a later round under way (ChainControl.publish)
+        self.shown: int | None = None  # the solutions the callbacks saw, while publishing
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
         # not tried again where a restart's kept shape is ranked anew
@@ -325,7 +327,7 @@ class _Steps(ChainControl):
             sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
             run.solutions.append(sol)
             self.accepted.append(rec)
-            if self.on_solution:
+            if self.on_solution and not self.silent:
                 self.on_solution(run, sol)
 
     def rank(self, current: Solution) -> tuple[list, Iterator[Choice], ChildForecast | None, float]:
@@ -622,19 +624,24 @@ def generate(
     assert trial.mechanism is not None  # a solution was analysed
     run.initial_dof = trial.mechanism.dof
     steps.record(rec, trial)
-    while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
-        stop = steps.reduce(run.solutions[-1])
-        if stop is not None and not (
-            steps.unbatch(stop)
-            or steps.restart(stop)
-            or steps.backtrack(stop)
-            or steps.restart(stop, after_backtracking=True)
-            or steps.reseed(stop, steps.final_deadline)
-        ):
-            steps.conclude(stop, steps.final_deadline)
-            break
-    else:
-        run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
+    try:
+        while run.solutions[-1].mechanism.dof > opts.target_dof:  # Steps 6-7, then 3-5 again
+            stop = steps.reduce(run.solutions[-1])
+            if stop is not None and not (
+                steps.unbatch(stop)
+                or steps.restart(stop)
+                or steps.backtrack(stop)
+                or steps.restart(stop, after_backtracking=True)
+                or steps.reseed(stop, steps.final_deadline)
+            ):
+                steps.conclude(stop, steps.final_deadline)
+                break
+        else:
+            run.stop, run.stop_detail = Stop.TARGET_REACHED, str(opts.target_dof)
+            steps.publish()
+    except KeyboardInterrupt:
+        steps.interrupted()  # the chain the callbacks have
+        raise
     final = run.final
     if final is not None:  # its margin, once: the search's where it took one
         attempt = steps.accepted[final.step].index

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rigidfold.generate import Generation, Stop
+from rigidfold.generate.final import known_to_deploy as deploys
 from rigidfold.outcomes import Outcome
 from rigidfold.rundir.schema import SolutionRecord, Stage
 
@@ -139,11 +140,18 @@ def known_to_deploy(record: SolutionRecord) -> bool:
 
 def _interrupted(run: Generation, records: list[SolutionRecord], files: list[Path]) -> RunVerdict:
     """The verdict on a run interrupted by Ctrl-C or SIGTERM (it fell short): its final
-    design is the lowest-DOF solution known to deploy (:func:`known_to_deploy`), None when
-    none is, which it then says."""
+    design is the lowest-DOF solution known to deploy (:func:`known_to_deploy`, or its path
+    traced since its record was written: naming a round's design), None when none is, which
+    it then says."""
     if len(records) != len(files):
         raise ValueError(f"{len(records)} records for {len(files)} solution files")
-    known = [k for k, record in enumerate(records) if known_to_deploy(record)]
+    chain = run.solutions
+
+    def is_known(k: int) -> bool:
+        traced = k < len(chain) and chain[k].step == records[k].step and deploys(chain[k])
+        return traced or known_to_deploy(records[k])
+
+    known = [k for k in range(len(records)) if is_known(k)]
     if known:
         k = known[-1]  # the chain's DOF falls as it goes: the last is the lowest
         short = (f"interrupted; best design known to deploy: DOF {records[k].dof}",)
