@@ -3,10 +3,11 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from rigidfold.generate import Generation, Stop
+from rigidfold.generate import AttemptOutcome, Generation, Stop
 from rigidfold.generate.final import known_to_deploy as deploys
 from rigidfold.outcomes import Outcome
 from rigidfold.rundir.schema import SolutionRecord, Stage
@@ -88,6 +89,9 @@ def run_verdict(
         short.append(
             f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"
         )
+        missed = _out_of_reach(run)
+        if missed:
+            short.append(missed)
         failed = run.n_path + run.n_rigid
         if run.deploy_check and failed and run.stop is not Stop.INTERRUPTED:
             counts = f"N_path {run.n_path}, N_rigid {run.n_rigid}" if run.n_rigid else "N_path"
@@ -128,6 +132,24 @@ def run_verdict(
         tuple(short),
         warnings,
         files[k] if named else None,
+    )
+
+
+def _out_of_reach(run: Generation) -> str | None:
+    """Where at least half the solves after the first were not accepted by Step 4
+    (``N_exceed``: F above ``f_tol``, no convergence), what a run that fell short ran into:
+    with more creases fixed, no shape met the constraints of problem (6) within dz of the
+    surface (a coarse pattern on a curved surface: the drawn single vertex on the dome); None
+    otherwise."""
+    later = run.attempts[1:]
+    missed = [a.F for a in later if a.outcome is AttemptOutcome.EXCEED]
+    if not later or 2 * len(missed) < len(later):
+        return None
+    least = min((F for F in missed if math.isfinite(F)), default=math.inf)
+    return (
+        f"{len(missed)} of the {len(later)} solves after the first met no shape within dz of "
+        f"the surface with their creases fixed (N_exceed; the least F {least:.2g}, above "
+        f"f_tol): the pattern reaches the surface only with more DOF ({SOLVE_HINT})"
     )
 
 
