@@ -37,7 +37,10 @@ predictor-corrector continuation on the sparse constraint Jacobian J (Allgower &
   line in fold angles: each step moves along the Gauss-Newton direction d that takes the
   free fold angles rho towards 0 within the mechanism, ``min |rho + J_rho d|^2 + mu |d|^2``
   subject to ``J d = 0`` (one sparse KKT system), and the corrector is the minimum-norm chord
-  iteration on the same factors. The path *stops short* where no such direction lowers m.
+  iteration on the same factors. The path *stops short* where no such direction lowers m,
+  and ends out of budget where it creeps: where, at the fall of m over its last
+  ``path_pace_steps`` steps, the flat state lies more than ``path_pace_margin`` times the
+  steps left away.
 
 Each step costs one sparse LU factorisation (SuperLU through SciPy). The step length (in
 mean edge lengths) grows after an easy correction, halves after a failed one, and near the
@@ -568,8 +571,8 @@ class _Tracer:
     def end(self, slope: int) -> _End | None:
         """Whether the path ends at the point just recorded (``slope`` the sign of dm/ds on
         the way to it): flat; stops short (m came no lower for ``path_wander_steps``, for a
-        descent ``path_stall_steps``, steps); or turned back (DOF 1: m, having fallen, rose
-        ``path_turn_back`` above its lowest)."""
+        descent ``path_stall_steps``, steps); a descent out of pace (:meth:`out_of_pace`); or
+        turned back (DOF 1: m, having fallen, rose ``path_turn_back`` above its lowest)."""
         settings, tr = self.settings.path, self.trace
         m, fold_max = tr.measure[-1], tr.max_fold[-1]
         if fold_max <= settings.flat_tol:
@@ -587,16 +590,15 @@ class _Tracer:
             )
         if self.mode is Mode.DESCENT:
             return self.out_of_pace()
-        if self.mode is not Mode.DESCENT:
-            if slope < 0:  # m falls: from here on a rise of path_turn_back is a turn back
-                self.lowest = min(self.lowest, m)
-            elif m > self.lowest + settings.turn_back:
-                k = int(np.argmin(tr.measure))
-                return _End(
-                    PathStatus.TURNED_BACK,
-                    f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest "
-                    f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees)",
-                )
+        if slope < 0:  # m falls: from here on a rise of path_turn_back is a turn back
+            self.lowest = min(self.lowest, m)
+        elif m > self.lowest + settings.turn_back:
+            k = int(np.argmin(tr.measure))
+            return _End(
+                PathStatus.TURNED_BACK,
+                f"the path turns back at m = {tr.measure[k]:.3g} of the design's (largest "
+                f"fold angle there {np.degrees(tr.max_fold[k]):.3g} degrees)",
+            )
         return None
 
 

@@ -145,11 +145,12 @@ def _out_of_reach(run: Generation) -> str | None:
     missed = [a.F for a in later if a.outcome is AttemptOutcome.EXCEED]
     if not later or 2 * len(missed) < len(later):
         return None
-    least = min((F for F in missed if math.isfinite(F)), default=math.inf)
+    least = min((F for F in missed if math.isfinite(F)), default=None)
+    worst = "" if least is None else f"; the least F {least:.2g}, above f_tol"
     return (
         f"{len(missed)} of the {len(later)} solves after the first met no shape within dz of "
-        f"the surface with their creases fixed (N_exceed; the least F {least:.2g}, above "
-        f"f_tol): the pattern reaches the surface only with more DOF ({SOLVE_HINT})"
+        f"the surface with their creases fixed (N_exceed{worst}): the pattern reaches the "
+        f"surface only with more DOF ({SOLVE_HINT})"
     )
 
 
