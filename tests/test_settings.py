@@ -60,6 +60,8 @@ def test_with_changes_a_copy_and_checks_it_again():
         DEFAULTS.with_(path_pace_steps=0)
     with pytest.raises(RigidfoldError, match="path_pace_margin must be a positive number"):
         DEFAULTS.with_(path_pace_margin=0.0)
+    with pytest.raises(RigidfoldError, match="exceed_share must be a fraction from 0 to 1"):
+        DEFAULTS.with_(exceed_share=1.5)
     with pytest.raises(RigidfoldError, match="fabricate_side must be one of bottom, top"):
         DEFAULTS.with_(fabricate_side="left")
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -227,6 +227,13 @@ class GenerationSettings(Group):
         "falls short spends its time on other chains (rounds of 10-70 s on the drawn "
         "patterns, docs/broad_set.md, session 34) instead of ending early.",
     )
+    exceed_share: float = setting(
+        0.5,
+        "The verdict on a run that falls short says that its pattern reaches the surface only "
+        "with more DOF where at least this share of the solves after the first found no shape "
+        "within dz (N_exceed): Origami Simulator's single vertex on the dome, 47 of 58 "
+        "(docs/broad_set.md, session 35). It decides what the verdict says, not the run.",
+    )
     reseed_spread: float = setting(
         0.1,
         "With ``reseeds``: the K_j of a later round are uniform in ``hinge_stiffness`` times "
@@ -383,6 +390,7 @@ class GenerationSettings(Group):
             "same_shape_tol",
         )
         self._fraction("reseed_spread", below_one=True)
+        self._fraction("exceed_share")
         if not self.time_limit_load_max >= 1:
             raise RigidfoldError(
                 f"time_limit_load_max must be at least 1, got {self.time_limit_load_max!r}"

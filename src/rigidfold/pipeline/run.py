@@ -121,7 +121,9 @@ def stopped(result: RunResult) -> RunResult:
     generation.stop, generation.stop_detail = Stop.INTERRUPTED, ""
     best_so_far(generation)
     files = list(result.solution_files)
-    verdict = run_verdict(generation, list(result.records), files, result.options.target_dof)
+    verdict = run_verdict(
+        generation, list(result.records), files, result.options.target_dof, result.case.settings
+    )
     return replace(result, verdict=verdict)
 
 
@@ -285,7 +287,9 @@ class _Run:
                     self.checked[final.step] = checked
             self.built_checks(final, checked)
         files = [solution_file(r.step, r.dof) for r in self.records]  # type: ignore[arg-type]
-        self.verdict = run_verdict(generation, self.records, files, self.options.target_dof)
+        self.verdict = run_verdict(
+            generation, self.records, files, self.options.target_dof, self.case.settings
+        )
         checked = None if final is None else self.checked.get(final.step)
         if final is not None and checked is not None and self.run_dir is not None:
             self.export(final.result.pattern, checked.coords2d, files[final.step].stem)
@@ -377,7 +381,7 @@ class _Run:
         assert generation is not None
         files = [solution_file(r.step, r.dof) for r in self.records]  # type: ignore[arg-type]
         verdict = self.verdict or run_verdict(
-            generation, self.records, files, self.options.target_dof
+            generation, self.records, files, self.options.target_dof, self.case.settings
         )
         self.verdict = RunVerdict(
             RunOutcome.FELL_SHORT,

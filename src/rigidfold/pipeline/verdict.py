@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from rigidfold.config import DEFAULTS, Settings
 from rigidfold.generate import AttemptOutcome, Generation, Stop
 from rigidfold.generate.final import known_to_deploy as deploys
 from rigidfold.outcomes import Outcome
@@ -61,7 +62,11 @@ surface (``generate``'s verdict, ``optimize``'s last line)."""
 
 
 def run_verdict(
-    run: Generation, records: list[SolutionRecord], files: list[Path], target: int
+    run: Generation,
+    records: list[SolutionRecord],
+    files: list[Path],
+    target: int,
+    settings: Settings = DEFAULTS,
 ) -> RunVerdict:
     """The verdict on ``run``: passed when it reached ``target`` (Stop.TARGET_REACHED, or
     DOF 0 for a target of 0) and every check that ran on the final design
@@ -74,7 +79,8 @@ def run_verdict(
     that fell short says so when no deployable design was found at a lower DOF (N_path > 0).
 
     records : each solution's checks, in the order of ``files`` (their FOLD paths, relative
-    to the run's DIR); :meth:`SolutionRecord.failed_stages` says what failed.
+    to the run's DIR); :meth:`SolutionRecord.failed_stages` says what failed. ``settings``:
+    the run's (``Settings.generation.exceed_share``).
     """
     if run.stop is Stop.INTERRUPTED:
         return _interrupted(run, records, files)
@@ -89,7 +95,7 @@ def run_verdict(
         short.append(
             f"target DOF {target} not reached: final DOF {final.mechanism.dof} ({run.stop_reason})"
         )
-        missed = _out_of_reach(run)
+        missed = _out_of_reach(run, settings.generation.exceed_share)
         if missed:
             short.append(missed)
         failed = run.n_path + run.n_rigid
@@ -135,15 +141,15 @@ def run_verdict(
     )
 
 
-def _out_of_reach(run: Generation) -> str | None:
-    """Where at least half the solves after the first were not accepted by Step 4
+def _out_of_reach(run: Generation, share: float) -> str | None:
+    """Where at least ``share`` of the solves after the first were not accepted by Step 4
     (``N_exceed``: F above ``f_tol``, no convergence), what a run that fell short ran into:
     with more creases fixed, no shape met the constraints of problem (6) within dz of the
     surface (a coarse pattern on a curved surface: the drawn single vertex on the dome); None
     otherwise."""
     later = run.attempts[1:]
     missed = [a.F for a in later if a.outcome is AttemptOutcome.EXCEED]
-    if not later or 2 * len(missed) < len(later):
+    if not later or not missed or len(missed) < share * len(later):
         return None
     least = min((F for F in missed if math.isfinite(F)), default=None)
     worst = "" if least is None else f"; the least F {least:.2g}, above f_tol"
