@@ -217,9 +217,10 @@ class GenerationSettings(Group):
         "creases, backtracking, the fold limits). The first round's final design is named "
         "when it ends; a later round is kept only where it reaches the target, otherwise the "
         "run ends as its first round did. The verdicts of the shapes rejected before are "
-        "kept (``same_shape_tol``). 0 (the default): one round, as before session 34: a "
-        "later round replaces the first round's files as it goes, so a run stopped by Ctrl-C "
-        "in it would have neither that design nor one of its own.",
+        "kept (``same_shape_tol``); while a later round goes, the run directory keeps the "
+        "first round's files and design (a run stopped by Ctrl-C ends with them). 0 (the "
+        "default): one round, as before session 34: without a time limit, rounds could take "
+        "this many times a round's time.",
     )
     reseeds_timed: int = setting(
         30,

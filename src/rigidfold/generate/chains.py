@@ -96,7 +96,6 @@ class ChainControl:
     search_round: int  # the round of the search (reseed), 0 the first
     first: Chain | None  # the first round's chain and design, once later rounds began
     silent: bool  # a later round under way: its solutions not shown to the callbacks (publish)
-    shown: int | None  # while a round is published: the solutions the callbacks have seen
     ladder: list[tuple[float, Case]]  # every round's restarts, in order
     unbounded: FormFindingProblem  # the problem of a round's first chain
 
@@ -256,39 +255,43 @@ class ChainControl:
     def publish(self) -> None:
         """A later round reached the target: the callbacks see the first round's chain
         retracted (but its initial shape) and the round's accepted, in order. Where an
-        interrupt comes as they do, :meth:`interrupted` keeps the chain as far as they saw
-        it."""
+        interrupt comes as they do, the chain ends as far as they saw it (the design then
+        the best known, :func:`rigidfold.generate.final.best_so_far`)."""
         if not self.silent:
             return
         first, run = self.first, self.run
         assert first is not None
         self.silent = False
-        self.shown = 1  # the initial shape, the chains' common start
         if self.on_retract and len(first.solutions) > 1:
             self.on_retract(run, tuple(reversed(first.solutions[1:])))
-        for k, solution in enumerate(run.solutions[1:], start=2):
-            if self.on_solution:
-                self.on_solution(run, solution)
-            self.shown = k
-        self.shown = None
+        shown = 1  # the initial shape, the chains' common start
+        try:
+            for solution in run.solutions[1:]:
+                self.show(solution)
+                shown += 1
+        except KeyboardInterrupt:
+            self.silent = True
+            self.retract(keep=shown)
+            self.silent = False
+            run.final_step = None
+            raise
+
+    def show(self, solution: Solution) -> None:
+        """The callback sees a solution kept (not in a :attr:`silent` round)."""
+        if self.on_solution and not self.silent:
+            self.on_solution(self.run, solution)
 
     def interrupted(self) -> None:
         """An interrupt (Ctrl-C, SIGTERM) stops the run: where a later round was under way,
         the run's chain is the first round's again and its design the one named at the
-        first round's end, as the callbacks have them; where it came as a round was
-        published, the chain as far as the callbacks saw it. Nothing is shown to the
-        callbacks."""
+        first round's end, as the callbacks have them. Nothing is shown to the callbacks."""
         if self.silent and self.first is not None:
             self.take_back(self.first)
             self.run.final_step = self.first.final_step
             for rec in self.run.attempts:  # one accepted as the interrupt came: its round's
                 if rec.search_round > 0 and rec.outcome is AttemptOutcome.ACCEPTED:
                     rec.outcome = AttemptOutcome.DEAD_END
-        elif self.shown is not None:  # publish was cut short
-            self.silent = True
-            self.retract(keep=self.shown)
-            self.run.final_step = None
-        self.silent, self.shown = False, None
+        self.silent = False
 
     def name_final(self, stop: Stop, deadline: float | None) -> None:
         """Name the final design of the chain as it stands (the lowest-DOF solution that
@@ -388,8 +391,7 @@ class ChainControl:
             assert solution.step == len(run.solutions)  # the chains share what is before
             run.solutions.append(solution)
             self.accepted.append(rec)
-            if self.on_solution and not self.silent:
-                self.on_solution(run, solution)
+            self.show(solution)
         run.stop, run.stop_detail = chain.stop, chain.detail
 
 

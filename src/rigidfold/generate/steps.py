@@ -173,7 +173,6 @@ class _Steps(ChainControl):
         self.stiffness = self.settings  # the K_j's spread: the paper's in the first round
         self.first: Chain | None = None  # the first round's chain, once later rounds began
         self.silent = False  # a later round under way (ChainControl.publish)
-        self.shown: int | None = None  # the solutions the callbacks saw, while publishing
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
         # not tried again where a restart's kept shape is ranked anew
@@ -327,8 +326,7 @@ class _Steps(ChainControl):
             sol = Solution(len(run.solutions), trial.result, trial.mechanism, trial.path)
             run.solutions.append(sol)
             self.accepted.append(rec)
-            if self.on_solution and not self.silent:
-                self.on_solution(run, sol)
+            self.show(sol)
 
     def rank(self, current: Solution) -> tuple[list, Iterator[Choice], ChildForecast | None, float]:
         """Step 6 at the shape ``current``: the ranked crease groups with their scores, the
