@@ -122,3 +122,44 @@ def test_a_folded_fold_files_angles_are_its_panels_not_its_projections(tmp_path)
     projected = case.pattern.with_coords(flat).corner_angles
     assert not np.allclose(np.sort(projected.ravel()), np.sort(drawn.ravel()))
     assert case.settings is DEFAULTS  # its panels' angles lie inside the paper's bounds
+
+
+HELD_PATTERN = DATA / "whirlpool.svg"
+"""A twist tessellation whose zigzag boundary is all corners, which (8) holds on the surface:
+two of its triangles have all three vertices there."""
+
+
+def test_a_triangle_held_at_three_corners_keeps_its_angles_and_no_bounds():
+    """On the plane z = 0.6 y the one held triangle whose lifted angles break the bounds made
+    problem (6) infeasible from the start; its angles are constants of the problem, so they
+    keep no bounds, the case says so in a note, and the first solve finds the developable
+    shape (the plane itself is one)."""
+    case = case_from_specs("expr", str(HELD_PATTERN), expr="0.6*y")
+    problem = case.problem()
+    held = problem.nlp.held
+    corners = np.zeros(case.pattern.n_vertices, dtype=bool)
+    corners[case.pattern.corners] = True
+    assert np.array_equal(held, np.flatnonzero(corners[case.pattern.faces].all(axis=1)))
+    lo, hi = problem.nlp.theta_bounds
+    n_faces = case.pattern.n_faces
+    rows = (np.arange(3)[:, None] * n_faces + held).ravel()
+    assert np.isneginf(lo[rows]).all() and np.isposinf(hi[rows]).all()
+    others = np.setdiff1d(np.arange(3 * n_faces), rows)
+    d = case.settings.design
+    assert (lo[others] == d.theta_min).all() and (hi[others] == d.theta_max).all()
+    angles = case.pattern.corner_angles[held]
+    assert ((angles < d.theta_min) | (angles > d.theta_max)).any()  # what the bounds broke
+    assert any("all three vertices at corners of the plan" in n for n in case.notes)
+    result = problem.solve(fixed=case.pattern.fixed.copy())
+    assert result.converged and result.F <= d.f_tol
+    assert result.max_violation <= 1e-6  # the held angles count for nothing
+
+
+def test_a_pattern_without_held_triangles_keeps_every_bound():
+    case = case_from_specs("bezier", "1", seed=1)
+    problem = case.problem(build_ipopt=False)
+    assert problem.nlp.held.size == 0
+    lo, hi = problem.nlp.theta_bounds
+    assert (lo == case.settings.design.theta_min).all()
+    assert (hi == case.settings.design.theta_max).all()
+    assert not any("corners of the plan" in n for n in case.notes)

@@ -139,9 +139,13 @@ def make_case(
         )
     given = settings.design
     settings = widened_angle_bounds(plan, settings)
-    notes = () if settings.design is given else (_widened_note(given, settings.design),)
+    notes: tuple[str, ...] = (
+        () if settings.design is given else (_widened_note(given, settings.design),)
+    )
     shape = patterns.build(plan, surf, settings=settings)
     check_sector_angles(shape, settings)
+    held = _held_note(shape, settings)
+    notes += () if held is None else (held,)
     planes = tuple(surf.mirror_planes) if symmetric else ()
     if symmetric and not planes:
         raise RigidfoldError(
@@ -188,6 +192,28 @@ def _widened_note(given: DesignSettings, widened: DesignSettings) -> str:
         f"the sector-angle bounds are {bounds(widened)} degrees (given: {bounds(given)}): "
         "the crease pattern's plan has angles outside those given, which a design could "
         "meet only by redrawing it (--theta-widen none keeps the bounds given)"
+    )
+
+
+def _held_note(shape: CreasePattern, settings: Settings) -> str | None:
+    """One sentence, where triangles whose three vertices are corners of the plan (held on
+    the surface by (8)) have angles there outside the sector-angle bounds: problem (6) keeps
+    those angles as they are (:func:`rigidfold.optimize.nlp.held_faces`); else None."""
+    corner = np.zeros(shape.n_vertices, dtype=bool)
+    corner[shape.corners] = True
+    held = corner[shape.faces].all(axis=1)
+    lo, hi = settings.design.theta_min, settings.design.theta_max
+    angles = shape.corner_angles[held]
+    breaks = ((angles < lo) | (angles > hi)).any(axis=1)
+    if not breaks.any():
+        return None
+    deg = np.degrees(angles[breaks])
+    return (
+        f"{int(breaks.sum())} triangle(s) with all three vertices at corners of the plan, "
+        f"which stay on the target surface, have angles there of {deg.min():.3g} to "
+        f"{deg.max():.4g} degrees, outside the sector-angle bounds "
+        f"[{math.degrees(lo):.4g}, {math.degrees(hi):.4g}]: no shape can change them, and the "
+        "design keeps them as they are"
     )
 
 

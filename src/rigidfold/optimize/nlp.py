@@ -6,14 +6,18 @@
     F1 = sum_{i in V_in} (2 pi - sum_k theta_ik)^2
     F2 = sum_{j in E_fix} |n_j1 x n_j2|^2
     s.t.     |z_i - f(x_i, y_i)| <= dz                  (every vertex that can move)
-             theta_min <= theta_ik <= theta_max          (every sector angle)
+             theta_min <= theta_ik <= theta_max          (every sector angle a shape can change)
              |rho_j| <= rho_max                          (free creases, optional, Eq. 12)
              P = T xi + t                                (Eqs. 7-11, eliminated)
 
 The model is built once per pattern, surface, symmetry and settings as CasADi SX
 expressions; the fixed-crease mask is a *parameter* ``w`` (E,), so fixing another crease
 needs no rebuild. Angles are ``atan2(|a x b|, a . b)``. Constraint (12) is imposed in the
-equivalent smooth form ``n_j1 . n_j2 >= cos(rho_max)``.
+equivalent smooth form ``n_j1 . n_j2 >= cos(rho_max)``. The angles of a triangle whose
+three corners (7)-(9) hold are constants of the problem: they keep no bounds, since no shape
+could change them (a drawn boundary of many corners, each held on the surface, can give such
+a triangle angles outside the bounds: with bounds the problem would be infeasible from the
+start; :func:`held_faces`).
 """
 
 from __future__ import annotations
@@ -53,6 +57,9 @@ class NLP:
         Bounds of g (-inf where a constraint has no lower bound).
     dz_vertices : (k,) int64
         The vertices that can move (not fixed by (7)-(9)), whose height is bounded by dz.
+    held : (h,) int64
+        The triangles whose three corners (7)-(9) hold (:func:`held_faces`): their angles'
+        rows of g are unbounded.
     """
 
     x: ca.SX
@@ -65,6 +72,14 @@ class NLP:
     lbg: np.ndarray
     ubg: np.ndarray
     dz_vertices: np.ndarray
+    held: np.ndarray
+
+    @property
+    def theta_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounds (3F,) each of the sector angles (entry k*F + f at ``faces[f, k]``)."""
+        n = len(self.dz_vertices)
+        rows = slice(n, n + self.theta.shape[0])
+        return self.lbg[rows], self.ubg[rows]
 
     def casadi(self) -> dict[str, ca.SX]:
         """The ``{"x", "p", "f", "g"}`` problem dict of CasADi's ``nlpsol``."""
@@ -89,6 +104,14 @@ def _dot(a, b):
 
 def _sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def held_faces(pattern: CreasePattern, lmap: LinearMap) -> np.ndarray:
+    """(h,) int64: the triangles whose three corners the linear map (7)-(9) holds, whose
+    angles no shape of problem (6) can change."""
+    held = np.zeros(pattern.n_vertices, dtype=bool)
+    held[lmap.held_vertices] = True
+    return np.flatnonzero(held[pattern.faces].all(axis=1))
 
 
 def build_nlp(
@@ -145,14 +168,18 @@ def build_nlp(
     F2 = ca.dot(w_int, flat)
 
     # dz constraint on every vertex that is not completely fixed by (7)-(9)
-    T = lmap.T.tocsr()
-    moves = np.diff(T.indptr).reshape(3, V).sum(axis=0) > 0
-    dz_vertices = np.flatnonzero(moves)
+    dz_vertices = np.setdiff1d(np.arange(V), lmap.held_vertices)
     mv = dz_vertices.tolist()
     height = surface.height(x[mv], y[mv], xp=ca)
     g = [z[mv] - height, theta]
-    lbg = [np.full(len(mv), -s.design.dz), np.full(theta.shape[0], s.design.theta_min)]
-    ubg = [np.full(len(mv), s.design.dz), np.full(theta.shape[0], s.design.theta_max)]
+    held = held_faces(pattern, lmap)
+    lo, hi = (
+        np.full((3, len(faces)), s.design.theta_min),
+        np.full((3, len(faces)), s.design.theta_max),
+    )
+    lo[:, held], hi[:, held] = -np.inf, np.inf  # constants of the problem
+    lbg = [np.full(len(mv), -s.design.dz), lo.ravel()]
+    ubg = [np.full(len(mv), s.design.dz), hi.ravel()]
     if s.design.rho_max is not None:
         g.append((1 - w_int) * (np.cos(s.design.rho_max) - _dot(na, nb)))
         lbg.append(np.full(len(interior), -np.inf))
@@ -168,4 +195,5 @@ def build_nlp(
         lbg=np.concatenate(lbg),
         ubg=np.concatenate(ubg),
         dz_vertices=dz_vertices,
+        held=held,
     )

@@ -188,11 +188,12 @@ class FormFindingProblem:
         s = self.settings
         shape = self.pattern.with_coords(coords)
         dz = coords[:, 2] - np.asarray(self.surface.height(coords[:, 0], coords[:, 1]))
-        theta = shape.corner_angles
+        theta = shape.corner_angles.T.ravel()  # the order of g's rows
+        lo, hi = self.nlp.theta_bounds
         parts = [
             np.abs(dz[self.nlp.dz_vertices]).max(initial=0.0) - s.design.dz,
-            s.design.theta_min - theta.min(),
-            theta.max() - s.design.theta_max,
+            float((lo - theta).max(initial=-np.inf)),
+            float((theta - hi).max(initial=-np.inf)),
             self.map.residual(coords),
         ]
         if s.design.rho_max is not None:

@@ -67,6 +67,13 @@ class LinearMap:
         """Independent variables (n,) taken from vertex coordinates (V, 3)."""
         return np.asarray(coords, dtype=float).T.ravel()[self.independent].copy()
 
+    @property
+    def held_vertices(self) -> np.ndarray:
+        """(k,) int64: the vertices that (7)-(9) hold completely (no coordinate depends on
+        ``xi``: the corners, by (8))."""
+        moves = np.diff(self.T.tocsr().indptr).reshape(3, -1).sum(axis=0) > 0
+        return np.flatnonzero(~moves)
+
     def residual(self, coords: np.ndarray) -> float:
         """max |Gamma P - c| of a shape: how far it is from satisfying (7)-(9)."""
         if self.gamma.shape[0] == 0:
