@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 import rigidfold.generate.deploy_check as deploy_check
@@ -100,6 +101,15 @@ def test_several_creases_per_solve_far_from_the_target_one_near_it(monkeypatch):
     for a in sets:
         if a.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END):
             assert a.dof >= opts.target_dof + single
+    # a set is sized by the exact DOF of its shape (the rank threshold), not the count
+    # with the gap, whose near-mechanisms a set does not remove first
+    accepted = [a for a in run.attempts if a.outcome is AttemptOutcome.ACCEPTED]
+    assert len(accepted) == len(run.solutions)
+    rank_tol = DEFAULTS.mechanism.rank_tol
+    exact = [s.mechanism.dof_at(rank_tol) for s in run.solutions]
+    for k, a in enumerate(accepted[1:], start=1):
+        if a.batch >= 2:
+            assert a.batch <= exact[k - 1] - opts.target_dof - single
     paper = generate(case, opts.replace(batch="off"))
     assert all(a.batch == 0 for a in paper.attempts)
     assert len(run.attempts) < len(paper.attempts)
@@ -266,3 +276,28 @@ def test_the_sets_end_sooner_at_rejected_paths(monkeypatch):
     assert sum(a.outcome in REJECTED for a in first) == 3
     _, off = _every_path_turns_back(monkeypatch, unbatched, "off")
     assert [(a.fixed_added, a.outcome) for a in off] == [(a.fixed_added, a.outcome) for a in first]
+
+
+def test_a_set_is_sized_by_the_exact_dof_not_the_near_mechanisms_counted_with_them():
+    """With the gap count a shape's DOF include its near-mechanisms (singular values
+    between the rank threshold and the gap), which a set of creases does not remove first:
+    the set's room is the exact DOF less the target and ``batch_single_dof``. The shape is
+    a solved 11 x 11 grid on the dome; ten of its singular values are put in the near band."""
+    import rigidfold.generate.steps as steps
+
+    case = case_from_specs("dome", "grid:11x11", size="3x3")
+    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, batch="auto")
+    run_steps = steps._Steps(case, opts, None, None)
+    rec, trial = run_steps.solve(case.pattern.fixed.copy(), None, (), None)
+    run_steps.record(rec, trial)
+    current = run_steps.run.solutions[-1]
+    g, m = DEFAULTS.generation, DEFAULTS.mechanism
+    run_steps.batch_size = g.batch_max
+    mech = current.mechanism
+    assert mech.dof_at(m.rank_tol) == mech.dof  # no near-mechanism of its own
+    room = mech.dof - opts.target_dof - g.batch_single_dof
+    assert run_steps.set_size(current) == min(g.batch_max, room)
+    near = np.full(10, math.sqrt(m.dof_gap) * m.rank_tol * mech.rank_scale)
+    softer = replace(mech, rank_values=np.concatenate([mech.rank_values, near]))
+    assert softer.dof == mech.dof and softer.dof_at(m.rank_tol) == mech.dof - 10
+    assert run_steps.set_size(replace(current, mechanism=softer)) == min(g.batch_max, room - 10)

@@ -530,11 +530,13 @@ class _Steps(ChainControl):
     def set_size(self, current: Solution) -> int:
         """The size of the next set of creases at the shape ``current``: 0 without sets
         (``GenerateOptions.batch``), otherwise at most the next set's size, never taking the
-        DOF within ``batch_single_dof`` of the target (below 2: one crease per solve)."""
+        exact DOF (at the rank threshold, without the near-mechanisms the gap count adds)
+        within ``batch_single_dof`` of the target (below 2: one crease per solve)."""
         if not self.batch:
             return 0
         g = self.settings.generation
-        room = current.mechanism.dof - max(self.options.target_dof, 1) - g.batch_single_dof
+        exact = current.mechanism.dof_at(self.settings.mechanism.rank_tol)
+        room = exact - max(self.options.target_dof, 1) - g.batch_single_dof
         return max(0, min(self.batch_size, g.batch_max, room))
 
     def fix_set(self, current: Solution, shape: Frame) -> Stop | bool:
