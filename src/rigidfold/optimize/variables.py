@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg
@@ -67,7 +68,7 @@ class LinearMap:
         """Independent variables (n,) taken from vertex coordinates (V, 3)."""
         return np.asarray(coords, dtype=float).T.ravel()[self.independent].copy()
 
-    @property
+    @cached_property
     def held_vertices(self) -> np.ndarray:
         """(k,) int64: the vertices that (7)-(9) hold completely (no coordinate depends on
         ``xi``: the corners, by (8))."""
