@@ -1,8 +1,9 @@
 """Later rounds of the search (``Settings.generation.reseeds``): where every chain of a round
 is spent without a design at the target DOF, the search starts again from the initial shape
 with other seeds for the ranking. The first round is the search of one round, attempt for
-attempt; every later round begins at the initial shape; a later round is kept only where it
-reaches the target, otherwise the run ends as its first round did; without the
+attempt; every later round begins at the initial shape; a later round is kept where it
+reaches the target or ends lower with a design known to deploy, otherwise the run ends as
+its first round did; without the
 deployability check there is one round (the paper's Step 7).
 
 The case: pattern 1 on Bezier seed 102 (S-hat, look-ahead, one crease per solve) with
@@ -78,23 +79,40 @@ def test_every_later_round_starts_again_from_the_initial_shape(rounds):
     assert all(starts[k] == 1 for k in range(1, max(tags) + 1))
 
 
-def test_the_run_ends_with_a_later_round_only_at_its_target(one_round, rounds):
-    """A later round is kept where it reaches the target (its chain is one round's, the
-    rounds share the initial shape alone); otherwise the run ends as its first round did:
-    its chain, its stop and its final design."""
+def _lowest_deploying(run) -> dict[int, int]:
+    """For each round, the lowest DOF of its solutions whose path reached the flat state
+    (kept, retracted or kept aside without a clear gap)."""
+    solutions = (AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END, AttemptOutcome.NO_GAP)
+    lows: dict[int, int] = {}
+    for a in run.attempts:
+        if a.outcome in solutions and a.path is not None and a.path["deploys"]:
+            lows[a.search_round] = min(lows.get(a.search_round, a.dof), a.dof)
+    return lows
+
+
+def test_the_run_ends_with_its_lowest_round_whose_design_deploys(one_round, rounds):
+    """A later round is kept where it reaches the target, or where it ends lower than the
+    first round's design with a design known to deploy (its chain is one round's, the rounds
+    share the initial shape alone); otherwise the run ends as its first round did: its
+    chain, its stop and its final design. No design known to deploy is left for a higher
+    one: with the tests' pinned numerics the first round names DOF 2 and the later rounds
+    find DOF 1 without a clear gap, which before session 37 the run left for DOF 2."""
     plain, _ = one_round
     run, _ = rounds
     accepted = [a for a in run.attempts if a.outcome is AttemptOutcome.ACCEPTED]
     assert len(accepted) == len(run.solutions)
-    if run.stop is Stop.TARGET_REACHED:
-        assert len({a.search_round for a in accepted[1:]}) == 1
-        assert accepted[-1].search_round >= 1
-        assert run.final.path is not None and run.final.path.deploys
-    else:
-        assert {a.search_round for a in accepted} == {0}
+    lows = _lowest_deploying(run)
+    assert run.final is not None and run.final.path is not None and run.final.path.deploys
+    assert run.final_dof <= min(lows.values())
+    if {a.search_round for a in accepted} == {0}:
         assert (run.stop, run.stop_detail) == (plain.stop, plain.stop_detail)
         assert [s.result.F for s in run.solutions] == [s.result.F for s in plain.solutions]
         assert run.final_step == plain.final_step and run.final_dof == plain.final_dof
+    else:
+        assert len({a.search_round for a in accepted[1:]}) == 1
+        assert accepted[-1].search_round >= 1
+        assert run.final is run.solutions[-1]
+        assert plain.final_dof is not None and run.final_dof < plain.final_dof
     assert [s.step for s in run.solutions] == list(range(len(run.solutions)))
     for before, after in zip(run.solutions, run.solutions[1:], strict=False):
         assert np.all(after.result.pattern.fixed[before.result.pattern.fixed])

@@ -215,12 +215,14 @@ class GenerationSettings(Group):
         "seed of its own and the wider spread ``reseed_spread`` for the fictitious hinge "
         "stiffnesses K_j of the criteria, whatever else as in the first round (the sets of "
         "creases, backtracking, the fold limits). The first round's final design is named "
-        "when it ends; a later round is kept only where it reaches the target, otherwise the "
-        "run ends as its first round did. The verdicts of the shapes rejected before are "
-        "kept (``same_shape_tol``); while a later round goes, the run directory keeps the "
-        "first round's files and design (a run stopped by Ctrl-C ends with them). 0 (the "
-        "default): one round, as before session 34: without a time limit, rounds could take "
-        "this many times a round's time.",
+        "when it ends; a later round is kept where it reaches the target, or where it ends "
+        "with a design known to deploy of lower DOF than the first round's and the later "
+        "rounds' before it (a DOF-1 design without a clear gap against the first round's "
+        "DOF 2, say); otherwise the run ends as its first round did. The verdicts of the "
+        "shapes rejected before are kept (``same_shape_tol``); while a later round goes, "
+        "the run directory keeps the first round's files and design (a run stopped by "
+        "Ctrl-C ends with them). 0 (the default): one round, as before session 34: without "
+        "a time limit, rounds could take this many times a round's time.",
     )
     reseeds_timed: int = setting(
         30,

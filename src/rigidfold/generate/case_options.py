@@ -205,7 +205,8 @@ class SettingsOptions:
         "with the deployability check: how many times the search starts again from the "
         "initial shape, with other fictitious hinge stiffnesses for the ranking, where every "
         "chain of a round (backtracking, --fold-limit) ended short of the target DOF; a later "
-        "round is kept only where it reaches the target (default: "
+        "round is kept where it reaches the target or ends lower than the rounds before with a "
+        "design known to deploy (default: "
         f"{DEFAULTS.generation.reseeds_timed} with --time-limit, which ends the last, "
         f"{DEFAULTS.generation.reseeds} without; 0: one round)",
         parse=int,

@@ -6,7 +6,8 @@ initial shape with bound (12) at the next fold limit, or ends its sets of crease
 ends with the chain that reached the lowest DOF (:meth:`ChainControl.settle`), and its final
 design is named; where it falls short of the target, later rounds start again from the
 initial shape with other fictitious hinge stiffnesses (:meth:`ChainControl.reseed`), kept
-only where one reaches the target (:meth:`ChainControl.conclude`).
+where one reaches the target, or ends with a design known to deploy of lower DOF than the
+first round's (:meth:`ChainControl.conclude`).
 
 :class:`ChainControl` holds these moves; the steps of one run (:mod:`rigidfold.generate.
 steps`) inherit them and own the state they act on, declared here.
@@ -22,7 +23,7 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.generate.case import Case
-from rigidfold.generate.final import deployable_final
+from rigidfold.generate.final import deployable_final, known_to_deploy
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import Attempt, AttemptOutcome, Generation, Solution, Stop
 from rigidfold.mechanism.second_order import ChildForecast
@@ -95,6 +96,7 @@ class ChainControl:
     locked_before: dict[tuple[int, ...], list[int]]  # look-ahead: fixes that locked
     search_round: int  # the round of the search (reseed), 0 the first
     first: Chain | None  # the first round's chain and design, once later rounds began
+    best: Chain | None  # the later rounds' lowest chain ending with a design that deploys
     silent: bool  # a later round under way: its solutions not shown to the callbacks (publish)
     ladder: list[tuple[float, Case]]  # every round's restarts, in order
     unbounded: FormFindingProblem  # the problem of a round's first chain
@@ -192,11 +194,17 @@ class ChainControl:
 
         At the first round's end, its chain is settled and its final design named
         (``deadline``, :func:`rigidfold.generate.final.deployable_final`) as a run of one
-        round would, and kept (:attr:`first`): a later round is kept only where it reaches
-        the target; otherwise :meth:`conclude` takes the first round's chain and design back.
+        round would, and kept (:attr:`first`): a later round is kept where it reaches the
+        target; at the end of one that falls short, its lowest chain is kept where it ends
+        with a design known to deploy below the design kept so far (:meth:`keep_best`: a
+        solution at the target without a clear gap, say, against the first round's DOF 2),
+        and :meth:`conclude` takes the lowest back, the first round's chain and design where
+        no later round ended lower. No path is traced for it: a later round's design is
+        kept only where its deployment is already known, so that the grace after the
+        search is not spent naming one (docs/broad_set.md, sessions 34 and 37).
         The later rounds are :attr:`silent`: the callbacks keep the first round's chain (a
         run directory its files, the design named) while they go, and see a round's chain
-        only once it reached the target (:meth:`publish`); an interrupt meanwhile ends the
+        only once it is kept at the run's end (:meth:`publish`); an interrupt meanwhile ends the
         run with the first round's chain (:meth:`interrupted`). Returns whether a round
         began."""
         if (
@@ -212,6 +220,8 @@ class ChainControl:
             self.first = Chain(
                 list(run.solutions), list(self.accepted), run.stop, run.stop_detail, run.final_step
             )
+        else:
+            self.keep_best(stop)
         if self.out_of_time():
             return False
         self.silent = True
@@ -241,16 +251,52 @@ class ChainControl:
     def conclude(self, stop: Stop, deadline: float | None) -> None:
         """The run ends with ``stop`` short of its target: its chain settled
         (:meth:`settle`) and its final design named (``deadline``); where later rounds
-        began (:meth:`reseed`) and none reached the target, the first round's chain and
-        design are taken back (its stop too)."""
+        began (:meth:`reseed`) and none reached the target, the lowest chain of theirs that
+        ends with a design known to deploy below the first round's design (:attr:`best`) is
+        taken back and shown to the callbacks (:meth:`publish`), its last solution the
+        design; where there is none, the first round's chain and design (its stop too)."""
         first = self.first
         if first is None:
             self.settle(stop)
             self.name_final(stop, deadline)
             return
+        self.keep_best(stop)
+        if self.best is not None:  # a later round ended lower, with a design that deploys
+            self.take_back(self.best)  # silently, then shown to the callbacks
+            self.run.final_step = self.run.solutions[-1].step
+            self.publish()
+            return
         self.take_back(first)  # silently: the callbacks have had its chain all along
         self.run.final_step = first.final_step
         self.silent = False
+
+    def keep_best(self, stop: Stop) -> None:
+        """At the end of a later round (with ``stop`` at its last shape): keep its lowest chain
+        as :attr:`best` where that chain's last solution is known to deploy (its path was
+        traced to the flat state: no trace is needed to name it) and its DOF is below that
+        of the design the run would end with so far (:meth:`kept_dof`). The round's lowest
+        chain is the chain as it stands or the one backtracking left (:attr:`deepest`; a
+        solution at the target without a clear gap, :meth:`keep_no_gap`, among them)."""
+        run = self.run
+        chains = [Chain(list(run.solutions), list(self.accepted), stop, run.stop_detail)]
+        if self.deepest is not None:
+            chains.append(self.deepest)
+        for chain in chains:
+            last = chain.solutions[-1]
+            if known_to_deploy(last) and last.mechanism.dof < self.kept_dof():
+                self.best = chain
+
+    def kept_dof(self) -> int:
+        """The DOF of the design a run in its later rounds would end with now: the later
+        rounds' :attr:`best`, else the first round's named design (where it named none, any
+        design known to deploy is lower: the first round's initial DOF plus one)."""
+        if self.best is not None:
+            return chain_dof(self.best.solutions)
+        first = self.first
+        assert first is not None  # a later round is under way
+        if first.final_step is None:
+            return first.solutions[0].mechanism.dof + 1
+        return first.solutions[first.final_step].mechanism.dof
 
     def publish(self) -> None:
         """A later round reached the target: the callbacks see the first round's chain

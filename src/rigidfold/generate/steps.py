@@ -172,6 +172,7 @@ class _Steps(ChainControl):
         self.search_round = 0  # Settings.generation.reseeds
         self.stiffness = self.settings  # the K_j's spread: the paper's in the first round
         self.first: Chain | None = None  # the first round's chain, once later rounds began
+        self.best: Chain | None = None  # a later round's chain that ended lower (conclude)
         self.silent = False  # a later round under way (ChainControl.publish)
         self.fold_limit: float | None = None  # the bound of the chain's solves (radians)
         # the fixes whose solutions were retracted, by the step of the shape they reduced:
