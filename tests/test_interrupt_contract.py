@@ -226,6 +226,48 @@ def test_the_exit_code_is_the_commands_once_it_has_ended(tmp_path):
     assert runs[()].returncode in (-signal.SIGINT, 130), runs[()].stderr
 
 
+def test_a_signal_once_the_verdict_is_printed_keeps_the_commands_exit_code(
+    tmp_path, monkeypatch, capsys
+):
+    """The moment the contract test found in session 37: SIGTERM as ``report.html`` appeared
+    reached the command just after the held block that prints the verdict ("passed: ..."),
+    which then said "interrupted" and exited 130 beside a summary saying the run reached its
+    target. The run had ended, every file written: the exit code is the verdict's
+    (:func:`rigidfold.runtime.interrupts.decide_exit`). The signal is made here by the
+    command's last flush of its output, after the verdict line."""
+    from rigidfold.cli.commands import main
+
+    class Stdout:
+        def __init__(self):
+            self.text, self.raised = "", False
+
+        def write(self, text):
+            self.text += text
+            return len(text)
+
+        def flush(self):
+            if "final design:" in self.text and not self.raised:
+                self.raised = True
+                raise KeyboardInterrupt
+
+    out = Stdout()
+    monkeypatch.setattr(sys, "stdout", out)
+    code = main([*CASE, "--no-report", "--out", str(tmp_path / "run")])
+    assert out.raised and out.text.splitlines()[-1].startswith("passed: ")
+    assert code == 0 and "interrupted" not in capsys.readouterr().err
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["stop"] == "target_reached"
+    # the next command in this process, interrupted as it runs, exits 130: nothing decided
+    import rigidfold.cli.commands as commands
+
+    def stopped(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(commands._COMMANDS, "generate", stopped)
+    assert main([*CASE, "--out", str(tmp_path / "again")]) == 130
+    assert "rigidfold: interrupted" in capsys.readouterr().err
+
+
 def test_a_signal_a_library_swallowed_while_imported_stops_the_run(tmp_path):
     """The moment CI found (session 23): SIGTERM 0.4 s after the start of a run on a loaded
     machine landed while CasADi was imported, whose module runs ``try: from numpy import pi

@@ -51,3 +51,42 @@ def test_a_run_that_falls_short_otherwise_is_not_told_so():
     run = generate(case, OPTIONS.replace(seed=102, batch="off"))
     assert run.stop is Stop.NO_DEPLOYABLE
     assert not [s for s in _verdict(run).shortfalls if "no shape within dz" in s]
+
+
+def test_a_design_at_the_target_without_a_clear_gap_falls_short_of_it():
+    """Issue 49, item 5: a design at the target DOF without a clear gap is not of that DOF
+    for a builder (its near-mechanisms are soft modes); delivered where the search found no
+    other, the verdict says first and plainly that the target was reached only without a
+    clear gap, and the run falls short (exit 1). Where the run accepted such a design
+    (``--accept-no-gap``) or had no deployability check (the paper's Step 5), the margin is
+    a note and the run passes. The margin is set here, not a singular value that one
+    machine's floating point puts on one side of a threshold."""
+    from rigidfold.pipeline.verdict import RunOutcome
+    from rigidfold.rundir.schema import STAGES, Stage
+
+    run = generate(case_from_specs("bezier", "1", seed=1), GenerateOptions(lookahead=True))
+    assert run.stop is Stop.TARGET_REACHED and run.deploy_check and run.dof_margin
+    developed = {"status": STAGES[Stage.DEVELOPMENT].passing.value}  # every check passed
+    records = [
+        SolutionRecord(s.step, s.mechanism.dof, development=developed) for s in run.solutions
+    ]
+    files = [Path(f"solutions/step_{s.step:02d}.fold") for s in run.solutions]
+
+    def verdict(settings=DEFAULTS):
+        return run_verdict(run, records, files, 1, settings)
+
+    assert verdict().outcome is RunOutcome.PASSED  # its own margin is clear
+    message = "the search counted DOF 1, the singular values of the constraints give DOF 2"
+    run.dof_margin = {**run.dof_margin, "clear": False, "message": message}
+    short = verdict()
+    assert short.outcome is RunOutcome.FELL_SHORT
+    assert short.shortfalls == (
+        f"the target DOF 1 was reached only without a clear DOF gap: {message}",
+    )
+    assert message not in short.warnings
+    assert short.final_design == files[-1]  # still delivered, named
+    accepted = verdict(DEFAULTS.with_(clear_gap=False))
+    assert accepted.outcome is RunOutcome.PASSED and accepted.warnings == (message,)
+    run.deploy_check = False
+    paper = verdict()
+    assert paper.outcome is RunOutcome.PASSED and paper.warnings == (message,)

@@ -29,7 +29,14 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.generate.case_options import CaseOptions, SettingsOptions
 from rigidfold.io import jsonable
-from rigidfold.runtime.interrupts import EXIT_INTERRUPTED, held_interrupts, interrupt_handled
+from rigidfold.runtime.interrupts import (
+    EXIT_INTERRUPTED,
+    decide_exit,
+    decided_exit,
+    forget_exit,
+    held_interrupts,
+    interrupt_handled,
+)
 from rigidfold.runtime.quiet import VERBOSE_ENV, native_output_shown
 from rigidfold.study import STUDY_OPTIONS
 
@@ -139,7 +146,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                 return _interrupted(result, writer, progress)
     with held_interrupts(reraise=False):  # the run's files are written: it has ended
         progress.close()
-        return _print_generated(args, writer.out, result)
+        return decide_exit(_print_generated(args, writer.out, result))
 
 
 def _interrupted(result, writer, progress) -> int:
@@ -503,6 +510,7 @@ _COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    forget_exit()  # nothing decided yet (a command run again in-process)
     try:  # a signal while the command line is read ends as any other: exit 130
         parser = build_parser()
         argv = attached_values(sys.argv[1:] if argv is None else argv)
@@ -532,6 +540,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USAGE
     except KeyboardInterrupt:
         interrupt_handled()
+        decided = decided_exit()
+        if decided is not None:  # the signal came once the run had ended: it stops nothing
+            return decided
         print("rigidfold: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:

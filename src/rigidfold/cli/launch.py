@@ -15,6 +15,7 @@ from rigidfold.runtime.clock import mark_command
 from rigidfold.runtime.interrupts import (
     EXIT_INTERRUPTED,
     command_ended,
+    decided_exit,
     interrupt_handled,
     terminate_interrupts,
 )
@@ -41,6 +42,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         code = cli_main(argv)
     except KeyboardInterrupt:
+        if code is None:
+            code = decided_exit()  # the run had ended: the signal stops nothing
         if code is None:
             print("rigidfold: interrupted", file=sys.stderr)
             code = EXIT_INTERRUPTED

@@ -103,7 +103,8 @@ class GenerationSettings(Group):
         "gap (:class:`rigidfold.mechanism.margin.DofMargin`: near-mechanisms, or the "
         "search's count and the singular values' differ) is a rejected candidate "
         "(``no_gap``): the search goes on for one with a clear gap and delivers that one "
-        "only where it finds none (the verdict says so). ``False`` (``--accept-no-gap``): "
+        "only where it finds none (the run then falls short, its verdict says so first). "
+        "``False`` (``--accept-no-gap``): "
         "such a solution ends the run, as before session 24.",
     )
     hinge_stiffness: float = setting(

@@ -216,7 +216,7 @@ class SettingsOptions:
         False,
         "with the deployability check: a design at the target DOF without a clear DOF gap "
         "(near-mechanisms) ends the run; by default the search goes on for one with a clear "
-        "gap and delivers such a design only where it finds none "
+        "gap and delivers such a design only where it finds none, the run falling short "
         "(Settings.generation.clear_gap)",
     )
     dof_count: str = option(

@@ -76,7 +76,11 @@ def run_verdict(
     (``--structure``), each failure with its detail. A check that failed on
     another solution is a warning, and so is a target at or above the initial DOF (no crease
     fixed) and a DOF-0 final design (it does not fold). With the deployability check, a run
-    that fell short says so when no deployable design was found at a lower DOF (N_path > 0).
+    that fell short says so when no deployable design was found at a lower DOF (N_path > 0),
+    and a design at the target DOF without a clear gap (:class:`rigidfold.mechanism.margin.
+    DofMargin`: its soft modes are mechanisms for a builder, issue 49) falls short of it,
+    saying so first, unless the run accepted such a design (``Settings.generation.clear_gap``
+    off, ``--accept-no-gap``: then, as without the check, the margin is a warning).
 
     records : each solution's checks, in the order of ``files`` (their FOLD paths, relative
     to the run's DIR); :meth:`SolutionRecord.failed_stages` says what failed. ``settings``:
@@ -127,7 +131,14 @@ def run_verdict(
         )
     margin = run.dof_margin
     if final is not None and margin is not None and not margin.get("clear", True):
-        warnings += (str(margin["message"]),)
+        if reached and run.deploy_check and settings.generation.clear_gap:
+            short.insert(
+                0,
+                f"the target DOF {target} was reached only without a clear DOF gap: "
+                f"{margin['message']}",
+            )
+        else:
+            warnings += (str(margin["message"]),)
     if final is not None and final.mechanism.dof == 0 and reached:
         warnings += (
             "a DOF-0 design has no mechanism: it does not fold (no folding motion or "

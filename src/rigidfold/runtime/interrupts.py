@@ -64,6 +64,27 @@ def interrupt_handled() -> None:
 
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_DECIDED: list[int] = []  # the exit code of a command whose run has ended (decide_exit)
+
+
+def decide_exit(code: int) -> int:
+    """The command's run has ended, every file of it written, and ``code`` is its exit
+    code: an interrupt from here on stops nothing, and the command's entry points, catching
+    it on the way out, exit with ``code`` (:func:`decided_exit`) rather than 130 beside a
+    summary that says the run ended (a signal just after the held block that prints the
+    verdict did so, once in the interrupt contract's runs). Returns ``code``."""
+    _DECIDED[:] = [code]
+    return code
+
+
+def forget_exit() -> None:
+    """No exit code is decided (a command run again in-process starts afresh)."""
+    _DECIDED.clear()
+
+
+def decided_exit() -> int | None:
+    """The exit code :func:`decide_exit` decided for the command (None: none yet)."""
+    return _DECIDED[0] if _DECIDED else None
 
 
 def command_ended() -> None:
