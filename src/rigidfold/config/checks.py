@@ -63,10 +63,15 @@ class PathSettings(Group):
         "more slowly is halved).",
     )
     turn_back: float = setting(
-        0.05,
+        1.0,
         "A 1-DOF path turns back (the shape does not deploy along it) when its folding "
         "measure, having fallen, rises this much (a fraction of the design's) above its "
-        "lowest.",
+        "lowest: by 1, it has gone further from the flat state than the design is. Below "
+        "that, the trace goes on while it finds new lows (``path_wander_steps``): a 1-DOF "
+        "path may fold some creases further before it unfolds (0.05 until session 37 "
+        "rejected such a design of Origami Simulator's sharp-angled Miura-ori on the dome, "
+        "whose measure rose 0.13 above its low on the way to the flat state; "
+        "docs/broad_set.md).",
     )
     max_turn: float = setting(
         math.radians(30.0),

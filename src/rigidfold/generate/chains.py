@@ -299,8 +299,9 @@ class ChainControl:
         return first.solutions[first.final_step].mechanism.dof
 
     def publish(self) -> None:
-        """A later round reached the target: the callbacks see the first round's chain
-        retracted (but its initial shape) and the round's accepted, in order. Where an
+        """A later round's chain is the run's (it reached the target, or ended lowest,
+        :meth:`conclude`): the callbacks see the first round's chain retracted (but its
+        initial shape) and the round's accepted, in order. Where an
         interrupt comes as they do, the chain ends as far as they saw it (the design then
         the best known, :func:`rigidfold.generate.final.best_so_far`)."""
         if not self.silent:
