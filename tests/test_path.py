@@ -247,7 +247,8 @@ STALLED = [
 
 
 def stalled_shape(file):
-    """A DOF-1 shape whose sparse continuation stalled (tests/data/stalled)."""
+    """A DOF-1 shape saved in tests/data (its coordinates, faces, edges, fixed creases and
+    DOF): one whose sparse continuation stalled (``stalled/``), or another path's case."""
     from rigidfold.mesh import CreasePattern
 
     data = np.load(file)
@@ -367,3 +368,21 @@ def test_a_path_along_a_second_near_flex_reaches_the_flat_state(file):
     path = trace_path(shape, dof=dof, support_face=support)
     assert path.status is PathStatus.FLAT, path.message
     assert path.max_length_error < 1e-8
+
+
+def test_a_path_that_folds_further_on_its_way_to_the_flat_state_deploys():
+    """A DOF-1 child of Origami Simulator's sharp-angled Miura-ori on the dome (761 free
+    creases; the clear DOF-2 shape of a run, crease 5 fixed and solved from it, session 37):
+    its folding measure falls to 0.93 of the design's, rises some 0.13 above that as creases
+    fold further, then falls to the flat state. With a turn back at a rise of 0.05 (the
+    setting before session 37) the trace called it "turns back" and the search rejected a
+    design that deploys; with ``path_turn_back`` 1 (a rise by the design's own measure) it
+    reaches the flat state, every point on the constraints to path_tol."""
+    shape, dof = stalled_shape(DATA / "turn_back" / "miura_sharpangle_dome_0.npz")
+    path = trace_path(shape, dof=dof)
+    assert path.status is PathStatus.FLAT, path.message
+    assert path.max_length_error < 1e-8
+    rise = path.measure - np.minimum.accumulate(path.measure)
+    assert 0.05 < rise.max() < DEFAULTS.path.turn_back  # it folds further on the way
+    early = trace_path(shape, dof=dof, settings=DEFAULTS.with_(path_turn_back=0.05))
+    assert early.status is PathStatus.TURNED_BACK
