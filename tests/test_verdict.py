@@ -90,3 +90,19 @@ def test_a_design_at_the_target_without_a_clear_gap_falls_short_of_it():
     run.deploy_check = False
     paper = verdict()
     assert paper.outcome is RunOutcome.PASSED and paper.warnings == (message,)
+
+
+def test_a_first_solve_not_accepted_says_how_the_solver_ended():
+    """The first solve of a run gives no design (here IPOPT allowed 3 iterations): the run
+    says the solver's status, F and the iterations it took (it said "(exceed)", the
+    attempt's outcome, for IPOPT's infeasibility and its iteration limit alike)."""
+    settings = DEFAULTS.with_(ipopt_max_iter=3)
+    run = generate(case_from_specs("bezier", "1", seed=1, settings=settings), OPTIONS)
+    first = run.attempts[0]
+    assert run.stop is Stop.INITIAL_FAILED and first.outcome is AttemptOutcome.INITIAL_FAILED
+    assert first.iterations <= 3
+    assert run.stop_reason == (
+        f"no developable polyhedron from the initial shape ({first.status.value}: "
+        f"F {first.F:.2g} after {first.iterations} iterations)"
+    )
+    assert _verdict(run).shortfalls[0].startswith(f"no solution: {run.stop_reason} (")

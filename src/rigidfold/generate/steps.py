@@ -618,7 +618,7 @@ def generate(
         steps.record(rec, trial)
         return run
     if not steps.is_solution(rec):
-        run.stop, run.stop_detail = Stop.INITIAL_FAILED, rec.outcome.value
+        run.stop, run.stop_detail = Stop.INITIAL_FAILED, _first_failure(rec)
         rec.outcome = AttemptOutcome.INITIAL_FAILED
         steps.record(rec, trial)
         return run
@@ -651,6 +651,15 @@ def generate(
         )
         run.dof_margin = margin.to_dict()
     return run
+
+
+def _first_failure(rec: Attempt) -> str:
+    """Why the first solve gave no design, in words: for a solve not accepted (``exceed``)
+    the solver's status with F and its iterations (IPOPT's "infeasible" or its iteration
+    limit are not what "exceed" says), otherwise the attempt's outcome (a lock, DOF 0)."""
+    if rec.outcome is not AttemptOutcome.EXCEED:
+        return rec.outcome.value
+    return f"{rec.status.value}: F {rec.F:.2g} after {rec.iterations} iterations"
 
 
 def _forecast_order(candidates: list, forecast: ChildForecast | None) -> Iterator[Choice]:
