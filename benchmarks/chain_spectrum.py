@@ -5,6 +5,8 @@ Run with::
     python benchmarks/chain_spectrum.py RUN/solutions [--steps 19,20]
     python benchmarks/chain_spectrum.py RUN/solutions --steps 71 --children 25 \\
         --surface dome --pattern tests/data/origami_simulator/miura_sharpangle.svg
+    python benchmarks/chain_spectrum.py RUN/solutions --steps 67 --children 25 \\
+        --surface dome --pattern ... --paths [--turn-back 100]
 
 For each saved shape (``step_NN_dof_MM.fold`` of ``rigidfold generate``) it prints the DOF
 counted with the gap (``Settings.mechanism.dof_gap`` times the rank threshold, the search's
@@ -13,7 +15,10 @@ and how many free creases turn in the counted and in the exact mechanisms (rows 
 above 1e-3 of the largest). With ``--children N`` (one step, and the run's case given as
 ``generate`` takes it) the N creases that turn least in the shape's exact mechanisms are
 fixed one at a time and solved from its coordinates, and each child is printed the same way,
-with whether it locks a crease. ``docs/broad_set.md`` (session 36) quotes its figures.
+with whether it locks a crease. With ``--paths`` the path of each DOF-1 child without a
+lock is traced (:func:`rigidfold.mechanism.path.trace_path`; ``--turn-back`` sets
+``Settings.path.turn_back``) and printed with the largest rise of its folding measure above
+its running low. ``docs/broad_set.md`` (sessions 36-37) quotes its figures.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from rigidfold.config import DEFAULTS
 from rigidfold.generate.specs import case_from_specs
 from rigidfold.io import read_fold
 from rigidfold.mechanism import Mechanism, analyze
+from rigidfold.mechanism.path import trace_path
 from rigidfold.mesh import CreasePattern
 
 MOVING = 1e-3
@@ -64,6 +70,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--surface", default=None)
     parser.add_argument("--pattern", default=None)
     parser.add_argument("--seed", type=int, default=None)
+    parser.add_argument("--paths", action="store_true", help="trace the DOF-1 children's paths")
+    parser.add_argument("--turn-back", type=float, default=None, help="Settings.path.turn_back")
     args = parser.parse_args(argv)
     wanted = None if args.steps is None else {int(s) for s in args.steps.split(",")}
     files = sorted(args.solutions.glob("step_*.fold"))
@@ -80,6 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     if len(shapes) != 1 or args.surface is None or args.pattern is None:
         parser.error("--children takes one step (--steps) and the run's --surface and --pattern")
     ((step, shape),) = shapes.items()
+    settings = DEFAULTS if args.turn_back is None else DEFAULTS.with_(path_turn_back=args.turn_back)
     case = case_from_specs(args.surface, args.pattern, seed=args.seed)
     problem = case.problem()
     _, counted, exact = describe(shape)
@@ -95,8 +104,16 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  crease {crease:4d}  {result.status.value}")
             continue
         moved = float(np.abs(result.coords - shape.coords).max())
-        line = describe(result.pattern)[0]
+        line, child, _ = describe(result.pattern)
         print(f"  crease {crease:4d}  share {share[j]:.1e}  moved {moved:.1e}  {line}", flush=True)
+        if args.paths and child.dof == 1 and not child.has_lock:
+            path = trace_path(result.pattern, dof=1, settings=settings)
+            rise = float(np.max(path.measure - np.minimum.accumulate(path.measure)))
+            print(
+                f"      path {path.status.value}  lowest m {path.measure.min():.3f}  "
+                f"rise {rise:.3f}  steps {path.steps}: {path.message}",
+                flush=True,
+            )
     return 0
 
 
