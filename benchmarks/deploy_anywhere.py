@@ -22,7 +22,9 @@ has a clear gap (``clear_gap``; ``near`` and ``nonzero_min`` of its margin), its
 solves, the solves per DOF removed, the seconds, and the rejected candidates by cause
 (``lock``, ``exceed``, ``second_order_rigid``, and for paths that do not reach the flat state
 their status: ``turned_back``, ``stops_short``, ``collision``, ``max_steps``, ``stalled`` (the
-tracer's failure), ``zero_dof``; ``dead_end``: retracted by backtracking). At the end, per
+tracer's failure), ``zero_dof``; ``dead_end``: retracted by backtracking), its seconds by
+part (``time_split``: the run's ``time_s``) and the candidates' trace seconds by how each
+trace ended (``path_s``: ``flat`` for the paths that deploy). At the end, per
 mode: the share (and of it, those with a clear gap), the median time and the median solves
 per DOF removed, and the causes summed; where the forecast ran, how its calls matched what
 the solve and trace found.
@@ -70,6 +72,7 @@ MODES: dict[str, dict] = {
     "trace-first": {"second_order_first": False, "same_shape_tol": 0.0},
     "one-round": {"reseeds": 0, "reseeds_timed": 0},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
+    "project-first": {"projection_vertices": 3},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
@@ -84,7 +87,8 @@ creases per solve far from the target (the default since session 31, as ``after`
 test only after a path that fails (the search before session 33, the same attempts);
 ``one-round`` the search without its later rounds of other seeds (``reseeds`` 0, the search
 before session 34); ``spread-first`` the first round's K_j spread by 10 % too (a probe of
-session 34)."""
+session 34); ``project-first`` the projection onto F = 0 before IPOPT at every size
+(``Settings.solver.projection_vertices`` 3; a probe of session 38)."""
 MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}, "batch-off": {"batch": "off"}}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
 per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``)."""
@@ -129,6 +133,17 @@ def cause(attempt) -> str | None:
     if outcome == "path":
         return attempt.path["status"] if attempt.path else "path"
     return outcome
+
+
+def path_seconds(attempts) -> Counter:
+    """Seconds of the candidates' path traces by how each ended (a trace's time is the
+    path check's: the second-order test and the trace)."""
+    out: Counter = Counter()
+    for a in attempts:
+        if a.path_time > 0:
+            key = a.path["status"] if a.path else (cause(a) or "accepted")
+            out[key] += round(a.path_time, 2)
+    return out
 
 
 def run(case: dict, mode: str) -> dict:
@@ -185,6 +200,8 @@ def run(case: dict, mode: str) -> dict:
         "N_rigid": gen.n_rigid,
         "N_backtrack": gen.n_backtrack,
         "causes": dict(Counter(c for a in gen.attempts if (c := cause(a)) is not None)),
+        "time_split": {k: round(v, 2) for k, v in gen.to_dict()["time_s"].items()},
+        "path_s": dict(path_seconds(gen.attempts)),
         "forecast": dict(forecast),
     }
 

@@ -64,14 +64,17 @@ class Case:
             )
         return out
 
-    def problem(self, *, build_ipopt: bool = True) -> FormFindingProblem:
-        """Build problem (6) for this case."""
+    def problem(
+        self, *, build_ipopt: bool = True, project_first: bool = False
+    ) -> FormFindingProblem:
+        """Build problem (6) for this case (``project_first``: see :class:`FormFindingProblem`)."""
         return FormFindingProblem(
             self.pattern,
             self.surface,
             planes=self.planes,
             settings=self.settings,
             build_ipopt=build_ipopt,
+            project_first=project_first,
         )
 
     def deviation(self, coords: np.ndarray) -> np.ndarray:

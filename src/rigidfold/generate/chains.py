@@ -171,7 +171,10 @@ class ChainControl:
         self.new_chain(keep=within(run.solutions, limit))
         self.fold_limit = limit
         t0 = time.perf_counter()
-        self.problem = case.problem(build_ipopt=self.options.solver == SolverName.IPOPT)
+        self.problem = case.problem(
+            build_ipopt=self.options.solver == SolverName.IPOPT,
+            project_first=self.options.project_first,
+        )
         run.build_time += time.perf_counter() - t0
         return True
 

@@ -33,6 +33,9 @@ from rigidfold.structure.design import StructureOptions
 BATCH_CHOICES = ("auto", "on", "off")
 """``GenerateOptions.batch``: several creases per solve (auto: with the deployability check,
 until the first chain's first dead end)."""
+PROJECTION_CHOICES = ("auto", "always", "large")
+"""``GenerateOptions.projection``: the projection onto F = 0 before IPOPT at every size or on
+large patterns only (auto: at every size with the deployability check)."""
 
 
 @dataclass(frozen=True)
@@ -132,6 +135,17 @@ class GenerateOptions:
         "one crease per solve; on = in every chain",
         choices=BATCH_CHOICES,
     )
+    projection: str = option(
+        "auto",
+        "how each solve of problem (6) begins: always = by the projection onto F = 0 from "
+        "the start (the parent's shape: the nearest developable shape to it, with one crease "
+        "more fixed), IPOPT only where that does not converge (rigidfold.optimize.large); "
+        "large = so only on patterns of Settings.solver.projection_vertices or more, IPOPT "
+        "alone on smaller ones (the paper's solver, its Tables 5-8); auto (the default) = "
+        "always with the deployability check, large without it (the paper's Step 5 and the "
+        "study)",
+        choices=PROJECTION_CHOICES,
+    )
     time_limit: float | None = option(
         None,
         "solve no further candidate after this many seconds (a candidate's path trace under "
@@ -147,7 +161,11 @@ class GenerateOptions:
 
     def _check_run(self) -> None:
         """Validate the options of Steps 2-9."""
-        for name, choices in (("criterion", CRITERIA), ("batch", BATCH_CHOICES)):
+        for name, choices in (
+            ("criterion", CRITERIA),
+            ("batch", BATCH_CHOICES),
+            ("projection", PROJECTION_CHOICES),
+        ):
             value = getattr(self, name)
             if value not in choices:
                 raise RigidfoldError(f"unknown {name} {value!r} (choose from {', '.join(choices)})")
@@ -213,6 +231,13 @@ class GenerateOptions:
         if self.structure is not None:
             return self.structure.material
         return material_named(DEFAULTS.structure.material)
+
+    @property
+    def project_first(self) -> bool:
+        """Whether every solve of problem (6) begins with the projection onto F = 0
+        (:attr:`projection` "always", or "auto" with the deployability check), not only on
+        patterns of ``Settings.solver.projection_vertices`` or more."""
+        return self.projection == "always" or (self.projection == "auto" and self.deploy_check)
 
     @property
     def panel_thickness(self) -> float | None:

@@ -129,7 +129,9 @@ class _Steps(ChainControl):
         self.budget = time_budget(
             self.started, options.time_limit, case.pattern.n_vertices, case.settings
         )
-        self.problem = case.problem(build_ipopt=options.solver == SolverName.IPOPT)
+        self.problem = case.problem(
+            build_ipopt=options.solver == SolverName.IPOPT, project_first=options.project_first
+        )
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
             crease_groups(case.pattern, case.planes, self.settings) if case.planes else None

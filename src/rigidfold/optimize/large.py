@@ -68,8 +68,13 @@ class ProjectedIpoptSolver:
 
 
 def ipopt_solver(problem: SolverProblem) -> Solver:
-    """``--solver ipopt``: IPOPT on patterns of fewer than ``Settings.solver.projection_vertices``
-    vertices, :class:`ProjectedIpoptSolver` on larger ones."""
-    if problem.pattern.n_vertices >= problem.settings.solver.projection_vertices:
+    """``--solver ipopt``: :class:`ProjectedIpoptSolver` where the problem projects first
+    (``project_first``: a generation run with the deployability check, ``GenerateOptions.
+    projection``) or has ``Settings.solver.projection_vertices`` vertices or more; IPOPT
+    alone otherwise (the paper's solver)."""
+    if (
+        problem.project_first
+        or problem.pattern.n_vertices >= problem.settings.solver.projection_vertices
+    ):
         return ProjectedIpoptSolver(problem)
     return IpoptSolver(problem)

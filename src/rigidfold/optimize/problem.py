@@ -70,6 +70,10 @@ class FormFindingProblem:
     build_ipopt : bool
         Build the IPOPT solver (exact Hessian of the Lagrangian) now, so that ``build_time``
         covers it; otherwise it is built on the first IPOPT solve.
+    project_first : bool
+        The IPOPT solver begins every solve with the projection onto F = 0 from the start
+        (:mod:`rigidfold.optimize.large`) whatever the pattern's size; False: only from
+        ``settings.solver.projection_vertices`` vertices on (IPOPT alone below, the paper's).
 
     Attributes
     ----------
@@ -95,8 +99,10 @@ class FormFindingProblem:
         planes: Sequence[SymmetryPlane] = (),
         settings: Settings = DEFAULTS,
         build_ipopt: bool = True,
+        project_first: bool = False,
     ) -> None:
         t0 = time.perf_counter()
+        self.project_first = project_first
         self.pattern = pattern
         self.surface = surface
         self.planes: tuple[SymmetryPlane, ...] = tuple(planes)

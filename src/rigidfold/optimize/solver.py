@@ -58,9 +58,11 @@ class SolverProblem(Protocol):
     objective_gradient : ca.Function (xi, w) -> (F, dF (n,))
     constraints : ca.Function (xi, w) -> g (m,)
     constraint_jacobian : ca.Function (xi, w) -> (g (m,), dg (m, n))
+    project_first : the IPOPT solver begins with the projection onto F = 0 at every size
     (see ``FormFindingProblem``, which satisfies it).
     """
 
+    project_first: bool
     pattern: CreasePattern
     surface: TargetSurface
     settings: Settings

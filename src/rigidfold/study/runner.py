@@ -37,10 +37,13 @@ PRESETS = {
 }
 
 
-STUDY_OPTIONS = GenerateOptions(deploy_check=False, deform=False, check=Check.ALL, batch="off")
+STUDY_OPTIONS = GenerateOptions(
+    deploy_check=False, deform=False, check=Check.ALL, batch="off", projection="large"
+)
 """The generate options of a study by default: the paper's Step 5 (no deployability check;
 the final design's path is traced after the run), no Step 9, and the paper's one crease per
-solve, with the deployability check too (``rigidfold study --deploy-check``)."""
+solve and solver (IPOPT alone on the paper's sizes, ``projection`` "large"), with the
+deployability check too (``rigidfold study --deploy-check``)."""
 
 
 @dataclass(frozen=True)
