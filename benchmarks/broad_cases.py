@@ -141,6 +141,52 @@ class BroadCase:
 
 FAMILIES = ("drawn", "perturbed", "mesh", "grid", "paper", "building")
 
+SAMPLE_40 = (
+    "grid/11x7-parallel/hp",
+    "grid/5x5-centre/dome",
+    "grid/5x5-parallel/hp",
+    "grid/6x9-parallel/hp",
+    "grid/7x7-alternate/bezier",
+    "grid/7x7-centre/dome",
+    "grid/9x9-alternate/bezier",
+    "grid/9x9-centre/dome",
+    "mesh/poly4-r14/bezier",
+    "mesh/poly4-r27/hp",
+    "mesh/poly4-r42/dome",
+    "mesh/poly4-r57/bezier",
+    "mesh/poly8-r3/dome",
+    "mesh/poly8-r71/hp",
+    "paper/1/bezier:1013",
+    "paper/1/bezier:2027",
+    "paper/11/bezier:1013",
+    "paper/1p/bezier:1013",
+    "paper/2/bezier:1013",
+    "paper/2/bezier:2027",
+    "perturbed/huffmanWaterbomb-p11/bezier",
+    "perturbed/langWedgeDoubleFaced-p11/hp",
+    "perturbed/miura-ori-p11/dome",
+    "perturbed/reschTriTessellation-p11/hp",
+    "perturbed/waterbomb-p11/bezier",
+    "perturbed/whirlpool-p11/dome",
+    "drawn/6ptHypar-anti/dome",
+    "drawn/MoosersTrainRigid-Gardner/bezier",
+    "drawn/boatBase/hp",
+    "drawn/cubeunwrapping/dome",
+    "drawn/flat_crane/bezier",
+    "drawn/huffmanExtrudedBoxes/hp",
+    "drawn/huffmanWaterbomb/dome",
+    "drawn/langHoneycomb/bezier",
+    "drawn/langOvalTessellation/hp",
+    "drawn/miura-ori/dome",
+    "drawn/origamisimulator/bezier",
+    "drawn/randlettflappingbird/hp",
+    "drawn/simpleVertex/dome",
+    "drawn/traditionalCrane/dome",
+)
+"""The sample of 40 cases measured since session 26 (``broad_set.py --only sample40``):
+session 23's 26 of four families (perturbed tessellations, ``mesh:`` polygons, ``grid:``
+patterns, the paper's patterns on other surfaces) and session 25's 14 drawn cases."""
+
 
 def name_seed(text: str) -> int:
     """A seed derived from a case's name (CRC-32 mod 10000): fixed, and not chosen."""

@@ -57,7 +57,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from broad_cases import FAMILIES, BroadCase, cases
+from broad_cases import FAMILIES, SAMPLE_40, BroadCase, cases
 
 VARIANTS: dict[str, tuple[str, ...]] = {
     "today": (),
@@ -71,6 +71,7 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "count-gap": ("--dof-count", "gap"),
     "backtrack-10": ("--backtrack", "10"),
     "one-round": ("--reseeds", "0"),
+    "projection-large": ("--projection", "large"),
     "reference": (),
 }
 """Named sets of extra ``rigidfold generate`` flags, compared side by side (``--variants``):
@@ -85,7 +86,9 @@ ends the run (the default before session 24); ``count-threshold`` and ``count-ga
 search's DOF count (``--dof-count``): the paper's threshold, or with the near-mechanisms;
 ``backtrack-10`` ten retractions a chain instead of three (``--backtrack 10``);
 ``one-round`` the search without its later rounds of other seeds (``--reseeds 0``, the
-search before session 34); ``reference``
+search before session 34); ``projection-large`` the projection onto F = 0 before IPOPT
+only on patterns of ``Settings.solver.projection_vertices`` or more (``--projection large``,
+the search before session 38); ``reference``
 the defaults of another checkout of rigidfold (``--reference DIR``: its ``src`` first on
 PYTHONPATH), to compare a change of the search with the search before it in the same run."""
 
@@ -421,7 +424,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
     parser.add_argument(
-        "--only", default=None, metavar="TEXT[,TEXT...]", help="cases whose name holds one"
+        "--only",
+        default=None,
+        metavar="TEXT[,TEXT...]",
+        help="cases whose name holds one; sample40: the 40 cases of broad_cases.SAMPLE_40",
     )
     parser.add_argument(
         "--sample",
@@ -486,7 +492,12 @@ def main(argv: list[str] | None = None) -> int:
         work.mkdir(parents=True, exist_ok=True)
         every, left = cases(work)
         wanted = None if args.only is None else [w for w in args.only.split(",") if w]
-        chosen = [c for c in every if wanted is None or any(w in c.name for w in wanted)]
+        sample = set(SAMPLE_40) if wanted and "sample40" in wanted else set()
+        chosen = [
+            c
+            for c in every
+            if wanted is None or c.name in sample or any(w in c.name for w in wanted)
+        ]
         if args.sample is not None:
             chosen = stratified(chosen, args.sample)
         if args.list:

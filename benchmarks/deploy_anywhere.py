@@ -72,7 +72,7 @@ MODES: dict[str, dict] = {
     "trace-first": {"second_order_first": False, "same_shape_tol": 0.0},
     "one-round": {"reseeds": 0, "reseeds_timed": 0},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
-    "project-first": {"projection_vertices": 3},
+    "projection-large": {},
 }
 """Each mode's settings changed from rigidfold's defaults: ``after`` the defaults; ``before``
 the search of session 17 (no restart with the fold limit); ``no-second-order`` without the
@@ -87,11 +87,17 @@ creases per solve far from the target (the default since session 31, as ``after`
 test only after a path that fails (the search before session 33, the same attempts);
 ``one-round`` the search without its later rounds of other seeds (``reseeds`` 0, the search
 before session 34); ``spread-first`` the first round's K_j spread by 10 % too (a probe of
-session 34); ``project-first`` the projection onto F = 0 before IPOPT at every size
-(``Settings.solver.projection_vertices`` 3; a probe of session 38)."""
-MODE_OPTIONS: dict[str, dict] = {"batch-auto": {"batch": "auto"}, "batch-off": {"batch": "off"}}
+session 34); ``projection-large`` see :data:`MODE_OPTIONS`."""
+MODE_OPTIONS: dict[str, dict] = {
+    "batch-auto": {"batch": "auto"},
+    "batch-off": {"batch": "off"},
+    "projection-large": {"projection": "large"},
+}
 """Each mode's options changed from ``generate``'s defaults: ``batch-auto`` several creases
-per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``)."""
+per solve (``generate --batch auto``; session 25), ``batch-off`` one (``--batch off``);
+``projection-large`` the projection onto F = 0 before IPOPT only from
+``Settings.solver.projection_vertices`` vertices on, IPOPT alone on smaller patterns
+(``--projection large``, the search before session 38)."""
 
 
 def paper_cases(surfaces: int) -> list[dict]:

@@ -21,8 +21,11 @@ from rigidfold.pipeline import RunWriter, run
 from rigidfold.rundir import load_run, read_log
 
 SEED = 102
-# one crease per solve: backtracking alone, not the end of the sets (tests/test_batch.py)
-OPTIONS = GenerateOptions(criterion="shat", seed=SEED, lookahead=True, deform=False, batch="off")
+# one crease per solve: backtracking alone, not the end of the sets (tests/test_batch.py);
+# the paper's solver, IPOPT alone, with which this case backtracks (GenerateOptions.projection)
+OPTIONS = GenerateOptions(
+    criterion="shat", seed=SEED, lookahead=True, deform=False, batch="off", projection="large"
+)
 
 
 def _case(backtrack_max: int):

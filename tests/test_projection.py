@@ -2,7 +2,8 @@
 
 Unit tests over reference patterns (the residuals are F, their Jacobian its derivative),
 invariants (every projected iterate is feasible; the fold-angle gradient equals the mechanism
-analysis's), and the solver's path: paper-size patterns run IPOPT alone, large ones project.
+analysis's), and the solver's path: paper-size patterns run IPOPT alone, large ones project,
+and every size projects first in a run with the deployability check.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import pytest
 
 from conftest import paper_generate as generate
 from rigidfold.config import DEFAULTS
+from rigidfold.errors import RigidfoldError
 from rigidfold.generate import GenerateOptions
 from rigidfold.generate.specs import case_from_specs
 from rigidfold.mechanism.kinematics import fold_angles_and_gradients
@@ -19,6 +21,7 @@ from rigidfold.optimize import Status, projection
 from rigidfold.optimize.hessian import angle_derivatives
 from rigidfold.optimize.projection import Projection
 from rigidfold.optimize.residuals import Residuals, angle_gradients, fold_angle_gradients
+from rigidfold.study.runner import STUDY_OPTIONS
 
 CASES = [
     ("bezier", "1", {"seed": 3}),
@@ -119,6 +122,37 @@ def test_fixing_one_more_crease_is_a_short_projection(solved_grid):
     assert again.iterations < DEFAULTS.solver.projection_max_iter
 
 
+def test_a_run_with_the_deployability_check_projects_first_at_every_size():
+    """``GenerateOptions.projection``: with the deployability check (the design tool's
+    search) every solve begins with the projection, on a paper-size pattern too; the paper's
+    Step 5 and the study keep IPOPT alone there (Tables 5-8)."""
+    assert GenerateOptions().project_first
+    assert not GenerateOptions(deploy_check=False).project_first
+    assert GenerateOptions(deploy_check=False, projection="always").project_first
+    assert not GenerateOptions(projection="large").project_first
+    assert not STUDY_OPTIONS.project_first
+    case = case_from_specs("dome", "grid:11x11", size="3x3")
+    assert case.pattern.n_vertices < DEFAULTS.solver.projection_vertices
+    first = case.problem().solve()
+    assert first.status is Status.CONVERGED
+    rho = np.abs(first.pattern.fold_angles)
+    folded = np.flatnonzero(~first.pattern.is_boundary_edge & (rho > 1e-3))
+    fixed = first.pattern.fixed.copy()
+    fixed[folded[np.argmin(rho[folded])]] = True
+    projected = case.problem(project_first=True).solve(fixed=fixed, start=first.coords)
+    alone = case.problem().solve(fixed=fixed, start=first.coords)
+    assert projected.status is Status.CONVERGED and alone.status is Status.CONVERGED
+    assert projected.message.startswith("projection: converged, F = ")
+    assert projected.max_violation == 0.0
+    assert alone.message.startswith("IPOPT: ")
+    assert "projection" not in alone.message
+
+
+def test_an_unknown_projection_is_refused_by_name():
+    with pytest.raises(RigidfoldError, match="unknown projection 'nearest'"):
+        GenerateOptions(projection="nearest")
+
+
 @pytest.fixture(scope="module")
 def tight_grid(solved_grid):
     """The 21 x 21 problem with the dz bound pulled in to its solution's own largest |dz|."""
@@ -215,6 +249,25 @@ def test_an_infeasible_start_is_not_projected():
     out = Projection(problem)(problem.start_point(), np.zeros(problem.pattern.n_edges))
     assert not out.converged and not out.feasible
     assert out.iterations == 0
+    assert "violates" in out.reason
+
+
+def test_a_start_with_a_collapsed_triangle_is_not_projected():
+    """The composite solver polishes IPOPT's last iterate, which can have a collapsed
+    triangle (Origami Simulator's 6ptHypar-anti on the dome): no shape, so not feasible, and
+    the solve fails as IPOPT's own would (the start kept), not with the pattern's error."""
+    problem = case_from_specs("dome", "grid:7x7", size="3x3").problem(
+        build_ipopt=False, project_first=True
+    )
+    pattern = problem.pattern
+    coords = pattern.coords.copy()
+    a, b, v = next(
+        (a, b, v) for a, b, v in pattern.faces.tolist() if not pattern.is_boundary_vertex[v]
+    )
+    coords[v] = 0.5 * (coords[a] + coords[b])  # the face (a, b, v) has no area
+    xi = problem.start_point(coords)
+    out = Projection(problem)(xi, np.zeros(pattern.n_edges))
+    assert not out.feasible and out.iterations == 0
     assert "violates" in out.reason
 
 

@@ -240,7 +240,9 @@ def test_a_rigid_candidate_is_rejected_before_its_trace_with_the_same_verdict(mo
         traced.clear()
         settings = DEFAULTS.with_(second_order_first=first, restart_after=2, fold_limits=())
         case = case_from_specs("bezier", "1", seed=1, settings=settings)
-        runs.append(generate(case, criterion="s", seed=1, lookahead=True, deform=False))
+        runs.append(  # the paper's solver, IPOPT alone, with which this case meets rigid ones
+            generate(case, criterion="s", seed=1, lookahead=True, deform=False, projection="large")
+        )
         traces.append(list(traced))
     before, after = runs
     rigid = [a for a in before.attempts if a.outcome is AttemptOutcome.RIGID]

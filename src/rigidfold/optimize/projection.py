@@ -101,9 +101,15 @@ class Projection:
         self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
 
     def feasible(self, xi: np.ndarray, w: np.ndarray) -> bool:
-        """Whether a point meets every constraint of (6), well inside ``constraint_tol``."""
+        """Whether a point meets every constraint of (6), well inside ``constraint_tol``; a
+        point that is no shape (a triangle collapsed, a coordinate not finite: an IPOPT
+        iterate stopped early can be one) does not."""
         coords = self.problem.map.expand(xi)
-        return self.problem.violation(coords, w > 0) <= 0.1 * self.settings.solver.constraint_tol
+        try:
+            violation = self.problem.violation(coords, w > 0)
+        except ValueError:  # rigidfold.mesh.CreasePattern refuses the shape
+            return False
+        return violation <= 0.1 * self.settings.solver.constraint_tol
 
     def __call__(
         self,
@@ -123,7 +129,8 @@ class Projection:
         xi = np.asarray(xi0, dtype=float).copy()
         w = np.asarray(w, dtype=float)
         if not self.feasible(xi, w):
-            r, _ = self.residuals(xi, w, jacobian=False)
+            with np.errstate(invalid="ignore", divide="ignore"):  # F of no shape is NaN
+                r, _ = self.residuals(xi, w, jacobian=False)
             reason = "the start violates a constraint of (6)"
             return Projected(xi, float(r @ r), 0, False, False, 0, reason)
         held = np.zeros(0, dtype=np.int64)  # the working set W
