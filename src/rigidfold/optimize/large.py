@@ -1,7 +1,9 @@
 """The solver of problem (6) on large patterns: projection, IPOPT, projection.
 
-On patterns of at least ``Settings.solver.projection_vertices`` vertices, ``--solver ipopt`` is
-this composite (:func:`ipopt_solver` chooses). IPOPT gets the gradient of F and the
+On patterns of at least ``Settings.solver.projection_vertices`` vertices, and on every pattern
+where the problem projects first (``project_first``: a generation run with the deployability
+check, ``GenerateOptions.projection``), ``--solver ipopt`` is this composite
+(:func:`ipopt_solver` chooses). IPOPT gets the gradient of F and the
 constraint Jacobian in closed form (:mod:`rigidfold.optimize.jacobian`; CasADi's cost most
 of a large build), and the solver does three things: the projection onto F = 0 from the
 start (:mod:`rigidfold.optimize.projection`), which is all that is needed after one more
