@@ -26,8 +26,8 @@ tracer's failure), ``zero_dof``; ``dead_end``: retracted by backtracking), its s
 part (``time_split``: the run's ``time_s``) and the candidates' trace seconds by how each
 trace ended (``path_s``: ``flat`` for the paths that deploy). At the end, per
 mode: the share (and of it, those with a clear gap), the median time and the median solves
-per DOF removed, and the causes summed; where the forecast ran, how its calls matched what
-the solve and trace found.
+per DOF removed, the causes summed, and the runs' seconds in all and by part; where the
+forecast ran, how its calls matched what the solve and trace found.
 """
 
 from __future__ import annotations
@@ -283,6 +283,11 @@ def main() -> None:
             f"{statistics.median(per_dof) if per_dof else float('nan'):.2f}"
         )
         print(f"{mode}: rejected candidates by cause {dict(causes.most_common())}")
+        split: Counter = Counter()
+        for r in sel:
+            split.update(r["time_split"])
+        total = sum(r["time_s"] for r in sel)
+        print(f"{mode}: {total:.0f} s in all, by part { {k: round(v) for k, v in split.items()} }")
         if forecast:
             print(f"{mode}: forecast -> found {dict(forecast.most_common())}")
 

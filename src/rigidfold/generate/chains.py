@@ -171,10 +171,7 @@ class ChainControl:
         self.new_chain(keep=within(run.solutions, limit))
         self.fold_limit = limit
         t0 = time.perf_counter()
-        self.problem = case.problem(
-            build_ipopt=self.options.solver == SolverName.IPOPT,
-            project_first=self.options.project_first,
-        )
+        self.problem = run_problem(case, self.options)
         run.build_time += time.perf_counter() - t0
         return True
 
@@ -461,6 +458,15 @@ def with_fold_limit(case: Case, options: GenerateOptions, limit: float) -> Case:
     if not options.deploy_check or s.design.rho_max is not None:
         return case
     return replace(case, settings=s.with_(rho_max=limit))
+
+
+def run_problem(case: Case, options: GenerateOptions) -> FormFindingProblem:
+    """Problem (6) of ``case`` as a run with ``options`` solves it: IPOPT built at once where
+    it is the run's solver, the projection first where the options ask it
+    (``GenerateOptions.project_first``)."""
+    return case.problem(
+        build_ipopt=options.solver == SolverName.IPOPT, project_first=options.project_first
+    )
 
 
 def makes_sets(options: GenerateOptions) -> bool:

@@ -63,6 +63,7 @@ from rigidfold.generate.chains import (
     attempt_time,
     chain_dof,
     makes_sets,
+    run_problem,
     with_fold_limit,
 )
 from rigidfold.generate.deploy_check import DeployCheck
@@ -80,7 +81,7 @@ from rigidfold.mechanism.path import FoldingPath
 from rigidfold.mechanism.second_order import ChildForecast
 from rigidfold.mechanism.stiffness import hinge_stiffness
 from rigidfold.mesh import CreasePattern
-from rigidfold.optimize import OptimizeResult, SolverName
+from rigidfold.optimize import OptimizeResult
 from rigidfold.runtime.numerics import numeric_environment
 from rigidfold.selection import (
     Choice,
@@ -129,9 +130,7 @@ class _Steps(ChainControl):
         self.budget = time_budget(
             self.started, options.time_limit, case.pattern.n_vertices, case.settings
         )
-        self.problem = case.problem(
-            build_ipopt=options.solver == SolverName.IPOPT, project_first=options.project_first
-        )
+        self.problem = run_problem(case, options)
         self.run.build_time = time.perf_counter() - t0
         self.groups = (
             crease_groups(case.pattern, case.planes, self.settings) if case.planes else None
