@@ -311,6 +311,15 @@ class GenerationSettings(Group):
         "(docs/broad_set.md, session 27: 26/40 either way on the broad set; a case that "
         "always failed passes, one that passes or fails by seconds at the limit failed).",
     )
+    reuse_max_dof: int = setting(
+        20,
+        "A candidate met again at the same shape (bitwise the same coordinates and fixed "
+        "creases, under the same fold limit) repeats the earlier attempt's solve, analysis "
+        "and check instead of computing them again (``Attempt.solve_from``; "
+        ":mod:`rigidfold.generate.memo`); the solutions of more DOF than this are not kept "
+        "(their mechanisms fill memory, their solves are quick). 0: every attempt is "
+        "computed.",
+    )
     same_shape_tol: float = setting(
         1e-6,
         "With the deployability check: a candidate's solution whose shape lies within this "
@@ -408,7 +417,7 @@ class GenerationSettings(Group):
                 "time_limit_reserve_share must lie in [0, 1), got "
                 f"{self.time_limit_reserve_share!r}"
             )
-        self._integer(near_tries=0, near_max=0, reseeds=0, reseeds_timed=0)
+        self._integer(near_tries=0, near_max=0, reseeds=0, reseeds_timed=0, reuse_max_dof=0)
         self._boolean("retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack")
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)

@@ -161,6 +161,11 @@ class Attempt:
         For a solution rejected without a trace because an earlier attempt's solution had
         the same shape (``Settings.generation.same_shape_tol``): that attempt's index, whose
         ``path`` and ``second_order`` this one repeats; None for any other.
+    solve_from : int or None
+        For an attempt that repeats an earlier one (the same fix from bitwise the same
+        shape under the same bound: :mod:`rigidfold.generate.memo`): that attempt's index,
+        whose solve, analysis and check it repeats without computing them again (its
+        seconds are 0); None for any other.
     search_round : int
         The round of the search it belongs to (``Settings.generation.reseeds``): 0 the
         first; a later round started again from the initial shape with other seeds.
@@ -193,6 +198,7 @@ class Attempt:
     batch: int = 0
     near: float | None = None
     path_from: int | None = None
+    solve_from: int | None = None
     search_round: int = 0
 
     def to_dict(self) -> dict:

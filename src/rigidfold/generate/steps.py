@@ -67,6 +67,7 @@ from rigidfold.generate.chains import (
     with_fold_limit,
 )
 from rigidfold.generate.deploy_check import DeployCheck
+from rigidfold.generate.memo import AttemptMemo, attempt_key
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import (
     Attempt,
@@ -180,6 +181,8 @@ class _Steps(ChainControl):
         # not tried again where a restart's kept shape is ranked anew
         self.dead: dict[int, set[tuple[int, ...]]] = {}
         self.checks = DeployCheck(options, self.settings)  # Step 5's check, its rejections
+        # the attempts by starting shape and fix: none is solved twice
+        self.memo: AttemptMemo[_Trial] = AttemptMemo(self.settings.generation.reuse_max_dof)
 
     def solve(
         self, fixed: np.ndarray, start, added, score, *, polish: bool = True
@@ -472,9 +475,29 @@ class _Steps(ChainControl):
         (:meth:`solve` from its coordinates, ``polish`` passed on); the attempt is charged
         the selection time not yet charged, and ``shape`` the attempt's seconds. Not yet
         recorded."""
-        trial_fixed = current.result.pattern.fixed.copy()
-        trial_fixed[list(fix)] = True
-        rec, trial = self.solve(trial_fixed, current.result.coords, fix, score, polish=polish)
+        start = current.result.pattern
+        key = attempt_key(start, fix, self.fold_limit, polish)
+        repeat = self.memo.repeat(key, len(self.run.attempts), self.search_round)
+        if repeat is not None:  # the same fix from the same shape: its attempt again
+            rec, trial = repeat
+            assert rec.solve_from is not None
+            if rec.solve_from in self.margins:
+                self.margins[rec.index] = self.margins[rec.solve_from]
+            rec.fixed_added, rec.score = tuple(fix), score
+            self.run.attempts.append(rec)
+        else:
+            trial_fixed = start.fixed.copy()
+            trial_fixed[list(fix)] = True
+            rec, trial = self.solve(trial_fixed, start.coords, fix, score, polish=polish)
+            self.memo.keep(
+                key,
+                rec,
+                trial
+                if self.is_solution(rec)
+                or trial.mechanism is None
+                or rec.outcome is AttemptOutcome.NO_GAP
+                else _Trial(trial.result, None, None),
+            )
         rec.selection_time, shape.t_sel = shape.t_sel, 0.0
         shape.spent += attempt_time(rec)
         return rec, trial
