@@ -248,7 +248,8 @@ LARGE_DOF = 40
 
 def _read_descent(path: Path) -> dict:
     """From a run's log.jsonl: ``solves_above`` (the attempts after the first solve up to the
-    first accepted solution at DOF <= ``ABOVE_DOF``, those retracted later included) per
+    first accepted solution at DOF <= ``ABOVE_DOF``, those retracted later included, the
+    repeats of an earlier attempt, ``solve_from``, not) per
     DOF removed above it, ``solves_above_per_dof`` (None where the run started at or below
     it, or never got there)."""
     try:
@@ -268,7 +269,9 @@ def _read_descent(path: Path) -> dict:
     initial = attempts[0]["dof"]
     if initial <= ABOVE_DOF:
         return {}
-    for n, record in enumerate(attempts[1:], start=1):
+    n = 0
+    for record in attempts[1:]:
+        n += record.get("solve_from") is None  # a repeat is no solve
         dof = record.get("dof")
         if record.get("outcome") == "accepted" and isinstance(dof, int) and dof <= ABOVE_DOF:
             return {"solves_above": n, "solves_above_per_dof": n / (initial - ABOVE_DOF)}

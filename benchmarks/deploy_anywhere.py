@@ -180,6 +180,7 @@ def run(case: dict, mode: str) -> dict:
     final = gen.final
     deploys = final is not None and final.path is not None and final.path.deploys
     margin = gen.dof_margin or {}
+    summary = gen.to_dict()
     removed = (gen.initial_dof or 0) - (gen.lowest_dof or gen.initial_dof or 0)
     forecast = Counter(
         f"{'rigid' if a.rigid_forecast else 'free'}->{cause(a) or 'accepted'}"
@@ -197,8 +198,9 @@ def run(case: dict, mode: str) -> dict:
         "clear_gap": bool(margin.get("clear")),
         "near": margin.get("near"),
         "nonzero_min": margin.get("nonzero_min"),
-        "solves": len(gen.attempts),
-        "solves_per_dof": len(gen.attempts) / removed if removed else None,
+        "solves": summary["n_solves"],
+        "repeats": summary["n_repeats"],
+        "solves_per_dof": summary["n_solves"] / removed if removed else None,
         "time_s": time.perf_counter() - t0,
         "cpu_s": time.process_time() - cpu0,
         "N_lock": gen.n_lock,
@@ -206,7 +208,7 @@ def run(case: dict, mode: str) -> dict:
         "N_rigid": gen.n_rigid,
         "N_backtrack": gen.n_backtrack,
         "causes": dict(Counter(c for a in gen.attempts if (c := cause(a)) is not None)),
-        "time_split": {k: round(v, 2) for k, v in gen.to_dict()["time_s"].items()},
+        "time_split": {k: round(v, 2) for k, v in summary["time_s"].items()},
         "path_s": dict(path_seconds(gen.attempts)),
         "forecast": dict(forecast),
     }

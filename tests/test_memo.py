@@ -55,6 +55,9 @@ def test_a_repeat_names_its_attempt_and_costs_no_solve(runs):
         assert set(first.fixed_added) == set(a.fixed_added)
         assert (first.F, first.iterations, first.status) == (a.F, a.iterations, a.status)
         assert a.solve_time == a.analysis_time == a.path_time == 0.0
+    summary = kept.to_dict()
+    assert summary["n_repeats"] == len(repeats)
+    assert summary["n_solves"] == len(kept.attempts) - len(repeats)
     back = Attempt.from_dict(repeats[0].to_dict())
     assert back.solve_from == repeats[0].solve_from
 

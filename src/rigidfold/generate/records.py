@@ -308,7 +308,8 @@ class Generation:
         name (``n_lock``: the paper's N_lock), the key of summary.json
         (:class:`rigidfold.rundir.RunSummary`) and the study's column."""
         accepted_F = [s.result.F for s in self.solutions]
-        all_F = [a.F for a in self.attempts if np.isfinite(a.F)]
+        solved = [a for a in self.attempts if a.solve_from is None]  # not repeats
+        all_F = [a.F for a in solved if np.isfinite(a.F)]
         return {
             "stop": self.stop.value,
             "stop_reason": self.stop_reason,
@@ -328,7 +329,8 @@ class Generation:
             ),
             "dof_margin": self.dof_margin,
             "n_solutions": len(self.solutions),
-            "n_solves": len(self.attempts),
+            "n_solves": len(solved),
+            "n_repeats": len(self.attempts) - len(solved),
             "n_skipped": self.n_skipped,
             "mean_f_accepted": float(np.mean(accepted_F)) if accepted_F else None,
             "mean_f_all_solves": float(np.mean(all_F)) if all_F else None,

@@ -415,7 +415,7 @@ def _tables(run: RunData) -> list[str]:
         "stop_reason initial_dof final_dof lowest_dof n_reduce n_lock n_exceed n_path n_rigid "
         "n_backtrack "
         "deploy_check "
-        "final_deploys n_solutions n_solves n_skipped mean_f_accepted mean_f_all_solves"
+        "final_deploys n_solutions n_solves n_repeats n_skipped mean_f_accepted mean_f_all_solves"
     ).split()
     blocks = [("Run", _pairs({k: s[k] for k in run_keys}))]
     for key, head in (

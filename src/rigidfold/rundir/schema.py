@@ -496,7 +496,8 @@ class RunSummary:
     n_rigid : the paper's counters, N_path, the solutions retracted by backtracking and
     the second-order rigid ones (None in a file without them); deploy_check : whether the
     deployability check ran; final_step, final_deploys : the final design's step and
-    whether its path reaches the flat state; dof_margin, n_solutions, n_solves, n_skipped,
+    whether its path reaches the flat state; dof_margin, n_solutions, n_solves (the solves
+    computed), n_repeats (attempts that repeat an earlier one, ``Attempt.solve_from``), n_skipped,
     mean_f_accepted, mean_f_all_solves, numerics, time_s : the run's other figures
     (:meth:`rigidfold.generate.Generation.to_dict`; ``time_s`` with the checks' stages);
     per_solution : the solutions' records; options, case : the generate options and the
@@ -524,6 +525,7 @@ class RunSummary:
     dof_margin: Annotated[dict | None, MarginFigures] = None
     n_solutions: int | None = None
     n_solves: int | None = None
+    n_repeats: int | None = None
     n_skipped: int | None = None
     mean_f_accepted: float | None = None
     mean_f_all_solves: float | None = None
