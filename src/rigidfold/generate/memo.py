@@ -6,10 +6,10 @@ start again from the initial shape (:mod:`rigidfold.generate.chains`), and a ret
 solution's children are met again below it. Every solve starts from the last accepted
 shape and is deterministic (one BLAS thread, :func:`rigidfold.config.one_blas_thread`), so
 the same fix from the same shape under the same bound gives the same solution, mechanism
-and verdict. On Origami Simulator's patterns on the dome, more than half of a run's
-attempts were such repeats (``dome:reschTriTessellation.svg``: 457 of 762, 23 of 43 s of
-solves; ``dome:huffmanWaterbomb.svg``: 476 of 796, 56 of 98 s; docs/broad_set.md, session
-39).
+and verdict. On Origami Simulator's patterns on the dome, a run that backtracks and starts
+rounds again meets hundreds of them (``dome:reschTriTessellation.svg``: 268 of its 762
+attempts; ``dome:huffmanWaterbomb.svg``: 367 of 1195 in its 3 minutes; docs/broad_set.md,
+session 39).
 
 A repeat is recorded as an attempt of its own (the search's decisions are those it made
 before: the same outcome, counted the same way) with ``Attempt.solve_from`` naming the
