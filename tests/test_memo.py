@@ -9,15 +9,19 @@ rounds; no fold limit, so no decision depends on seconds).
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
+from conftest import main_code
 from rigidfold.config import DEFAULTS
 from rigidfold.errors import RigidfoldError
 from rigidfold.generate import Attempt, AttemptOutcome, GenerateOptions, generate
 from rigidfold.generate.memo import AttemptMemo, attempt_key
 from rigidfold.generate.specs import case_from_specs
 from rigidfold.optimize import Status
+from rigidfold.rundir import read_log
 
 OPTIONS = GenerateOptions(criterion="shat", seed=3, lookahead=True, deform=False)
 
@@ -60,6 +64,23 @@ def test_a_repeat_names_its_attempt_and_costs_no_solve(runs):
     assert summary["n_solves"] == len(kept.attempts) - len(repeats)
     back = Attempt.from_dict(repeats[0].to_dict())
     assert back.solve_from == repeats[0].solve_from
+
+
+def test_the_command_line_counts_the_repeats(tmp_path, capsys):
+    """``generate`` says how many of its attempts repeated one; summary.json and log.jsonl
+    agree with it."""
+    out = tmp_path / "run"
+    argv = "generate --surface bezier --pattern grid:4x4 --size 1x1 --seed 3 --lookahead"
+    argv += " --no-deform --quiet --no-report --reseeds 1 --fold-limit 0 --out"
+    main_code([*argv.split(), str(out)])
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["n_repeats"] > 0
+    attempts = read_log(out / "log.jsonl")
+    assert len(attempts) == summary["n_solves"] + summary["n_repeats"]
+    assert sum(a.solve_from is not None for a in attempts) == summary["n_repeats"]
+    said = capsys.readouterr()
+    text = said.out + said.err
+    assert f"{summary['n_solves']} solves ({summary['n_repeats']} repeated)" in text
 
 
 def _attempt(outcome: AttemptOutcome, dof: int | None, index: int = 0) -> Attempt:

@@ -33,9 +33,9 @@ def test_a_pattern_that_cannot_reach_the_surface_with_fewer_dof_is_told_so():
     case = case_from_specs("dome", str(DATA / "simpleVertex.svg"), seed=4648)
     run = generate(case, OPTIONS)
     assert run.stop is not Stop.TARGET_REACHED
-    later = run.attempts[1:]
+    later = [a for a in run.attempts[1:] if a.solve_from is None]  # the solves computed
     missed = [a for a in later if a.outcome is AttemptOutcome.EXCEED]
-    assert 2 * len(missed) >= len(later) and len(missed) == run.n_exceed
+    assert 2 * len(missed) >= len(later) and len(missed) <= run.n_exceed
     line = [s for s in _verdict(run).shortfalls if "no shape within dz" in s]
     assert len(line) == 1
     assert line[0].startswith(f"{len(missed)} of the {len(later)} solves after the first")

@@ -99,15 +99,17 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
 
 def _counters(summary: dict, stop_reason: str) -> str:
-    """The line of a finished run's counters: the DOF reduced, N_*, the solves, and the
-    final design's DOF where it is not the lowest reached."""
+    """The line of a finished run's counters: the DOF reduced, N_*, the solves (and the
+    attempts that repeated one, where there are any), and the final design's DOF where it
+    is not the lowest reached."""
     rigid = f" N_rigid={summary['n_rigid']}" if summary["n_rigid"] else ""
+    repeats = f" ({summary['n_repeats']} repeated)" if summary.get("n_repeats") else ""
     final = summary["final_dof"]
     return (
         f"{stop_reason}: DOF {summary['initial_dof']} -> {summary['lowest_dof']}, "
         f"N_reduce={summary['n_reduce']} N_lock={summary['n_lock']} "
         f"N_exceed={summary['n_exceed']} N_path={summary['n_path']}{rigid}, "
-        f"{summary['n_solves']} solves"
+        f"{summary['n_solves']} solves{repeats}"
         + ("" if final == summary["lowest_dof"] else f"; final design DOF {final}")
     )
 

@@ -153,12 +153,13 @@ def run_verdict(
 
 
 def _out_of_reach(run: Generation, share: float) -> str | None:
-    """Where at least ``share`` of the solves after the first were not accepted by Step 4
+    """Where at least ``share`` of the solves after the first (those computed, not the
+    attempts that repeat one: ``Attempt.solve_from``) were not accepted by Step 4
     (``N_exceed``: F above ``f_tol``, no convergence), what a run that fell short ran into:
     with more creases fixed, no shape met the constraints of problem (6) within dz of the
     surface (a coarse pattern on a curved surface: the drawn single vertex on the dome); None
     otherwise."""
-    later = run.attempts[1:]
+    later = [a for a in run.attempts[1:] if a.solve_from is None]
     missed = [a.F for a in later if a.outcome is AttemptOutcome.EXCEED]
     if not later or not missed or len(missed) < share * len(later):
         return None
