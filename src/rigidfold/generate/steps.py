@@ -472,9 +472,10 @@ class _Steps(ChainControl):
         polish: bool = True,
     ) -> tuple[Attempt, _Trial]:
         """Steps 3-5 at the shape ``current`` with the creases ``fix`` fixed as well
-        (:meth:`solve` from its coordinates, ``polish`` passed on); the attempt is charged
-        the selection time not yet charged, and ``shape`` the attempt's seconds. Not yet
-        recorded."""
+        (:meth:`solve` from its coordinates, ``polish`` passed on; a fix met before at bitwise
+        the same shape repeats that attempt instead, :mod:`rigidfold.generate.memo`); the
+        attempt is charged the selection time not yet charged, and ``shape`` the attempt's
+        seconds. Not yet recorded."""
         start = current.result.pattern
         key = attempt_key(start, fix, self.fold_limit, polish)
         repeat = self.memo.repeat(key, len(self.run.attempts), self.search_round)
@@ -489,15 +490,9 @@ class _Steps(ChainControl):
             trial_fixed = start.fixed.copy()
             trial_fixed[list(fix)] = True
             rec, trial = self.solve(trial_fixed, start.coords, fix, score, polish=polish)
-            self.memo.keep(
-                key,
-                rec,
-                trial
-                if self.is_solution(rec)
-                or trial.mechanism is None
-                or rec.outcome is AttemptOutcome.NO_GAP
-                else _Trial(trial.result, None, None),
-            )
+            # a rejected candidate's mechanism and path are not needed again
+            needed = self.is_solution(rec) or rec.outcome is AttemptOutcome.NO_GAP
+            self.memo.keep(key, rec, trial if needed else _Trial(trial.result, None, None))
         rec.selection_time, shape.t_sel = shape.t_sel, 0.0
         shape.spent += attempt_time(rec)
         return rec, trial
