@@ -59,7 +59,7 @@ class AttemptMemo(Generic[T]):
 
     def keep(self, key: Key, rec: Attempt, trial: T) -> None:
         """Keep attempt ``rec`` (a copy, as it is now: before a retraction makes it a dead
-        end) with its trial, unless the time limit cut it or it is a solution of more than
+        end) with its trial, unless the time limit cut it or its shape has more than
         ``max_dof`` DOF."""
         if self.max_dof <= 0 or rec.outcome is AttemptOutcome.TIME_LIMIT:
             return
@@ -83,8 +83,6 @@ class AttemptMemo(Generic[T]):
             analysis_time=0.0,
             selection_time=0.0,
             path_time=0.0,
-            solve_from=first.index if first.solve_from is None else first.solve_from,
-            locked=list(first.locked),
-            locked_fold_deg=list(first.locked_fold_deg),
+            solve_from=first.index,  # only attempts that were computed are kept
         )
         return rec, trial
