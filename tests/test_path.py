@@ -19,7 +19,7 @@ from rigidfold.generate import AttemptOutcome, generate
 from rigidfold.generate.specs import case_from_specs
 from rigidfold.io.fold import pattern_from_fold
 from rigidfold.mechanism.path import PathStatus, trace_path
-from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System
+from rigidfold.mechanism.rigid_folding import RigidFoldingConstraints, System, correct
 from rigidfold.mesh.geometry import edge_lengths
 from rigidfold.patterns import miura
 from rigidfold.rundir import read_log
@@ -386,3 +386,30 @@ def test_a_path_that_folds_further_on_its_way_to_the_flat_state_deploys():
     assert 0.05 < rise.max() < DEFAULTS.path.turn_back  # it folds further on the way
     early = trace_path(shape, dof=dof, settings=DEFAULTS.with_(path_turn_back=0.05))
     assert early.status is PathStatus.TURNED_BACK
+
+
+def test_the_corrector_gives_a_prediction_beyond_newtons_reach_up_at_its_bound():
+    """``Settings.path.corrector_factorizations``: a trace's corrector that would factorise
+    its system more often than that for one step fails there (the step is halved), where it
+    went on before, 5 to 9 factorisations for a step it failed anyway; a step within
+    Newton's reach converges to the same point either way."""
+    shape, _ = stalled_shape(DATA / "turn_back" / "miura_sharpangle_dome_0.npz")
+    cons = RigidFoldingConstraints(shape, default_support_face(shape))
+    mode = "augmented" if cons.n_rows == cons.n - 1 else "projection"
+    J, J_rho = cons.jacobian(cons.x0)
+    rho = cons.free_angles(cons.x0)
+    t = System(J, J_rho, "projection", None, DEFAULTS).direction(-(J_rho.T @ rho), rho)
+    t /= np.linalg.norm(t)
+    rms = math.sqrt(shape.n_vertices)  # one mean edge length of root-mean-square steps
+    most = DEFAULTS.path.corrector_factorizations
+    assert most > 0
+
+    def corrected(length, bound):
+        return correct(cons, cons.x0 + length * rms * t, mode, t, DEFAULTS, most=bound)
+
+    near, near_bounded = corrected(1e-3, 0), corrected(1e-3, most)
+    assert near[1] and near_bounded[1] and near[2] <= most
+    assert np.array_equal(near[0], near_bounded[0])
+    far, far_bounded = corrected(2.0, 0), corrected(2.0, most)
+    assert not far[1] and far[2] > most  # the corrector went on, and failed
+    assert not far_bounded[1] and far_bounded[2] == most

@@ -62,6 +62,16 @@ class PathSettings(Group):
         "Largest ratio of successive corrections the corrector accepts (a step that converges "
         "more slowly is halved).",
     )
+    corrector_factorizations: int = setting(
+        3,
+        "A trace's corrector (all constraint rows) that would factorise its system more than "
+        "this many times for one step gives the step up, and the trace halves it: from a "
+        "prediction within Newton's reach the corrector converges after 1 or 2 (all but one "
+        "of the 251 steps of four turned-back paths of ``dome:polygamiCross``, which took "
+        "3), and the steps it failed took 5 to 9 each: 1205 of those traces' 1495 "
+        "factorisations "
+        "(docs/deployability.md, session 40). 0: no bound.",
+    )
     turn_back: float = setting(
         1.0,
         "A 1-DOF path turns back (the shape does not deploy along it) when its folding "
@@ -151,7 +161,7 @@ class PathSettings(Group):
     )
 
     def __post_init__(self) -> None:
-        self._integer(pace_steps=1)
+        self._integer(pace_steps=1, corrector_factorizations=0)
         self._positive("pace_margin")
 
 

@@ -427,6 +427,7 @@ class _Tracer:
             self.settings,
             self.rows,
             self.frozen,
+            most=self.settings.path.corrector_factorizations,
         )
         self.trace.factorizations += nf
         beyond = None if ok else _beyond_tolerance(self.cons, y, system, self.settings)

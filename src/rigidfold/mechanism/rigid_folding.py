@@ -280,13 +280,17 @@ def correct(
     settings: Settings,
     rows: np.ndarray | None = None,
     frozen: np.ndarray | None = None,
+    most: int = 0,
 ) -> tuple[np.ndarray, bool, int, System | None]:
     """Corrector from the prediction y onto c = 0: chord steps on the factors of the latest
     iterate, refactored where they contract by less than ``path_contraction``; converged when
     every |c_i| <= ``path_tol`` (after at least one factorisation, which the next direction
     needs). ``rows`` (r,) int: the system is made of these rows of J only (the independent
     rows of :func:`independent_rows`, so that ``[J_rows; t^T]`` is square), but convergence
-    is still every row of c to ``path_tol``; ``frozen``: see :class:`System`.
+    is still every row of c to ``path_tol``; ``frozen``: see :class:`System`. ``most`` (0:
+    no bound): without ``rows``, a correction that would need more factorisations than this
+    fails there (``Settings.path.corrector_factorizations``: the prediction is beyond
+    Newton's reach, and the caller halves the step).
 
     returns (y, converged, factorizations, the last system).
     """
@@ -299,6 +303,8 @@ def correct(
         # the contraction is that of the part of c a step removes (all of it without rows)
         size = norm if system is None else system.reducible_norm(c)
         if system is None or size > settings.path.contraction * previous:
+            if most and rows is None and factorizations >= most:
+                return y, False, factorizations, system
             try:
                 system = System(*cons.jacobian(y), mode, t, settings, rows, frozen)
             except RuntimeError:  # an exactly singular factor
