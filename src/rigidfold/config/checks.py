@@ -69,8 +69,7 @@ class PathSettings(Group):
         "prediction within Newton's reach the corrector converges after 1 or 2 (all but one "
         "of the 251 steps of four turned-back paths of ``dome:polygamiCross``, which took "
         "3), and the steps it failed took 5 to 9 each: 1205 of those traces' 1495 "
-        "factorisations "
-        "(docs/deployability.md, session 40). 0: no bound.",
+        "factorisations (docs/deployability.md, session 40). 0: no bound.",
     )
     turn_back: float = setting(
         1.0,
