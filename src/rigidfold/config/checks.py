@@ -67,9 +67,10 @@ class PathSettings(Group):
         "A trace's corrector (all constraint rows) that would factorise its system more than "
         "this many times for one step gives the step up, and the trace halves it: from a "
         "prediction within Newton's reach the corrector converges after 1 or 2 (all but one "
-        "of the 251 steps of four turned-back paths of ``dome:polygamiCross``, which took "
-        "3), and the steps it failed took 5 to 9 each: 1205 of those traces' 1495 "
-        "factorisations (docs/deployability.md, session 40). 0: no bound.",
+        "of the 273 corrections that converged on four turned-back paths of "
+        "``dome:polygamiCross``, which took 3), and the 223 that failed took 1205 of those "
+        "traces' 1495 factorisations, most of them 5 to 9 each (docs/deployability.md, "
+        "session 40). 0: no bound.",
     )
     turn_back: float = setting(
         1.0,
