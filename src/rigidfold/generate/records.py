@@ -291,6 +291,12 @@ class Generation:
         return self.solutions[-1].mechanism.dof if self.solutions else None
 
     @property
+    def solved(self) -> list[Attempt]:
+        """The attempts whose solve was computed, in order (not those that repeat an earlier
+        one, ``Attempt.solve_from``): the run's solves."""
+        return [a for a in self.attempts if a.solve_from is None]
+
+    @property
     def n_skipped(self) -> int:
         """Candidates skipped by the look-ahead (predicted to lock, not solved)."""
         return sum(a.skipped for a in self.attempts)
@@ -308,7 +314,7 @@ class Generation:
         name (``n_lock``: the paper's N_lock), the key of summary.json
         (:class:`rigidfold.rundir.RunSummary`) and the study's column."""
         accepted_F = [s.result.F for s in self.solutions]
-        solved = [a for a in self.attempts if a.solve_from is None]  # not repeats
+        solved = self.solved
         all_F = [a.F for a in solved if np.isfinite(a.F)]
         return {
             "stop": self.stop.value,

@@ -159,7 +159,7 @@ def _out_of_reach(run: Generation, share: float) -> str | None:
     with more creases fixed, no shape met the constraints of problem (6) within dz of the
     surface (a coarse pattern on a curved surface: the drawn single vertex on the dome); None
     otherwise."""
-    later = [a for a in run.attempts[1:] if a.solve_from is None]
+    later = run.solved[1:]  # the first attempt is the initial solve, never a repeat
     missed = [a.F for a in later if a.outcome is AttemptOutcome.EXCEED]
     if not later or not missed or len(missed) < share * len(later):
         return None
