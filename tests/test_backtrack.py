@@ -8,15 +8,21 @@ so that one folding path that does not reach the flat state gives a shape up (se
 
 from __future__ import annotations
 
+import dataclasses
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+import rigidfold.generate.deploy_check as deploy_check
+import rigidfold.generate.final as final
 from conftest import main_code, paper_generate
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, GenerateOptions, Stop, generate
+from rigidfold.generate.final import lowest_deploying
 from rigidfold.generate.specs import case_from_specs
+from rigidfold.mechanism.path import PathStatus
 from rigidfold.pipeline import RunWriter, run
 from rigidfold.rundir import load_run, read_log
 
@@ -139,3 +145,81 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     on_disk = sorted(p.name for p in (tmp_path / "solutions").iterdir())
     final = names[summary["final_step"]]  # the development diagram of the final design only
     assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{final}.svg"])
+
+
+def test_lowest_deploying_bisects_between_a_deploying_and_a_failing_solution():
+    """``lowest_deploying`` names a solution that deploys whose next one does not, in about
+    log2 of the span traces, from a known deploying solution (or none, -1) and a failing
+    one (or the chain's end)."""
+    chain = [SimpleNamespace(step=k) for k in range(17)]
+    for last_good in (-1, 0, 3, 9, 15):
+        asked: list[int] = []
+
+        def deploys(solution, last_good=last_good, asked=asked):
+            asked.append(solution.step)
+            return solution.step <= last_good
+
+        found = lowest_deploying(chain, -1 if last_good < 0 else 0, len(chain), deploys)
+        assert found == last_good
+        assert len(asked) <= 5  # ceil(log2(18))
+    assert lowest_deploying(chain, 4, 5, lambda s: pytest.fail("no trace between neighbours")) == 4
+
+
+def test_a_dead_end_whose_shape_does_not_deploy_rewinds_to_the_lowest_that_does(monkeypatch):
+    """``Settings.generation.rewind``: every DOF-1 candidate's path is made to turn back, so
+    the chain dead-ends at a DOF-2 shape; the shapes' own paths (traced by the rewind) are
+    made to deploy from DOF ``ABOVE`` up and to turn back below. Backtracking then retracts,
+    in one step of its budget, every solution below DOF ``ABOVE`` (not only the last): the
+    chain goes on from the lowest shape that deploys, without the fix that led below it;
+    the run, short of its target, names that shape (its path known) as its design.
+    Without the rewind, backtracking retracts one solution."""
+    above = 4
+    traced: list[int] = []
+
+    def candidates_turn_back(pattern, **kwargs):
+        return dataclasses.replace(real(pattern, **kwargs), status=PathStatus.TURNED_BACK)
+
+    def by_dof(pattern, *, dof, **kwargs):
+        traced.append(dof)
+        path = real(pattern, dof=dof, **kwargs)
+        status = PathStatus.FLAT if dof >= above else PathStatus.TURNED_BACK
+        return dataclasses.replace(path, status=status)
+
+    real = deploy_check.trace_path
+    monkeypatch.setattr(deploy_check, "trace_path", candidates_turn_back)
+    monkeypatch.setattr(final, "trace_path", by_dof)
+    for rewind in (True, False):
+        settings = DEFAULTS.with_(
+            deploy_max_candidates=1, backtrack_max=1, fold_limits=(), reseeds=0, rewind=rewind
+        )
+        case = case_from_specs("bezier", "1", seed=SEED, settings=settings)
+        retractions: list[tuple[int, list[int], int]] = []
+        traced.clear()
+
+        def on_retract(run, taken, retractions=retractions):
+            dofs = [s.mechanism.dof for s in taken]
+            retractions.append((run.solutions[-1].step, dofs, len(traced)))
+
+        run = generate(case, OPTIONS, on_retract=on_retract)
+        kept, taken, n_traced = retractions[0]
+        if not rewind:
+            assert len(taken) == 1 and taken[0] == 2 and n_traced == 0
+            continue
+        assert taken[-1] >= 2 and taken[0] < above  # the dead end first, the lowest last
+        assert all(dof < above for dof in taken)
+        assert len(taken) >= 2, "the case's chain has more than one solution below DOF 4"
+        assert run.attempts[0].dof is not None and run.attempts[0].dof >= above
+        # the lowest deploying shape: the chain's solution just before the first retracted
+        assert traced[0] == 2  # the dead end's own shape first
+        assert n_traced <= 1 + int(np.ceil(np.log2(kept + len(taken) + 1)))
+        after = [a for a in run.attempts if a.index > 0 and a.outcome.value != "dead_end"]
+        dead = {a.fixed_added for a in run.attempts if a.outcome is AttemptOutcome.DEAD_END}
+        assert run.stop is Stop.NO_DEPLOYABLE
+        assert run.final is not None and run.final.mechanism.dof >= above
+        assert run.final.path is not None and run.final.path.deploys
+        assert after  # the chain went on from the kept shape
+        first_dead = min(
+            (a for a in run.attempts if a.outcome is AttemptOutcome.DEAD_END),
+            key=lambda a: a.index,
+        )
+        assert first_dead.fixed_added in dead

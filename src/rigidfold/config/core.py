@@ -164,6 +164,19 @@ class GenerationSettings(Group):
         "nothing.",
     )
 
+    rewind: bool = setting(
+        True,
+        "With the deployability check: at a dead end of a shape whose children get the check "
+        "(its DOF-1 candidates all failed), the shape's own folding path is traced; where it "
+        "does not reach the flat state, the chain lost its deployability above it, and "
+        "backtracking (or the first chain's restart) goes back to the lowest solution of the "
+        "chain whose path deploys (a bisection, about log2 of the chain's length in traces, "
+        ":func:`rigidfold.generate.final.lowest_deploying`) instead of to the shape before: "
+        "one retraction of the budget (``backtrack_max``). The first chain gives up such a "
+        "shape at ``restart_after`` rejected paths whatever its candidates cost. False: "
+        "backtracking retracts one solution at a time (before session 41).",
+    )
+
     second_order: bool = setting(
         True,
         "With the deployability check: a solution whose folding path does not reach the flat "
@@ -418,7 +431,9 @@ class GenerationSettings(Group):
                 f"{self.time_limit_reserve_share!r}"
             )
         self._integer(near_tries=0, near_max=0, reseeds=0, reseeds_timed=0, reuse_max_dof=0)
-        self._boolean("retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack")
+        self._boolean(
+            "retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack", "rewind"
+        )
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):

@@ -23,7 +23,13 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.generate.case import Case
-from rigidfold.generate.final import deployable_final, known_to_deploy
+from rigidfold.generate.deploy_check import DeployCheck
+from rigidfold.generate.final import (
+    deployable_final,
+    known_to_deploy,
+    lowest_deploying,
+    traced_deploys,
+)
 from rigidfold.generate.options import GenerateOptions
 from rigidfold.generate.records import Attempt, AttemptOutcome, Generation, Solution, Stop
 from rigidfold.mechanism.second_order import ChildForecast
@@ -100,15 +106,22 @@ class ChainControl:
     silent: bool  # a later round under way: its solutions not shown to the callbacks (publish)
     ladder: list[tuple[float, Case]]  # every round's restarts, in order
     unbounded: FormFindingProblem  # the problem of a round's first chain
+    checks: DeployCheck  # the deployability check of the run's candidates
 
     def worth_more(self, shape: Frame) -> bool:
         """Whether the first chain keeps trying candidates at ``shape`` past
         ``restart_after`` rejected paths instead of restarting: while its next candidates
         are still forecast to deploy (the last one tried was not put off by the look-ahead
         or the second-order forecast) and what its candidates have cost so far is less than
-        re-solving the chain to this shape (the seconds of its accepted attempts)."""
+        re-solving the chain to this shape (the seconds of its accepted attempts), and, once
+        ``restart_after`` of them were rejected, the shape's own path reaches the flat state
+        (:meth:`lost_above`)."""
         chain = sum(attempt_time(rec) for rec in self.accepted[1:])
-        return not shape.fallback and shape.spent < chain
+        if shape.fallback or shape.spent >= chain:
+            return False
+        # a shape that does not deploy itself is not worth more (Settings.generation.rewind)
+        restart_after = self.settings.generation.restart_after
+        return shape.undeployable < restart_after or self.lost_above() is None
 
     def spent(self) -> bool:
         """Whether the chain, bounded and with a further fold limit, has had as many
@@ -132,13 +145,50 @@ class ChainControl:
         ):
             return False
         self.keep_deepest(stop)
-        self.shapes.pop()
-        parent = len(run.solutions) - 2
-        self.dead.setdefault(parent, set()).add(tuple(self.accepted[-1].fixed_added))
-        self.retract()
+        last = len(run.solutions) - 1
+        keep = min(self.lost_above() or last, last)
+        while self.shapes and self.shapes[-1].solution.step >= keep:
+            self.shapes.pop()
+        if keep < last:  # a rewind: the retracted shapes' dead ends go with them
+            self.dead = {step: fixes for step, fixes in self.dead.items() if step < keep}
+        self.dead.setdefault(keep - 1, set()).add(tuple(self.accepted[keep].fixed_added))
+        self.retract(keep=keep)
         self.backtracks += 1
         run.stop_detail = ""
         return True
+
+    def lost_above(self) -> int | None:
+        """Where the chain lost its deployability (``Settings.generation.rewind``): at a dead
+        end of its last shape, whose children get the check, the shape's own path is traced;
+        where that does not reach the flat state, the number of the chain's solutions up to
+        the lowest whose path deploys (:func:`lowest_deploying` between the latest known
+        to deploy, or the initial shape, and the last), which backtracking and a restart
+        keep. None: the rewind does not apply, the last shape deploys, or a trace was cut by
+        the deadline. The traces are kept on the solutions (``Solution.path``): a shape is
+        traced once a run, and the final design's naming reads them."""
+        run, chain = self.run, self.run.solutions
+        if (
+            not self.settings.generation.rewind
+            or len(chain) < 3
+            or not self.checks.checks_children(chain[-1].mechanism.dof)
+        ):
+            return None
+        cut = False
+
+        def deploys(solution: Solution) -> bool:
+            nonlocal cut
+            verdict, seconds = traced_deploys(
+                solution, self.options, self.settings, self.deadline
+            )
+            run.rewind_path_time += seconds
+            cut = cut or verdict is None
+            return bool(verdict)
+
+        if deploys(chain[-1]) or cut:
+            return None
+        known = [k for k, solution in enumerate(chain[:-1]) if known_to_deploy(solution)]
+        lowest = lowest_deploying(chain, max(known, default=0), len(chain) - 1, deploys)
+        return None if cut else lowest + 1
 
     def keep_deepest(self, stop: Stop) -> None:
         """Keep the chain as it stands (with ``stop``) as :attr:`deepest` where it reached a
@@ -168,7 +218,8 @@ class ChainControl:
             return False
         self.keep_deepest(stop)
         limit, case = self.restarts.pop(0)
-        self.new_chain(keep=within(run.solutions, limit))
+        keep = within(run.solutions, limit)
+        self.new_chain(keep=min(keep, self.lost_above() or keep))
         self.fold_limit = limit
         t0 = time.perf_counter()
         self.problem = run_problem(case, self.options)
@@ -177,6 +228,11 @@ class ChainControl:
 
     def out_of_time(self) -> bool:
         """Whether the search's time is spent (the steps' time limit)."""
+        raise NotImplementedError
+
+    @property
+    def deadline(self) -> float | None:
+        """The end of the search (the steps' time limit), a time of ``time.monotonic()``."""
         raise NotImplementedError
 
     def reseed(self, stop: Stop, deadline: float | None) -> bool:

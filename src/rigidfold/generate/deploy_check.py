@@ -82,6 +82,14 @@ class DeployCheck:
             and (limit <= 0 or mech.dof <= max(limit, self.options.target_dof))
         )
 
+    def checks_children(self, dof: int) -> bool:
+        """Whether the children of a shape of DOF ``dof`` (one DOF fewer) get the check
+        (:meth:`applies`)."""
+        limit = self.settings.generation.deploy_check_max_dof
+        return self.options.deploy_check and (
+            limit <= 0 or dof - 1 <= max(limit, self.options.target_dof)
+        )
+
     def check(
         self, pattern: CreasePattern, dof: int, index: int, deadline: float | None
     ) -> Checked:
@@ -158,12 +166,10 @@ class DeployCheck:
     def child_forecast(self, pattern: CreasePattern, dof: int) -> ChildForecast | None:
         """At a shape of DOF ``dof`` whose children get the check: the second-order forecast
         of its candidates (None where it is not made)."""
-        opts, settings = self.options, self.settings
-        limit = settings.generation.deploy_check_max_dof
+        settings = self.settings
         if (
-            not (opts.deploy_check and settings.generation.second_order)
+            not (self.checks_children(dof) and settings.generation.second_order)
             or dof < 2
-            or (limit > 0 and dof - 1 > max(limit, opts.target_dof))
             or pattern.n_vertices > settings.mechanism.second_order_vertices
         ):
             return None

@@ -14,6 +14,7 @@ names the best design known to deploy.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 from rigidfold.config import Settings
 from rigidfold.generate.options import GenerateOptions
@@ -55,22 +56,9 @@ def deployable_final(
         return
 
     def deploys(solution: Solution) -> bool:
-        if solution.path is None:
-            if deadline is not None and time.monotonic() > deadline:
-                return False
-            t0 = time.perf_counter()
-            path = trace_path(
-                solution.result.pattern,
-                dof=solution.mechanism.dof,
-                support_face=options.support_face,
-                settings=settings,
-                deadline=deadline,
-            )
-            run.final_path_time += time.perf_counter() - t0
-            if path.cut:
-                return False
-            solution.path = path
-        return solution.path.deploys
+        verdict, seconds = traced_deploys(solution, options, settings, deadline)
+        run.final_path_time += seconds
+        return bool(verdict)
 
     chain = run.solutions
     known = [i for i, s in enumerate(chain) if known_to_deploy(s)]
@@ -82,11 +70,48 @@ def deployable_final(
             lo = probe
             break
         hi, back = probe, 2 * back
+    lo = lowest_deploying(chain, lo, hi, deploys)
+    if lo >= 0:
+        run.final_step = chain[lo].step
+
+
+def lowest_deploying(
+    chain: list[Solution], lo: int, hi: int, deploys: Callable[[Solution], bool]
+) -> int:
+    """Bisect ``chain`` between the solution ``lo`` (-1: none), whose path reaches the flat
+    state, and ``hi`` (``len(chain)``: none), whose path does not: the index of a solution
+    whose path deploys (``deploys``) and whose next solution's does not (``lo`` where
+    they are next to each other): about log2(hi - lo) traces."""
     while hi - lo > 1:
         mid = (lo + hi) // 2
         lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
-    if lo >= 0:
-        run.final_step = chain[lo].step
+    return lo
+
+
+def traced_deploys(
+    solution: Solution, options: GenerateOptions, settings: Settings, deadline: float | None
+) -> tuple[bool | None, float]:
+    """Whether the solution's folding path reaches the flat state: its path's verdict where
+    it was traced, else traced now (to ``deadline``, of ``time.monotonic()``) and kept
+    (``Solution.path``). None where the deadline cut the trace or had passed (nothing
+    kept). Returns the verdict and the seconds of the trace (0.0: none)."""
+    if solution.path is not None:
+        return bool(solution.path.deploys), 0.0
+    if deadline is not None and time.monotonic() > deadline:
+        return None, 0.0
+    t0 = time.perf_counter()
+    path = trace_path(
+        solution.result.pattern,
+        dof=solution.mechanism.dof,
+        support_face=options.support_face,
+        settings=settings,
+        deadline=deadline,
+    )
+    seconds = time.perf_counter() - t0
+    if path.cut:
+        return None, seconds
+    solution.path = path
+    return bool(path.deploys), seconds
 
 
 def best_so_far(run: Generation) -> None:

@@ -262,6 +262,7 @@ class Generation:
     dof_margin: dict | None = None  # rigidfold.mechanism.margin.DofMargin.to_dict()
     build_time: float = 0.0
     final_path_time: float = 0.0  # the traces that named the final design (time_s.path)
+    rewind_path_time: float = 0.0  # the traces of chain shapes that rewinds probed (time_s.path)
     numerics: dict | None = None  # rigidfold.runtime.numerics.NumericEnvironment.to_dict()
 
     @property
@@ -346,6 +347,8 @@ class Generation:
                 "solve": sum(a.solve_time for a in self.attempts),
                 "analysis": sum(a.analysis_time for a in self.attempts),
                 "selection": sum(a.selection_time for a in self.attempts),
-                "path": sum(a.path_time for a in self.attempts) + self.final_path_time,
+                "path": sum(a.path_time for a in self.attempts)
+                + self.final_path_time
+                + self.rewind_path_time,
             },
         }
