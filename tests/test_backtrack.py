@@ -147,22 +147,28 @@ def test_backtracking_that_finds_nothing_lower_ends_with_the_chain_it_had(tmp_pa
     assert on_disk == sorted([f"{n}.fold" for n in names] + [f"{final}.svg"])
 
 
-def test_lowest_deploying_bisects_between_a_deploying_and_a_failing_solution():
-    """``lowest_deploying`` names a solution that deploys whose next one does not, in about
-    log2 of the span traces, from a known deploying solution (or none, -1) and a failing
-    one (or the chain's end)."""
-    chain = [SimpleNamespace(step=k) for k in range(17)]
-    for last_good in (-1, 0, 3, 9, 15):
-        asked: list[int] = []
+def test_lowest_deploying_probes_from_the_end_or_bisects():
+    """``lowest_deploying`` names a solution that deploys whose next one does not, from a
+    known deploying solution (or none, -1): galloping back from the chain's end, in about
+    2 log2(d) traces for one d solutions above the last, never probing below the known one;
+    bisecting, in about log2 of the chain's length."""
+    chain = [SimpleNamespace(step=k) for k in range(33)]
+    for last_good in (-1, 0, 3, 9, 29, 31, 32):
+        for gallop in (True, False):
+            asked: list[int] = []
 
-        def deploys(solution, last_good=last_good, asked=asked):
-            asked.append(solution.step)
-            return solution.step <= last_good
+            def deploys(solution, last_good=last_good, asked=asked):
+                asked.append(solution.step)
+                return solution.step <= last_good
 
-        found = lowest_deploying(chain, -1 if last_good < 0 else 0, len(chain), deploys)
-        assert found == last_good
-        assert len(asked) <= 5  # ceil(log2(18))
-    assert lowest_deploying(chain, 4, 5, lambda s: pytest.fail("no trace between neighbours")) == 4
+            found = lowest_deploying(chain, -1 if last_good < 0 else 0, deploys, gallop=gallop)
+            assert found == last_good
+            assert all(step > 0 for step in asked) or last_good < 0
+            d = len(chain) - last_good
+            most = 2 * int(np.ceil(np.log2(d))) + 1 if gallop else 6  # ceil(log2(34))
+            assert len(asked) <= most, (last_good, gallop, asked)
+    never = lambda s: pytest.fail("no trace below a known deploying solution")  # noqa: E731
+    assert lowest_deploying(chain, 32, never, gallop=True) == 32
 
 
 def test_a_dead_end_whose_shape_does_not_deploy_rewinds_to_the_lowest_that_does(monkeypatch):
@@ -198,7 +204,7 @@ def test_a_dead_end_whose_shape_does_not_deploy_rewinds_to_the_lowest_that_does(
 
         def on_retract(run, taken, retractions=retractions):
             dofs = [s.mechanism.dof for s in taken]
-            retractions.append((run.solutions[-1].step, dofs, len(traced)))
+            retractions.append((run.solutions[-1].mechanism.dof, dofs, len(traced)))
 
         run = generate(case, OPTIONS, on_retract=on_retract)
         kept, taken, n_traced = retractions[0]
@@ -208,10 +214,9 @@ def test_a_dead_end_whose_shape_does_not_deploy_rewinds_to_the_lowest_that_does(
         assert taken[-1] >= 2 and taken[0] < above  # the dead end first, the lowest last
         assert all(dof < above for dof in taken)
         assert len(taken) >= 2, "the case's chain has more than one solution below DOF 4"
-        assert run.attempts[0].dof is not None and run.attempts[0].dof >= above
-        # the lowest deploying shape: the chain's solution just before the first retracted
+        assert kept >= above  # the lowest deploying shape: the chain's solution kept
         assert traced[0] == 2  # the dead end's own shape first
-        assert n_traced <= 1 + int(np.ceil(np.log2(kept + len(taken) + 1)))
+        assert n_traced <= 1 + 2 * int(np.ceil(np.log2(len(taken) + 1)))
         after = [a for a in run.attempts if a.index > 0 and a.outcome.value != "dead_end"]
         dead = {a.fixed_added for a in run.attempts if a.outcome is AttemptOutcome.DEAD_END}
         assert run.stop is Stop.NO_DEPLOYABLE

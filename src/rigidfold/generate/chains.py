@@ -161,9 +161,9 @@ class ChainControl:
         """Where the chain lost its deployability (``Settings.generation.rewind``): at a dead
         end of its last shape, whose children get the check, the shape's own path is traced;
         where that does not reach the flat state, the number of the chain's solutions up to
-        the lowest whose path deploys (:func:`lowest_deploying` between the latest known
-        to deploy, or the initial shape, and the last), which backtracking and a restart
-        keep. None: the rewind does not apply, the last shape deploys, or a trace was cut by
+        the lowest whose path deploys (:func:`lowest_deploying` from the chain's end back,
+        down to the latest known to deploy, or the initial shape), which backtracking and a
+        restart keep. None: the rewind does not apply, the last shape deploys, or a trace was cut by
         the deadline. The traces are kept on the solutions (``Solution.path``): a shape is
         traced once a run, and the final design's naming reads them."""
         run, chain = self.run, self.run.solutions
@@ -177,17 +177,15 @@ class ChainControl:
 
         def deploys(solution: Solution) -> bool:
             nonlocal cut
-            verdict, seconds = traced_deploys(
-                solution, self.options, self.settings, self.deadline
-            )
+            verdict, seconds = traced_deploys(solution, self.options, self.settings, self.deadline)
             run.rewind_path_time += seconds
             cut = cut or verdict is None
             return bool(verdict)
 
         if deploys(chain[-1]) or cut:
             return None
-        known = [k for k, solution in enumerate(chain[:-1]) if known_to_deploy(solution)]
-        lowest = lowest_deploying(chain, max(known, default=0), len(chain) - 1, deploys)
+        known = [k for k, solution in enumerate(chain) if known_to_deploy(solution)]
+        lowest = lowest_deploying(chain, max(known, default=0), deploys, gallop=True)
         return None if cut else lowest + 1
 
     def keep_deepest(self, stop: Stop) -> None:

@@ -62,26 +62,29 @@ def deployable_final(
 
     chain = run.solutions
     known = [i for i, s in enumerate(chain) if known_to_deploy(s)]
-    lo, hi = (known[-1] if known else -1), len(chain)  # deploys at lo; not at the probes above
-    back = 1
-    while not bisect and len(chain) - back > lo:  # gallop back from the end
-        probe = len(chain) - back
-        if deploys(chain[probe]):
-            lo = probe
-            break
-        hi, back = probe, 2 * back
-    lo = lowest_deploying(chain, lo, hi, deploys)
+    lo = lowest_deploying(chain, known[-1] if known else -1, deploys, gallop=not bisect)
     if lo >= 0:
         run.final_step = chain[lo].step
 
 
 def lowest_deploying(
-    chain: list[Solution], lo: int, hi: int, deploys: Callable[[Solution], bool]
+    chain: list[Solution], lo: int, deploys: Callable[[Solution], bool], *, gallop: bool
 ) -> int:
-    """Bisect ``chain`` between the solution ``lo`` (-1: none), whose path reaches the flat
-    state, and ``hi`` (``len(chain)``: none), whose path does not: the index of a solution
-    whose path deploys (``deploys``) and whose next solution's does not (``lo`` where
-    they are next to each other): about log2(hi - lo) traces."""
+    """The index of a solution of ``chain`` whose path reaches the flat state (``deploys``)
+    and whose next probed solution's does not, at or above ``lo`` (a solution that deploys;
+    -1: none), or ``lo``. With ``gallop``, the solutions above ``lo`` are probed from the
+    chain's end back at 1, 2, 4, ... solutions above the last, until one deploys, and the
+    gap between it and the probe below it bisected: about 2 log2(d) traces for a solution
+    d above the last, all of them of the chain's last, fewest-DOF shapes. Without, the
+    chain between ``lo`` and its end is bisected from its middle: about log2 of its
+    length in traces."""
+    hi, back = len(chain), 1
+    while gallop and len(chain) - back > lo:
+        probe = len(chain) - back
+        if deploys(chain[probe]):
+            lo = probe
+            break
+        hi, back = probe, 2 * back
     while hi - lo > 1:
         mid = (lo + hi) // 2
         lo, hi = (mid, hi) if deploys(chain[mid]) else (lo, mid)
