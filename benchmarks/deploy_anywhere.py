@@ -71,6 +71,7 @@ MODES: dict[str, dict] = {
     "check-dof-2": {"deploy_check_max_dof": 2},
     "trace-first": {"second_order_first": False, "same_shape_tol": 0.0},
     "one-round": {"reseeds": 0, "reseeds_timed": 0},
+    "rewind": {"rewind": True},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
     "projection-large": {},
 }
@@ -87,7 +88,9 @@ creases per solve far from the target (the default since session 31, as ``after`
 test only after a path that fails (the search before session 33, the same attempts);
 ``one-round`` the search without its later rounds of other seeds (``reseeds`` 0, the search
 before session 34); ``spread-first`` the first round's K_j spread by 10 % too (a probe of
-session 34); ``projection-large`` see :data:`MODE_OPTIONS`."""
+session 34); ``rewind`` backtracking back to the chain's lowest shape that deploys
+(``Settings.generation.rewind``, a probe of session 41); ``projection-large`` see
+:data:`MODE_OPTIONS`."""
 MODE_OPTIONS: dict[str, dict] = {
     "batch-auto": {"batch": "auto"},
     "batch-off": {"batch": "off"},

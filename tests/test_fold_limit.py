@@ -69,7 +69,6 @@ def test_dead_ends_restart_the_chain_within_each_fold_limit_in_turn(monkeypatch)
         deploy_max_candidates=1,
         fold_limits=tuple(math.radians(a) for a in limits),
         second_order_first=False,  # every candidate traced: the first two are the made-up
-        rewind=False,  # no trace of a dead end's own shape (tested in test_backtrack.py)
     )
     case = case_from_specs("bezier", "1", seed=1, settings=settings)
     taken_at_once: list[int] = []
@@ -251,10 +250,7 @@ def test_the_first_chain_is_not_given_up_while_trying_is_cheaper(monkeypatch):
     candidate that deploys (here the fourth, made to) ends the run without a restart; where
     re-solving costs nothing, it restarts after ``restart_after``."""
     settings = DEFAULTS.with_(
-        restart_after=1,
-        second_order=False,
-        fold_limits=(math.radians(60.0),),
-        rewind=False,  # the cost rule alone: no trace of the shape itself (test_backtrack.py)
+        restart_after=1, second_order=False, fold_limits=(math.radians(60.0),)
     )
     case = case_from_specs("bezier", "1", seed=1, settings=settings)
     _first_turn_back(monkeypatch, 3, then=PathStatus.FLAT)

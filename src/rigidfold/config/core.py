@@ -165,7 +165,7 @@ class GenerationSettings(Group):
     )
 
     rewind: bool = setting(
-        True,
+        False,
         "With the deployability check: at a dead end of a shape whose children get the check "
         "(its DOF-1 candidates all failed), the shape's own folding path is traced; where it "
         "does not reach the flat state, the chain lost its deployability above it, and "
@@ -174,8 +174,11 @@ class GenerationSettings(Group):
         "bisected: about 2 log2(d) traces for a shape d solutions above the dead end, "
         ":func:`rigidfold.generate.final.lowest_deploying`) instead of to the shape before: "
         "one retraction of the budget (``backtrack_max``). The first chain gives up such a "
-        "shape at ``restart_after`` rejected paths whatever its candidates cost. False: "
-        "backtracking retracts one solution at a time (before session 41).",
+        "shape at ``restart_after`` rejected paths whatever its candidates cost. False (the "
+        "default): backtracking retracts one solution at a time. On the broad set the rewind "
+        "passed the same cases as without it and its median run took 8.1 s against 6.7 s "
+        "(docs/broad_set.md, session 41): a DOF-2 shape whose children all fail often "
+        "deploys itself, and one that does not costs its traces.",
     )
 
     second_order: bool = setting(

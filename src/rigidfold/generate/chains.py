@@ -113,13 +113,13 @@ class ChainControl:
         ``restart_after`` rejected paths instead of restarting: while its next candidates
         are still forecast to deploy (the last one tried was not put off by the look-ahead
         or the second-order forecast) and what its candidates have cost so far is less than
-        re-solving the chain to this shape (the seconds of its accepted attempts), and, once
-        ``restart_after`` of them were rejected, the shape's own path reaches the flat state
-        (:meth:`lost_above`)."""
+        re-solving the chain to this shape (the seconds of its accepted attempts), and, with
+        ``Settings.generation.rewind`` once ``restart_after`` of them were rejected, while
+        the shape's own path reaches the flat state (:meth:`lost_above`)."""
         chain = sum(attempt_time(rec) for rec in self.accepted[1:])
         if shape.fallback or shape.spent >= chain:
             return False
-        # a shape that does not deploy itself is not worth more (Settings.generation.rewind)
+        # with the rewind, a shape that does not deploy itself is not worth more
         restart_after = self.settings.generation.restart_after
         return shape.undeployable < restart_after or self.lost_above() is None
 
@@ -134,8 +134,10 @@ class ChainControl:
         """Step 7 beyond the last fix: after ``stop`` at the last solution's shape, retract
         that solution (not the initial shape's) while the run's budget
         (``Settings.generation.backtrack_max``) lasts and the deployability check runs; its
-        attempt's outcome becomes DEAD_END. Returns whether it did (then the shape before it
-        is reduced again)."""
+        attempt's outcome becomes DEAD_END. With ``Settings.generation.rewind``, where the
+        shape does not deploy itself, every solution below the chain's lowest that deploys
+        is retracted instead (:meth:`lost_above`), as one retraction of the budget. Returns
+        whether it did (then the shape before it, or that lowest one, is reduced again)."""
         run = self.run
         if (
             not self.options.deploy_check
@@ -205,8 +207,10 @@ class ChainControl:
         at one shape, before any backtracking; a bounded chain once its backtracking is spent
         (``after_backtracking``) or, where a further limit is left, once
         ``deploy_max_candidates`` of its candidates were rejected by their paths, at whatever
-        shapes (:meth:`spent`). Where no later chain ends lower, the run ends with the lowest
-        (:meth:`settle`). Returns whether it did."""
+        shapes (:meth:`spent`). With ``Settings.generation.rewind`` the new chain keeps no
+        solution below the old one's lowest that deploys (:meth:`lost_above`). Where no later
+        chain ends lower, the run ends with the lowest (:meth:`settle`). Returns whether it
+        did."""
         run = self.run
         if (
             not self.restarts
