@@ -164,6 +164,17 @@ class GenerationSettings(Group):
         "nothing.",
     )
 
+    idle_last: bool = setting(
+        True,
+        "With the deployability check and the look-ahead: a candidate whose creases do not "
+        "turn in any mechanism of the shape (their rows of H_phi still in every mode, "
+        ":func:`rigidfold.selection.lock_forecast`) removes no DOF when fixed, and is put off "
+        "like one forecast to lock (tried once every other candidate has failed). The "
+        "criteria rank such creases first (fixing a crease that does not move costs no "
+        "strain energy): on a 25 x 13 barrel vault the search fixed flat creases one per "
+        "solve, 528 solves for the first 59 DOF removed, DOF 34 kept for 100 solves in a "
+        "row (docs/broad_set.md, session 41). False: the criterion's order.",
+    )
     rewind: bool = setting(
         False,
         "With the deployability check: at a dead end of a shape whose children get the check "
@@ -436,7 +447,12 @@ class GenerationSettings(Group):
             )
         self._integer(near_tries=0, near_max=0, reseeds=0, reseeds_timed=0, reuse_max_dof=0)
         self._boolean(
-            "retry_zero_dof", "clear_gap", "second_order", "near_rigid_backtrack", "rewind"
+            "retry_zero_dof",
+            "clear_gap",
+            "second_order",
+            "near_rigid_backtrack",
+            "rewind",
+            "idle_last",
         )
         for name in ("batch_first", "batch_max", "batch_single_dof"):
             value = getattr(self, name)

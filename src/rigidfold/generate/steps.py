@@ -352,6 +352,7 @@ class _Steps(ChainControl):
                 dof0_ends=self.zero_ends,
                 locked_before=self.locked_before,
                 rigid=None if forecast is None else forecast.rigid,
+                idle_last=self.options.deploy_check and self.settings.generation.idle_last,
             )
             if self.options.lookahead
             else _forecast_order([g for g, _ in ranked], forecast)

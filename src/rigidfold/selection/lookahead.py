@@ -262,6 +262,8 @@ class Choice:
     passed : the put-off candidates ranked between this one and the one before it
     rigid : its fix is forecast to leave a shape that is mobile at first order only
         (second-order rigid; :class:`rigidfold.mechanism.second_order.ChildForecast`)
+    idle : its fix is forecast to remove no mechanism (its creases are still in every mode,
+        :func:`lock_forecast`'s rank 0): the shape keeps its DOF
     """
 
     index: int
@@ -270,12 +272,13 @@ class Choice:
     carried: np.ndarray = field(default_factory=_no_edges)
     passed: tuple[Choice, ...] = ()
     rigid: bool = False
+    idle: bool = False
 
     @property
     def put_off(self) -> bool:
-        """Forecast to lock or to be second-order rigid, or locked at an earlier shape:
-        tried once all others failed."""
-        return bool(len(self.locks) or len(self.locked_before) or self.rigid)
+        """Forecast to lock, to be second-order rigid or to remove no mechanism, or locked
+        at an earlier shape: tried once all others failed."""
+        return bool(len(self.locks) or len(self.locked_before) or self.rigid or self.idle)
 
 
 def carried_angles(
@@ -353,6 +356,7 @@ def lookahead_order(
     block: int = 8,
     locked_before: Mapping[tuple[int, ...], Sequence[int]] | None = None,
     rigid: Callable[[tuple[int, ...]], bool] | None = None,
+    idle_last: bool = False,
 ) -> Iterator[Choice]:
     """The order to try ranked candidates with look-ahead: put off those predicted to lock.
 
@@ -362,7 +366,8 @@ def lookahead_order(
     (its edges, as ranked): the creases its fix locked at an earlier shape of the run}; such a
     candidate is put off too. rigid : whether a candidate's fix (its edges) is forecast to
     leave a second-order rigid shape (that shape cannot fold); such a candidate that leaves
-    DOF >= 1 is put off too.
+    DOF >= 1 is put off too. idle_last : a candidate forecast to remove no mechanism (every
+    crease of it still in every mode: the shape keeps its DOF) is put off too.
     yields : :class:`Choice`: first every candidate not put off, in the criterion's order,
         with ``passed``, the put-off ones ranked between it and the one before; then the
         groups of :func:`flat_groups` (a candidate with the nearly flat creases it would
@@ -387,7 +392,8 @@ def lookahead_order(
             before = np.asarray(known.get(tuple(map(int, group)), ()), dtype=np.int64)
             moves = bool(forecast.dof_after[i] > 0)
             stiff = rigid is not None and moves and rigid(tuple(map(int, group)))
-            choice = Choice(start + i, forecast.locks(i), before, rigid=stiff)
+            idle = idle_last and bool(forecast.dof_after[i] == mechanism.dof)
+            choice = Choice(start + i, forecast.locks(i), before, rigid=stiff, idle=idle)
             if choice.put_off and not ends[i]:
                 passed.append(choice)
                 put_off.append(choice)
