@@ -72,6 +72,7 @@ MODES: dict[str, dict] = {
     "trace-first": {"second_order_first": False, "same_shape_tol": 0.0},
     "one-round": {"reseeds": 0, "reseeds_timed": 0},
     "rewind": {"rewind": True},
+    "idle-first": {"idle_last": False},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
     "projection-large": {},
 }
@@ -89,7 +90,9 @@ test only after a path that fails (the search before session 33, the same attemp
 ``one-round`` the search without its later rounds of other seeds (``reseeds`` 0, the search
 before session 34); ``spread-first`` the first round's K_j spread by 10 % too (a probe of
 session 34); ``rewind`` backtracking back to the chain's lowest shape that deploys
-(``Settings.generation.rewind``, a probe of session 41); ``projection-large`` see
+(``Settings.generation.rewind``, a probe of session 41); ``idle-first`` the candidates
+that remove no mechanism in the criterion's order (``idle_last`` False, the search before
+session 41); ``projection-large`` see
 :data:`MODE_OPTIONS`."""
 MODE_OPTIONS: dict[str, dict] = {
     "batch-auto": {"batch": "auto"},

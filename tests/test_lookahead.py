@@ -357,3 +357,34 @@ def test_generate_command_passes_lookahead_to_the_log(tmp_path):
     (first, second) = [a.to_dict() for a in read_log(out / "log.jsonl")]
     assert first["predicted_locks"] is None and second["predicted_locks"] == []
     assert second["skipped"] == 0 and second["skipped_locks"] == []
+
+
+def test_a_candidate_still_in_every_mode_removes_no_dof_and_is_put_off():
+    """``Settings.generation.idle_last``: on a 5 x 3 grid lifted onto a barrel vault, some
+    free creases do not turn in any mechanism (their rows of H_phi are still): the forecast
+    says their fix keeps the DOF, and the analysis with them fixed agrees, where a moving
+    crease's fix lowers it. With ``idle_last`` they are put off (``Choice.idle``) behind
+    every candidate that is not; without it, the order is the forecast's as before."""
+    case = case_from_specs("expr", "grid:5x3", seed=0, size="4x2", expr="0.1*x*(4-x)")
+    pattern = case.pattern
+    mech = analyze(pattern)
+    groups = [(int(e),) for e in mech.hinges]
+    forecast = lock_forecast(mech, groups)
+    idle = [g for g, after in zip(groups, forecast.dof_after, strict=True) if after == mech.dof]
+    moving = [g for g in groups if g not in idle]
+    assert idle and moving
+    for group in (idle[0], moving[0]):
+        fixed = pattern.fixed.copy()
+        fixed[list(group)] = True
+        after = analyze(dataclasses.replace(pattern, fixed=fixed)).dof
+        assert (after == mech.dof) == (group in idle)
+
+    order = [(groups[c.index], c) for c in lookahead_order(mech, groups, idle_last=True)]
+    assert sorted(g for g, _ in order) == sorted(groups)  # every candidate, once
+    tried_first = [g for g, c in order if not c.put_off]
+    assert not set(tried_first) & set(idle)
+    assert all(c.idle == (g in idle) for g, c in order)
+    first_idle = min(k for k, (g, _) in enumerate(order) if g in idle)
+    assert all(c.put_off for _, c in order[first_idle:])
+    plain = [(groups[c.index], c) for c in lookahead_order(mech, groups)]
+    assert not any(c.idle for _, c in plain)

@@ -113,8 +113,10 @@ class Attempt:
         The creases locked at the shape found (every folded free crease at DOF 0).
     skipped, skipped_locks : int, list of dict
         With look-ahead: the candidates passed over just before this one because they were
-        predicted to lock or had locked at an earlier shape, each as ``{"fixed": [edges],
-        "locks": [edges it would lock], "locked_before": [edges its fix locked before]}``.
+        predicted to lock, had locked at an earlier shape, were forecast second-order rigid
+        or (``Settings.generation.idle_last``) to remove no mechanism, each as ``{"fixed":
+        [edges], "locks": [edges it would lock], "locked_before": [edges its fix locked
+        before], "rigid": bool, "idle": bool}``.
     predicted_locks : list of int or None
         With look-ahead: the creases this fix was predicted to lock (non-empty only where
         every other candidate had failed); None without look-ahead and for the initial

@@ -377,6 +377,7 @@ class _Steps(ChainControl):
                     "locks": c.locks.tolist(),
                     "locked_before": c.locked_before.tolist(),
                     "rigid": c.rigid,
+                    "idle": c.idle,
                 }
                 for c in choice.passed
             ]
