@@ -148,7 +148,7 @@ class ChainControl:
             return False
         self.keep_deepest(stop)
         last = len(run.solutions) - 1
-        keep = min(self.lost_above() or last, last)
+        keep = self.lost_above() or last  # the lowest that deploys lies below the last
         while self.shapes and self.shapes[-1].solution.step >= keep:
             self.shapes.pop()
         if keep < last:  # a rewind: the retracted shapes' dead ends go with them
@@ -165,9 +165,10 @@ class ChainControl:
         where that does not reach the flat state, the number of the chain's solutions up to
         the lowest whose path deploys (:func:`lowest_deploying` from the chain's end back,
         down to the latest known to deploy, or the initial shape), which backtracking and a
-        restart keep. None: the rewind does not apply, the last shape deploys, or a trace was cut by
-        the deadline. The traces are kept on the solutions (``Solution.path``): a shape is
-        traced once a run, and the final design's naming reads them."""
+        restart keep: at most the chain's length less one. None: the rewind does not apply,
+        the last shape deploys, or a trace was cut by the deadline. The traces are kept on
+        the solutions (``Solution.path``): a shape is traced once a run, and the final
+        design's naming reads them."""
         run, chain = self.run, self.run.solutions
         if (
             not self.settings.generation.rewind
