@@ -73,6 +73,7 @@ MODES: dict[str, dict] = {
     "one-round": {"reseeds": 0, "reseeds_timed": 0},
     "rewind": {"rewind": True},
     "idle-first": {"idle_last": False},
+    "near-gain": {"near_gain": True},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
     "projection-large": {},
 }
@@ -92,7 +93,9 @@ before session 34); ``spread-first`` the first round's K_j spread by 10 % too (a
 session 34); ``rewind`` backtracking back to the chain's lowest shape that deploys
 (``Settings.generation.rewind``, a probe of session 41); ``idle-first`` the candidates
 that remove no mechanism in the criterion's order (``idle_last`` False, the search before
-session 41); ``projection-large`` see
+session 41); ``near-gain`` a near-mechanism fix of the same DOF count as its shape not
+kept, and the shapes after one whose near fixes all gained nothing skipping them
+(``near_gain``, a probe of session 43); ``projection-large`` see
 :data:`MODE_OPTIONS`."""
 MODE_OPTIONS: dict[str, dict] = {
     "batch-auto": {"batch": "auto"},

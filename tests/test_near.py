@@ -222,3 +222,77 @@ def test_the_exact_count_from_the_gap_counts_factorisation_is_a_second_analysis(
     assert counted.dof_at(0.0) <= exact.dof
     with pytest.raises(ValueError, match="above"):
         exact.dof_at(m.rank_tol * m.dof_gap)
+
+
+def _same_count_near_run(monkeypatch, settings):
+    """A run on a 5 x 5 grid where every shape has one near-mechanism and one near candidate
+    whose solve keeps its shape's count; each call of fix_near recorded as (shapes to skip
+    before, whether it looked for candidates, shapes to skip after, next skip after)."""
+    import rigidfold.generate.steps as steps
+
+    looked: list[bool] = []
+    calls: list[tuple[int, bool, int, int]] = []
+
+    def one_candidate(counted, exact, groups, ratio, floor, most=None):
+        looked.append(True)
+        return [((int(counted.hinges[0]),), 0.0)]
+
+    solve = steps._Steps.try_fix
+
+    def same_count(self, current, shape, fix, score, **kwargs):
+        rec, trial = solve(self, current, shape, fix, score, **kwargs)
+        if score is None and rec.outcome is AttemptOutcome.ACCEPTED:
+            rec.dof = current.mechanism.dof  # a near fix that traded one soft mode for another
+        return rec, trial
+
+    fix_near = steps._Steps.fix_near
+
+    def recorded(self, current, shape):
+        skip, n = self.near_skip, len(looked)
+        done = fix_near(self, current, shape)
+        calls.append((skip, len(looked) > n, self.near_skip, self.near_backoff))
+        return done
+
+    def one_near(self, rank_tol):
+        return self.dof - 1
+
+    monkeypatch.setattr(steps, "near_candidates", one_candidate)
+    monkeypatch.setattr(steps._Steps, "try_fix", same_count)
+    monkeypatch.setattr(steps._Steps, "fix_near", recorded)
+    monkeypatch.setattr(steps.Mechanism, "dof_at", one_near)
+    case = case_from_specs("dome", "grid:5x5", size="2x2", settings=settings)
+    options = GenerateOptions(deform=False, lookahead=True, time_limit=120, batch="off")
+    return generate(case, options), calls
+
+
+def test_a_near_fix_that_keeps_the_count_is_not_kept_and_the_next_shapes_skip(monkeypatch):
+    """With ``near_gain`` a near fix must take a DOF away: one that keeps its shape's count
+    is ``no_gain``, and after a shape whose near fixes all gained nothing the next 1, 2, 4,
+    ... shapes (that would look) go without looking."""
+    run, calls = _same_count_near_run(monkeypatch, DEFAULTS.with_(near_gain=True))
+    near = [a for a in run.attempts if a.near is not None]
+    assert near and all(a.outcome is AttemptOutcome.NO_GAIN for a in near)
+    assert not any(a.near is not None for a in run.attempts if a.outcome is AttemptOutcome.ACCEPTED)
+    looked = [c for c in calls if c[1]]
+    assert len(looked) >= 2 and any(c[0] > 0 for c in calls)
+    for skip, look, skip_after, backoff in calls:
+        if skip > 0:  # skipped: no candidates looked for, one shape fewer to skip
+            assert not look and skip_after == skip - 1
+        elif look:  # looked, gained nothing: the next skip doubles
+            assert skip_after == backoff
+    assert [c[3] for c in looked] == [2**k for k in range(len(looked))]
+
+
+def test_without_near_gain_a_near_fix_of_the_same_count_is_kept(monkeypatch):
+    """Without ``near_gain`` (the default): a near fix is refused only when its count rose;
+    one that keeps the count is a solution, and no shape skips the near-mechanisms."""
+    assert DEFAULTS.generation.near_gain is False
+    run, calls = _same_count_near_run(monkeypatch, DEFAULTS)
+    assert any(a.near is not None and a.outcome is AttemptOutcome.ACCEPTED for a in run.attempts)
+    assert not any(a.outcome is AttemptOutcome.NO_GAIN for a in run.attempts)
+    assert all(c[0] == 0 and c[2] == 0 for c in calls)
+
+
+def test_near_gain_is_a_boolean():
+    with pytest.raises(RigidfoldError, match="near_gain"):
+        DEFAULTS.with_(near_gain="yes")

@@ -358,6 +358,16 @@ class GenerationSettings(Group):
         "backtracking, meets the same candidates again; their traces (seconds each, the "
         "solve a fraction of that) are not repeated. 0: every path is traced.",
     )
+    near_gain: bool = setting(
+        False,
+        "With ``near_tries``: a near-mechanism fix is kept only when its solution has fewer "
+        "DOF than its shape, and after a shape whose near fixes all gained nothing the next "
+        "1, 2, 4, ... shapes skip them. False: kept unless the count rose. Measured on the "
+        "broad set (docs/broad_set.md, session 43): the 25 x 13 vault's solves per DOF "
+        "above DOF 10 fall from 1.36 to 0.81, but a same-count fix is sometimes the step to a "
+        "chain that deploys (the L-shaped hall: 5.7 s and 19 solves without, 50.2 s and 292 "
+        "with), and one case that passed fails; not adopted.",
+    )
     near_ratio: float = setting(
         1e-2,
         "With ``near_tries``: a candidate is tried first when its rotation in the shape's "
@@ -451,6 +461,7 @@ class GenerationSettings(Group):
             "clear_gap",
             "second_order",
             "near_rigid_backtrack",
+            "near_gain",
             "rewind",
             "idle_last",
         )

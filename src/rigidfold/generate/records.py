@@ -53,8 +53,9 @@ class AttemptOutcome(Outcome):
     NO_GAIN = (
         "no_gain",
         "a fix of a near-mechanism (``Settings.generation.near_tries``) whose solution has "
-        "more DOF than its shape: not kept (the solve moved the shape into softer modes), "
-        "the shape goes on with its ranked candidates",
+        "more DOF than its shape (with ``Settings.generation.near_gain``, no fewer): not kept "
+        "(the solve moved the shape into softer modes), the shape goes on with its ranked "
+        "candidates",
     )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (

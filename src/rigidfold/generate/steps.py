@@ -163,6 +163,9 @@ class _Steps(ChainControl):
         self.margins: dict[int, DofMargin] = {}  # by attempt index: those of target solutions
         self.backtracks = 0  # retractions by backtracking in the chain being built
         self.rejected = 0  # the chain's candidates whose paths do not reach the flat state
+        # near-mechanisms first: shapes still to skip, and the next skip after one whose near
+        # fixes all gained nothing (1, 2, 4, ...; Settings.generation.near_gain)
+        self.near_skip = self.near_backoff = 0
         # the restarts with bound (12) at each fold limit in turn: (limit, case) not yet used
         self.restarts: list[tuple[float, Case]] = [
             (limit, bounded)
@@ -505,7 +508,9 @@ class _Steps(ChainControl):
         that turn in its near-mechanisms but hardly in the exact ones (share below
         ``near_ratio``) are fixed one per solve before the ranked ones, where the shape has
         at most ``near_max`` near-mechanisms; a fix whose solution has more DOF than its
-        shape is not kept (``no_gain``). Returns True when one gave a solution, the run's
+        shape (with ``near_gain``: no fewer) is not kept (``no_gain``), and with
+        ``near_gain``, after a shape whose fixes all gained nothing, the next 1, 2, 4, ...
+        shapes skip them. Returns True when one gave a solution, the run's
         Stop (the time limit; NO_CANDIDATE for a shape after the first without an exact
         mechanism, with ``near_rigid_backtrack``), or False (the shape goes on with its ranked
         candidates, those tried here left out)."""
@@ -518,6 +523,9 @@ class _Steps(ChainControl):
             return Stop.NO_CANDIDATE  # rigid but for near-mechanisms: a dead end
         if exact_dof in (0, counted.dof) or counted.dof - exact_dof > g.near_max:
             return False  # no near-mechanism to take away, or a continuum (near_candidates)
+        if self.near_skip > 0:
+            self.near_skip -= 1  # the last near fixes gained nothing: this shape goes without
+            return False
         t1 = time.perf_counter()
         exact = analyze(
             current.result.pattern, support_face=self.options.support_face, settings=self.settings
@@ -532,21 +540,30 @@ class _Steps(ChainControl):
         )
         shape.t_sel += time.perf_counter() - t1
         dead = self.dead.get(current.step, ())
+        tried = no_gain = 0
         for group, share in [c for c in found if c[0] not in dead][: g.near_tries]:
             if self.out_of_time():
                 return self.time_up()
             shape.tried.add(group)
             rec, trial = self.try_fix(current, shape, group, None)
             rec.near = share
-            if self.is_solution(rec) and (rec.dof or 0) > current.mechanism.dof:
-                rec.outcome = AttemptOutcome.NO_GAIN  # the count rose: not kept
+            # a count that rose is refused; with near_gain, one that stayed too
+            if self.is_solution(rec) and (rec.dof or 0) >= current.mechanism.dof + (
+                not g.near_gain
+            ):
+                rec.outcome = AttemptOutcome.NO_GAIN
             self.record(rec, trial)
+            tried += 1
+            no_gain += rec.outcome is AttemptOutcome.NO_GAIN
             if self.is_solution(rec):
+                self.near_backoff = 0
                 return True
             if rec.outcome is AttemptOutcome.TIME_LIMIT:
                 return self.time_up()
             if rec.outcome is AttemptOutcome.ZERO_DOF:
                 return Stop.ZERO_DOF
+        if g.near_gain and tried and no_gain == tried:
+            self.near_backoff = self.near_skip = max(1, 2 * self.near_backoff)
         return False
 
     def set_size(self, current: Solution) -> int:

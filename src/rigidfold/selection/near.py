@@ -32,7 +32,9 @@ nearly flat grids the singular values run evenly across the gap's bound (a 41 x 
 the dome: from 5e-8 to 1e-5 of the largest, 68 near-mechanisms at the first shape), there
 is no separate near-mechanism to remove, and a single fix moves the count up as often as
 down. A fix whose solution counts more DOF than its shape is not kept
-(``AttemptOutcome.NO_GAIN``).
+(``AttemptOutcome.NO_GAIN``); with ``Settings.generation.near_gain`` (off), neither is one of
+the same count, and after a shape whose fixes all gained nothing the next 1, 2, 4, ... shapes
+go without (docs/broad_set.md, session 43).
 """
 
 from __future__ import annotations
