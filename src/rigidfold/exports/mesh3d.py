@@ -27,6 +27,7 @@ import numpy as np
 from rigidfold.errors import RigidfoldError
 from rigidfold.io.files import atomic_write, text_bytes
 from rigidfold.mesh import CreasePattern
+from rigidfold.runtime.interrupts import held_import
 
 MESH_FORMATS = ("obj", "stl", "ply", "glb")
 """The 3D formats of :func:`write_mesh` (file suffixes, without the dot)."""
@@ -84,16 +85,14 @@ def obj_text(pattern: CreasePattern, *, title: str = "") -> str:
 
 def stl_bytes(pattern: CreasePattern) -> bytes:
     """Binary STL of the folded form (float32, metres, z up)."""
-    from trimesh.exchange.stl import export_stl
-
+    export_stl = held_import("trimesh.exchange.stl").export_stl
     return export_stl(_trimesh(pattern))
 
 
 def ply_bytes(pattern: CreasePattern) -> bytes:
     """Binary little-endian PLY of the folded form: vertices (float32, metres, z up), faces
     with the integer property ``panel`` and the panel's colour."""
-    from trimesh.exchange.ply import export_ply
-
+    export_ply = held_import("trimesh.exchange.ply").export_ply
     mesh = _trimesh(pattern)
     mesh.visual.face_colors = panel_colours(pattern)[pattern.facets]
     mesh.face_attributes["panel"] = pattern.facets.astype(np.int32)
@@ -102,8 +101,7 @@ def ply_bytes(pattern: CreasePattern) -> bytes:
 
 def glb_bytes(pattern: CreasePattern) -> bytes:
     """glTF binary of the folded form: one node per panel under a y-up node (module)."""
-    import trimesh
-
+    trimesh = held_import("trimesh")
     scene = trimesh.Scene()
     scene.graph.update(frame_from=scene.graph.base_frame, frame_to="rigidfold", matrix=Y_UP)
     colours = panel_colours(pattern)
@@ -149,6 +147,5 @@ def write_mesh(path: str | os.PathLike, pattern: CreasePattern, *, title: str = 
 
 def _trimesh(pattern: CreasePattern):
     """The folded form as one ``trimesh.Trimesh`` (vertices and faces as they are)."""
-    import trimesh
-
+    trimesh = held_import("trimesh")
     return trimesh.Trimesh(vertices=pattern.coords, faces=pattern.faces, process=False)

@@ -33,6 +33,7 @@ import numpy as np
 
 from rigidfold.fabricate.motion import PanelMotion
 from rigidfold.fabricate.solids import Solids
+from rigidfold.runtime.interrupts import held_import
 
 
 @dataclass(frozen=True)
@@ -137,9 +138,7 @@ class _Distances:
     through python-fcl."""
 
     def __init__(self, solids: Solids) -> None:
-        import fcl
-
-        self.fcl = fcl
+        self.fcl = fcl = held_import("fcl")
         # unsigned: libccd's penetration depth (EPA) aborts the process on some touching
         # configurations (fcl throws std::logic_error through the binding)
         self.request = fcl.DistanceRequest(enable_nearest_points=True)

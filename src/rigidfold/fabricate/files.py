@@ -33,6 +33,7 @@ from rigidfold.errors import RigidfoldError
 from rigidfold.exports.mesh3d import Y_UP, panel_colours, panel_names
 from rigidfold.fabricate.build import Fabrication
 from rigidfold.io.files import parse_json, text_bytes, write_together
+from rigidfold.runtime.interrupts import held_import
 
 HINGE_COLUMNS = (
     "hinge",
@@ -76,8 +77,7 @@ def _meshes(fab: Fabrication) -> list[tuple[str, np.ndarray, np.ndarray]]:
 
 def glb_bytes(fab: Fabrication) -> bytes:
     """glTF binary of the solids: one node per panel under a y-up node."""
-    import trimesh
-
+    trimesh = held_import("trimesh")
     scene = trimesh.Scene()
     scene.graph.update(frame_from=scene.graph.base_frame, frame_to="rigidfold", matrix=Y_UP)
     colours = panel_colours(fab.panels.pattern)
@@ -115,8 +115,8 @@ def _empty_glb() -> bytes:
 
 def stl_bytes(fab: Fabrication) -> bytes:
     """Binary STL of all the solids."""
-    import trimesh
-    from trimesh.exchange.stl import export_stl
+    trimesh = held_import("trimesh")
+    export_stl = held_import("trimesh.exchange.stl").export_stl
 
     parts = [(v, f) for _, v, f in _meshes(fab) if len(f)]
     if not parts:  # every panel trimmed away: a binary STL of no triangle
@@ -150,12 +150,12 @@ def rhino_bytes(fab: Fabrication) -> bytes:
     shows where the files are written, with its cause, not as a refusal of rhino3dm."""
     import base64
 
-    import rhino3dm  # its stubs do not know the setters and the attribute arguments
+    rhino3dm = held_import("rhino3dm")  # typed Any: its stubs do not know the setters
 
     p = fab.panels
     pattern = p.pattern
     model = rhino3dm.File3dm()
-    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters  # type: ignore[misc]
+    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters
     layers = {}
     for name, colour in (
         ("PANELS", (200, 170, 120, 255)),
@@ -170,8 +170,8 @@ def rhino_bytes(fab: Fabrication) -> bytes:
 
     def attributes(layer: str, name: str):
         attr = rhino3dm.ObjectAttributes()
-        attr.LayerIndex = layers[layer]  # type: ignore[misc]
-        attr.Name = name  # type: ignore[misc]
+        attr.LayerIndex = layers[layer]
+        attr.Name = name
         return attr
 
     for name, verts, faces in _meshes(fab):
@@ -183,24 +183,24 @@ def rhino_bytes(fab: Fabrication) -> bytes:
         for a, b, c in faces.tolist():
             mesh.Faces.AddFace(a, b, c)
         mesh.Normals.ComputeNormals()
-        model.Objects.AddMesh(mesh, attributes("PANELS", name))  # type: ignore[call-arg]
+        model.Objects.AddMesh(mesh, attributes("PANELS", name))
     coords = pattern.coords
     for h, e in enumerate(p.hinge_edges.tolist()):
         u, v = p.hinge_vertices[h].tolist()
         line = rhino3dm.LineCurve(rhino3dm.Point3d(*coords[u]), rhino3dm.Point3d(*coords[v]))
-        model.Objects.AddCurve(line, attributes("HINGES", f"hinge_{e}"))  # type: ignore[call-arg]
+        model.Objects.AddCurve(line, attributes("HINGES", f"hinge_{e}"))
     for e, (u, v) in enumerate(pattern.edges.tolist()):
         if pattern.fixed[e]:
             continue
         line = rhino3dm.LineCurve(rhino3dm.Point3d(*coords[u]), rhino3dm.Point3d(*coords[v]))
-        model.Objects.AddCurve(line, attributes("CREASES", f"edge_{e}"))  # type: ignore[call-arg]
+        model.Objects.AddCurve(line, attributes("CREASES", f"edge_{e}"))
     for k, name in enumerate(panel_names(pattern)):
         centre = coords[p.vertices[k]].mean(axis=0)
         point = rhino3dm.Point3d(*centre)
-        model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))  # type: ignore[call-arg]
+        model.Objects.AddTextDot(str(k), point, attributes("LABELS", name))
     options = rhino3dm.File3dmWriteOptions()
-    options.Version = 7  # type: ignore[misc]
-    data = base64.b64decode(model.Encode(options) or "")  # type: ignore[attr-defined]
+    options.Version = 7
+    data = base64.b64decode(model.Encode(options) or "")
     if not data:
         raise RigidfoldError("cannot make the Rhino model (rhino3dm made no file of it)")
     return data

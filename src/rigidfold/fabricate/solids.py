@@ -57,6 +57,7 @@ from functools import cached_property
 import numpy as np
 
 from rigidfold.fabricate.panels import Panels
+from rigidfold.runtime.interrupts import held_import
 
 _ON_LINE = 1e-9
 """A triangle vertex within this many edge lengths of a hinge's line counts as on it."""
@@ -315,7 +316,7 @@ def _prism(panels: Panels, panel: int, thickness: float):
 def _wedge(b: _Bevel, d: np.ndarray, thickness: float):
     """The bevel's removal region as a convex solid (a little past the surface and the far
     face, so that no face of it lies on one of the prism's)."""
-    import manifold3d as mf
+    mf = held_import("manifold3d")
 
     eps = 1e-3 * thickness
     tan = math.tan(b.alpha)
@@ -421,7 +422,7 @@ def thicken(
     """The :class:`Solids` of ``panels`` at ``thickness`` (metres), with the bevel (H,) of
     each hinge (radians, from :func:`bevel_angles`) and the relief radius (V,) at each
     vertex (metres). Hinges with a bevel <= 0 trim their panels away."""
-    import manifold3d as mf
+    mf = held_import("manifold3d")
 
     p = panels.pattern
     coords = p.coords
@@ -497,7 +498,7 @@ def thicken(
 def _closed_manifold(points: np.ndarray, tri: np.ndarray):
     """The manifold3d solid of a closed triangle mesh: points (N, 3), tri (T, 3) of one
     consistent winding, turned to face outwards (positive signed volume)."""
-    import manifold3d as mf
+    mf = held_import("manifold3d")
 
     x0, x1, x2 = (points[tri[:, k]] for k in range(3))
     if np.einsum("ij,ij->i", x0, np.cross(x1, x2)).sum() < 0:
