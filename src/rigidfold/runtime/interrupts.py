@@ -218,7 +218,7 @@ def held_import(name: str) -> ModuleType:
     raise the interrupt once it is imported. A native extension module interrupted while it
     initialises can crash the process: a SIGTERM landing in ``import trimesh`` (which imports
     manifold3d, whose initialisation ran the handler's KeyboardInterrupt) ended a run with a
-    segmentation fault, its lock left and nothing said (twice in 48 runs signalled there on a
+    segmentation fault, its lock left and nothing said (twice in 76 runs signalled there on a
     loaded machine). Use it for every lazy import of a native library (trimesh, manifold3d,
     python-fcl, rhino3dm)."""
     with held_interrupts():
