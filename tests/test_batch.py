@@ -301,3 +301,63 @@ def test_a_set_is_sized_by_the_exact_dof_not_the_near_mechanisms_counted_with_th
     softer = replace(mech, rank_values=np.concatenate([mech.rank_values, near]))
     assert softer.dof == mech.dof and softer.dof_at(m.rank_tol) == mech.dof - 10
     assert run_steps.set_size(replace(current, mechanism=softer)) == min(g.batch_max, room - 10)
+
+
+def _turning_back(monkeypatch, turned: set[int], peel: bool):
+    """The 11 x 11 grid on the dome to DOF 8 with ``batch`` auto and ``unbatch_peel``
+    ``peel``, the traced paths numbered in ``turned`` (1 the first) made to turn back and a
+    chain's seconds made free (a shape is given up at its first rejected path): the run."""
+    from rigidfold.mechanism.path import PathStatus
+
+    real, traces = deploy_check.trace_path, []
+
+    def turns_back(pattern, **kwargs):
+        path = real(pattern, **kwargs)
+        traces.append(path)
+        return replace(path, status=PathStatus.TURNED_BACK) if len(traces) in turned else path
+
+    monkeypatch.setattr(deploy_check, "trace_path", turns_back)
+    for module in ("chains", "steps"):
+        monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
+    settings = DEFAULTS.with_(restart_after=1, unbatch_peel=peel)
+    case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
+    opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8)
+    return generate(case, opts.replace(batch="auto"))
+
+
+def test_peeling_retracts_the_sets_one_at_a_time_from_the_last(monkeypatch):
+    """``unbatch_peel``: the batched chain's first dead end retracts its last set of creases
+    only (the chain goes on one crease per solve from the shape before it, the earlier set
+    kept); the next dead end retracts the set before it, here back to the initial shape.
+    Without it, the first dead end goes back to before the first set."""
+    run = _turning_back(monkeypatch, {1}, peel=True)
+    first = next(k for k, a in enumerate(run.attempts) if a.outcome is AttemptOutcome.PATH)
+    chain = run.attempts[:first]  # the first chain, every attempt accepted until the trace
+    assert all(a.outcome in (AttemptOutcome.ACCEPTED, AttemptOutcome.DEAD_END) for a in chain)
+    sets = [k for k, a in enumerate(chain) if a.batch >= 2]
+    assert len(sets) >= 2  # 37 DOF to 8 with sets far from the target: 8 creases, then more
+    after = run.attempts[first + 1]
+    assert after.batch == 0 and len(after.fixed_added) == 1
+    assert after.dof == chain[sets[-1] - 1].dof - 1  # from the shape before the last set
+    assert run.attempts[sets[-1]].outcome is AttemptOutcome.DEAD_END
+    assert run.attempts[sets[0]].outcome is AttemptOutcome.ACCEPTED  # kept to the end
+    assert run.final_dof == 8
+    assert all(a.batch == 0 for a in run.attempts[first:])  # no set after a dead end
+
+    run = _turning_back(monkeypatch, {1, 2}, peel=True)
+    turned = [k for k, a in enumerate(run.attempts) if a.outcome is AttemptOutcome.PATH]
+    assert len(turned) == 2
+    again = run.attempts[turned[1] + 1]
+    assert again.dof == chain[sets[-2] - 1].dof - 1  # the set before it retracted too
+    assert all(run.attempts[k].outcome is AttemptOutcome.DEAD_END for k in sets)
+    assert run.final_dof == 8
+
+    run = _turning_back(monkeypatch, {1}, peel=False)
+    first = next(k for k, a in enumerate(run.attempts) if a.outcome is AttemptOutcome.PATH)
+    assert run.attempts[first + 1].dof == run.initial_dof - 1  # before the first set
+    assert all(run.attempts[k].outcome is AttemptOutcome.DEAD_END for k in sets)
+
+
+def test_unbatch_peel_is_a_boolean():
+    with pytest.raises(RigidfoldError, match="unbatch_peel"):
+        DEFAULTS.with_(unbatch_peel=1)

@@ -307,6 +307,17 @@ class GenerationSettings(Group):
         "of seconds of traces; one gave up a shape whose second child deploys "
         "(docs/broad_set.md, session 32).",
     )
+    unbatch_peel: bool = setting(
+        False,
+        'With ``GenerateOptions.batch`` "auto": at the batched chain\'s first dead end the '
+        "last set of creases is retracted (not every set from the first), and the chain goes "
+        "on one crease per solve from the shape before it; each later dead end while the "
+        "chain still holds a set retracts its last one, before backtracking, until none is "
+        "left. False: the first dead end goes back to before the first set (the chain of "
+        '``batch`` "off" from there). Where the sets dead-end at DOF 2 (16 of the 20 cases of '
+        "docs/broad_set.md, sessions 42-43), going back past every set throws away the solves "
+        "that took the chain there.",
+    )
     batch_tol: float = setting(
         1e-3,
         "With ``GenerateOptions.batch``: a candidate joins the set when each of its creases' "
@@ -462,6 +473,7 @@ class GenerationSettings(Group):
             "second_order",
             "near_rigid_backtrack",
             "near_gain",
+            "unbatch_peel",
             "rewind",
             "idle_last",
         )

@@ -90,6 +90,7 @@ class ChainControl:
     rng: np.random.Generator
     batch: bool  # sets of creases are made (GenerateOptions.batch)
     batch_size: int  # the next set's size
+    peeling: bool  # a dead end retracts the chain's last set (Settings.generation.unbatch_peel)
     stiffness: Settings  # the settings of the round's K_j (reseed_spread after the first)
     shapes: list[Frame]  # Step 6 at each solution being reduced, the last on top
     accepted: list[Attempt]  # the attempt of each solution
@@ -294,6 +295,7 @@ class ChainControl:
         self.problem = self.unbounded
         self.batch = makes_sets(self.options)
         self.batch_size = self.settings.generation.batch_first
+        self.peeling = False
         self.rng = np.random.default_rng([self.options.seed, self.search_round])
         g = self.settings.generation
         self.stiffness = self.settings.with_(
@@ -441,16 +443,23 @@ class ChainControl:
         of ``batch`` "off" (the sets cost what their solves took). Where the sets dead-end
         (the waterbomb family: DOF 2 in a few solves, no DOF-1 child deploys) the paper's
         order is not lost; where they reach the target, the run took a few solves per
-        dozen DOF. Returns whether it retracted (no set accepted: the chain is already the
-        paper's, and the run goes on as without sets)."""
-        if not (self.batch and self.options.batch == "auto") or stop not in DEAD_ENDS:
+        dozen DOF. With ``Settings.generation.unbatch_peel`` the sets are peeled instead:
+        this dead end and each later one while the chain holds a set retract only from its
+        last set on (:attr:`peeling`), before backtracking does, until no set is left.
+        Returns whether it retracted (no set accepted: the chain is already the paper's,
+        and the run goes on as without sets)."""
+        if self.options.batch != "auto" or stop not in DEAD_ENDS:
+            return False
+        if not (self.batch or self.peeling):
             return False
         self.batch = False
-        first = next((k for k, rec in enumerate(self.accepted) if rec.batch >= 2), None)
-        if first is None:
+        sets = [k for k, rec in enumerate(self.accepted) if rec.batch >= 2]
+        if not sets:
+            self.peeling = False
             return False
+        self.peeling = self.settings.generation.unbatch_peel
         self.keep_deepest(stop)
-        self.new_chain(keep=first)
+        self.new_chain(keep=sets[-1] if self.peeling else sets[0])
         # the ranking's draws as at the start, so that from the initial shape the chain is
         # the one of batch "off" (the sets' rankings drew from the same generator)
         self.rng = np.random.default_rng(self.options.seed)

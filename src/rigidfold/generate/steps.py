@@ -149,6 +149,7 @@ class _Steps(ChainControl):
         )
         self.batch = makes_sets(options)
         self.batch_size = self.settings.generation.batch_first  # the next set's size
+        self.peeling = False  # the chain's sets retracted one at a time (unbatch)
         # near-mechanisms first (rigidfold.selection.near): with the gap count and the check
         self.sweep = (
             options.deploy_check and self.count == "gap" and self.settings.generation.near_tries > 0
