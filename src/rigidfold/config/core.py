@@ -175,6 +175,17 @@ class GenerationSettings(Group):
         "solve, 528 solves for the first 59 DOF removed, DOF 34 kept for 100 solves in a "
         "row (docs/broad_set.md, session 41). False: the criterion's order.",
     )
+    idle_gain: bool = setting(
+        False,
+        "With ``idle_last``: a candidate put off as idle (forecast to remove no DOF) is kept "
+        "only where its solution has fewer DOF than its shape. Such a candidate is tried once "
+        "every other candidate of the shape failed; a solution that keeps the count is the "
+        "same shape with a crease that does not turn fixed (no solver iteration moves it), "
+        "and its ranked candidates are the shape's own, which all failed: keeping it replays "
+        "them. On ``paper/2/bezier:1013`` a chain kept 30 such solutions at DOF 3 in a row, "
+        "each followed by the same 16 failed solves (docs/broad_set.md, session 44). False: "
+        "kept unless the count rose.",
+    )
     rewind: bool = setting(
         False,
         "With the deployability check: at a dead end of a shape whose children get the check "
@@ -473,6 +484,7 @@ class GenerationSettings(Group):
             "second_order",
             "near_rigid_backtrack",
             "near_gain",
+            "idle_gain",
             "unbatch_peel",
             "rewind",
             "idle_last",

@@ -55,7 +55,9 @@ class AttemptOutcome(Outcome):
         "a fix of a near-mechanism (``Settings.generation.near_tries``) whose solution has "
         "more DOF than its shape (with ``Settings.generation.near_gain``, no fewer): not kept "
         "(the solve moved the shape into softer modes), the shape goes on with its ranked "
-        "candidates",
+        "candidates; or, with ``Settings.generation.idle_gain``, a candidate forecast to "
+        "remove no DOF whose solution has no fewer DOF than its shape: the same shape with "
+        "one more crease fixed, not kept",
     )
     INITIAL_FAILED = "initial_failed", "the solve from the target surface was not accepted"
     DEAD_END = (
