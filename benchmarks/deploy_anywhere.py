@@ -74,7 +74,7 @@ MODES: dict[str, dict] = {
     "rewind": {"rewind": True},
     "idle-first": {"idle_last": False},
     "near-gain": {"near_gain": True},
-    "peel": {"unbatch_peel": True},
+    "search-43": {"unbatch_peel": False, "idle_gain": False},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
     "projection-large": {},
 }
@@ -96,8 +96,9 @@ session 34); ``rewind`` backtracking back to the chain's lowest shape that deplo
 that remove no mechanism in the criterion's order (``idle_last`` False, the search before
 session 41); ``near-gain`` a near-mechanism fix of the same DOF count as its shape not
 kept, and the shapes after one whose near fixes all gained nothing skipping them
-(``near_gain``, a probe of session 43); ``peel`` the batched chain's sets retracted one at
-a time from the last at its dead ends (``unbatch_peel``, session 44); ``projection-large`` see
+(``near_gain``, a probe of session 43); ``search-43`` the batched chain's first dead end
+back to before its first set and an idle candidate that keeps its shape's DOF kept (the
+search before session 44: ``unbatch_peel`` and ``idle_gain`` off); ``projection-large`` see
 :data:`MODE_OPTIONS`."""
 MODE_OPTIONS: dict[str, dict] = {
     "batch-auto": {"batch": "auto"},

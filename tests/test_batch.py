@@ -147,7 +147,9 @@ def _restarted(monkeypatch, batch: str, keep):
     )
     for module in ("chains", "steps"):  # restart at once
         monkeypatch.setattr(f"rigidfold.generate.{module}.attempt_time", lambda rec: 0.0)
-    settings = DEFAULTS.with_(restart_after=1, fold_limits=(math.radians(120.0),))
+    settings = DEFAULTS.with_(
+        restart_after=1, fold_limits=(math.radians(120.0),), unbatch_peel=False
+    )
     case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8, batch=batch)
     run = generate(case, opts)
@@ -157,10 +159,11 @@ def _restarted(monkeypatch, batch: str, keep):
 
 
 def test_auto_leaves_sets_at_the_first_dead_end_for_one_crease_per_solve(monkeypatch):
-    """``batch`` auto: at the batched first chain's first dead end (its first traced path
-    made to turn back), the solutions from the first set on are retracted and the chain
-    goes on from the shape before it (the initial one) one crease per solve, without a fold
-    limit: from there the run is the paper's order (``batch`` off)."""
+    """``batch`` auto without ``unbatch_peel``: at the batched first chain's first dead end
+    (its first traced path made to turn back), the solutions from the first set on are
+    retracted and the chain goes on from the shape before it (the initial one) one crease
+    per solve, without a fold limit: from there the run is the paper's order (``batch``
+    off)."""
     _, run, first, _ = _restarted(monkeypatch, "auto", keep=lambda solutions: 1)
     assert first[1].batch >= 2  # the first set was made at the initial shape
     turned = next(k for k, a in enumerate(first) if a.outcome is AttemptOutcome.PATH)
@@ -172,8 +175,8 @@ def test_auto_leaves_sets_at_the_first_dead_end_for_one_crease_per_solve(monkeyp
 
 
 def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
-    """From the initial shape, the chain that follows the sets' dead end is the run of
-    ``batch`` off, attempt for attempt (the same fixes, outcomes and DOF: the ranking draws
+    """Without ``unbatch_peel``, from the initial shape, the chain that follows the sets'
+    dead end is the run of ``batch`` off, attempt for attempt (the same fixes, outcomes and DOF: the ranking draws
     from its generator as at the start)."""
     import rigidfold.generate.steps as steps
     from rigidfold.mechanism.path import PathStatus
@@ -185,7 +188,7 @@ def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
         traces.append(path)
         return replace(path, status=PathStatus.TURNED_BACK) if len(traces) == 1 else path
 
-    settings = DEFAULTS.with_(restart_after=1)
+    settings = DEFAULTS.with_(restart_after=1, unbatch_peel=False)
     case = case_from_specs("dome", "grid:11x11", size="3x3", settings=settings)
     opts = GenerateOptions(deform=False, criterion="s", lookahead=True, target_dof=8)
     paper = generate(case, opts.replace(batch="off"))
@@ -260,6 +263,7 @@ def test_the_sets_end_sooner_at_rejected_paths(monkeypatch):
         deploy_max_candidates=3,
         backtrack_max=0,
         fold_limits=(math.radians(120.0),),
+        unbatch_peel=False,
     )
     ends = settings.generation.batch_end_after
     assert 1 <= ends < 3

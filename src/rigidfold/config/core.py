@@ -176,15 +176,16 @@ class GenerationSettings(Group):
         "row (docs/broad_set.md, session 41). False: the criterion's order.",
     )
     idle_gain: bool = setting(
-        False,
+        True,
         "With ``idle_last``: a candidate put off as idle (forecast to remove no DOF) is kept "
         "only where its solution has fewer DOF than its shape. Such a candidate is tried once "
         "every other candidate of the shape failed; a solution that keeps the count is the "
         "same shape with a crease that does not turn fixed (no solver iteration moves it), "
         "and its ranked candidates are the shape's own, which all failed: keeping it replays "
-        "them. On ``paper/2/bezier:1013`` a chain kept 30 such solutions at DOF 3 in a row, "
-        "each followed by the same 16 failed solves (docs/broad_set.md, session 44). False: "
-        "kept unless the count rose.",
+        "them. On ``paper/2/bezier:1013`` with ``unbatch_peel`` a chain kept 30 such "
+        "solutions at DOF 3 in a row, each followed by the same 16 failed solves: 164.3 s, "
+        "and 25.1 s with it (docs/broad_set.md, session 44). False: kept unless the count "
+        "rose.",
     )
     rewind: bool = setting(
         False,
@@ -319,15 +320,16 @@ class GenerationSettings(Group):
         "(docs/broad_set.md, session 32).",
     )
     unbatch_peel: bool = setting(
-        False,
+        True,
         'With ``GenerateOptions.batch`` "auto": at the batched chain\'s first dead end the '
         "last set of creases is retracted (not every set from the first), and the chain goes "
         "on one crease per solve from the shape before it; each later dead end while the "
         "chain still holds a set retracts its last one, before backtracking, until none is "
-        "left. False: the first dead end goes back to before the first set (the chain of "
-        '``batch`` "off" from there). Where the sets dead-end at DOF 2 (16 of the 20 cases of '
+        "left. Where the sets dead-end at DOF 2 (16 of the 20 such cases of the broad set, "
         "docs/broad_set.md, sessions 42-43), going back past every set throws away the solves "
-        "that took the chain there.",
+        "that took the chain there. With ``idle_gain``, on the broad set's 46 cases: 34 pass "
+        "against 32, none lost (docs/broad_set.md, session 44). False: the first dead end "
+        'goes back to before the first set (the chain of ``batch`` "off" from there).',
     )
     batch_tol: float = setting(
         1e-3,
