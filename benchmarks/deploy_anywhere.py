@@ -75,6 +75,8 @@ MODES: dict[str, dict] = {
     "idle-first": {"idle_last": False},
     "near-gain": {"near_gain": True},
     "search-43": {"unbatch_peel": False, "idle_gain": False},
+    "first-set": {"unbatch_peel": False},
+    "idle-kept": {"idle_gain": False},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
     "projection-large": {},
 }
@@ -98,7 +100,8 @@ session 41); ``near-gain`` a near-mechanism fix of the same DOF count as its sha
 kept, and the shapes after one whose near fixes all gained nothing skipping them
 (``near_gain``, a probe of session 43); ``search-43`` the batched chain's first dead end
 back to before its first set and an idle candidate that keeps its shape's DOF kept (the
-search before session 44: ``unbatch_peel`` and ``idle_gain`` off); ``projection-large`` see
+search before session 44: ``unbatch_peel`` and ``idle_gain`` off), ``first-set`` and
+``idle-kept`` each of the two alone; ``projection-large`` see
 :data:`MODE_OPTIONS`."""
 MODE_OPTIONS: dict[str, dict] = {
     "batch-auto": {"batch": "auto"},

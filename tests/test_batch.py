@@ -176,8 +176,8 @@ def test_auto_leaves_sets_at_the_first_dead_end_for_one_crease_per_solve(monkeyp
 
 def test_after_the_sets_the_run_is_the_one_crease_runs(monkeypatch):
     """Without ``unbatch_peel``, from the initial shape, the chain that follows the sets'
-    dead end is the run of ``batch`` off, attempt for attempt (the same fixes, outcomes and DOF: the ranking draws
-    from its generator as at the start)."""
+    dead end is the run of ``batch`` off, attempt for attempt (the same fixes, outcomes and
+    DOF: the ranking draws from its generator as at the start)."""
     import rigidfold.generate.steps as steps
     from rigidfold.mechanism.path import PathStatus
 

@@ -184,8 +184,8 @@ class GenerationSettings(Group):
         "and its ranked candidates are the shape's own, which all failed: keeping it replays "
         "them. On ``paper/2/bezier:1013`` with ``unbatch_peel`` a chain kept 30 such "
         "solutions at DOF 3 in a row, each followed by the same 16 failed solves: 164.3 s, "
-        "and 25.1 s with it (docs/broad_set.md, session 44). False: kept unless the count "
-        "rose.",
+        "and 25.1 s with ``idle_gain`` (docs/broad_set.md, session 44). False: kept unless "
+        "the count rose.",
     )
     rewind: bool = setting(
         False,
@@ -320,16 +320,16 @@ class GenerationSettings(Group):
         "(docs/broad_set.md, session 32).",
     )
     unbatch_peel: bool = setting(
-        True,
+        False,
         'With ``GenerateOptions.batch`` "auto": at the batched chain\'s first dead end the '
         "last set of creases is retracted (not every set from the first), and the chain goes "
         "on one crease per solve from the shape before it; each later dead end while the "
         "chain still holds a set retracts its last one, before backtracking, until none is "
-        "left. Where the sets dead-end at DOF 2 (16 of the 20 such cases of the broad set, "
-        "docs/broad_set.md, sessions 42-43), going back past every set throws away the solves "
-        "that took the chain there. With ``idle_gain``, on the broad set's 46 cases: 34 pass "
-        "against 32, none lost (docs/broad_set.md, session 44). False: the first dead end "
-        'goes back to before the first set (the chain of ``batch`` "off" from there).',
+        "left. False: the first dead end goes back to before the first set (the chain of "
+        '``batch`` "off" from there). Measured in session 44 (docs/broad_set.md): on the '
+        "broad set's 46 cases 34 pass against 32, none lost, but on the 25 drawn and roof "
+        "cases 18 against 19 (lost: the HP's Miura-ori and the dome's Resch triangles; won: "
+        "the HP's double-faced wedge); not adopted.",
     )
     batch_tol: float = setting(
         1e-3,
