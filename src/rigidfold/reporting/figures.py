@@ -49,7 +49,7 @@ OUTCOME_STYLE = {
     "second_order_rigid": ("p", "#bcbd22", "rigid at second order (N_rigid)"),
     "time_limit": ("|", "#000000", "cut by the time limit"),
     "no_gap": ("h", "#17becf", "target DOF without a clear gap"),
-    "no_gain": ("1", "#aec7e8", "near-mechanism fix raised the DOF"),
+    "no_gain": ("1", "#aec7e8", "fix removed no DOF: not kept"),
     "initial_failed": ("D", "#7f7f7f", "initial solve failed"),
     "dead_end": ("*", "#e377c2", "retracted: no deployable candidate at its shape"),
 }
