@@ -448,9 +448,11 @@ class ChainControl:
         last set on (:attr:`peeling`), before backtracking does, until no set is left.
         Returns whether it retracted (no set accepted: the chain is already the paper's,
         and the run goes on as without sets)."""
-        if self.options.batch != "auto" or stop not in DEAD_ENDS:
-            return False
-        if not (self.batch or self.peeling):
+        if (
+            self.options.batch != "auto"
+            or stop not in DEAD_ENDS
+            or not (self.batch or self.peeling)
+        ):
             return False
         self.batch = False
         sets = [k for k, rec in enumerate(self.accepted) if rec.batch >= 2]
@@ -461,7 +463,8 @@ class ChainControl:
         self.keep_deepest(stop)
         self.new_chain(keep=sets[-1] if self.peeling else sets[0])
         # the ranking's draws as at the start, so that from the initial shape the chain is
-        # the one of batch "off" (the sets' rankings drew from the same generator)
+        # the one of batch "off" (the sets' rankings drew from the same generator); a peel
+        # from a later shape draws from the start too
         self.rng = np.random.default_rng(self.options.seed)
         return True
 

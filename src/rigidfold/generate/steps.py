@@ -428,9 +428,13 @@ class _Steps(ChainControl):
             if fix in self.dead.get(current.step, ()) or fix in shape.tried:
                 continue  # retracted before (a dead end), or tried first (fix_near)
             rec, trial = self.try_fix(current, shape, fix, score)
-            if choice.idle and self.is_solution(rec) and self.settings.generation.idle_gain:
-                if (rec.dof or 0) >= current.mechanism.dof:  # the shape again: not kept
-                    rec.outcome = AttemptOutcome.NO_GAIN
+            if (  # an idle fix that kept the DOF: the shape again, not kept (idle_gain)
+                choice.idle
+                and self.settings.generation.idle_gain
+                and self.is_solution(rec)
+                and (rec.dof or 0) >= current.mechanism.dof
+            ):
+                rec.outcome = AttemptOutcome.NO_GAIN
             shape.fallback = choice.put_off  # every candidate forecast to deploy was tried
             self.annotate(rec, choice, shape, current)
             self.record(rec, trial)
