@@ -236,6 +236,20 @@ def test_iteration_limit_is_a_status_not_silence():
     assert "Maximum_Iterations_Exceeded" in result.message
 
 
+def test_a_solve_own_iteration_limit_is_ipopts():
+    """A solve's own limit (a generation run's children, ``child_max_iter``) ends IPOPT where
+    the settings' limit would: the same iterate, the same status."""
+    problem = case_from_specs("dome", "11").problem()
+    own = problem.solve(max_iter=3)
+    limited = case_from_specs("dome", "11", settings=DEFAULTS.with_(ipopt_max_iter=3))
+    settings = limited.problem().solve()
+    assert own.status is Status.ITERATION_LIMIT and own.iterations == 3
+    assert own.message == settings.message
+    np.testing.assert_array_equal(own.pattern.coords, settings.pattern.coords)
+    free = problem.solve()  # the same solver's next solve has no limit of its own
+    assert free.converged and free.iterations > 3
+
+
 def test_impossible_bounds_are_not_converged():
     """A tight dz bound on a strongly curved dome cannot be met with F <= F_tol."""
     case = case_from_specs("dome", "11", settings=DEFAULTS.with_(dz=1e-4))

@@ -265,6 +265,18 @@ class GenerationSettings(Group):
         "Ctrl-C ends with them). 0 (the default): one round, as before session 34: without "
         "a time limit, rounds could take this many times a round's time.",
     )
+    child_max_iter: int = setting(
+        300,
+        "With the deployability check: the solver's iteration limit of a child's solve "
+        "(from its parent's shape, one crease or one set more fixed; the first solve, from "
+        "the target surface, keeps ``Settings.solver.ipopt_max_iter``). On the 25 drawn and "
+        "roof cases, of the 3397 child solves that converged none took more than 295 "
+        "iterations, the projections' steps and IPOPT's together (99 % within 150), and the "
+        "77 that did not took a quarter of the runs' time, six of them 7.6-16.8 s at IPOPT's "
+        "limit (docs/broad_set.md, session 45); the limit bounds IPOPT's own iterations. "
+        "Without the check (the "
+        "paper's Step 5, its study) every solve keeps the settings' limit.",
+    )
     reseeds_timed: int = setting(
         30,
         "As ``reseeds``, for a run with a time limit, which ends the last round: a run that "
@@ -479,7 +491,14 @@ class GenerationSettings(Group):
                 "time_limit_reserve_share must lie in [0, 1), got "
                 f"{self.time_limit_reserve_share!r}"
             )
-        self._integer(near_tries=0, near_max=0, reseeds=0, reseeds_timed=0, reuse_max_dof=0)
+        self._integer(
+            near_tries=0,
+            near_max=0,
+            reseeds=0,
+            reseeds_timed=0,
+            reuse_max_dof=0,
+            child_max_iter=1,
+        )
         self._boolean(
             "retry_zero_dof",
             "clear_gap",

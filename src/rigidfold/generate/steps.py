@@ -196,13 +196,22 @@ class _Steps(ChainControl):
         the path.
         With a time limit the solve ends at the run's deadline, the initial solve (``start``
         None: without it the run has no design) half a grace after T
-        (:attr:`TimeBudget.first_solve`)."""
+        (:attr:`TimeBudget.first_solve`); with the deployability check a child's solve
+        (``start`` given) ends after ``Settings.generation.child_max_iter`` iterations."""
         opts = self.options
         if start is not None or self.budget is None:
             deadline = self.deadline
         else:
             deadline = self.budget.first_solve
-        result = self.problem.solve(fixed=fixed, start=start, solver=opts.solver, deadline=deadline)
+        # a child's solve that runs on mostly finds no shape within dz (child_max_iter)
+        max_iter = (
+            self.settings.generation.child_max_iter
+            if start is not None and opts.deploy_check
+            else None
+        )
+        result = self.problem.solve(
+            fixed=fixed, start=start, solver=opts.solver, deadline=deadline, max_iter=max_iter
+        )
         cut = deadline is not None and time.monotonic() > deadline
         if opts.deploy_check and polish:
             result = self.problem.polish(result, deadline)

@@ -5,7 +5,9 @@ form, and IPOPT can be stopped early by an iteration callback (:class:`EarlyStop
 are what the composite solver of large patterns (:mod:`rigidfold.optimize.large`) asks of
 it. The same callback ends a solve at a deadline (a run's time limit, :meth:`IpoptSolver.
 solve`): CasADi fixes IPOPT's options (its ``max_wall_time`` too) when it builds the solver
-once per problem, so the remaining time of each solve is the callback's to keep.
+once per problem, so the remaining time of each solve is the callback's to keep, and so is
+a solve's own iteration limit where it is lower than the settings' (a generation run's
+children, ``Settings.generation.child_max_iter``).
 """
 
 from __future__ import annotations
@@ -27,7 +29,8 @@ _OUTCOME = {
     "Maximum_Iterations_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_WallTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
-    # EarlyStop asks, at F <= ipopt_stop_f (SOLVED) or at its deadline (see IpoptSolver.solve)
+    # EarlyStop asks, at F <= ipopt_stop_f (SOLVED), at its deadline or at its iteration
+    # limit (see IpoptSolver.solve)
     "User_Requested_Stop": SolverOutcome.SOLVED,
 }
 
@@ -101,21 +104,29 @@ class IpoptSolver:
         with native_quiet():
             self.nlpsol: ca.Function = ca.nlpsol("form_finding", "ipopt", nlp.casadi(), options)
 
-    def solve(self, xi0: np.ndarray, w: np.ndarray, deadline: float | None = None) -> SolverRun:
+    def solve(
+        self,
+        xi0: np.ndarray,
+        w: np.ndarray,
+        deadline: float | None = None,
+        max_iter: int | None = None,
+    ) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,); the run's message
         is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``. ``deadline``: a time
         of ``time.monotonic()`` after which the solve ends at its iterate (an iteration
-        limit, ``"IPOPT: Maximum_WallTime_Exceeded"``)."""
-        self._stop.start(deadline)
+        limit, ``"IPOPT: Maximum_WallTime_Exceeded"``); ``max_iter``: the solve ends at that
+        iteration (``"IPOPT: Maximum_Iterations_Exceeded"``, as at IPOPT's own limit,
+        ``Settings.solver.ipopt_max_iter``, which stays the bound)."""
+        self._stop.start(deadline, max_iter)
         try:
             with native_quiet():
                 sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
         finally:
-            timed_out = self._stop.start(None)
+            ended = self._stop.finish()
         stats = self.nlpsol.stats()
         status = str(stats.get("return_status", "unknown"))
-        if timed_out and status == "User_Requested_Stop":
-            status = "Maximum_WallTime_Exceeded"
+        if ended is not None and status == "User_Requested_Stop":
+            status = ended
         return SolverRun(
             xi=np.asarray(sol["x"], dtype=float).ravel(),
             iterations=int(stats.get("iter_count", 0)),
@@ -126,7 +137,8 @@ class IpoptSolver:
 
 class EarlyStop(ca.Callback):
     """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f`` (None:
-    never), or at the first iterate after the solve's deadline (:meth:`start`).
+    never), at the first iterate after the solve's deadline, or at the solve's iteration
+    limit (:meth:`start`).
 
     CasADi calls it with nlpsol's outputs (x, f, g, lam_x, lam_g, lam_p) after each iteration;
     a return value of 1 ends the run as ``User_Requested_Stop`` at that iterate.
@@ -136,7 +148,9 @@ class EarlyStop(ca.Callback):
         ca.Callback.__init__(self)
         self.stop_f = stop_f
         self.deadline: float | None = None
-        self.timed_out = False
+        self.max_iter: int | None = None
+        self.calls = 0  # iterates seen in this solve: IPOPT calls at iteration 0 too
+        self.ended: str | None = None  # IPOPT's status for a stop by the deadline or limit
         self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
         self.tol = 0.1 * problem.settings.solver.constraint_tol
         self.sizes = {
@@ -165,19 +179,31 @@ class EarlyStop(ca.Callback):
         size = self.sizes[ca.nlpsol_out(i)]
         return ca.Sparsity.dense(size, 1) if size else ca.Sparsity(0, 1)
 
-    def start(self, deadline: float | None) -> bool:
-        """Set the deadline of the next solve (a time of ``time.monotonic()``; None: none);
-        returns whether the solve before was ended by its deadline."""
-        timed_out, self.deadline, self.timed_out = self.timed_out, deadline, False
-        return timed_out
+    def start(self, deadline: float | None, max_iter: int | None = None) -> None:
+        """Set the deadline of the next solve (a time of ``time.monotonic()``; None: none)
+        and its iteration limit (None: IPOPT's own)."""
+        self.deadline, self.max_iter = deadline, max_iter
+        self.calls, self.ended = 0, None
+
+    def finish(self) -> str | None:
+        """After a solve: the status that says why the callback ended it where that was its
+        deadline or its iteration limit (None otherwise); the next solve has neither."""
+        ended = self.ended
+        self.start(None)
+        return ended
 
     def eval(self, arg):
+        iteration, self.calls = self.calls, self.calls + 1
         if self.deadline is not None and time.monotonic() > self.deadline:
-            self.timed_out = True
+            self.ended = "Maximum_WallTime_Exceeded"
             return [1]
         f = float(arg[1])
-        if self.stop_f is None or not f <= self.stop_f:
-            return [0]
-        g = np.asarray(arg[2], dtype=float).ravel()
-        violation = max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0))
-        return [1 if violation <= self.tol else 0]
+        if self.stop_f is not None and f <= self.stop_f:
+            g = np.asarray(arg[2], dtype=float).ravel()
+            violation = max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0))
+            if violation <= self.tol:
+                return [1]
+        if self.max_iter is not None and iteration >= self.max_iter:
+            self.ended = "Maximum_Iterations_Exceeded"
+            return [1]
+        return [0]

@@ -222,12 +222,14 @@ class FormFindingProblem:
         start: np.ndarray | None = None,
         solver: SolverName = SolverName.IPOPT,
         deadline: float | None = None,
+        max_iter: int | None = None,
     ) -> OptimizeResult:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
         ``solver`` is a :class:`SolverName`; the result's ``wall_time`` is that of the solve alone.
         ``deadline``: a time of ``time.monotonic()`` (a run's time limit) at which the solve
-        ends at its iterate (judged as any other: accepted only at F <= F_tol).
+        ends at its iterate (judged as any other: accepted only at F <= F_tol); so does
+        ``max_iter``, the solver's iterations (None: its limit of the settings).
         A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
         failed: the result is the start, Status.FAILED, its message saying why.
         """
@@ -237,7 +239,7 @@ class FormFindingProblem:
         w = mask.astype(float)
         t0 = time.perf_counter()
         with one_blas_thread():  # which zero of F is reached depends on round-off
-            run = backend.solve(xi0, w) if deadline is None else backend.solve(xi0, w, deadline)
+            run = backend.solve(xi0, w, deadline, max_iter)
         wall = time.perf_counter() - t0
         xi = run.xi
         coords = self.map.expand(xi)

@@ -41,12 +41,19 @@ class SlsqpSolver:
         self._hi_rows = np.flatnonzero(np.isfinite(ubg))
         self._lo, self._hi = lbg[self._lo_rows], ubg[self._hi_rows]
 
-    def solve(self, xi0: np.ndarray, w: np.ndarray, deadline: float | None = None) -> SolverRun:
+    def solve(
+        self,
+        xi0: np.ndarray,
+        w: np.ndarray,
+        deadline: float | None = None,
+        max_iter: int | None = None,
+    ) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
         The run's message is SciPy's, e.g. ``"SLSQP: Optimization terminated successfully"``.
         ``deadline`` (of ``time.monotonic()``): the run ends at the first iterate after it
-        (SciPy's callback stops it; an iteration limit).
+        (SciPy's callback stops it; an iteration limit). ``max_iter``: SLSQP's iteration
+        limit where it is below ``Settings.solver.slsqp_max_iter``.
         """
         from scipy.optimize import minimize  # only when SLSQP runs: not on the import path
 
@@ -73,7 +80,10 @@ class SlsqpSolver:
 
         s = self._settings
         constraint = {"type": "ineq", "fun": inequalities}
-        options = {"maxiter": s.solver.slsqp_max_iter, "ftol": s.solver.slsqp_ftol}
+        limit = s.solver.slsqp_max_iter
+        if max_iter is not None:
+            limit = min(limit, max_iter)
+        options = {"maxiter": limit, "ftol": s.solver.slsqp_ftol}
         if self.exact:
             constraint["jac"] = inequality_jacobian
             res = minimize(

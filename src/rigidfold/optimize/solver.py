@@ -87,8 +87,15 @@ class SolverProblem(Protocol):
 class Solver(Protocol):
     """A solver of problem (6), built for one ``SolverProblem`` (a ``FormFindingProblem``)."""
 
-    def solve(self, xi0: np.ndarray, w: np.ndarray, deadline: float | None = None) -> SolverRun:
+    def solve(
+        self,
+        xi0: np.ndarray,
+        w: np.ndarray,
+        deadline: float | None = None,
+        max_iter: int | None = None,
+    ) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,); ``deadline`` (a time
         of ``time.monotonic()``; None: none) ends the run at its iterate, an iteration
-        limit (``SolverOutcome.ITERATION_LIMIT``)."""
+        limit (``SolverOutcome.ITERATION_LIMIT``), and so does ``max_iter`` (None: the
+        solver's limit of the settings), where it is lower than that limit."""
         ...
