@@ -77,6 +77,7 @@ MODES: dict[str, dict] = {
     "search-43": {"unbatch_peel": False, "idle_gain": False},
     "first-set": {"unbatch_peel": False},
     "idle-kept": {"idle_gain": False},
+    "peel": {"unbatch_peel": True},
     "spread-first": {"hinge_stiffness_spread": 1e-4},
     "projection-large": {},
 }
@@ -101,7 +102,8 @@ kept, and the shapes after one whose near fixes all gained nothing skipping them
 (``near_gain``, a probe of session 43); ``search-43`` the batched chain's first dead end
 back to before its first set and an idle candidate that keeps its shape's DOF kept (the
 search before session 44: ``unbatch_peel`` and ``idle_gain`` off), ``first-set`` and
-``idle-kept`` each of the two alone; ``projection-large`` see
+``idle-kept`` each of the two alone; ``peel`` the sets peeled one at a time from the last
+(``unbatch_peel``, a probe of session 45); ``projection-large`` see
 :data:`MODE_OPTIONS`."""
 MODE_OPTIONS: dict[str, dict] = {
     "batch-auto": {"batch": "auto"},

@@ -271,7 +271,7 @@ class GenerationSettings(Group):
         "(from its parent's shape, one crease or one set more fixed; the first solve, from "
         "the target surface, keeps ``Settings.solver.ipopt_max_iter``). On the 25 drawn and "
         "roof cases, of the 3397 child solves that converged none took more than 295 "
-        "iterations, the projections' steps and IPOPT's together (99 % within 150), and the "
+        "iterations, the projections' steps and IPOPT's together (99 % within 155), and the "
         "77 that did not took a quarter of the runs' time, six of them 7.6-16.8 s at IPOPT's "
         "limit (docs/broad_set.md, session 45); the limit bounds IPOPT's own iterations. "
         "Without the check (the "
