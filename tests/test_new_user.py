@@ -117,7 +117,7 @@ def test_a_solver_point_with_a_collapsed_face_is_a_failed_solve(monkeypatch):
     face = case.pattern.faces[0]
     coords[face[2]] = coords[face[0]]  # face 0 collapses onto an edge
 
-    def collapsed(self, xi0, w, deadline=None, max_iter=None):
+    def collapsed(self, xi0, w, deadline=None, max_iter=None, stall=None):
         return SolverRun(problem.start_point(coords), 7, SolverOutcome.SOLVED, "IPOPT: x")
 
     monkeypatch.setattr(IpoptSolver, "solve", collapsed)

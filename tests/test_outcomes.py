@@ -22,6 +22,7 @@ VALUES = {
         "tolerance_not_met",
         "infeasible",
         "iteration_limit",
+        "stalled",
         "folded_back",
         "failed",
     ],

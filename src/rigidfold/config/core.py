@@ -277,6 +277,16 @@ class GenerationSettings(Group):
         "Without the check (the "
         "paper's Step 5, its study) every solve keeps the settings' limit.",
     )
+    child_stall: int = setting(
+        60,
+        "With the deployability check: a child's solve also ends where its best F has not "
+        "halved in this many iterations while above ``f_tol`` (Status.STALLED, counted in "
+        "N_exceed): it sits at a local minimum of F, the fixed creases cannot be flattened "
+        "within dz from the parent's shape (:func:`rigidfold.optimize.solver.stalled`). On "
+        "the 25 drawn and roof cases no child solve that converged went 60 iterations "
+        "above F_tol without halving its best F, and the failing solves it ends took 161 s "
+        "of the runs' 1540 s after that point (docs/broad_set.md, session 46).",
+    )
     reseeds_timed: int = setting(
         30,
         "As ``reseeds``, for a run with a time limit, which ends the last round: a run that "
@@ -498,6 +508,7 @@ class GenerationSettings(Group):
             reseeds_timed=0,
             reuse_max_dof=0,
             child_max_iter=1,
+            child_stall=1,
         )
         self._boolean(
             "retry_zero_dof",

@@ -197,20 +197,24 @@ class _Steps(ChainControl):
         With a time limit the solve ends at the run's deadline, the initial solve (``start``
         None: without it the run has no design) half a grace after T
         (:attr:`TimeBudget.first_solve`); with the deployability check a child's solve
-        (``start`` given) ends after ``Settings.generation.child_max_iter`` iterations."""
+        (``start`` given) ends after ``Settings.generation.child_max_iter`` iterations, or
+        where its best F has not halved in ``child_stall`` iterations above F_tol."""
         opts = self.options
         if start is not None or self.budget is None:
             deadline = self.deadline
         else:
             deadline = self.budget.first_solve
-        # a child's solve that runs on mostly finds no shape within dz (child_max_iter)
-        max_iter = (
-            self.settings.generation.child_max_iter
-            if start is not None and opts.deploy_check
-            else None
-        )
+        # a child's solve that runs on, or whose F stalls, mostly finds no shape within dz
+        # (child_max_iter, child_stall)
+        child = start is not None and opts.deploy_check
+        gen = self.settings.generation
         result = self.problem.solve(
-            fixed=fixed, start=start, solver=opts.solver, deadline=deadline, max_iter=max_iter
+            fixed=fixed,
+            start=start,
+            solver=opts.solver,
+            deadline=deadline,
+            max_iter=gen.child_max_iter if child else None,
+            stall=gen.child_stall if child else None,
         )
         cut = deadline is not None and time.monotonic() > deadline
         if opts.deploy_check and polish:

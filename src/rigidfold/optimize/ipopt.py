@@ -19,8 +19,11 @@ import numpy as np
 
 from rigidfold.config import Settings
 from rigidfold.optimize.hessian import closed_form_hess_lag
-from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
+from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun, stalled
 from rigidfold.runtime.quiet import native_quiet
+
+STALLED = "Stalled"
+"""The status of a run that :class:`EarlyStop` ended where F stalled (not one of IPOPT's)."""
 
 _OUTCOME = {
     "Solve_Succeeded": SolverOutcome.SOLVED,
@@ -29,8 +32,9 @@ _OUTCOME = {
     "Maximum_Iterations_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
     "Maximum_WallTime_Exceeded": SolverOutcome.ITERATION_LIMIT,
-    # EarlyStop asks, at F <= ipopt_stop_f (SOLVED), at its deadline or at its iteration
-    # limit (see IpoptSolver.solve)
+    STALLED: SolverOutcome.STALLED,
+    # EarlyStop asks, at F <= ipopt_stop_f (SOLVED), at its deadline, at its iteration
+    # limit or where F stalled (see IpoptSolver.solve)
     "User_Requested_Stop": SolverOutcome.SOLVED,
 }
 
@@ -110,14 +114,17 @@ class IpoptSolver:
         w: np.ndarray,
         deadline: float | None = None,
         max_iter: int | None = None,
+        stall: int | None = None,
     ) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,); the run's message
         is IPOPT's return status, e.g. ``"IPOPT: Solve_Succeeded"``. ``deadline``: a time
         of ``time.monotonic()`` after which the solve ends at its iterate (an iteration
         limit, ``"IPOPT: Maximum_WallTime_Exceeded"``); ``max_iter``: the solve ends at that
         iteration (``"IPOPT: Maximum_Iterations_Exceeded"``, as at IPOPT's own limit,
-        ``Settings.solver.ipopt_max_iter``, which stays the bound)."""
-        self._stop.start(deadline, max_iter)
+        ``Settings.solver.ipopt_max_iter``, which stays the bound); ``stall``: the solve
+        ends where its best F has not halved in that many iterations above F_tol
+        (``"IPOPT: Stalled"``)."""
+        self._stop.start(deadline, max_iter, stall)
         try:
             with native_quiet():
                 sol = self.nlpsol(x0=xi0, p=w, lbg=self._lbg, ubg=self._ubg)
@@ -137,8 +144,9 @@ class IpoptSolver:
 
 class EarlyStop(ca.Callback):
     """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f`` (None:
-    never), at the first iterate after the solve's deadline, or at the solve's iteration
-    limit (:meth:`start`).
+    never), at the first iterate after the solve's deadline, at the solve's iteration
+    limit, or where its best F has stalled (:meth:`start`, :func:`~rigidfold.optimize.solver.
+    stalled`).
 
     CasADi calls it with nlpsol's outputs (x, f, g, lam_x, lam_g, lam_p) after each iteration;
     a return value of 1 ends the run as ``User_Requested_Stop`` at that iterate.
@@ -149,6 +157,9 @@ class EarlyStop(ca.Callback):
         self.stop_f = stop_f
         self.deadline: float | None = None
         self.max_iter: int | None = None
+        self.stall: int | None = None
+        self.best: list[float] = []  # the best feasible F after each iterate (inf: none yet)
+        self.f_tol = problem.settings.design.f_tol
         self.calls = 0  # iterates seen in this solve: IPOPT calls at iteration 0 too
         self.ended: str | None = None  # IPOPT's status for a stop by the deadline or limit
         self.lbg, self.ubg = problem.nlp.lbg, problem.nlp.ubg
@@ -179,15 +190,18 @@ class EarlyStop(ca.Callback):
         size = self.sizes[ca.nlpsol_out(i)]
         return ca.Sparsity.dense(size, 1) if size else ca.Sparsity(0, 1)
 
-    def start(self, deadline: float | None, max_iter: int | None = None) -> None:
-        """Set the deadline of the next solve (a time of ``time.monotonic()``; None: none)
-        and its iteration limit (None: IPOPT's own)."""
-        self.deadline, self.max_iter = deadline, max_iter
-        self.calls, self.ended = 0, None
+    def start(
+        self, deadline: float | None, max_iter: int | None = None, stall: int | None = None
+    ) -> None:
+        """Set the deadline of the next solve (a time of ``time.monotonic()``; None: none),
+        its iteration limit (None: IPOPT's own) and its stall window (None: none)."""
+        self.deadline, self.max_iter, self.stall = deadline, max_iter, stall
+        self.calls, self.ended, self.best = 0, None, []
 
     def finish(self) -> str | None:
         """After a solve: the status that says why the callback ended it where that was its
-        deadline or its iteration limit (None otherwise); the next solve has neither."""
+        deadline, its iteration limit or a stall (None otherwise); the next solve has none
+        of them."""
         ended = self.ended
         self.start(None)
         return ended
@@ -198,12 +212,25 @@ class EarlyStop(ca.Callback):
             self.ended = "Maximum_WallTime_Exceeded"
             return [1]
         f = float(arg[1])
+        feasible = None  # decided only where needed
         if self.stop_f is not None and f <= self.stop_f:
-            g = np.asarray(arg[2], dtype=float).ravel()
-            violation = max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0))
-            if violation <= self.tol:
+            feasible = self._feasible(arg[2])
+            if feasible:
                 return [1]
         if self.max_iter is not None and iteration >= self.max_iter:
             self.ended = "Maximum_Iterations_Exceeded"
             return [1]
+        if self.stall is not None:
+            if feasible is None:
+                feasible = self._feasible(arg[2])
+            self.best.append(min(f if feasible else np.inf, self.best[-1] if self.best else np.inf))
+            if stalled(self.best, self.stall, self.f_tol):
+                self.ended = STALLED
+                return [1]
         return [0]
+
+    def _feasible(self, g) -> bool:
+        """Whether constraint values g (m,) meet (6) far inside ``constraint_tol``."""
+        g = np.asarray(g, dtype=float).ravel()
+        violation = max(np.max(self.lbg - g, initial=0.0), np.max(g - self.ubg, initial=0.0))
+        return bool(violation <= self.tol)

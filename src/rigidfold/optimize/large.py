@@ -56,18 +56,20 @@ class ProjectedIpoptSolver:
         w: np.ndarray,
         deadline: float | None = None,
         max_iter: int | None = None,
+        stall: int | None = None,
     ) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,); the run's message
         says what the projection did before and after IPOPT, and IPOPT's return status.
         ``deadline`` (of ``time.monotonic()``) ends each part at its iterate; ``max_iter``
-        bounds IPOPT's iterations (the projections keep ``projection_max_iter``)."""
+        and ``stall`` bound IPOPT's iterations (the projections keep
+        ``projection_max_iter``)."""
         first = self.projection(xi0, w, deadline=deadline)
         if first.converged or (first.feasible and first.F <= self._stop_f):
             # IPOPT would stop at once and hand the same point back
             return SolverRun(
                 first.xi, first.iterations, SolverOutcome.SOLVED, f"projection: {first.reason}"
             )
-        run = self.ipopt.solve(xi0, w, deadline, max_iter)
+        run = self.ipopt.solve(xi0, w, deadline, max_iter, stall)
         polish = self.projection(run.xi, w, deadline=deadline)
         iterations = first.iterations + run.iterations + polish.iterations
         message = f"projection: {first.reason}; {run.message}; projection: {polish.reason}"

@@ -223,13 +223,16 @@ class FormFindingProblem:
         solver: SolverName = SolverName.IPOPT,
         deadline: float | None = None,
         max_iter: int | None = None,
+        stall: int | None = None,
     ) -> OptimizeResult:
         """Solve (6) from ``start`` coordinates (V, 3) with the creases ``fixed`` fixed.
 
         ``solver`` is a :class:`SolverName`; the result's ``wall_time`` is that of the solve alone.
         ``deadline``: a time of ``time.monotonic()`` (a run's time limit) at which the solve
         ends at its iterate (judged as any other: accepted only at F <= F_tol); so does
-        ``max_iter``, the solver's iterations (None: its limit of the settings).
+        ``max_iter``, the solver's iterations (None: its limit of the settings), and
+        ``stall``: where the best F has not halved in that many iterations above F_tol
+        (None: never; ``Status.STALLED``).
         A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
         failed: the result is the start, Status.FAILED, its message saying why.
         """
@@ -239,7 +242,7 @@ class FormFindingProblem:
         w = mask.astype(float)
         t0 = time.perf_counter()
         with one_blas_thread():  # which zero of F is reached depends on round-off
-            run = backend.solve(xi0, w, deadline, max_iter)
+            run = backend.solve(xi0, w, deadline, max_iter, stall)
         wall = time.perf_counter() - t0
         xi = run.xi
         coords = self.map.expand(xi)
@@ -358,6 +361,8 @@ def classify(
         return Status.INFEASIBLE, f"constraint violation {violation:.3g}"
     if outcome == SolverOutcome.ITERATION_LIMIT:
         return Status.ITERATION_LIMIT, f"stopped at F = {F:.3g}"
+    if outcome == SolverOutcome.STALLED:
+        return Status.STALLED, f"F stalled at {F:.3g} > F_tol = {settings.design.f_tol:.3g}"
     if outcome == SolverOutcome.SOLVED:
         return Status.TOLERANCE_NOT_MET, f"F = {F:.3g} > F_tol = {settings.design.f_tol:.3g}"
     return Status.FAILED, f"F = {F:.3g}, constraint violation {violation:.3g}"

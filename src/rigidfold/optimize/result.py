@@ -23,6 +23,11 @@ class Status(Outcome):
         "iteration_limit",
         "the iteration (or time) limit was reached before F <= F_tol",
     )
+    STALLED = (
+        "stalled",
+        "the solve was ended where its best F had not halved in its stall window above F_tol "
+        "(a child's solve in a design search, ``Settings.generation.child_stall``)",
+    )
     FOLDED_BACK = (
         "folded_back",
         "F <= F_tol, but a fixed crease is folded onto itself (|fold angle| above 90 "

@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun
+from rigidfold.optimize.solver import SolverOutcome, SolverProblem, SolverRun, stalled
 
 # SciPy's SLSQP exit modes (scipy/optimize/_slsqp_py.py)
 _OUTCOME = {
@@ -47,13 +47,16 @@ class SlsqpSolver:
         w: np.ndarray,
         deadline: float | None = None,
         max_iter: int | None = None,
+        stall: int | None = None,
     ) -> SolverRun:
         """Solve from ``xi0`` (n,) with fixed-crease weights ``w`` (E,).
 
         The run's message is SciPy's, e.g. ``"SLSQP: Optimization terminated successfully"``.
         ``deadline`` (of ``time.monotonic()``): the run ends at the first iterate after it
         (SciPy's callback stops it; an iteration limit). ``max_iter``: SLSQP's iteration
-        limit where it is below ``Settings.solver.slsqp_max_iter``.
+        limit where it is below ``Settings.solver.slsqp_max_iter``. ``stall``: the run ends
+        where its best F has not halved in that many iterations above F_tol (the callback
+        stops it; ``SolverOutcome.STALLED``).
         """
         from scipy.optimize import minimize  # only when SLSQP runs: not on the import path
 
@@ -74,8 +77,19 @@ class SlsqpSolver:
             jac = self._constraint_jacobian(xi, w)[1].full()
             return np.vstack([jac[lo_rows], -jac[hi_rows]])
 
+        best: list[float] = []  # the best feasible F after each iteration (inf: none yet)
+        f_tol = self._settings.design.f_tol
+        feasible_tol = 0.1 * self._settings.solver.constraint_tol  # as IPOPT's
+
         def callback(intermediate_result):
             if deadline is not None and time.monotonic() > deadline:
+                raise StopIteration
+            if stall is None:
+                return
+            feasible = np.min(inequalities(intermediate_result.x), initial=0.0) >= -feasible_tol
+            f = float(intermediate_result.fun) if feasible else np.inf
+            best.append(min(f, best[-1] if best else np.inf))
+            if stalled(best, stall, f_tol):
                 raise StopIteration
 
         s = self._settings
@@ -110,6 +124,13 @@ class SlsqpSolver:
                 iterations=int(res.nit),
                 outcome=SolverOutcome.ITERATION_LIMIT,
                 message=f"SLSQP: stopped at its deadline ({res.message})",
+            )
+        if int(res.status) != 0 and stalled(best, stall, f_tol):
+            return SolverRun(
+                xi=np.asarray(res.x, dtype=float),
+                iterations=int(res.nit),
+                outcome=SolverOutcome.STALLED,
+                message=f"SLSQP: F stalled ({res.message})",
             )
         return SolverRun(
             xi=np.asarray(res.x, dtype=float),
