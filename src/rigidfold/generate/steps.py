@@ -198,7 +198,7 @@ class _Steps(ChainControl):
         None: without it the run has no design) half a grace after T
         (:attr:`TimeBudget.first_solve`); with the deployability check a child's solve
         (``start`` given) ends after ``Settings.generation.child_max_iter`` iterations, or
-        where its best F has not halved in ``child_stall`` iterations above F_tol."""
+        where its least feasible F has not halved in ``child_stall`` iterations above F_tol."""
         opts = self.options
         if start is not None or self.budget is None:
             deadline = self.deadline

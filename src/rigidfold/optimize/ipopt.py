@@ -122,7 +122,7 @@ class IpoptSolver:
         limit, ``"IPOPT: Maximum_WallTime_Exceeded"``); ``max_iter``: the solve ends at that
         iteration (``"IPOPT: Maximum_Iterations_Exceeded"``, as at IPOPT's own limit,
         ``Settings.solver.ipopt_max_iter``, which stays the bound); ``stall``: the solve
-        ends where its best F has not halved in that many iterations above F_tol
+        ends where its least feasible F has not halved in that many iterations above F_tol
         (``"IPOPT: Stalled"``)."""
         self._stop.start(deadline, max_iter, stall)
         try:
@@ -145,8 +145,8 @@ class IpoptSolver:
 class EarlyStop(ca.Callback):
     """IPOPT's ``iteration_callback``: stop at a feasible iterate with F <= ``stop_f`` (None:
     never), at the first iterate after the solve's deadline, at the solve's iteration
-    limit, or where its best F has stalled (:meth:`start`, :func:`~rigidfold.optimize.solver.
-    stalled`).
+    limit, or where its least feasible F has stalled (:meth:`start`,
+    :func:`~rigidfold.optimize.solver.stalled`).
 
     CasADi calls it with nlpsol's outputs (x, f, g, lam_x, lam_g, lam_p) after each iteration;
     a return value of 1 ends the run as ``User_Requested_Stop`` at that iterate.

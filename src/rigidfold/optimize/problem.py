@@ -231,7 +231,7 @@ class FormFindingProblem:
         ``deadline``: a time of ``time.monotonic()`` (a run's time limit) at which the solve
         ends at its iterate (judged as any other: accepted only at F <= F_tol); so does
         ``max_iter``, the solver's iterations (None: its limit of the settings), and
-        ``stall``: where the best F has not halved in that many iterations above F_tol
+        ``stall``: where the least feasible F has not halved in that many iterations above F_tol
         (None: never; ``Status.STALLED``).
         A solver that ends where a triangle has collapsed (or at non-finite coordinates) has
         failed: the result is the start, Status.FAILED, its message saying why.

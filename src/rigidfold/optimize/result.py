@@ -25,8 +25,8 @@ class Status(Outcome):
     )
     STALLED = (
         "stalled",
-        "the solve was ended where its best F had not halved in its stall window above F_tol "
-        "(a child's solve in a design search, ``Settings.generation.child_stall``)",
+        "the solve was ended where its least feasible F had not halved in its stall window "
+        "above F_tol (a child's solve in a design search, ``Settings.generation.child_stall``)",
     )
     FOLDED_BACK = (
         "folded_back",

@@ -55,7 +55,7 @@ class SlsqpSolver:
         ``deadline`` (of ``time.monotonic()``): the run ends at the first iterate after it
         (SciPy's callback stops it; an iteration limit). ``max_iter``: SLSQP's iteration
         limit where it is below ``Settings.solver.slsqp_max_iter``. ``stall``: the run ends
-        where its best F has not halved in that many iterations above F_tol (the callback
+        where its least feasible F has not halved in that many iterations above F_tol (the callback
         stops it; ``SolverOutcome.STALLED``).
         """
         from scipy.optimize import minimize  # only when SLSQP runs: not on the import path

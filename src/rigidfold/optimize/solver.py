@@ -122,9 +122,9 @@ def stalled(best: list[float], window: int | None, f_tol: float) -> bool:
     (the creases cannot be flattened within dz from there) or crawls along the bounds of
     (6). Of the child solves of the 25 drawn and roof cases and of 37 cases of the broad set
     that converged, none went 60 iterations above F_tol without halving its best F (at worst
-    it fell to a quarter), while 69 of the 82 of the drawn cases that did not converge would
-    have ended there, most on a plateau of F for hundreds of iterations (docs/broad_set.md,
-    session 46).
+    it fell to about a quarter), while 68 of the 76 of the drawn cases that did not converge
+    would have ended there, most on a plateau of F for hundreds of iterations
+    (``benchmarks/stall_traces.py``, docs/broad_set.md, session 46).
     """
     if window is None or len(best) <= window:
         return False
