@@ -281,13 +281,13 @@ class GenerationSettings(Group):
         60,
         "With the deployability check: a child's solve also ends where the least F of its "
         "feasible iterates has not halved in this many iterations while above ``f_tol`` "
-        "(Status.STALLED, counted in "
-        "N_exceed): it sits at a local minimum of F, the fixed creases cannot be flattened "
-        "within dz from the parent's shape (:func:`rigidfold.optimize.solver.stalled`). On "
-        "the 25 drawn and roof cases and 37 of the broad set's sample no child solve that "
-        "converged went 60 iterations above F_tol without halving that F, and the 68 "
-        "failing solves of the drawn cases that it ends ran 174.5 s of the runs' 1585 s "
-        "after that point (``benchmarks/stall_traces.py``, docs/broad_set.md, session 46).",
+        "(Status.STALLED, counted in N_exceed): it sits at a local minimum of F, and the "
+        "fixed creases cannot be flattened within dz from the parent's shape "
+        "(:func:`rigidfold.optimize.solver.stalled`). On the 25 drawn and roof cases and 37 "
+        "of the broad set's sample no child solve that converged went 60 iterations above "
+        "F_tol without halving that F, and the 68 failing solves of the drawn cases that it "
+        "ends ran 174.5 s of the runs' 1585 s after that point "
+        "(``benchmarks/stall_traces.py``, docs/broad_set.md, session 46).",
     )
     reseeds_timed: int = setting(
         30,

@@ -32,8 +32,8 @@ class SolverOutcome(Outcome):
     ITERATION_LIMIT = "iteration_limit", "the solver reached its iteration or time limit"
     STALLED = (
         "stalled",
-        "the run was ended where its best F had not halved in its stall window (see "
-        ":func:`stalled`)",
+        "the run was ended where its least feasible F had not halved in its stall window "
+        "(see :func:`stalled`)",
     )
     FAILED = "failed", "the solver failed"
 
@@ -104,8 +104,8 @@ class Solver(Protocol):
         of ``time.monotonic()``; None: none) ends the run at its iterate, an iteration
         limit (``SolverOutcome.ITERATION_LIMIT``), and so does ``max_iter`` (None: the
         solver's limit of the settings), where it is lower than that limit. ``stall``
-        (None: never) ends it where its best F has not halved in that many iterations
-        while above F_tol (``SolverOutcome.STALLED``, :func:`stalled`)."""
+        (None: never) ends it where its least feasible F has not halved in that many
+        iterations while above F_tol (``SolverOutcome.STALLED``, :func:`stalled`)."""
         ...
 
 
