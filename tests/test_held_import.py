@@ -15,8 +15,13 @@ from rigidfold.runtime.interrupts import held_import, terminate_interrupts
 
 @pytest.fixture
 def interrupting():
-    """SIGINT and SIGTERM raise KeyboardInterrupt, as in a command; put back after."""
+    """SIGINT and SIGTERM raise KeyboardInterrupt, as in a command; put back after. Both
+    start from Python's defaults, whatever an earlier test in the same process left (under
+    pytest-xdist the SIGINT case once inherited a handler that was not the default and raised
+    nothing)."""
     saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     terminate_interrupts()
     yield
     for s, handler in saved.items():
