@@ -29,16 +29,8 @@ def run(case: dict) -> dict:
     outcome, solve seconds, creases added)."""
     from rigidfold.config import DEFAULTS
     from rigidfold.generate import Stop, generate
-    from rigidfold.generate.specs import case_from_specs
 
-    built = case_from_specs(
-        case["surface"],
-        case["pattern"],
-        seed=case["seed"],
-        size=case.get("size"),
-        expr=case.get("expr"),
-        settings=DEFAULTS,
-    )
+    built = da.build(case, DEFAULTS)
     t0 = time.perf_counter()
     gen = generate(
         built,

@@ -169,15 +169,11 @@ def path_seconds(attempts) -> Counter:
     return out
 
 
-def run(case: dict, mode: str) -> dict:
-    """One run of ``case`` with the settings of ``mode`` (:data:`MODES`)."""
-    from rigidfold.config import DEFAULTS
-    from rigidfold.generate import Stop, generate
+def build(case: dict, settings):
+    """The initial shape of ``case`` under ``settings`` (a :class:`rigidfold.generate.Case`)."""
     from rigidfold.generate.specs import case_from_specs
 
-    settings = DEFAULTS.with_(**MODES[mode])
-    t0, cpu0 = time.perf_counter(), time.process_time()
-    built = case_from_specs(
+    return case_from_specs(
         case["surface"],
         case["pattern"],
         seed=case["seed"],
@@ -185,6 +181,16 @@ def run(case: dict, mode: str) -> dict:
         expr=case.get("expr"),
         settings=settings,
     )
+
+
+def run(case: dict, mode: str) -> dict:
+    """One run of ``case`` with the settings of ``mode`` (:data:`MODES`)."""
+    from rigidfold.config import DEFAULTS
+    from rigidfold.generate import Stop, generate
+
+    settings = DEFAULTS.with_(**MODES[mode])
+    t0, cpu0 = time.perf_counter(), time.process_time()
+    built = build(case, settings)
     gen = generate(
         built,
         criterion=case["criterion"],
