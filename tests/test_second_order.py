@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import rigidfold.generate.deploy_check as deploy_check
+from conftest import folded_grid
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import AttemptOutcome, Generation, Solution, Stop
 from rigidfold.mechanism import analyze
@@ -254,3 +255,67 @@ def test_a_rigid_candidate_is_rejected_before_its_trace_with_the_same_verdict(mo
     assert len(traces[0]) == len(traces[1]) - len(rigid)
     traced_after = [a for a in after.attempts if a.outcome is AttemptOutcome.RIGID]
     assert all(a.path is not None and not a.path["deploys"] for a in traced_after)
+
+
+def _spanned(P: np.ndarray, Q: np.ndarray) -> float:
+    """The sine of the largest principal angle between the spans of P and Q (same width)."""
+    assert P.shape == Q.shape
+    if P.shape[1] == 0:
+        return 0.0
+    cosines = np.linalg.svd(np.linalg.qr(P)[0].T @ np.linalg.qr(Q)[0], compute_uv=False)
+    return float(np.sqrt(max(0.0, 1.0 - cosines.min() ** 2)))
+
+
+def _sparse_cases() -> dict[str, CreasePattern]:
+    """Shapes with self-stresses and second-order rigid children: a generic folded grid
+    with creases fixed, a flat grid (its flexes leave the plane; every fixed crease adds a
+    self-stress of its flat vertices), the flat degree-3 vertex (second-order rigid) and
+    the generic flat degree-4 vertex (every child second-order rigid)."""
+    rng = np.random.default_rng(3)
+    folded = folded_grid(8, amplitude=0.15, seed=2)
+    fixed = folded.fixed.copy()
+    fixed[rng.choice(folded.interior_edges, 40, replace=False)] = True
+    flat = folded_grid(5, amplitude=0.0)
+    flat_fixed = flat.fixed.copy()
+    flat_fixed[rng.choice(flat.interior_edges, 14, replace=False)] = True
+    return {
+        "folded-8x8": folded.with_fixed(fixed),
+        "flat-5x5": flat.with_fixed(flat_fixed),
+        "degree-3": degree3(),
+        "generic-4": CreasePattern.from_faces(GENERIC4, FACES4),
+    }
+
+
+@pytest.mark.parametrize("name", ["folded-8x8", "flat-5x5", "degree-3", "generic-4"])
+def test_the_sparse_first_order_spans_the_dense_one_and_forecasts_the_same(name):
+    """From ``mechanism_sparse_analysis_vertices`` on, the flexes and self-stresses come from
+    the smallest singular values of A and A^T without a dense SVD: the same spans, the same
+    stress singular values, the same second-order verdicts on the shape and on every child."""
+    shape = _sparse_cases()[name]
+    dof = analyze(shape, support_face=0).dof
+    dense_settings = DEFAULTS.with_(sparse_analysis_vertices=10**6)
+    sparse_settings = DEFAULTS.with_(sparse_analysis_vertices=3)
+    dense = first_order(shape, 0, dof, dense_settings)
+    sparse = first_order(shape, 0, dof, sparse_settings)
+    assert (dense.method, sparse.method) == ("dense", "sparse")
+    assert sparse.flexes.shape == dense.flexes.shape
+    assert sparse.stresses.shape == dense.stresses.shape and dense.stresses.shape[1] > 0
+    assert _spanned(dense.flexes, sparse.flexes) < 1e-6
+    assert _spanned(dense.stresses, sparse.stresses) < 1e-6
+    np.testing.assert_allclose(sparse.flexes.T @ sparse.flexes, np.eye(dof), atol=1e-12)
+    np.testing.assert_allclose(
+        np.sort(sparse.stress_values), np.sort(dense.stress_values), rtol=1e-6, atol=1e-12
+    )
+    a = obstruction(shape, 0, dof, dense_settings)
+    b = obstruction(shape, 0, dof, sparse_settings)
+    assert (a.rigid, a.finite_motion, a.stresses) == (b.rigid, b.finite_motion, b.stresses)
+    # margins near zero are round-off of either basis: they agree to the test's tolerance
+    assert b.margin == pytest.approx(a.margin, rel=1e-4, abs=DEFAULTS.structure.prestress_tol)
+    if dof >= 2:
+        fa = ChildForecast.at(shape, 0, dof, dense_settings)
+        fb = ChildForecast.at(shape, 0, dof, sparse_settings)
+        assert fa.dead_end == fb.dead_end
+        free = [int(c) for c in shape.interior_edges if not shape.fixed[c]]
+        said = [fa.rigid((c,)) for c in free]
+        assert said == [fb.rigid((c,)) for c in free]
+        assert name != "generic-4" or all(said)

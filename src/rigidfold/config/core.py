@@ -693,8 +693,10 @@ class MechanismSettings(Group):
     second_order_vertices: int = setting(
         800,
         "The second-order test of a shape in generation (:mod:`rigidfold.mechanism."
-        "second_order`) factorises the constraint matrix densely (one SVD of about 3V x 3V): "
-        "above this many vertices it is not made (the failed path stays in N_path).",
+        "second_order`; dense below ``mechanism_sparse_analysis_vertices`` vertices, sparse "
+        "from there on) and the dense recoveries of a stalled path trace "
+        "(``path_reduce``, ``path_escape_tol``) are made up to this many vertices: above, "
+        "the test is not made (the failed path stays in N_path).",
     )
     dof_count: str = setting(
         "auto",

@@ -67,9 +67,27 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
         return np.zeros((C.shape[1], 0)), np.zeros(0), C.shape[1]
     order = _vertex_order(A, free // 3)
     free, A = free[order], A[:, order].tocsr()
+    Y = _filtered_subspace(A, max(n - k, 0), "NATURAL", settings)
+    _, s, vt = np.linalg.svd(np.linalg.qr(A @ Y, mode="r"))  # vt: (m', m')
+    values = np.concatenate([s, np.zeros(Y.shape[1] - len(s))])  # k < m': zeros
+    small = values <= limit
+    N = np.zeros((C.shape[1], int(small.sum())))
+    N[free] = Y @ vt[small].T
+    return N, values, C.shape[1] - N.shape[1]
+
+
+def _filtered_subspace(
+    A: sp.csr_matrix, expected: int, order: str, settings: Settings
+) -> np.ndarray:
+    """Basis (n, m') of a subspace that holds the right singular vectors of A (k, n) of the
+    smallest singular values (steps 2, 3 and 5 of the module's text): ``expected`` (the
+    directions looked for) plus ``Settings.mechanism.sparse_oversampling`` random columns
+    from a fixed seed, filtered by ``(A^T A + delta I)^-1`` (SuperLU's column order
+    ``order``), grown while the filter keeps more directions than leave room."""
+    n = A.shape[1]
     lu = spla.splu(
         (A.T @ A + settings.mechanism.sparse_shift * sp.identity(n)).tocsc(),
-        permc_spec="NATURAL",
+        permc_spec=order,
         diag_pivot_thresh=0.0,
         options={"SymmetricMode": True},
     )
@@ -84,22 +102,52 @@ def sparse_kernel(C: sp.csr_matrix, settings: Settings) -> tuple[np.ndarray, np.
             W = lu.solve(W / np.sqrt(np.einsum("ij,ij->j", W, W)))
         return W / np.sqrt(np.einsum("ij,ij->j", W, W))
 
-    W = filtered(min(max(n - k, 0) + p, n))
+    W = filtered(min(expected + p, n))
     while True:
         Y = _span(W)
         m = W.shape[1]
         if m == n or Y.shape[1] <= m - p // 2:
-            break
+            return Y
         # step 5: room for the directions the filter keeps, and p more; twice the columns
         # when the span is full (no sign of how many there are)
         grow = Y.shape[1] + p - m if Y.shape[1] < m else m
         W = np.hstack([W, filtered(min(grow, n - m))])
+
+
+def smallest_singular(
+    A: sp.spmatrix, count: int, settings: Settings
+) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` smallest singular values of A (k, n) and their right singular vectors,
+    without a dense factorisation: Rayleigh-Ritz (step 4) on the filtered subspace of
+    :func:`_filtered_subspace` (SuperLU's minimum-degree order; A need not be a constraint
+    matrix of vertices).
+
+    returns : (values (count,) decreasing, the Ritz values, each no smaller than the singular
+        value it approximates, 0 for the directions beyond A's rows; vectors (n, count),
+        orthonormal to about 1e-4 of the span's round-off, in the same order)
+    """
+    A = sp.csr_matrix(A)
+    n = A.shape[1]
+    if count <= 0:
+        return np.zeros(0), np.zeros((n, 0))
+    Y = _filtered_subspace(A, count, "MMD_AT_PLUS_A", settings)
     _, s, vt = np.linalg.svd(np.linalg.qr(A @ Y, mode="r"))  # vt: (m', m')
-    values = np.concatenate([s, np.zeros(Y.shape[1] - len(s))])  # k < m': zeros
-    small = values <= limit
-    N = np.zeros((C.shape[1], int(small.sum())))
-    N[free] = Y @ vt[small].T
-    return N, values, C.shape[1] - N.shape[1]
+    values = np.concatenate([s, np.zeros(Y.shape[1] - len(s))])
+    count = min(count, Y.shape[1])
+    return values[-count:], Y @ vt[-count:].T
+
+
+def largest_singular(A: sp.spmatrix) -> float:
+    """The largest singular value of A (Lanczos on A^T A from a fixed start: the same value
+    on every run)."""
+    M = sp.csr_matrix(A)
+    n = M.shape[1]
+    if n == 0 or M.nnz == 0:
+        return 0.0
+    if n < 3:
+        return float(np.linalg.norm(M.toarray(), 2))
+    top = spla.eigsh((M.T @ M).tocsc(), k=1, which="LA", v0=np.ones(n), return_eigenvectors=False)
+    return float(np.sqrt(max(float(top[0]), 0.0)))
 
 
 def row_scale(C: sp.spmatrix) -> float:
