@@ -349,6 +349,23 @@ def test_the_square_system_of_the_independent_rows_corrects_by_least_squares():
     assert np.allclose(left, system.irreducible(c), atol=1e-12)
 
 
+@pytest.mark.parametrize("n", [3, 8])
+def test_the_sparse_independent_rows_span_the_row_space_as_the_dense_ones(n):
+    """From ``mechanism_sparse_analysis_vertices`` on the self-stresses whose rows are
+    dropped come from the smallest singular values of J^T (no dense SVD): n - 1 rows kept,
+    of full rank, the same smallest singular value."""
+    from rigidfold.mechanism.rigid_folding import independent_rows
+
+    shape = miura(n, n, height=0.6)
+    cons = RigidFoldingConstraints(shape, default_support_face(shape))
+    J = cons.jacobian(cons.x0)[0]
+    dense, sigma = independent_rows(J, 1)
+    sparse, sigma_sparse = independent_rows(J, 1, DEFAULTS)
+    assert len(sparse) == len(dense) == cons.n - 1 < cons.n_rows
+    assert np.linalg.matrix_rank(J[sparse].toarray()) == cons.n - 1
+    assert sigma < DEFAULTS.mechanism.rank_tol and sigma_sparse < DEFAULTS.mechanism.rank_tol
+
+
 # DOF-1 shapes of the paper's patterns whose constraints keep a second near flex along the
 # whole path (J's second smallest singular value about 1e-9 of the largest, at the rank
 # threshold): Newton's corrector converges there at its linear rate, the steps stay small,

@@ -1,6 +1,6 @@
 """The recover steps of the path tracer (:mod:`rigidfold.mechanism.path`): where the sparse
 continuation of a rigid-folding path stalls (its step halved below ``path_min_step``), the
-ways it goes on, each from one dense SVD of the constraint Jacobian J at the last point x:
+ways it goes on, each from one SVD of the constraint Jacobian J at the last point x:
 
 * :func:`reduce_rows`: a 1-DOF trace in the projection form drops the redundant rows of
   self-stressed constraints and goes on by the square system ``[J_rows; t^T]``;
@@ -9,7 +9,8 @@ ways it goes on, each from one dense SVD of the constraint Jacobian J at the las
 * :func:`escape`: one dense step past a singular or bifurcation point, along the branch
   continued, a branch of the bifurcation equation (:func:`_branches`) or towards flat.
 
-Each is limited to ``mechanism_second_order_vertices`` vertices (the dense SVD).
+Each is limited to ``mechanism_second_order_vertices`` vertices (the dense SVD; that of
+:func:`reduce_rows` is sparse from ``mechanism_sparse_analysis_vertices`` vertices on).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from rigidfold.mechanism.rigid_folding import (
 
 def may_reduce(cons: RigidFoldingConstraints, settings: Settings) -> bool:
     """The redundant rows of a 1-DOF shape are dropped where its projection continuation
-    stalls (``path_reduce``), up to ``mechanism_second_order_vertices`` vertices (one dense
+    stalls (``path_reduce``), up to ``mechanism_second_order_vertices`` vertices (one
     SVD)."""
     return (
         settings.path.reduce and cons.pattern.n_vertices <= settings.mechanism.second_order_vertices
@@ -43,9 +44,11 @@ def reduce_rows(
 ) -> tuple[np.ndarray, System, float] | None:
     """(rows (n - 1,) int, the factored ``[J_rows; t^T]`` at x, J's smallest singular value
     over its largest there): the independent rows of the constraints of a 1-DOF shape at x
-    (:func:`rigidfold.mechanism.rigid_folding.independent_rows`) and the square augmented
-    system they make with the tangent t (n,); None where it is exactly singular."""
-    rows, sigma = independent_rows(cons.jacobian(x)[0], 1)
+    (:func:`rigidfold.mechanism.rigid_folding.independent_rows`, sparse from
+    ``mechanism_sparse_analysis_vertices`` vertices on) and the square augmented system
+    they make with the tangent t (n,); None where it is exactly singular."""
+    large = cons.pattern.n_vertices >= settings.mechanism.sparse_analysis_vertices
+    rows, sigma = independent_rows(cons.jacobian(x)[0], 1, settings if large else None)
     try:
         return rows, System(*cons.jacobian(x), "augmented", t, settings, rows), sigma
     except RuntimeError:

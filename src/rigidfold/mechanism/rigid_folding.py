@@ -33,6 +33,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from rigidfold.config import Settings
+from rigidfold.mechanism.sparse import largest_singular, smallest_singular
 from rigidfold.mesh import CreasePattern
 from rigidfold.mesh.geometry import angle_change
 from rigidfold.optimize.residuals import fold_angle_gradients
@@ -318,22 +319,36 @@ def correct(
     return y, False, factorizations, system
 
 
-def independent_rows(J: sp.spmatrix, dof: int) -> tuple[np.ndarray, float]:
+def independent_rows(
+    J: sp.spmatrix, dof: int, sparse: Settings | None = None
+) -> tuple[np.ndarray, float]:
     """(rows (n - dof,) int sorted, J's smallest singular value over its largest): rows of
     the constraint Jacobian J (m, n) of a shape of ``dof`` DOF that are independent, the
     other m - (n - dof) (a basis of its self-stresses) dropped.
 
     The self-stresses are the left singular vectors W (m, k) of the k = m - (n - dof)
-    smallest singular values of J (one dense SVD); the rows dropped are the k pivots of a
-    QR of W^T with column pivoting, so that W's rows there form a well-conditioned k x k
-    block and the rows kept span J's row space (rank n - dof). Where the constraints are
-    redundant along the path (a rigid quad cut by a fixed crease), the rows kept imply the
-    others near the path; the corrector still checks every row.
+    smallest singular values of J (one dense SVD; with ``sparse``, the settings of the
+    sparse method, the smallest singular values of J^T and J of
+    :func:`rigidfold.mechanism.sparse.smallest_singular` instead, for shapes of
+    ``mechanism_sparse_analysis_vertices`` vertices or more); the rows dropped are the k
+    pivots of a QR of W^T with column pivoting, so that W's rows there form a
+    well-conditioned k x k block and the rows kept span J's row space (rank n - dof). Where
+    the constraints are redundant along the path (a rigid quad cut by a fixed crease), the
+    rows kept imply the others near the path; the corrector still checks every row.
     """
     m, n = J.shape
-    U, s, _ = np.linalg.svd(J.toarray(), full_matrices=True)
-    sigma = float(s[-1] / s[0]) if m >= n else 0.0
-    return rows_without_stresses(U, n, dof), sigma
+    if sparse is None:
+        U, s, _ = np.linalg.svd(J.toarray(), full_matrices=True)
+        sigma = float(s[-1] / s[0]) if m >= n else 0.0
+        return rows_without_stresses(U, n, dof), sigma
+    top = largest_singular(J)
+    sigma = 0.0
+    if m >= n and top > 0:
+        sigma = float(smallest_singular(J, 1, sparse)[0][-1] / top)
+    k = m - (n - dof)
+    if k <= 0:
+        return np.arange(m), sigma
+    return _rows_kept(smallest_singular(J.T, k, sparse)[1]), sigma
 
 
 def rows_without_stresses(U: np.ndarray, n: int, dof: int) -> np.ndarray:
@@ -343,5 +358,12 @@ def rows_without_stresses(U: np.ndarray, n: int, dof: int) -> np.ndarray:
     k = m - (n - dof)
     if k <= 0:
         return np.arange(m)
-    _, _, pivots = scipy.linalg.qr(U[:, m - k :].T, pivoting=True, mode="economic")
+    return _rows_kept(U[:, m - k :])
+
+
+def _rows_kept(W: np.ndarray) -> np.ndarray:
+    """The rows (m - k,) int, sorted, left where the k pivots of a QR of W^T (W (m, k), a
+    basis of the self-stresses) with column pivoting are dropped."""
+    m, k = W.shape
+    _, _, pivots = scipy.linalg.qr(W.T, pivoting=True, mode="economic")
     return np.setdiff1d(np.arange(m), pivots[:k])
