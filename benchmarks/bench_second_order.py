@@ -24,10 +24,10 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
 
+from bench_scale import timed  # this folder is on sys.path (a script)
 from rigidfold.config import DEFAULTS
 from rigidfold.generate import generate
 from rigidfold.generate.specs import case_from_specs
@@ -66,15 +66,6 @@ def spanned(P: np.ndarray, Q: np.ndarray) -> float:
         return float("nan") if P.shape != Q.shape else 0.0
     cosines = np.linalg.svd(np.linalg.qr(P)[0].T @ np.linalg.qr(Q)[0], compute_uv=False)
     return float(np.sqrt(max(0.0, 1.0 - cosines.min() ** 2)))
-
-
-def timed(fn, repeat: int):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), out
 
 
 def main() -> None:
