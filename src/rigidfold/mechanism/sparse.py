@@ -30,7 +30,15 @@ dimensions, so this module finds it in a space of about that size:
    out-of-plane modes of a flat sheet), as many again as W has.
 
 Every rank decision is made on the small dense matrix of step 4, as the dense method makes
-it on the whole matrix; ``tests/test_sparse_mechanism.py`` compares the two. Cost: one
+it on the whole matrix; ``tests/test_sparse_mechanism.py`` compares the two.
+
+The same filtered subspace gives any sparse matrix's smallest singular values and vectors
+(:func:`smallest_singular`, steps 2-5 on A itself, the count given): on A^T it gives the
+left ones, the self-stresses, which the second-order test
+(:mod:`rigidfold.mechanism.second_order`) and the redundant rows of a stalled path trace
+(:func:`rigidfold.mechanism.rigid_folding.independent_rows`) need from 200 vertices on
+(``tests/test_second_order.py``, ``tests/test_path.py`` compare them with the dense SVD;
+``benchmarks/bench_second_order.py`` times both). Cost: one
 sparse factorisation, ``sparse_iterations`` solves with m right-hand sides and two Householder
 R factors of n x m matrices, about ``nnz(LU) m + n m^2``; memory about 10 n m floats.
 """
@@ -139,15 +147,21 @@ def smallest_singular(
 
 def largest_singular(A: sp.spmatrix) -> float:
     """The largest singular value of A (Lanczos on A^T A from a fixed start: the same value
-    on every run)."""
+    on every run; should it not converge, its best estimate, or the largest absolute row sum
+    of A^T A, a bound from above)."""
     M = sp.csr_matrix(A)
     n = M.shape[1]
     if n == 0 or M.nnz == 0:
         return 0.0
     if n < 3:
         return float(np.linalg.norm(M.toarray(), 2))
-    top = spla.eigsh((M.T @ M).tocsc(), k=1, which="LA", v0=np.ones(n), return_eigenvectors=False)
-    return float(np.sqrt(max(float(top[0]), 0.0)))
+    G = (M.T @ M).tocsc()
+    try:
+        top = float(spla.eigsh(G, k=1, which="LA", v0=np.ones(n), return_eigenvectors=False)[0])
+    except spla.ArpackNoConvergence as err:  # its best estimate, else a bound from above
+        found = np.asarray(err.eigenvalues)
+        top = float(found.max()) if found.size else float(abs(G).sum(axis=1).max())
+    return float(np.sqrt(max(top, 0.0)))
 
 
 def row_scale(C: sp.spmatrix) -> float:
