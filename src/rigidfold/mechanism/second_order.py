@@ -404,7 +404,8 @@ class FirstOrder:
     ``Settings.mechanism.sparse_analysis_vertices`` vertices, from there on the smallest
     singular values of each side without a dense factorisation
     (:func:`rigidfold.mechanism.sparse.smallest_singular` on A for the flexes, on A^T for the
-    self-stresses: a 625-vertex shape in 0.2 s instead of 6 s, the same spans to about 1e-7).
+    self-stresses: a 625-vertex shape in 0.16-0.24 s instead of 2.4-3.0 s, the same spans to
+    about 1e-7, ``benchmarks/bench_second_order.py``).
 
     cons : Constraints of the scaled shape, its support triangle's vertices held
     flexes : (3V, k) orthonormal: the right singular vectors of the k smallest singular values

@@ -131,8 +131,9 @@ def smallest_singular(
     matrix of vertices).
 
     returns : (values (count,) decreasing, the Ritz values, each no smaller than the singular
-        value it approximates, 0 for the directions beyond A's rows; vectors (n, count),
-        orthonormal to about 1e-4 of the span's round-off, in the same order)
+        value it approximates, 0 for the directions beyond A's rows; vectors (n, count) in
+        the same order, columns orthonormal to about 1e-4 as those of :func:`_span`; fewer
+        than ``count`` only where the subspace holds fewer directions)
     """
     A = sp.csr_matrix(A)
     n = A.shape[1]
